@@ -1,0 +1,111 @@
+//! The BRDF contract between reflectance models and the virtual instrument.
+//!
+//! A model evaluates f_r(ωi, ωo) for all of its spectral samples at once, and tells the integrator what it
+//! needs in order to find the mass of the function: the ideal-mirror (delta) component with its weight, and
+//! the glossy lobes with their widths. The integrator never searches for a lobe blindly (adaptive cubature
+//! silently returns 0 on a lobe narrower than its first sample spacing; `docs/instrument.md` §Quadrature).
+//!
+//! Conventions (all models): local frame with the specimen normal along +z and the plane of measurement x–z;
+//! `wi` points from the surface towards the source, `wo` towards the receptor; both are unit vectors with
+//! z > 0. `eval` returns the *regular* part of f_r in sr⁻¹ (no cosine factor); a delta component is reported
+//! separately by [`Brdf::delta_reflectance`].
+use crate::spectrum::Sampling;
+use crate::Vec3;
+
+pub mod albedo;
+pub mod conductor;
+pub mod dielectric;
+pub mod lambert;
+pub mod multilobe;
+pub mod paint;
+pub mod phong;
+pub mod ward;
+
+/// A glossy lobe centred on the specular direction (half vector along the normal, or, for a lobe formed
+/// under a smooth coat, along the normal inside the coat). Every model in this crate produces only such
+/// lobes; the integrator splits its lobe variable at multiples of the width around the specular direction.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Lobe {
+    /// Width of the facet (or flake) normal distribution as a slope: the Beckmann rms slope m, the GGX α,
+    /// or the equivalent for Phong / Ward lobes. Dimensionless (tan of an angle).
+    pub slope_width: f64,
+    /// Refractive index of the medium in which the lobe is formed: 1 for a lobe on the surface, the coat
+    /// index for flakes under a smooth clear coat (refraction widens the lobe when it leaves).
+    pub medium_eta: f64,
+    /// Short label for `--explain`, e.g. "metallic flakes".
+    pub label: String,
+}
+
+/// A term of a model, for the measurement plan's explanation: what is evaluated and how.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Term {
+    pub label: String,
+    /// How the integrator must treat it.
+    pub kind: TermKind,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum TermKind {
+    /// Ideal specular reflection: integrated analytically over the aperture overlap.
+    Delta,
+    /// Smooth in direction (Lambertian-like): no lobe splitting needed.
+    Diffuse,
+    /// A glossy lobe, see [`Lobe`].
+    Lobe(Lobe),
+}
+
+/// A reflectance model. Implementations must be pure: the same arguments give the same bits.
+pub trait Brdf: Send + Sync + std::fmt::Debug {
+    /// The spectral samples this model evaluates.
+    fn sampling(&self) -> &Sampling;
+
+    /// Regular part of f_r(ωi, ωo) in sr⁻¹, one value per spectral sample, written to `out`
+    /// (`out.len() == self.sampling().len()`).
+    fn eval(&self, wi: Vec3, wo: Vec3, out: &mut [f64]);
+
+    /// The ideal-mirror component: f_δ = R(ωi)·δ(ωo − mirror(ωi)) / cos θo. Writes R per sample and returns
+    /// true if the model has one; returns false (and leaves `out` alone) otherwise.
+    fn delta_reflectance(&self, _wi: Vec3, _out: &mut [f64]) -> bool {
+        false
+    }
+
+    /// The terms of the model (delta, diffuse, lobes) in evaluation order. The integrator uses the lobes to
+    /// place its splits and the delta flag to add the analytic part; `--explain` prints them.
+    fn terms(&self) -> Vec<Term>;
+
+    /// Whether f_r(ωi, ωo) = f_r(ωo, ωi) holds for this model (Helmholtz reciprocity).
+    fn is_reciprocal(&self) -> bool {
+        true
+    }
+
+    /// A one-line human description, e.g. "microfacet (GGX α = 0.1, n = 1.5, Smith height-correlated)".
+    fn describe(&self) -> String;
+}
+
+impl dyn Brdf {
+    /// The lobes among [`Brdf::terms`].
+    pub fn lobes(&self) -> Vec<Lobe> {
+        self.terms()
+            .into_iter()
+            .filter_map(|t| match t.kind {
+                TermKind::Lobe(l) => Some(l),
+                _ => None,
+            })
+            .collect()
+    }
+
+    pub fn has_delta(&self) -> bool {
+        self.terms().iter().any(|t| t.kind == TermKind::Delta)
+    }
+
+    /// True if `eval` can be non-zero (the model has a diffuse or lobe term).
+    pub fn has_regular(&self) -> bool {
+        self.terms().iter().any(|t| t.kind != TermKind::Delta)
+    }
+}
+
+/// Mirror direction of `w` about the normal z.
+#[inline]
+pub fn mirror(w: Vec3) -> Vec3 {
+    Vec3::new(-w.x, -w.y, w.z)
+}

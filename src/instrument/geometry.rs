@@ -1,0 +1,136 @@
+//! Instrument geometry: apertures as field stops in the focal planes of collimating lenses, and the map
+//! from a point of a stop to a direction.
+//!
+//! The model (stated in full in `docs/instrument.md`): specimen normal z, plane of measurement x–z. For a
+//! geometry of angle θ the source axis (pointing towards the source) is s0 = (−sin θ, 0, cos θ) and the
+//! receptor axis r0 = (sin θ, 0, cos θ). A point (p, q) of a stop, in tangent coordinates (p = x/f, q = y/f),
+//! is the direction normalize(axis + p·e∥ + q·e⊥) with e⊥ = (0, 1, 0), e∥ = e⊥ × axis, and solid-angle
+//! element dω = dp dq / (1 + p² + q²)^{3/2}. The mirror image of source point (p, q) is receptor point
+//! (−p, −q), so the specular manifold is p_s + p_r = 0, q_s + q_r = 0.
+use crate::Vec3;
+
+/// A rectangular field stop in tangent coordinates: p ∈ [p0, p1] in the plane of measurement (positive p
+/// towards grazing for the receptor, towards the normal for the source), q ∈ [q0, q1] perpendicular to it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Stop {
+    pub p: [f64; 2],
+    pub q: [f64; 2],
+}
+
+impl Stop {
+    /// A stop of full angular size `in_plane` × `perpendicular` (radians) whose centre is offset by
+    /// `offset` (radians, in the plane of measurement) from the lens axis: p spans
+    /// [tan(offset − in_plane/2), tan(offset + in_plane/2)], q spans ±tan(perpendicular/2).
+    pub fn from_angles(in_plane: f64, perpendicular: f64, offset: f64) -> Stop {
+        Stop {
+            p: [(offset - 0.5 * in_plane).tan(), (offset + 0.5 * in_plane).tan()],
+            q: [-(0.5 * perpendicular).tan(), (0.5 * perpendicular).tan()],
+        }
+    }
+
+    /// Solid angle of the stop, ∫∫ dp dq / (1 + p² + q²)^{3/2}, in closed form:
+    /// Ω = Σ ± atan(p q / sqrt(1 + p² + q²)) over the four corners.
+    pub fn solid_angle(&self) -> f64 {
+        let f = |p: f64, q: f64| (p * q / (1.0 + p * p + q * q).sqrt()).atan();
+        f(self.p[1], self.q[1]) - f(self.p[0], self.q[1]) - f(self.p[1], self.q[0]) + f(self.p[0], self.q[0])
+    }
+}
+
+/// The two lens axes of a geometry of angle θ (radians from the normal).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Axes {
+    pub theta: f64,
+    sin: f64,
+    cos: f64,
+}
+
+impl Axes {
+    pub fn new(theta: f64) -> Self {
+        Axes { theta, sin: theta.sin(), cos: theta.cos() }
+    }
+
+    /// Direction (towards the source) of source-stop point (p, q), and the factor 1/(1+p²+q²)^{1/2}.
+    /// s0 = (−sin θ, 0, cos θ), e∥ = (cos θ, 0, sin θ).
+    #[inline]
+    pub fn source_dir(&self, p: f64, q: f64) -> Vec3 {
+        let v = Vec3::new(-self.sin + p * self.cos, q, self.cos + p * self.sin);
+        v / (1.0 + p * p + q * q).sqrt()
+    }
+
+    /// Direction (towards the receptor) of receptor-stop point (p, q). r0 = (sin θ, 0, cos θ),
+    /// e∥ = (cos θ, 0, −sin θ).
+    #[inline]
+    pub fn receptor_dir(&self, p: f64, q: f64) -> Vec3 {
+        let v = Vec3::new(self.sin + p * self.cos, q, self.cos - p * self.sin);
+        v / (1.0 + p * p + q * q).sqrt()
+    }
+}
+
+/// dω / (dp dq) = (1 + p² + q²)^{-3/2}.
+#[inline]
+pub fn solid_angle_density(p: f64, q: f64) -> f64 {
+    let r2 = 1.0 + p * p + q * q;
+    1.0 / (r2 * r2.sqrt())
+}
+
+/// What a geometry reads, compiled from a standard's `readings` list.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ReadingSpec {
+    /// Specular gloss, GU: 100·Φ(specimen, receptor) / Φ(standard, receptor).
+    Gloss { receptor: String },
+    /// Reflection haze, HU: 100·mean_r Φ(specimen, r) / Φ(standard, `specular`) over the haze receptors.
+    Haze { receptors: Vec<String>, specular: String },
+    /// Logarithmic haze: k·log10(H/20 + 1) of the linear haze above (BYK micro-haze plus, k = 1285.1).
+    LogHaze { receptors: Vec<String>, specular: String, k: f64 },
+    /// Distinctness of image: 100·(Φ(specular) − mean_r Φ(r)) / Φ(specular), all on the specimen.
+    Doi { specular: String, offset: Vec<String> },
+    /// Haze index (ASTM D4039): gloss of one geometry minus the gloss of another.
+    HazeIndex { minuend: String, subtrahend: String },
+}
+
+impl ReadingSpec {
+    pub fn quantity(&self) -> &'static str {
+        match self {
+            ReadingSpec::Gloss { .. } => "gloss",
+            ReadingSpec::Haze { .. } => "haze",
+            ReadingSpec::LogHaze { .. } => "log-haze",
+            ReadingSpec::Doi { .. } => "doi",
+            ReadingSpec::HazeIndex { .. } => "haze-index",
+        }
+    }
+
+    pub fn unit(&self) -> &'static str {
+        match self {
+            ReadingSpec::Gloss { .. } | ReadingSpec::HazeIndex { .. } => "GU",
+            ReadingSpec::Haze { .. } => "HU",
+            ReadingSpec::LogHaze { .. } => "HU(log)",
+            ReadingSpec::Doi { .. } => "DOI",
+        }
+    }
+}
+
+/// A compiled instrument geometry: everything the engine needs, in radians and tangent coordinates.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Geometry {
+    pub id: String,
+    pub title: String,
+    /// Angle of incidence = angle of reflection, radians (0 for purely composite geometries).
+    pub theta: f64,
+    /// Refractive index of the gloss standard (a smooth, non-absorbing dielectric).
+    pub reference_index: f64,
+    pub source: Stop,
+    /// Named receptor stops (all on the receptor lens, offsets inside its focal plane).
+    pub receptors: Vec<(String, Stop)>,
+    pub readings: Vec<ReadingSpec>,
+}
+
+impl Geometry {
+    pub fn receptor(&self, name: &str) -> Option<&Stop> {
+        self.receptors.iter().find(|(n, _)| n == name).map(|(_, s)| s)
+    }
+
+    /// True if this geometry only combines readings of other geometries (ASTM D4039).
+    pub fn is_composite(&self) -> bool {
+        self.readings.iter().all(|r| matches!(r, ReadingSpec::HazeIndex { .. }))
+    }
+}

@@ -1,0 +1,3 @@
+//! The virtual instrument. (Being written.)
+pub mod geometry;
+pub mod standards;

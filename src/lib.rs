@@ -1,0 +1,26 @@
+//! glossmeter: a virtual gloss, haze and distinctness-of-image meter.
+//!
+//! The crate is a stack of small layers, each with one job (see `docs/architecture.md`):
+//!
+//! * [`optics`]: pure functions of physical optics (Fresnel, Kubelka–Munk, thin films, microfacets).
+//! * [`brdf`]: the [`brdf::Brdf`] trait and the reflectance models built from the optics, including the
+//!   paint model of Ďurikovič & Ágošton (2007).
+//! * [`recipe`]: JSON recipes → validated BRDFs, with errors that name the file and the field.
+//! * [`spectrum`]: spectral sampling and the luminous (CIE illuminant C × V(λ)) weighting.
+//! * [`quadrature`]: the deterministic adaptive cubature with error estimates.
+//! * [`instrument`]: aperture geometry, the standards as data, the measurement plan and the readings.
+//! * [`cli`]: the thin command-line layer.
+pub mod brdf;
+pub mod cli;
+pub mod error;
+pub mod instrument;
+pub mod optics;
+pub mod quadrature;
+pub mod recipe;
+pub mod spectrum;
+
+pub use error::{Error, Result};
+
+/// Double-precision 3-vector used for directions. Local shading frame: z is the specimen normal,
+/// x–z is the plane of measurement, and every direction points away from the surface.
+pub type Vec3 = glam::DVec3;

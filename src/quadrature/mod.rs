@@ -1,0 +1,1 @@
+//! Deterministic adaptive cubature with error estimates. (Being written.)

@@ -1,0 +1,3 @@
+//! Recipes: JSON descriptions of materials, validated into BRDFs. (Being written.)
+pub mod fields;
+pub mod paint;

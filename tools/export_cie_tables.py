@@ -1,0 +1,48 @@
+#!/usr/bin/env python3
+"""Export the CIE tables glossmeter needs to standards/cie/*.csv, with provenance headers.
+
+Run by hand (not by CI):  python3 tools/export_cie_tables.py
+Requires: colour-science 0.4.7 (pip install colour-science==0.4.7).
+
+Tables written:
+  standards/cie/illuminant-c.csv   CIE illuminant C relative SPD, 5 nm, 360-780 nm
+  standards/cie/cie1931-ybar.csv   CIE 1931 2-degree ybar(lambda) = V(lambda), 5 nm, 360-780 nm
+colour-science takes them from CIE 15:2004 (illuminant C, Table T.1) and CIE 018:2019 / the CIE
+1931 2-degree standard observer (cvrl.org / CIE S 014-1). We copy values, not code.
+"""
+import pathlib
+import warnings
+
+warnings.filterwarnings("ignore")
+import colour  # noqa: E402
+
+OUT = pathlib.Path(__file__).resolve().parent.parent / "standards" / "cie"
+OUT.mkdir(parents=True, exist_ok=True)
+GRID = range(360, 781, 5)
+
+c = colour.SDS_ILLUMINANTS["C"]
+cmfs = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"]
+
+header_common = (
+    "# exported by tools/export_cie_tables.py from colour-science {v}\n"
+    "# columns: wavelength in nm, value\n"
+).format(v=colour.__version__)
+
+with open(OUT / "illuminant-c.csv", "w") as f:
+    f.write("# CIE standard illuminant C, relative spectral power distribution (the scale of CIE 15 Table T.1; only ratios matter).\n")
+    f.write("# Source: CIE 15:2004 Colorimetry, 3rd ed., Table T.1, as tabulated in colour-science\n")
+    f.write("# colour.SDS_ILLUMINANTS['C'] (5 nm steps). Used as the source spectrum of ASTM D523 / ISO 2813.\n")
+    f.write(header_common)
+    f.write("wavelength_nm,value\n")
+    for w in GRID:
+        f.write(f"{w},{c[w]:.6g}\n")
+
+with open(OUT / "cie1931-ybar.csv", "w") as f:
+    f.write("# CIE 1931 2-degree standard observer colour-matching function ybar = photopic V(lambda).\n")
+    f.write("# Source: CIE 018:2019 / CIE 15:2004 Table T.4 (1 nm data, sampled here every 5 nm), as tabulated in\n")
+    f.write("# colour-science colour.MSDS_CMFS['CIE 1931 2 Degree Standard Observer'].\n")
+    f.write(header_common)
+    f.write("wavelength_nm,value\n")
+    for w in GRID:
+        f.write(f"{w},{cmfs[w][1]:.6g}\n")
+print("wrote", OUT)
