@@ -1,1 +1,50 @@
-//! (being written)
+//! The ideally smooth conductor: f = R(θi)·δ(ωo − mirror(ωi))/cos θo with R the unpolarised Fresnel
+//! reflectance of a complex index n + ik (Born & Wolf, *Principles of Optics* §14.2; pbrt-v4 `FrConductor`).
+//! A rough conductor is [`super::dielectric::MicrofacetSurface`] with [`super::dielectric::Ior::Conductor`].
+use super::dielectric::Ior;
+use super::{Brdf, Term, TermKind};
+use crate::spectrum::Sampling;
+use crate::Vec3;
+use num_complex::Complex64;
+
+/// A smooth conductor with a complex index per spectral sample.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SmoothConductor {
+    /// n + ik (k ≥ 0) per spectral sample, relative to air.
+    pub ior: Vec<Complex64>,
+    pub sampling: Sampling,
+}
+
+impl SmoothConductor {
+    /// Panics if `ior.len() != sampling.len()` (recipes are validated before this).
+    pub fn new(ior: Vec<Complex64>, sampling: Sampling) -> Self {
+        assert_eq!(ior.len(), sampling.len(), "one index per spectral sample");
+        SmoothConductor { ior, sampling }
+    }
+}
+
+impl Brdf for SmoothConductor {
+    fn sampling(&self) -> &Sampling {
+        &self.sampling
+    }
+
+    fn eval(&self, _wi: Vec3, _wo: Vec3, out: &mut [f64]) {
+        out.fill(0.0);
+    }
+
+    fn delta_reflectance(&self, wi: Vec3, out: &mut [f64]) -> bool {
+        for (o, eta) in out.iter_mut().zip(&self.ior) {
+            *o = Ior::Conductor(*eta).reflectance(wi.z);
+        }
+        true
+    }
+
+    fn terms(&self) -> Vec<Term> {
+        vec![Term { label: "specular reflection (conductor Fresnel)".into(), kind: TermKind::Delta }]
+    }
+
+    fn describe(&self) -> String {
+        let parts: Vec<String> = self.ior.iter().map(|e| format!("{} + {}i", e.re, e.im)).collect();
+        format!("smooth conductor (n = {})", parts.join("; "))
+    }
+}

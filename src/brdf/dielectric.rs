@@ -1,1 +1,193 @@
-//! (being written)
+//! Smooth and rough interfaces: the ideal mirror of a dielectric and the Torrance–Sparrow / Cook–Torrance
+//! microfacet model of a rough dielectric or conductor.
+//!
+//! * [`SmoothDielectric`]: f = R(θi)·δ(ωo − mirror(ωi))/cos θo with R the unpolarised Fresnel reflectance
+//!   (Born & Wolf, *Principles of Optics* §1.5.2; pbrt-v4 `FrDielectric`). Light transmitted into the body
+//!   is lost: the model is an opaque black-backed glass such as the polished black-glass gloss standard
+//!   (ISO 2813 §5.4 / ASTM D523 §7.1, n_D = 1.567).
+//! * [`MicrofacetSurface`]: f = F(ωi·h)·D(h)·G(ωi, ωo)/(4 cos θi cos θo), h = normalize(ωi + ωo) (Torrance &
+//!   Sparrow 1967; Cook & Torrance 1982 with the 1/4 of Walter et al. 2007 Eq. 20), D Beckmann or GGX, G
+//!   Smith height-correlated (Heitz 2014 Eq. 99, default) or the V-cavity G of Cook & Torrance (1982). Below
+//!   [`Microfacet::SMOOTH_THRESHOLD`] the lobe is replaced by its delta limit R(θi) = F(cos θi) (D → δ(h − n),
+//!   G → 1, ωi·h → cos θi), so the directional albedo is continuous across the switch.
+use super::{Brdf, Lobe, Term, TermKind};
+use crate::optics::fresnel::{fr_conductor, fr_dielectric};
+use crate::optics::microfacet::{Distribution, Microfacet, Shadowing};
+use crate::spectrum::Sampling;
+use crate::Vec3;
+use num_complex::Complex64;
+
+/// Refractive index of the body, relative to the ambient medium (air, n = 1).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Ior {
+    /// A real index n (dielectric; the transmitted light is lost).
+    Dielectric(f64),
+    /// A complex index n + ik, k ≥ 0 (conductor; the transmitted light is absorbed).
+    Conductor(Complex64),
+}
+
+impl Ior {
+    /// Unpolarised Fresnel reflectance at cos θ = `cos_i` (Born & Wolf §1.5.2 / §14.2; pbrt-v4 `FrDielectric`,
+    /// `FrConductor`).
+    pub fn reflectance(&self, cos_i: f64) -> f64 {
+        let c = cos_i.clamp(0.0, 1.0);
+        match *self {
+            Ior::Dielectric(n) => fr_dielectric(c, n),
+            Ior::Conductor(eta) => fr_conductor(c, eta),
+        }
+    }
+
+    pub fn describe(&self) -> String {
+        match self {
+            Ior::Dielectric(n) => format!("n = {n}"),
+            Ior::Conductor(e) => format!("n = {} + {}i", e.re, e.im),
+        }
+    }
+}
+
+fn describe_iors(ior: &[Ior]) -> String {
+    if ior.len() == 1 || ior.windows(2).all(|w| w[0] == w[1]) {
+        ior[0].describe()
+    } else {
+        format!("[{}]", ior.iter().map(Ior::describe).collect::<Vec<_>>().join("; "))
+    }
+}
+
+/// An ideally smooth, opaque (black-backed) dielectric: a delta reflection of weight R = F(cos θi, n).
+#[derive(Clone, Debug, PartialEq)]
+pub struct SmoothDielectric {
+    /// Real refractive index n relative to air.
+    pub ior: f64,
+    pub sampling: Sampling,
+}
+
+impl SmoothDielectric {
+    pub fn new(ior: f64) -> Self {
+        SmoothDielectric { ior, sampling: Sampling::grey() }
+    }
+}
+
+impl Brdf for SmoothDielectric {
+    fn sampling(&self) -> &Sampling {
+        &self.sampling
+    }
+
+    fn eval(&self, _wi: Vec3, _wo: Vec3, out: &mut [f64]) {
+        out.fill(0.0);
+    }
+
+    fn delta_reflectance(&self, wi: Vec3, out: &mut [f64]) -> bool {
+        out.fill(Ior::Dielectric(self.ior).reflectance(wi.z));
+        true
+    }
+
+    fn terms(&self) -> Vec<Term> {
+        vec![Term { label: "specular reflection (Fresnel)".into(), kind: TermKind::Delta }]
+    }
+
+    fn describe(&self) -> String {
+        format!("smooth dielectric (n = {}, black-backed)", self.ior)
+    }
+}
+
+/// A rough interface (dielectric or conductor) with a single microfacet lobe; see the module documentation.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MicrofacetSurface {
+    pub facets: Microfacet,
+    pub shadowing: Shadowing,
+    /// Index per spectral sample.
+    pub ior: Vec<Ior>,
+    pub sampling: Sampling,
+}
+
+impl MicrofacetSurface {
+    /// Panics if `ior.len() != sampling.len()` (recipes are validated before this).
+    pub fn new(facets: Microfacet, shadowing: Shadowing, ior: Vec<Ior>, sampling: Sampling) -> Self {
+        assert_eq!(ior.len(), sampling.len(), "one index per spectral sample");
+        MicrofacetSurface { facets, shadowing, ior, sampling }
+    }
+}
+
+/// "Beckmann m = 0.1" / "GGX α = 0.1".
+pub(crate) fn describe_facets(f: &Microfacet) -> String {
+    match f.distribution {
+        Distribution::Beckmann => format!("Beckmann m = {}", f.alpha),
+        Distribution::Ggx => format!("GGX α = {}", f.alpha),
+    }
+}
+
+pub(crate) fn describe_shadowing(s: Shadowing) -> &'static str {
+    match s {
+        Shadowing::SmithHeightCorrelated => "Smith height-correlated",
+        Shadowing::VCavity => "V-cavity",
+    }
+}
+
+/// D(h)·G/(4 cos θi cos θo) and ωi·h for a microfacet lobe, or None when either direction is at or below
+/// the horizon (the regular part is zero there).
+pub(crate) fn microfacet_factor(facets: &Microfacet, shadowing: Shadowing, wi: Vec3, wo: Vec3) -> Option<(f64, f64)> {
+    if wi.z <= 0.0 || wo.z <= 0.0 {
+        return None;
+    }
+    let h = (wi + wo).normalize();
+    let cos_d = wi.dot(h).clamp(0.0, 1.0);
+    let d = facets.d(h);
+    if d == 0.0 {
+        return Some((0.0, cos_d));
+    }
+    let g = facets.g(wi, wo, h, shadowing);
+    Some((d * g / (4.0 * wi.z * wo.z), cos_d))
+}
+
+impl Brdf for MicrofacetSurface {
+    fn sampling(&self) -> &Sampling {
+        &self.sampling
+    }
+
+    fn eval(&self, wi: Vec3, wo: Vec3, out: &mut [f64]) {
+        if self.facets.effectively_smooth() {
+            out.fill(0.0);
+            return;
+        }
+        match microfacet_factor(&self.facets, self.shadowing, wi, wo) {
+            None => out.fill(0.0),
+            Some((dg, cos_d)) => {
+                for (o, ior) in out.iter_mut().zip(&self.ior) {
+                    *o = if dg == 0.0 { 0.0 } else { ior.reflectance(cos_d) * dg };
+                }
+            }
+        }
+    }
+
+    fn delta_reflectance(&self, wi: Vec3, out: &mut [f64]) -> bool {
+        if !self.facets.effectively_smooth() {
+            return false;
+        }
+        for (o, ior) in out.iter_mut().zip(&self.ior) {
+            *o = ior.reflectance(wi.z);
+        }
+        true
+    }
+
+    fn terms(&self) -> Vec<Term> {
+        if self.facets.effectively_smooth() {
+            vec![Term { label: "specular reflection (smooth limit of the microfacet lobe)".into(), kind: TermKind::Delta }]
+        } else {
+            let label = format!("microfacet lobe ({})", describe_facets(&self.facets));
+            vec![Term {
+                label: label.clone(),
+                kind: TermKind::Lobe(Lobe { slope_width: self.facets.alpha, medium_eta: 1.0, label }),
+            }]
+        }
+    }
+
+    fn describe(&self) -> String {
+        let smooth = if self.facets.effectively_smooth() { ", evaluated as its smooth (delta) limit" } else { "" };
+        format!(
+            "microfacet ({}, {}, {}{smooth})",
+            describe_facets(&self.facets),
+            describe_iors(&self.ior),
+            describe_shadowing(self.shadowing)
+        )
+    }
+}

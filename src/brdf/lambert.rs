@@ -1,1 +1,54 @@
-//! (being written)
+//! The Lambertian (ideal diffuse) reflector: f_r = ρ/π.
+//!
+//! Source: J. H. Lambert, *Photometria* (1760); in modern form e.g. Pharr, Jakob & Humphreys, *Physically
+//! Based Rendering* 4th ed. (pbrt-v4) §9.2 `DiffuseBxDF`. Its directional albedo ∫ f cos θo dωo = ρ for every
+//! incident direction (the closed form checked in `tests/brdf_models.rs`).
+use super::{Brdf, Term, TermKind};
+use crate::spectrum::Sampling;
+use crate::Vec3;
+use std::f64::consts::PI;
+
+/// Lambertian reflector with directional-hemispherical albedo ρ ∈ [0, 1] per spectral sample.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Lambert {
+    /// Albedo ρ per spectral sample (`albedo.len() == sampling.len()`).
+    pub albedo: Vec<f64>,
+    pub sampling: Sampling,
+}
+
+impl Lambert {
+    /// Panics if the lengths disagree (a programming error; recipes are validated before this).
+    pub fn new(albedo: Vec<f64>, sampling: Sampling) -> Self {
+        assert_eq!(albedo.len(), sampling.len(), "one albedo per spectral sample");
+        Lambert { albedo, sampling }
+    }
+}
+
+impl Brdf for Lambert {
+    fn sampling(&self) -> &Sampling {
+        &self.sampling
+    }
+
+    fn eval(&self, _wi: Vec3, _wo: Vec3, out: &mut [f64]) {
+        for (o, r) in out.iter_mut().zip(&self.albedo) {
+            *o = r / PI;
+        }
+    }
+
+    fn terms(&self) -> Vec<Term> {
+        vec![Term { label: "Lambertian".into(), kind: TermKind::Diffuse }]
+    }
+
+    fn describe(&self) -> String {
+        format!("Lambert (albedo {})", fmt_values(&self.albedo))
+    }
+}
+
+/// Format per-sample values compactly: one number, or `[a, b, c]`.
+pub(crate) fn fmt_values(v: &[f64]) -> String {
+    if v.len() == 1 {
+        format!("{}", v[0])
+    } else {
+        format!("[{}]", v.iter().map(|x| format!("{x}")).collect::<Vec<_>>().join(", "))
+    }
+}
