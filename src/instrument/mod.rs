@@ -1,5 +1,5 @@
 //! The virtual instrument. (Being written.)
 pub mod flux;
 pub mod geometry;
-// pub mod plan; (enabled once standards.rs lands)
+pub mod plan;
 pub mod standards;

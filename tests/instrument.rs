@@ -1,0 +1,252 @@
+//! Acceptance tests of the virtual instrument (issue 3). Every reference here is computed independently
+//! of the engine: Lambert's closed form for the projected solid angle of a spherical polygon, or a
+//! separate nested Gauss–Legendre integration of the mirror overlap.
+use std::sync::Arc;
+
+use glossmeter::brdf::{Brdf, Lobe, Term, TermKind};
+use glossmeter::instrument::flux::{FluxProblem, Spectral};
+use glossmeter::instrument::geometry::{Axes, Stop};
+use glossmeter::instrument::plan::{Plan, PlanOptions, Reading};
+use glossmeter::instrument::standards;
+use glossmeter::optics::fresnel::fr_dielectric;
+use glossmeter::spectrum::Sampling;
+use glossmeter::Vec3;
+
+#[derive(Debug)]
+struct TestLambert(f64, Sampling);
+impl Brdf for TestLambert {
+    fn sampling(&self) -> &Sampling {
+        &self.1
+    }
+    fn eval(&self, _: Vec3, _: Vec3, out: &mut [f64]) {
+        out[0] = self.0 / std::f64::consts::PI;
+    }
+    fn terms(&self) -> Vec<Term> {
+        vec![Term { label: "lambert".into(), kind: TermKind::Diffuse }]
+    }
+    fn describe(&self) -> String {
+        "test lambert".into()
+    }
+}
+
+/// Smooth dielectric or perfect mirror (index None), delta only.
+#[derive(Debug)]
+struct TestMirror(Option<f64>, Sampling);
+impl Brdf for TestMirror {
+    fn sampling(&self) -> &Sampling {
+        &self.1
+    }
+    fn eval(&self, _: Vec3, _: Vec3, out: &mut [f64]) {
+        out[0] = 0.0;
+    }
+    fn delta_reflectance(&self, wi: Vec3, out: &mut [f64]) -> bool {
+        out[0] = match self.0 {
+            Some(n) => fr_dielectric(wi.z, n),
+            None => 1.0,
+        };
+        true
+    }
+    fn terms(&self) -> Vec<Term> {
+        vec![Term { label: "mirror".into(), kind: TermKind::Delta }]
+    }
+    fn describe(&self) -> String {
+        "test mirror".into()
+    }
+}
+
+/// Beckmann microfacet on a dielectric (F·D·G/(4 cos cos)), written out here from Walter et al. 2007 so
+/// the test does not share code with the models under test; G = Smith height-correlated.
+#[derive(Debug)]
+struct TestBeckmann {
+    m: f64,
+    n: f64,
+    s: Sampling,
+}
+impl TestBeckmann {
+    fn lambda(&self, w: Vec3) -> f64 {
+        let t2 = (w.x * w.x + w.y * w.y) / (w.z * w.z);
+        if t2 == 0.0 {
+            return 0.0;
+        }
+        let a = 1.0 / (self.m * t2.sqrt());
+        0.5 * ((-a * a).exp() / (a * std::f64::consts::PI.sqrt()) - libm::erfc(a))
+    }
+}
+impl Brdf for TestBeckmann {
+    fn sampling(&self) -> &Sampling {
+        &self.s
+    }
+    fn eval(&self, wi: Vec3, wo: Vec3, out: &mut [f64]) {
+        let h = (wi + wo).normalize();
+        let t2 = (h.x * h.x + h.y * h.y) / (h.z * h.z);
+        let m2 = self.m * self.m;
+        let d = (-t2 / m2).exp() / (std::f64::consts::PI * m2 * h.z.powi(4));
+        let g = 1.0 / (1.0 + self.lambda(wi) + self.lambda(wo));
+        out[0] = fr_dielectric(wi.dot(h), self.n) * d * g / (4.0 * wi.z * wo.z);
+    }
+    fn terms(&self) -> Vec<Term> {
+        vec![Term { label: "beckmann".into(), kind: TermKind::Lobe(Lobe { slope_width: self.m, medium_eta: 1.0, label: "beckmann".into() }) }]
+    }
+    fn describe(&self) -> String {
+        format!("test beckmann m = {}", self.m)
+    }
+}
+
+/// Projected solid angle ∫ cos θ dω of the pyramid over a stop, by Lambert's formula for a spherical
+/// polygon: ½ |Σ_edges γ_e (n_e · z)|, γ_e the angle subtended by the edge, n_e the unit normal of the
+/// plane through the edge and the origin (Lambert 1760; e.g. Arvo 1995, "Applications of irradiance
+/// tensors", Eq. 3).
+fn projected_solid_angle(axis: Vec3, e_par: Vec3, stop: Stop) -> f64 {
+    let e_perp = Vec3::new(0.0, 1.0, 0.0);
+    let corners = [(stop.p[0], stop.q[0]), (stop.p[1], stop.q[0]), (stop.p[1], stop.q[1]), (stop.p[0], stop.q[1])];
+    let v: Vec<Vec3> = corners.iter().map(|(p, q)| (axis + *p * e_par + *q * e_perp).normalize()).collect();
+    let mut s = 0.0;
+    for i in 0..4 {
+        let (a, b) = (v[i], v[(i + 1) % 4]);
+        let gamma = a.cross(b).length().atan2(a.dot(b));
+        s += gamma * a.cross(b).normalize().z;
+    }
+    0.5 * s.abs()
+}
+
+fn gauss_legendre(n: usize) -> Vec<(f64, f64)> {
+    // Newton iteration on P_n (Golub–Welsch would do too); nodes on [-1, 1].
+    (0..n)
+        .map(|i| {
+            let mut x = (std::f64::consts::PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
+            let mut dp = 0.0;
+            for _ in 0..100 {
+                let (mut p0, mut p1) = (1.0, x);
+                for k in 2..=n {
+                    let p2 = ((2 * k - 1) as f64 * x * p1 - (k - 1) as f64 * p0) / k as f64;
+                    p0 = p1;
+                    p1 = p2;
+                }
+                dp = n as f64 * (x * p1 - p0) / (x * x - 1.0);
+                let dx = p1 / dp;
+                x -= dx;
+                if dx.abs() < 1e-16 {
+                    break;
+                }
+            }
+            (x, 2.0 / ((1.0 - x * x) * dp * dp))
+        })
+        .collect()
+}
+
+/// Independent mirror flux: ∫∫ over source points whose mirror is in the receptor of R(θi) cos θi dω,
+/// by a 48×48 Gauss–Legendre product rule (the integrand is smooth on the overlap box).
+fn mirror_flux_reference(theta: f64, src: Stop, rec: Stop, refl: &dyn Fn(f64) -> f64) -> f64 {
+    let gl = gauss_legendre(48);
+    let (p0, p1) = (src.p[0].max(-rec.p[1]), src.p[1].min(-rec.p[0]));
+    let (q0, q1) = (src.q[0].max(-rec.q[1]), src.q[1].min(-rec.q[0]));
+    let (c, s) = (theta.cos(), theta.sin());
+    let mut total = 0.0;
+    for (xp, wp) in &gl {
+        let p = 0.5 * (p0 + p1) + 0.5 * (p1 - p0) * xp;
+        for (xq, wq) in &gl {
+            let q = 0.5 * (q0 + q1) + 0.5 * (q1 - q0) * xq;
+            let r2 = 1.0 + p * p + q * q;
+            let cos_i = (c + p * s) / r2.sqrt();
+            total += wp * wq * refl(cos_i) * cos_i / (r2 * r2.sqrt());
+        }
+    }
+    total * 0.25 * (p1 - p0) * (q1 - q0)
+}
+
+fn geometry(id: &str) -> glossmeter::instrument::geometry::Geometry {
+    standards::find(id).unwrap().geometry
+}
+
+fn gloss_of(brdf: Arc<dyn Brdf>, id: &str, rtol: f64) -> Reading {
+    let plan = Plan::compile(brdf, vec![standards::find(id).unwrap()], PlanOptions { rtol, ..Default::default() }).unwrap();
+    plan.execute().into_iter().find(|r| r.quantity == "gloss").unwrap()
+}
+
+#[test]
+fn lambertian_flux_matches_closed_form() {
+    for id in ["astm-d523-20", "astm-d523-60", "astm-d523-85", "astm-e430-30"] {
+        let g = geometry(id);
+        let axes_src = Vec3::new(-g.theta.sin(), 0.0, g.theta.cos());
+        let epar_src = Vec3::new(g.theta.cos(), 0.0, g.theta.sin());
+        let axes_rec = Vec3::new(g.theta.sin(), 0.0, g.theta.cos());
+        let epar_rec = Vec3::new(g.theta.cos(), 0.0, -g.theta.sin());
+        let rho = 0.5;
+        let brdf = TestLambert(rho, Sampling::grey());
+        for (name, stop) in &g.receptors {
+            let exact = rho / std::f64::consts::PI * projected_solid_angle(axes_src, epar_src, g.source) * projected_solid_angle(axes_rec, epar_rec, *stop);
+            let f = FluxProblem {
+                brdf: &brdf,
+                theta: g.theta,
+                source: g.source,
+                receptor: *stop,
+                spectral: Spectral::Folded(vec![1.0]),
+                lobes: vec![],
+                include_delta: false,
+                include_regular: true,
+                rtol: 1e-11,
+                atol: 0.0,
+                max_evals: 10_000_000,
+            }
+            .solve();
+            let rel = (f.value - exact).abs() / exact;
+            assert!(rel < 1e-9, "{id}/{name}: {} vs {exact} (rel {rel:e})", f.value);
+            assert!((f.value - exact).abs() <= f.error.max(1e-15 * exact), "{id}/{name}: error estimate {:e} below actual {:e}", f.error, (f.value - exact).abs());
+        }
+    }
+}
+
+#[test]
+fn gloss_standard_reads_100_and_dielectric_15_reads_aperture_averaged_values() {
+    let _ = Axes::new(0.1);
+    for (id, expect_15) in [("astm-d523-20", 82.05), ("astm-d523-60", 89.14), ("astm-d523-85", 98.97)] {
+        let g = geometry(id);
+        let std = gloss_of(Arc::new(TestMirror(Some(g.reference_index), Sampling::grey())), id, 1e-9);
+        assert!((std.value.unwrap() - 100.0).abs() < 1e-9, "{id}: standard reads {:?}", std.value);
+        let r = gloss_of(Arc::new(TestMirror(Some(1.5), Sampling::grey())), id, 1e-9);
+        let v = r.value.unwrap();
+        let rec = g.receptor("gloss").copied().unwrap();
+        let reference = 100.0 * mirror_flux_reference(g.theta, g.source, rec, &|c| fr_dielectric(c, 1.5))
+            / mirror_flux_reference(g.theta, g.source, rec, &|c| fr_dielectric(c, g.reference_index));
+        assert!((v - reference).abs() < 1e-9 * reference, "{id}: {v} vs independent {reference}");
+        assert!((v - reference).abs() <= r.error_estimate.max(1e-12), "{id}: estimate {:e} < actual {:e}", r.error_estimate, (v - reference).abs());
+        assert!((v - expect_15).abs() < 0.01, "{id}: {v} vs about {expect_15}");
+        let mirror = gloss_of(Arc::new(TestMirror(None, Sampling::grey())), id, 1e-9).value.unwrap();
+        let reference = 100.0 * mirror_flux_reference(g.theta, g.source, rec, &|_| 1.0)
+            / mirror_flux_reference(g.theta, g.source, rec, &|c| fr_dielectric(c, g.reference_index));
+        assert!((mirror - reference).abs() < 1e-9 * reference, "{id}: mirror {mirror} vs {reference}");
+    }
+}
+
+#[test]
+fn perfect_mirror_reads_about_2038_999_162() {
+    for (id, about) in [("astm-d523-20", 2038.0), ("astm-d523-60", 999.0), ("astm-d523-85", 162.0)] {
+        let v = gloss_of(Arc::new(TestMirror(None, Sampling::grey())), id, 1e-8).value.unwrap();
+        assert!((v - about).abs() / about < 0.005, "{id}: {v} vs about {about}");
+    }
+}
+
+#[test]
+fn delta_limit_of_a_narrow_lobe_is_reached_monotonically() {
+    for id in ["astm-d523-20", "astm-d523-60", "astm-d523-85"] {
+        let n = geometry(id).reference_index;
+        let smooth = gloss_of(Arc::new(TestMirror(Some(n), Sampling::grey())), id, 1e-10).value.unwrap();
+        let mut last_gap = f64::INFINITY;
+        for m in [1e-2, 1e-3, 1e-4, 1e-5, 1e-6] {
+            let r = gloss_of(Arc::new(TestBeckmann { m, n, s: Sampling::grey() }), id, 1e-8);
+            let gap = (r.value.unwrap() - smooth).abs();
+            assert!(gap <= last_gap, "{id}: m = {m}: gap {gap:e} grew from {last_gap:e}");
+            last_gap = gap;
+            if m == 1e-6 {
+                assert!(gap / smooth < 1e-6, "{id}: m = 1e-6 reads {:?}, smooth {smooth}", r.value);
+            }
+        }
+    }
+}
+
+#[test]
+fn a_lobe_much_narrower_than_the_apertures_is_found() {
+    let r = gloss_of(Arc::new(TestBeckmann { m: 1e-5, n: 1.567, s: Sampling::grey() }), "astm-d523-20", 1e-6);
+    let v = r.value.unwrap();
+    assert!((v - 100.0).abs() < 0.01, "roughness 1e-5 at 20° reads {v}, expected ≈ 100");
+}
