@@ -1,1 +1,495 @@
-//! (being written)
+//! The standards as data: every shipped instrument geometry is a JSON file in `standards/`, embedded in
+//! the binary, parsed and validated here into a compiled [`Geometry`]. User geometry files use the same
+//! format (documented in `docs/instrument.md`).
+//!
+//! Every number in a geometry file carries its provenance:
+//! `{"value": 1.8, "source": "…citation or reason…", "status": "verified" | "secondary" | "assumed"}`.
+//! Errors name the file, the field path and what is allowed.
+use crate::instrument::geometry::{Geometry, ReadingSpec, Stop};
+use crate::recipe::fields::{kind, parse_json, Obj};
+use crate::{Error, Result};
+use serde_json::Value;
+use std::collections::HashSet;
+use std::path::Path;
+
+/// Every shipped geometry file: (file name, text). A test checks this equals the set of `standards/*.json`.
+pub const BUILTIN: &[(&str, &str)] = &[
+    ("astm-d523-20.json", include_str!("../../standards/astm-d523-20.json")),
+    ("astm-d523-60.json", include_str!("../../standards/astm-d523-60.json")),
+    ("astm-d523-85.json", include_str!("../../standards/astm-d523-85.json")),
+    ("iso-2813-20.json", include_str!("../../standards/iso-2813-20.json")),
+    ("iso-2813-60.json", include_str!("../../standards/iso-2813-60.json")),
+    ("iso-2813-85.json", include_str!("../../standards/iso-2813-85.json")),
+    ("astm-e430-30.json", include_str!("../../standards/astm-e430-30.json")),
+    ("astm-e430-20.json", include_str!("../../standards/astm-e430-20.json")),
+    ("iso-13803-20.json", include_str!("../../standards/iso-13803-20.json")),
+    ("astm-d4039.json", include_str!("../../standards/astm-d4039.json")),
+    ("astm-d2457-45.json", include_str!("../../standards/astm-d2457-45.json")),
+    ("tappi-t480-75.json", include_str!("../../standards/tappi-t480-75.json")),
+];
+
+/// The allowed provenance words of a sourced number.
+pub const STATUSES: &[&str] = &["verified", "secondary", "assumed"];
+
+/// A compiled geometry together with its display names and the original specification.
+#[derive(Clone, Debug)]
+pub struct StandardGeometry {
+    pub geometry: Geometry,
+    /// One display name per entry of `geometry.readings` (the reading's `name`, or its quantity).
+    pub reading_names: Vec<String>,
+    /// The original JSON, kept for provenance display ([`describe`]).
+    pub spec: Value,
+    /// `"builtin"` or the path of the user file.
+    pub origin: String,
+}
+
+const TOP_FIELDS: &[&str] =
+    &["id", "title", "standards", "angle_deg", "reference_index", "source", "receptors", "readings", "notes"];
+const GEOMETRY_ONLY: &[&str] = &["angle_deg", "reference_index", "source", "receptors"];
+
+/// Parse and validate every builtin geometry, and check that they are consistent with each other (each
+/// file's id equals its file name, ids are unique, composites name existing non-composite geometries).
+pub fn builtin() -> Result<Vec<StandardGeometry>> {
+    let mut out = Vec::with_capacity(BUILTIN.len());
+    for (file, text) in BUILTIN {
+        let label = format!("<builtin:{file}>");
+        let mut g = parse(text, &label)?;
+        let stem = file.trim_end_matches(".json");
+        if g.geometry.id != stem {
+            return Err(Error::input(
+                label,
+                "id",
+                format!("id \"{}\" must equal the file name \"{stem}\"", g.geometry.id),
+            ));
+        }
+        if out.iter().any(|o: &StandardGeometry| o.geometry.id == g.geometry.id) {
+            return Err(Error::input(label, "id", format!("duplicate id \"{}\"", g.geometry.id)));
+        }
+        g.origin = "builtin".to_string();
+        out.push(g);
+    }
+    for g in &out {
+        for (i, r) in g.geometry.readings.iter().enumerate() {
+            if let ReadingSpec::HazeIndex { minuend, subtrahend } = r {
+                for (key, id) in [("minuend", minuend), ("subtrahend", subtrahend)] {
+                    let ok = out.iter().any(|o| &o.geometry.id == id && !o.geometry.is_composite());
+                    if !ok {
+                        return Err(Error::input(
+                            format!("<builtin:{}.json>", g.geometry.id),
+                            format!("readings[{i}].{key}"),
+                            format!("\"{id}\" is not a builtin non-composite geometry id; known: {}", ids(&out)),
+                        ));
+                    }
+                }
+            }
+        }
+    }
+    Ok(out)
+}
+
+fn ids(gs: &[StandardGeometry]) -> String {
+    gs.iter().map(|g| g.geometry.id.as_str()).collect::<Vec<_>>().join(", ")
+}
+
+/// The builtin geometry with this id; an unknown id is a usage error listing the known ids.
+pub fn find(id: &str) -> Result<StandardGeometry> {
+    let all = builtin()?;
+    match all.iter().position(|g| g.geometry.id == id) {
+        Some(i) => Ok(all.into_iter().nth(i).expect("index from position")),
+        None => Err(Error::Usage(format!("unknown geometry id \"{id}\"; known ids: {}", ids(&all)))),
+    }
+}
+
+/// Load a user geometry file (same format as the builtin ones).
+pub fn load_file(path: &Path) -> Result<StandardGeometry> {
+    let name = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|source| Error::Io { file: name.clone(), source })?;
+    parse(&text, &name)
+}
+
+/// Parse and validate a geometry from JSON text; `origin` names the file in errors and in `origin`.
+pub fn parse(text: &str, origin: &str) -> Result<StandardGeometry> {
+    let spec = parse_json(text, origin)?;
+    let o = Obj::new(origin, "", &spec)?;
+    o.deny_unknown(TOP_FIELDS)?;
+    let id = o.str("id")?;
+    if id.is_empty() || !id.chars().all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '-' || c == '.') {
+        return Err(o.err("id", format!("\"{id}\" is not a valid id: use lower-case letters, digits, '-' and '.'")));
+    }
+    let title = nonempty_str(&o, "title")?;
+    string_list(&o, "standards")?;
+    if let Some(v) = o.get("notes") {
+        if !v.is_string() {
+            return Err(o.err("notes", format!("expected a string, got {}", kind(v))));
+        }
+    }
+
+    // Readings are read first: a geometry whose readings are haze-index is a composite and has no optics.
+    let readings_v = o.array("readings")?;
+    if readings_v.is_empty() {
+        return Err(o.err("readings", "at least one reading is required"));
+    }
+    let mut quantities = Vec::with_capacity(readings_v.len());
+    for (i, v) in readings_v.iter().enumerate() {
+        let r = Obj::new(origin, format!("readings[{i}]"), v)?;
+        quantities.push(r.str("quantity")?);
+    }
+    let composite = quantities.contains(&"haze-index");
+
+    let (theta, reference_index, source, receptors) = if composite {
+        if let Some(i) = quantities.iter().position(|q| *q != "haze-index") {
+            return Err(Error::input(
+                origin,
+                format!("readings[{i}].quantity"),
+                "a composite geometry (one with haze-index readings) may only have haze-index readings",
+            ));
+        }
+        if let Some(k) = GEOMETRY_ONLY.iter().find(|k| o.get(k).is_some()) {
+            return Err(o.err(
+                k,
+                "a composite geometry (haze-index readings) has no angle, reference index, source or receptors of its own; \
+                 they come from the geometries it names",
+            ));
+        }
+        (0.0, 0.0, Stop { p: [0.0, 0.0], q: [0.0, 0.0] }, Vec::new())
+    } else {
+        let angle = sourced(&o, "angle_deg", Range::Open(0.0, 90.0), "the angle of incidence in degrees")?;
+        let n = sourced(&o, "reference_index", Range::Closed(1.3, 2.0), "the refractive index of the gloss standard")?;
+        let src = o.obj("source")?;
+        let (s_in, s_perp) = aperture(&src, &["shape", "in_plane_deg", "perpendicular_deg"])?;
+        if angle + 0.5 * s_in >= 90.0 {
+            return Err(src.err(
+                "in_plane_deg",
+                format!(
+                    "the source stop reaches {:.4}° from the normal (angle + in_plane/2), at or below the specimen plane; \
+                     it must stay below 90°",
+                    angle + 0.5 * s_in
+                ),
+            ));
+        }
+        let source = Stop::from_angles(s_in.to_radians(), s_perp.to_radians(), 0.0);
+        let rec_v = o.array("receptors")?;
+        if rec_v.is_empty() {
+            return Err(o.err("receptors", "at least one receptor is required"));
+        }
+        let mut receptors: Vec<(String, Stop)> = Vec::with_capacity(rec_v.len());
+        for (i, v) in rec_v.iter().enumerate() {
+            let r = Obj::new(origin, format!("receptors[{i}]"), v)?;
+            let name = nonempty_str(&r, "name")?;
+            if receptors.iter().any(|(n, _)| *n == name) {
+                return Err(r.err("name", format!("duplicate receptor name \"{name}\"")));
+            }
+            let (r_in, r_perp) = aperture(&r, &["name", "shape", "in_plane_deg", "perpendicular_deg", "offset_deg"])?;
+            let off = sourced(
+                &r,
+                "offset_deg",
+                Range::Closed(-45.0, 45.0),
+                "the in-plane offset of the stop centre from the specular axis in degrees (positive towards grazing)",
+            )?;
+            let top = angle + off + 0.5 * r_in;
+            if top >= 90.0 {
+                return Err(r.err(
+                    "offset_deg",
+                    format!(
+                        "the receptor stop reaches {top:.4}° from the normal (angle + offset + in_plane/2), at or below the \
+                         specimen plane; it must stay below 90°"
+                    ),
+                ));
+            }
+            receptors.push((name, Stop::from_angles(r_in.to_radians(), r_perp.to_radians(), off.to_radians())));
+        }
+        (angle.to_radians(), n, source, receptors)
+    };
+
+    let names: Vec<&str> = receptors.iter().map(|(n, _)| n.as_str()).collect();
+    let mut readings = Vec::with_capacity(readings_v.len());
+    let mut reading_names: Vec<String> = Vec::with_capacity(readings_v.len());
+    for (i, v) in readings_v.iter().enumerate() {
+        let r = Obj::new(origin, format!("readings[{i}]"), v)?;
+        let (spec, name) = reading(&r, &names, id)?;
+        let display = name.unwrap_or_else(|| spec.quantity().to_string());
+        if reading_names.contains(&display) {
+            return Err(r.err(
+                "name",
+                format!("two readings would both be displayed as \"{display}\"; give them distinct \"name\" fields"),
+            ));
+        }
+        reading_names.push(display);
+        readings.push(spec);
+    }
+
+    let geometry = Geometry { id: id.to_string(), title, theta, reference_index, source, receptors, readings };
+    Ok(StandardGeometry { geometry, reading_names, spec, origin: origin.to_string() })
+}
+
+/// Allowed range of a sourced number.
+#[derive(Clone, Copy)]
+enum Range {
+    /// lo < x < hi
+    Open(f64, f64),
+    /// lo ≤ x ≤ hi
+    Closed(f64, f64),
+}
+
+/// The value of a `{"value", "source", "status"}` object at `o.key`, with its provenance checked.
+fn sourced(o: &Obj, key: &str, range: Range, what: &str) -> Result<f64> {
+    let s = o.obj(key)?;
+    s.deny_unknown(&["value", "source", "status"])?;
+    let (lo, hi) = match range {
+        Range::Open(lo, hi) | Range::Closed(lo, hi) => (lo, hi),
+    };
+    let value = s.num("value", lo, hi, what)?;
+    if let Range::Open(lo, hi) = range {
+        if value <= lo || value >= hi {
+            return Err(s.err("value", format!("{value} is out of range: {what} must be > {lo} and < {hi}")));
+        }
+    }
+    let source = s.str("source")?;
+    if source.trim().is_empty() {
+        return Err(s.err("source", "must not be empty: cite where the number comes from, or why it was chosen"));
+    }
+    let status = s.str("status")?;
+    if !STATUSES.contains(&status) {
+        return Err(s.err("status", format!("\"{status}\" is not a status; allowed: {}", STATUSES.join(", "))));
+    }
+    Ok(value)
+}
+
+/// The shape and size of a stop: (in-plane, perpendicular) full angles in degrees. The shape is checked
+/// before unknown fields, so a circle's `diameter_deg` gets the circle message, not "unknown field".
+fn aperture(o: &Obj, allowed: &[&str]) -> Result<(f64, f64)> {
+    let shape = o.str("shape")?;
+    match shape {
+        "rectangle" => {}
+        "circle" => return Err(o.err(
+            "shape",
+            "circular stops are not supported yet; give the rectangle circumscribing the circle (side = diameter), \
+                 the inscribed one (side = diameter/√2) or the square of equal solid angle (side ≈ 0.886 × diameter), \
+                 and say which in the numbers' \"source\"",
+        )),
+        other => return Err(o.err("shape", format!("unknown shape \"{other}\"; allowed: rectangle"))),
+    }
+    o.deny_unknown(allowed)?;
+    let what = "a full aperture angle in degrees";
+    let a = sourced(o, "in_plane_deg", Range::Open(0.0, 20.0), what)?;
+    let b = sourced(o, "perpendicular_deg", Range::Open(0.0, 20.0), what)?;
+    Ok((a, b))
+}
+
+fn nonempty_str(o: &Obj, key: &str) -> Result<String> {
+    let s = o.str(key)?;
+    if s.trim().is_empty() {
+        return Err(o.err(key, "must not be empty"));
+    }
+    Ok(s.to_string())
+}
+
+/// A non-empty array of non-empty strings.
+fn string_list(o: &Obj, key: &str) -> Result<Vec<String>> {
+    let a = o.array(key)?;
+    if a.is_empty() {
+        return Err(o.err(key, "must list at least one entry"));
+    }
+    a.iter()
+        .enumerate()
+        .map(|(i, v)| match v.as_str() {
+            Some(s) if !s.trim().is_empty() => Ok(s.to_string()),
+            _ => Err(Error::input(
+                o.file,
+                format!("{}[{i}]", o.field(key)),
+                format!("expected a non-empty string, got {}", kind(v)),
+            )),
+        })
+        .collect()
+}
+
+fn receptor_ref(o: &Obj, key: &str, names: &[&str]) -> Result<String> {
+    let s = o.str(key)?;
+    check_receptor(o, &o.field(key), s, names)?;
+    Ok(s.to_string())
+}
+
+fn receptor_list(o: &Obj, key: &str, names: &[&str]) -> Result<Vec<String>> {
+    let list = string_list(o, key)?;
+    for (i, s) in list.iter().enumerate() {
+        check_receptor(o, &format!("{}[{i}]", o.field(key)), s, names)?;
+    }
+    Ok(list)
+}
+
+fn check_receptor(o: &Obj, path: &str, name: &str, names: &[&str]) -> Result<()> {
+    if names.contains(&name) {
+        Ok(())
+    } else {
+        Err(Error::input(
+            o.file,
+            path,
+            format!("unknown receptor \"{name}\"; receptors defined in this geometry: {}", names.join(", ")),
+        ))
+    }
+}
+
+/// One entry of `readings`: the compiled spec and its optional display name.
+fn reading(r: &Obj, names: &[&str], own_id: &str) -> Result<(ReadingSpec, Option<String>)> {
+    let q = r.str("quantity")?;
+    let allowed: &[&str] = match q {
+        "gloss" => &["quantity", "name", "receptor"],
+        "haze" => &["quantity", "name", "receptors", "specular"],
+        "log-haze" => &["quantity", "name", "receptors", "specular", "k"],
+        "doi" => &["quantity", "name", "specular", "offset"],
+        "haze-index" => &["quantity", "name", "minuend", "subtrahend"],
+        other => {
+            return Err(r.err(
+                "quantity",
+                format!("unknown quantity \"{other}\"; allowed: gloss, haze, log-haze, doi, haze-index"),
+            ))
+        }
+    };
+    r.deny_unknown(allowed)?;
+    let name = match r.get("name") {
+        None => None,
+        Some(_) => Some(nonempty_str(r, "name")?),
+    };
+    let spec = match q {
+        "gloss" => ReadingSpec::Gloss { receptor: receptor_ref(r, "receptor", names)? },
+        "haze" => ReadingSpec::Haze {
+            receptors: receptor_list(r, "receptors", names)?,
+            specular: receptor_ref(r, "specular", names)?,
+        },
+        "log-haze" => ReadingSpec::LogHaze {
+            receptors: receptor_list(r, "receptors", names)?,
+            specular: receptor_ref(r, "specular", names)?,
+            k: sourced(r, "k", Range::Open(0.0, 1e6), "the log-haze scale factor K")?,
+        },
+        "doi" => ReadingSpec::Doi {
+            specular: receptor_ref(r, "specular", names)?,
+            offset: receptor_list(r, "offset", names)?,
+        },
+        _ => {
+            let minuend = nonempty_str(r, "minuend")?;
+            let subtrahend = nonempty_str(r, "subtrahend")?;
+            for (key, v) in [("minuend", &minuend), ("subtrahend", &subtrahend)] {
+                if v == own_id {
+                    return Err(r.err(key, "a composite geometry cannot name itself"));
+                }
+            }
+            ReadingSpec::HazeIndex { minuend, subtrahend }
+        }
+    };
+    Ok((spec, name))
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// Display
+// ---------------------------------------------------------------------------------------------------------
+
+/// One sourced number from the spec as "value unit [status] source".
+fn sourced_text(v: Option<&Value>, unit: &str) -> String {
+    let Some(v) = v else { return "(absent)".to_string() };
+    let value = v.get("value").map(|x| x.to_string()).unwrap_or_default();
+    let status = v.get("status").and_then(Value::as_str).unwrap_or("?");
+    let source = v.get("source").and_then(Value::as_str).unwrap_or("");
+    format!("{value}{unit} [{status}]\n        source: {source}")
+}
+
+/// A multi-line description: title, standards, every number with its value, unit, status and source.
+pub fn describe(g: &StandardGeometry) -> String {
+    let s = &g.spec;
+    let geo = &g.geometry;
+    let mut out = format!("{} — {}\n", geo.id, geo.title);
+    let standards: Vec<&str> = s
+        .get("standards")
+        .and_then(Value::as_array)
+        .map(|a| a.iter().filter_map(Value::as_str).collect())
+        .unwrap_or_default();
+    out += &format!("  standards: {}\n  origin: {}\n", standards.join("; "), g.origin);
+    if geo.is_composite() {
+        out += "  composite geometry (no optics of its own)\n";
+    } else {
+        out += &format!("  angle of incidence: {}\n", sourced_text(s.get("angle_deg"), "°"));
+        out += &format!("  reference index (gloss standard): {}\n", sourced_text(s.get("reference_index"), ""));
+        if let Some(src) = s.get("source") {
+            out += &format!(
+                "  source stop: {} (solid angle {:.4e} sr)\n",
+                src.get("shape").and_then(Value::as_str).unwrap_or("?"),
+                geo.source.solid_angle()
+            );
+            out += &format!("    in plane: {}\n", sourced_text(src.get("in_plane_deg"), "°"));
+            out += &format!("    perpendicular: {}\n", sourced_text(src.get("perpendicular_deg"), "°"));
+        }
+        let recs = s.get("receptors").and_then(Value::as_array).cloned().unwrap_or_default();
+        for (r, (name, stop)) in recs.iter().zip(&geo.receptors) {
+            out += &format!(
+                "  receptor \"{name}\": {} (solid angle {:.4e} sr)\n",
+                r.get("shape").and_then(Value::as_str).unwrap_or("?"),
+                stop.solid_angle()
+            );
+            out += &format!("    in plane: {}\n", sourced_text(r.get("in_plane_deg"), "°"));
+            out += &format!("    perpendicular: {}\n", sourced_text(r.get("perpendicular_deg"), "°"));
+            out += &format!("    offset from specular: {}\n", sourced_text(r.get("offset_deg"), "°"));
+        }
+    }
+    out += "  readings:\n";
+    let rv = s.get("readings").and_then(Value::as_array).cloned().unwrap_or_default();
+    for ((spec, name), raw) in geo.readings.iter().zip(&g.reading_names).zip(&rv) {
+        out += &format!("    {name} ({}): {}\n", spec.unit(), reading_summary(spec));
+        if let ReadingSpec::LogHaze { .. } = spec {
+            out += &format!("      K: {}\n", sourced_text(raw.get("k"), ""));
+        }
+    }
+    if let Some(n) = s.get("notes").and_then(Value::as_str) {
+        out += &format!("  notes: {n}\n");
+    }
+    out
+}
+
+fn reading_summary(r: &ReadingSpec) -> String {
+    match r {
+        ReadingSpec::Gloss { receptor } => format!("100·Φ({receptor}) / Φ_standard({receptor})"),
+        ReadingSpec::Haze { receptors, specular } => {
+            format!("100·mean Φ({}) / Φ_standard({specular})", receptors.join(", "))
+        }
+        ReadingSpec::LogHaze { receptors, specular, k } => {
+            format!("{k}·log10(H/20 + 1), H = 100·mean Φ({}) / Φ_standard({specular})", receptors.join(", "))
+        }
+        ReadingSpec::Doi { specular, offset } => {
+            format!("100·(Φ({specular}) − mean Φ({})) / Φ({specular})", offset.join(", "))
+        }
+        ReadingSpec::HazeIndex { minuend, subtrahend } => format!("gloss({minuend}) − gloss({subtrahend})"),
+    }
+}
+
+/// One line: id, angle, reference index, receptors (size and offset), readings.
+pub fn list_line(g: &StandardGeometry) -> String {
+    let geo = &g.geometry;
+    let readings = g.reading_names.join(", ");
+    if geo.is_composite() {
+        let parts: Vec<String> = geo.readings.iter().map(reading_summary).collect();
+        return format!("{:<15} composite            {}  [{}]", geo.id, readings, parts.join("; "));
+    }
+    let recs = g.spec.get("receptors").and_then(Value::as_array).cloned().unwrap_or_default();
+    let val = |r: &Value, k: &str| r.get(k).and_then(|x| x.get("value")).map(|x| x.to_string()).unwrap_or_default();
+    let receptors: Vec<String> = recs
+        .iter()
+        .map(|r| {
+            let name = r.get("name").and_then(Value::as_str).unwrap_or("?");
+            let off = val(r, "offset_deg");
+            let off = if off == "0" || off == "0.0" { String::new() } else { format!("@{off}°") };
+            format!("{name} {}°×{}°{off}", val(r, "in_plane_deg"), val(r, "perpendicular_deg"))
+        })
+        .collect();
+    format!(
+        "{:<15} {:>4.1}°  n={:<6}  receptors: {}  readings: {}",
+        geo.id,
+        geo.theta.to_degrees(),
+        geo.reference_index,
+        receptors.join(", "),
+        readings
+    )
+}
+
+/// Ids of the builtin geometries, in table order (without parsing them).
+pub fn builtin_ids() -> Vec<&'static str> {
+    let mut seen = HashSet::new();
+    BUILTIN.iter().map(|(f, _)| f.trim_end_matches(".json")).filter(|id| seen.insert(*id)).collect()
+}
