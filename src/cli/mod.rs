@@ -1,1 +1,187 @@
-//! Command-line layer. (Being written.)
+//! The command-line layer: argument parsing and output formatting only. Every computation lives in the
+//! library modules; this module turns their results into tables, JSON or CSV, and their errors into a
+//! message on stderr and a non-zero exit status (2 for bad input or usage, 1 for anything else).
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use clap::{Parser, Subcommand, ValueEnum};
+
+use crate::instrument::plan::{Plan, PlanOptions, Reading};
+use crate::instrument::standards;
+use crate::{recipe, Error, Result};
+
+pub mod convergence;
+pub mod format;
+
+#[derive(Parser, Debug)]
+#[command(name = "glossmeter", version, about = "A virtual gloss, haze and DOI meter: reads a BRDF through the apertures of ASTM D523 / ISO 2813 / ASTM E430 / ISO 13803 instruments.")]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Format {
+    Table,
+    Json,
+    Csv,
+}
+
+#[derive(Subcommand, Debug)]
+pub enum Command {
+    /// Read a material (recipe JSON) through instrument geometries.
+    Measure {
+        /// The recipe (JSON; see `glossmeter schema` and docs/recipe-format.md).
+        recipe: PathBuf,
+        /// A shipped geometry id (repeatable); see `glossmeter standards`. Default: ASTM D523 20°/60°/85°,
+        /// ASTM E430 30° (gloss, haze, DOI), ISO 13803 20° haze and the ASTM D4039 haze index.
+        #[arg(long = "geometry", short = 'g')]
+        geometries: Vec<String>,
+        /// A user geometry file in the standards format (repeatable).
+        #[arg(long = "geometry-file")]
+        geometry_files: Vec<PathBuf>,
+        /// Relative tolerance of every reading.
+        #[arg(long, default_value_t = 1e-6)]
+        rtol: f64,
+        #[arg(long, value_enum, default_value_t = Format::Table)]
+        format: Format,
+        /// Print the measurement plan before measuring.
+        #[arg(long)]
+        explain: bool,
+        /// Leave the wall-time column out (everything else is reproducible bit for bit).
+        #[arg(long)]
+        no_timing: bool,
+        /// Write the result to this file instead of stdout (refuses to overwrite an existing file).
+        #[arg(long, short = 'o')]
+        output: Option<PathBuf>,
+    },
+    /// List the shipped geometries, or show one with the provenance of every number.
+    Standards {
+        /// A geometry id.
+        id: Option<String>,
+    },
+    /// Print the JSON Schema of the recipe format.
+    Schema,
+    /// Error against run time over a sweep of tolerances (table, CSV, JSON, and a log–log plot).
+    Convergence(convergence::ConvergenceArgs),
+}
+
+/// The default panel of `measure`.
+pub const DEFAULT_GEOMETRIES: &[&str] = &["astm-d523-20", "astm-d523-60", "astm-d523-85", "astm-e430-30", "iso-13803-20", "astm-d4039"];
+
+/// Run the CLI; returns the process exit status.
+pub fn run<I, T>(args: I) -> i32
+where
+    I: IntoIterator<Item = T>,
+    T: Into<std::ffi::OsString> + Clone,
+{
+    let cli = match Cli::try_parse_from(args) {
+        Ok(c) => c,
+        Err(e) => {
+            let _ = e.print();
+            return if e.use_stderr() { 2 } else { 0 };
+        }
+    };
+    match dispatch(cli) {
+        Ok(()) => 0,
+        Err(e) => {
+            eprintln!("error: {e}");
+            match e {
+                Error::Input { .. } | Error::Usage(_) => 2,
+                _ => 1,
+            }
+        }
+    }
+}
+
+fn dispatch(cli: Cli) -> Result<()> {
+    match cli.command {
+        Command::Measure { recipe, geometries, geometry_files, rtol, format, explain, no_timing, output } => {
+            let material = recipe::load_file(&recipe)?;
+            let geos = resolve_geometries(&geometries, &geometry_files)?;
+            let plan = Plan::compile(material.brdf.clone(), geos, PlanOptions { rtol, ..PlanOptions::default() })?;
+            let mut text = String::new();
+            if explain {
+                let e = plan.explain();
+                match format {
+                    Format::Table => text.push_str(&format!("{e}\n")),
+                    // Keep machine formats parseable: the plan goes to stderr.
+                    _ => eprint!("{e}"),
+                }
+            }
+            let readings = plan.execute();
+            text.push_str(&match format {
+                Format::Table => format::table(&material, &readings, !no_timing),
+                Format::Json => format::json(&material, &readings, !no_timing),
+                Format::Csv => format::csv(&readings, !no_timing)?,
+            });
+            emit(&text, output.as_deref())?;
+            if readings.iter().any(|r| r.value.is_none()) {
+                return Err(Error::Numeric("some readings have no value (see the table)".into()));
+            }
+            Ok(())
+        }
+        Command::Standards { id } => {
+            match id {
+                None => {
+                    for g in standards::builtin()? {
+                        println!("{}", standards::list_line(&g));
+                    }
+                }
+                Some(id) => println!("{}", standards::describe(&standards::find(&id)?)),
+            }
+            Ok(())
+        }
+        Command::Convergence(args) => convergence::run(args),
+        Command::Schema => {
+            println!("{}", serde_json::to_string_pretty(&recipe::schema::schema()).expect("schema serialises"));
+            Ok(())
+        }
+    }
+}
+
+/// Builtin ids and user files, in the order given; the default panel if neither is given.
+pub fn resolve_geometries(ids: &[String], files: &[PathBuf]) -> Result<Vec<standards::StandardGeometry>> {
+    let mut out = Vec::new();
+    if ids.is_empty() && files.is_empty() {
+        for id in DEFAULT_GEOMETRIES {
+            out.push(standards::find(id)?);
+        }
+    }
+    for id in ids {
+        out.push(standards::find(id)?);
+    }
+    for f in files {
+        out.push(standards::load_file(f)?);
+    }
+    Ok(out)
+}
+
+/// Write to stdout, or to a new file (never overwriting one).
+pub fn emit(text: &str, output: Option<&Path>) -> Result<()> {
+    match output {
+        None => {
+            let mut out = std::io::stdout().lock();
+            out.write_all(text.as_bytes()).map_err(|e| Error::Io { file: "<stdout>".into(), source: e })
+        }
+        Some(p) => {
+            let file = std::fs::OpenOptions::new().write(true).create_new(true).open(p).map_err(|e| {
+                if e.kind() == std::io::ErrorKind::AlreadyExists {
+                    Error::Usage(format!("{}: already exists; glossmeter never overwrites a file (choose another name)", p.display()))
+                } else {
+                    Error::Io { file: p.display().to_string(), source: e }
+                }
+            })?;
+            let mut w = std::io::BufWriter::new(file);
+            w.write_all(text.as_bytes()).map_err(|e| Error::Io { file: p.display().to_string(), source: e })
+        }
+    }
+}
+
+/// Readings as a list, for other modules (e.g. comparisons) that need the engine's output.
+pub fn measure(recipe_path: &Path, ids: &[String], rtol: f64) -> Result<(recipe::Material, Vec<Reading>)> {
+    let material = recipe::load_file(recipe_path)?;
+    let geos = resolve_geometries(ids, &[])?;
+    let plan = Plan::compile(material.brdf.clone(), geos, PlanOptions { rtol, ..PlanOptions::default() })?;
+    Ok((material, plan.execute()))
+}

@@ -1,0 +1,148 @@
+//! Output formats of `measure`. The JSON form is a contract for scripts and CI (docs/instrument.md
+//! §Output); the table is for people. A reading without a finite value is printed as "—" in the table,
+//! null in JSON, empty in CSV, with the reason: never as NaN or inf.
+use crate::instrument::plan::Reading;
+use crate::recipe::Material;
+use crate::{Error, Result};
+use serde_json::json;
+
+/// Decimal places that show the error estimate's leading digit (between 2 and 10).
+fn decimals(error: f64) -> usize {
+    if !(error > 0.0) || !error.is_finite() {
+        return 4;
+    }
+    (-error.log10().floor() as i64).clamp(2, 10) as usize
+}
+
+fn secs(s: f64) -> String {
+    if s < 1e-3 {
+        format!("{:.1} µs", s * 1e6)
+    } else if s < 1.0 {
+        format!("{:.2} ms", s * 1e3)
+    } else {
+        format!("{s:.2} s")
+    }
+}
+
+pub fn table(material: &Material, readings: &[Reading], timing: bool) -> String {
+    let mut rows: Vec<Vec<String>> = vec![];
+    let mut head = vec!["geometry", "reading", "value", "unit", "± error", "evaluations"];
+    if timing {
+        head.push("time");
+    }
+    rows.push(head.iter().map(|s| s.to_string()).collect());
+    let mut notes = vec![];
+    for r in readings {
+        let mut row = vec![r.geometry.clone(), r.name.clone()];
+        match r.value {
+            Some(v) => {
+                row.push(format!("{:.*}", decimals(r.error_estimate), v));
+                row.push(r.unit.clone());
+                row.push(format!("{:.1e}", r.error_estimate));
+            }
+            None => {
+                row.push("—".into());
+                row.push(r.unit.clone());
+                row.push("—".into());
+            }
+        }
+        row.push(r.evaluations.to_string());
+        if timing {
+            row.push(secs(r.seconds));
+        }
+        if let Some(p) = &r.problem {
+            notes.push(format!("{} {}: {p}", r.geometry, r.name));
+        }
+        rows.push(row);
+    }
+    let ncol = rows[0].len();
+    let widths: Vec<usize> = (0..ncol).map(|c| rows.iter().map(|r| r[c].chars().count()).max().unwrap_or(0)).collect();
+    let mut s = format!("{} ({})\n{}\n\n", material.name, material.file, material.brdf.describe());
+    for (i, r) in rows.iter().enumerate() {
+        let cells: Vec<String> = r
+            .iter()
+            .enumerate()
+            .map(|(c, v)| {
+                let pad = widths[c] - v.chars().count();
+                // numbers right-aligned, words left-aligned
+                if matches!(c, 2 | 4 | 5 | 6) {
+                    format!("{}{v}", " ".repeat(pad))
+                } else {
+                    format!("{v}{}", " ".repeat(pad))
+                }
+            })
+            .collect();
+        s.push_str(cells.join("  ").trim_end());
+        s.push('\n');
+        if i == 0 {
+            s.push_str(&widths.iter().map(|w| "-".repeat(*w)).collect::<Vec<_>>().join("  "));
+            s.push('\n');
+        }
+    }
+    for n in notes {
+        s.push_str(&format!("note: {n}\n"));
+    }
+    s
+}
+
+pub fn json(material: &Material, readings: &[Reading], timing: bool) -> String {
+    let rs: Vec<serde_json::Value> = readings
+        .iter()
+        .map(|r| {
+            let mut o = json!({
+                "geometry": r.geometry,
+                "name": r.name,
+                "quantity": r.quantity,
+                "value": r.value,
+                "unit": r.unit,
+                "error_estimate": if r.value.is_some() { Some(r.error_estimate) } else { None },
+                "evaluations": r.evaluations,
+                "converged": r.converged,
+            });
+            if timing {
+                o["seconds"] = json!(r.seconds);
+            }
+            if let Some(p) = &r.problem {
+                o["problem"] = json!(p);
+            }
+            o
+        })
+        .collect();
+    let doc = json!({
+        "material": {"name": material.name, "file": material.file, "model": material.brdf.describe()},
+        "readings": rs,
+    });
+    let mut s = serde_json::to_string_pretty(&doc).expect("finite values serialise");
+    s.push('\n');
+    s
+}
+
+pub fn csv(readings: &[Reading], timing: bool) -> Result<String> {
+    let mut w = csv::Writer::from_writer(vec![]);
+    let mut head = vec!["geometry", "name", "quantity", "value", "unit", "error_estimate", "evaluations", "converged"];
+    if timing {
+        head.push("seconds");
+    }
+    head.push("problem");
+    let err = |e: csv::Error| Error::Io { file: "<csv>".into(), source: std::io::Error::other(e) };
+    w.write_record(&head).map_err(err)?;
+    for r in readings {
+        let mut rec = vec![
+            r.geometry.clone(),
+            r.name.clone(),
+            r.quantity.clone(),
+            r.value.map(|v| format!("{v:e}")).unwrap_or_default(),
+            r.unit.clone(),
+            r.value.map(|_| format!("{:e}", r.error_estimate)).unwrap_or_default(),
+            r.evaluations.to_string(),
+            r.converged.to_string(),
+        ];
+        if timing {
+            rec.push(format!("{:e}", r.seconds));
+        }
+        rec.push(r.problem.clone().unwrap_or_default());
+        w.write_record(&rec).map_err(err)?;
+    }
+    let bytes = w.into_inner().map_err(|e| Error::Io { file: "<csv>".into(), source: std::io::Error::other(e.to_string()) })?;
+    Ok(String::from_utf8(bytes).expect("csv is utf-8"))
+}
