@@ -1,4 +1,20 @@
-//! Thin-film interference in a layer stack. (Signatures fixed; bodies being written.)
+//! Thin-film interference in a layer stack.
+//!
+//! Sources: Born & Wolf, *Principles of Optics*, §1.6.4 (Airy summation for a film); Hirayama et al.,
+//! "Visualization of optical phenomena caused by multilayer films based on wave optics", *The Visual
+//! Computer* 17 (2001) 106 (the recursion from the last interface upward that the paper's Eq. 6 copies);
+//! Byrnes, "Multilayer optical calculations", arXiv:1603.02720 (conventions for s/p amplitudes, complex
+//! angles, the power formulas T = Re(n_f cos θf)/Re(n_i cos θi)|t|² for s and
+//! Re(n_f cos θf*)/Re(n_i cos θi*)|t|² for p, §3 for incoherent layers); Katsidis & Siapkas, *Appl. Opt.* 41
+//! (2002) 3978 (incoherent combination of coherent sub-stacks with power coefficients).
+//!
+//! Paper corrections (Ďurikovič & Ágošton 2007, Eq. 6–7; see `docs/optics.md`): the phase is
+//! φⱼ = (2π dⱼ/λ)·√(ηⱼ² − η_{j−1}² sin²θ_{j−1}) (printed with 1π and with sin² outside the root); the
+//! powers are |ρ|², |τ|² (printed as squares of complex amplitudes); the transmittance factor is
+//! η_out cos θout/(η_in cos θin) (printed inverted); the mica platelet, which the paper's text calls too
+//! thick to interfere, is handled incoherently here (`coherent == false`) while the printed recursion runs
+//! coherently through it.
+use crate::optics::fresnel::{amplitudes, complex_cos_transmitted};
 use num_complex::Complex64;
 
 /// One layer of a stack.
@@ -31,9 +47,334 @@ impl StackResult {
     }
 }
 
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Pol {
+    S,
+    P,
+}
+
+/// A homogeneous medium as seen by the plane wave: index, cos θ and n cos θ (forward/decaying branch).
+#[derive(Clone, Copy)]
+struct Medium {
+    n: Complex64,
+    cos: Complex64,
+    /// Thickness in nm (0 for the semi-infinite media).
+    d: f64,
+}
+
+impl Medium {
+    fn ncos(&self) -> Complex64 {
+        self.n * self.cos
+    }
+    /// Power-flux factor of Byrnes (arXiv:1603.02720 Eqs. 13–14): Re(n cos θ) for s, Re(n cos θ*) for p.
+    fn flux(&self, pol: Pol) -> f64 {
+        match pol {
+            Pol::S => (self.n * self.cos).re,
+            Pol::P => (self.n * self.cos.conj()).re,
+        }
+    }
+    /// e^{iφ} with φ = (2π d/λ)·n cos θ = (2π d/λ)√(n² − n₀² sin²θ₀); Im φ ≥ 0, so |e^{iφ}| ≤ 1 (only
+    /// decaying exponentials are ever formed: no overflow for thick absorbing layers).
+    fn phase(&self, wavelength_nm: f64) -> Complex64 {
+        let phi = self.ncos() * (2.0 * std::f64::consts::PI * self.d / wavelength_nm);
+        (Complex64::i() * phi).exp()
+    }
+}
+
+/// Amplitude r, t of a coherent group of layers between two semi-infinite media `top` and `bottom`, light
+/// incident from `top`: the Airy recursion from the last interface upward (Hirayama et al. 2001; paper
+/// Eq. 6 corrected): ρ ← r_{N,N+1}, τ ← t_{N,N+1}; for j = N..1 with interface (j−1 → j) coefficients r, t
+/// and layer phase φⱼ: ρ ← (r + ρ e^{2iφⱼ})/(1 + r ρ e^{2iφⱼ}), τ ← t τ e^{iφⱼ}/(1 + r ρ e^{2iφⱼ}).
+fn coherent_amplitudes(media: &[Medium], pol: Pol, wavelength_nm: f64) -> (Complex64, Complex64) {
+    let iface = |a: &Medium, b: &Medium| {
+        let c = amplitudes(a.n, a.cos, b.n, b.cos);
+        match pol {
+            Pol::S => (c.rs, c.ts),
+            Pol::P => (c.rp, c.tp),
+        }
+    };
+    let last = media.len() - 1;
+    let (mut rho, mut tau) = iface(&media[last - 1], &media[last]);
+    for j in (1..last).rev() {
+        let e1 = media[j].phase(wavelength_nm);
+        let e2 = e1 * e1;
+        let (r, t) = iface(&media[j - 1], &media[j]);
+        let den = 1.0 + r * rho * e2;
+        rho = (r + rho * e2) / den;
+        tau = t * tau * e1 / den;
+    }
+    (rho, tau)
+}
+
+/// Power R, T of a coherent group (media[0] and media[last] semi-infinite), Byrnes Eqs. 13–15.
+fn coherent_power(media: &[Medium], pol: Pol, wavelength_nm: f64) -> (f64, f64) {
+    let (r, t) = coherent_amplitudes(media, pol, wavelength_nm);
+    let top = media[0].flux(pol);
+    let bottom = media[media.len() - 1].flux(pol);
+    let tt = if top > 0.0 { t.norm_sqr() * bottom / top } else { 0.0 };
+    (r.norm_sqr(), tt.max(0.0))
+}
+
 /// Reflectance and transmittance of `layers` between a real incident medium `n_in` (light arrives at
 /// cos θ = `cos_i`) and an exit medium `n_out` (complex allowed), at `wavelength_nm`.
+///
+/// Angles: the tangential invariant n_in sin θ_in is real; in each medium n cos θ = √(n² − n_in² sin²θ_in)
+/// on the decaying/forward branch ([`complex_cos_transmitted`]).
+/// Coherent layers: [`coherent_amplitudes`] per polarisation (convention of
+/// [`crate::optics::fresnel::amplitudes`]), R = |ρ|², T = |τ|² Re(n_out cos θout)/(n_in cos θin) for s and
+/// |τ|² Re(n_out cos θout*)/(n_in cos θin) for p (Byrnes Eqs. 13–14). For an absorbing exit medium this is
+/// the power crossing the exit interface (it is then absorbed in the exit medium); R + T = 1 still holds for
+/// a single interface.
+/// Incoherent layers (`coherent == false`) split the stack into coherent groups between "incoherent media";
+/// each group gives power coefficients (Rf, Tf) from above and (Rb, Tb) from below, and the groups are
+/// combined from the exit upward with the one-pass power transmission of the incoherent layer
+/// P = |e^{iφ}|² = exp(−4π d Im(n cos θ)/λ) (≈ exp(−4π k d/(λ cos θ)) for weak absorption, Byrnes §3,
+/// Katsidis & Siapkas 2002): R = Rf + Tf Tb P² R′/(1 − Rb P² R′), T = Tf P T′/(1 − Rb P² R′), where R′, T′
+/// describe everything below the incoherent layer. This matches `tmm.inc_tmm`.
+/// Grazing incidence (cos_i ≤ 0) returns the limit R = 1, T = 0.
 pub fn stack(n_in: f64, layers: &[FilmLayer], n_out: Complex64, cos_i: f64, wavelength_nm: f64) -> StackResult {
-    let _ = (n_in, layers, n_out, cos_i, wavelength_nm);
-    todo!()
+    if cos_i <= 0.0 {
+        return StackResult { rs: 1.0, rp: 1.0, ts: 0.0, tp: 0.0 };
+    }
+    let cos_i = cos_i.min(1.0);
+    let n0 = Complex64::new(n_in, 0.0);
+    let c0 = Complex64::new(cos_i, 0.0);
+    let medium = |n: Complex64, d: f64| Medium { n, cos: complex_cos_transmitted(n0, c0, n), d };
+    let ambient = Medium { n: n0, cos: c0, d: 0.0 };
+    let exit = medium(n_out, 0.0);
+
+    // Split into groups: incoherent media M_0 = ambient, the incoherent layers, M_last = exit; between
+    // consecutive incoherent media a (possibly empty) list of coherent layers.
+    let mut inc_media = vec![ambient];
+    let mut groups: Vec<Vec<Medium>> = vec![Vec::new()];
+    for l in layers {
+        let m = medium(l.n, l.thickness_nm.max(0.0));
+        if l.coherent {
+            groups.last_mut().unwrap().push(m);
+        } else {
+            inc_media.push(m);
+            groups.push(Vec::new());
+        }
+    }
+    inc_media.push(exit);
+
+    let mut out = [(0.0, 0.0); 2];
+    for (slot, pol) in out.iter_mut().zip([Pol::S, Pol::P]) {
+        let full = |i: usize, reversed: bool| -> Vec<Medium> {
+            let mut v = Vec::with_capacity(groups[i].len() + 2);
+            let (mut top, mut bot) = (inc_media[i], inc_media[i + 1]);
+            top.d = 0.0;
+            bot.d = 0.0;
+            if reversed {
+                v.push(bot);
+                v.extend(groups[i].iter().rev().copied());
+                v.push(top);
+            } else {
+                v.push(top);
+                v.extend(groups[i].iter().copied());
+                v.push(bot);
+            }
+            v
+        };
+        let k = groups.len() - 1;
+        let (mut r_below, mut t_below) = coherent_power(&full(k, false), pol, wavelength_nm);
+        for i in (0..k).rev() {
+            let (rf, tf) = coherent_power(&full(i, false), pol, wavelength_nm);
+            if tf == 0.0 {
+                r_below = rf;
+                t_below = 0.0;
+                continue;
+            }
+            let (rb, tb) = coherent_power(&full(i, true), pol, wavelength_nm);
+            let p = inc_media[i + 1].phase(wavelength_nm).norm_sqr();
+            let loop_gain = rb * p * p * r_below;
+            let den = 1.0 - loop_gain;
+            let r = rf + tf * tb * p * p * r_below / den;
+            let t = tf * p * t_below / den;
+            r_below = r;
+            t_below = t;
+        }
+        *slot = (r_below, t_below);
+    }
+    StackResult { rs: out[0].0, rp: out[1].0, ts: out[0].1, tp: out[1].1 }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::optics::fresnel::{fresnel_conductor, fresnel_dielectric};
+
+    fn c(re: f64, im: f64) -> Complex64 {
+        Complex64::new(re, im)
+    }
+    fn coh(n: Complex64, d: f64) -> FilmLayer {
+        FilmLayer { n, thickness_nm: d, coherent: true }
+    }
+    fn inc(n: Complex64, d: f64) -> FilmLayer {
+        FilmLayer { n, thickness_nm: d, coherent: false }
+    }
+    fn angles() -> impl Iterator<Item = f64> {
+        [0.0, 20.0, 45.0, 60.0, 75.0, 85.0].into_iter().map(|d: f64| d.to_radians().cos())
+    }
+
+    /// Quarter-wave film at normal incidence (Born & Wolf §1.6.4, Eq. 1.6(62)):
+    /// R = ((n0 ns − n1²)/(n0 ns + n1²))²; zero for n1 = √(n0 ns). Fixes the phase as 2π n d/λ (the printed
+    /// 1π would make this a half-wave, absentee layer).
+    #[test]
+    fn quarter_wave_closed_form() {
+        for &(n0, n1, ns) in &[(1.0, 1.38, 1.52), (1.0, 2.3, 1.52), (1.5, 2.5, 1.58), (1.0, 1.52f64.sqrt(), 1.52)] {
+            let lambda = 550.0;
+            let d = lambda / (4.0 * n1);
+            let r = stack(n0, &[coh(c(n1, 0.0), d)], c(ns, 0.0), 1.0, lambda);
+            let want = ((n0 * ns - n1 * n1) / (n0 * ns + n1 * n1)).powi(2);
+            assert!((r.rs - want).abs() < 1e-14 && (r.rp - want).abs() < 1e-14, "{n1}: {r:?} vs {want}");
+            assert!((r.rs + r.ts - 1.0).abs() < 1e-14);
+        }
+    }
+
+    /// Absentee layer at oblique incidence: with d = λ / (2√(n1² − n0² sin²θ0)) (φ = π, the sin² inside the
+    /// root) the film is invisible and R equals the bare interface; thickness from the misprinted phase
+    /// (sin² outside the root) is not absentee.
+    #[test]
+    fn absentee_layer_fixes_phase_reading() {
+        let (n0, n1, ns, lambda) = (1.0, 2.0, 1.5, 600.0);
+        for deg in [30.0f64, 50.0, 70.0] {
+            let th = deg.to_radians();
+            let s2 = th.sin().powi(2);
+            let bare = fresnel_dielectric(th.cos(), ns / n0);
+            let d = lambda / (2.0 * (n1 * n1 - n0 * n0 * s2).sqrt());
+            let r = stack(n0, &[coh(c(n1, 0.0), d)], c(ns, 0.0), th.cos(), lambda);
+            assert!((r.rs - bare.rs).abs() < 1e-14 && (r.rp - bare.rp).abs() < 1e-14, "{deg}: {r:?} {bare:?}");
+            let d_misprint = lambda / (2.0 * (n1 * n1 - n0 * n0).sqrt() * s2);
+            let r2 = stack(n0, &[coh(c(n1, 0.0), d_misprint)], c(ns, 0.0), th.cos(), lambda);
+            assert!((r2.rs - bare.rs).abs() > 1e-3, "{deg}");
+        }
+    }
+
+    /// No layers: the single interface, equal to the Fresnel functions (dielectric and conductor exit);
+    /// R + T = 1 for a single interface also into an absorbing medium (the transmitted power is absorbed there).
+    #[test]
+    fn bare_interface_is_fresnel() {
+        for ci in angles() {
+            for &eta in &[1.5, 0.7] {
+                let r = stack(1.0, &[], c(eta, 0.0), ci, 500.0);
+                let f = fresnel_dielectric(ci, eta);
+                assert!((r.rs - f.rs).abs() < 1e-14 && (r.rp - f.rp).abs() < 1e-14);
+                assert!((r.ts - f.ts).abs() < 1e-14 && (r.tp - f.tp).abs() < 1e-14, "{eta} {ci} {r:?} {f:?}");
+            }
+            let m = c(0.2, 3.0);
+            let r = stack(1.0, &[], m, ci, 500.0);
+            let f = fresnel_conductor(ci, m);
+            assert!((r.rs - f.rs).abs() < 1e-14 && (r.rp - f.rp).abs() < 1e-14);
+            assert!((r.rs + r.ts - 1.0).abs() < 1e-14 && (r.rp + r.tp - 1.0).abs() < 1e-14, "{r:?}");
+        }
+    }
+
+    /// Zero-thickness coherent layers (of any index, absorbing too) change nothing.
+    #[test]
+    fn zero_thickness_layers_change_nothing() {
+        let base = [coh(c(2.5, 0.0), 120.0), coh(c(1.38, 0.0), 95.0)];
+        let with = [
+            coh(c(3.0, 0.5), 0.0),
+            coh(c(2.5, 0.0), 120.0),
+            coh(c(1.1, 0.0), 0.0),
+            coh(c(1.38, 0.0), 95.0),
+            coh(c(0.2, 3.0), 0.0),
+        ];
+        for ci in angles() {
+            for lambda in [400.0, 550.0, 700.0] {
+                let a = stack(1.0, &base, c(1.52, 0.0), ci, lambda);
+                let b = stack(1.0, &with, c(1.52, 0.0), ci, lambda);
+                for (x, y) in [(a.rs, b.rs), (a.rp, b.rp), (a.ts, b.ts), (a.tp, b.tp)] {
+                    assert!((x - y).abs() < 1e-13, "{a:?} {b:?}");
+                }
+            }
+        }
+    }
+
+    /// Energy conservation for lossless stacks at oblique incidence, s and p, coherent and incoherent, also
+    /// with total internal reflection at the exit (T = 0, R = 1) and frustrated TIR through a thin gap.
+    #[test]
+    fn lossless_r_plus_t_is_one() {
+        let stacks: Vec<(f64, Vec<FilmLayer>, f64)> = vec![
+            (1.0, vec![coh(c(2.5, 0.0), 100.0), coh(c(1.58, 0.0), 500.0), coh(c(2.5, 0.0), 100.0)], 1.5),
+            (1.5, vec![coh(c(2.5, 0.0), 80.0), inc(c(1.58, 0.0), 500.0), coh(c(2.5, 0.0), 80.0)], 1.5),
+            (1.0, vec![inc(c(1.5, 0.0), 1e6)], 1.0),
+            (1.5, vec![coh(c(1.0, 0.0), 200.0)], 1.5),      // frustrated TIR beyond 41.8°
+            (1.5, vec![coh(c(1.38, 0.0), 100.0)], 1.0),     // TIR at the exit beyond 41.8°
+            (1.0, vec![inc(c(2.0, 0.0), 2e4), coh(c(1.3, 0.0), 90.0), inc(c(1.7, 0.0), 5e4)], 1.45),
+        ];
+        for (n_in, layers, n_out) in &stacks {
+            for ci in angles() {
+                for lambda in [420.0, 555.0, 690.0] {
+                    let r = stack(*n_in, layers, c(*n_out, 0.0), ci, lambda);
+                    assert!((r.rs + r.ts - 1.0).abs() < 1e-13, "s {n_in} {layers:?} {ci} {r:?}");
+                    assert!((r.rp + r.tp - 1.0).abs() < 1e-13, "p {n_in} {layers:?} {ci} {r:?}");
+                }
+            }
+        }
+        // TIR at the exit: nothing is transmitted.
+        let r = stack(1.5, &[coh(c(1.38, 0.0), 100.0)], c(1.0, 0.0), 60f64.to_radians().cos(), 500.0);
+        assert!(r.ts == 0.0 && r.tp == 0.0 && (r.rs - 1.0).abs() < 1e-14);
+    }
+
+    /// Absorbing stacks lose energy: 0 < R + T < 1.
+    #[test]
+    fn absorbing_stack_absorbs() {
+        let layers = [coh(c(2.5, 0.01), 100.0), inc(c(1.58, 0.001), 500.0), coh(c(2.5, 0.01), 100.0)];
+        for ci in angles() {
+            let r = stack(1.5, &layers, c(1.5, 0.0), ci, 500.0);
+            assert!(r.rs + r.ts < 1.0 - 1e-6 && r.rp + r.tp < 1.0 - 1e-6 && r.r() > 0.0 && r.t() > 0.0);
+        }
+    }
+
+    /// A 1 mm incoherent slab of n = 1.5 in air: R = 2r/(1 + r) with r the single-interface reflectance (sum
+    /// of the incoherent multiple reflections), per polarisation, and T = (1 − r)/(1 + r).
+    #[test]
+    fn incoherent_slab() {
+        for ci in angles() {
+            let f = fresnel_dielectric(ci, 1.5);
+            let r = stack(1.0, &[inc(c(1.5, 0.0), 1e6)], c(1.0, 0.0), ci, 550.0);
+            assert!((r.rs - 2.0 * f.rs / (1.0 + f.rs)).abs() < 1e-14, "{ci} {r:?}");
+            assert!((r.rp - 2.0 * f.rp / (1.0 + f.rp)).abs() < 1e-14);
+            assert!((r.ts - (1.0 - f.rs) / (1.0 + f.rs)).abs() < 1e-14);
+        }
+        // normal incidence: r = 0.04 → R = 0.0769230769… (numerics-notes §3, tmm inc_tmm)
+        let r = stack(1.0, &[inc(c(1.5, 0.0), 1e6)], c(1.0, 0.0), 1.0, 550.0);
+        assert!((r.r() - 0.08 / 1.04).abs() < 1e-15);
+    }
+
+    /// Reciprocity of transmission (Stokes / Lorentz reciprocity, lossless and lossy coherent stacks between
+    /// real media): T(in → out) = T(out → in) for the reversed stack at the Snell-related angle.
+    #[test]
+    fn transmission_reciprocity() {
+        let layers = [coh(c(2.5, 0.05), 110.0), coh(c(1.58, 0.0), 300.0), coh(c(2.2, 0.0), 70.0)];
+        let rev: Vec<_> = layers.iter().rev().copied().collect();
+        let (n_in, n_out) = (1.0, 1.5);
+        for deg in [0.0f64, 30.0, 60.0, 80.0] {
+            let th = deg.to_radians();
+            let th_out = (n_in * th.sin() / n_out).asin();
+            let a = stack(n_in, &layers, c(n_out, 0.0), th.cos(), 520.0);
+            let b = stack(n_out, &rev, c(n_in, 0.0), th_out.cos(), 520.0);
+            assert!((a.ts - b.ts).abs() < 1e-13 && (a.tp - b.tp).abs() < 1e-13, "{deg}: {a:?} {b:?}");
+        }
+    }
+
+    /// A thick strongly absorbing layer (100 µm, k = 0.5 and k = 3): finite R and T, T underflows to 0 and R
+    /// is the reflectance of the semi-infinite absorbing medium (only decaying exponentials are formed).
+    #[test]
+    fn thick_absorbing_layer_is_stable() {
+        for m in [c(1.5, 0.5), c(0.2, 3.0)] {
+            for incoherent in [false, true] {
+                let l = FilmLayer { n: m, thickness_nm: 1e5, coherent: !incoherent };
+                for ci in angles() {
+                    let r = stack(1.0, &[l], c(1.5, 0.0), ci, 500.0);
+                    assert!(r.rs.is_finite() && r.rp.is_finite() && r.ts.is_finite() && r.tp.is_finite());
+                    assert!(r.ts < 1e-300 && r.tp < 1e-300);
+                    let f = fresnel_conductor(ci, m);
+                    assert!((r.rs - f.rs).abs() < 1e-14 && (r.rp - f.rp).abs() < 1e-14, "{r:?} {f:?}");
+                }
+            }
+        }
+    }
 }
