@@ -287,20 +287,25 @@ impl Paint {
         }
         let c = &spec.coat;
         check_range("clear coat index", c.index, 1.3, 1.8)?;
-        check_range("clear coat thickness (µm)", c.thickness_um, 0.0, f64::MAX)?;
+        check_range(
+            "clear coat thickness (µm)",
+            c.thickness_um,
+            0.0,
+            f64::INFINITY,
+        )?;
         check_range("clear coat roughness", c.roughness, 0.0, 1.0)?;
         let l = &spec.layer;
         check_range(
             "pigmented layer thickness (mm)",
             l.thickness_mm,
             0.0,
-            f64::MAX,
+            f64::INFINITY,
         )?;
         check_spectral("primer reflectance", &l.primer_reflectance, n, 0.0, 1.0)?;
         for p in &l.pigments {
-            check_range("pigment concentration", p.concentration, 0.0, f64::MAX)?;
-            check_spectral("pigment K (per mm)", &p.k_per_mm, n, 0.0, f64::MAX)?;
-            check_spectral("pigment S (per mm)", &p.s_per_mm, n, 0.0, f64::MAX)?;
+            check_range("pigment concentration", p.concentration, 0.0, f64::INFINITY)?;
+            check_spectral("pigment K (per mm)", &p.k_per_mm, n, 0.0, f64::INFINITY)?;
+            check_spectral("pigment S (per mm)", &p.s_per_mm, n, 0.0, f64::INFINITY)?;
         }
         let am = spec.metallic.as_ref().map_or(0.0, |m| m.area_ratio);
         let ap = spec.pearlescent.as_ref().map_or(0.0, |p| p.area_ratio);

@@ -21,11 +21,8 @@ pub const DEFAULT_TIO2_INDEX: f64 = 2.5;
 /// Default mica (muscovite) index: n ≈ 1.55–1.61 (CRC Handbook); Pfaff & Reynders, Chem. Rev. 99, 1963 (1999).
 pub const DEFAULT_MICA_INDEX: f64 = 1.58;
 
+/// Root fields of a paint recipe besides the descriptive ones (`crate::recipe::META_FIELDS`).
 const ROOT_FIELDS: &[&str] = &[
-    "model",
-    "name",
-    "description",
-    "notes",
     "form",
     "internal_reflection",
     "wavelengths_nm",
@@ -45,7 +42,12 @@ pub fn parse_paint(obj: &Obj) -> Result<Arc<dyn Brdf>> {
 
 /// Parse a paint recipe into its [`PaintSpec`] (validated field by field).
 pub fn parse_paint_spec(obj: &Obj) -> Result<PaintSpec> {
-    obj.deny_unknown(ROOT_FIELDS)?;
+    let allowed: Vec<&str> = crate::recipe::META_FIELDS
+        .iter()
+        .chain(ROOT_FIELDS)
+        .copied()
+        .collect();
+    obj.deny_unknown(&allowed)?;
     if let Some(m) = obj.opt_str("model")? {
         if m != "paint" {
             return Err(obj.err("model", format!("expected \"paint\", got \"{m}\"")));
@@ -53,6 +55,7 @@ pub fn parse_paint_spec(obj: &Obj) -> Result<PaintSpec> {
     }
     opt_string(obj, "name")?;
     opt_string(obj, "description")?;
+    opt_string(obj, "provenance")?;
     notes(obj)?;
     let form = match obj.opt_str("form")? {
         None | Some("physical") => Form::Physical,
@@ -127,7 +130,12 @@ fn parse_coat(o: &Obj) -> Result<ClearCoat> {
     notes(o)?;
     let index = o.num("index", 1.3, 1.8, "clear-coat refractive index")?;
     let thickness_um = o
-        .opt_num("thickness_um", 0.0, f64::MAX, "clear-coat thickness in µm")?
+        .opt_num(
+            "thickness_um",
+            0.0,
+            f64::INFINITY,
+            "clear-coat thickness in µm",
+        )?
         .unwrap_or(0.0);
     let roughness = o
         .opt_num(
@@ -137,17 +145,18 @@ fn parse_coat(o: &Obj) -> Result<ClearCoat> {
             "clear-coat roughness (Beckmann rms slope or GGX α; 0 = smooth)",
         )?
         .unwrap_or(0.0);
-    let distribution =
-        match o.opt_str("distribution")? {
-            None | Some("beckmann") => Distribution::Beckmann,
-            Some("ggx") => Distribution::Ggx,
-            Some(other) => return Err(o.err(
+    let distribution = match o.opt_str("distribution")? {
+        None | Some("beckmann") => Distribution::Beckmann,
+        Some("ggx") => Distribution::Ggx,
+        Some(other) => {
+            return Err(o.err(
                 "distribution",
                 format!(
                     "unknown distribution \"{other}\"; allowed: \"beckmann\" (default), \"ggx\""
                 ),
-            )),
-        };
+            ))
+        }
+    };
     Ok(ClearCoat {
         index,
         thickness_um,
@@ -162,7 +171,7 @@ fn parse_layer(o: &Obj, n: usize) -> Result<PigmentedLayer> {
     let thickness_mm = o.num(
         "thickness_mm",
         0.0,
-        f64::MAX,
+        f64::INFINITY,
         "pigmented-layer thickness X in mm",
     )?;
     let primer_reflectance = o.num_array(
@@ -195,7 +204,12 @@ fn parse_pigment(o: &Obj, n: usize, i: usize) -> Result<Pigment> {
     ])?;
     notes(o)?;
     let name = opt_string(o, "name")?.unwrap_or_else(|| format!("pigment {i}"));
-    let concentration = o.num("concentration", 0.0, f64::MAX, "pigment concentration C")?;
+    let concentration = o.num(
+        "concentration",
+        0.0,
+        f64::INFINITY,
+        "pigment concentration C",
+    )?;
     let has_ks = o.get("k_per_mm").is_some() || o.get("s_per_mm").is_some();
     let (k_per_mm, s_per_mm) = match (has_ks, o.opt_obj("measured")?) {
         (true, Some(_)) => {
@@ -211,8 +225,20 @@ fn parse_pigment(o: &Obj, n: usize, i: usize) -> Result<Pigment> {
             ));
         }
         (true, None) => (
-            o.num_array("k_per_mm", Some(n), 0.0, f64::MAX, "absorption K per mm")?,
-            o.num_array("s_per_mm", Some(n), 0.0, f64::MAX, "scattering S per mm")?,
+            o.num_array(
+                "k_per_mm",
+                Some(n),
+                0.0,
+                f64::INFINITY,
+                "absorption K per mm",
+            )?,
+            o.num_array(
+                "s_per_mm",
+                Some(n),
+                0.0,
+                f64::INFINITY,
+                "scattering S per mm",
+            )?,
         ),
         (false, Some(m)) => parse_measured(&m, n)?,
     };
@@ -237,7 +263,7 @@ fn parse_measured(m: &Obj, n: usize) -> Result<(Vec<f64>, Vec<f64>)> {
     let x = m.num(
         "thickness_mm",
         f64::MIN_POSITIVE,
-        f64::MAX,
+        f64::INFINITY,
         "drawdown thickness in mm (> 0)",
     )?;
     let rw = m.num_array(
@@ -348,7 +374,7 @@ fn parse_pearl(o: &Obj, x: f64) -> Result<PearlescentFlakes> {
 }
 
 fn depth(o: &Obj, x: f64, what: &str) -> Result<f64> {
-    let d = o.num("depth_mm", 0.0, f64::MAX, what)?;
+    let d = o.num("depth_mm", 0.0, f64::INFINITY, what)?;
     if d > x {
         return Err(o.err(
             "depth_mm",

@@ -1,0 +1,1150 @@
+//! Tests of the paint model (src/brdf/paint.rs, docs/model.md): fixtures, energy conservation, reciprocity,
+//! closed-form limits, the delta switch of the flakes, the corrections to the paper, and recipe errors.
+//!
+//! Independent references used here (not the crate's optics): the Fresnel equations written out from the
+//! amplitudes of the paper's §5.1, Snell's law, Simpson's rule, and Kubelka–Munk's Eq. (3)/(4) transcribed.
+use glossmeter::brdf::albedo::directional_albedo;
+use glossmeter::brdf::paint::{
+    internal_diffuse_reflectance, ClearCoat, Form, MetallicFlakes, Paint, PaintSpec,
+    PearlescentFlakes, Pigment, PigmentedLayer, MAX_SAMPLES,
+};
+use glossmeter::brdf::{Brdf, TermKind};
+use glossmeter::optics::microfacet::Distribution;
+use glossmeter::optics::thin_film::{stack, FilmLayer};
+use glossmeter::recipe::fields::{parse_json, Obj};
+use glossmeter::recipe::paint::parse_paint;
+use glossmeter::spectrum::Sampling;
+use glossmeter::Vec3;
+use num_complex::Complex64;
+use proptest::prelude::*;
+use serde_json::{json, Value};
+use std::f64::consts::PI;
+use std::sync::Arc;
+
+// ---------------------------------------------------------------------------------------------------------
+// Helpers
+// ---------------------------------------------------------------------------------------------------------
+
+const FIXTURES: [&str; 3] = ["cerulean-blue-a", "cerulean-blue-b", "cerulean-blue-c"];
+
+fn fixture_json(name: &str) -> Value {
+    let file = format!(
+        "{}/fixtures/recipes/{name}.json",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let text = std::fs::read_to_string(&file).unwrap();
+    parse_json(&text, &file).unwrap()
+}
+
+fn from_json(v: &Value) -> glossmeter::Result<Arc<dyn Brdf>> {
+    let obj = Obj::new("test.json", "", v)?;
+    parse_paint(&obj)
+}
+
+fn load(name: &str) -> Arc<dyn Brdf> {
+    from_json(&fixture_json(name)).unwrap()
+}
+
+fn dir(theta_deg: f64, phi_deg: f64) -> Vec3 {
+    let (t, p) = (theta_deg.to_radians(), phi_deg.to_radians());
+    Vec3::new(t.sin() * p.cos(), t.sin() * p.sin(), t.cos())
+}
+
+fn eval(b: &dyn Brdf, wi: Vec3, wo: Vec3) -> Vec<f64> {
+    let mut out = vec![f64::NAN; b.sampling().len()];
+    b.eval(wi, wo, &mut out);
+    out
+}
+
+/// Unpolarised Fresnel reflectance of a dielectric interface written out from the paper's §5.1 amplitudes
+/// (η1 = 1, η2 = eta; eta < 1 for light leaving the coat, with total internal reflection).
+fn fresnel_r(cos_i: f64, eta: f64) -> f64 {
+    let sin2_t = (1.0 - cos_i * cos_i) / (eta * eta);
+    if sin2_t >= 1.0 {
+        return 1.0;
+    }
+    let cos_t = (1.0 - sin2_t).sqrt();
+    let rs = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
+    let rp = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
+    0.5 * (rs * rs + rp * rp)
+}
+
+fn fresnel_t(cos_i: f64, eta: f64) -> f64 {
+    1.0 - fresnel_r(cos_i, eta)
+}
+
+/// Composite Simpson's rule on [a, b] with `n` (even) intervals.
+fn simpson(f: impl Fn(f64) -> f64, a: f64, b: f64, n: usize) -> f64 {
+    let h = (b - a) / n as f64;
+    let mut s = f(a) + f(b);
+    for i in 1..n {
+        s += f(a + i as f64 * h) * if i % 2 == 1 { 4.0 } else { 2.0 };
+    }
+    s * h / 3.0
+}
+
+/// r_e = ∫₀¹ F(μ) 2μ dμ by Simpson's rule with the test's own Fresnel equations.
+fn r_e_simpson(eta: f64) -> f64 {
+    simpson(|mu| fresnel_r(mu, eta) * 2.0 * mu, 0.0, 1.0, 20_000)
+}
+
+/// Snell refraction into the coat (same azimuth, sin θ' = sin θ / η).
+fn refract_in(w: Vec3, eta: f64) -> Vec3 {
+    let (x, y) = (w.x / eta, w.y / eta);
+    Vec3::new(x, y, (1.0 - x * x - y * y).sqrt())
+}
+
+/// Snell refraction out of the coat; None beyond the critical angle.
+fn refract_out(w: Vec3, eta: f64) -> Option<Vec3> {
+    let (x, y) = (w.x * eta, w.y * eta);
+    let s2 = x * x + y * y;
+    (s2 < 1.0).then(|| Vec3::new(x, y, (1.0 - s2).sqrt()))
+}
+
+/// Adaptive Simpson quadrature of a vector integrand on [a, b]: adds the integral to `sum`, the error
+/// estimate (|S₂ − S₁|/15, maximum over the components) to `err`.
+#[allow(clippy::too_many_arguments)]
+fn adapt(
+    f: &dyn Fn(f64) -> Vec<f64>,
+    a: f64,
+    b: f64,
+    fa: &[f64],
+    fm: &[f64],
+    fb: &[f64],
+    whole: &[f64],
+    tol: f64,
+    depth: u32,
+    sum: &mut [f64],
+    err: &mut f64,
+) {
+    let m = 0.5 * (a + b);
+    let (lm, rm) = (0.5 * (a + m), 0.5 * (m + b));
+    let (flm, frm) = (f(lm), f(rm));
+    let h = (b - a) / 12.0;
+    let left: Vec<f64> = (0..sum.len())
+        .map(|k| h * (fa[k] + 4.0 * flm[k] + fm[k]))
+        .collect();
+    let right: Vec<f64> = (0..sum.len())
+        .map(|k| h * (fm[k] + 4.0 * frm[k] + fb[k]))
+        .collect();
+    let diff = (0..sum.len())
+        .map(|k| (left[k] + right[k] - whole[k]).abs())
+        .fold(0.0, f64::max);
+    if depth == 0 || diff <= 15.0 * tol {
+        for k in 0..sum.len() {
+            let lr = left[k] + right[k];
+            sum[k] += lr + (lr - whole[k]) / 15.0;
+        }
+        *err += diff / 15.0;
+    } else {
+        adapt(f, a, m, fa, &flm, fm, &left, 0.5 * tol, depth - 1, sum, err);
+        adapt(
+            f,
+            m,
+            b,
+            fm,
+            &frm,
+            fb,
+            &right,
+            0.5 * tol,
+            depth - 1,
+            sum,
+            err,
+        );
+    }
+}
+
+fn integrate(f: &dyn Fn(f64) -> Vec<f64>, breaks: &[f64], tol: f64, n: usize) -> (Vec<f64>, f64) {
+    let mut sum = vec![0.0; n];
+    let mut err = 0.0;
+    let panels = (breaks.len() - 1) as f64;
+    for w in breaks.windows(2) {
+        let (a, b) = (w[0], w[1]);
+        let m = 0.5 * (a + b);
+        let (fa, fm, fb) = (f(a), f(m), f(b));
+        let whole: Vec<f64> = (0..n)
+            .map(|k| (b - a) / 6.0 * (fa[k] + 4.0 * fm[k] + fb[k]))
+            .collect();
+        adapt(
+            f,
+            a,
+            b,
+            &fa,
+            &fm,
+            &fb,
+            &whole,
+            tol / panels,
+            30,
+            &mut sum,
+            &mut err,
+        );
+    }
+    (sum, err)
+}
+
+/// Directional albedo a(ωi) = ∫ f cos θo dωo + R_δ of a paint under a coat of index `eta`, integrated in the
+/// *interior* half-vector coordinates where every flake lobe is centred on the normal (independent of the
+/// crate's albedo integrator): ωo' = 2(ωi'·h)h − ωi', ωo = refract_out(ωo'), and
+/// cos θo dωo = η² cos θo' dωo' (étendue n² cos θ dω is conserved), dωo' = 4 (ωi'·h) dωh,
+/// dωh = sin θh dθh dφ. Radial panels start at a quarter of the narrowest lobe width `width` and double.
+/// Returns (albedo per sample, error estimate). `wi` must lie in the x–z plane (φ-symmetry is used).
+fn albedo_interior(b: &dyn Brdf, eta: f64, wi: Vec3, width: f64, tol: f64) -> (Vec<f64>, f64) {
+    let n = b.sampling().len();
+    let wi_in = refract_in(wi, eta);
+    let inner = |phi: f64| -> Vec<f64> {
+        let g = |th: f64| -> Vec<f64> {
+            let h = Vec3::new(th.sin() * phi.cos(), th.sin() * phi.sin(), th.cos());
+            let c = wi_in.dot(h);
+            let mut v = vec![0.0; n];
+            if c <= 0.0 {
+                return v;
+            }
+            let wo_in = 2.0 * c * h - wi_in;
+            if wo_in.z <= 0.0 {
+                return v;
+            }
+            let Some(wo) = refract_out(wo_in, eta) else {
+                return v;
+            };
+            b.eval(wi, wo, &mut v);
+            let jac = eta * eta * wo_in.z * 4.0 * c * th.sin();
+            v.iter_mut().for_each(|x| *x *= jac);
+            v
+        };
+        let mut breaks = vec![0.0];
+        let mut s = 0.25 * width;
+        while s.atan() < 1.2 {
+            breaks.push(s.atan());
+            s *= 2.0;
+        }
+        breaks.push(0.5 * PI);
+        integrate(&g, &breaks, tol, n).0
+    };
+    let phis: Vec<f64> = (0..=8).map(|i| PI * i as f64 / 8.0).collect();
+    let (mut a, err) = integrate(&inner, &phis, tol, n);
+    a.iter_mut().for_each(|x| *x *= 2.0); // φ ∈ [0, π] by symmetry about the plane of incidence
+    let mut d = vec![0.0; n];
+    if b.delta_reflectance(wi, &mut d) {
+        a.iter_mut().zip(&d).for_each(|(x, y)| *x += y);
+    }
+    (a, 2.0 * err)
+}
+
+fn rgb_spec(eta: f64, x: f64, rg: [f64; 3], k: [f64; 3], s: [f64; 3]) -> PaintSpec {
+    PaintSpec {
+        sampling: Sampling::rgb(),
+        coat: ClearCoat {
+            index: eta,
+            thickness_um: 20.0,
+            roughness: 0.0,
+            distribution: Distribution::Beckmann,
+        },
+        layer: PigmentedLayer {
+            thickness_mm: x,
+            primer_reflectance: rg.to_vec(),
+            pigments: vec![Pigment {
+                name: "p".into(),
+                concentration: 1.0,
+                k_per_mm: k.to_vec(),
+                s_per_mm: s.to_vec(),
+            }],
+        },
+        metallic: None,
+        pearlescent: None,
+        form: Form::Physical,
+        internal_reflection: true,
+    }
+}
+
+fn metal(spread_deg: f64, area: f64, depth: f64) -> MetallicFlakes {
+    MetallicFlakes {
+        n: vec![0.93; 3],
+        k: vec![6.33; 3],
+        spread_deg,
+        area_ratio: area,
+        depth_mm: depth,
+    }
+}
+
+fn pearl(spread_deg: f64, area: f64, depth: f64) -> PearlescentFlakes {
+    PearlescentFlakes {
+        spread_deg,
+        area_ratio: area,
+        depth_mm: depth,
+        tio2_thickness_nm: 135.0,
+        tio2_index: 2.5,
+        mica_thickness_nm: 400.0,
+        mica_index: 1.58,
+    }
+}
+
+/// Kubelka–Munk R∞ (paper Eq. 4) transcribed.
+fn r_inf(k: f64, s: f64) -> f64 {
+    let a = k / s;
+    1.0 + a - (a * a + 2.0 * a).sqrt()
+}
+
+/// Paper Eq. (3) with its first factor as printed (`printed = true`: (1 − R∞)) or corrected (1/R∞).
+fn km_eq3(k: f64, s: f64, x: f64, rg: f64, printed: bool) -> f64 {
+    let ri = r_inf(k, s);
+    let e = (s * x * (1.0 / ri - ri)).exp();
+    let first = if printed { 1.0 - ri } else { 1.0 / ri };
+    (first * (rg - ri) - ri * (rg - 1.0 / ri) * e) / ((rg - ri) - (rg - 1.0 / ri) * e)
+}
+
+fn rel(a: f64, b: f64) -> f64 {
+    (a - b).abs() / a.abs().max(b.abs()).max(1e-300)
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// Fixtures
+// ---------------------------------------------------------------------------------------------------------
+
+#[test]
+fn fixtures_load_and_evaluate_finite_non_negative_values() {
+    for name in FIXTURES {
+        let b = load(name);
+        assert_eq!(b.sampling().len(), 3, "{name}: RGB sampling");
+        for ti in (0..90).step_by(7) {
+            for to in (0..90).step_by(11) {
+                for po in [0.0, 37.0, 90.0, 180.0, 271.0] {
+                    let (wi, wo) = (dir(ti as f64, 0.0), dir(to as f64, po));
+                    let f = eval(&*b, wi, wo);
+                    assert!(
+                        f.iter().all(|v| v.is_finite() && *v >= 0.0),
+                        "{name} {ti} {to} {po}: {f:?}"
+                    );
+                }
+                // Exactly at the specular direction too (the flake lobes peak there).
+                let f = eval(&*b, dir(ti as f64, 0.0), dir(ti as f64, 180.0));
+                assert!(
+                    f.iter().all(|v| v.is_finite() && *v >= 0.0),
+                    "{name} specular {ti}: {f:?}"
+                );
+            }
+        }
+        let mut d = [f64::NAN; 3];
+        assert!(
+            b.delta_reflectance(dir(60.0, 0.0), &mut d),
+            "{name}: a smooth coat has a delta"
+        );
+        assert!(
+            (d[0] - fresnel_r(60f64.to_radians().cos(), 1.5)).abs() < 1e-12,
+            "{name}: delta = coat Fresnel"
+        );
+        assert!(b.is_reciprocal());
+    }
+}
+
+#[test]
+fn fixture_terms_list_only_what_the_recipe_has() {
+    let labels = |n: &str| {
+        load(n)
+            .terms()
+            .into_iter()
+            .map(|t| t.label)
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(
+        labels("cerulean-blue-a"),
+        [
+            "clear coat (Fresnel, delta)",
+            "pigmented layer (Kubelka–Munk, diffuse)"
+        ]
+    );
+    assert_eq!(
+        labels("cerulean-blue-b"),
+        [
+            "clear coat (Fresnel, delta)",
+            "pigmented layer (Kubelka–Munk, diffuse)",
+            "metallic flakes"
+        ]
+    );
+    assert_eq!(
+        labels("cerulean-blue-c"),
+        [
+            "clear coat (Fresnel, delta)",
+            "pigmented layer (Kubelka–Munk, diffuse)",
+            "metallic flakes",
+            "pearlescent flakes"
+        ]
+    );
+    let c = load("cerulean-blue-c");
+    let lobes = c.lobes();
+    assert_eq!(lobes.len(), 2);
+    assert!((lobes[0].slope_width - 0.25f64.to_radians().tan()).abs() < 1e-15);
+    assert!((lobes[1].slope_width - 0.35f64.to_radians().tan()).abs() < 1e-15);
+    assert!(lobes.iter().all(|l| l.medium_eta == 1.5));
+}
+
+#[test]
+fn fixture_a_body_is_the_closed_form() {
+    // f = T(θi) T(θo) R_l / (π η² (1 − r_i R_l)) with R_l from the corrected Eq. (3) written out here.
+    let b = load("cerulean-blue-a");
+    let (k, s) = ([1.52, 0.32, 0.25], [0.06, 0.25, 0.4]);
+    let r_i = 1.0 - (1.0 - r_e_simpson(1.5)) / 2.25;
+    for (ti, to, po) in [
+        (0.0, 0.0, 0.0),
+        (20.0, 45.0, 90.0),
+        (60.0, 10.0, 200.0),
+        (85.0, 85.0, 180.0),
+    ] {
+        let (wi, wo) = (dir(ti, 0.0), dir(to, po));
+        let f = eval(&*b, wi, wo);
+        let tt = fresnel_t(wi.z, 1.5) * fresnel_t(wo.z, 1.5);
+        for j in 0..3 {
+            let r_l = km_eq3(0.4 * k[j], 0.4 * s[j], 0.15, 0.7, false);
+            let want = tt * r_l / (PI * 2.25 * (1.0 - r_i * r_l));
+            assert!(
+                rel(f[j], want) < 1e-9,
+                "({ti},{to},{po}) sample {j}: {} vs {want}",
+                f[j]
+            );
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// Energy conservation (white furnace)
+// ---------------------------------------------------------------------------------------------------------
+
+#[test]
+fn white_furnace_fixtures_physical_form() {
+    for name in FIXTURES {
+        let b = load(name);
+        let width = b.lobes().iter().map(|l| l.slope_width).fold(0.05, f64::min);
+        for ti in (0..90).step_by(4).chain([89]) {
+            let wi = dir(ti as f64, 0.0);
+            let (a, err) = albedo_interior(&*b, 1.5, wi, width, 1e-7);
+            for (j, v) in a.iter().enumerate() {
+                assert!(
+                    *v <= 1.0 + err + 1e-9,
+                    "{name} θi = {ti}° sample {j}: albedo {v} ± {err}"
+                );
+                assert!(*v > 0.0);
+            }
+        }
+    }
+}
+
+#[test]
+fn white_furnace_agrees_with_crate_albedo_integrator() {
+    // Cross-check of two independent quadratures (exterior half vectors vs interior half vectors).
+    for name in FIXTURES {
+        let b = load(name);
+        let width = b.lobes().iter().map(|l| l.slope_width).fold(0.05, f64::min);
+        for ti in [0.0, 30.0, 60.0, 80.0] {
+            let wi = dir(ti, 0.0);
+            let (mine, err) = albedo_interior(&*b, 1.5, wi, width, 1e-8);
+            let (theirs, err2) = directional_albedo(&*b, wi);
+            for j in 0..3 {
+                assert!(
+                    theirs[j] <= 1.0 + err2 + 1e-9,
+                    "{name} {ti}: crate albedo {} ± {err2}",
+                    theirs[j]
+                );
+                assert!(
+                    (mine[j] - theirs[j]).abs() < 1e-5 + err + err2,
+                    "{name} θi {ti} sample {j}: {} vs {} (± {err}, {err2})",
+                    mine[j],
+                    theirs[j]
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn white_furnace_body_term_matches_saunderson_closed_form() {
+    // Am = Ap = 0: the albedo is ρ(θi) + T(θi)·R_l(1 − r_i)/(1 − r_i R_l) exactly (docs/model.md §Energy).
+    let spec = rgb_spec(1.5, 0.2, [0.9, 0.5, 1.0], [0.0, 3.0, 0.0], [40.0, 2.0, 0.0]);
+    let p = Paint::new(spec).unwrap();
+    let r_l = p.pigmented_reflectance().to_vec();
+    let r_i = p.internal_diffuse_reflectance();
+    for ti in [0.0, 45.0, 75.0, 89.0] {
+        let wi = dir(ti, 0.0);
+        let (a, err) = albedo_interior(&p, 1.5, wi, 0.05, 1e-9);
+        for j in 0..3 {
+            let want = fresnel_r(wi.z, 1.5)
+                + fresnel_t(wi.z, 1.5) * r_l[j] * (1.0 - r_i) / (1.0 - r_i * r_l[j]);
+            assert!(
+                (a[j] - want).abs() < 1e-6 + err,
+                "θi {ti} sample {j}: {} vs {want}",
+                a[j]
+            );
+        }
+    }
+    // A white body (R_l = 1) under the coat is a white furnace: albedo exactly 1.
+    let white = Paint::new(rgb_spec(1.5, 0.0, [1.0; 3], [0.0; 3], [0.0; 3])).unwrap();
+    for ti in [0.0, 50.0, 85.0] {
+        let (a, err) = albedo_interior(&white, 1.5, dir(ti, 0.0), 0.05, 1e-9);
+        assert!(
+            a.iter().all(|v| (v - 1.0).abs() < 1e-6 + err),
+            "θi {ti}: {a:?}"
+        );
+    }
+}
+
+#[test]
+fn rough_coat_energy_and_reciprocity() {
+    // The rough coat uses smooth-interface transmittances at the macroscopic angles (an approximation,
+    // docs/model.md): check that it still conserves energy for the coats and roughnesses of interest.
+    for (dist, alpha) in [
+        (Distribution::Beckmann, 0.05),
+        (Distribution::Beckmann, 0.3),
+        (Distribution::Ggx, 0.1),
+    ] {
+        let mut spec = rgb_spec(1.5, 0.0, [1.0; 3], [0.0; 3], [0.0; 3]);
+        spec.coat.roughness = alpha;
+        spec.coat.distribution = dist;
+        let p = Paint::new(spec).unwrap();
+        assert!(!p.delta_reflectance(dir(30.0, 0.0), &mut [0.0; 3]));
+        assert_eq!(
+            p.terms()[0].kind,
+            TermKind::Lobe(glossmeter::brdf::Lobe {
+                slope_width: alpha,
+                medium_eta: 1.0,
+                label: "clear coat".into()
+            })
+        );
+        for ti in [0.0, 30.0, 60.0, 80.0, 89.0] {
+            let (a, err) = directional_albedo(&p, dir(ti, 0.0));
+            assert!(
+                a.iter().all(|v| *v <= 1.0 + err + 1e-9),
+                "{dist:?} {alpha} θi {ti}: {a:?} ± {err}"
+            );
+        }
+        let (wi, wo) = (dir(35.0, 10.0), dir(70.0, 200.0));
+        let (f, g) = (eval(&p, wi, wo), eval(&p, wo, wi));
+        assert!(rel(f[0], g[0]) < 1e-12);
+    }
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// Randomised recipes: energy and reciprocity
+// ---------------------------------------------------------------------------------------------------------
+
+#[derive(Debug, Clone)]
+struct Random {
+    spec: PaintSpec,
+}
+
+fn random_spec() -> impl Strategy<Value = Random> {
+    let arr = |lo: f64, hi: f64| prop::array::uniform3(lo..hi);
+    (
+        1.3f64..1.8,
+        0f64..1.0,
+        arr(0.0, 1.0),
+        arr(0.0, 1e3),
+        arr(0.0, 1e3),
+        (
+            0f64..1.0,
+            0f64..1.0,
+            0.1f64..20.0,
+            0.1f64..20.0,
+            0f64..1.0,
+            0f64..1.0,
+        ),
+        (
+            0.1f64..3.0,
+            0f64..8.0,
+            0f64..300.0,
+            1.8f64..2.9,
+            any::<bool>(),
+        ),
+    )
+        .prop_map(
+            |(eta, x, rg, k, s, (am, ap_frac, sm, sp, dm, dp), (n, kk, tio2, tio2_n, ir))| {
+                let mut spec = rgb_spec(eta, x, rg, k, s);
+                let ap = (1.0 - am) * ap_frac; // Am + Ap ≤ 1
+                spec.metallic = Some(MetallicFlakes {
+                    n: vec![n; 3],
+                    k: vec![kk; 3],
+                    ..metal(sm, am, dm * x)
+                });
+                spec.pearlescent = Some(PearlescentFlakes {
+                    tio2_thickness_nm: tio2,
+                    tio2_index: tio2_n,
+                    ..pearl(sp, ap, dp * x)
+                });
+                spec.internal_reflection = ir;
+                Random { spec }
+            },
+        )
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 24, ..ProptestConfig::default() })]
+
+    #[test]
+    fn random_recipes_conserve_energy(r in random_spec(), ti in 0f64..89.5) {
+        let eta = r.spec.coat.index;
+        let p = Paint::new(r.spec).unwrap();
+        let width = p.terms().iter().filter_map(|t| match &t.kind { TermKind::Lobe(l) => Some(l.slope_width), _ => None })
+            .fold(0.05, f64::min);
+        let (a, err) = albedo_interior(&p, eta, dir(ti, 0.0), width, 1e-6);
+        for v in &a {
+            prop_assert!(*v <= 1.0 + err + 1e-9, "albedo {} ± {} at θi {}", v, err, ti);
+        }
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 256, ..ProptestConfig::default() })]
+
+    #[test]
+    fn random_recipes_are_reciprocal(r in random_spec(), ti in 0f64..89.9, pi in 0f64..360.0,
+                                     to in 0f64..89.9, po in 0f64..360.0, near in any::<bool>()) {
+        let p = Paint::new(r.spec).unwrap();
+        prop_assert!(p.is_reciprocal());
+        let wi = dir(ti, pi);
+        // Half of the cases close to the specular direction, where the flake lobes are.
+        let wo = if near { dir(ti + 0.01 * (to - 45.0) / 45.0, pi + 180.0 + 0.02 * (po - 180.0) / 180.0) } else { dir(to, po) };
+        let wo = if wo.z <= 0.0 { dir(to, po) } else { wo };
+        let (f, g) = (eval(&p, wi, wo), eval(&p, wo, wi));
+        for j in 0..3 {
+            prop_assert!(f[j].is_finite() && f[j] >= 0.0);
+            prop_assert!((f[j] - g[j]).abs() <= 1e-10 * f[j].abs().max(g[j].abs()) + 1e-300, "{} vs {}", f[j], g[j]);
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// Limits and closed forms
+// ---------------------------------------------------------------------------------------------------------
+
+#[test]
+fn bare_primer_under_the_coat_is_the_closed_form() {
+    // Am = Ap = 0, X = 0: a Lambertian body of albedo Rg under the coat,
+    // f = T(θi) T(θo) Rg S / (π η²), S = 1 / (1 − r_i Rg).
+    for eta in [1.3, 1.5, 1.8] {
+        let rg = [0.05, 0.5, 0.97];
+        let p = Paint::new(rgb_spec(eta, 0.0, rg, [5.0, 1.0, 0.0], [3.0, 0.0, 20.0])).unwrap();
+        let r_i = 1.0 - (1.0 - r_e_simpson(eta)) / (eta * eta);
+        assert!(
+            (p.internal_diffuse_reflectance() - r_i).abs() < 1e-10,
+            "η {eta}: r_i"
+        );
+        for (ti, to, po) in [(0.0, 0.0, 0.0), (33.0, 71.0, 123.0), (80.0, 5.0, 180.0)] {
+            let (wi, wo) = (dir(ti, 0.0), dir(to, po));
+            let f = eval(&p, wi, wo);
+            for j in 0..3 {
+                let want = fresnel_t(wi.z, eta) * fresnel_t(wo.z, eta) * rg[j]
+                    / (1.0 - r_i * rg[j])
+                    / (PI * eta * eta);
+                assert!(
+                    rel(f[j], want) < 1e-9,
+                    "η {eta} ({ti},{to},{po}) {j}: {} vs {want}",
+                    f[j]
+                );
+            }
+        }
+        // Without the Saunderson factor: S = 1.
+        let mut spec = rgb_spec(eta, 0.0, rg, [0.0; 3], [0.0; 3]);
+        spec.internal_reflection = false;
+        let p = Paint::new(spec).unwrap();
+        let (wi, wo) = (dir(20.0, 0.0), dir(50.0, 90.0));
+        let f = eval(&p, wi, wo);
+        let want = fresnel_t(wi.z, eta) * fresnel_t(wo.z, eta) * rg[1] / (PI * eta * eta);
+        assert!(rel(f[1], want) < 1e-12);
+    }
+}
+
+#[test]
+fn internal_diffuse_reflectance_identity_and_literature_value() {
+    // r_i computed directly (diffuse light inside hitting the coat–air interface, TIR beyond the critical
+    // angle) equals 1 − (1 − r_e)/η²; for η = 1.5 it is the classic 0.596 (Judd 1942), r_e ≈ 0.092.
+    for eta in [1.3f64, 1.5, 1.8] {
+        let mu_c = (1.0 - 1.0 / (eta * eta)).sqrt();
+        let direct =
+            simpson(|mu| fresnel_r(mu, 1.0 / eta) * 2.0 * mu, mu_c, 1.0, 20_000) + mu_c * mu_c;
+        let via_re = internal_diffuse_reflectance(eta);
+        assert!(
+            (direct - via_re).abs() < 1e-7,
+            "η {eta}: {direct} vs {via_re}"
+        );
+        let p = Paint::new(rgb_spec(eta, 0.1, [0.5; 3], [1.0; 3], [1.0; 3])).unwrap();
+        assert!(
+            (p.external_diffuse_reflectance() - r_e_simpson(eta)).abs() < 1e-11,
+            "η {eta}: r_e"
+        );
+    }
+    assert!((r_e_simpson(1.5) - 0.0918).abs() < 1e-3);
+    assert!((internal_diffuse_reflectance(1.5) - 0.596).abs() < 1e-3);
+}
+
+#[test]
+fn infinitely_thick_layer_gives_r_infinity() {
+    let (k, s) = ([0.3, 2.0, 1e-3], [5.0, 1.0, 0.7]);
+    let p = Paint::new(rgb_spec(1.5, 1e5, [0.0, 0.5, 1.0], k, s)).unwrap();
+    let r_i = p.internal_diffuse_reflectance();
+    let (wi, wo) = (dir(10.0, 0.0), dir(40.0, 30.0));
+    let f = eval(&p, wi, wo);
+    let tt = fresnel_t(wi.z, 1.5) * fresnel_t(wo.z, 1.5);
+    for j in 0..3 {
+        let want = r_inf(k[j], s[j]);
+        assert!(rel(p.pigmented_reflectance()[j], want) < 1e-9, "sample {j}");
+        assert!(rel(f[j], tt * want / (1.0 - r_i * want) / (PI * 2.25)) < 1e-9);
+    }
+}
+
+#[test]
+fn corrected_eq3_is_the_models_layer_and_the_printed_one_fails_at_zero_thickness() {
+    // Printed Eq. (3) with (1 − R∞) does not return Rg for X = 0; with 1/R∞ it does (and R∞ as X → ∞).
+    for (k, s, rg) in [(0.6, 0.024, 0.7), (0.128, 0.1, 0.7), (0.1, 0.16, 0.2)] {
+        assert!((km_eq3(k, s, 0.0, rg, false) - rg).abs() < 1e-12);
+        assert!(
+            (km_eq3(k, s, 0.0, rg, true) - rg).abs() > 1e-2,
+            "printed Eq. 3 at X = 0"
+        );
+        assert!((km_eq3(k, s, 200.0, rg, false) - r_inf(k, s)).abs() < 1e-9);
+    }
+    let p = Paint::new(rgb_spec(
+        1.5,
+        0.15,
+        [0.7; 3],
+        [0.608, 0.128, 0.1],
+        [0.024, 0.1, 0.16],
+    ))
+    .unwrap();
+    for j in 0..3 {
+        let want = km_eq3(
+            [0.608, 0.128, 0.1][j],
+            [0.024, 0.1, 0.16][j],
+            0.15,
+            0.7,
+            false,
+        );
+        assert!(rel(p.pigmented_reflectance()[j], want) < 1e-10);
+    }
+}
+
+#[test]
+fn corrected_eq2_transmittance_conserves_energy_and_the_printed_ratio_does_not() {
+    // τ = η2 cos θt / (η1 cos θi) · ½(|t⊥|² + |t∥|²) gives ρ + τ = 1; the printed inverse ratio does not.
+    let eta = 1.5;
+    for deg in [10.0f64, 40.0, 70.0, 85.0] {
+        let ci = deg.to_radians().cos();
+        let ct = (1.0 - (1.0 - ci * ci) / (eta * eta)).sqrt();
+        let ts = 2.0 * ci / (ci + eta * ct);
+        let tp = 2.0 * ci / (eta * ci + ct);
+        let tt = 0.5 * (ts * ts + tp * tp);
+        let corrected = eta * ct / ci * tt;
+        let printed = eta * ci / ct * tt;
+        let rho = fresnel_r(ci, eta);
+        assert!((rho + corrected - 1.0).abs() < 1e-13, "{deg}°");
+        assert!(
+            (rho + printed - 1.0).abs() > 1e-3,
+            "{deg}°: printed ratio conserves energy?"
+        );
+        let crate_t = glossmeter::optics::fresnel::fresnel_dielectric(ci, eta).t();
+        assert!((crate_t - corrected).abs() < 1e-13);
+    }
+}
+
+#[test]
+fn thin_film_phase_is_two_pi_n_d_cos_over_lambda() {
+    // Eq. (6): φ = (2π d/λ)·sqrt(η_j² − η_{j−1}² sin²θ_{j−1}) = 2π η_j d cos θ_j / λ. A film in a symmetric
+    // surrounding is absent (reflects nothing) when 2φ = 2π, i.e. d = λ/(2 η_j cos θ_j), at any angle. With
+    // the printed "1π" (or the sin² outside the root) this thickness would be a quarter-wave maximum instead.
+    let (n_film, n_med, lambda): (f64, f64, f64) = (2.5, 1.5, 546.1);
+    for deg in [0.0f64, 30.0, 60.0] {
+        let ci = deg.to_radians().cos();
+        let sin2_film = (n_med / n_film).powi(2) * (1.0 - ci * ci);
+        let cos_film = (1.0 - sin2_film).sqrt();
+        let d = lambda / (2.0 * n_film * cos_film);
+        let film = FilmLayer {
+            n: Complex64::new(n_film, 0.0),
+            thickness_nm: d,
+            coherent: true,
+        };
+        let r = stack(n_med, &[film], Complex64::new(n_med, 0.0), ci, lambda);
+        assert!(r.r() < 1e-12, "{deg}°: half-wave film reflects {}", r.r());
+        let quarter = FilmLayer {
+            thickness_nm: 0.5 * d,
+            ..film
+        };
+        let rq = stack(n_med, &[quarter], Complex64::new(n_med, 0.0), ci, lambda);
+        // Quarter-wave maximum 4r²/(1 + r²)² per polarisation; check it against s polarisation bound.
+        assert!(rq.r() > 0.1, "{deg}°: quarter-wave film {}", rq.r());
+        // Eq. (7) corrected: ρ_p + τ_p = 1 for a lossless stack (the cosine ratio the right way round).
+        assert!((rq.r() + rq.t() - 1.0).abs() < 1e-12);
+    }
+}
+
+#[test]
+fn paper_eq1_normalisation_is_four_times_the_energy_normalised_lobe() {
+    // Am = 1 (no body), flakes just under the surface (X' = 0): R_m = ρ_m. At normal incidence the regular
+    // albedo of the flake lobe is ≈ T(0)²·ρ_m(0) in the physical form and ≈ 4·τ(0)·ρ_m(0) as printed: the
+    // Cook–Torrance 1982 form with its un-normalised D (∫ D_CT cos = π) divided by π cos θi cos θo is four
+    // times F·D·G/(4 cos θi cos θo). The printed form then reflects more than it receives.
+    let mut spec = rgb_spec(1.5, 0.1, [0.5; 3], [0.0; 3], [0.0; 3]);
+    spec.metallic = Some(MetallicFlakes {
+        n: vec![0.05; 3],
+        k: vec![4.0; 3],
+        ..metal(2.0, 1.0, 0.0)
+    });
+    let phys = Paint::new(spec.clone()).unwrap();
+    spec.form = Form::PaperEq1;
+    let paper = Paint::new(spec).unwrap();
+    assert!(!paper.is_reciprocal());
+    let m = 2f64.to_radians().tan();
+    let wi = dir(0.0, 0.0);
+    let rho0 = fresnel_r(1.0, 1.5);
+    let rho_m = {
+        // Normal-incidence conductor reflectance |(n − η)/(n + η)|² with n = (0.05 + 4i), η = 1.5.
+        let n = Complex64::new(0.05, 4.0);
+        ((n - 1.5) / (n + 1.5)).norm_sqr()
+    };
+    let t0 = 1.0 - rho0;
+    let (a, err) = albedo_interior(&phys, 1.5, wi, m, 1e-9);
+    assert!(
+        (a[0] - rho0 - t0 * t0 * rho_m).abs() < 2e-3 + err,
+        "physical {} vs {}",
+        a[0] - rho0,
+        t0 * t0 * rho_m
+    );
+    let (b, err2) = directional_albedo(&paper, wi);
+    assert!(
+        ((b[0] - rho0) / (4.0 * t0 * rho_m) - 1.0).abs() < 5e-3 + err2,
+        "paper {} vs {}",
+        b[0] - rho0,
+        4.0 * t0 * rho_m
+    );
+    assert!(b[0] > 1.0, "the printed Eq. 1 is not energy-conserving");
+    // And it is not reciprocal: τ(θi) is applied once.
+    let (x, y) = (dir(10.0, 0.0), dir(70.0, 180.0));
+    assert!(rel(eval(&paper, x, y)[0], eval(&paper, y, x)[0]) > 1e-3);
+}
+
+#[test]
+fn paper_eq1_body_is_tau_times_lambertian() {
+    let mut spec = rgb_spec(1.5, 0.15, [0.7; 3], [0.608, 0.128, 0.1], [0.024, 0.1, 0.16]);
+    spec.form = Form::PaperEq1;
+    let p = Paint::new(spec).unwrap();
+    let (wi, wo) = (dir(25.0, 0.0), dir(60.0, 45.0));
+    let f = eval(&p, wi, wo);
+    for j in 0..3 {
+        assert!(
+            rel(
+                f[j],
+                fresnel_t(wi.z, 1.5) * p.pigmented_reflectance()[j] / PI
+            ) < 1e-12
+        );
+    }
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// Flakes: delta switch, Eq. (5) corrected, terms
+// ---------------------------------------------------------------------------------------------------------
+
+#[test]
+fn flake_delta_switch_is_continuous_and_is_eq5_corrected() {
+    // Below Microfacet::SMOOTH_THRESHOLD (slope 1e-7 ⇔ 5.7e-6°) the flake lobe is a delta of weight
+    // T(θi)²·A·R_m(θi'), with R_m = KM layer of thickness X' over ρ_m (Eq. 5 corrected). Just above it, the
+    // lobe's integral equals that weight.
+    let (k, s) = ([0.608, 0.128, 0.1], [0.024, 0.1, 0.16]);
+    let build = |spread: f64, form: Form| {
+        let mut spec = rgb_spec(1.5, 0.15, [0.7; 3], k, s);
+        spec.metallic = Some(metal(spread, 0.6, 0.05));
+        spec.pearlescent = Some(pearl(spread, 0.4, 0.1));
+        spec.form = form;
+        Paint::new(spec).unwrap()
+    };
+    let smooth = build(1e-6, Form::Physical);
+    assert!(
+        smooth
+            .terms()
+            .iter()
+            .filter(|t| t.kind == TermKind::Delta)
+            .count()
+            == 3
+    );
+    assert!(
+        !smooth
+            .terms()
+            .iter()
+            .any(|t| matches!(t.kind, TermKind::Diffuse)),
+        "Am + Ap = 1: no body"
+    );
+    for ti in [0.0, 40.0, 75.0] {
+        let wi = dir(ti, 0.0);
+        let mut d = [0.0; 3];
+        assert!(smooth.delta_reflectance(wi, &mut d));
+        // Eq. (5) corrected, by hand, for the metallic part.
+        let ct_in = refract_in(wi, 1.5).z;
+        let eta_rel = Complex64::new(0.93, 6.33) / 1.5;
+        let st = (1.0 - ct_in * ct_in) / (eta_rel * eta_rel);
+        let ct_t = (Complex64::new(1.0, 0.0) - st).sqrt();
+        let rs = ((ct_in - eta_rel * ct_t) / (ct_in + eta_rel * ct_t)).norm_sqr();
+        let rp = ((eta_rel * ct_in - ct_t) / (eta_rel * ct_in + ct_t)).norm_sqr();
+        let rho_m = 0.5 * (rs + rp);
+        let t = fresnel_t(wi.z, 1.5);
+        let film = [
+            FilmLayer {
+                n: Complex64::new(2.5, 0.0),
+                thickness_nm: 135.0,
+                coherent: true,
+            },
+            FilmLayer {
+                n: Complex64::new(1.58, 0.0),
+                thickness_nm: 400.0,
+                coherent: false,
+            },
+            FilmLayer {
+                n: Complex64::new(2.5, 0.0),
+                thickness_nm: 135.0,
+                coherent: true,
+            },
+        ];
+        for j in 0..3 {
+            let lam = Sampling::rgb().wavelengths_nm[j];
+            let rho_p = stack(1.5, &film, Complex64::new(1.5, 0.0), ct_in, lam).r();
+            let want = fresnel_r(wi.z, 1.5)
+                + t * t
+                    * (0.6 * km_eq3(k[j], s[j], 0.05, rho_m, false)
+                        + 0.4 * km_eq3(k[j], s[j], 0.1, rho_p, false));
+            assert!(
+                rel(d[j], want) < 1e-9,
+                "θi {ti} sample {j}: {} vs {want}",
+                d[j]
+            );
+        }
+        // Continuity: the lobe just above the threshold integrates to the same reflectance.
+        for spread in [1e-4, 1e-2] {
+            let lobe = build(spread, Form::Physical);
+            let m = spread.to_radians().tan();
+            let (a, err) = albedo_interior(&lobe, 1.5, wi, m, 1e-10);
+            for j in 0..3 {
+                assert!(
+                    (a[j] - d[j]).abs() < 1e-4 * (1.0 + spread * 100.0) + err,
+                    "θi {ti} spread {spread} {j}: {} vs {}",
+                    a[j],
+                    d[j]
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn zero_area_ratio_builds_no_flake_terms() {
+    let mut v = fixture_json("cerulean-blue-c");
+    v["metallic_flakes"]["area_ratio"] = json!(0.0);
+    v["pearlescent_flakes"]["area_ratio"] = json!(0.0);
+    let b = from_json(&v).unwrap();
+    let a = load("cerulean-blue-a");
+    assert_eq!(b.terms(), a.terms());
+    for (ti, to) in [(20.0, 20.0), (60.0, 30.0)] {
+        let (wi, wo) = (dir(ti, 0.0), dir(to, 180.0));
+        assert_eq!(eval(&*b, wi, wo), eval(&*a, wi, wo));
+    }
+}
+
+#[test]
+fn spectral_recipe_samples_and_interference_colour() {
+    // A spectral recipe: 5 wavelengths; the pearlescent film's reflectance depends on λ (interference).
+    let mut v = fixture_json("cerulean-blue-c");
+    let wl = [420.0, 480.0, 540.0, 600.0, 680.0];
+    v["wavelengths_nm"] = json!(wl);
+    v["pigmented_layer"]["primer_reflectance"] = json!(vec![0.7; 5]);
+    v["pigmented_layer"]["pigments"][0]["k_per_mm"] = json!(vec![0.0; 5]);
+    v["pigmented_layer"]["pigments"][0]["s_per_mm"] = json!(vec![0.0; 5]);
+    v["metallic_flakes"]["area_ratio"] = json!(0.0);
+    let b = from_json(&v).unwrap();
+    assert_eq!(b.sampling().wavelengths_nm, wl);
+    let wi = dir(0.0, 0.0);
+    // The coat's delta is grey.
+    let mut d = [0.0; 5];
+    assert!(b.delta_reflectance(wi, &mut d) && d.iter().all(|x| *x == d[0]));
+    // Just off the normal (inside the lobe peak) f = grey body + c·ρ_p(λ): f follows the film's reflectance.
+    let f = eval(&*b, wi, dir(0.05, 180.0));
+    let film = [
+        FilmLayer {
+            n: Complex64::new(2.5, 0.0),
+            thickness_nm: 135.0,
+            coherent: true,
+        },
+        FilmLayer {
+            n: Complex64::new(1.58, 0.0),
+            thickness_nm: 400.0,
+            coherent: false,
+        },
+        FilmLayer {
+            n: Complex64::new(2.5, 0.0),
+            thickness_nm: 135.0,
+            coherent: true,
+        },
+    ];
+    let rho: Vec<f64> = wl
+        .iter()
+        .map(|&l| stack(1.5, &film, Complex64::new(1.5, 0.0), 1.0, l).r())
+        .collect();
+    // K = S = 0: the cover layer is transparent (R_p = ρ_p) and the body is the same for all samples, so the
+    // samples are ordered as the film's reflectances are.
+    let order_f: Vec<usize> = argsort(&f);
+    let order_r: Vec<usize> = argsort(&rho);
+    assert_eq!(order_f, order_r, "f {f:?} film {rho:?}");
+    // Wrong length refused with the field path.
+    v["pigmented_layer"]["primer_reflectance"] = json!(vec![0.7; 3]);
+    let e = from_json(&v).unwrap_err().to_string();
+    assert!(
+        e.contains("pigmented_layer.primer_reflectance") && e.contains("expected 5 values"),
+        "{e}"
+    );
+}
+
+fn argsort(v: &[f64]) -> Vec<usize> {
+    let mut i: Vec<usize> = (0..v.len()).collect();
+    i.sort_by(|&a, &b| v[a].partial_cmp(&v[b]).unwrap());
+    i
+}
+
+#[test]
+fn measured_pigment_inverts_white_black() {
+    // K, S from a drawdown over white and black reproduce the drawdown's reflectances.
+    let (k0, s0, x) = (0.8, 3.0, 0.05);
+    let wb = 0.9;
+    let rw = km_eq3(k0, s0, x, wb, false);
+    let rb = km_eq3(k0, s0, x, 0.0, false);
+    let mut v = fixture_json("cerulean-blue-a");
+    v["pigmented_layer"]["pigments"][0] = json!({
+        "name": "drawdown", "concentration": 1.0,
+        "measured": { "thickness_mm": x, "over_white": vec![rw; 3], "over_black": vec![rb; 3], "white_background": wb }
+    });
+    v["pigmented_layer"]["thickness_mm"] = json!(x);
+    v["pigmented_layer"]["primer_reflectance"] = json!(vec![wb; 3]);
+    let b = from_json(&v).unwrap();
+    let p = Paint::new(rgb_spec(1.5, x, [wb; 3], [k0; 3], [s0; 3])).unwrap();
+    let (wi, wo) = (dir(15.0, 0.0), dir(45.0, 100.0));
+    let (f, g) = (eval(&*b, wi, wo), eval(&p, wi, wo));
+    assert!(rel(f[0], g[0]) < 1e-6, "{} vs {}", f[0], g[0]);
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// Bad recipes
+// ---------------------------------------------------------------------------------------------------------
+
+#[test]
+fn bad_recipes_are_refused_with_the_field_path() {
+    type Edit = fn(&mut Value);
+    let cases: Vec<(&str, Edit, &[&str])> = vec![
+        (
+            "negative thickness",
+            |v| v["pigmented_layer"]["thickness_mm"] = json!(-0.1),
+            &["pigmented_layer.thickness_mm", "≥ 0"],
+        ),
+        (
+            "Am + Ap > 1",
+            |v| v["pearlescent_flakes"]["area_ratio"] = json!(0.7),
+            &["pearlescent_flakes.area_ratio", "exceed 1"],
+        ),
+        (
+            "wrong spectral length",
+            |v| v["pigmented_layer"]["pigments"][0]["k_per_mm"] = json!([1.0, 2.0]),
+            &["pigmented_layer.pigments[0].k_per_mm", "expected 3 values"],
+        ),
+        (
+            "NaN as a string",
+            |v| v["clear_coat"]["index"] = json!("NaN"),
+            &["clear_coat.index", "expected a finite number"],
+        ),
+        (
+            "unknown field",
+            |v| v["metallic_flakes"]["spread"] = json!(0.25),
+            &["metallic_flakes.spread", "unknown field", "spread_deg"],
+        ),
+        (
+            "X' > X",
+            |v| v["metallic_flakes"]["depth_mm"] = json!(0.2),
+            &[
+                "metallic_flakes.depth_mm",
+                "deeper than the pigmented layer",
+            ],
+        ),
+        (
+            "coat index out of range",
+            |v| v["clear_coat"]["index"] = json!(2.0),
+            &["clear_coat.index", "[1.3, 1.8]"],
+        ),
+        (
+            "bad form",
+            |v| v["form"] = json!("paper"),
+            &["form", "paper-eq1"],
+        ),
+        (
+            "negative K",
+            |v| v["pigmented_layer"]["pigments"][0]["s_per_mm"] = json!([0.1, -1.0, 0.2]),
+            &["pigmented_layer.pigments[0].s_per_mm[1]"],
+        ),
+        (
+            "Rg > 1",
+            |v| v["pigmented_layer"]["primer_reflectance"] = json!([0.7, 1.2, 0.7]),
+            &["pigmented_layer.primer_reflectance[1]"],
+        ),
+        (
+            "missing layer",
+            |v| {
+                v.as_object_mut().unwrap().remove("pigmented_layer");
+            },
+            &["pigmented_layer", "missing"],
+        ),
+        (
+            "bad distribution",
+            |v| v["clear_coat"]["distribution"] = json!("phong"),
+            &["clear_coat.distribution", "ggx"],
+        ),
+        (
+            "both K/S and measured",
+            |v| v["pigmented_layer"]["pigments"][0]["measured"] = json!({}),
+            &["pigmented_layer.pigments[0].measured", "not both"],
+        ),
+        (
+            "internal_reflection not a bool",
+            |v| v["internal_reflection"] = json!(1),
+            &["internal_reflection", "true or false"],
+        ),
+        (
+            "too many wavelengths",
+            |v| {
+                v["wavelengths_nm"] = json!((0..=MAX_SAMPLES)
+                    .map(|i| 400.0 + i as f64)
+                    .collect::<Vec<_>>())
+            },
+            &["wavelengths_nm", "at most"],
+        ),
+        (
+            "negative area ratio",
+            |v| v["metallic_flakes"]["area_ratio"] = json!(-0.1),
+            &["metallic_flakes.area_ratio"],
+        ),
+    ];
+    for (what, edit, needles) in cases {
+        let mut v = fixture_json("cerulean-blue-c");
+        edit(&mut v);
+        let e = from_json(&v).expect_err(what).to_string();
+        assert!(e.starts_with("test.json"), "{what}: {e}");
+        for n in needles {
+            assert!(e.contains(n), "{what}: message `{e}` lacks `{n}`");
+        }
+    }
+}
+
+#[test]
+fn paint_new_refuses_bad_specs_without_panicking() {
+    let mut s = rgb_spec(1.5, 0.1, [0.5; 3], [1.0; 3], [1.0; 3]);
+    s.metallic = Some(metal(1.0, 0.7, 0.05));
+    s.pearlescent = Some(pearl(1.0, 0.4, 0.05));
+    assert!(Paint::new(s.clone())
+        .unwrap_err()
+        .to_string()
+        .contains("exceed 1"));
+    s.pearlescent = None;
+    s.layer.primer_reflectance = vec![f64::NAN; 3];
+    assert!(Paint::new(s.clone()).is_err());
+    s.layer.primer_reflectance = vec![0.5; 2];
+    assert!(Paint::new(s)
+        .unwrap_err()
+        .to_string()
+        .contains("sampling has 3"));
+}
