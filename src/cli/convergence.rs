@@ -1,7 +1,18 @@
-//! `glossmeter convergence`: error against run time over a sweep of tolerances. (Being written.)
-use std::path::PathBuf;
+//! `glossmeter convergence`: value, estimated error, actual error, evaluations and time of every reading
+//! over a sweep of tolerances, as a table, CSV or JSON, and optionally a log–log plot of error against
+//! time (SVG). The computation is `instrument::convergence::sweep`; this module parses, formats and writes.
+use std::path::{Path, PathBuf};
 
-use crate::Result;
+use serde_json::json;
+
+use super::{emit, plot, Format};
+use crate::instrument::convergence::{self, ReferenceKind, Sweep, SweepOptions, DEFAULT_TOLERANCES};
+use crate::instrument::standards::{self, StandardGeometry};
+use crate::recipe::{self, Material};
+use crate::{Error, Result};
+
+/// The geometries swept when none is given.
+pub const DEFAULT_GEOMETRIES: &[&str] = &["astm-d523-20", "astm-d523-60", "astm-d523-85"];
 
 /// Arguments of `glossmeter convergence`.
 #[derive(clap::Args, Debug)]
@@ -11,8 +22,305 @@ pub struct ConvergenceArgs {
     /// Shipped geometry ids (repeatable); default: astm-d523-20, -60, -85.
     #[arg(long = "geometry", short = 'g')]
     pub geometries: Vec<String>,
+    /// A user geometry file in the standards format (repeatable).
+    #[arg(long = "geometry-file")]
+    pub geometry_files: Vec<PathBuf>,
+    /// Relative tolerances to sweep, comma-separated, each in (0, 1) [default: 1e-2,1e-3,…,1e-10].
+    #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
+    pub tolerances: Vec<f64>,
+    #[arg(long, value_enum, default_value_t = Format::Table)]
+    pub format: Format,
+    /// Also draw actual and estimated error against time, log–log, to this new .svg file.
+    #[arg(long)]
+    pub plot: Option<PathBuf>,
+    /// Write the table/CSV/JSON to this new file instead of stdout (refuses to overwrite).
+    #[arg(long, short = 'o')]
+    pub output: Option<PathBuf>,
+    /// Repeat each execution until this many milliseconds have elapsed (or --max-repetitions), and report
+    /// the minimum time per execution.
+    #[arg(long, default_value_t = 20.0)]
+    pub min_time_ms: f64,
+    /// At most this many timed executions per tolerance.
+    #[arg(long, default_value_t = 50)]
+    pub max_repetitions: usize,
+    /// Compare with a run at 1/100 of the tightest tolerance even when a closed form exists.
+    #[arg(long)]
+    pub reference_run: bool,
+}
+
+fn resolve(ids: &[String], files: &[PathBuf]) -> Result<Vec<StandardGeometry>> {
+    let mut out = Vec::new();
+    if ids.is_empty() && files.is_empty() {
+        for id in DEFAULT_GEOMETRIES {
+            out.push(standards::find(id)?);
+        }
+    }
+    for id in ids {
+        out.push(standards::find(id)?);
+    }
+    for f in files {
+        out.push(standards::load_file(f)?);
+    }
+    Ok(out)
+}
+
+fn refuse_existing(p: &Path, what: &str) -> Result<()> {
+    if p.exists() {
+        return Err(Error::Usage(format!(
+            "{what} {}: already exists; glossmeter never overwrites a file (choose another name)",
+            p.display()
+        )));
+    }
+    Ok(())
 }
 
 pub fn run(args: ConvergenceArgs) -> Result<()> {
-    Err(crate::Error::Usage(format!("convergence: not implemented yet ({})", args.recipe.display())))
+    // Every check that can fail cheaply comes before the (possibly long) sweep.
+    let tolerances = if args.tolerances.is_empty() { DEFAULT_TOLERANCES.to_vec() } else { args.tolerances.clone() };
+    convergence::validate_tolerances(&tolerances)?;
+    if !(args.min_time_ms.is_finite() && args.min_time_ms >= 0.0) {
+        return Err(Error::Usage(format!("--min-time-ms must be a number ≥ 0, got {}", args.min_time_ms)));
+    }
+    if args.max_repetitions == 0 {
+        return Err(Error::Usage("--max-repetitions must be at least 1".into()));
+    }
+    if let Some(p) = &args.output {
+        refuse_existing(p, "--output")?;
+    }
+    if let Some(p) = &args.plot {
+        plot::check_plot_path(p)?;
+        if args.output.as_deref() == Some(p.as_path()) {
+            return Err(Error::Usage(format!("--plot and --output name the same file {}", p.display())));
+        }
+    }
+    let material = recipe::load_file(&args.recipe)?;
+    let geometries = resolve(&args.geometries, &args.geometry_files)?;
+    let options = SweepOptions {
+        min_seconds: args.min_time_ms * 1e-3,
+        max_repetitions: args.max_repetitions,
+        force_run_reference: args.reference_run,
+        ..SweepOptions::default()
+    };
+    let sweep = convergence::sweep(material.brdf.clone(), geometries, &tolerances, &options)?;
+    let text = match args.format {
+        Format::Table => table(&material, &sweep),
+        Format::Json => json(&material, &sweep),
+        Format::Csv => csv(&sweep)?,
+    };
+    if let Some(p) = &args.plot {
+        let title = format!("{}: error vs time", material.name);
+        let s = plot::write_svg(&sweep, &title, p)?;
+        eprintln!(
+            "plot: {} ({} series; errors below {:.1e} drawn at that floor: {} actual, {} estimated)",
+            p.display(),
+            s.series,
+            s.floor,
+            s.clamped_actual,
+            s.clamped_estimated
+        );
+    }
+    emit(&text, args.output.as_deref())?;
+    if sweep.rows.iter().any(|r| r.value.is_none()) {
+        return Err(Error::Numeric("some readings have no value (see the rows' problem)".into()));
+    }
+    Ok(())
+}
+
+fn secs(s: f64) -> String {
+    if s < 1e-3 {
+        format!("{:.1} µs", s * 1e6)
+    } else if s < 1.0 {
+        format!("{:.2} ms", s * 1e3)
+    } else {
+        format!("{s:.2} s")
+    }
+}
+
+/// Decimals that show a value to one digit below its estimated error (2 to 14).
+fn decimals(err: Option<f64>) -> usize {
+    match err {
+        Some(e) if e > 0.0 && e.is_finite() => ((-e.log10().floor()) as i64 + 1).clamp(2, 14) as usize,
+        _ => 14,
+    }
+}
+
+fn err_cell(e: Option<f64>) -> String {
+    match e {
+        Some(x) if x == 0.0 => "0".into(),
+        Some(x) => format!("{x:.2e}"),
+        None => "—".into(),
+    }
+}
+
+fn reference_note(sweep: &Sweep) -> String {
+    match &sweep.reference {
+        ReferenceKind::ClosedForm => {
+            "Reference: closed form (Lambertian material: (ρ/π)·P_s·P_r by Lambert's polygon formula; gloss standard by 64×64 Gauss–Legendre), independent of the engine.".into()
+        }
+        ReferenceKind::Run { rtol } => format!(
+            "Reference: the same engine at rtol = {rtol:e} (100× tighter than the tightest of the sweep; {}); an actual error below the reference's own estimate is not resolved.",
+            secs(sweep.reference_seconds)
+        ),
+    }
+}
+
+/// The aligned table.
+pub fn table(material: &Material, sweep: &Sweep) -> String {
+    let head = ["rtol", "geometry", "reading", "value", "est. error", "actual error", "evaluations", "time", "reference"];
+    let mut rows: Vec<Vec<String>> = vec![head.iter().map(|s| s.to_string()).collect()];
+    let mut notes = Vec::new();
+    for r in &sweep.rows {
+        let value = match r.value {
+            Some(v) => format!("{:.*}", decimals(r.error_estimate.map(|e| e.min(r.actual_error.unwrap_or(e)))), v),
+            None => "—".into(),
+        };
+        let mark = if r.converged { "" } else { " *" };
+        rows.push(vec![
+            format!("{:.0e}", r.rtol),
+            r.geometry.clone(),
+            format!("{} ({})", r.reading, r.unit),
+            value,
+            err_cell(r.error_estimate),
+            err_cell(r.actual_error),
+            format!("{}{mark}", r.evaluations),
+            secs(r.seconds),
+            r.reference_kind.clone(),
+        ]);
+        if let Some(p) = &r.problem {
+            notes.push(format!("rtol {:e} {} {}: {p}", r.rtol, r.geometry, r.reading));
+        }
+    }
+    let ncol = head.len();
+    let widths: Vec<usize> = (0..ncol).map(|c| rows.iter().map(|r| r[c].chars().count()).max().unwrap_or(0)).collect();
+    let mut s = format!("{} ({})\n{}\n{}\n", material.name, material.file, material.brdf.describe(), reference_note(sweep));
+    s.push_str(&format!(
+        "Time: per reading (sum of the wall times of the aperture integrals it uses), minimum over repeated executions (until {} ms or {} executions).\n\n",
+        sweep.options.min_seconds * 1e3,
+        sweep.options.max_repetitions
+    ));
+    for (i, r) in rows.iter().enumerate() {
+        let cells: Vec<String> = r
+            .iter()
+            .enumerate()
+            .map(|(c, v)| {
+                let pad = " ".repeat(widths[c] - v.chars().count());
+                if matches!(c, 0 | 3 | 4 | 5 | 6 | 7) {
+                    format!("{pad}{v}")
+                } else {
+                    format!("{v}{pad}")
+                }
+            })
+            .collect();
+        s.push_str(cells.join("  ").trim_end());
+        s.push('\n');
+        if i == 0 {
+            s.push_str(&widths.iter().map(|w| "-".repeat(*w)).collect::<Vec<_>>().join("  "));
+            s.push('\n');
+        }
+    }
+    if sweep.rows.iter().any(|r| !r.converged) {
+        s.push_str("* evaluation budget exhausted before the tolerance was met\n");
+    }
+    for n in notes {
+        s.push_str(&format!("note: {n}\n"));
+    }
+    s
+}
+
+/// CSV: one line per row, every number in full precision; empty cells where there is no value.
+pub fn csv(sweep: &Sweep) -> Result<String> {
+    let mut w = csv::Writer::from_writer(vec![]);
+    let err = |e: csv::Error| Error::Io { file: "<csv>".into(), source: std::io::Error::other(e) };
+    w.write_record([
+        "rtol",
+        "geometry",
+        "reading",
+        "quantity",
+        "unit",
+        "value",
+        "error_estimate",
+        "actual_error",
+        "reference",
+        "reference_error",
+        "reference_kind",
+        "evaluations",
+        "seconds",
+        "plan_seconds",
+        "repetitions",
+        "converged",
+        "problem",
+    ])
+    .map_err(err)?;
+    let opt = |x: Option<f64>| x.map(|v| format!("{v:e}")).unwrap_or_default();
+    for r in &sweep.rows {
+        w.write_record([
+            format!("{:e}", r.rtol),
+            r.geometry.clone(),
+            r.reading.clone(),
+            r.quantity.clone(),
+            r.unit.clone(),
+            opt(r.value),
+            opt(r.error_estimate),
+            opt(r.actual_error),
+            opt(r.reference),
+            opt(r.reference_error),
+            r.reference_kind.clone(),
+            r.evaluations.to_string(),
+            format!("{:e}", r.seconds),
+            format!("{:e}", r.plan_seconds),
+            r.repetitions.to_string(),
+            r.converged.to_string(),
+            r.problem.clone().unwrap_or_default(),
+        ])
+        .map_err(err)?;
+    }
+    let bytes = w.into_inner().map_err(|e| Error::Io { file: "<csv>".into(), source: std::io::Error::other(e.to_string()) })?;
+    Ok(String::from_utf8(bytes).expect("csv is utf-8"))
+}
+
+/// JSON: the sweep's settings and one object per row (null where there is no value).
+pub fn json(material: &Material, sweep: &Sweep) -> String {
+    let rows: Vec<serde_json::Value> = sweep
+        .rows
+        .iter()
+        .map(|r| {
+            json!({
+                "rtol": r.rtol,
+                "geometry": r.geometry,
+                "reading": r.reading,
+                "quantity": r.quantity,
+                "unit": r.unit,
+                "value": r.value,
+                "error_estimate": r.error_estimate,
+                "actual_error": r.actual_error,
+                "reference": r.reference,
+                "reference_error": r.reference_error,
+                "reference_kind": r.reference_kind,
+                "evaluations": r.evaluations,
+                "seconds": r.seconds,
+                "plan_seconds": r.plan_seconds,
+                "repetitions": r.repetitions,
+                "converged": r.converged,
+                "problem": r.problem,
+            })
+        })
+        .collect();
+    let reference = match &sweep.reference {
+        ReferenceKind::ClosedForm => json!({"kind": "closed form", "rtol": null, "seconds": null}),
+        ReferenceKind::Run { rtol } => json!({"kind": sweep.reference.label(), "rtol": rtol, "seconds": sweep.reference_seconds}),
+    };
+    let doc = json!({
+        "material": {"name": material.name, "file": material.file, "model": material.brdf.describe()},
+        "tolerances": sweep.tolerances,
+        "reference": reference,
+        "timing": {
+            "statistic": "minimum over repeated executions",
+            "min_seconds": sweep.options.min_seconds,
+            "max_repetitions": sweep.options.max_repetitions,
+        },
+        "rows": rows,
+    });
+    let mut s = serde_json::to_string_pretty(&doc).expect("finite values serialise");
+    s.push('\n');
+    s
 }

@@ -11,6 +11,7 @@ use crate::instrument::standards;
 use crate::{recipe, Error, Result};
 
 pub mod convergence;
+pub mod plot;
 pub mod format;
 
 #[derive(Parser, Debug)]

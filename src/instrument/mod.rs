@@ -1,4 +1,5 @@
 //! The virtual instrument. (Being written.)
+pub mod convergence;
 pub mod flux;
 pub mod geometry;
 pub mod plan;

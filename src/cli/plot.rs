@@ -1,0 +1,189 @@
+//! Plots of `glossmeter convergence`: a log–log chart of the actual error (solid line, filled points) and
+//! the estimated error (dashed line) against the time per reading, one colour per reading. SVG only (the
+//! crate builds plotters with its SVG backend alone; a PNG needs the bitmap backend and a font).
+//!
+//! An error of exactly 0, or below the floor of the chart, cannot be drawn on a log axis: it is drawn at
+//! the floor as a hollow point, and the caption under the chart says so and gives the floor.
+use std::io::Write;
+use std::path::Path;
+
+use plotters::prelude::*;
+
+use crate::instrument::convergence::Sweep;
+use crate::{Error, Result};
+
+/// What was drawn, for messages.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PlotSummary {
+    pub series: usize,
+    /// The floor under which errors are drawn at the floor.
+    pub floor: f64,
+    /// How many actual (estimated) errors were drawn at the floor.
+    pub clamped_actual: usize,
+    pub clamped_estimated: usize,
+    /// Rows left out because the reading had no value.
+    pub skipped: usize,
+}
+
+/// Refuse anything but an `.svg` file name; say why for `.png`.
+pub fn check_plot_path(path: &Path) -> Result<()> {
+    let ext = path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase());
+    match ext.as_deref() {
+        Some("svg") => {}
+        Some("png") => {
+            return Err(Error::Usage(format!(
+                "--plot {}: PNG output is not available (glossmeter builds plotters with its SVG backend only); use a .svg file name",
+                path.display()
+            )))
+        }
+        _ => return Err(Error::Usage(format!("--plot {}: the plot file name must end in .svg", path.display()))),
+    }
+    if path.exists() {
+        return Err(Error::Usage(format!("{}: already exists; glossmeter never overwrites a file (choose another name)", path.display())));
+    }
+    Ok(())
+}
+
+fn plot_err(e: impl std::fmt::Display) -> Error {
+    Error::Numeric(format!("plotting failed: {e}"))
+}
+
+/// One series: (time, actual error, estimated error) per tolerance, loose to tight.
+struct Series {
+    label: String,
+    points: Vec<(f64, f64, f64)>,
+}
+
+/// Render the sweep as SVG text. `title` goes on top of the chart.
+pub fn render_svg(sweep: &Sweep, title: &str) -> Result<(String, PlotSummary)> {
+    let mut series: Vec<Series> = Vec::new();
+    let mut skipped = 0;
+    let mut scale: f64 = 0.0;
+    for r in &sweep.rows {
+        let (Some(v), Some(a), Some(e)) = (r.value, r.actual_error, r.error_estimate) else {
+            skipped += 1;
+            continue;
+        };
+        scale = scale.max(v.abs()).max(r.reference.unwrap_or(0.0).abs());
+        let label = format!("{} {}", r.geometry, r.reading);
+        let t = r.seconds.max(1e-9);
+        match series.iter_mut().find(|s| s.label == label) {
+            Some(s) => s.points.push((t, a, e)),
+            None => series.push(Series { label, points: vec![(t, a, e)] }),
+        }
+    }
+    if series.is_empty() {
+        return Err(Error::Numeric("nothing to plot: no reading of the sweep has a value and an actual error".into()));
+    }
+    // The floor: 1e-16 of the largest value (the relative rounding level of a double).
+    let floor = if scale > 0.0 { 1e-16 * scale } else { 1e-300 };
+    let clamp = |x: f64| x.max(floor);
+    let mut clamped_actual = 0;
+    let mut clamped_estimated = 0;
+    let (mut tmin, mut tmax, mut emax) = (f64::INFINITY, 0.0f64, floor);
+    for s in &series {
+        for &(t, a, e) in &s.points {
+            tmin = tmin.min(t);
+            tmax = tmax.max(t);
+            emax = emax.max(a).max(e);
+            clamped_actual += usize::from(a < floor);
+            clamped_estimated += usize::from(e < floor);
+        }
+    }
+    let x_range = (tmin / 2.0)..(tmax * 2.0);
+    let y_range = (floor / 3.0)..(emax * 3.0);
+
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (1000, 720)).into_drawing_area();
+        root.fill(&WHITE).map_err(plot_err)?;
+        let (chart_area, caption_area) = root.split_vertically(660);
+        let mut chart = ChartBuilder::on(&chart_area)
+            .caption(title, ("sans-serif", 20))
+            .margin(12)
+            .x_label_area_size(45)
+            .y_label_area_size(75)
+            .build_cartesian_2d(x_range.log_scale(), y_range.log_scale())
+            .map_err(plot_err)?;
+        chart
+            .configure_mesh()
+            .x_desc("time per reading (s), minimum over repeated runs")
+            .y_desc("error (reading units)")
+            .x_label_formatter(&|x| format!("{x:.0e}"))
+            .y_label_formatter(&|y| format!("{y:.0e}"))
+            .draw()
+            .map_err(plot_err)?;
+        for (i, s) in series.iter().enumerate() {
+            let colour = Palette99::pick(i).to_rgba();
+            let actual: Vec<(f64, f64)> = s.points.iter().map(|&(t, a, _)| (t, clamp(a))).collect();
+            let estimated: Vec<(f64, f64)> = s.points.iter().map(|&(t, _, e)| (t, clamp(e))).collect();
+            chart
+                .draw_series(LineSeries::new(actual.clone(), colour.stroke_width(2)))
+                .map_err(plot_err)?
+                .label(format!("{}: actual error", s.label))
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2)));
+            chart
+                .draw_series(s.points.iter().map(|&(t, a, _)| {
+                    let filled = a >= floor;
+                    Circle::new((t, clamp(a)), 4, if filled { colour.filled() } else { colour.stroke_width(1) })
+                }))
+                .map_err(plot_err)?;
+            chart
+                .draw_series(DashedLineSeries::new(estimated.clone(), 6, 4, colour.stroke_width(1)))
+                .map_err(plot_err)?
+                .label(format!("{}: estimated error (dashed)", s.label))
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 6, y), (x + 10, y), (x + 16, y)], colour.stroke_width(1)));
+            chart.draw_series(estimated.iter().map(|&p| Cross::new(p, 3, colour.stroke_width(1)))).map_err(plot_err)?;
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperRight)
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .label_font(("sans-serif", 12))
+            .draw()
+            .map_err(plot_err)?;
+        let mut lines = vec![format!(
+            "Reference: {}. Points from loose to tight tolerance ({}); solid = actual error |value − reference|, dashed = the engine's estimate.",
+            sweep.reference.label(),
+            tolerance_span(&sweep.tolerances)
+        )];
+        lines.push(format!(
+            "Errors of exactly 0 or below {floor:.1e} (1e-16 of the largest value) are drawn at {floor:.1e} as hollow points: {clamped_actual} actual, {clamped_estimated} estimated."
+        ));
+        if skipped > 0 {
+            lines.push(format!("{skipped} row(s) without a value or an actual error are not drawn."));
+        }
+        for (k, l) in lines.iter().enumerate() {
+            caption_area
+                .draw(&Text::new(l.clone(), (15, 8 + 18 * k as i32), ("sans-serif", 13).into_font().color(&BLACK)))
+                .map_err(plot_err)?;
+        }
+        root.present().map_err(plot_err)?;
+    }
+    Ok((svg, PlotSummary { series: series.len(), floor, clamped_actual, clamped_estimated, skipped }))
+}
+
+fn tolerance_span(t: &[f64]) -> String {
+    match (t.first(), t.last()) {
+        (Some(a), Some(b)) if t.len() > 1 => format!("rtol {a:e} … {b:e}"),
+        (Some(a), _) => format!("rtol {a:e}"),
+        _ => String::new(),
+    }
+}
+
+/// Render and write to a new file (refusing to overwrite one).
+pub fn write_svg(sweep: &Sweep, title: &str, path: &Path) -> Result<PlotSummary> {
+    check_plot_path(path)?;
+    let (svg, summary) = render_svg(sweep, title)?;
+    let file = std::fs::OpenOptions::new().write(true).create_new(true).open(path).map_err(|e| {
+        if e.kind() == std::io::ErrorKind::AlreadyExists {
+            Error::Usage(format!("{}: already exists; glossmeter never overwrites a file (choose another name)", path.display()))
+        } else {
+            Error::Io { file: path.display().to_string(), source: e }
+        }
+    })?;
+    let mut w = std::io::BufWriter::new(file);
+    w.write_all(svg.as_bytes()).and_then(|_| w.flush()).map_err(|e| Error::Io { file: path.display().to_string(), source: e })?;
+    Ok(summary)
+}

@@ -1,0 +1,515 @@
+//! Convergence sweeps: how a reading's value, its error estimate and its actual error behave as the
+//! tolerance tightens, and what each tolerance costs (`glossmeter convergence`, `docs/accuracy.md`).
+//!
+//! For every tolerance of the sweep the measurement plan is compiled with `PlanOptions { rtol, .. }` and
+//! executed; every reported reading gives one [`Row`]: value, the engine's error estimate, the actual error
+//! against a reference, integrand evaluations, time and the converged flag.
+//!
+//! **The reference.** Where a closed form exists it is used, computed here independently of the engine
+//! (no code shared with `flux.rs` or `plan.rs` except the Fresnel reflectance of the gloss standard, which
+//! is tested on its own in `optics::fresnel`):
+//!
+//! * a *Lambertian* material (f_r = ρ/π, detected by [`lambertian_value`]): the specimen flux through a
+//!   source stop and a receptor stop is (ρ_lum/π)·P_s·P_r, with P the projected solid angle ∫ cos θ dω of
+//!   the pyramid over each stop, by Lambert's formula for a spherical polygon ([`projected_solid_angle`]);
+//! * the gloss standard's flux Φ_std, an ideal-mirror term, is ∫ R(θi) cos θi dω over the source points
+//!   whose mirror lies in the receptor, by a 64 × 64 Gauss–Legendre product rule on that overlap box
+//!   ([`mirror_flux_reference`]; the integrand is smooth there).
+//!
+//! The reading is then assembled from these fluxes by the definitions of the readings (gloss, haze,
+//! log-haze, DOI, haze index), written out again here. Every other material is compared with a run of the
+//! same engine at a tolerance 100× tighter than the tightest of the sweep: each row says which reference
+//! it used ("closed form" or "rtol=1e-12 run"), and in the second case the reference's own error estimate
+//! is reported with it: an actual error below that estimate is not resolved.
+//!
+//! **Timing.** The plan is compiled once per tolerance (not timed) and executed repeatedly until at least
+//! `min_seconds` (default 20 ms) of wall time have elapsed or `max_repetitions` (default 50) executions
+//! were made, whichever comes first; the minimum over the executions is reported (the least disturbed by
+//! other work on the machine). Two times are kept: `seconds`, the minimum over executions of the reading's
+//! own time (the sum of the wall times of the aperture integrals it uses; an integral shared by several
+//! readings counts in each of them), and `plan_seconds`, the minimum wall time of a whole
+//! `Plan::execute()` (all readings, integrals run in parallel). The values of every execution must be the
+//! same bits (the engine is deterministic); a difference is reported as an error, not averaged away.
+use std::sync::Arc;
+use std::time::Instant;
+
+use crate::brdf::{Brdf, TermKind};
+use crate::instrument::geometry::{ReadingSpec, Stop};
+use crate::instrument::plan::{Job, Plan, PlanOptions, PlannedReading, Reading, Target};
+use crate::instrument::standards::StandardGeometry;
+use crate::optics::fresnel::fr_dielectric;
+use crate::{Error, Result, Vec3};
+
+/// The default sweep: 1e-2, 1e-3, …, 1e-10.
+pub const DEFAULT_TOLERANCES: [f64; 9] = [1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10];
+
+/// How much tighter than the tightest tolerance of the sweep the reference run is.
+pub const REFERENCE_FACTOR: f64 = 100.0;
+
+/// Knobs of a sweep.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SweepOptions {
+    /// Repeat each execution until this much wall time has elapsed (seconds)...
+    pub min_seconds: f64,
+    /// ...or this many executions were made.
+    pub max_repetitions: usize,
+    /// Evaluation budget per flux integral (as `PlanOptions::max_evals`).
+    pub max_evals: usize,
+    /// Use a reference run even when a closed form exists (for testing the tight-run path).
+    pub force_run_reference: bool,
+}
+
+impl Default for SweepOptions {
+    fn default() -> Self {
+        SweepOptions {
+            min_seconds: 0.02,
+            max_repetitions: 50,
+            max_evals: PlanOptions::default().max_evals,
+            force_run_reference: false,
+        }
+    }
+}
+
+/// Where the reference values come from.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ReferenceKind {
+    /// Independent closed forms (Lambertian material).
+    ClosedForm,
+    /// The same engine at this tolerance.
+    Run { rtol: f64 },
+}
+
+impl ReferenceKind {
+    /// The label printed in every row: "closed form" or "rtol=1e-12 run".
+    pub fn label(&self) -> String {
+        match self {
+            ReferenceKind::ClosedForm => "closed form".into(),
+            ReferenceKind::Run { rtol } => format!("rtol={rtol:e} run"),
+        }
+    }
+}
+
+/// The reference value of one reading.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ReferenceValue {
+    pub geometry: String,
+    pub reading: String,
+    /// None when the reference has no finite value (then no actual error can be given).
+    pub value: Option<f64>,
+    /// The reference's own error estimate (None for a closed form: exact up to rounding).
+    pub error_estimate: Option<f64>,
+}
+
+/// One row of the sweep: one reading at one tolerance.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Row {
+    pub rtol: f64,
+    pub geometry: String,
+    pub reading: String,
+    pub quantity: String,
+    pub unit: String,
+    /// None when the engine gave no finite value (`problem` says why).
+    pub value: Option<f64>,
+    /// The engine's error estimate (None with `value`).
+    pub error_estimate: Option<f64>,
+    /// |value − reference| (None if either is missing).
+    pub actual_error: Option<f64>,
+    pub reference: Option<f64>,
+    /// The reference's own error estimate (None for a closed form).
+    pub reference_error: Option<f64>,
+    /// "closed form" or "rtol=… run".
+    pub reference_kind: String,
+    pub evaluations: usize,
+    /// Minimum over the executions of the reading's own time (see the module documentation).
+    pub seconds: f64,
+    /// Minimum wall time of a whole `Plan::execute()` at this tolerance.
+    pub plan_seconds: f64,
+    /// Number of executions timed.
+    pub repetitions: usize,
+    pub converged: bool,
+    pub problem: Option<String>,
+}
+
+/// The result of a sweep.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Sweep {
+    pub tolerances: Vec<f64>,
+    pub reference: ReferenceKind,
+    pub references: Vec<ReferenceValue>,
+    /// Wall time of the reference run (0 for a closed form).
+    pub reference_seconds: f64,
+    pub rows: Vec<Row>,
+    pub options: SweepOptions,
+}
+
+/// Check a list of tolerances: each finite, in (0, 1). Errors name the offending entry.
+pub fn validate_tolerances(tolerances: &[f64]) -> Result<()> {
+    if tolerances.is_empty() {
+        return Err(Error::Usage("--tolerances: at least one tolerance is required".into()));
+    }
+    for (i, t) in tolerances.iter().enumerate() {
+        if !(t.is_finite() && *t > 0.0 && *t < 1.0) {
+            return Err(Error::Usage(format!(
+                "--tolerances: entry {} is {t}; every tolerance must be a number in (0, 1), e.g. 1e-2,1e-4,1e-6",
+                i + 1
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// If the material is Lambertian — a single `Diffuse` term, no ideal-mirror part, and a luminous BRDF
+/// value that is the same (to 1e-14 relative) for a set of quite different direction pairs — its luminous
+/// f_r = ρ_lum/π; otherwise None.
+pub fn lambertian_value(brdf: &dyn Brdf) -> Option<f64> {
+    let terms = brdf.terms();
+    if terms.len() != 1 || terms[0].kind != TermKind::Diffuse {
+        return None;
+    }
+    let n = brdf.sampling().len();
+    let mut buf = vec![0.0; n];
+    let dir = |theta: f64, phi: f64| Vec3::new(theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos());
+    if brdf.delta_reflectance(dir(0.3, 0.0), &mut buf) {
+        return None;
+    }
+    let pairs = [
+        (dir(0.0, 0.0), dir(0.0, 0.0)),
+        (dir(0.35, 3.1), dir(0.35, 0.0)),
+        (dir(1.05, 3.14159), dir(1.05, 0.0)),
+        (dir(1.48, 3.0), dir(0.2, 1.0)),
+        (dir(0.7, 0.4), dir(1.3, 2.5)),
+        (dir(1.55, 0.0), dir(1.55, 0.0)),
+    ];
+    let mut first: Option<f64> = None;
+    for (wi, wo) in pairs {
+        buf.iter_mut().for_each(|v| *v = 0.0);
+        brdf.eval(wi, wo, &mut buf);
+        let f = brdf.sampling().luminous(&buf);
+        if !f.is_finite() {
+            return None;
+        }
+        match first {
+            None => first = Some(f),
+            Some(f0) if (f - f0).abs() <= 1e-14 * f0.abs() => {}
+            Some(_) => return None,
+        }
+    }
+    first
+}
+
+/// Projected solid angle ∫ cos θ dω of the pyramid over a stop (tangent coordinates about `axis`, with
+/// in-plane unit vector `e_par` and perpendicular unit vector y), by Lambert's formula for a spherical
+/// polygon: ½ |Σ_edges γ_e (n_e · z)|, γ_e the angle subtended by the edge and n_e the unit normal of the
+/// plane through the edge and the origin (Lambert 1760; Arvo 1995, "Applications of irradiance tensors",
+/// Eq. 3). Valid for a polygon on or above the horizon.
+pub fn projected_solid_angle(axis: Vec3, e_par: Vec3, stop: Stop) -> f64 {
+    let e_perp = Vec3::new(0.0, 1.0, 0.0);
+    let corners = [(stop.p[0], stop.q[0]), (stop.p[1], stop.q[0]), (stop.p[1], stop.q[1]), (stop.p[0], stop.q[1])];
+    let v: Vec<Vec3> = corners.iter().map(|(p, q)| (axis + *p * e_par + *q * e_perp).normalize()).collect();
+    let mut s = 0.0;
+    for i in 0..4 {
+        let (a, b) = (v[i], v[(i + 1) % 4]);
+        let c = a.cross(b);
+        let len = c.length();
+        if len == 0.0 {
+            continue;
+        }
+        let gamma = len.atan2(a.dot(b));
+        s += gamma * c.z / len;
+    }
+    0.5 * s.abs()
+}
+
+/// Gauss–Legendre nodes and weights on [−1, 1], by Newton's iteration on P_n.
+pub fn gauss_legendre(n: usize) -> Vec<(f64, f64)> {
+    (0..n)
+        .map(|i| {
+            let mut x = (std::f64::consts::PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
+            let mut dp = 1.0;
+            for _ in 0..100 {
+                let (mut p0, mut p1) = (1.0, x);
+                for k in 2..=n {
+                    let p2 = ((2 * k - 1) as f64 * x * p1 - (k - 1) as f64 * p0) / k as f64;
+                    p0 = p1;
+                    p1 = p2;
+                }
+                dp = n as f64 * (x * p1 - p0) / (x * x - 1.0);
+                let dx = p1 / dp;
+                x -= dx;
+                if dx.abs() < 1e-16 {
+                    break;
+                }
+            }
+            (x, 2.0 / ((1.0 - x * x) * dp * dp))
+        })
+        .collect()
+}
+
+/// The part of a stop above the horizon. A source point (p, q) points along s0 + p e∥ + q e⊥ whose z is
+/// cos θ + p sin θ, so the source is above the horizon for p > −cot θ; a receptor point's z is
+/// cos θ − p sin θ, above the horizon for p < cot θ. None if nothing is left.
+fn above_horizon(stop: Stop, theta: f64, is_source: bool) -> Option<Stop> {
+    let mut s = stop;
+    if theta.sin() > 0.0 {
+        let cot = theta.cos() / theta.sin();
+        if is_source {
+            s.p[0] = s.p[0].max(-cot);
+        } else {
+            s.p[1] = s.p[1].min(cot);
+        }
+    }
+    (s.p[1] > s.p[0] && s.q[1] > s.q[0]).then_some(s)
+}
+
+/// Independent mirror flux: ∫∫ R(θi) cos θi dω over the source points (p, q) whose mirror image (−p, −q)
+/// lies in the receptor, by a 64 × 64 Gauss–Legendre product rule on that overlap box.
+pub fn mirror_flux_reference(theta: f64, src: Stop, rec: Stop, refl: &dyn Fn(f64) -> f64) -> f64 {
+    let (Some(src), Some(rec)) = (above_horizon(src, theta, true), above_horizon(rec, theta, false)) else {
+        return 0.0;
+    };
+    let (p0, p1) = (src.p[0].max(-rec.p[1]), src.p[1].min(-rec.p[0]));
+    let (q0, q1) = (src.q[0].max(-rec.q[1]), src.q[1].min(-rec.q[0]));
+    if !(p1 > p0 && q1 > q0) {
+        return 0.0;
+    }
+    let gl = gauss_legendre(64);
+    let (c, s) = (theta.cos(), theta.sin());
+    let mut total = 0.0;
+    for (xp, wp) in &gl {
+        let p = 0.5 * (p0 + p1) + 0.5 * (p1 - p0) * xp;
+        for (xq, wq) in &gl {
+            let q = 0.5 * (q0 + q1) + 0.5 * (q1 - q0) * xq;
+            let r2 = 1.0 + p * p + q * q;
+            let cos_i = ((c + p * s) / r2.sqrt()).max(0.0);
+            total += wp * wq * refl(cos_i) * cos_i / (r2 * r2.sqrt());
+        }
+    }
+    total * 0.25 * (p1 - p0) * (q1 - q0)
+}
+
+/// Independent Lambertian flux (f = `f_lum` everywhere) through one source and one receptor stop.
+pub fn lambertian_flux_reference(theta: f64, src: Stop, rec: Stop, f_lum: f64) -> f64 {
+    let (Some(src), Some(rec)) = (above_horizon(src, theta, true), above_horizon(rec, theta, false)) else {
+        return 0.0;
+    };
+    let (s, c) = theta.sin_cos();
+    let ps = projected_solid_angle(Vec3::new(-s, 0.0, c), Vec3::new(c, 0.0, s), src);
+    let pr = projected_solid_angle(Vec3::new(s, 0.0, c), Vec3::new(c, 0.0, -s), rec);
+    f_lum * ps * pr
+}
+
+/// The reference flux of one job of the plan, for a Lambertian specimen of luminous value `f_lum`.
+fn closed_form_flux(job: &Job, f_lum: f64) -> f64 {
+    match job.target {
+        Target::Specimen => lambertian_flux_reference(job.theta, job.source, job.receptor, f_lum),
+        Target::Standard => {
+            let n = job.reference_index;
+            mirror_flux_reference(job.theta, job.source, job.receptor, &|c| fr_dielectric(c, n))
+        }
+    }
+}
+
+/// A reading from reference fluxes, by the definitions in `instrument::geometry::ReadingSpec`.
+fn closed_form_reading(r: &PlannedReading, flux: &[f64], done: &[Option<f64>]) -> Option<f64> {
+    let spec = |rx: &String| flux[r.specimen[rx]];
+    let std = |rx: &String| flux[r.standard[rx]];
+    let mean = |rxs: &[String]| rxs.iter().map(spec).sum::<f64>() / rxs.len() as f64;
+    let v = match &r.spec {
+        ReadingSpec::Gloss { receptor } => 100.0 * spec(receptor) / std(receptor),
+        ReadingSpec::Haze { receptors, specular } => 100.0 * mean(receptors) / std(specular),
+        ReadingSpec::LogHaze { receptors, specular, k } => {
+            let h = 100.0 * mean(receptors) / std(specular);
+            k * (h / 20.0 + 1.0).log10()
+        }
+        ReadingSpec::Doi { specular, offset } => 100.0 * (1.0 - mean(offset) / spec(specular)),
+        ReadingSpec::HazeIndex { .. } => done[r.parts[0]]? - done[r.parts[1]]?,
+    };
+    v.is_finite().then_some(v)
+}
+
+/// Closed-form references for every reported reading of `plan` (Lambertian material of luminous value
+/// `f_lum`), in the order of `plan.execute()`.
+pub fn closed_form_references(plan: &Plan, f_lum: f64) -> Vec<ReferenceValue> {
+    let flux: Vec<f64> = plan.jobs.iter().map(|j| closed_form_flux(j, f_lum)).collect();
+    let mut done: Vec<Option<f64>> = Vec::with_capacity(plan.readings.len());
+    for r in &plan.readings {
+        let v = closed_form_reading(r, &flux, &done);
+        done.push(v);
+    }
+    plan.readings
+        .iter()
+        .zip(done)
+        .filter(|(r, _)| r.reported)
+        .map(|(r, v)| ReferenceValue { geometry: r.geometry.clone(), reading: r.name.clone(), value: v, error_estimate: None })
+        .collect()
+}
+
+/// Execute `plan` repeatedly (see the module documentation); the readings of the first execution, the
+/// per-reading minimum times, the minimum plan time and the number of executions.
+fn timed_execute(plan: &Plan, options: &SweepOptions) -> Result<(Vec<Reading>, Vec<f64>, f64, usize)> {
+    let start = Instant::now();
+    let mut first: Option<Vec<Reading>> = None;
+    let mut best_plan = f64::INFINITY;
+    let mut best: Vec<f64> = vec![];
+    let mut reps = 0;
+    loop {
+        let t0 = Instant::now();
+        let readings = plan.execute();
+        let dt = t0.elapsed().as_secs_f64();
+        reps += 1;
+        best_plan = best_plan.min(dt);
+        match &first {
+            None => {
+                best = readings.iter().map(|r| r.seconds).collect();
+                first = Some(readings);
+            }
+            Some(f) => {
+                for (i, (a, b)) in f.iter().zip(&readings).enumerate() {
+                    let same = a.value.map(f64::to_bits) == b.value.map(f64::to_bits)
+                        && a.error_estimate.to_bits() == b.error_estimate.to_bits();
+                    if !same {
+                        return Err(Error::Numeric(format!(
+                            "{} {}: two executions at rtol = {:e} gave different results ({:?} ± {:e} vs {:?} ± {:e}); the engine should be deterministic",
+                            a.geometry, a.name, plan.options.rtol, a.value, a.error_estimate, b.value, b.error_estimate
+                        )));
+                    }
+                    best[i] = best[i].min(b.seconds);
+                }
+            }
+        }
+        if start.elapsed().as_secs_f64() >= options.min_seconds || reps >= options.max_repetitions.max(1) {
+            break;
+        }
+    }
+    Ok((first.expect("executed at least once"), best, best_plan, reps))
+}
+
+fn finite(x: f64) -> Option<f64> {
+    x.is_finite().then_some(x)
+}
+
+/// Run the sweep. `tolerances` are validated, sorted from loose to tight and de-duplicated.
+pub fn sweep(material: Arc<dyn Brdf>, geometries: Vec<StandardGeometry>, tolerances: &[f64], options: &SweepOptions) -> Result<Sweep> {
+    validate_tolerances(tolerances)?;
+    if !(options.min_seconds.is_finite() && options.min_seconds >= 0.0) {
+        return Err(Error::Usage(format!("minimum timing interval must be a number ≥ 0 s, got {}", options.min_seconds)));
+    }
+    let mut tols = tolerances.to_vec();
+    tols.sort_by(|a, b| b.total_cmp(a));
+    tols.dedup();
+    let tightest = *tols.last().expect("validated non-empty");
+    let plan_options = |rtol: f64| PlanOptions { rtol, max_evals: options.max_evals, ..PlanOptions::default() };
+
+    // The reference.
+    let probe = Plan::compile(material.clone(), geometries.clone(), plan_options(tightest))?;
+    let lambert = if options.force_run_reference { None } else { lambertian_value(material.as_ref()) };
+    let (kind, references, reference_seconds) = match lambert {
+        Some(f_lum) => (ReferenceKind::ClosedForm, closed_form_references(&probe, f_lum), 0.0),
+        None => {
+            let rtol = tightest / REFERENCE_FACTOR;
+            let plan = Plan::compile(material.clone(), geometries.clone(), plan_options(rtol))?;
+            let t0 = Instant::now();
+            let readings = plan.execute();
+            let secs = t0.elapsed().as_secs_f64();
+            let refs = readings
+                .iter()
+                .map(|r| ReferenceValue {
+                    geometry: r.geometry.clone(),
+                    reading: r.name.clone(),
+                    value: r.value.filter(|v| v.is_finite()),
+                    error_estimate: r.value.and_then(|_| finite(r.error_estimate)),
+                })
+                .collect();
+            (ReferenceKind::Run { rtol }, refs, secs)
+        }
+    };
+    let label = kind.label();
+
+    let mut rows = Vec::new();
+    for &rtol in &tols {
+        let plan = Plan::compile(material.clone(), geometries.clone(), plan_options(rtol))?;
+        let (readings, secs, plan_secs, reps) = timed_execute(&plan, options)?;
+        if readings.len() != references.len() {
+            return Err(Error::Numeric(format!(
+                "rtol = {rtol:e}: {} readings but {} references",
+                readings.len(),
+                references.len()
+            )));
+        }
+        for ((r, s), reference) in readings.iter().zip(secs).zip(&references) {
+            if r.geometry != reference.geometry || r.name != reference.reading {
+                return Err(Error::Numeric(format!(
+                    "reading order differs from the reference: {} {} vs {} {}",
+                    r.geometry, r.name, reference.geometry, reference.reading
+                )));
+            }
+            let value = r.value.filter(|v| v.is_finite());
+            let error_estimate = value.and_then(|_| finite(r.error_estimate));
+            let actual_error = match (value, reference.value) {
+                (Some(v), Some(x)) => finite((v - x).abs()),
+                _ => None,
+            };
+            rows.push(Row {
+                rtol,
+                geometry: r.geometry.clone(),
+                reading: r.name.clone(),
+                quantity: r.quantity.clone(),
+                unit: r.unit.clone(),
+                value,
+                error_estimate,
+                actual_error,
+                reference: reference.value,
+                reference_error: reference.error_estimate,
+                reference_kind: label.clone(),
+                evaluations: r.evaluations,
+                seconds: s,
+                plan_seconds: plan_secs,
+                repetitions: reps,
+                converged: r.converged,
+                problem: r.problem.clone(),
+            });
+        }
+    }
+    Ok(Sweep { tolerances: tols, reference: kind, references, reference_seconds, rows, options: options.clone() })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn projected_solid_angle_of_a_small_stop_is_cos_times_solid_angle() {
+        // A 1 mrad square stop about an axis at 60°: P ≈ cos 60° · Ω to second order in the size.
+        let t: f64 = 60f64.to_radians();
+        let stop = Stop { p: [-5e-4, 5e-4], q: [-5e-4, 5e-4] };
+        let p = projected_solid_angle(Vec3::new(-t.sin(), 0.0, t.cos()), Vec3::new(t.cos(), 0.0, t.sin()), stop);
+        let expect = t.cos() * stop.solid_angle();
+        assert!((p - expect).abs() < 1e-6 * expect, "{p} vs {expect}");
+    }
+
+    #[test]
+    fn projected_solid_angle_of_the_hemisphere_is_pi() {
+        // The whole tangent plane about the normal, truncated far out, tends to π.
+        let big = 1e7;
+        let p = projected_solid_angle(Vec3::Z, Vec3::X, Stop { p: [-big, big], q: [-big, big] });
+        assert!((p - std::f64::consts::PI).abs() < 1e-6, "{p}");
+    }
+
+    #[test]
+    fn gauss_legendre_integrates_polynomials_exactly() {
+        let gl = gauss_legendre(64);
+        let s: f64 = gl.iter().map(|(x, w)| w * x.powi(126)).sum();
+        assert!((s - 2.0 / 127.0).abs() < 1e-14, "{s}");
+        let w: f64 = gl.iter().map(|(_, w)| w).sum();
+        assert!((w - 2.0).abs() < 1e-14);
+    }
+
+    #[test]
+    fn tolerances_are_validated() {
+        assert!(validate_tolerances(&[1e-3, 1e-6]).is_ok());
+        for bad in [0.0, -1e-3, 1.0, 2.0, f64::NAN, f64::INFINITY] {
+            assert!(validate_tolerances(&[1e-3, bad]).is_err(), "{bad} accepted");
+        }
+        assert!(validate_tolerances(&[]).is_err());
+    }
+}
