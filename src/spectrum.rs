@@ -95,7 +95,11 @@ impl Sampling {
             return Err(bad("the grid carries no luminous weight".into()));
         }
         weights.iter_mut().for_each(|w| *w /= total);
-        Ok(Sampling { kind: SamplingKind::Spectral, wavelengths_nm: wavelengths_nm.to_vec(), luminous_weights: weights })
+        Ok(Sampling {
+            kind: SamplingKind::Spectral,
+            wavelengths_nm: wavelengths_nm.to_vec(),
+            luminous_weights: weights,
+        })
     }
 
     pub fn len(&self) -> usize {

@@ -85,7 +85,10 @@ impl Brdf for TestBeckmann {
         out[0] = fr_dielectric(wi.dot(h), self.n) * d * g / (4.0 * wi.z * wo.z);
     }
     fn terms(&self) -> Vec<Term> {
-        vec![Term { label: "beckmann".into(), kind: TermKind::Lobe(Lobe { slope_width: self.m, medium_eta: 1.0, label: "beckmann".into() }) }]
+        vec![Term {
+            label: "beckmann".into(),
+            kind: TermKind::Lobe(Lobe { slope_width: self.m, medium_eta: 1.0, label: "beckmann".into() }),
+        }]
     }
     fn describe(&self) -> String {
         format!("test beckmann m = {}", self.m)
@@ -159,7 +162,8 @@ fn geometry(id: &str) -> glossmeter::instrument::geometry::Geometry {
 }
 
 fn gloss_of(brdf: Arc<dyn Brdf>, id: &str, rtol: f64) -> Reading {
-    let plan = Plan::compile(brdf, vec![standards::find(id).unwrap()], PlanOptions { rtol, ..Default::default() }).unwrap();
+    let plan =
+        Plan::compile(brdf, vec![standards::find(id).unwrap()], PlanOptions { rtol, ..Default::default() }).unwrap();
     plan.execute().into_iter().find(|r| r.quantity == "gloss").unwrap()
 }
 
@@ -174,7 +178,9 @@ fn lambertian_flux_matches_closed_form() {
         let rho = 0.5;
         let brdf = TestLambert(rho, Sampling::grey());
         for (name, stop) in &g.receptors {
-            let exact = rho / std::f64::consts::PI * projected_solid_angle(axes_src, epar_src, g.source) * projected_solid_angle(axes_rec, epar_rec, *stop);
+            let exact = rho / std::f64::consts::PI
+                * projected_solid_angle(axes_src, epar_src, g.source)
+                * projected_solid_angle(axes_rec, epar_rec, *stop);
             let f = FluxProblem {
                 brdf: &brdf,
                 theta: g.theta,
@@ -191,7 +197,12 @@ fn lambertian_flux_matches_closed_form() {
             .solve();
             let rel = (f.value - exact).abs() / exact;
             assert!(rel < 1e-9, "{id}/{name}: {} vs {exact} (rel {rel:e})", f.value);
-            assert!((f.value - exact).abs() <= f.error.max(1e-15 * exact), "{id}/{name}: error estimate {:e} below actual {:e}", f.error, (f.value - exact).abs());
+            assert!(
+                (f.value - exact).abs() <= f.error.max(1e-15 * exact),
+                "{id}/{name}: error estimate {:e} below actual {:e}",
+                f.error,
+                (f.value - exact).abs()
+            );
         }
     }
 }
@@ -209,7 +220,12 @@ fn gloss_standard_reads_100_and_dielectric_15_reads_aperture_averaged_values() {
         let reference = 100.0 * mirror_flux_reference(g.theta, g.source, rec, &|c| fr_dielectric(c, 1.5))
             / mirror_flux_reference(g.theta, g.source, rec, &|c| fr_dielectric(c, g.reference_index));
         assert!((v - reference).abs() < 1e-9 * reference, "{id}: {v} vs independent {reference}");
-        assert!((v - reference).abs() <= r.error_estimate.max(1e-12), "{id}: estimate {:e} < actual {:e}", r.error_estimate, (v - reference).abs());
+        assert!(
+            (v - reference).abs() <= r.error_estimate.max(1e-12),
+            "{id}: estimate {:e} < actual {:e}",
+            r.error_estimate,
+            (v - reference).abs()
+        );
         assert!((v - expect_15).abs() < 0.01, "{id}: {v} vs about {expect_15}");
         let mirror = gloss_of(Arc::new(TestMirror(None, Sampling::grey())), id, 1e-9).value.unwrap();
         let reference = 100.0 * mirror_flux_reference(g.theta, g.source, rec, &|_| 1.0)
@@ -249,4 +265,24 @@ fn a_lobe_much_narrower_than_the_apertures_is_found() {
     let r = gloss_of(Arc::new(TestBeckmann { m: 1e-5, n: 1.567, s: Sampling::grey() }), "astm-d523-20", 1e-6);
     let v = r.value.unwrap();
     assert!((v - 100.0).abs() < 0.01, "roughness 1e-5 at 20° reads {v}, expected ≈ 100");
+}
+
+#[test]
+fn haze_index_alone_or_first_is_g60_minus_g20() {
+    let brdf: Arc<dyn Brdf> = Arc::new(TestBeckmann { m: 0.05, n: 1.5, s: Sampling::grey() });
+    let alone = Plan::compile(brdf.clone(), vec![standards::find("astm-d4039").unwrap()], PlanOptions::default())
+        .unwrap()
+        .execute();
+    assert_eq!(alone.len(), 1, "only the requested composite is reported");
+    let all = Plan::compile(
+        brdf,
+        ["astm-d4039", "astm-d523-60", "astm-d523-20"].iter().map(|id| standards::find(id).unwrap()).collect(),
+        PlanOptions::default(),
+    )
+    .unwrap()
+    .execute();
+    let g = |id: &str| all.iter().find(|r| r.geometry == id).unwrap().value.unwrap();
+    let h = g("astm-d4039");
+    assert_eq!(h.to_bits(), alone[0].value.unwrap().to_bits());
+    assert_eq!(h, g("astm-d523-60") - g("astm-d523-20"));
 }

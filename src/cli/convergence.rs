@@ -166,7 +166,8 @@ fn reference_note(sweep: &Sweep) -> String {
 
 /// The aligned table.
 pub fn table(material: &Material, sweep: &Sweep) -> String {
-    let head = ["rtol", "geometry", "reading", "value", "est. error", "actual error", "evaluations", "time", "reference"];
+    let head =
+        ["rtol", "geometry", "reading", "value", "est. error", "actual error", "evaluations", "time", "reference"];
     let mut rows: Vec<Vec<String>> = vec![head.iter().map(|s| s.to_string()).collect()];
     let mut notes = Vec::new();
     for r in &sweep.rows {
@@ -192,7 +193,8 @@ pub fn table(material: &Material, sweep: &Sweep) -> String {
     }
     let ncol = head.len();
     let widths: Vec<usize> = (0..ncol).map(|c| rows.iter().map(|r| r[c].chars().count()).max().unwrap_or(0)).collect();
-    let mut s = format!("{} ({})\n{}\n{}\n", material.name, material.file, material.brdf.describe(), reference_note(sweep));
+    let mut s =
+        format!("{} ({})\n{}\n{}\n", material.name, material.file, material.brdf.describe(), reference_note(sweep));
     s.push_str(&format!(
         "Time: per reading (sum of the wall times of the aperture integrals it uses), minimum over repeated executions (until {} ms or {} executions).\n\n",
         sweep.options.min_seconds * 1e3,
@@ -274,7 +276,8 @@ pub fn csv(sweep: &Sweep) -> Result<String> {
         ])
         .map_err(err)?;
     }
-    let bytes = w.into_inner().map_err(|e| Error::Io { file: "<csv>".into(), source: std::io::Error::other(e.to_string()) })?;
+    let bytes =
+        w.into_inner().map_err(|e| Error::Io { file: "<csv>".into(), source: std::io::Error::other(e.to_string()) })?;
     Ok(String::from_utf8(bytes).expect("csv is utf-8"))
 }
 
@@ -307,7 +310,9 @@ pub fn json(material: &Material, sweep: &Sweep) -> String {
         .collect();
     let reference = match &sweep.reference {
         ReferenceKind::ClosedForm => json!({"kind": "closed form", "rtol": null, "seconds": null}),
-        ReferenceKind::Run { rtol } => json!({"kind": sweep.reference.label(), "rtol": rtol, "seconds": sweep.reference_seconds}),
+        ReferenceKind::Run { rtol } => {
+            json!({"kind": sweep.reference.label(), "rtol": rtol, "seconds": sweep.reference_seconds})
+        }
     };
     let doc = json!({
         "material": {"name": material.name, "file": material.file, "model": material.brdf.describe()},

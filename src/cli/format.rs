@@ -143,6 +143,7 @@ pub fn csv(readings: &[Reading], timing: bool) -> Result<String> {
         rec.push(r.problem.clone().unwrap_or_default());
         w.write_record(&rec).map_err(err)?;
     }
-    let bytes = w.into_inner().map_err(|e| Error::Io { file: "<csv>".into(), source: std::io::Error::other(e.to_string()) })?;
+    let bytes =
+        w.into_inner().map_err(|e| Error::Io { file: "<csv>".into(), source: std::io::Error::other(e.to_string()) })?;
     Ok(String::from_utf8(bytes).expect("csv is utf-8"))
 }

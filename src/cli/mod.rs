@@ -11,11 +11,15 @@ use crate::instrument::standards;
 use crate::{recipe, Error, Result};
 
 pub mod convergence;
-pub mod plot;
 pub mod format;
+pub mod plot;
 
 #[derive(Parser, Debug)]
-#[command(name = "glossmeter", version, about = "A virtual gloss, haze and DOI meter: reads a BRDF through the apertures of ASTM D523 / ISO 2813 / ASTM E430 / ISO 13803 instruments.")]
+#[command(
+    name = "glossmeter",
+    version,
+    about = "A virtual gloss, haze and DOI meter: reads a BRDF through the apertures of ASTM D523 / ISO 2813 / ASTM E430 / ISO 13803 instruments."
+)]
 pub struct Cli {
     #[command(subcommand)]
     pub command: Command,
@@ -68,7 +72,8 @@ pub enum Command {
 }
 
 /// The default panel of `measure`.
-pub const DEFAULT_GEOMETRIES: &[&str] = &["astm-d523-20", "astm-d523-60", "astm-d523-85", "astm-e430-30", "iso-13803-20", "astm-d4039"];
+pub const DEFAULT_GEOMETRIES: &[&str] =
+    &["astm-d523-20", "astm-d523-60", "astm-d523-85", "astm-e430-30", "iso-13803-20", "astm-d4039"];
 
 /// Run the CLI; returns the process exit status.
 pub fn run<I, T>(args: I) -> i32
@@ -168,7 +173,10 @@ pub fn emit(text: &str, output: Option<&Path>) -> Result<()> {
         Some(p) => {
             let file = std::fs::OpenOptions::new().write(true).create_new(true).open(p).map_err(|e| {
                 if e.kind() == std::io::ErrorKind::AlreadyExists {
-                    Error::Usage(format!("{}: already exists; glossmeter never overwrites a file (choose another name)", p.display()))
+                    Error::Usage(format!(
+                        "{}: already exists; glossmeter never overwrites a file (choose another name)",
+                        p.display()
+                    ))
                 } else {
                     Error::Io { file: p.display().to_string(), source: e }
                 }

@@ -39,7 +39,10 @@ pub fn check_plot_path(path: &Path) -> Result<()> {
         _ => return Err(Error::Usage(format!("--plot {}: the plot file name must end in .svg", path.display()))),
     }
     if path.exists() {
-        return Err(Error::Usage(format!("{}: already exists; glossmeter never overwrites a file (choose another name)", path.display())));
+        return Err(Error::Usage(format!(
+            "{}: already exists; glossmeter never overwrites a file (choose another name)",
+            path.display()
+        )));
     }
     Ok(())
 }
@@ -132,7 +135,9 @@ pub fn render_svg(sweep: &Sweep, title: &str) -> Result<(String, PlotSummary)> {
                 .draw_series(DashedLineSeries::new(estimated.clone(), 6, 4, colour.stroke_width(1)))
                 .map_err(plot_err)?
                 .label(format!("{}: estimated error (dashed)", s.label))
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 6, y), (x + 10, y), (x + 16, y)], colour.stroke_width(1)));
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 6, y), (x + 10, y), (x + 16, y)], colour.stroke_width(1))
+                });
             chart.draw_series(estimated.iter().map(|&p| Cross::new(p, 3, colour.stroke_width(1)))).map_err(plot_err)?;
         }
         chart
@@ -178,12 +183,17 @@ pub fn write_svg(sweep: &Sweep, title: &str, path: &Path) -> Result<PlotSummary>
     let (svg, summary) = render_svg(sweep, title)?;
     let file = std::fs::OpenOptions::new().write(true).create_new(true).open(path).map_err(|e| {
         if e.kind() == std::io::ErrorKind::AlreadyExists {
-            Error::Usage(format!("{}: already exists; glossmeter never overwrites a file (choose another name)", path.display()))
+            Error::Usage(format!(
+                "{}: already exists; glossmeter never overwrites a file (choose another name)",
+                path.display()
+            ))
         } else {
             Error::Io { file: path.display().to_string(), source: e }
         }
     })?;
     let mut w = std::io::BufWriter::new(file);
-    w.write_all(svg.as_bytes()).and_then(|_| w.flush()).map_err(|e| Error::Io { file: path.display().to_string(), source: e })?;
+    w.write_all(svg.as_bytes())
+        .and_then(|_| w.flush())
+        .map_err(|e| Error::Io { file: path.display().to_string(), source: e })?;
     Ok(summary)
 }

@@ -160,8 +160,18 @@ impl FluxProblem<'_> {
         let weights = self.spectral.weights().to_vec();
         let n = weights.len();
         let axes = Axes::new(self.theta);
-        let (Some(src), Some(rec)) = (clip(self.source, self.theta, true), clip(self.receptor, self.theta, false)) else {
-            return Flux { value: 0.0, error: 0.0, delta: 0.0, regular: 0.0, evaluations: 0, regions: 0, converged: true, seconds: 0.0 };
+        let (Some(src), Some(rec)) = (clip(self.source, self.theta, true), clip(self.receptor, self.theta, false))
+        else {
+            return Flux {
+                value: 0.0,
+                error: 0.0,
+                delta: 0.0,
+                regular: 0.0,
+                evaluations: 0,
+                regions: 0,
+                converged: true,
+                seconds: 0.0,
+            };
         };
         let (separate, ncomp) = match self.spectral {
             Spectral::Folded(_) => (false, 1),
@@ -169,7 +179,10 @@ impl FluxProblem<'_> {
         };
         let lum = |e: &Estimate| -> (f64, f64) {
             if separate {
-                (weights.iter().zip(&e.value).map(|(w, v)| w * v).sum(), weights.iter().zip(&e.error).map(|(w, v)| w * v).sum())
+                (
+                    weights.iter().zip(&e.value).map(|(w, v)| w * v).sum(),
+                    weights.iter().zip(&e.error).map(|(w, v)| w * v).sum(),
+                )
             } else {
                 (e.value[0], e.error[0])
             }

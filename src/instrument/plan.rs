@@ -171,7 +171,16 @@ impl Plan {
             .collect();
         let has_delta = terms.iter().any(|t| t.kind == TermKind::Delta);
         let has_regular = terms.iter().any(|t| t.kind != TermKind::Delta);
-        let mut plan = Plan { material, options, geometries: Vec::new(), jobs: Vec::new(), readings: Vec::new(), lobes, has_delta, has_regular };
+        let mut plan = Plan {
+            material,
+            options,
+            geometries: Vec::new(),
+            jobs: Vec::new(),
+            readings: Vec::new(),
+            lobes,
+            has_delta,
+            has_regular,
+        };
         let mut index: HashMap<Vec<u64>, usize> = HashMap::new();
         // Requested geometries first, then the dependencies of composites.
         let mut queue: Vec<(StandardGeometry, bool)> = geometries.into_iter().map(|g| (g, true)).collect();
@@ -202,7 +211,9 @@ impl Plan {
                         .readings
                         .iter()
                         .position(|x| &x.geometry == id && matches!(x.spec, ReadingSpec::Gloss { .. }))
-                        .ok_or_else(|| Error::Usage(format!("{}: geometry `{id}` has no gloss reading", plan.readings[r].geometry)))?;
+                        .ok_or_else(|| {
+                            Error::Usage(format!("{}: geometry `{id}` has no gloss reading", plan.readings[r].geometry))
+                        })?;
                     parts.push(part);
                 }
                 plan.readings[r].parts = parts;
@@ -228,7 +239,12 @@ impl Plan {
         self.jobs.len() - 1
     }
 
-    fn add_geometry(&mut self, sg: &StandardGeometry, reported: bool, index: &mut HashMap<Vec<u64>, usize>) -> Result<()> {
+    fn add_geometry(
+        &mut self,
+        sg: &StandardGeometry,
+        reported: bool,
+        index: &mut HashMap<Vec<u64>, usize>,
+    ) -> Result<()> {
         let g = &sg.geometry;
         for (ri, spec) in g.readings.iter().enumerate() {
             let name = sg.reading_names.get(ri).cloned().unwrap_or_else(|| spec.quantity().to_string());
@@ -237,7 +253,9 @@ impl Plan {
                 ReadingSpec::Haze { receptors, specular } | ReadingSpec::LogHaze { receptors, specular, .. } => {
                     (receptors.iter().collect(), vec![specular])
                 }
-                ReadingSpec::Doi { specular, offset } => (std::iter::once(specular).chain(offset.iter()).collect(), vec![]),
+                ReadingSpec::Doi { specular, offset } => {
+                    (std::iter::once(specular).chain(offset.iter()).collect(), vec![])
+                }
                 ReadingSpec::HazeIndex { .. } => (vec![], vec![]),
             };
             let mut pr = PlannedReading {
@@ -251,9 +269,9 @@ impl Plan {
             };
             for (names, target) in [(spec_rx, Target::Specimen), (std_rx, Target::Standard)] {
                 for rx in names {
-                    let stop = *g
-                        .receptor(rx)
-                        .ok_or_else(|| Error::Usage(format!("{}: reading `{}` names unknown receptor `{rx}`", g.id, pr.name)))?;
+                    let stop = *g.receptor(rx).ok_or_else(|| {
+                        Error::Usage(format!("{}: reading `{}` names unknown receptor `{rx}`", g.id, pr.name))
+                    })?;
                     let j = self.job(
                         index,
                         Job {
@@ -340,19 +358,33 @@ impl Plan {
                 .fold(0.0, f64::max);
             1e-4 * self.options.rtol * m
         };
-        let spec_jobs: Vec<(usize, f64)> =
-            (0..self.jobs.len()).filter(|&j| self.jobs[j].target == Target::Specimen).map(|j| (j, floor(self.jobs[j].theta))).collect();
+        let spec_jobs: Vec<(usize, f64)> = (0..self.jobs.len())
+            .filter(|&j| self.jobs[j].target == Target::Specimen)
+            .map(|j| (j, floor(self.jobs[j].theta)))
+            .collect();
         let spec_flux: Vec<Flux> = spec_jobs.par_iter().map(|&(j, atol)| self.run_job(&self.jobs[j], atol)).collect();
         for ((j, _), f) in spec_jobs.iter().zip(spec_flux) {
             flux[*j] = Some(f);
         }
         let flux: Vec<Flux> = flux.into_iter().map(|f| f.expect("every job ran")).collect();
-        let mut out: Vec<Reading> = Vec::with_capacity(self.readings.len());
-        for r in &self.readings {
-            let reading = compute_reading(r, &flux, &out);
-            out.push(reading);
+        // Direct readings first, then composites, which combine direct readings (their parts may come
+        // later in plan order when the user asked for the composite before its parts, or only for it).
+        let mut out: Vec<Option<Reading>> = vec![None; self.readings.len()];
+        for (i, r) in self.readings.iter().enumerate() {
+            if r.parts.is_empty() {
+                out[i] = Some(compute_reading(r, &flux, &out));
+            }
         }
-        out.into_iter().zip(&self.readings).filter(|(_, p)| p.reported).map(|(r, _)| r).collect()
+        for (i, r) in self.readings.iter().enumerate() {
+            if !r.parts.is_empty() {
+                out[i] = Some(compute_reading(r, &flux, &out));
+            }
+        }
+        out.into_iter()
+            .zip(&self.readings)
+            .filter(|(_, p)| p.reported)
+            .map(|(r, _)| r.expect("every reading computed"))
+            .collect()
     }
 
     /// The plan in plain words.
@@ -369,12 +401,19 @@ impl Plan {
         s.push_str("Terms of the material, and how each is integrated:\n");
         for t in m.terms() {
             let how = match &t.kind {
-                TermKind::Delta => "ideal mirror: analytic in the lobe variables, a 2-D integral over the stops' mirror overlap".to_string(),
+                TermKind::Delta => {
+                    "ideal mirror: analytic in the lobe variables, a 2-D integral over the stops' mirror overlap"
+                        .to_string()
+                }
                 TermKind::Diffuse => "smooth in direction: no lobe splits needed".to_string(),
                 TermKind::Lobe(l) => format!(
                     "glossy lobe, slope width {:.3e}{}: lobe variables split at 0 and ±(1, 3, 10, 30, 100)× its width",
                     l.slope_width,
-                    if l.medium_eta != 1.0 { format!(" inside a medium of index {}", l.medium_eta) } else { String::new() }
+                    if l.medium_eta != 1.0 {
+                        format!(" inside a medium of index {}", l.medium_eta)
+                    } else {
+                        String::new()
+                    }
                 ),
             };
             s.push_str(&format!("  - {}: {how}\n", t.label));
@@ -383,13 +422,25 @@ impl Plan {
         for g in &self.geometries {
             let geo = &g.geometry;
             if geo.is_composite() {
-                s.push_str(&format!("Geometry {} ({}): combines other geometries' gloss readings\n", geo.id, geo.title));
+                s.push_str(&format!(
+                    "Geometry {} ({}): combines other geometries' gloss readings\n",
+                    geo.id, geo.title
+                ));
                 continue;
             }
-            s.push_str(&format!("Geometry {} ({}), θ = {:.4}°, standard n = {}\n", geo.id, geo.title, geo.theta.to_degrees(), geo.reference_index));
+            s.push_str(&format!(
+                "Geometry {} ({}), θ = {:.4}°, standard n = {}\n",
+                geo.id,
+                geo.title,
+                geo.theta.to_degrees(),
+                geo.reference_index
+            ));
             for l in &self.lobes {
                 let w = lobe_widths_uv(l, geo.theta);
-                s.push_str(&format!("  lobe '{}' is {:.3e} × {:.3e} wide in the lobe variables (u, v)\n", l.label, w[0], w[1]));
+                s.push_str(&format!(
+                    "  lobe '{}' is {:.3e} × {:.3e} wide in the lobe variables (u, v)\n",
+                    l.label, w[0], w[1]
+                ));
             }
         }
         let n_spec = self.jobs.iter().filter(|j| j.target == Target::Specimen).count();
@@ -401,7 +452,11 @@ impl Plan {
             n_std,
             uses,
             self.readings.len(),
-            if self.options.share_fluxes { "; each distinct integral computed once and shared" } else { "; sharing off" }
+            if self.options.share_fluxes {
+                "; each distinct integral computed once and shared"
+            } else {
+                "; sharing off"
+            }
         ));
         for (i, j) in self.jobs.iter().enumerate() {
             s.push_str(&format!(
@@ -411,7 +466,10 @@ impl Plan {
                 j.used_by.join(", ")
             ));
         }
-        s.push_str(&format!("Tolerance: relative {:e} on every reading (each flux to half of it).\n", self.options.rtol));
+        s.push_str(&format!(
+            "Tolerance: relative {:e} on every reading (each flux to half of it).\n",
+            self.options.rtol
+        ));
         s
     }
 }
@@ -432,7 +490,7 @@ fn problem_reading(r: &PlannedReading, why: String) -> Reading {
 }
 
 /// Combine fluxes into a reading, with first-order error propagation.
-fn compute_reading(r: &PlannedReading, flux: &[Flux], done: &[Reading]) -> Reading {
+fn compute_reading(r: &PlannedReading, flux: &[Flux], done: &[Option<Reading>]) -> Reading {
     let spec = |rx: &String| &flux[r.specimen[rx]];
     let std = |rx: &String| &flux[r.standard[rx]];
     let used: Vec<&Flux> = r.specimen.values().chain(r.standard.values()).map(|&j| &flux[j]).collect();
@@ -467,8 +525,9 @@ fn compute_reading(r: &PlannedReading, flux: &[Flux], done: &[Reading]) -> Readi
             ratio(o, oe, s.value, s.error).map(|(v, e)| (100.0 * (1.0 - v), 100.0 * e))
         }
         ReadingSpec::HazeIndex { .. } => {
-            let a = &done[r.parts[0]];
-            let b = &done[r.parts[1]];
+            let (Some(a), Some(b)) = (&done[r.parts[0]], &done[r.parts[1]]) else {
+                return problem_reading(r, "a gloss reading it combines was not computed".into());
+            };
             let mut rd = match (a.value, b.value) {
                 (Some(x), Some(y)) => Reading {
                     geometry: r.geometry.clone(),
@@ -501,7 +560,11 @@ fn compute_reading(r: &PlannedReading, flux: &[Flux], done: &[Reading]) -> Readi
             evaluations,
             seconds,
             converged,
-            problem: if converged { None } else { Some("evaluation budget exhausted before the tolerance was met".into()) },
+            problem: if converged {
+                None
+            } else {
+                Some("evaluation budget exhausted before the tolerance was met".into())
+            },
         },
         Ok(_) => problem_reading(r, "non-finite result".into()),
         Err(why) => problem_reading(r, why),

@@ -96,7 +96,13 @@ impl<const D: usize> Rule<D> {
             200.0 / 19683.0,
             6859.0 / 19683.0 / (1u64 << D) as f64,
         ];
-        let w5 = [(729.0 - 950.0 * d + 50.0 * d * d) / 729.0, 245.0 / 486.0, (265.0 - 100.0 * d) / 1458.0, 25.0 / 729.0, 0.0];
+        let w5 = [
+            (729.0 - 950.0 * d + 50.0 * d * d) / 729.0,
+            245.0 / 486.0,
+            (265.0 - 100.0 * d) / 1458.0,
+            25.0 / 729.0,
+            0.0,
+        ];
         Rule { points, w7, w5 }
     }
 
@@ -243,9 +249,8 @@ pub fn integrate<const D: usize, F: FnMut(&[f64; D], &mut [f64])>(
         }
         heap.push(r);
     }
-    let done = |total: &[f64], err: &[f64]| {
-        total.iter().zip(err).all(|(t, e)| *e <= opts.atol.max(opts.rtol * t.abs()))
-    };
+    let done =
+        |total: &[f64], err: &[f64]| total.iter().zip(err).all(|(t, e)| *e <= opts.atol.max(opts.rtol * t.abs()));
     let mut converged = done(&total, &err);
     while !converged && evals + 2 * npts <= opts.max_evals {
         let Some(r) = heap.pop() else { break };
@@ -341,7 +346,12 @@ mod tests {
             let est = integrate::<2, _>(
                 |x, o| o[0] = (-(x[0] * x[0] + x[1] * x[1]) / (2.0 * sigma * sigma)).exp(),
                 1,
-                &[([-1.0, -1.0], [0.0, 0.0]), ([0.0, -1.0], [1.0, 0.0]), ([-1.0, 0.0], [0.0, 1.0]), ([0.0, 0.0], [1.0, 1.0])],
+                &[
+                    ([-1.0, -1.0], [0.0, 0.0]),
+                    ([0.0, -1.0], [1.0, 0.0]),
+                    ([-1.0, 0.0], [0.0, 1.0]),
+                    ([0.0, 0.0], [1.0, 1.0]),
+                ],
                 &Options { rtol: 1e-9, atol: 0.0, max_evals: 10_000_000 },
             );
             let e = libm::erf(1.0 / (sigma * 2f64.sqrt()));

@@ -111,7 +111,9 @@ pub fn number(file: &str, path: &str, v: &Value, lo: f64, hi: f64, what: &str) -
     let range = if hi.is_infinite() { format!("≥ {lo}") } else { format!("in [{lo}, {hi}]") };
     match x {
         Some(x) if x.is_finite() && x >= lo && x <= hi => Ok(x),
-        Some(x) if x.is_finite() => Err(Error::input(file, path, format!("{x} is out of range: {what} must be {range}"))),
+        Some(x) if x.is_finite() => {
+            Err(Error::input(file, path, format!("{x} is out of range: {what} must be {range}")))
+        }
         _ => Err(Error::input(file, path, format!("expected a finite number ({what}, {range}), got {}", kind(v)))),
     }
 }
@@ -131,7 +133,6 @@ pub fn kind(v: &Value) -> String {
 
 /// Parse JSON text, reporting the line and column of a syntax error.
 pub fn parse_json(text: &str, file: &str) -> Result<Value> {
-    serde_json::from_str(text).map_err(|e| {
-        Error::input(file, "", format!("malformed JSON at line {}, column {}: {e}", e.line(), e.column()))
-    })
+    serde_json::from_str(text)
+        .map_err(|e| Error::input(file, "", format!("malformed JSON at line {}, column {}: {e}", e.line(), e.column())))
 }
