@@ -41,11 +41,19 @@ const WGK: [f64; 8] = [
     0.209_482_141_084_727_8,
 ];
 /// Gauss weights for the nodes XGK[1], XGK[3], XGK[5], XGK[7].
-const WG: [f64; 4] = [0.129_484_966_168_869_7, 0.279_705_391_489_276_7, 0.381_830_050_505_118_9, 0.417_959_183_673_469_4];
+const WG: [f64; 4] =
+    [0.129_484_966_168_869_7, 0.279_705_391_489_276_7, 0.381_830_050_505_118_9, 0.417_959_183_673_469_4];
 
 /// One G7/K15 panel of a vector integrand of `n` components: (K15 values, max |K15 − G7| over the first
 /// `checked` components).
-fn gk15(f: &mut dyn FnMut(f64, &mut [f64]), a: f64, b: f64, n: usize, checked: usize, tmp: &mut [f64]) -> (Vec<f64>, f64) {
+fn gk15(
+    f: &mut dyn FnMut(f64, &mut [f64]),
+    a: f64,
+    b: f64,
+    n: usize,
+    checked: usize,
+    tmp: &mut [f64],
+) -> (Vec<f64>, f64) {
     let c = 0.5 * (a + b);
     let hw = 0.5 * (b - a);
     let mut k = vec![0.0; n];
@@ -99,7 +107,8 @@ fn adaptive(
             break;
         }
         // Bisect the panel with the largest error (first one on ties: deterministic).
-        let (idx, _) = panels.iter().enumerate().fold((0, -1.0), |acc, (i, p)| if p.3 > acc.1 { (i, p.3) } else { acc });
+        let (idx, _) =
+            panels.iter().enumerate().fold((0, -1.0), |acc, (i, p)| if p.3 > acc.1 { (i, p.3) } else { acc });
         let (a, b, _, _) = panels.swap_remove(idx);
         let m = 0.5 * (a + b);
         if !(m > a && m < b) {
@@ -115,8 +124,8 @@ fn adaptive(
     let mut sum = vec![0.0; n];
     let mut err = 0.0;
     for p in &panels {
-        for i in 0..n {
-            sum[i] += p.2[i];
+        for (s, v) in sum.iter_mut().zip(&p.2) {
+            *s += v;
         }
         err += p.3;
     }
@@ -132,7 +141,7 @@ pub const ALBEDO_TOLERANCE: f64 = 1e-9;
 pub fn directional_albedo(brdf: &dyn Brdf, wi: Vec3) -> (Vec<f64>, f64) {
     let n = brdf.sampling().len();
     let mut total = vec![0.0; n];
-    if !(wi.z > 0.0) {
+    if wi.z.is_nan() || wi.z <= 0.0 {
         return (total, 0.0);
     }
     let wi = wi.normalize();

@@ -171,7 +171,10 @@ impl Brdf for MicrofacetSurface {
 
     fn terms(&self) -> Vec<Term> {
         if self.facets.effectively_smooth() {
-            vec![Term { label: "specular reflection (smooth limit of the microfacet lobe)".into(), kind: TermKind::Delta }]
+            vec![Term {
+                label: "specular reflection (smooth limit of the microfacet lobe)".into(),
+                kind: TermKind::Delta,
+            }]
         } else {
             let label = format!("microfacet lobe ({})", describe_facets(&self.facets));
             vec![Term {

@@ -70,7 +70,10 @@ impl Brdf for Ward {
             t.push(Term { label: "Lambertian".into(), kind: TermKind::Diffuse });
         }
         let label = format!("Ward lobe (α = {})", self.alpha);
-        t.push(Term { label: label.clone(), kind: TermKind::Lobe(Lobe { slope_width: self.alpha, medium_eta: 1.0, label }) });
+        t.push(Term {
+            label: label.clone(),
+            kind: TermKind::Lobe(Lobe { slope_width: self.alpha, medium_eta: 1.0, label }),
+        });
         t
     }
 

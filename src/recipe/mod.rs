@@ -296,7 +296,9 @@ fn distribution(obj: &Obj, required: bool) -> Result<Distribution> {
     match s {
         None | Some("beckmann") => Ok(Distribution::Beckmann),
         Some("ggx") => Ok(Distribution::Ggx),
-        Some(other) => Err(obj.err("distribution", format!("unknown distribution \"{other}\"; allowed: \"beckmann\", \"ggx\""))),
+        Some(other) => {
+            Err(obj.err("distribution", format!("unknown distribution \"{other}\"; allowed: \"beckmann\", \"ggx\"")))
+        }
     }
 }
 
