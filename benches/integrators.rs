@@ -165,7 +165,10 @@ impl Brdf for BenchMicrofacet {
     }
     fn terms(&self) -> Vec<Term> {
         let label = format!("{:?} {}", self.dist, self.alpha);
-        vec![Term { label: label.clone(), kind: TermKind::Lobe(Lobe { slope_width: self.alpha, medium_eta: 1.0, label }) }]
+        vec![Term {
+            label: label.clone(),
+            kind: TermKind::Lobe(Lobe { slope_width: self.alpha, medium_eta: 1.0, label }),
+        }]
     }
     fn describe(&self) -> String {
         format!("{:?} α = {}, n = {}", self.dist, self.alpha, self.n)
@@ -185,9 +188,21 @@ struct Case {
     receptor: Stop,
 }
 
+/// The recipe of each case (written by the `convergence` work; the same B1–B4).
+fn recipe_of(id: &str) -> Option<&'static str> {
+    match id {
+        "B1" => Some("bench-b1-lambert.json"),
+        "B2" => Some("bench-b2-beckmann-0.1.json"),
+        "B3" => Some("bench-b3-beckmann-1e-4.json"),
+        "B4" => Some("bench-b4-ggx-0.3.json"),
+        _ => None,
+    }
+}
+
 fn case(id: &'static str, title: &str, brdf: Arc<dyn Brdf>, geometry: &str) -> Case {
     let g = standards::find(geometry).expect("builtin geometry");
-    let (theta, source, receptor) = (g.geometry.theta, g.geometry.source, *g.geometry.receptor("gloss").expect("gloss receptor"));
+    let (theta, source, receptor) =
+        (g.geometry.theta, g.geometry.source, *g.geometry.receptor("gloss").expect("gloss receptor"));
     Case { id, title: title.into(), brdf, geometry: g, theta, source, receptor }
 }
 
@@ -261,7 +276,9 @@ fn monte_carlo(c: &Case, n: usize, seed: u64) -> (f64, f64) {
 fn midpoint_grid(c: &Case, n: usize) -> f64 {
     let mut p = Plain::new(c);
     let (s, r) = (c.source, c.receptor);
-    let mid = |a: [f64; 2], n: usize| -> Vec<f64> { (0..n).map(|i| a[0] + (a[1] - a[0]) * (i as f64 + 0.5) / n as f64).collect() };
+    let mid = |a: [f64; 2], n: usize| -> Vec<f64> {
+        (0..n).map(|i| a[0] + (a[1] - a[0]) * (i as f64 + 0.5) / n as f64).collect()
+    };
     let (ps, qs, pr, qr) = (mid(s.p, n), mid(s.q, n), mid(r.p, n), mid(r.q, n));
     let vol = (s.p[1] - s.p[0]) * (s.q[1] - s.q[0]) * (r.p[1] - r.p[0]) * (r.q[1] - r.q[0]);
     let mut total = 0.0;
@@ -377,7 +394,9 @@ fn git_commit() -> String {
 }
 
 fn loadavg() -> String {
-    std::fs::read_to_string("/proc/loadavg").map(|s| s.split_whitespace().take(3).collect::<Vec<_>>().join(" ")).unwrap_or_else(|_| "?".into())
+    std::fs::read_to_string("/proc/loadavg")
+        .map(|s| s.split_whitespace().take(3).collect::<Vec<_>>().join(" "))
+        .unwrap_or_else(|_| "?".into())
 }
 
 fn date() -> String {
@@ -407,12 +426,33 @@ fn main() {
     );
 
     let cases = vec![
-        case("B1", "Lambert ρ = 0.5, astm-d523-60", Arc::new(BenchLambert { albedo: 0.5, s: Sampling::grey() }), "astm-d523-60"),
-        case("B2", "Beckmann m = 0.1, n = 1.5, astm-d523-20", Arc::new(BenchMicrofacet::new(Dist::Beckmann, 0.1, 1.5)), "astm-d523-20"),
-        case("B3", "Beckmann m = 1e-4, n = 1.5, astm-d523-20", Arc::new(BenchMicrofacet::new(Dist::Beckmann, 1e-4, 1.5)), "astm-d523-20"),
-        case("B4", "GGX α = 0.3, n = 1.5, astm-d523-85", Arc::new(BenchMicrofacet::new(Dist::Ggx, 0.3, 1.5)), "astm-d523-85"),
+        case(
+            "B1",
+            "Lambert ρ = 0.5, astm-d523-60",
+            Arc::new(BenchLambert { albedo: 0.5, s: Sampling::grey() }),
+            "astm-d523-60",
+        ),
+        case(
+            "B2",
+            "Beckmann m = 0.1, n = 1.5, astm-d523-20",
+            Arc::new(BenchMicrofacet::new(Dist::Beckmann, 0.1, 1.5)),
+            "astm-d523-20",
+        ),
+        case(
+            "B3",
+            "Beckmann m = 1e-4, n = 1.5, astm-d523-20",
+            Arc::new(BenchMicrofacet::new(Dist::Beckmann, 1e-4, 1.5)),
+            "astm-d523-20",
+        ),
+        case(
+            "B4",
+            "GGX α = 0.3, n = 1.5, astm-d523-85",
+            Arc::new(BenchMicrofacet::new(Dist::Ggx, 0.3, 1.5)),
+            "astm-d523-85",
+        ),
     ];
-    let mc_sizes: Vec<usize> = if quick { vec![1_000, 10_000, 100_000] } else { vec![1_000, 10_000, 100_000, 1_000_000, 10_000_000] };
+    let mc_sizes: Vec<usize> =
+        if quick { vec![1_000, 10_000, 100_000] } else { vec![1_000, 10_000, 100_000, 1_000_000, 10_000_000] };
     let grid_sizes: Vec<usize> = if quick { vec![4, 8, 16] } else { vec![4, 8, 16, 32, 48] };
 
     let mut all_rows: Vec<Row> = Vec::new();
@@ -432,9 +472,24 @@ fn main() {
         let fine_s = t.elapsed().as_secs_f64();
         let (reference, ref_note) = if c.id == "B1" {
             let exact = lambert_exact(c, 0.5);
-            (exact, format!("closed form (Lambert's polygon formula); our rtol-1e-12 run differs by {:.1e}", (fine.value - exact).abs() / exact))
+            (
+                exact,
+                format!(
+                    "closed form (Lambert's polygon formula); our rtol-1e-12 run differs by {:.1e}",
+                    (fine.value - exact).abs() / exact
+                ),
+            )
         } else {
-            (fine.value, format!("our engine at rtol 1e-12: {} evaluations, {}, est. rel. err {:.1e}, converged {}", fine.evaluations, fmt_time(fine_s), fine.error / fine.value, fine.converged))
+            (
+                fine.value,
+                format!(
+                    "our engine at rtol 1e-12: {} evaluations, {}, est. rel. err {:.1e}, converged {}",
+                    fine.evaluations,
+                    fmt_time(fine_s),
+                    fine.error / fine.value,
+                    fine.converged
+                ),
+            )
         };
         refs.push((c.id, c.title.clone(), reference, ref_note));
         let mut rows = Vec::new();
@@ -453,9 +508,35 @@ fn main() {
                 note: format!("{} regions{}", f.regions, if f.converged { "" } else { ", NOT converged" }),
             });
         }
+        // The same case with the material from its recipe (the engine's own model): checks that the bench
+        // BRDF and the crate's model agree, and what the recipe model costs.
+        if let Some(file) = recipe_of(c.id) {
+            if let Some(brdf) = recipe(file) {
+                let rc = Case { brdf, geometry: c.geometry.clone(), title: c.title.clone(), ..*c };
+                let p = problem(&rc, 1e-6);
+                if let Some((f, secs, runs)) = try_run(file, || timed(|| p.solve())) {
+                    rows.push(Row {
+                        case: c.id,
+                        method: "ours, recipe BRDF, rtol 1e-6".into(),
+                        value: f.value,
+                        claimed: f.error / f.value.abs(),
+                        rel_err: (f.value - reference).abs() / reference,
+                        evals: f.evaluations,
+                        seconds: secs,
+                        runs,
+                        note: format!("fixtures/recipes/{file}"),
+                    });
+                }
+            }
+        }
         // Our gloss reading through the plan (standard + specimen + ratio), for the record.
         {
-            let plan = Plan::compile(c.brdf.clone(), vec![c.geometry.clone()], PlanOptions { rtol: 1e-6, ..Default::default() }).expect("plan");
+            let plan = Plan::compile(
+                c.brdf.clone(),
+                vec![c.geometry.clone()],
+                PlanOptions { rtol: 1e-6, ..Default::default() },
+            )
+            .expect("plan");
             let (r, secs, runs): (Vec<Reading>, f64, usize) = timed(|| plan.execute());
             let g = r.iter().find(|x| x.quantity == "gloss").expect("gloss reading");
             rows.push(Row {
@@ -472,7 +553,13 @@ fn main() {
         }
         for (i, &n) in mc_sizes.iter().enumerate() {
             let ((v, se), secs, runs) = timed(|| monte_carlo(c, n, 0x5EED_0000 + i as u64));
-            let silent = if se == 0.0 && v == 0.0 { "sees nothing: 0 ± 0" } else if (v - reference).abs() > 5.0 * se { "error > 5σ: claim wrong" } else { "" };
+            let silent = if se == 0.0 && v == 0.0 {
+                "sees nothing: 0 ± 0"
+            } else if (v - reference).abs() > 5.0 * se {
+                "error > 5σ: claim wrong"
+            } else {
+                ""
+            };
             rows.push(Row {
                 case: c.id,
                 method: format!("Monte Carlo N = {n:.0e}"),
@@ -561,15 +648,36 @@ fn main() {
             None => ("none of the baselines".into(), "–".into(), "∞ (no baseline reaches it)".into()),
         };
         let at3 = match baseline(1e-3) {
-            Some(b) => format!("{} in {} vs ours {} (ratio {:.2})", b.method, fmt_time(b.seconds), fmt_time(ours3.seconds), b.seconds / ours3.seconds),
+            Some(b) => format!(
+                "{} in {} vs ours {} (ratio {:.2})",
+                b.method,
+                fmt_time(b.seconds),
+                fmt_time(ours3.seconds),
+                b.seconds / ours3.seconds
+            ),
             None => format!("no baseline reaches 1e-3; ours {} in {}", fmt_e(ours3.rel_err), fmt_time(ours3.seconds)),
         };
-        let _ = writeln!(md, "| {} | {} | {} | {} | {} | {} | {} |", c.id, fmt_time(ours.seconds), fmt_e(ours.rel_err), bname, btime, speed, at3);
+        let _ = writeln!(
+            md,
+            "| {} | {} | {} | {} | {} | {} | {} |",
+            c.id,
+            fmt_time(ours.seconds),
+            fmt_e(ours.rel_err),
+            bname,
+            btime,
+            speed,
+            at3
+        );
     }
     let t2 = all_rows.iter().find(|r| r.case == "B2" && r.method == "ours, rtol 1e-6").map(|r| (r.seconds, r.evals));
     let t3 = all_rows.iter().find(|r| r.case == "B3" && r.method == "ours, rtol 1e-6").map(|r| (r.seconds, r.evals));
     if let (Some(a), Some(b)) = (t2, t3) {
-        let _ = writeln!(md, "\nB3/B2 cost at rtol 1e-6: time ratio {:.2}, evaluation ratio {:.2} (target ≤ 2).", b.0 / a.0, b.1 as f64 / a.1 as f64);
+        let _ = writeln!(
+            md,
+            "\nB3/B2 cost at rtol 1e-6: time ratio {:.2}, evaluation ratio {:.2} (target ≤ 2).",
+            b.0 / a.0,
+            b.1 as f64 / a.1 as f64
+        );
     }
 
     b5(&mut md, quick);
@@ -603,6 +711,45 @@ fn recipe(name: &str) -> Option<Arc<dyn Brdf>> {
     }
 }
 
+/// Counts the specimen BRDF evaluations of a plan (regular and delta), i.e. the real work, whatever the
+/// sharing of fluxes between readings. Used in a separate, untimed run.
+#[derive(Debug)]
+struct Counting {
+    inner: Arc<dyn Brdf>,
+    n: std::sync::atomic::AtomicUsize,
+}
+
+impl Brdf for Counting {
+    fn sampling(&self) -> &Sampling {
+        self.inner.sampling()
+    }
+    fn eval(&self, wi: Vec3, wo: Vec3, out: &mut [f64]) {
+        self.n.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        self.inner.eval(wi, wo, out)
+    }
+    fn delta_reflectance(&self, wi: Vec3, out: &mut [f64]) -> bool {
+        self.n.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        self.inner.delta_reflectance(wi, out)
+    }
+    fn terms(&self) -> Vec<Term> {
+        self.inner.terms()
+    }
+    fn is_reciprocal(&self) -> bool {
+        self.inner.is_reciprocal()
+    }
+    fn describe(&self) -> String {
+        self.inner.describe()
+    }
+}
+
+fn count_evaluations(brdf: Arc<dyn Brdf>, opts: PlanOptions) -> usize {
+    let c = Arc::new(Counting { inner: brdf, n: Default::default() });
+    let plan = Plan::compile(c.clone(), panel(), opts).expect("plan compiles");
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build().expect("pool");
+    pool.install(|| plan.execute());
+    c.n.load(std::sync::atomic::Ordering::Relaxed)
+}
+
 struct PanelRun {
     readings: Vec<Reading>,
     seconds: f64,
@@ -622,7 +769,7 @@ fn run_panel(brdf: Arc<dyn Brdf>, opts: PlanOptions) -> PanelRun {
 fn b5(md: &mut String, quick: bool) {
     let _ = writeln!(md, "\n## B5: Cerulean Blue over the default panel ({})\n", PANEL.join(", "));
     let _ = writeln!(md, "Plan at rtol 1e-6, executed in a 1-thread rayon pool (single-core time). evaluations = Σ over the plan's distinct integrals.\n");
-    let _ = writeln!(md, "| recipe | plan options | integrals | evaluations | time | runs | readings |");
+    let _ = writeln!(md, "| recipe | plan options | integrals | specimen BRDF evaluations | time | runs | readings |");
     let _ = writeln!(md, "|---|---|---|---|---|---|---|");
     let default = PlanOptions { rtol: 1e-6, ..Default::default() };
     let variants: Vec<(&str, &str, PlanOptions)> = vec![
@@ -632,28 +779,69 @@ fn b5(md: &mut String, quick: bool) {
         ("cerulean-blue-b.json", "default (metallic flakes only)", default.clone()),
         ("cerulean-blue-a.json", "default (no flakes)", default.clone()),
     ];
+    let mut details: Vec<(&str, Vec<Reading>)> = Vec::new();
     for (file, label, opts) in variants {
         let Some(brdf) = recipe(file) else {
             let _ = writeln!(md, "| {file} | {label} | – | – | – | – | recipe failed to load |");
             continue;
         };
-        match try_run(&format!("{file} {label}"), || run_panel(brdf, opts)) {
-            Some(r) => {
-                let evals: usize = total_evaluations(&r.readings);
+        let detail = label.starts_with("default (fold");
+        match try_run(&format!("{file} {label}"), || {
+            (run_panel(brdf.clone(), opts.clone()), count_evaluations(brdf, opts))
+        }) {
+            Some((r, evals)) => {
+                if detail {
+                    details.push((file, r.readings.clone()));
+                }
                 let vals = r
                     .readings
                     .iter()
-                    .map(|x| format!("{}/{} {}", x.geometry, x.name, x.value.map(|v| format!("{v:.4}")).unwrap_or_else(|| "–".into())))
+                    .map(|x| {
+                        format!(
+                            "{}/{} {}",
+                            x.geometry,
+                            x.name,
+                            x.value.map(|v| format!("{v:.4}")).unwrap_or_else(|| "–".into())
+                        )
+                    })
                     .collect::<Vec<_>>()
                     .join("; ");
-                let _ = writeln!(md, "| {file} | {label} | {} | {evals} | {} | {} | {vals} |", r.jobs, fmt_time(r.seconds), r.runs);
+                let _ = writeln!(
+                    md,
+                    "| {file} | {label} | {} | {evals} | {} | {} | {vals} |",
+                    r.jobs,
+                    fmt_time(r.seconds),
+                    r.runs
+                );
             }
             None => {
-                let _ = writeln!(md, "| {file} | {label} | – | – | – | – | engine part not implemented yet (panicked) |");
+                let _ =
+                    writeln!(md, "| {file} | {label} | – | – | – | – | engine part not implemented yet (panicked) |");
             }
         }
     }
-    let _ = writeln!(md, "\n(evaluations per row are summed over readings, so shared integrals are counted once per reading that uses them.)\n");
+    let _ = writeln!(
+        md,
+        "\nSpecimen BRDF evaluations are counted by a wrapper in a separate untimed run (the work actually done).\n"
+    );
+    for (file, readings) in details {
+        let _ = writeln!(md, "Per reading, {file} (default plan; evaluations and seconds of the integrals each reading uses, shared ones counted in every reading that uses them; seconds are per-integral wall time in the 1-thread pool):\n");
+        let _ = writeln!(md, "| geometry | reading | value | error estimate | evaluations | seconds |");
+        let _ = writeln!(md, "|---|---|---|---|---|---|");
+        for x in &readings {
+            let _ = writeln!(
+                md,
+                "| {} | {} | {} | {:.1e} | {} | {} |",
+                x.geometry,
+                x.name,
+                x.value.map(|v| format!("{v:.6}")).unwrap_or_else(|| "–".into()),
+                x.error_estimate,
+                x.evaluations,
+                fmt_time(x.seconds)
+            );
+        }
+        let _ = writeln!(md);
+    }
     batch(md, quick);
 }
 
@@ -677,9 +865,17 @@ fn batch(md: &mut String, quick: bool) {
     };
     let probe = glossmeter::recipe::parse_str(&microfacet(0), "probe.json").ok();
     let works = probe
-        .and_then(|m| try_run("microfacet recipe", || m.brdf.eval(Vec3::new(-0.3, 0.0, 0.95).normalize(), Vec3::new(0.3, 0.0, 0.95).normalize(), &mut [0.0])))
+        .and_then(|m| {
+            try_run("microfacet recipe", || {
+                m.brdf.eval(Vec3::new(-0.3, 0.0, 0.95).normalize(), Vec3::new(0.3, 0.0, 0.95).normalize(), &mut [0.0])
+            })
+        })
         .is_some();
-    let (kind, texts): (&str, Vec<String>) = if works { ("microfacet (Beckmann/GGX, roughness 0.02–0.5, n = 1.5)", (0..n).map(microfacet).collect()) } else { ("ward (α 0.02–0.5; the microfacet model was not implemented yet)", (0..n).map(ward).collect()) };
+    let (kind, texts): (&str, Vec<String>) = if works {
+        ("microfacet (Beckmann/GGX, roughness 0.02–0.5, n = 1.5)", (0..n).map(microfacet).collect())
+    } else {
+        ("ward (α 0.02–0.5; the microfacet model was not implemented yet)", (0..n).map(ward).collect())
+    };
     let one = |text: &String| -> usize {
         let m = glossmeter::recipe::parse_str(text, "batch.json").expect("batch recipe");
         let plan = Plan::compile(m.brdf, panel(), PlanOptions { rtol: 1e-6, ..Default::default() }).expect("plan");

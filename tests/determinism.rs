@@ -97,7 +97,10 @@ impl Brdf for TestBeckmann {
         out.iter_mut().for_each(|o| *o = f);
     }
     fn terms(&self) -> Vec<Term> {
-        vec![Term { label: "beckmann".into(), kind: TermKind::Lobe(Lobe { slope_width: self.m, medium_eta: 1.0, label: "beckmann".into() }) }]
+        vec![Term {
+            label: "beckmann".into(),
+            kind: TermKind::Lobe(Lobe { slope_width: self.m, medium_eta: 1.0, label: "beckmann".into() }),
+        }]
     }
     fn describe(&self) -> String {
         format!("test beckmann m = {}", self.m)
@@ -113,13 +116,21 @@ fn test_beckmann_panel_is_bitwise_reproducible_across_thread_counts() {
 
 #[test]
 fn ward_recipe_is_bitwise_reproducible_across_thread_counts() {
-    let m = glossmeter::recipe::parse_str(r#"{"model": "ward", "alpha": 0.05, "rho_s": [0.04, 0.05, 0.06], "rho_d": 0.3}"#, "ward.json").unwrap();
+    let m = glossmeter::recipe::parse_str(
+        r#"{"model": "ward", "alpha": 0.05, "rho_s": [0.04, 0.05, 0.06], "rho_d": 0.3}"#,
+        "ward.json",
+    )
+    .unwrap();
     check(m.brdf, "ward recipe");
 }
 
 #[test]
 fn microfacet_recipe_is_bitwise_reproducible_across_thread_counts() {
-    let m = glossmeter::recipe::parse_str(r#"{"model": "microfacet", "distribution": "ggx", "roughness": 0.05, "ior": 1.5}"#, "mf.json").unwrap();
+    let m = glossmeter::recipe::parse_str(
+        r#"{"model": "microfacet", "distribution": "ggx", "roughness": 0.05, "ior": 1.5}"#,
+        "mf.json",
+    )
+    .unwrap();
     check(m.brdf, "microfacet recipe");
 }
 
