@@ -88,7 +88,17 @@ impl AxisMap {
     fn splits(&self, widths: &[f64]) -> Vec<f64> {
         let [a, b] = self.range();
         let mut pts = vec![a, b, self.s[1] + self.r[0], self.s[0] + self.r[1]];
-        for &w in widths {
+        // Lobes within a factor 3 of a narrower one share its splits: the splits are geometric (×3 apart),
+        // so they already resolve it, and each extra set multiplies the number of initial boxes.
+        let mut ws: Vec<f64> = widths.iter().copied().filter(|w| *w > 0.0).collect();
+        ws.sort_by(f64::total_cmp);
+        let mut kept: Vec<f64> = Vec::new();
+        for w in ws {
+            if kept.last().is_none_or(|k| w > 3.0 * k) {
+                kept.push(w);
+            }
+        }
+        for &w in &kept {
             if w > 0.0 && w < 0.5 * (b - a) {
                 pts.push(0.0);
                 for k in [1.0, 3.0, 10.0, 30.0, 100.0] {
