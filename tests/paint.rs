@@ -5,8 +5,8 @@
 //! amplitudes of the paper's §5.1, Snell's law, Simpson's rule, and Kubelka–Munk's Eq. (3)/(4) transcribed.
 use glossmeter::brdf::albedo::directional_albedo;
 use glossmeter::brdf::paint::{
-    internal_diffuse_reflectance, ClearCoat, Form, MetallicFlakes, Paint, PaintSpec,
-    PearlescentFlakes, Pigment, PigmentedLayer, MAX_SAMPLES,
+    internal_diffuse_reflectance, ClearCoat, Form, MetallicFlakes, Paint, PaintSpec, PearlescentFlakes, Pigment,
+    PigmentedLayer, MAX_SAMPLES,
 };
 use glossmeter::brdf::{Brdf, TermKind};
 use glossmeter::optics::microfacet::Distribution;
@@ -28,10 +28,7 @@ use std::sync::Arc;
 const FIXTURES: [&str; 3] = ["cerulean-blue-a", "cerulean-blue-b", "cerulean-blue-c"];
 
 fn fixture_json(name: &str) -> Value {
-    let file = format!(
-        "{}/fixtures/recipes/{name}.json",
-        env!("CARGO_MANIFEST_DIR")
-    );
+    let file = format!("{}/fixtures/recipes/{name}.json", env!("CARGO_MANIFEST_DIR"));
     let text = std::fs::read_to_string(&file).unwrap();
     parse_json(&text, &file).unwrap()
 }
@@ -121,15 +118,9 @@ fn adapt(
     let (lm, rm) = (0.5 * (a + m), 0.5 * (m + b));
     let (flm, frm) = (f(lm), f(rm));
     let h = (b - a) / 12.0;
-    let left: Vec<f64> = (0..sum.len())
-        .map(|k| h * (fa[k] + 4.0 * flm[k] + fm[k]))
-        .collect();
-    let right: Vec<f64> = (0..sum.len())
-        .map(|k| h * (fm[k] + 4.0 * frm[k] + fb[k]))
-        .collect();
-    let diff = (0..sum.len())
-        .map(|k| (left[k] + right[k] - whole[k]).abs())
-        .fold(0.0, f64::max);
+    let left: Vec<f64> = (0..sum.len()).map(|k| h * (fa[k] + 4.0 * flm[k] + fm[k])).collect();
+    let right: Vec<f64> = (0..sum.len()).map(|k| h * (fm[k] + 4.0 * frm[k] + fb[k])).collect();
+    let diff = (0..sum.len()).map(|k| (left[k] + right[k] - whole[k]).abs()).fold(0.0, f64::max);
     if depth == 0 || diff <= 15.0 * tol {
         for k in 0..sum.len() {
             let lr = left[k] + right[k];
@@ -138,19 +129,7 @@ fn adapt(
         *err += diff / 15.0;
     } else {
         adapt(f, a, m, fa, &flm, fm, &left, 0.5 * tol, depth - 1, sum, err);
-        adapt(
-            f,
-            m,
-            b,
-            fm,
-            &frm,
-            fb,
-            &right,
-            0.5 * tol,
-            depth - 1,
-            sum,
-            err,
-        );
+        adapt(f, m, b, fm, &frm, fb, &right, 0.5 * tol, depth - 1, sum, err);
     }
 }
 
@@ -162,22 +141,8 @@ fn integrate(f: &dyn Fn(f64) -> Vec<f64>, breaks: &[f64], tol: f64, n: usize) ->
         let (a, b) = (w[0], w[1]);
         let m = 0.5 * (a + b);
         let (fa, fm, fb) = (f(a), f(m), f(b));
-        let whole: Vec<f64> = (0..n)
-            .map(|k| (b - a) / 6.0 * (fa[k] + 4.0 * fm[k] + fb[k]))
-            .collect();
-        adapt(
-            f,
-            a,
-            b,
-            &fa,
-            &fm,
-            &fb,
-            &whole,
-            tol / panels,
-            30,
-            &mut sum,
-            &mut err,
-        );
+        let whole: Vec<f64> = (0..n).map(|k| (b - a) / 6.0 * (fa[k] + 4.0 * fm[k] + fb[k])).collect();
+        adapt(f, a, b, &fa, &fm, &fb, &whole, tol / panels, 30, &mut sum, &mut err);
     }
     (sum, err)
 }
@@ -233,12 +198,7 @@ fn albedo_interior(b: &dyn Brdf, eta: f64, wi: Vec3, width: f64, tol: f64) -> (V
 fn rgb_spec(eta: f64, x: f64, rg: [f64; 3], k: [f64; 3], s: [f64; 3]) -> PaintSpec {
     PaintSpec {
         sampling: Sampling::rgb(),
-        coat: ClearCoat {
-            index: eta,
-            thickness_um: 20.0,
-            roughness: 0.0,
-            distribution: Distribution::Beckmann,
-        },
+        coat: ClearCoat { index: eta, thickness_um: 20.0, roughness: 0.0, distribution: Distribution::Beckmann },
         layer: PigmentedLayer {
             thickness_mm: x,
             primer_reflectance: rg.to_vec(),
@@ -257,13 +217,7 @@ fn rgb_spec(eta: f64, x: f64, rg: [f64; 3], k: [f64; 3], s: [f64; 3]) -> PaintSp
 }
 
 fn metal(spread_deg: f64, area: f64, depth: f64) -> MetallicFlakes {
-    MetallicFlakes {
-        n: vec![0.93; 3],
-        k: vec![6.33; 3],
-        spread_deg,
-        area_ratio: area,
-        depth_mm: depth,
-    }
+    MetallicFlakes { n: vec![0.93; 3], k: vec![6.33; 3], spread_deg, area_ratio: area, depth_mm: depth }
 }
 
 fn pearl(spread_deg: f64, area: f64, depth: f64) -> PearlescentFlakes {
@@ -310,55 +264,27 @@ fn fixtures_load_and_evaluate_finite_non_negative_values() {
                 for po in [0.0, 37.0, 90.0, 180.0, 271.0] {
                     let (wi, wo) = (dir(ti as f64, 0.0), dir(to as f64, po));
                     let f = eval(&*b, wi, wo);
-                    assert!(
-                        f.iter().all(|v| v.is_finite() && *v >= 0.0),
-                        "{name} {ti} {to} {po}: {f:?}"
-                    );
+                    assert!(f.iter().all(|v| v.is_finite() && *v >= 0.0), "{name} {ti} {to} {po}: {f:?}");
                 }
                 // Exactly at the specular direction too (the flake lobes peak there).
                 let f = eval(&*b, dir(ti as f64, 0.0), dir(ti as f64, 180.0));
-                assert!(
-                    f.iter().all(|v| v.is_finite() && *v >= 0.0),
-                    "{name} specular {ti}: {f:?}"
-                );
+                assert!(f.iter().all(|v| v.is_finite() && *v >= 0.0), "{name} specular {ti}: {f:?}");
             }
         }
         let mut d = [f64::NAN; 3];
-        assert!(
-            b.delta_reflectance(dir(60.0, 0.0), &mut d),
-            "{name}: a smooth coat has a delta"
-        );
-        assert!(
-            (d[0] - fresnel_r(60f64.to_radians().cos(), 1.5)).abs() < 1e-12,
-            "{name}: delta = coat Fresnel"
-        );
+        assert!(b.delta_reflectance(dir(60.0, 0.0), &mut d), "{name}: a smooth coat has a delta");
+        assert!((d[0] - fresnel_r(60f64.to_radians().cos(), 1.5)).abs() < 1e-12, "{name}: delta = coat Fresnel");
         assert!(b.is_reciprocal());
     }
 }
 
 #[test]
 fn fixture_terms_list_only_what_the_recipe_has() {
-    let labels = |n: &str| {
-        load(n)
-            .terms()
-            .into_iter()
-            .map(|t| t.label)
-            .collect::<Vec<_>>()
-    };
-    assert_eq!(
-        labels("cerulean-blue-a"),
-        [
-            "clear coat (Fresnel, delta)",
-            "pigmented layer (Kubelka–Munk, diffuse)"
-        ]
-    );
+    let labels = |n: &str| load(n).terms().into_iter().map(|t| t.label).collect::<Vec<_>>();
+    assert_eq!(labels("cerulean-blue-a"), ["clear coat (Fresnel, delta)", "pigmented layer (Kubelka–Munk, diffuse)"]);
     assert_eq!(
         labels("cerulean-blue-b"),
-        [
-            "clear coat (Fresnel, delta)",
-            "pigmented layer (Kubelka–Munk, diffuse)",
-            "metallic flakes"
-        ]
+        ["clear coat (Fresnel, delta)", "pigmented layer (Kubelka–Munk, diffuse)", "metallic flakes"]
     );
     assert_eq!(
         labels("cerulean-blue-c"),
@@ -383,23 +309,14 @@ fn fixture_a_body_is_the_closed_form() {
     let b = load("cerulean-blue-a");
     let (k, s) = ([1.52, 0.32, 0.25], [0.06, 0.25, 0.4]);
     let r_i = 1.0 - (1.0 - r_e_simpson(1.5)) / 2.25;
-    for (ti, to, po) in [
-        (0.0, 0.0, 0.0),
-        (20.0, 45.0, 90.0),
-        (60.0, 10.0, 200.0),
-        (85.0, 85.0, 180.0),
-    ] {
+    for (ti, to, po) in [(0.0, 0.0, 0.0), (20.0, 45.0, 90.0), (60.0, 10.0, 200.0), (85.0, 85.0, 180.0)] {
         let (wi, wo) = (dir(ti, 0.0), dir(to, po));
         let f = eval(&*b, wi, wo);
         let tt = fresnel_t(wi.z, 1.5) * fresnel_t(wo.z, 1.5);
         for j in 0..3 {
             let r_l = km_eq3(0.4 * k[j], 0.4 * s[j], 0.15, 0.7, false);
             let want = tt * r_l / (PI * 2.25 * (1.0 - r_i * r_l));
-            assert!(
-                rel(f[j], want) < 1e-9,
-                "({ti},{to},{po}) sample {j}: {} vs {want}",
-                f[j]
-            );
+            assert!(rel(f[j], want) < 1e-9, "({ti},{to},{po}) sample {j}: {} vs {want}", f[j]);
         }
     }
 }
@@ -417,10 +334,7 @@ fn white_furnace_fixtures_physical_form() {
             let wi = dir(ti as f64, 0.0);
             let (a, err) = albedo_interior(&*b, 1.5, wi, width, 1e-7);
             for (j, v) in a.iter().enumerate() {
-                assert!(
-                    *v <= 1.0 + err + 1e-9,
-                    "{name} θi = {ti}° sample {j}: albedo {v} ± {err}"
-                );
+                assert!(*v <= 1.0 + err + 1e-9, "{name} θi = {ti}° sample {j}: albedo {v} ± {err}");
                 assert!(*v > 0.0);
             }
         }
@@ -438,11 +352,7 @@ fn white_furnace_agrees_with_crate_albedo_integrator() {
             let (mine, err) = albedo_interior(&*b, 1.5, wi, width, 1e-8);
             let (theirs, err2) = directional_albedo(&*b, wi);
             for j in 0..3 {
-                assert!(
-                    theirs[j] <= 1.0 + err2 + 1e-9,
-                    "{name} {ti}: crate albedo {} ± {err2}",
-                    theirs[j]
-                );
+                assert!(theirs[j] <= 1.0 + err2 + 1e-9, "{name} {ti}: crate albedo {} ± {err2}", theirs[j]);
                 assert!(
                     (mine[j] - theirs[j]).abs() < 1e-5 + err + err2,
                     "{name} θi {ti} sample {j}: {} vs {} (± {err}, {err2})",
@@ -465,23 +375,15 @@ fn white_furnace_body_term_matches_saunderson_closed_form() {
         let wi = dir(ti, 0.0);
         let (a, err) = albedo_interior(&p, 1.5, wi, 0.05, 1e-9);
         for j in 0..3 {
-            let want = fresnel_r(wi.z, 1.5)
-                + fresnel_t(wi.z, 1.5) * r_l[j] * (1.0 - r_i) / (1.0 - r_i * r_l[j]);
-            assert!(
-                (a[j] - want).abs() < 1e-6 + err,
-                "θi {ti} sample {j}: {} vs {want}",
-                a[j]
-            );
+            let want = fresnel_r(wi.z, 1.5) + fresnel_t(wi.z, 1.5) * r_l[j] * (1.0 - r_i) / (1.0 - r_i * r_l[j]);
+            assert!((a[j] - want).abs() < 1e-6 + err, "θi {ti} sample {j}: {} vs {want}", a[j]);
         }
     }
     // A white body (R_l = 1) under the coat is a white furnace: albedo exactly 1.
     let white = Paint::new(rgb_spec(1.5, 0.0, [1.0; 3], [0.0; 3], [0.0; 3])).unwrap();
     for ti in [0.0, 50.0, 85.0] {
         let (a, err) = albedo_interior(&white, 1.5, dir(ti, 0.0), 0.05, 1e-9);
-        assert!(
-            a.iter().all(|v| (v - 1.0).abs() < 1e-6 + err),
-            "θi {ti}: {a:?}"
-        );
+        assert!(a.iter().all(|v| (v - 1.0).abs() < 1e-6 + err), "θi {ti}: {a:?}");
     }
 }
 
@@ -507,22 +409,12 @@ fn rough_coat_energy_and_reciprocity() {
         assert!(!p.delta_reflectance(dir(30.0, 0.0), &mut [0.0; 3]));
         assert_eq!(
             p.terms()[0].kind,
-            TermKind::Lobe(glossmeter::brdf::Lobe {
-                slope_width: alpha,
-                medium_eta: 1.0,
-                label: "clear coat".into()
-            })
+            TermKind::Lobe(glossmeter::brdf::Lobe { slope_width: alpha, medium_eta: 1.0, label: "clear coat".into() })
         );
         for ti in [0.0, 20.0, 40.0, 60.0, 70.0, 80.0, 89.0] {
             let (a, err) = directional_albedo(&p, dir(ti, 0.0));
-            eprintln!(
-                "rough coat {dist:?} {alpha} θi {ti}: white-body albedo {} ± {err}",
-                a[0]
-            );
-            assert!(
-                a.iter().all(|v| *v <= 1.0 + ROUGH_COAT_EXCESS + err),
-                "{dist:?} {alpha} θi {ti}: {a:?} ± {err}"
-            );
+            eprintln!("rough coat {dist:?} {alpha} θi {ti}: white-body albedo {} ± {err}", a[0]);
+            assert!(a.iter().all(|v| *v <= 1.0 + ROUGH_COAT_EXCESS + err), "{dist:?} {alpha} θi {ti}: {a:?} ± {err}");
         }
         let (wi, wo) = (dir(35.0, 10.0), dir(70.0, 200.0));
         let (f, g) = (eval(&p, wi, wo), eval(&p, wo, wi));
@@ -547,40 +439,18 @@ fn random_spec() -> impl Strategy<Value = Random> {
         arr(0.0, 1.0),
         arr(0.0, 1e3),
         arr(0.0, 1e3),
-        (
-            0f64..1.0,
-            0f64..1.0,
-            0.1f64..20.0,
-            0.1f64..20.0,
-            0f64..1.0,
-            0f64..1.0,
-        ),
-        (
-            0.1f64..3.0,
-            0f64..8.0,
-            0f64..300.0,
-            1.8f64..2.9,
-            any::<bool>(),
-        ),
+        (0f64..1.0, 0f64..1.0, 0.1f64..20.0, 0.1f64..20.0, 0f64..1.0, 0f64..1.0),
+        (0.1f64..3.0, 0f64..8.0, 0f64..300.0, 1.8f64..2.9, any::<bool>()),
     )
-        .prop_map(
-            |(eta, x, rg, k, s, (am, ap_frac, sm, sp, dm, dp), (n, kk, tio2, tio2_n, ir))| {
-                let mut spec = rgb_spec(eta, x, rg, k, s);
-                let ap = (1.0 - am) * ap_frac; // Am + Ap ≤ 1
-                spec.metallic = Some(MetallicFlakes {
-                    n: vec![n; 3],
-                    k: vec![kk; 3],
-                    ..metal(sm, am, dm * x)
-                });
-                spec.pearlescent = Some(PearlescentFlakes {
-                    tio2_thickness_nm: tio2,
-                    tio2_index: tio2_n,
-                    ..pearl(sp, ap, dp * x)
-                });
-                spec.internal_reflection = ir;
-                Random { spec }
-            },
-        )
+        .prop_map(|(eta, x, rg, k, s, (am, ap_frac, sm, sp, dm, dp), (n, kk, tio2, tio2_n, ir))| {
+            let mut spec = rgb_spec(eta, x, rg, k, s);
+            let ap = (1.0 - am) * ap_frac; // Am + Ap ≤ 1
+            spec.metallic = Some(MetallicFlakes { n: vec![n; 3], k: vec![kk; 3], ..metal(sm, am, dm * x) });
+            spec.pearlescent =
+                Some(PearlescentFlakes { tio2_thickness_nm: tio2, tio2_index: tio2_n, ..pearl(sp, ap, dp * x) });
+            spec.internal_reflection = ir;
+            Random { spec }
+        })
 }
 
 proptest! {
@@ -631,22 +501,13 @@ fn bare_primer_under_the_coat_is_the_closed_form() {
         let rg = [0.05, 0.5, 0.97];
         let p = Paint::new(rgb_spec(eta, 0.0, rg, [5.0, 1.0, 0.0], [3.0, 0.0, 20.0])).unwrap();
         let r_i = 1.0 - (1.0 - r_e_simpson(eta)) / (eta * eta);
-        assert!(
-            (p.internal_diffuse_reflectance() - r_i).abs() < 1e-10,
-            "η {eta}: r_i"
-        );
+        assert!((p.internal_diffuse_reflectance() - r_i).abs() < 1e-10, "η {eta}: r_i");
         for (ti, to, po) in [(0.0, 0.0, 0.0), (33.0, 71.0, 123.0), (80.0, 5.0, 180.0)] {
             let (wi, wo) = (dir(ti, 0.0), dir(to, po));
             let f = eval(&p, wi, wo);
             for j in 0..3 {
-                let want = fresnel_t(wi.z, eta) * fresnel_t(wo.z, eta) * rg[j]
-                    / (1.0 - r_i * rg[j])
-                    / (PI * eta * eta);
-                assert!(
-                    rel(f[j], want) < 1e-9,
-                    "η {eta} ({ti},{to},{po}) {j}: {} vs {want}",
-                    f[j]
-                );
+                let want = fresnel_t(wi.z, eta) * fresnel_t(wo.z, eta) * rg[j] / (1.0 - r_i * rg[j]) / (PI * eta * eta);
+                assert!(rel(f[j], want) < 1e-9, "η {eta} ({ti},{to},{po}) {j}: {} vs {want}", f[j]);
             }
         }
         // Without the Saunderson factor: S = 1.
@@ -666,18 +527,11 @@ fn internal_diffuse_reflectance_identity_and_literature_value() {
     // angle) equals 1 − (1 − r_e)/η²; for η = 1.5 it is the classic 0.596 (Judd 1942), r_e ≈ 0.092.
     for eta in [1.3f64, 1.5, 1.8] {
         let mu_c = (1.0 - 1.0 / (eta * eta)).sqrt();
-        let direct =
-            simpson(|mu| fresnel_r(mu, 1.0 / eta) * 2.0 * mu, mu_c, 1.0, 20_000) + mu_c * mu_c;
+        let direct = simpson(|mu| fresnel_r(mu, 1.0 / eta) * 2.0 * mu, mu_c, 1.0, 20_000) + mu_c * mu_c;
         let via_re = internal_diffuse_reflectance(eta);
-        assert!(
-            (direct - via_re).abs() < 1e-7,
-            "η {eta}: {direct} vs {via_re}"
-        );
+        assert!((direct - via_re).abs() < 1e-7, "η {eta}: {direct} vs {via_re}");
         let p = Paint::new(rgb_spec(eta, 0.1, [0.5; 3], [1.0; 3], [1.0; 3])).unwrap();
-        assert!(
-            (p.external_diffuse_reflectance() - r_e_simpson(eta)).abs() < 1e-11,
-            "η {eta}: r_e"
-        );
+        assert!((p.external_diffuse_reflectance() - r_e_simpson(eta)).abs() < 1e-11, "η {eta}: r_e");
     }
     assert!((r_e_simpson(1.5) - 0.0918).abs() < 1e-3);
     assert!((internal_diffuse_reflectance(1.5) - 0.596).abs() < 1e-3);
@@ -703,28 +557,12 @@ fn corrected_eq3_is_the_models_layer_and_the_printed_one_fails_at_zero_thickness
     // Printed Eq. (3) with (1 − R∞) does not return Rg for X = 0; with 1/R∞ it does (and R∞ as X → ∞).
     for (k, s, rg) in [(0.6, 0.024, 0.7), (0.128, 0.1, 0.7), (0.1, 0.16, 0.2)] {
         assert!((km_eq3(k, s, 0.0, rg, false) - rg).abs() < 1e-12);
-        assert!(
-            (km_eq3(k, s, 0.0, rg, true) - rg).abs() > 1e-2,
-            "printed Eq. 3 at X = 0"
-        );
+        assert!((km_eq3(k, s, 0.0, rg, true) - rg).abs() > 1e-2, "printed Eq. 3 at X = 0");
         assert!((km_eq3(k, s, 200.0, rg, false) - r_inf(k, s)).abs() < 1e-9);
     }
-    let p = Paint::new(rgb_spec(
-        1.5,
-        0.15,
-        [0.7; 3],
-        [0.608, 0.128, 0.1],
-        [0.024, 0.1, 0.16],
-    ))
-    .unwrap();
+    let p = Paint::new(rgb_spec(1.5, 0.15, [0.7; 3], [0.608, 0.128, 0.1], [0.024, 0.1, 0.16])).unwrap();
     for j in 0..3 {
-        let want = km_eq3(
-            [0.608, 0.128, 0.1][j],
-            [0.024, 0.1, 0.16][j],
-            0.15,
-            0.7,
-            false,
-        );
+        let want = km_eq3([0.608, 0.128, 0.1][j], [0.024, 0.1, 0.16][j], 0.15, 0.7, false);
         assert!(rel(p.pigmented_reflectance()[j], want) < 1e-10);
     }
 }
@@ -743,10 +581,7 @@ fn corrected_eq2_transmittance_conserves_energy_and_the_printed_ratio_does_not()
         let printed = eta * ci / ct * tt;
         let rho = fresnel_r(ci, eta);
         assert!((rho + corrected - 1.0).abs() < 1e-13, "{deg}°");
-        assert!(
-            (rho + printed - 1.0).abs() > 1e-3,
-            "{deg}°: printed ratio conserves energy?"
-        );
+        assert!((rho + printed - 1.0).abs() > 1e-3, "{deg}°: printed ratio conserves energy?");
         let crate_t = glossmeter::optics::fresnel::fresnel_dielectric(ci, eta).t();
         assert!((crate_t - corrected).abs() < 1e-13);
     }
@@ -763,17 +598,10 @@ fn thin_film_phase_is_two_pi_n_d_cos_over_lambda() {
         let sin2_film = (n_med / n_film).powi(2) * (1.0 - ci * ci);
         let cos_film = (1.0 - sin2_film).sqrt();
         let d = lambda / (2.0 * n_film * cos_film);
-        let film = FilmLayer {
-            n: Complex64::new(n_film, 0.0),
-            thickness_nm: d,
-            coherent: true,
-        };
+        let film = FilmLayer { n: Complex64::new(n_film, 0.0), thickness_nm: d, coherent: true };
         let r = stack(n_med, &[film], Complex64::new(n_med, 0.0), ci, lambda);
         assert!(r.r() < 1e-12, "{deg}°: half-wave film reflects {}", r.r());
-        let quarter = FilmLayer {
-            thickness_nm: 0.5 * d,
-            ..film
-        };
+        let quarter = FilmLayer { thickness_nm: 0.5 * d, ..film };
         let rq = stack(n_med, &[quarter], Complex64::new(n_med, 0.0), ci, lambda);
         // Quarter-wave maximum 4r²/(1 + r²)² per polarisation; check it against s polarisation bound.
         assert!(rq.r() > 0.1, "{deg}°: quarter-wave film {}", rq.r());
@@ -789,11 +617,7 @@ fn paper_eq1_normalisation_is_four_times_the_energy_normalised_lobe() {
     // Cook–Torrance 1982 form with its un-normalised D (∫ D_CT cos = π) divided by π cos θi cos θo is four
     // times F·D·G/(4 cos θi cos θo). The printed form then reflects more than it receives.
     let mut spec = rgb_spec(1.5, 0.1, [0.5; 3], [0.0; 3], [0.0; 3]);
-    spec.metallic = Some(MetallicFlakes {
-        n: vec![0.05; 3],
-        k: vec![4.0; 3],
-        ..metal(2.0, 1.0, 0.0)
-    });
+    spec.metallic = Some(MetallicFlakes { n: vec![0.05; 3], k: vec![4.0; 3], ..metal(2.0, 1.0, 0.0) });
     let phys = Paint::new(spec.clone()).unwrap();
     spec.form = Form::PaperEq1;
     let paper = Paint::new(spec).unwrap();
@@ -808,12 +632,7 @@ fn paper_eq1_normalisation_is_four_times_the_energy_normalised_lobe() {
     };
     let t0 = 1.0 - rho0;
     let (a, err) = albedo_interior(&phys, 1.5, wi, m, 1e-9);
-    assert!(
-        (a[0] - rho0 - t0 * t0 * rho_m).abs() < 2e-3 + err,
-        "physical {} vs {}",
-        a[0] - rho0,
-        t0 * t0 * rho_m
-    );
+    assert!((a[0] - rho0 - t0 * t0 * rho_m).abs() < 2e-3 + err, "physical {} vs {}", a[0] - rho0, t0 * t0 * rho_m);
     let (b, err2) = directional_albedo(&paper, wi);
     assert!(
         ((b[0] - rho0) / (4.0 * t0 * rho_m) - 1.0).abs() < 5e-3 + err2,
@@ -834,13 +653,8 @@ fn paper_eq1_body_is_tau_times_lambertian() {
     let p = Paint::new(spec).unwrap();
     let (wi, wo) = (dir(25.0, 0.0), dir(60.0, 45.0));
     let f = eval(&p, wi, wo);
-    for j in 0..3 {
-        assert!(
-            rel(
-                f[j],
-                fresnel_t(wi.z, 1.5) * p.pigmented_reflectance()[j] / PI
-            ) < 1e-12
-        );
+    for (fj, r_l) in f.iter().zip(p.pigmented_reflectance()) {
+        assert!(rel(*fj, fresnel_t(wi.z, 1.5) * r_l / PI) < 1e-12);
     }
 }
 
@@ -862,21 +676,8 @@ fn flake_delta_switch_is_continuous_and_is_eq5_corrected() {
         Paint::new(spec).unwrap()
     };
     let smooth = build(1e-6, Form::Physical);
-    assert!(
-        smooth
-            .terms()
-            .iter()
-            .filter(|t| t.kind == TermKind::Delta)
-            .count()
-            == 3
-    );
-    assert!(
-        !smooth
-            .terms()
-            .iter()
-            .any(|t| matches!(t.kind, TermKind::Diffuse)),
-        "Am + Ap = 1: no body"
-    );
+    assert!(smooth.terms().iter().filter(|t| t.kind == TermKind::Delta).count() == 3);
+    assert!(!smooth.terms().iter().any(|t| matches!(t.kind, TermKind::Diffuse)), "Am + Ap = 1: no body");
     for ti in [0.0, 40.0, 75.0] {
         let wi = dir(ti, 0.0);
         let mut d = [0.0; 3];
@@ -891,34 +692,16 @@ fn flake_delta_switch_is_continuous_and_is_eq5_corrected() {
         let rho_m = 0.5 * (rs + rp);
         let t = fresnel_t(wi.z, 1.5);
         let film = [
-            FilmLayer {
-                n: Complex64::new(2.5, 0.0),
-                thickness_nm: 135.0,
-                coherent: true,
-            },
-            FilmLayer {
-                n: Complex64::new(1.58, 0.0),
-                thickness_nm: 400.0,
-                coherent: false,
-            },
-            FilmLayer {
-                n: Complex64::new(2.5, 0.0),
-                thickness_nm: 135.0,
-                coherent: true,
-            },
+            FilmLayer { n: Complex64::new(2.5, 0.0), thickness_nm: 135.0, coherent: true },
+            FilmLayer { n: Complex64::new(1.58, 0.0), thickness_nm: 400.0, coherent: false },
+            FilmLayer { n: Complex64::new(2.5, 0.0), thickness_nm: 135.0, coherent: true },
         ];
         for j in 0..3 {
             let lam = Sampling::rgb().wavelengths_nm[j];
             let rho_p = stack(1.5, &film, Complex64::new(1.5, 0.0), ct_in, lam).r();
             let want = fresnel_r(wi.z, 1.5)
-                + t * t
-                    * (0.6 * km_eq3(k[j], s[j], 0.05, rho_m, false)
-                        + 0.4 * km_eq3(k[j], s[j], 0.1, rho_p, false));
-            assert!(
-                rel(d[j], want) < 1e-9,
-                "θi {ti} sample {j}: {} vs {want}",
-                d[j]
-            );
+                + t * t * (0.6 * km_eq3(k[j], s[j], 0.05, rho_m, false) + 0.4 * km_eq3(k[j], s[j], 0.1, rho_p, false));
+            assert!(rel(d[j], want) < 1e-9, "θi {ti} sample {j}: {} vs {want}", d[j]);
         }
         // Continuity: the lobe just above the threshold integrates to the same reflectance.
         for spread in [1e-4, 1e-2] {
@@ -970,26 +753,11 @@ fn spectral_recipe_samples_and_interference_colour() {
     // Just off the normal (inside the lobe peak) f = grey body + c·ρ_p(λ): f follows the film's reflectance.
     let f = eval(&*b, wi, dir(0.05, 180.0));
     let film = [
-        FilmLayer {
-            n: Complex64::new(2.5, 0.0),
-            thickness_nm: 135.0,
-            coherent: true,
-        },
-        FilmLayer {
-            n: Complex64::new(1.58, 0.0),
-            thickness_nm: 400.0,
-            coherent: false,
-        },
-        FilmLayer {
-            n: Complex64::new(2.5, 0.0),
-            thickness_nm: 135.0,
-            coherent: true,
-        },
+        FilmLayer { n: Complex64::new(2.5, 0.0), thickness_nm: 135.0, coherent: true },
+        FilmLayer { n: Complex64::new(1.58, 0.0), thickness_nm: 400.0, coherent: false },
+        FilmLayer { n: Complex64::new(2.5, 0.0), thickness_nm: 135.0, coherent: true },
     ];
-    let rho: Vec<f64> = wl
-        .iter()
-        .map(|&l| stack(1.5, &film, Complex64::new(1.5, 0.0), 1.0, l).r())
-        .collect();
+    let rho: Vec<f64> = wl.iter().map(|&l| stack(1.5, &film, Complex64::new(1.5, 0.0), 1.0, l).r()).collect();
     // K = S = 0: the cover layer is transparent (R_p = ρ_p) and the body is the same for all samples, so the
     // samples are ordered as the film's reflectances are.
     let order_f: Vec<usize> = argsort(&f);
@@ -998,10 +766,7 @@ fn spectral_recipe_samples_and_interference_colour() {
     // Wrong length refused with the field path.
     v["pigmented_layer"]["primer_reflectance"] = json!(vec![0.7; 3]);
     let e = from_json(&v).unwrap_err().to_string();
-    assert!(
-        e.contains("pigmented_layer.primer_reflectance") && e.contains("expected 5 values"),
-        "{e}"
-    );
+    assert!(e.contains("pigmented_layer.primer_reflectance") && e.contains("expected 5 values"), "{e}");
 }
 
 fn argsort(v: &[f64]) -> Vec<usize> {
@@ -1067,21 +832,10 @@ fn bad_recipes_are_refused_with_the_field_path() {
         (
             "X' > X",
             |v| v["metallic_flakes"]["depth_mm"] = json!(0.2),
-            &[
-                "metallic_flakes.depth_mm",
-                "deeper than the pigmented layer",
-            ],
+            &["metallic_flakes.depth_mm", "deeper than the pigmented layer"],
         ),
-        (
-            "coat index out of range",
-            |v| v["clear_coat"]["index"] = json!(2.0),
-            &["clear_coat.index", "[1.3, 1.8]"],
-        ),
-        (
-            "bad form",
-            |v| v["form"] = json!("paper"),
-            &["form", "paper-eq1"],
-        ),
+        ("coat index out of range", |v| v["clear_coat"]["index"] = json!(2.0), &["clear_coat.index", "[1.3, 1.8]"]),
+        ("bad form", |v| v["form"] = json!("paper"), &["form", "paper-eq1"]),
         (
             "negative K",
             |v| v["pigmented_layer"]["pigments"][0]["s_per_mm"] = json!([0.1, -1.0, 0.2]),
@@ -1099,11 +853,7 @@ fn bad_recipes_are_refused_with_the_field_path() {
             },
             &["pigmented_layer", "missing"],
         ),
-        (
-            "bad distribution",
-            |v| v["clear_coat"]["distribution"] = json!("phong"),
-            &["clear_coat.distribution", "ggx"],
-        ),
+        ("bad distribution", |v| v["clear_coat"]["distribution"] = json!("phong"), &["clear_coat.distribution", "ggx"]),
         (
             "both K/S and measured",
             |v| v["pigmented_layer"]["pigments"][0]["measured"] = json!({}),
@@ -1116,18 +866,10 @@ fn bad_recipes_are_refused_with_the_field_path() {
         ),
         (
             "too many wavelengths",
-            |v| {
-                v["wavelengths_nm"] = json!((0..=MAX_SAMPLES)
-                    .map(|i| 400.0 + i as f64)
-                    .collect::<Vec<_>>())
-            },
+            |v| v["wavelengths_nm"] = json!((0..=MAX_SAMPLES).map(|i| 400.0 + i as f64).collect::<Vec<_>>()),
             &["wavelengths_nm", "at most"],
         ),
-        (
-            "negative area ratio",
-            |v| v["metallic_flakes"]["area_ratio"] = json!(-0.1),
-            &["metallic_flakes.area_ratio"],
-        ),
+        ("negative area ratio", |v| v["metallic_flakes"]["area_ratio"] = json!(-0.1), &["metallic_flakes.area_ratio"]),
     ];
     for (what, edit, needles) in cases {
         let mut v = fixture_json("cerulean-blue-c");
@@ -1145,16 +887,10 @@ fn paint_new_refuses_bad_specs_without_panicking() {
     let mut s = rgb_spec(1.5, 0.1, [0.5; 3], [1.0; 3], [1.0; 3]);
     s.metallic = Some(metal(1.0, 0.7, 0.05));
     s.pearlescent = Some(pearl(1.0, 0.4, 0.05));
-    assert!(Paint::new(s.clone())
-        .unwrap_err()
-        .to_string()
-        .contains("exceed 1"));
+    assert!(Paint::new(s.clone()).unwrap_err().to_string().contains("exceed 1"));
     s.pearlescent = None;
     s.layer.primer_reflectance = vec![f64::NAN; 3];
     assert!(Paint::new(s.clone()).is_err());
     s.layer.primer_reflectance = vec![0.5; 2];
-    assert!(Paint::new(s)
-        .unwrap_err()
-        .to_string()
-        .contains("sampling has 3"));
+    assert!(Paint::new(s).unwrap_err().to_string().contains("sampling has 3"));
 }

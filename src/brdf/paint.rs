@@ -155,14 +155,9 @@ impl FlakeTerm {
     fn rho(&self, k: usize, cos_local: f64, wavelength_nm: f64) -> f64 {
         match &self.optics {
             FlakeOptics::Metal(eta) => fr_conductor(cos_local, eta[k]),
-            FlakeOptics::Pearl { layers, medium } => stack(
-                *medium,
-                layers,
-                Complex64::new(*medium, 0.0),
-                cos_local,
-                wavelength_nm,
-            )
-            .r(),
+            FlakeOptics::Pearl { layers, medium } => {
+                stack(*medium, layers, Complex64::new(*medium, 0.0), cos_local, wavelength_nm).r()
+            }
         }
     }
 
@@ -252,18 +247,13 @@ fn check_range(what: &str, v: f64, lo: f64, hi: f64) -> Result<()> {
     if v.is_finite() && v >= lo && v <= hi {
         Ok(())
     } else {
-        Err(usage(format!(
-            "{what} = {v} must be a finite number in [{lo}, {hi}]"
-        )))
+        Err(usage(format!("{what} = {v} must be a finite number in [{lo}, {hi}]")))
     }
 }
 
 fn check_spectral(what: &str, v: &[f64], n: usize, lo: f64, hi: f64) -> Result<()> {
     if v.len() != n {
-        return Err(usage(format!(
-            "{what} has {} values; the sampling has {n}",
-            v.len()
-        )));
+        return Err(usage(format!("{what} has {} values; the sampling has {n}", v.len())));
     }
     for (i, &x) in v.iter().enumerate() {
         check_range(&format!("{what}[{i}]"), x, lo, hi)?;
@@ -281,26 +271,14 @@ impl Paint {
     pub fn new(spec: PaintSpec) -> Result<Paint> {
         let n = spec.sampling.len();
         if n == 0 || n > MAX_SAMPLES {
-            return Err(usage(format!(
-                "{n} spectral samples; a paint takes 1 to {MAX_SAMPLES}"
-            )));
+            return Err(usage(format!("{n} spectral samples; a paint takes 1 to {MAX_SAMPLES}")));
         }
         let c = &spec.coat;
         check_range("clear coat index", c.index, 1.3, 1.8)?;
-        check_range(
-            "clear coat thickness (µm)",
-            c.thickness_um,
-            0.0,
-            f64::INFINITY,
-        )?;
+        check_range("clear coat thickness (µm)", c.thickness_um, 0.0, f64::INFINITY)?;
         check_range("clear coat roughness", c.roughness, 0.0, 1.0)?;
         let l = &spec.layer;
-        check_range(
-            "pigmented layer thickness (mm)",
-            l.thickness_mm,
-            0.0,
-            f64::INFINITY,
-        )?;
+        check_range("pigmented layer thickness (mm)", l.thickness_mm, 0.0, f64::INFINITY)?;
         check_spectral("primer reflectance", &l.primer_reflectance, n, 0.0, 1.0)?;
         for p in &l.pigments {
             check_range("pigment concentration", p.concentration, 0.0, f64::INFINITY)?;
@@ -319,12 +297,7 @@ impl Paint {
         if let Some(p) = &spec.pearlescent {
             check_range("pearlescent flake spread (deg)", p.spread_deg, 0.0, 60.0)?;
             check_range("pearlescent flake area ratio", p.area_ratio, 0.0, 1.0)?;
-            check_range(
-                "pearlescent flake depth (mm)",
-                p.depth_mm,
-                0.0,
-                l.thickness_mm,
-            )?;
+            check_range("pearlescent flake depth (mm)", p.depth_mm, 0.0, l.thickness_mm)?;
             check_range("TiO2 thickness (nm)", p.tio2_thickness_nm, 0.0, 1e5)?;
             check_range("TiO2 index", p.tio2_index, 1.0, 4.0)?;
             check_range("mica thickness (nm)", p.mica_thickness_nm, 0.0, 1e6)?;
@@ -339,19 +312,12 @@ impl Paint {
         let mut k_mix = vec![0.0; n];
         let mut s_mix = vec![0.0; n];
         for j in 0..n {
-            let (k, s) = kubelka_munk::mix(
-                l.pigments
-                    .iter()
-                    .map(|p| (p.concentration, p.k_per_mm[j], p.s_per_mm[j])),
-            );
+            let (k, s) = kubelka_munk::mix(l.pigments.iter().map(|p| (p.concentration, p.k_per_mm[j], p.s_per_mm[j])));
             k_mix[j] = k;
             s_mix[j] = s;
         }
         let r_l: Vec<f64> = (0..n)
-            .map(|j| {
-                kubelka_munk::layer(k_mix[j], s_mix[j], l.thickness_mm)
-                    .over(l.primer_reflectance[j])
-            })
+            .map(|j| kubelka_munk::layer(k_mix[j], s_mix[j], l.thickness_mm).over(l.primer_reflectance[j]))
             .collect();
         let r_e = diffuse_fresnel_reflectance(eta);
         let r_i = 1.0 - (1.0 - r_e) / (eta * eta);
@@ -360,86 +326,31 @@ impl Paint {
         let body: Vec<f64> = r_l
             .iter()
             .map(|&r| {
-                let s = if use_saunderson {
-                    1.0 / (1.0 - r_i * r)
-                } else {
-                    1.0
-                };
+                let s = if use_saunderson { 1.0 / (1.0 - r_i * r) } else { 1.0 };
                 body_weight * r / PI * s
             })
             .collect();
-        let rough_coat = (c.roughness >= Microfacet::SMOOTH_THRESHOLD)
-            .then(|| Microfacet::new(c.distribution, c.roughness));
-        let cover = |depth: f64| -> Vec<Layer> {
-            (0..n)
-                .map(|j| kubelka_munk::layer(k_mix[j], s_mix[j], depth))
-                .collect()
-        };
+        let rough_coat =
+            (c.roughness >= Microfacet::SMOOTH_THRESHOLD).then(|| Microfacet::new(c.distribution, c.roughness));
+        let cover =
+            |depth: f64| -> Vec<Layer> { (0..n).map(|j| kubelka_munk::layer(k_mix[j], s_mix[j], depth)).collect() };
         let flake = |label, spread_deg: f64, area, depth, optics| {
             let facets = Microfacet::new(Distribution::Beckmann, spread_to_slope(spread_deg));
-            FlakeTerm {
-                label,
-                area,
-                facets,
-                smooth: facets.effectively_smooth(),
-                cover: cover(depth),
-                optics,
-            }
+            FlakeTerm { label, area, facets, smooth: facets.effectively_smooth(), cover: cover(depth), optics }
         };
-        let metallic = spec
-            .metallic
-            .as_ref()
-            .filter(|m| m.area_ratio > 0.0)
-            .map(|m| {
-                let rel = (0..n)
-                    .map(|j| Complex64::new(m.n[j], m.k[j]) / eta)
-                    .collect();
-                flake(
-                    "metallic flakes",
-                    m.spread_deg,
-                    m.area_ratio,
-                    m.depth_mm,
-                    FlakeOptics::Metal(rel),
-                )
-            });
-        let pearlescent = spec
-            .pearlescent
-            .as_ref()
-            .filter(|p| p.area_ratio > 0.0)
-            .map(|p| {
-                let tio2 = FilmLayer {
-                    n: Complex64::new(p.tio2_index, 0.0),
-                    thickness_nm: p.tio2_thickness_nm,
-                    coherent: true,
-                };
-                let mica = FilmLayer {
-                    n: Complex64::new(p.mica_index, 0.0),
-                    thickness_nm: p.mica_thickness_nm,
-                    coherent: false,
-                };
-                let optics = FlakeOptics::Pearl {
-                    layers: [tio2, mica, tio2],
-                    medium: eta,
-                };
-                flake(
-                    "pearlescent flakes",
-                    p.spread_deg,
-                    p.area_ratio,
-                    p.depth_mm,
-                    optics,
-                )
-            });
-        Ok(Paint {
-            spec,
-            body_weight,
-            r_l,
-            body,
-            r_e,
-            r_i,
-            rough_coat,
-            metallic,
-            pearlescent,
-        })
+        let metallic = spec.metallic.as_ref().filter(|m| m.area_ratio > 0.0).map(|m| {
+            let rel = (0..n).map(|j| Complex64::new(m.n[j], m.k[j]) / eta).collect();
+            flake("metallic flakes", m.spread_deg, m.area_ratio, m.depth_mm, FlakeOptics::Metal(rel))
+        });
+        let pearlescent = spec.pearlescent.as_ref().filter(|p| p.area_ratio > 0.0).map(|p| {
+            let tio2 =
+                FilmLayer { n: Complex64::new(p.tio2_index, 0.0), thickness_nm: p.tio2_thickness_nm, coherent: true };
+            let mica =
+                FilmLayer { n: Complex64::new(p.mica_index, 0.0), thickness_nm: p.mica_thickness_nm, coherent: false };
+            let optics = FlakeOptics::Pearl { layers: [tio2, mica, tio2], medium: eta };
+            flake("pearlescent flakes", p.spread_deg, p.area_ratio, p.depth_mm, optics)
+        });
+        Ok(Paint { spec, body_weight, r_l, body, r_e, r_i, rough_coat, metallic, pearlescent })
     }
 
     pub fn spec(&self) -> &PaintSpec {
@@ -475,7 +386,7 @@ impl Brdf for Paint {
         let n = self.spec.sampling.len();
         let out = &mut out[..n];
         out.fill(0.0);
-        if !(wi.z > 0.0 && wo.z > 0.0) {
+        if wi.z.is_nan() || wo.z.is_nan() || wi.z <= 0.0 || wo.z <= 0.0 {
             return;
         }
         let eta = self.spec.coat.index;
@@ -494,8 +405,7 @@ impl Brdf for Paint {
         let t_i = fresnel_dielectric(wi.z.min(1.0), eta).t();
         match self.spec.form {
             Form::Physical => {
-                let (Some(wi_in), Some(wo_in)) = (refract_into(wi, eta), refract_into(wo, eta))
-                else {
+                let (Some(wi_in), Some(wo_in)) = (refract_into(wi, eta), refract_into(wo, eta)) else {
                     return;
                 };
                 let t_o = fresnel_dielectric(wo.z.min(1.0), eta).t();
@@ -506,11 +416,9 @@ impl Brdf for Paint {
                 let h = (wi_in + wo_in).normalize();
                 let cos_local = wi_in.dot(h).clamp(0.0, 1.0);
                 for fl in self.flakes().filter(|f| !f.smooth) {
-                    let geo = fl.facets.d(h)
-                        * fl.facets
-                            .g(wi_in, wo_in, h, Shadowing::SmithHeightCorrelated)
+                    let geo = fl.facets.d(h) * fl.facets.g(wi_in, wo_in, h, Shadowing::SmithHeightCorrelated)
                         / (4.0 * wi_in.z * wo_in.z);
-                    if !(geo.is_finite() && geo > 0.0) {
+                    if !geo.is_finite() || geo <= 0.0 {
                         continue;
                     }
                     let w = factor * fl.area * geo;
@@ -529,9 +437,8 @@ impl Brdf for Paint {
                 for fl in self.flakes().filter(|f| !f.smooth) {
                     // Cook–Torrance 1982: D_CT = π·D (their Beckmann has no 1/π), divided by π cos θi cos θo.
                     let d_ct = PI * fl.facets.d(h);
-                    let geo =
-                        d_ct * fl.facets.g(wi, wo, h, Shadowing::VCavity) / (PI * wi.z * wo.z);
-                    if !(geo.is_finite() && geo > 0.0) {
+                    let geo = d_ct * fl.facets.g(wi, wo, h, Shadowing::VCavity) / (PI * wi.z * wo.z);
+                    if !geo.is_finite() || geo <= 0.0 {
                         continue;
                     }
                     let w = tau * fl.area * geo;
@@ -551,7 +458,7 @@ impl Brdf for Paint {
         let n = self.spec.sampling.len();
         let out = &mut out[..n];
         out.fill(0.0);
-        if !(wi.z > 0.0) {
+        if wi.z.is_nan() || wi.z <= 0.0 {
             return true;
         }
         let eta = self.spec.coat.index;
@@ -583,24 +490,14 @@ impl Brdf for Paint {
     fn terms(&self) -> Vec<Term> {
         let mut t = Vec::new();
         match &self.rough_coat {
-            None => t.push(Term {
-                label: "clear coat (Fresnel, delta)".into(),
-                kind: TermKind::Delta,
-            }),
+            None => t.push(Term { label: "clear coat (Fresnel, delta)".into(), kind: TermKind::Delta }),
             Some(mf) => t.push(Term {
                 label: "clear coat (rough, microfacet)".into(),
-                kind: TermKind::Lobe(Lobe {
-                    slope_width: mf.alpha,
-                    medium_eta: 1.0,
-                    label: "clear coat".into(),
-                }),
+                kind: TermKind::Lobe(Lobe { slope_width: mf.alpha, medium_eta: 1.0, label: "clear coat".into() }),
             }),
         }
         if self.body_weight > 0.0 {
-            t.push(Term {
-                label: "pigmented layer (Kubelka–Munk, diffuse)".into(),
-                kind: TermKind::Diffuse,
-            });
+            t.push(Term { label: "pigmented layer (Kubelka–Munk, diffuse)".into(), kind: TermKind::Diffuse });
         }
         let medium = match self.spec.form {
             Form::Physical => self.spec.coat.index,
@@ -610,16 +507,9 @@ impl Brdf for Paint {
             let kind = if fl.smooth {
                 TermKind::Delta
             } else {
-                TermKind::Lobe(Lobe {
-                    slope_width: fl.facets.alpha,
-                    medium_eta: medium,
-                    label: fl.label.into(),
-                })
+                TermKind::Lobe(Lobe { slope_width: fl.facets.alpha, medium_eta: medium, label: fl.label.into() })
             };
-            t.push(Term {
-                label: fl.label.into(),
-                kind,
-            });
+            t.push(Term { label: fl.label.into(), kind });
         }
         t
     }
@@ -629,9 +519,7 @@ impl Brdf for Paint {
         // τ(θi) once, which breaks the symmetry whenever anything lies under the coat.
         match self.spec.form {
             Form::Physical => true,
-            Form::PaperEq1 => {
-                self.body_weight == 0.0 && self.metallic.is_none() && self.pearlescent.is_none()
-            }
+            Form::PaperEq1 => self.body_weight == 0.0 && self.metallic.is_none() && self.pearlescent.is_none(),
         }
     }
 
@@ -643,10 +531,7 @@ impl Brdf for Paint {
         };
         let coat = match &self.rough_coat {
             None => format!("smooth coat η = {}", s.coat.index),
-            Some(mf) => format!(
-                "rough coat η = {} ({:?} {})",
-                s.coat.index, mf.distribution, mf.alpha
-            ),
+            Some(mf) => format!("rough coat η = {} ({:?} {})", s.coat.index, mf.distribution, mf.alpha),
         };
         let mut d = format!(
             "paint (Ďurikovič & Ágošton 2007, {form}): {coat}, KM layer X = {} mm with {} pigment(s)",
