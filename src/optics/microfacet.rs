@@ -8,6 +8,12 @@
 //! choices: numerics-notes §4.4–4.5.
 use crate::Vec3;
 
+/// x > 0, false for NaN: used so that NaN inputs take the "outside the domain" branch.
+#[inline]
+fn positive(x: f64) -> bool {
+    x > 0.0
+}
+
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Distribution {
     Beckmann,
@@ -55,7 +61,7 @@ impl Microfacet {
     /// h_z > 0 and α ≥ [`Self::SMOOTH_THRESHOLD`] (D(normal) = 1/(πα²) ≤ 3.2·10¹³).
     pub fn d(&self, h: Vec3) -> f64 {
         let a = self.alpha;
-        if !(h.z > 0.0) || !(a > 0.0) {
+        if !positive(h.z) || !positive(a) {
             return 0.0;
         }
         let r2 = h.x * h.x + h.y * h.y;
@@ -88,11 +94,11 @@ impl Microfacet {
     /// tan²θ = (w_x² + w_y²)/w_z² from components. Λ = 0 along the normal (and for α = 0); Λ = +∞ for
     /// w_z ≤ 0 (grazing or below: G1 = 0).
     pub fn lambda(&self, w: Vec3) -> f64 {
-        if !(w.z > 0.0) {
+        if !positive(w.z) {
             return f64::INFINITY;
         }
         let t2 = (w.x * w.x + w.y * w.y) / (w.z * w.z);
-        if t2 == 0.0 || !(self.alpha > 0.0) {
+        if t2 == 0.0 || !positive(self.alpha) {
             return 0.0;
         }
         match self.distribution {
@@ -137,12 +143,12 @@ impl Microfacet {
     /// Both are symmetric in (ωi, ωo) and in [0, 1].
     pub fn g(&self, wi: Vec3, wo: Vec3, h: Vec3, shadowing: Shadowing) -> f64 {
         let len = h.length();
-        if !(len > 0.0) || !(wi.z > 0.0) || !(wo.z > 0.0) {
+        if !positive(len) || !positive(wi.z) || !positive(wo.z) {
             return 0.0;
         }
         let h = h / len;
         let (ih, oh) = (wi.dot(h), wo.dot(h));
-        if !(ih > 0.0) || !(oh > 0.0) {
+        if !positive(ih) || !positive(oh) {
             return 0.0;
         }
         match shadowing {
