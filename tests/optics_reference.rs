@@ -5,8 +5,8 @@ use glossmeter::optics::fresnel::{fresnel_conductor, fresnel_dielectric};
 use glossmeter::optics::kubelka_munk::{layer_reflectance, r_infinity};
 use glossmeter::optics::microfacet::{Distribution, Microfacet};
 use glossmeter::optics::thin_film::{stack, FilmLayer};
-use num_complex::Complex64;
 use glossmeter::Vec3;
+use num_complex::Complex64;
 use serde_json::Value;
 
 fn fixture(name: &str) -> Value {
@@ -87,7 +87,11 @@ fn thin_film_stacks_vs_tmm() {
             .as_array()
             .unwrap()
             .iter()
-            .map(|l| FilmLayer { n: cplx(&l["n"]), thickness_nm: f(l, "d_nm"), coherent: l["coherent"].as_bool().unwrap() })
+            .map(|l| FilmLayer {
+                n: cplx(&l["n"]),
+                thickness_nm: f(l, "d_nm"),
+                coherent: l["coherent"].as_bool().unwrap(),
+            })
             .collect();
         let ci = f(case, "theta_deg").to_radians().cos();
         let got = stack(f(case, "n_in"), &layers, cplx(&case["n_out"]), ci, f(case, "wavelength_nm"));

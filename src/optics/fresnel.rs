@@ -196,6 +196,19 @@ mod tests {
         }
     }
 
+    /// The paper's Eq. (2) as printed, τ = η₂ cos θi/(η₁ cos θt)·t², violates R + T = 1 at oblique incidence;
+    /// the implemented factor η₂ cos θt/(η₁ cos θi) satisfies it (see `dielectric_r_plus_t_is_one`).
+    #[test]
+    fn printed_eq2_transmittance_factor_is_wrong() {
+        let (eta, th) = (1.5f64, 60f64.to_radians());
+        let (ci, ct) = (th.cos(), cos_transmitted(th.cos(), eta).unwrap());
+        let ts_amp = 2.0 * ci / (ci + eta * ct);
+        let printed = eta * ci / ct * ts_amp * ts_amp;
+        let f = fresnel_dielectric(ci, eta);
+        assert!((f.rs + printed - 1.0).abs() > 0.1, "{}", f.rs + printed);
+        assert!((f.rs + eta * ct / ci * ts_amp * ts_amp - 1.0).abs() < 1e-15);
+    }
+
     /// Normal incidence: R = ((η − 1)/(η + 1))² for both polarisations (Born & Wolf §1.5.3 Eq. 33).
     #[test]
     fn normal_incidence_closed_form() {

@@ -300,8 +300,8 @@ mod tests {
             (1.0, vec![coh(c(2.5, 0.0), 100.0), coh(c(1.58, 0.0), 500.0), coh(c(2.5, 0.0), 100.0)], 1.5),
             (1.5, vec![coh(c(2.5, 0.0), 80.0), inc(c(1.58, 0.0), 500.0), coh(c(2.5, 0.0), 80.0)], 1.5),
             (1.0, vec![inc(c(1.5, 0.0), 1e6)], 1.0),
-            (1.5, vec![coh(c(1.0, 0.0), 200.0)], 1.5),      // frustrated TIR beyond 41.8°
-            (1.5, vec![coh(c(1.38, 0.0), 100.0)], 1.0),     // TIR at the exit beyond 41.8°
+            (1.5, vec![coh(c(1.0, 0.0), 200.0)], 1.5), // frustrated TIR beyond 41.8°
+            (1.5, vec![coh(c(1.38, 0.0), 100.0)], 1.0), // TIR at the exit beyond 41.8°
             (1.0, vec![inc(c(2.0, 0.0), 2e4), coh(c(1.3, 0.0), 90.0), inc(c(1.7, 0.0), 5e4)], 1.45),
         ];
         for (n_in, layers, n_out) in &stacks {
