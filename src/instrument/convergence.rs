@@ -22,7 +22,9 @@
 //! it used ("closed form" or "rtol=1e-12 run"), and in the second case the reference's own error estimate
 //! is reported with it: an actual error below that estimate is not resolved.
 //!
-//! **Timing.** The plan is compiled once per tolerance (not timed) and executed repeatedly until at least
+//! **Timing.** After one untimed warm-up execution at the loosest tolerance (the first execution after a
+//! long reference run was seen to be ~100× slower than later ones), the plan is compiled once per tolerance
+//! (not timed) and executed repeatedly until at least
 //! `min_seconds` (default 20 ms) of wall time have elapsed or `max_repetitions` (default 50) executions
 //! were made, whichever comes first; the minimum over the executions is reported (the least disturbed by
 //! other work on the machine). Two times are kept: `seconds`, the minimum over executions of the reading's
@@ -340,7 +342,12 @@ pub fn closed_form_references(plan: &Plan, f_lum: f64) -> Vec<ReferenceValue> {
         .iter()
         .zip(done)
         .filter(|(r, _)| r.reported)
-        .map(|(r, v)| ReferenceValue { geometry: r.geometry.clone(), reading: r.name.clone(), value: v, error_estimate: None })
+        .map(|(r, v)| ReferenceValue {
+            geometry: r.geometry.clone(),
+            reading: r.name.clone(),
+            value: v,
+            error_estimate: None,
+        })
         .collect()
 }
 
@@ -389,10 +396,18 @@ fn finite(x: f64) -> Option<f64> {
 }
 
 /// Run the sweep. `tolerances` are validated, sorted from loose to tight and de-duplicated.
-pub fn sweep(material: Arc<dyn Brdf>, geometries: Vec<StandardGeometry>, tolerances: &[f64], options: &SweepOptions) -> Result<Sweep> {
+pub fn sweep(
+    material: Arc<dyn Brdf>,
+    geometries: Vec<StandardGeometry>,
+    tolerances: &[f64],
+    options: &SweepOptions,
+) -> Result<Sweep> {
     validate_tolerances(tolerances)?;
     if !(options.min_seconds.is_finite() && options.min_seconds >= 0.0) {
-        return Err(Error::Usage(format!("minimum timing interval must be a number ≥ 0 s, got {}", options.min_seconds)));
+        return Err(Error::Usage(format!(
+            "minimum timing interval must be a number ≥ 0 s, got {}",
+            options.min_seconds
+        )));
     }
     let mut tols = tolerances.to_vec();
     tols.sort_by(|a, b| b.total_cmp(a));
@@ -406,7 +421,8 @@ pub fn sweep(material: Arc<dyn Brdf>, geometries: Vec<StandardGeometry>, toleran
     let (kind, references, reference_seconds) = match lambert {
         Some(f_lum) => (ReferenceKind::ClosedForm, closed_form_references(&probe, f_lum), 0.0),
         None => {
-            let rtol = tightest / REFERENCE_FACTOR;
+            // Rounded to 12 significant digits, so that 1e-5 / 100 is 1e-7 and not 1.0000000000000001e-7.
+            let rtol: f64 = format!("{:.12e}", tightest / REFERENCE_FACTOR).parse().expect("a formatted float parses");
             let plan = Plan::compile(material.clone(), geometries.clone(), plan_options(rtol))?;
             let t0 = Instant::now();
             let readings = plan.execute();
@@ -424,6 +440,10 @@ pub fn sweep(material: Arc<dyn Brdf>, geometries: Vec<StandardGeometry>, toleran
         }
     };
     let label = kind.label();
+
+    // One untimed execution at the loosest tolerance first: the first execution after a long reference
+    // run was seen to take ~100× its later time (B3 at rtol 1e-2: 127 ms once, then 1.4 ms).
+    Plan::compile(material.clone(), geometries.clone(), plan_options(tols[0]))?.execute();
 
     let mut rows = Vec::new();
     for &rtol in &tols {
