@@ -30,10 +30,7 @@ fn every_fixture_loads() {
         let m = recipe::load_file(&p).unwrap_or_else(|e| panic!("{e}"));
         assert_eq!(m.file, p.display().to_string());
         assert!(!m.name.is_empty());
-        assert_eq!(
-            m.brdf.sampling().len(),
-            m.brdf.sampling().luminous_weights.len()
-        );
+        assert_eq!(m.brdf.sampling().len(), m.brdf.sampling().luminous_weights.len());
     }
 }
 
@@ -59,32 +56,17 @@ fn the_documented_forms_load() {
 
 #[test]
 fn name_and_sampling() {
-    let m = recipe::parse_str(
-        r#"{"model": "lambert", "albedo": 0.5}"#,
-        "dir/grey-thing.json",
-    )
-    .unwrap();
+    let m = recipe::parse_str(r#"{"model": "lambert", "albedo": 0.5}"#, "dir/grey-thing.json").unwrap();
     assert_eq!(m.name, "grey-thing", "the name defaults to the file stem");
     assert_eq!(m.brdf.sampling().kind, SamplingKind::Grey);
-    let m = recipe::parse_str(
-        r#"{"model": "lambert", "albedo": [0.5, 0.4, 0.3], "name": "Rgb"}"#,
-        "x.json",
-    )
-    .unwrap();
+    let m = recipe::parse_str(r#"{"model": "lambert", "albedo": [0.5, 0.4, 0.3], "name": "Rgb"}"#, "x.json").unwrap();
     assert_eq!(m.name, "Rgb");
     assert_eq!(m.brdf.sampling().kind, SamplingKind::Rgb);
     // One RGB colour makes the whole material RGB; a grey value is broadcast.
-    let m = recipe::parse_str(
-        r#"{"model": "ward", "alpha": 0.1, "rho_s": 0.1, "rho_d": [0.2, 0.3, 0.4]}"#,
-        "x",
-    )
-    .unwrap();
+    let m =
+        recipe::parse_str(r#"{"model": "ward", "alpha": 0.1, "rho_s": 0.1, "rho_d": [0.2, 0.3, 0.4]}"#, "x").unwrap();
     let mut f = vec![0.0; 3];
-    m.brdf.eval(
-        glossmeter::Vec3::Z,
-        glossmeter::Vec3::new(0.6, 0.0, 0.8),
-        &mut f,
-    );
+    m.brdf.eval(glossmeter::Vec3::Z, glossmeter::Vec3::new(0.6, 0.0, 0.8), &mut f);
     assert!(f[0] < f[1] && f[1] < f[2]);
     assert_eq!(m.json["alpha"], 0.1);
 }
@@ -101,111 +83,31 @@ fn io_error_names_the_file() {
 /// (file under fixtures/bad, expected field path, substrings the message must contain)
 const BAD: &[(&str, &str, &[&str])] = &[
     ("malformed.json", "", &["malformed JSON", "line 3"]),
-    (
-        "unknown-model.json",
-        "model",
-        &[
-            "unknown model \"glass\"",
-            "\"smooth-dielectric\"",
-            "\"paint\"",
-        ],
-    ),
-    (
-        "missing-model.json",
-        "model",
-        &["missing required field", "\"lambert\""],
-    ),
-    (
-        "missing-field.json",
-        "roughness",
-        &["missing required field"],
-    ),
+    ("unknown-model.json", "model", &["unknown model \"glass\"", "\"smooth-dielectric\"", "\"paint\""]),
+    ("missing-model.json", "model", &["missing required field", "\"lambert\""]),
+    ("missing-field.json", "roughness", &["missing required field"]),
     ("unknown-field.json", "albdo", &["unknown field", "albedo"]),
     ("nan-string.json", "albedo", &["string \"NaN\"", "[0, 1]"]),
-    (
-        "infinite.json",
-        "",
-        &["line 1, column", "number out of range"],
-    ),
-    (
-        "string-number.json",
-        "roughness",
-        &["finite number", "string \"0.1\""],
-    ),
-    (
-        "negative-roughness.json",
-        "roughness",
-        &["-0.1 is out of range", "[0, 10]"],
-    ),
-    (
-        "roughness-too-large.json",
-        "roughness",
-        &["12 is out of range", "[0, 10]"],
-    ),
-    (
-        "negative-albedo.json",
-        "albedo",
-        &["out of range", "[0, 1]"],
-    ),
-    (
-        "albedo-above-one.json",
-        "albedo[1]",
-        &["1.2 is out of range", "[0, 1]"],
-    ),
-    (
-        "albedo-wrong-length.json",
-        "albedo",
-        &["[r, g, b]", "an array of 2"],
-    ),
-    (
-        "dielectric-ior-low.json",
-        "ior",
-        &["0.8 is out of range", "[1, 4]"],
-    ),
-    (
-        "dielectric-ior-high.json",
-        "ior",
-        &["4.5 is out of range", "[1, 4]"],
-    ),
-    (
-        "conductor-n-range.json",
-        "ior[0]",
-        &["out of range", "[0.01, 10]"],
-    ),
-    (
-        "conductor-k-range.json",
-        "ior[1]",
-        &["25 is out of range", "[0, 20]"],
-    ),
+    ("infinite.json", "", &["line 1, column", "number out of range"]),
+    ("string-number.json", "roughness", &["finite number", "string \"0.1\""]),
+    ("negative-roughness.json", "roughness", &["-0.1 is out of range", "[0, 10]"]),
+    ("roughness-too-large.json", "roughness", &["12 is out of range", "[0, 10]"]),
+    ("negative-albedo.json", "albedo", &["out of range", "[0, 1]"]),
+    ("albedo-above-one.json", "albedo[1]", &["1.2 is out of range", "[0, 1]"]),
+    ("albedo-wrong-length.json", "albedo", &["[r, g, b]", "an array of 2"]),
+    ("dielectric-ior-low.json", "ior", &["0.8 is out of range", "[1, 4]"]),
+    ("dielectric-ior-high.json", "ior", &["4.5 is out of range", "[1, 4]"]),
+    ("conductor-n-range.json", "ior[0]", &["out of range", "[0.01, 10]"]),
+    ("conductor-k-range.json", "ior[1]", &["25 is out of range", "[0, 20]"]),
     ("conductor-real.json", "ior", &["[n, k]", "number 1.5"]),
-    (
-        "unknown-distribution.json",
-        "distribution",
-        &["\"phong\"", "\"beckmann\", \"ggx\""],
-    ),
-    (
-        "unknown-shadowing.json",
-        "shadowing",
-        &["\"smith\"", "\"v-cavity\""],
-    ),
+    ("unknown-distribution.json", "distribution", &["\"phong\"", "\"beckmann\", \"ggx\""]),
+    ("unknown-shadowing.json", "shadowing", &["\"smith\"", "\"v-cavity\""]),
     ("energy-phong.json", "ks", &["kd + ks = 1.1", "≤ 1"]),
     ("energy-lobes.json", "lobes", &["channel G", "≤ 1"]),
-    (
-        "lobe-unknown-field.json",
-        "lobes[0].n",
-        &["unknown field", "ks, r, m"],
-    ),
+    ("lobe-unknown-field.json", "lobes[0].n", &["unknown field", "ks, r, m"]),
     ("no-lobes.json", "lobes", &["0 lobes", "1 to 8"]),
-    (
-        "ward-alpha-zero.json",
-        "alpha",
-        &["out of range", "[0.000001, 1]"],
-    ),
-    (
-        "phong-exponent-negative.json",
-        "exponent",
-        &["-5 is out of range"],
-    ),
+    ("ward-alpha-zero.json", "alpha", &["out of range", "[0.000001, 1]"]),
+    ("phong-exponent-negative.json", "exponent", &["-5 is out of range"]),
     ("not-an-object.json", "", &["expected a JSON object"]),
     ("name-not-string.json", "name", &["expected a string"]),
 ];
@@ -215,30 +117,18 @@ fn every_bad_recipe_is_refused_with_file_field_and_allowed() {
     let listed: Vec<&str> = BAD.iter().map(|b| b.0).collect();
     for p in json_files("fixtures/bad") {
         let name = p.file_name().unwrap().to_str().unwrap().to_string();
-        assert!(
-            listed.contains(&name.as_str()),
-            "fixtures/bad/{name} has no expectation in BAD"
-        );
+        assert!(listed.contains(&name.as_str()), "fixtures/bad/{name} has no expectation in BAD");
     }
     for (name, field, needles) in BAD {
         let p = root().join("fixtures/bad").join(name);
-        let e = recipe::load_file(&p)
-            .err()
-            .unwrap_or_else(|| panic!("{name} was accepted"));
+        let e = recipe::load_file(&p).err().unwrap_or_else(|| panic!("{name} was accepted"));
         let shown = e.to_string();
         match &e {
-            Error::Input {
-                file,
-                field: f,
-                message,
-            } => {
+            Error::Input { file, field: f, message } => {
                 assert_eq!(file, &p.display().to_string(), "{name}: file");
                 assert_eq!(f, field, "{name}: field (message: {message})");
                 for n in *needles {
-                    assert!(
-                        message.contains(n),
-                        "{name}: message {message:?} lacks {n:?}"
-                    );
+                    assert!(message.contains(n), "{name}: message {message:?} lacks {n:?}");
                 }
                 assert!(shown.starts_with(&p.display().to_string()));
             }
@@ -268,10 +158,7 @@ fn resolve<'a>(s: &'a Value, v: &'a Value) -> &'a Value {
 /// false, recursively into objects and arrays of objects.
 fn check(s: &Value, sub: &Value, v: &Value, path: &str, errors: &mut Vec<String>) {
     let sub = resolve(s, sub);
-    if let (Some(props), Some(obj)) = (
-        sub.get("properties").and_then(Value::as_object),
-        v.as_object(),
-    ) {
+    if let (Some(props), Some(obj)) = (sub.get("properties").and_then(Value::as_object), v.as_object()) {
         for r in sub["required"].as_array().into_iter().flatten() {
             if !obj.contains_key(r.as_str().unwrap()) {
                 errors.push(format!("{path}: missing required {r}"));
@@ -280,9 +167,7 @@ fn check(s: &Value, sub: &Value, v: &Value, path: &str, errors: &mut Vec<String>
         for (k, x) in obj {
             match props.get(k) {
                 Some(p) => check(s, p, x, &format!("{path}.{k}"), errors),
-                None if sub["additionalProperties"] == false => {
-                    errors.push(format!("{path}: {k} not allowed"))
-                }
+                None if sub["additionalProperties"] == false => errors.push(format!("{path}: {k} not allowed")),
                 None => {}
             }
         }
@@ -298,12 +183,8 @@ fn check(s: &Value, sub: &Value, v: &Value, path: &str, errors: &mut Vec<String>
 fn schema_covers_every_model_and_every_fixture_matches_it() {
     let s = schema();
     assert_eq!(s["$schema"], "https://json-schema.org/draft/2020-12/schema");
-    let models: Vec<&str> = s["properties"]["model"]["enum"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|m| m.as_str().unwrap())
-        .collect();
+    let models: Vec<&str> =
+        s["properties"]["model"]["enum"].as_array().unwrap().iter().map(|m| m.as_str().unwrap()).collect();
     assert_eq!(models, recipe::MODELS);
     for m in recipe::MODELS {
         subschema(&s, m);
@@ -329,32 +210,18 @@ fn schema_covers_every_model_and_every_fixture_matches_it() {
 fn schema_ranges_agree_with_validator() {
     let s = schema();
     let ior = &s["$defs"]["dielectric_ior"];
-    let (lo, hi) = (
-        ior["minimum"].as_f64().unwrap(),
-        ior["maximum"].as_f64().unwrap(),
-    );
-    let load = |x: f64| {
-        recipe::parse_str(
-            &format!(r#"{{"model": "smooth-dielectric", "ior": {x}}}"#),
-            "t",
-        )
-        .is_ok()
-    };
+    let (lo, hi) = (ior["minimum"].as_f64().unwrap(), ior["maximum"].as_f64().unwrap());
+    let load = |x: f64| recipe::parse_str(&format!(r#"{{"model": "smooth-dielectric", "ior": {x}}}"#), "t").is_ok();
     assert!(load(lo) && load(hi) && !load(hi + 1e-9) && !load(lo - 1e-9));
     let r = &subschema(&s, "microfacet")["properties"]["roughness"];
     let hi = r["maximum"].as_f64().unwrap();
     let load = |x: f64| {
         recipe::parse_str(
-            &format!(
-                r#"{{"model": "microfacet", "distribution": "ggx", "roughness": {x}, "ior": 1.5}}"#
-            ),
+            &format!(r#"{{"model": "microfacet", "distribution": "ggx", "roughness": {x}, "ior": 1.5}}"#),
             "t",
         )
         .is_ok()
     };
     assert!(load(hi) && !load(hi * 1.0001));
-    assert!(
-        Path::new(&root().join("docs/recipe-format.md")).exists(),
-        "docs/recipe-format.md documents the format"
-    );
+    assert!(Path::new(&root().join("docs/recipe-format.md")).exists(), "docs/recipe-format.md documents the format");
 }

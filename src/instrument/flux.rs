@@ -61,6 +61,9 @@ pub fn lobe_widths_uv(lobe: &Lobe, theta: f64) -> [f64; 2] {
     [2.0 * m * eta * ct / c, 2.0 * m * eta * ct]
 }
 
+/// A list of boxes (lower corner, upper corner) in the 4-D lobe coordinates (u, t_p, v, t_q).
+type Boxes4 = Vec<([f64; 4], [f64; 4])>;
+
 /// One axis of the (source, receptor) pair in lobe coordinates.
 #[derive(Clone, Copy, Debug)]
 struct AxisMap {
@@ -149,7 +152,7 @@ pub struct FluxProblem<'a> {
 
 impl FluxProblem<'_> {
     /// The initial boxes of the regular integral in (u, t_p, v, t_q), and the axis maps.
-    fn partition(&self, src: Stop, rec: Stop) -> (AxisMap, AxisMap, Vec<([f64; 4], [f64; 4])>) {
+    fn partition(&self, src: Stop, rec: Stop) -> (AxisMap, AxisMap, Boxes4) {
         let ap = AxisMap { s: src.p, r: rec.p };
         let aq = AxisMap { s: src.q, r: rec.q };
         let widths: Vec<[f64; 2]> = self.lobes.iter().map(|l| lobe_widths_uv(l, self.theta)).collect();
