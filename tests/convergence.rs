@@ -11,7 +11,11 @@ use glossmeter::recipe;
 /// A fresh scratch directory per call (tests run in parallel).
 fn scratch() -> PathBuf {
     static N: AtomicUsize = AtomicUsize::new(0);
-    let d = std::env::temp_dir().join(format!("glossmeter-convergence-test-{}-{}", std::process::id(), N.fetch_add(1, Ordering::SeqCst)));
+    let d = std::env::temp_dir().join(format!(
+        "glossmeter-convergence-test-{}-{}",
+        std::process::id(),
+        N.fetch_add(1, Ordering::SeqCst)
+    ));
     let _ = std::fs::remove_dir_all(&d);
     std::fs::create_dir_all(&d).unwrap();
     d
@@ -36,7 +40,10 @@ fn quick() -> SweepOptions {
 fn lambertian_sweep_actual_error_is_within_the_estimate_and_decreases() {
     let dir = scratch();
     let material = recipe::load_file(&lambert_recipe(&dir)).unwrap();
-    let geos: Vec<_> = ["astm-d523-20", "astm-d523-60", "astm-d523-85", "astm-e430-30"].iter().map(|id| standards::find(id).unwrap()).collect();
+    let geos: Vec<_> = ["astm-d523-20", "astm-d523-60", "astm-d523-85", "astm-e430-30"]
+        .iter()
+        .map(|id| standards::find(id).unwrap())
+        .collect();
     let sweep = convergence::sweep(material.brdf.clone(), geos, &convergence::DEFAULT_TOLERANCES, &quick()).unwrap();
     assert_eq!(sweep.reference, ReferenceKind::ClosedForm);
     // 9 tolerances × (3 gloss + E430's gloss, haze, log-haze, DOI readings).
@@ -45,7 +52,9 @@ fn lambertian_sweep_actual_error_is_within_the_estimate_and_decreases() {
     let mut series: std::collections::BTreeMap<(String, String), Vec<(f64, f64)>> = Default::default();
     for r in &sweep.rows {
         assert_eq!(r.reference_kind, "closed form");
-        let v = r.value.unwrap_or_else(|| panic!("{} {} at {:e}: no value ({:?})", r.geometry, r.reading, r.rtol, r.problem));
+        let v = r
+            .value
+            .unwrap_or_else(|| panic!("{} {} at {:e}: no value ({:?})", r.geometry, r.reading, r.rtol, r.problem));
         let est = r.error_estimate.unwrap();
         let actual = r.actual_error.unwrap();
         let reference = r.reference.unwrap();
@@ -65,7 +74,13 @@ fn lambertian_sweep_actual_error_is_within_the_estimate_and_decreases() {
         // (Not for DOI, log-haze or haze index: rtol applies to the fluxes, not to those derived numbers.)
         if matches!(r.quantity.as_str(), "gloss" | "haze") {
             let bound = r.rtol * (0.6 * v.abs() + 0.01) * (1.0 + 1e-9);
-            assert!(est <= bound, "{} {} at {:e}: estimate {est:e} above rtol·(0.6|value| + 0.01) = {bound:e}", r.geometry, r.reading, r.rtol);
+            assert!(
+                est <= bound,
+                "{} {} at {:e}: estimate {est:e} above rtol·(0.6|value| + 0.01) = {bound:e}",
+                r.geometry,
+                r.reading,
+                r.rtol
+            );
         }
         // Errors relative to the scale of the reading: its value, except for DOI = 100·(1 − Φ_off/Φ_spec),
         // a small difference (0.003 for a Lambertian) whose rounding level is set by the 100, not by itself.
@@ -81,7 +96,12 @@ fn lambertian_sweep_actual_error_is_within_the_estimate_and_decreases() {
         // monotonicity is not a property of adaptive cubature; growth by more than 2× would be a defect.
         for w in pts.windows(2) {
             let (a, b) = (w[0].1, w[1].1);
-            assert!(b <= 2.0 * a || b <= 1e-13, "{g} {name}: actual error grew from {a:e} (rtol {:e}) to {b:e} (rtol {:e})", w[0].0, w[1].0);
+            assert!(
+                b <= 2.0 * a || b <= 1e-13,
+                "{g} {name}: actual error grew from {a:e} (rtol {:e}) to {b:e} (rtol {:e})",
+                w[0].0,
+                w[1].0
+            );
         }
         // Over the sweep it goes down. Where the initial partition already meets a tolerance the engine
         // does no more work and the value is the same bits (E430 30° gloss: 530 evaluations and the same
@@ -105,7 +125,12 @@ fn lambertian_closed_form_agrees_with_a_tight_run() {
     let closed = convergence::sweep(material.brdf.clone(), geos, &[1e-10], &quick()).unwrap();
     for (a, b) in run.references.iter().zip(&closed.references) {
         let (x, y) = (a.value.unwrap(), b.value.unwrap());
-        assert!((x - y).abs() <= a.error_estimate.unwrap() + 1e-14 * y.abs(), "{} {}: run {x} vs closed form {y}", a.geometry, a.reading);
+        assert!(
+            (x - y).abs() <= a.error_estimate.unwrap() + 1e-14 * y.abs(),
+            "{} {}: run {x} vs closed form {y}",
+            a.geometry,
+            a.reading
+        );
     }
 }
 
@@ -116,7 +141,9 @@ fn a_non_lambertian_material_is_compared_with_a_tight_run() {
     std::fs::write(&p, r#"{"model":"microfacet","distribution":"beckmann","roughness":0.1,"ior":1.5}"#).unwrap();
     let material = recipe::load_file(&p).unwrap();
     assert!(convergence::lambertian_value(material.brdf.as_ref()).is_none());
-    let sweep = convergence::sweep(material.brdf, vec![standards::find("astm-d523-60").unwrap()], &[1e-3, 1e-5], &quick()).unwrap();
+    let sweep =
+        convergence::sweep(material.brdf, vec![standards::find("astm-d523-60").unwrap()], &[1e-3, 1e-5], &quick())
+            .unwrap();
     assert_eq!(sweep.reference, ReferenceKind::Run { rtol: 1e-7 });
     for r in &sweep.rows {
         assert_eq!(r.reference_kind, "rtol=1e-7 run");
@@ -166,7 +193,18 @@ fn json_output_parses_and_has_the_fields() {
     }
     // The output file now exists: a second run must refuse it and leave it alone.
     let before = std::fs::read(&out).unwrap();
-    let code = run(&["convergence", recipe.to_str().unwrap(), "-g", "astm-d523-60", "--tolerances", "1e-3", "--format", "json", "-o", out.to_str().unwrap()]);
+    let code = run(&[
+        "convergence",
+        recipe.to_str().unwrap(),
+        "-g",
+        "astm-d523-60",
+        "--tolerances",
+        "1e-3",
+        "--format",
+        "json",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
     assert_eq!(code, 2);
     assert_eq!(std::fs::read(&out).unwrap(), before);
 }
@@ -176,7 +214,18 @@ fn csv_output_has_one_line_per_row() {
     let dir = scratch();
     let recipe = lambert_recipe(&dir);
     let out = dir.join("sweep.csv");
-    let code = run(&["convergence", recipe.to_str().unwrap(), "--tolerances", "1e-2,1e-4,1e-6", "--format", "csv", "--max-repetitions", "1", "-o", out.to_str().unwrap()]);
+    let code = run(&[
+        "convergence",
+        recipe.to_str().unwrap(),
+        "--tolerances",
+        "1e-2,1e-4,1e-6",
+        "--format",
+        "csv",
+        "--max-repetitions",
+        "1",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
     assert_eq!(code, 0);
     let text = std::fs::read_to_string(&out).unwrap();
     let lines: Vec<&str> = text.lines().collect();

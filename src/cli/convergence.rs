@@ -146,7 +146,7 @@ fn decimals(err: Option<f64>) -> usize {
 
 fn err_cell(e: Option<f64>) -> String {
     match e {
-        Some(x) if x == 0.0 => "0".into(),
+        Some(0.0) => "0".into(),
         Some(x) => format!("{x:.2e}"),
         None => "—".into(),
     }

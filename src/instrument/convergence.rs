@@ -177,7 +177,7 @@ pub fn lambertian_value(brdf: &dyn Brdf) -> Option<f64> {
     let pairs = [
         (dir(0.0, 0.0), dir(0.0, 0.0)),
         (dir(0.35, 3.1), dir(0.35, 0.0)),
-        (dir(1.05, 3.14159), dir(1.05, 0.0)),
+        (dir(1.05, 3.0), dir(1.05, 0.0)),
         (dir(1.48, 3.0), dir(0.2, 1.0)),
         (dir(0.7, 0.4), dir(1.3, 2.5)),
         (dir(1.55, 0.0), dir(1.55, 0.0)),
