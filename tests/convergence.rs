@@ -69,8 +69,9 @@ fn lambertian_sweep_actual_error_is_within_the_estimate_and_decreases() {
             r.reading,
             r.rtol
         );
-        // For ratios of fluxes (gloss, haze) the estimate honours the requested tolerance: each specimen
-        // flux to rtol/2, the standard to rtol/10, plus the absolute floor 1e-4·rtol·Φ_std = 0.01·rtol GU.
+        // For ratios of fluxes (gloss, haze) the estimate honours the requested tolerance: the specimen
+        // flux is asked for rtol/2 (its delta and regular parts rtol/4 each), the standard for rtol/10 (its
+        // delta part rtol/20), plus half the absolute floor 1e-4·rtol·Φ_std, i.e. 0.005·rtol GU.
         // (Not for DOI, log-haze or haze index: rtol applies to the fluxes, not to those derived numbers.)
         if matches!(r.quantity.as_str(), "gloss" | "haze") {
             let bound = r.rtol * (0.6 * v.abs() + 0.01) * (1.0 + 1e-9);

@@ -93,8 +93,17 @@ pub fn render_svg(sweep: &Sweep, title: &str) -> Result<(String, PlotSummary)> {
             clamped_estimated += usize::from(e < floor);
         }
     }
+    // The reference's own error estimate (tight-run references only): actual errors below it are not
+    // resolved; drawn as a grey dotted line.
+    let ref_err = sweep.rows.iter().filter_map(|r| r.reference_error).fold(0.0f64, f64::max);
+    let emin = series
+        .iter()
+        .flat_map(|s| s.points.iter().flat_map(|&(_, a, e)| [clamp(a), clamp(e)]))
+        .chain((ref_err > 0.0).then_some(clamp(ref_err)))
+        .fold(f64::INFINITY, f64::min);
+    let emax = emax.max(ref_err);
     let x_range = (tmin / 2.0)..(tmax * 2.0);
-    let y_range = (floor / 3.0)..(emax * 3.0);
+    let y_range = (emin / 3.0)..(emax * 3.0);
 
     let mut svg = String::new();
     {
@@ -136,9 +145,24 @@ pub fn render_svg(sweep: &Sweep, title: &str) -> Result<(String, PlotSummary)> {
                 .map_err(plot_err)?
                 .label(format!("{}: estimated error (dashed)", s.label))
                 .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 6, y), (x + 10, y), (x + 16, y)], colour.stroke_width(1))
+                    EmptyElement::at((x, y))
+                        + PathElement::new(vec![(0, 0), (6, 0)], colour.stroke_width(1))
+                        + PathElement::new(vec![(10, 0), (16, 0)], colour.stroke_width(1))
                 });
             chart.draw_series(estimated.iter().map(|&p| Cross::new(p, 3, colour.stroke_width(1)))).map_err(plot_err)?;
+        }
+        if ref_err > 0.0 {
+            let grey = RGBColor(110, 110, 110);
+            chart
+                .draw_series(DashedLineSeries::new(
+                    vec![(tmin / 2.0, clamp(ref_err)), (tmax * 2.0, clamp(ref_err))],
+                    2,
+                    4,
+                    grey.stroke_width(1),
+                ))
+                .map_err(plot_err)?
+                .label(format!("largest error estimate of the reference run ({ref_err:.1e}): actual errors below it are not resolved"))
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], grey.stroke_width(1)));
         }
         chart
             .configure_series_labels()
