@@ -20,6 +20,8 @@ pub enum Error {
     Usage(String),
     /// A computation that did not produce a finite result.
     Numeric(String),
+    /// A comparison with a sheet found readings outside their allowed difference (exit status 1).
+    Check(String),
 }
 
 pub type Result<T> = std::result::Result<T, Error>;
@@ -38,6 +40,7 @@ impl fmt::Display for Error {
             Error::Io { file, source } => write!(f, "{file}: {source}"),
             Error::Usage(m) => write!(f, "{m}"),
             Error::Numeric(m) => write!(f, "numerical failure: {m}"),
+            Error::Check(m) => write!(f, "check failed: {m}"),
         }
     }
 }

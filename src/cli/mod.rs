@@ -10,6 +10,7 @@ use crate::instrument::plan::{Plan, PlanOptions, Reading};
 use crate::instrument::standards;
 use crate::{recipe, Error, Result};
 
+pub mod compare;
 pub mod convergence;
 pub mod format;
 pub mod plot;
@@ -67,6 +68,8 @@ pub enum Command {
     },
     /// Print the JSON Schema of the recipe format.
     Schema,
+    /// Set predictions beside a glossmeter sheet (CSV); exits 1 if a reading falls outside its uncertainty.
+    Compare(compare::CompareArgs),
     /// Error against run time over a sweep of tolerances (table, CSV, JSON, and a log–log plot).
     Convergence(convergence::ConvergenceArgs),
 }
@@ -123,7 +126,7 @@ fn dispatch(cli: Cli) -> Result<()> {
             });
             emit(&text, output.as_deref())?;
             if readings.iter().any(|r| r.value.is_none()) {
-                return Err(Error::Numeric("some readings have no value (see the table)".into()));
+                return Err(Error::Numeric("some readings have no finite value (see the notes in the output)".into()));
             }
             Ok(())
         }
@@ -139,6 +142,7 @@ fn dispatch(cli: Cli) -> Result<()> {
             Ok(())
         }
         Command::Convergence(args) => convergence::run(args),
+        Command::Compare(args) => compare::run(args),
         Command::Schema => {
             println!("{}", serde_json::to_string_pretty(&recipe::schema::schema()).expect("schema serialises"));
             Ok(())

@@ -3,4 +3,5 @@ pub mod convergence;
 pub mod flux;
 pub mod geometry;
 pub mod plan;
+pub mod sheet;
 pub mod standards;
