@@ -680,6 +680,7 @@ fn main() {
         );
     }
 
+    where_the_evaluations_go(&mut md, &cases);
     b5(&mut md, quick);
 
     print!("{md}");
@@ -690,6 +691,75 @@ fn main() {
     match std::fs::write(&out, &md) {
         Ok(()) => eprintln!("[bench] wrote {}", out.display()),
         Err(e) => eprintln!("[bench] could not write {}: {e}", out.display()),
+    }
+}
+
+/// Records, for every regular evaluation, the lobe coordinates (u, v) = (p_s + p_r, q_s + q_r) in units of
+/// the lobe widths, recovered from the directions: for the source p = (ω·e∥)/(ω·s0), q = ω_y/(ω·s0).
+#[derive(Debug)]
+struct Recording {
+    inner: Arc<dyn Brdf>,
+    theta: f64,
+    widths: [f64; 2],
+    seen: std::sync::Mutex<Vec<f64>>,
+}
+
+impl Brdf for Recording {
+    fn sampling(&self) -> &Sampling {
+        self.inner.sampling()
+    }
+    fn eval(&self, wi: Vec3, wo: Vec3, out: &mut [f64]) {
+        let (s, c) = (self.theta.sin(), self.theta.cos());
+        let (s0, es) = (Vec3::new(-s, 0.0, c), Vec3::new(c, 0.0, s));
+        let (r0, er) = (Vec3::new(s, 0.0, c), Vec3::new(c, 0.0, -s));
+        let (ps, qs) = (wi.dot(es) / wi.dot(s0), wi.y / wi.dot(s0));
+        let (pr, qr) = (wo.dot(er) / wo.dot(r0), wo.y / wo.dot(r0));
+        let x = ((ps + pr) / self.widths[0]).abs().max(((qs + qr) / self.widths[1]).abs());
+        self.seen.lock().expect("lock").push(x);
+        self.inner.eval(wi, wo, out)
+    }
+    fn terms(&self) -> Vec<Term> {
+        self.inner.terms()
+    }
+    fn describe(&self) -> String {
+        self.inner.describe()
+    }
+}
+
+/// Histogram of the evaluation points of our rtol-1e-6 runs over max(|u|/w_u, |v|/w_v), for the lobed cases.
+fn where_the_evaluations_go(md: &mut String, cases: &[Case]) {
+    use glossmeter::instrument::flux::lobe_widths_uv;
+    let _ = writeln!(md, "\n## Where our evaluations go (rtol 1e-6)\n");
+    let _ = writeln!(
+        md,
+        "Evaluation points binned by x = max(|u|/w_u, |v|/w_v), (u, v) the lobe variables and (w_u, w_v) the lobe widths the engine uses for its splits (it splits at 0, ±1, ±3, ±10, ±30, ±100 w). For Beckmann the lobe is ≈ exp(−x²) there: beyond x = 10 it is below e⁻¹⁰⁰ of its peak.\n"
+    );
+    let _ = writeln!(md, "| case | w_u | w_v | evaluations | x < 1 | 1–3 | 3–10 | 10–30 | 30–100 | ≥ 100 |");
+    let _ = writeln!(md, "|---|---|---|---|---|---|---|---|---|---|");
+    for c in cases.iter().filter(|c| c.id != "B1") {
+        let lobe = c.brdf.lobes()[0].clone();
+        let widths = lobe_widths_uv(&lobe, c.theta);
+        let rec = Arc::new(Recording { inner: c.brdf.clone(), theta: c.theta, widths, seen: Default::default() });
+        let rc = Case { brdf: rec.clone(), geometry: c.geometry.clone(), title: c.title.clone(), ..*c };
+        let f = problem(&rc, 1e-6).solve();
+        let xs = rec.seen.lock().expect("lock");
+        let edges = [0.0, 1.0, 3.0, 10.0, 30.0, 100.0, f64::INFINITY];
+        let mut counts = [0usize; 6];
+        for &x in xs.iter() {
+            let k = (0..6).find(|&k| x >= edges[k] && x < edges[k + 1]).unwrap_or(5);
+            counts[k] += 1;
+        }
+        let n = xs.len().max(1) as f64;
+        let cells: Vec<String> = counts.iter().map(|&k| format!("{k} ({:.0} %)", 100.0 * k as f64 / n)).collect();
+        let _ = writeln!(
+            md,
+            "| {} | {:.2e} | {:.2e} | {} | {} |",
+            c.id,
+            widths[0],
+            widths[1],
+            f.evaluations,
+            cells.join(" | ")
+        );
     }
 }
 
