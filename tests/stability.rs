@@ -365,8 +365,19 @@ fn r_external(eta: f64) -> f64 {
 /// and Fresnel from the denser side above; the square-root behaviour at μc is removed by μ = μc + (1 − μc)v².
 fn r_internal(eta: f64) -> f64 {
     let mu_c = (1.0 - 1.0 / (eta * eta)).sqrt();
-    let above =
-        gl1(&|v| fresnel_real(mu_c + (1.0 - mu_c) * v * v, 1.0 / eta) * 2.0 * (mu_c + (1.0 - mu_c) * v * v) * 2.0 * (1.0 - mu_c) * v, 0.0, 1.0, 64);
+    let above = gl1(
+        &|v| {
+            fresnel_real(mu_c + (1.0 - mu_c) * v * v, 1.0 / eta)
+                * 2.0
+                * (mu_c + (1.0 - mu_c) * v * v)
+                * 2.0
+                * (1.0 - mu_c)
+                * v
+        },
+        0.0,
+        1.0,
+        64,
+    );
     mu_c * mu_c + above
 }
 
@@ -429,7 +440,15 @@ fn every_geometry_lambert_and_smooth_dielectric() {
         let horizon = g.theta.cos() / g.theta.sin();
         let reaches_below = if source { stop.p[0] < -horizon } else { stop.p[1] > horizon };
         let ok = (closed - gl).abs() <= 1e-12 * closed && reaches_below;
-        stab(test, &format!("89° clipped {} stop: projected solid angle", if source { "source" } else { "receptor" }), closed, 0.0, (closed - gl).abs(), 1e-12 * closed, ok);
+        stab(
+            test,
+            &format!("89° clipped {} stop: projected solid angle", if source { "source" } else { "receptor" }),
+            closed,
+            0.0,
+            (closed - gl).abs(),
+            1e-12 * closed,
+            ok,
+        );
         if !ok {
             fails.push(format!("clipped PSA: closed {closed} vs GL {gl} (reaches below: {reaches_below})"));
         }
@@ -454,8 +473,447 @@ fn every_geometry_lambert_and_smooth_dielectric() {
         * projected_solid_angle(g.theta, g.source, true)
         * projected_solid_angle(g.theta, g.receptors[0].1, false);
     let actual = (f.value - exact).abs();
-    if !stab(test, "89° clipped flux (FluxProblem, lambert)", f.value, f.error, actual, f.error, f.value.is_finite() && actual <= f.error) {
+    if !stab(
+        test,
+        "89° clipped flux (FluxProblem, lambert)",
+        f.value,
+        f.error,
+        actual,
+        f.error,
+        f.value.is_finite() && actual <= f.error,
+    ) {
         fails.push(format!("clipped lambert flux {} vs {exact}: est {:e}", f.value, f.error));
+    }
+    finish(test, fails);
+}
+
+/// Microfacet surfaces (n = 1.5) from roughness 1e-6 to 1, Beckmann and GGX, on every D523 geometry, against
+/// runs 100× tighter; continuity across the "effectively smooth" switch (roughness 1e-7 × (1 ± 1e-4)) and
+/// across the flux engine's lobe-split switch (splits only where the lobe is narrower than half the range of
+/// the lobe variable; w_u = 2m, w_v = 2m cos θ for a surface lobe, docs/instrument.md §Quadrature).
+#[test]
+fn microfacet_roughness_sweep_and_switches() {
+    let test = "microfacet_roughness_sweep_and_switches";
+    let mut fails = Vec::new();
+    let mf = microfacet;
+    let gs = d523();
+    for dist in ["beckmann", "ggx"] {
+        for m in [1e-6, 1e-5, 1e-4, 1e-3, 1e-2, 0.1, 0.3, 1.0] {
+            if dist == "ggx" && m <= 1e-6 {
+                continue; // `ggx_narrow_lobe_below_1e_6` (ignored: bug)
+            }
+            check_against_tight(test, &format!("{dist} m={m:e}"), &mf(dist, m), &gs, &mut fails);
+        }
+        if dist == "beckmann" {
+            smooth_switch(test, dist, &gs, &mut fails);
+        }
+        // Lobe-split switch at 60°, for the u axis (in-plane) and the v axis (perpendicular).
+        let g60 = &geoms(&["astm-d523-60"]);
+        let g = &g60[0].geometry;
+        let rec = g.receptor("gloss").unwrap();
+        let range_u = (g.source.p[1] + rec.p[1]) - (g.source.p[0] + rec.p[0]);
+        let range_v = (g.source.q[1] + rec.q[1]) - (g.source.q[0] + rec.q[0]);
+        for (axis, m_star) in [("u", range_u / 4.0), ("v", range_v / (4.0 * g.theta.cos()))] {
+            let a = run(&mf(dist, m_star * (1.0 - 1e-6)), g60, RTOL);
+            let b = run(&mf(dist, m_star * (1.0 + 1e-6)), g60, RTOL);
+            check_gap(
+                test,
+                &format!("{dist} split switch {axis} m={m_star:.5e}(1±1e-6)"),
+                &a[0],
+                &b[0],
+                RTOL,
+                0.0,
+                &mut fails,
+            );
+        }
+    }
+    // Split sharing: a lobe within a factor 3 of a narrower one shares its splits (flux.rs `splits`).
+    let lobes = |m2: f64| {
+        recipe(&json!({"model": "cook-torrance-lobes", "kd": 0.0,
+            "lobes": [{"ks": 0.5, "r": 0.04, "m": 0.003}, {"ks": 0.5, "r": 0.04, "m": m2}]}))
+    };
+    let (a, b) = (run(&lobes(0.009 * (1.0 - 1e-6)), &gs, RTOL), run(&lobes(0.009 * (1.0 + 1e-6)), &gs, RTOL));
+    for (x, y) in a.iter().zip(&b) {
+        check_gap(test, "two lobes, split-sharing switch m2=3·m1(1±1e-6)", x, y, RTOL, 0.0, &mut fails);
+    }
+    finish(test, fails);
+}
+
+fn microfacet(dist: &str, m: f64) -> Arc<dyn Brdf> {
+    recipe(&json!({"model": "microfacet", "distribution": dist, "roughness": m, "ior": 1.5}))
+}
+
+/// Continuity across the microfacet "effectively smooth" switch: roughness 1e-7 × (1 ± 1e-4).
+fn smooth_switch(test: &str, dist: &str, gs: &[StandardGeometry], fails: &mut Vec<String>) {
+    let t = Microfacet::SMOOTH_THRESHOLD;
+    let (above, below) = (microfacet(dist, t * (1.0 + 1e-4)), microfacet(dist, t * (1.0 - 1e-4)));
+    assert!(!above.has_delta() && below.has_delta(), "the two sides must be on either side of the switch");
+    for (a, b) in run(&above, gs, RTOL).iter().zip(&run(&below, gs, RTOL)) {
+        check_gap(test, &format!("{dist} smooth switch m=1e-7(1±1e-4)"), a, b, RTOL, 0.0, fails);
+    }
+}
+
+/// GGX lobes of roughness ≤ 1e-6: the reading at rtol 1e-5 falls short of the run 100× tighter (and of the
+/// smooth limit) by about 3e-5 relative, ten times its error estimate, and the two sides of the smooth switch
+/// differ by 6e-5 relative. GGX keeps a fraction 1/(1 + (t/α)²) of its mass beyond slope t, i.e. 1e-4 beyond
+/// the last split point at 100 widths; between there and the edge of the range (hundreds to thousands of
+/// widths away for α ≤ 1e-6) the 1/t⁴ tail sits in one box per side, which the degree-7/degree-5 pair
+/// under-integrates with a small |I₇ − I₅|.
+#[test]
+#[ignore = "bug: GGX lobe α ≤ 1e-6 under-read beyond its error estimate (heavy tail past the last split)"]
+fn ggx_narrow_lobe_below_1e_6() {
+    let test = "ggx_narrow_lobe_below_1e_6";
+    let mut fails = Vec::new();
+    let gs = d523();
+    check_against_tight(test, "ggx m=1e-6", &microfacet("ggx", 1e-6), &gs, &mut fails);
+    smooth_switch(test, "ggx", &gs, &mut fails);
+    finish(test, fails);
+}
+
+/// A clear coat of index 1.8 (internal diffuse reflectance with total internal reflection beyond 33.7°)
+/// read at 85° and 89° (as shipped, and with stops reaching below the horizon): the readings against the
+/// factorised closed form of `paint_flux` with r_i integrated directly through the TIR region; the model's
+/// r_i; energy ≤ 1 by the crate's white-furnace integrator.
+#[test]
+fn clear_coat_1_8_total_internal_reflection() {
+    let test = "clear_coat_1_8_total_internal_reflection";
+    let mut fails = Vec::new();
+    let (eta, k, s, x, rg) = (1.8, 0.5, 2.0, 0.15, 0.7);
+    let v = paint_recipe(eta, k, s, x, rg);
+    let brdf = recipe(&v);
+    let gs = vec![standards::find("astm-d523-85").unwrap(), user_89(), user_89_clipped()];
+    let refs = references(&gs, &|g, rec| paint_flux(g.theta, g.source, rec, eta, 1.0, km(k, s, x, rg)));
+    check_all(test, "coat 1.8", &run(&brdf, &gs, RTOL), &refs, &mut fails);
+
+    let p = paint_of(&v);
+    let (model, direct) = (p.internal_diffuse_reflectance(), r_internal(eta));
+    let ok = (model - direct).abs() <= 1e-12;
+    if !stab(test, "r_i(1.8): model vs direct TIR integral", model, 0.0, (model - direct).abs(), 1e-12, ok) {
+        fails.push(format!("r_i: model {model} vs direct {direct}"));
+    }
+    for th in [0.0, 60.0, 85.0, 89.0, 89.9] {
+        let wi = dir(th);
+        let (a, err) = directional_albedo(brdf.as_ref(), wi);
+        let ok = a[0].is_finite() && err.is_finite() && a[0] <= 1.0 + err;
+        if !stab(test, &format!("coat 1.8 albedo at {th}°"), a[0], err, (a[0] - 1.0).max(0.0), err, ok) {
+            fails.push(format!("albedo at {th}°: {} ± {err}", a[0]));
+        }
+    }
+    finish(test, fails);
+}
+
+fn dir(theta_deg: f64) -> Vec3 {
+    let t = theta_deg.to_radians();
+    Vec3::new(-t.sin(), 0.0, t.cos())
+}
+
+/// The recipe as a `Paint` (to reach R_l and r_i), through the same parser as `parse_str`.
+fn paint_of(v: &Value) -> glossmeter::brdf::paint::Paint {
+    let obj = glossmeter::recipe::fields::Obj::new("<stability>", "", v).unwrap();
+    glossmeter::brdf::paint::Paint::new(glossmeter::recipe::paint::parse_paint_spec(&obj).unwrap()).unwrap()
+}
+
+/// Kubelka–Munk extremes: K/S → 0 and 1e12, S·X → 0 and 1e4, K = 0, S = 0, X = 0. R_l against the closed
+/// forms of `km`; the paints' readings against the factorised closed form; continuity between K/S = 1e-12 and
+/// K = 0, between S·X = 1e-12 and S = 0, and between K/S = 1e12 and a body of reflectance 0 (the smooth
+/// dielectric of the coat's index); R_l over a sweep of S·X through the engine's internal switches.
+#[test]
+fn kubelka_munk_extremes() {
+    let test = "kubelka_munk_extremes";
+    let mut fails = Vec::new();
+    let eta = 1.5;
+    let cases: [(&str, f64, f64, f64, f64); 9] = [
+        ("K/S=1e-12 SX=1", 1e-12, 1.0, 1.0, 0.7),
+        ("K=0 SX=1", 0.0, 1.0, 1.0, 0.7),
+        ("K/S=1e12 SX=1", 1e12, 1.0, 1.0, 0.7),
+        ("SX=1e-12 KX=0.5", 0.5, 1e-12, 1.0, 0.7),
+        ("S=0 KX=0.5", 0.5, 0.0, 1.0, 0.7),
+        ("SX=1e4 K/S=1e-4", 1.0, 1e4, 1.0, 0.7),
+        ("SX=1e4 K=0", 0.0, 1e4, 1.0, 0.7),
+        ("K=S=0", 0.0, 0.0, 1.0, 0.7),
+        ("X=0", 0.5, 2.0, 0.0, 0.7),
+    ];
+    let gs = geoms(&["astm-d523-60", "astm-d523-85"]);
+    let mut readings = Vec::new();
+    for (name, k, s, x, rg) in cases {
+        let v = paint_recipe(eta, k, s, x, rg);
+        let r_l = paint_of(&v).pigmented_reflectance()[0];
+        let want = km(k, s, x, rg);
+        let dev = (r_l - want).abs();
+        let ok = r_l.is_finite() && dev <= 1e-12 * want.max(1e-300) + 1e-300;
+        if !stab(test, &format!("{name}: R_l vs closed form"), r_l, 0.0, dev, 1e-12 * want, ok) {
+            fails.push(format!("{name}: R_l {r_l} vs closed form {want}"));
+        }
+        let refs = references(&gs, &|g, rec| paint_flux(g.theta, g.source, rec, eta, 1.0, want));
+        let r = run(&recipe(&v), &gs, RTOL);
+        check_all(test, name, &r, &refs, &mut fails);
+        readings.push(r);
+    }
+    // Limits that hold exactly in the closed forms: K/S = 1e12 → R∞ ≈ 5e-13; S·X ≥ 1e4 → R∞ (K > 0).
+    let checks = [
+        (
+            "K/S=1e12: R_l = R∞ = 1/(a + b)",
+            km(1e12, 1.0, 1.0, 0.7),
+            1.0 / (1.0 + 1e12 + (1e12f64 * (2.0 + 1e12)).sqrt()),
+        ),
+        ("SX=1e4 K/S=1e-4: R_l = R∞", km(1.0, 1e4, 1.0, 0.7), 1.0 / (1.0 + 1e-4 + (1e-4f64 * (2.0 + 1e-4)).sqrt())),
+    ];
+    for (name, got, want) in checks {
+        let ok = (got - want).abs() <= 1e-9 * want;
+        if !stab(test, name, got, 0.0, (got - want).abs(), 1e-9 * want, ok) {
+            fails.push(format!("{name}: {got} vs {want}"));
+        }
+    }
+    let glass = run(&recipe(&json!({"model": "smooth-dielectric", "ior": eta})), &gs, RTOL);
+    for i in 0..gs.len() {
+        check_gap(test, "K/S=1e-12 vs K=0", &readings[0][i], &readings[1][i], RTOL, 0.0, &mut fails);
+        check_gap(test, "SX=1e-12 vs S=0", &readings[3][i], &readings[4][i], RTOL, 0.0, &mut fails);
+        check_gap(
+            test,
+            "K/S=1e12 vs body 0 (smooth dielectric 1.5)",
+            &readings[2][i],
+            &glass[i],
+            RTOL,
+            0.0,
+            &mut fails,
+        );
+    }
+    // R_l over S·X from 1e-8 to 1e5 for K/S from 1e-12 to 1e12 (crosses the engine's z = 1/2 and u = 1
+    // switches), and on both sides of z = bSX = 1/2 for K/S = 1.
+    let mut worst: f64 = 0.0;
+    for q in [1e-12, 1e-6, 1e-2, 1.0, 1e2, 1e6, 1e12] {
+        for i in 0..=260 {
+            let sx = 10f64.powf(-8.0 + 13.0 * i as f64 / 260.0);
+            for rg in [0.0, 0.7, 1.0] {
+                let got = glossmeter::optics::kubelka_munk::layer(q * 1.0, 1.0, sx).over(rg);
+                let want = km(q, 1.0, sx, rg);
+                worst = worst.max((got - want).abs() / want.max(1e-300));
+            }
+        }
+    }
+    let ok = worst <= 1e-10;
+    if !stab(test, "R_l sweep SX 1e-8..1e5, K/S 1e-12..1e12, Rg 0/0.7/1: max rel dev", worst, 0.0, worst, 1e-10, ok) {
+        fails.push(format!("R_l sweep: worst relative deviation {worst:e}"));
+    }
+    let sx_half = 0.5 / 3f64.sqrt();
+    // Each side against the closed form at its own S·X (the sides are 2e-9 apart in S·X, so they differ
+    // physically by about 1e-9; the closed form has no switch there).
+    let (sx_lo, sx_hi) = (sx_half * (1.0 - 1e-9), sx_half * (1.0 + 1e-9));
+    let lo = glossmeter::optics::kubelka_munk::layer(1.0, 1.0, sx_lo).over(0.7);
+    let hi = glossmeter::optics::kubelka_munk::layer(1.0, 1.0, sx_hi).over(0.7);
+    let dev = (lo - km(1.0, 1.0, sx_lo, 0.7)).abs().max((hi - km(1.0, 1.0, sx_hi, 0.7)).abs());
+    let ok = dev <= 1e-13;
+    if !stab(test, "R_l on both sides of z = 1/2 (K/S = 1) vs closed form", lo, 0.0, dev, 1e-13, ok) {
+        fails.push(format!("z = 1/2 switch: {lo} / {hi}, deviation from the closed form {dev:e}"));
+    }
+    finish(test, fails);
+}
+
+/// Conductors: k ≫ n (0.05 + 10i) reads close to a perfect mirror, and equals 100·Φ(Fresnel)/Φ_std with
+/// Φ from a separate Gauss–Legendre rule and Fresnel in complex form; k = 0 reads as the smooth dielectric of
+/// the same n. Every shipped geometry and the 89° user geometries.
+#[test]
+fn conductors_k_much_larger_than_n_and_k_zero() {
+    let test = "conductors_k_much_larger_than_n_and_k_zero";
+    let mut fails = Vec::new();
+    let mut gs = standards::builtin().unwrap();
+    gs.push(user_89());
+    gs.push(user_89_clipped());
+    let eta = Complex64::new(0.05, 10.0);
+    let metal = run(&recipe(&json!({"model": "conductor", "ior": [0.05, 10.0]})), &gs, RTOL);
+    let refs = references(&gs, &|g, rec| mirror_flux(g.theta, g.source, rec, &|c| fresnel(c, eta)));
+    check_all(test, "conductor 0.05+10i", &metal, &refs, &mut fails);
+    let mirror = references(&gs, &|g, rec| mirror_flux(g.theta, g.source, rec, &|_| 1.0));
+    for (r, (_, _, m)) in metal.iter().zip(&mirror) {
+        if r.quantity != "gloss" {
+            continue;
+        }
+        let ratio = r.value.unwrap_or(f64::NAN) / m;
+        let ok = (0.99..=1.0).contains(&ratio);
+        if !stab(test, &format!("0.05+10i / perfect mirror {}", r.geometry), ratio, 0.0, 1.0 - ratio, 0.01, ok) {
+            fails.push(format!("{}: conductor/mirror = {ratio}", r.geometry));
+        }
+    }
+    let k0 = run(&recipe(&json!({"model": "conductor", "ior": [1.5, 0.0]})), &gs, RTOL);
+    let glass = run(&recipe(&json!({"model": "smooth-dielectric", "ior": 1.5})), &gs, RTOL);
+    for (a, b) in k0.iter().zip(&glass) {
+        check_gap(test, "conductor 1.5+0i vs dielectric 1.5", a, b, RTOL, 0.0, &mut fails);
+    }
+    finish(test, fails);
+}
+
+fn pearl_recipe(tio2_nm: f64, tio2_index: f64) -> Value {
+    let mut v = paint_recipe(1.5, 0.5, 2.0, 0.15, 0.7);
+    v["pearlescent_flakes"] = json!({"spread_deg": 0.35, "area_ratio": 0.2, "depth_mm": 0.075,
+        "tio2_thickness_nm": tio2_nm, "tio2_index": tio2_index, "mica_thickness_nm": 400.0, "mica_index": 1.58});
+    v
+}
+
+/// s and p Fresnel power reflectances of a real interface (relative index η).
+fn fresnel_sp(c: f64, eta: f64) -> (f64, f64) {
+    let w = (eta * eta - (1.0 - c) * (1.0 + c)).sqrt();
+    let (rs, rp) = ((c - w) / (c + w), (eta * eta * c - w) / (eta * eta * c + w));
+    (rs * rs, rp * rp)
+}
+
+/// Pearlescent flakes with TiO2 films 0, 50 nm, 1 µm and 100 µm thick (coherent), against runs 100× tighter
+/// (60°); a zero-thickness film equals an index-matched one (both leave the resin | mica | resin slab); at
+/// the optics level the zero-thickness flake is the incoherent slab 2r/(1 + r) per polarisation, and an
+/// absorbing TiO2 (2.5 + 0.5i, which recipes cannot express: `tio2_index` is real) gives finite R, T with
+/// R + T ≤ 1, and a 100 µm absorbing film reflects as the bare resin | TiO2 interface.
+#[test]
+fn thin_films_zero_to_100_um_and_absorbing() {
+    let test = "thin_films_zero_to_100_um_and_absorbing";
+    let mut fails = Vec::new();
+    let gs = geoms(&["astm-d523-60"]);
+    let mut zero = Vec::new();
+    for t in [0.0, 50.0, 1000.0, 1e5] {
+        let r =
+            check_against_tight(test, &format!("pearl TiO2 {t} nm"), &recipe(&pearl_recipe(t, 2.5)), &gs, &mut fails);
+        if t == 0.0 {
+            zero = r;
+        }
+    }
+    let matched = run(&recipe(&pearl_recipe(50.0, 1.5)), &gs, RTOL);
+    check_gap(test, "TiO2 0 nm vs 50 nm index-matched (n = 1.5)", &zero[0], &matched[0], RTOL, 0.0, &mut fails);
+
+    let film = |n: Complex64, d: f64| FilmLayer { n, thickness_nm: d, coherent: true };
+    let mica = FilmLayer { n: Complex64::new(1.58, 0.0), thickness_nm: 400.0, coherent: false };
+    let mut worst: f64 = 0.0;
+    for c in [1.0, 0.8, 0.5, 0.2, 0.05, 1e-3] {
+        let st = stack(
+            1.5,
+            &[film(Complex64::new(2.5, 0.0), 0.0), mica, film(Complex64::new(2.5, 0.0), 0.0)],
+            Complex64::new(1.5, 0.0),
+            c,
+            560.0,
+        );
+        let (rs, rp) = fresnel_sp(c, 1.58 / 1.5);
+        let want = 0.5 * (2.0 * rs / (1.0 + rs) + 2.0 * rp / (1.0 + rp));
+        worst = worst.max((st.r() - want).abs());
+    }
+    let ok = worst <= 1e-12;
+    if !stab(test, "zero-thickness TiO2: stack = incoherent slab 2r/(1+r)", worst, 0.0, worst, 1e-12, ok) {
+        fails.push(format!("zero-thickness stack deviates by {worst:e}"));
+    }
+    let tio2 = Complex64::new(2.5, 0.5);
+    let (mut bad, mut worst_thick) = (0, 0.0f64);
+    for d in [0.0, 50.0, 1000.0, 1e5] {
+        for c in [1.0, 0.8, 0.5, 0.2, 0.05, 1e-3] {
+            let st = stack(1.5, &[film(tio2, d), mica, film(tio2, d)], Complex64::new(1.5, 0.0), c, 560.0);
+            let fine = [st.rs, st.rp, st.ts, st.tp].iter().all(|x| x.is_finite() && *x >= 0.0)
+                && st.rs + st.ts <= 1.0 + 1e-12
+                && st.rp + st.tp <= 1.0 + 1e-12;
+            if !fine {
+                bad += 1;
+                fails.push(format!("absorbing TiO2 {d} nm, cos {c}: {st:?}"));
+            }
+            if d == 1e5 {
+                worst_thick = worst_thick.max((st.r() - fresnel(c, tio2 / 1.5)).abs());
+            }
+        }
+    }
+    stab(
+        test,
+        "absorbing TiO2 2.5+0.5i, 0..100 µm: finite, R+T ≤ 1 (bad count)",
+        bad as f64,
+        0.0,
+        bad as f64,
+        0.0,
+        bad == 0,
+    );
+    let ok = worst_thick <= 1e-12;
+    if !stab(test, "absorbing TiO2 100 µm: R = bare resin|TiO2 Fresnel", worst_thick, 0.0, worst_thick, 1e-12, ok) {
+        fails.push(format!("thick absorbing film deviates from the bare interface by {worst_thick:e}"));
+    }
+    finish(test, fails);
+}
+
+fn metallic_recipe(spread_deg: f64, area: f64) -> Value {
+    let mut v = paint_recipe(1.5, 0.5, 2.0, 0.15, 0.7);
+    v["metallic_flakes"] =
+        json!({"n": 0.93, "k": 6.33, "spread_deg": spread_deg, "area_ratio": area, "depth_mm": 0.075});
+    v
+}
+
+/// Metallic flakes with orientation spreads 0.25° (the paper's), 0.01° and 0.001°, all narrower than the
+/// source aperture (0.75°), against runs 100× tighter on every D523 geometry; continuity across the flake
+/// and the rough-coat "effectively smooth" switches (slope 1e-7 × (1 ± 1e-4)).
+#[test]
+fn narrow_flakes_and_smooth_switches() {
+    let test = "narrow_flakes_and_smooth_switches";
+    let mut fails = Vec::new();
+    let gs = d523();
+    for spread in [0.25, 0.01, 0.001] {
+        check_against_tight(
+            test,
+            &format!("metallic spread {spread}°"),
+            &recipe(&metallic_recipe(spread, 0.4)),
+            &gs,
+            &mut fails,
+        );
+    }
+    let t = Microfacet::SMOOTH_THRESHOLD;
+    let spread = |m: f64| m.atan().to_degrees();
+    let (above, below) = (
+        recipe(&metallic_recipe(spread(t * (1.0 + 1e-4)), 0.4)),
+        recipe(&metallic_recipe(spread(t * (1.0 - 1e-4)), 0.4)),
+    );
+    let kinds = |b: &Arc<dyn Brdf>| b.terms().iter().filter(|t| matches!(t.kind, TermKind::Lobe(_))).count();
+    assert_eq!((kinds(&above), kinds(&below)), (1, 0), "the two sides must be on either side of the switch");
+    for (a, b) in run(&above, &gs, RTOL).iter().zip(&run(&below, &gs, RTOL)) {
+        check_gap(test, "flake smooth switch slope 1e-7(1±1e-4)", a, b, RTOL, 0.0, &mut fails);
+    }
+    let coat = |m: f64| {
+        let mut v = paint_recipe(1.5, 0.5, 2.0, 0.15, 0.7);
+        v["clear_coat"]["roughness"] = json!(m);
+        recipe(&v)
+    };
+    let (above, below) = (coat(t * (1.0 + 1e-4)), coat(t * (1.0 - 1e-4)));
+    assert!(!above.has_delta() && below.has_delta());
+    for (a, b) in run(&above, &gs, RTOL).iter().zip(&run(&below, &gs, RTOL)) {
+        check_gap(test, "rough-coat smooth switch 1e-7(1±1e-4)", a, b, RTOL, 0.0, &mut fails);
+    }
+    finish(test, fails);
+}
+
+/// Area ratios: metallic A = 0 reads bit-identically to no metallic flakes; A = 1 has no body term, finite
+/// readings within their estimates (against runs 100× tighter) and directional albedo ≤ 1.
+#[test]
+fn area_ratios_zero_and_one() {
+    let test = "area_ratios_zero_and_one";
+    let mut fails = Vec::new();
+    let gs = d523();
+    let none = run(&recipe(&paint_recipe(1.5, 0.5, 2.0, 0.15, 0.7)), &gs, RTOL);
+    let zero = run(&recipe(&metallic_recipe(0.25, 0.0)), &gs, RTOL);
+    for (a, b) in zero.iter().zip(&none) {
+        let same = a.value.map(f64::to_bits) == b.value.map(f64::to_bits)
+            && a.error_estimate.to_bits() == b.error_estimate.to_bits();
+        let diff = (a.value.unwrap_or(f64::NAN) - b.value.unwrap_or(f64::NAN)).abs();
+        if !stab(
+            test,
+            &format!("metallic A=0 vs none {} (bitwise)", a.geometry),
+            a.value.unwrap_or(f64::NAN),
+            a.error_estimate,
+            diff,
+            0.0,
+            same,
+        ) {
+            fails.push(format!("{}: A = 0 {:?} vs none {:?}", a.geometry, a.value, b.value));
+        }
+    }
+    let full = recipe(&metallic_recipe(0.25, 1.0));
+    let has_body = full.terms().iter().any(|t| t.kind == TermKind::Diffuse);
+    if !stab(test, "metallic A=1: no body term", has_body as u8 as f64, 0.0, 0.0, 0.0, !has_body) {
+        fails.push("A = 1 still has a diffuse body term".into());
+    }
+    check_against_tight(test, "metallic A=1", &full, &gs, &mut fails);
+    for th in [0.0, 20.0, 60.0, 85.0, 89.0] {
+        let (a, err) = directional_albedo(full.as_ref(), dir(th));
+        let ok = a[0].is_finite() && err.is_finite() && a[0] <= 1.0 + err;
+        if !stab(test, &format!("metallic A=1 albedo at {th}°"), a[0], err, (a[0] - 1.0).max(0.0), err, ok) {
+            fails.push(format!("A = 1 albedo at {th}°: {} ± {err}", a[0]));
+        }
     }
     finish(test, fails);
 }
