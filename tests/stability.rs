@@ -591,6 +591,19 @@ fn clear_coat_1_8_total_internal_reflection() {
     if !stab(test, "r_i(1.8): model vs direct TIR integral", model, 0.0, (model - direct).abs(), 1e-12, ok) {
         fails.push(format!("r_i: model {model} vs direct {direct}"));
     }
+    let identity = 1.0 - (1.0 - r_external(eta)) / (eta * eta);
+    let ok = (identity - direct).abs() <= 1e-12;
+    if !stab(
+        test,
+        "r_i(1.8): identity 1 − (1 − r_e)/η² vs direct TIR integral",
+        identity,
+        0.0,
+        (identity - direct).abs(),
+        1e-12,
+        ok,
+    ) {
+        fails.push(format!("r_i identity {identity} vs direct {direct}"));
+    }
     for th in [0.0, 60.0, 85.0, 89.0, 89.9] {
         let wi = dir(th);
         let (a, err) = directional_albedo(brdf.as_ref(), wi);
@@ -823,7 +836,7 @@ fn thin_films_zero_to_100_um_and_absorbing() {
         bad == 0,
     );
     let ok = worst_thick <= 1e-12;
-    if !stab(test, "absorbing TiO2 100 µm: R = bare resin|TiO2 Fresnel", worst_thick, 0.0, worst_thick, 1e-12, ok) {
+    if !stab(test, "absorbing TiO2 100 µm: R = bare resin/TiO2 Fresnel", worst_thick, 0.0, worst_thick, 1e-12, ok) {
         fails.push(format!("thick absorbing film deviates from the bare interface by {worst_thick:e}"));
     }
     finish(test, fails);
