@@ -514,11 +514,13 @@ fn microfacet_roughness_sweep_and_switches() {
         let range_u = (g.source.p[1] + rec.p[1]) - (g.source.p[0] + rec.p[0]);
         let range_v = (g.source.q[1] + rec.q[1]) - (g.source.q[0] + rec.q[0]);
         for (axis, m_star) in [("u", range_u / 4.0), ("v", range_v / (4.0 * g.theta.cos()))] {
-            let a = run(&mf(dist, m_star * (1.0 - 1e-6)), g60, RTOL);
-            let b = run(&mf(dist, m_star * (1.0 + 1e-6)), g60, RTOL);
+            let a = run(&mf(dist, m_star * (1.0 - 1e-9)), g60, RTOL);
+            let b = run(&mf(dist, m_star * (1.0 + 1e-9)), g60, RTOL);
+            // Evidence that the partition changed: the initial boxes differ, so do the evaluation counts.
+            assert_ne!(a[0].evaluations, b[0].evaluations, "{dist} {axis}: the split switch was not crossed");
             check_gap(
                 test,
-                &format!("{dist} split switch {axis} m={m_star:.5e}(1±1e-6)"),
+                &format!("{dist} split switch {axis} m={m_star:.5e}(1±1e-9)"),
                 &a[0],
                 &b[0],
                 RTOL,
@@ -532,9 +534,10 @@ fn microfacet_roughness_sweep_and_switches() {
         recipe(&json!({"model": "cook-torrance-lobes", "kd": 0.0,
             "lobes": [{"ks": 0.5, "r": 0.04, "m": 0.003}, {"ks": 0.5, "r": 0.04, "m": m2}]}))
     };
-    let (a, b) = (run(&lobes(0.009 * (1.0 - 1e-6)), &gs, RTOL), run(&lobes(0.009 * (1.0 + 1e-6)), &gs, RTOL));
+    let (a, b) = (run(&lobes(0.009 * (1.0 - 1e-9)), &gs, RTOL), run(&lobes(0.009 * (1.0 + 1e-9)), &gs, RTOL));
     for (x, y) in a.iter().zip(&b) {
-        check_gap(test, "two lobes, split-sharing switch m2=3·m1(1±1e-6)", x, y, RTOL, 0.0, &mut fails);
+        assert_ne!(x.evaluations, y.evaluations, "the split-sharing switch was not crossed");
+        check_gap(test, "two lobes, split-sharing switch m2=3·m1(1±1e-9)", x, y, RTOL, 0.0, &mut fails);
     }
     finish(test, fails);
 }
