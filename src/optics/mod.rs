@@ -4,4 +4,5 @@
 pub mod fresnel;
 pub mod kubelka_munk;
 pub mod microfacet;
+pub mod tabulated;
 pub mod thin_film;
