@@ -24,6 +24,7 @@ use super::{Brdf, Lobe, Term, TermKind};
 use crate::optics::fresnel::{fr_conductor, fr_dielectric, fresnel_dielectric, refract_into};
 use crate::optics::kubelka_munk::{self, Layer};
 use crate::optics::microfacet::{Distribution, Microfacet, Shadowing};
+use crate::optics::tabulated::ChebTable;
 use crate::optics::thin_film::{stack, FilmLayer};
 use crate::spectrum::Sampling;
 use crate::{Error, Result, Vec3};
@@ -147,7 +148,14 @@ struct FlakeTerm {
     /// KM operator of the pigment above the flake (thickness X' or X''), per sample.
     cover: Vec<Layer>,
     optics: FlakeOptics,
+    /// R_m or R_p per sample as a verified Chebyshev table over the local cosine ∈ [0, 1] (max deviation
+    /// from the direct evaluation ≤ `TABLE_TOLERANCE` at check points), or None when no table met it.
+    table: Option<Vec<ChebTable>>,
 }
+
+/// Largest accepted deviation of a flake-reflectance table from the direct evaluation (absolute, on a
+/// reflectance ≤ 1): far below any tolerance a reading is asked for.
+pub const TABLE_TOLERANCE: f64 = 1e-12;
 
 impl FlakeTerm {
     /// Flake reflectance ρ at the local cosine `cos_local` for sample `k` (before the pigment above it).
@@ -161,10 +169,27 @@ impl FlakeTerm {
         }
     }
 
-    /// R_m or R_p: the KM reflectance of the pigment above the flake over the flake (Eqs. 5, 8 corrected).
+    /// R_m or R_p: the KM reflectance of the pigment above the flake over the flake (Eqs. 5, 8 corrected),
+    /// from the verified table when there is one.
     #[inline]
     fn reflectance(&self, k: usize, cos_local: f64, wavelength_nm: f64) -> f64 {
+        match &self.table {
+            Some(t) => t[k].eval(cos_local),
+            None => self.reflectance_direct(k, cos_local, wavelength_nm),
+        }
+    }
+
+    /// R_m or R_p evaluated directly (no table).
+    fn reflectance_direct(&self, k: usize, cos_local: f64, wavelength_nm: f64) -> f64 {
         self.cover[k].over(self.rho(k, cos_local, wavelength_nm).clamp(0.0, 1.0))
+    }
+
+    /// Build the per-sample tables; all or none.
+    fn tabulate(&mut self, wavelengths_nm: &[f64]) {
+        let tables: Option<Vec<ChebTable>> = (0..self.cover.len())
+            .map(|k| ChebTable::fit(|c| self.reflectance_direct(k, c, wavelengths_nm[k]), 0.0, 1.0, TABLE_TOLERANCE))
+            .collect();
+        self.table = tables;
     }
 }
 
@@ -336,7 +361,17 @@ impl Paint {
             |depth: f64| -> Vec<Layer> { (0..n).map(|j| kubelka_munk::layer(k_mix[j], s_mix[j], depth)).collect() };
         let flake = |label, spread_deg: f64, area, depth, optics| {
             let facets = Microfacet::new(Distribution::Beckmann, spread_to_slope(spread_deg));
-            FlakeTerm { label, area, facets, smooth: facets.effectively_smooth(), cover: cover(depth), optics }
+            let mut term = FlakeTerm {
+                label,
+                area,
+                facets,
+                smooth: facets.effectively_smooth(),
+                cover: cover(depth),
+                optics,
+                table: None,
+            };
+            term.tabulate(&spec.sampling.wavelengths_nm);
+            term
         };
         let metallic = spec.metallic.as_ref().filter(|m| m.area_ratio > 0.0).map(|m| {
             let rel = (0..n).map(|j| Complex64::new(m.n[j], m.k[j]) / eta).collect();
@@ -542,8 +577,16 @@ impl Brdf for Paint {
             d.push_str(&format!(", Saunderson r_i = {:.4}", self.r_i));
         }
         for fl in self.flakes() {
+            let table = match &fl.table {
+                Some(t) => format!(
+                    ", reflectance tabulated ({} pieces, max deviation {:.0e})",
+                    t[0].pieces(),
+                    t.iter().map(|x| x.max_error).fold(0.0, f64::max)
+                ),
+                None => String::new(),
+            };
             d.push_str(&format!(
-                ", {} A = {} m = {:.3e}{}",
+                ", {} A = {} m = {:.3e}{}{table}",
                 fl.label,
                 fl.area,
                 fl.facets.alpha,
