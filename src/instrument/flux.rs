@@ -8,7 +8,8 @@
 //! u = p_s + p_r, v = q_s + q_r, and over the position t ∈ [0, 1] along the exact overlap of the stops for
 //! that u: per axis, p_s ∈ [max(s0, u − r1), min(s1, u − r0)], p_s = lo + t·(hi − lo), Jacobian hi − lo.
 //! The overlap length is piecewise linear in u with kinks at s0 + r0, s1 + r0, s0 + r1, s1 + r1: those are
-//! split points. Each lobe adds split points at 0 and ±k·w (k = 1, 3, 10, 30, 100) with w its width in u,
+//! split points. Each lobe adds split points at 0 and ±k·w (k = 1, 3, 10, 30, … out to the range) with w its
+//! width in u,
 //! so a lobe of any width is resolved by the initial partition. An ideal-mirror (delta) component is
 //! integrated analytically in u (it sits at u = v = 0) as a 2-D integral over the stops' mirror overlap.
 use crate::brdf::{Brdf, Lobe};
@@ -101,12 +102,20 @@ impl AxisMap {
                 kept.push(w);
             }
         }
+        // Geometric splits at ±w, ±3w, ±10w, ±30w, … out to the end of the range: no box spans more than a
+        // factor ≈ 3 in distance from the lobe centre, so even a heavy tail (GGX falls off as u⁻⁴ and holds
+        // ~1e-4 of its mass beyond 100 widths) is seen by the first samples of every box.
+        let reach = a.abs().max(b.abs());
         for &w in &kept {
             if w > 0.0 && w < 0.5 * (b - a) {
                 pts.push(0.0);
-                for k in [1.0, 3.0, 10.0, 30.0, 100.0] {
+                let mut k = 1.0;
+                let mut step = 3.0;
+                while k * w < reach {
                     pts.push(k * w);
                     pts.push(-k * w);
+                    k *= step;
+                    step = if step == 3.0 { 10.0 / 3.0 } else { 3.0 };
                 }
             }
         }

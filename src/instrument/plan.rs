@@ -407,7 +407,7 @@ impl Plan {
                 }
                 TermKind::Diffuse => "smooth in direction: no lobe splits needed".to_string(),
                 TermKind::Lobe(l) => format!(
-                    "glossy lobe, slope width {:.3e}{}: lobe variables split at 0 and ±(1, 3, 10, 30, 100)× its width",
+                    "glossy lobe, slope width {:.3e}{}: lobe variables split at 0 and ±(1, 3, 10, 30, …)× its width out to the aperture range",
                     l.slope_width,
                     if l.medium_eta != 1.0 {
                         format!(" inside a medium of index {}", l.medium_eta)
