@@ -53,6 +53,9 @@ pub fn table(material: &Material, readings: &[Reading], timing: bool) -> String 
         if let Some(p) = &r.problem {
             notes.push(format!("{} {}: {p}", r.geometry, r.name));
         }
+        if let Some(n) = &r.note {
+            notes.push(format!("{} {}: {n}", r.geometry, r.name));
+        }
         rows.push(row);
     }
     let ncol = rows[0].len();
@@ -104,6 +107,9 @@ pub fn json(material: &Material, readings: &[Reading], timing: bool) -> String {
             }
             if let Some(p) = &r.problem {
                 o["problem"] = json!(p);
+            }
+            if let Some(n) = &r.note {
+                o["note"] = json!(n);
             }
             o
         })

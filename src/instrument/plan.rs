@@ -126,7 +126,10 @@ pub struct Reading {
     pub evaluations: usize,
     pub seconds: f64,
     pub converged: bool,
+    /// Why there is no value (or why it may be inaccurate: budget exhausted).
     pub problem: Option<String>,
+    /// A caveat on a valid value (e.g. a specimen outside the scope of the standard's formula).
+    pub note: Option<String>,
 }
 
 /// The compiled plan.
@@ -486,6 +489,7 @@ fn problem_reading(r: &PlannedReading, why: String) -> Reading {
         seconds: 0.0,
         converged: false,
         problem: Some(why),
+        note: None,
     }
 }
 
@@ -540,6 +544,12 @@ fn compute_reading(r: &PlannedReading, flux: &[Flux], done: &[Option<Reading>]) 
                     seconds: a.seconds + b.seconds,
                     converged: a.converged && b.converged,
                     problem: None,
+                    note: (a.value.unwrap_or(0.0) <= 70.0 || x - y < 0.0).then(|| {
+                        "outside the scope of ASTM D4039, which is defined for non-metallic specimens with G60 > 70 \
+                         (a negative index means the 20° receptor gathers relatively more than the 60° one, as for \
+                         near-mirror flakes)"
+                            .to_string()
+                    }),
                 },
                 _ => problem_reading(r, "a gloss reading it combines has no value".into()),
             };
@@ -565,6 +575,7 @@ fn compute_reading(r: &PlannedReading, flux: &[Flux], done: &[Option<Reading>]) 
             } else {
                 Some("evaluation budget exhausted before the tolerance was met".into())
             },
+            note: None,
         },
         Ok(_) => problem_reading(r, "non-finite result".into()),
         Err(why) => problem_reading(r, why),
