@@ -16,6 +16,11 @@ use crate::brdf::{Brdf, Lobe};
 use crate::instrument::geometry::{solid_angle_density, Axes, Stop};
 use crate::quadrature::{integrate, Estimate, Options};
 
+/// Fraction of a flux's tolerance given to its delta part. The delta part is a smooth 2-D integral that
+/// converges to near machine precision in a few hundred evaluations, so it is asked for much more than its
+/// half and the expensive 4-D regular part gets the rest.
+pub const DELTA_SHARE: f64 = 0.01;
+
 /// How the spectral samples enter the integral.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Spectral {
@@ -239,7 +244,11 @@ impl FluxProblem<'_> {
                     },
                     ncomp,
                     &[(lo, hi)],
-                    &Options { rtol: 0.5 * self.rtol, atol: 0.5 * self.atol, max_evals: self.max_evals },
+                    &Options {
+                        rtol: DELTA_SHARE * self.rtol,
+                        atol: DELTA_SHARE * self.atol,
+                        max_evals: self.max_evals,
+                    },
                 );
                 (delta, delta_err) = lum(&est);
                 evaluations += est.evaluations;
@@ -254,7 +263,10 @@ impl FluxProblem<'_> {
             let (ap, aq, boxes) = self.partition(src, rec);
             let brdf = self.brdf;
             let w = &weights;
-            let atol = (0.5 * self.atol).max(0.5 * self.rtol * delta.abs());
+            // The regular part gets the rest of the budget: err_r ≤ max(atol, r·|Φ_δ|, r·|Φ_r|) with
+            // r = (1 − DELTA_SHARE)·rtol, so err_δ + err_r ≤ rtol·(|Φ_δ| + |Φ_r|) (+ the floor) as both parts are ≥ 0.
+            let share = 1.0 - DELTA_SHARE;
+            let atol = (share * self.atol).max(share * self.rtol * delta.abs());
             let est = integrate::<4, _>(
                 |x, out| {
                     let (ps, pr, jp) = ap.at(x[0], x[1]);
@@ -280,7 +292,7 @@ impl FluxProblem<'_> {
                 },
                 ncomp,
                 &boxes,
-                &Options { rtol: 0.5 * self.rtol, atol, max_evals: self.max_evals },
+                &Options { rtol: share * self.rtol, atol, max_evals: self.max_evals },
             );
             (regular, regular_err) = lum(&est);
             evaluations += est.evaluations;
