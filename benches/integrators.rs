@@ -917,6 +917,7 @@ fn b5(md: &mut String, quick: bool) {
         md,
         "\nSpecimen BRDF evaluations are counted by a wrapper in a separate untimed run (the work actually done).\n"
     );
+    tolerance_sweep(md);
     for (file, readings) in details {
         let _ = writeln!(md, "Per reading, {file} (default plan; evaluations and seconds of the integrals each reading uses, shared ones counted in every reading that uses them; seconds are per-integral wall time in the 1-thread pool):\n");
         let _ = writeln!(md, "| geometry | reading | value | error estimate | evaluations | seconds |");
@@ -936,6 +937,38 @@ fn b5(md: &mut String, quick: bool) {
         let _ = writeln!(md);
     }
     batch(md, quick);
+}
+
+/// cerulean-c over the panel at several rtol against an rtol-1e-9 run: how pessimistic the estimate is, and
+/// what a tighter estimate would let the plan save.
+fn tolerance_sweep(md: &mut String) {
+    let Some(brdf) = recipe("cerulean-blue-c.json") else { return };
+    let Some(reference) = try_run("cerulean-c rtol 1e-9", || {
+        run_panel(brdf.clone(), PlanOptions { rtol: 1e-9, ..Default::default() }, 1)
+    }) else {
+        return;
+    };
+    let _ = writeln!(md, "cerulean-blue-c.json over the panel at several rtol, against an rtol-1e-9 run ({} in one thread): worst relative deviation over the readings, and the worst ratio of actual deviation to the reading's own error estimate.\n", fmt_time(reference.seconds));
+    let _ = writeln!(
+        md,
+        "| rtol | time (1 thread) | specimen BRDF evaluations | worst actual rel. err | worst actual / estimate |"
+    );
+    let _ = writeln!(md, "|---|---|---|---|---|");
+    for rtol in [1e-3, 1e-4, 1e-5, 1e-6, 1e-7] {
+        let opts = PlanOptions { rtol, ..Default::default() };
+        let r = run_panel(brdf.clone(), opts.clone(), 1);
+        let evals = count_evaluations(brdf.clone(), opts);
+        let (mut worst, mut ratio) = (0.0f64, 0.0f64);
+        for (x, y) in r.readings.iter().zip(&reference.readings) {
+            if let (Some(a), Some(b)) = (x.value, y.value) {
+                let d = (a - b).abs();
+                worst = worst.max(d / b.abs().max(1e-300));
+                ratio = ratio.max(d / x.error_estimate.max(1e-300));
+            }
+        }
+        let _ = writeln!(md, "| {rtol:.0e} | {} | {evals} | {worst:.1e} | {ratio:.2} |", fmt_time(r.seconds));
+    }
+    let _ = writeln!(md);
 }
 
 fn total_evaluations(r: &[Reading]) -> usize {
