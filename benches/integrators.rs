@@ -33,7 +33,7 @@ use glossmeter::spectrum::Sampling;
 use glossmeter::Vec3;
 
 /// The default measurement panel (as `DEFAULT_GEOMETRIES` of the CLI).
-const PANEL: &[&str] = &["astm-d523-20", "astm-d523-60", "astm-d523-85", "astm-e430-30", "iso-13803-20", "astm-d4039"];
+const PANEL: &[&str] = glossmeter::cli::DEFAULT_GEOMETRIES;
 
 // ---------------------------------------------------------------------------------------------------------
 // Timing and random numbers.

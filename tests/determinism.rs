@@ -12,7 +12,7 @@ use glossmeter::spectrum::Sampling;
 use glossmeter::Vec3;
 
 /// The default panel of the CLI.
-const PANEL: &[&str] = &["astm-d523-20", "astm-d523-60", "astm-d523-85", "astm-e430-30", "iso-13803-20", "astm-d4039"];
+const PANEL: &[&str] = glossmeter::cli::DEFAULT_GEOMETRIES;
 
 fn panel() -> Vec<StandardGeometry> {
     PANEL.iter().map(|id| standards::find(id).unwrap()).collect()
