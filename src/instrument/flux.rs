@@ -52,6 +52,8 @@ pub struct Flux {
     pub regions: usize,
     pub converged: bool,
     pub seconds: f64,
+    /// The variables the regular part was integrated in.
+    pub variables: Variables,
 }
 
 /// Width in u (in-plane) and v (perpendicular) of a lobe at geometry angle θ.
@@ -65,6 +67,33 @@ pub fn lobe_widths_uv(lobe: &Lobe, theta: f64) -> [f64; 2] {
     let c = theta.cos().max(1e-6);
     let m = lobe.slope_width;
     [2.0 * m * eta * ct / c, 2.0 * m * eta * ct]
+}
+
+/// The variables the regular part is integrated in, chosen per integral by [`choose_variables`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Variables {
+    /// The plain product of the stops, (p_s, q_s, p_r, q_r): one box, no kinks. Right when every lobe is at
+    /// least as wide as the whole lobe-variable range on both axes (or there is none): the integrand is then
+    /// smooth over the product and one 57-point Genz–Malik region may already meet the tolerance.
+    Plain,
+    /// The lobe variables (u, t_p, v, t_q) with splits at the overlap kinks and at multiples of the lobe
+    /// widths: needed as soon as one lobe is narrower than the apertures.
+    Lobe,
+}
+
+/// Choose the variables of the regular part for these (clipped) stops and lobes at angle θ.
+pub fn choose_variables(lobes: &[Lobe], theta: f64, source: Stop, receptor: Stop) -> Variables {
+    let range_u = (source.p[1] - source.p[0]) + (receptor.p[1] - receptor.p[0]);
+    let range_v = (source.q[1] - source.q[0]) + (receptor.q[1] - receptor.q[0]);
+    let wide = |l: &Lobe| {
+        let w = lobe_widths_uv(l, theta);
+        w[0] >= range_u && w[1] >= range_v
+    };
+    if lobes.iter().all(wide) {
+        Variables::Plain
+    } else {
+        Variables::Lobe
+    }
 }
 
 /// A list of boxes (lower corner, upper corner) in the 4-D lobe coordinates (u, t_p, v, t_q).
@@ -134,7 +163,7 @@ impl AxisMap {
 
 /// Clip a stop to the upper hemisphere. For the source, z ∝ cos θ + p sin θ; for the receptor,
 /// z ∝ cos θ − p sin θ: the horizon is the line p = ∓cot θ, independent of q, so clipping is exact.
-fn clip(stop: Stop, theta: f64, is_source: bool) -> Option<Stop> {
+pub fn clip(stop: Stop, theta: f64, is_source: bool) -> Option<Stop> {
     let mut s = stop;
     if theta > 0.0 {
         let cot = theta.cos() / theta.sin();
@@ -198,6 +227,7 @@ impl FluxProblem<'_> {
                 regions: 0,
                 converged: true,
                 seconds: 0.0,
+                variables: Variables::Plain,
             };
         };
         let (separate, ncomp) = match self.spectral {
@@ -257,10 +287,19 @@ impl FluxProblem<'_> {
             }
         }
 
-        // 2. The regular part in lobe coordinates.
+        // 2. The regular part, in the plain variables or in lobe coordinates (`choose_variables`).
         let (mut regular, mut regular_err) = (0.0, 0.0);
+        let variables = choose_variables(&self.lobes, self.theta, src, rec);
         if self.include_regular {
-            let (ap, aq, boxes) = self.partition(src, rec);
+            let (ap, aq, boxes) = match variables {
+                Variables::Lobe => self.partition(src, rec),
+                Variables::Plain => (
+                    AxisMap { s: src.p, r: rec.p },
+                    AxisMap { s: src.q, r: rec.q },
+                    vec![([src.p[0], src.q[0], rec.p[0], rec.q[0]], [src.p[1], src.q[1], rec.p[1], rec.q[1]])],
+                ),
+            };
+            let plain = variables == Variables::Plain;
             let brdf = self.brdf;
             let w = &weights;
             // The regular part gets the rest of the budget: err_r ≤ max(atol, r·|Φ_δ|, r·|Φ_r|) with
@@ -269,9 +308,13 @@ impl FluxProblem<'_> {
             let atol = (share * self.atol).max(share * self.rtol * delta.abs());
             let est = integrate::<4, _>(
                 |x, out| {
-                    let (ps, pr, jp) = ap.at(x[0], x[1]);
-                    let (qs, qr, jq) = aq.at(x[2], x[3]);
-                    let jac = jp * jq;
+                    let (ps, qs, pr, qr, jac) = if plain {
+                        (x[0], x[1], x[2], x[3], 1.0)
+                    } else {
+                        let (ps, pr, jp) = ap.at(x[0], x[1]);
+                        let (qs, qr, jq) = aq.at(x[2], x[3]);
+                        (ps, qs, pr, qr, jp * jq)
+                    };
                     if jac <= 0.0 {
                         return;
                     }
@@ -308,6 +351,7 @@ impl FluxProblem<'_> {
             regions,
             converged,
             seconds: start.elapsed().as_secs_f64(),
+            variables,
         }
     }
 }

@@ -18,7 +18,7 @@ use std::sync::Arc;
 use rayon::prelude::*;
 
 use crate::brdf::{Brdf, Lobe, Term, TermKind};
-use crate::instrument::flux::{lobe_widths_uv, Flux, FluxProblem, Spectral};
+use crate::instrument::flux::{choose_variables, clip, lobe_widths_uv, Flux, FluxProblem, Spectral, Variables};
 use crate::instrument::geometry::{ReadingSpec, Stop};
 use crate::instrument::standards::{self, StandardGeometry};
 use crate::optics::fresnel::fr_dielectric;
@@ -469,8 +469,25 @@ impl Plan {
             }
         ));
         for (i, j) in self.jobs.iter().enumerate() {
+            let how = match j.target {
+                Target::Standard => "analytic (delta) only".to_string(),
+                Target::Specimen => {
+                    let vars = match (clip(j.source, j.theta, true), clip(j.receptor, j.theta, false)) {
+                        (Some(a), Some(b)) => match choose_variables(&self.lobes, j.theta, a, b) {
+                            Variables::Plain => "plain variables (no lobe narrower than the stops)",
+                            Variables::Lobe => "lobe variables",
+                        },
+                        _ => "stops below the horizon: zero",
+                    };
+                    if self.has_regular {
+                        format!("{}{vars}", if self.has_delta { "analytic delta + " } else { "" })
+                    } else {
+                        "analytic (delta) only".to_string()
+                    }
+                }
+            };
             s.push_str(&format!(
-                "  #{i}: {:?} at {:.4}°, used by {}\n",
+                "  #{i}: {:?} at {:.4}°, {how}; used by {}\n",
                 j.target,
                 j.theta.to_degrees(),
                 j.used_by.join(", ")
