@@ -20,6 +20,7 @@ use serde_json::Value;
 use std::sync::Arc;
 
 pub mod fields;
+pub mod measured;
 pub mod paint;
 pub mod schema;
 
@@ -165,6 +166,7 @@ pub fn parse_brdf(obj: &Obj) -> Result<Arc<dyn Brdf>> {
             Arc::new(Ward::new(rho_d, rho_s, alpha, sampling))
         }
         "cook-torrance-lobes" => parse_lobes(obj)?,
+        "merl" => measured::parse_merl(obj)?,
         other => return Err(obj.err("model", format!("unknown model \"{other}\"; {}", allowed()))),
     };
     Ok(brdf)
