@@ -131,7 +131,22 @@ impl Microfacet {
 
     /// G1(ω) = 1 / (1 + Λ(ω)).
     pub fn g1(&self, w: Vec3) -> f64 {
-        1.0 / (1.0 + self.lambda(w))
+        1.0 / (1.0 + self.lambda_in_g(w))
+    }
+
+    /// Λ as it enters G: 0 when the Beckmann Λ is below 2⁻⁵⁴, where 1 + Λ rounds to exactly 1, so G is the
+    /// same bits. For a = 1/(α tan θ) > 6.5, Λ < e^{−a²}/(2a√π) < 3·10⁻²⁰. This skips an `erfc` and two
+    /// `exp` in the common case of narrow lobes (flakes, α ~ 10⁻³) away from grazing.
+    #[inline]
+    fn lambda_in_g(&self, w: Vec3) -> f64 {
+        if self.distribution == Distribution::Beckmann && w.z > 0.0 {
+            let t2 = (w.x * w.x + w.y * w.y) / (w.z * w.z);
+            // a² = 1/(α² tan²θ) > 6.5² ⇔ α² tan²θ·42.25 < 1
+            if self.alpha * self.alpha * t2 * 42.25 < 1.0 {
+                return 0.0;
+            }
+        }
+        self.lambda(w)
     }
 
     /// Masking-shadowing G(ωi, ωo) for the half vector `h` under the chosen shadowing model.
@@ -153,7 +168,7 @@ impl Microfacet {
         }
         match shadowing {
             // Λi + Λo first: IEEE addition is commutative, so G is bitwise symmetric.
-            Shadowing::SmithHeightCorrelated => 1.0 / (1.0 + (self.lambda(wi) + self.lambda(wo))),
+            Shadowing::SmithHeightCorrelated => 1.0 / (1.0 + (self.lambda_in_g(wi) + self.lambda_in_g(wo))),
             Shadowing::VCavity => {
                 let k = 2.0 * h.z;
                 (k * wo.z / oh).min(k * wi.z / ih).min(1.0)
@@ -372,6 +387,22 @@ mod tests {
                     assert!((ratio - 1.0).abs() < 1e-8, "{dist:?} α={alpha} θo={deg}: {ratio}");
                 }
             }
+        }
+    }
+
+    #[test]
+    fn g_shortcut_changes_no_bits() {
+        // Around the cut-off a = 6.5 and far from it, G and G1 equal 1/(1 + Λ) with the full Λ, bit for bit.
+        let m = Microfacet::new(Distribution::Beckmann, 0.01);
+        for k in 0..2000 {
+            let tan = 1e-4 * (1.0 + k as f64 * 0.05);
+            let w = Vec3::new(tan, 0.0, 1.0).normalize();
+            let full = 1.0 / (1.0 + m.lambda(w));
+            assert_eq!(m.g1(w).to_bits(), full.to_bits(), "tan θ = {tan}");
+            let wo = Vec3::new(-0.3 * tan, 0.1 * tan, 1.0).normalize();
+            let h = (w + wo).normalize();
+            let g_full = 1.0 / (1.0 + (m.lambda(w) + m.lambda(wo)));
+            assert_eq!(m.g(w, wo, h, Shadowing::SmithHeightCorrelated).to_bits(), g_full.to_bits());
         }
     }
 }
