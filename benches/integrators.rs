@@ -167,7 +167,12 @@ impl Brdf for BenchMicrofacet {
         let label = format!("{:?} {}", self.dist, self.alpha);
         vec![Term {
             label: label.clone(),
-            kind: TermKind::Lobe(Lobe { slope_width: self.alpha, medium_eta: 1.0, label }),
+            kind: TermKind::Lobe(Lobe {
+                slope_width: self.alpha,
+                medium_eta: 1.0,
+                label,
+                heavy_tail: self.dist == Dist::Ggx,
+            }),
         }]
     }
     fn describe(&self) -> String {

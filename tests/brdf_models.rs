@@ -315,8 +315,12 @@ impl Brdf for WardDur2006 {
         out[0] = (-tan2 / a2).exp() / (4.0 * PI * a2 * wi.z * wo.z);
     }
     fn terms(&self) -> Vec<glossmeter::brdf::Term> {
-        let lobe =
-            glossmeter::brdf::Lobe { slope_width: self.alpha, medium_eta: 1.0, label: "Ward–Dür 2006".into() };
+        let lobe = glossmeter::brdf::Lobe {
+            slope_width: self.alpha,
+            medium_eta: 1.0,
+            label: "Ward–Dür 2006".into(),
+            heavy_tail: false,
+        };
         vec![glossmeter::brdf::Term { label: "Ward–Dür 2006".into(), kind: TermKind::Lobe(lobe) }]
     }
     fn describe(&self) -> String {

@@ -99,7 +99,12 @@ impl Brdf for TestBeckmann {
     fn terms(&self) -> Vec<Term> {
         vec![Term {
             label: "beckmann".into(),
-            kind: TermKind::Lobe(Lobe { slope_width: self.m, medium_eta: 1.0, label: "beckmann".into() }),
+            kind: TermKind::Lobe(Lobe {
+                slope_width: self.m,
+                medium_eta: 1.0,
+                label: "beckmann".into(),
+                heavy_tail: false,
+            }),
         }]
     }
     fn describe(&self) -> String {

@@ -409,7 +409,12 @@ fn rough_coat_energy_and_reciprocity() {
         assert!(!p.delta_reflectance(dir(30.0, 0.0), &mut [0.0; 3]));
         assert_eq!(
             p.terms()[0].kind,
-            TermKind::Lobe(glossmeter::brdf::Lobe { slope_width: alpha, medium_eta: 1.0, label: "clear coat".into() })
+            TermKind::Lobe(glossmeter::brdf::Lobe {
+                slope_width: alpha,
+                medium_eta: 1.0,
+                label: "clear coat".into(),
+                heavy_tail: dist == Distribution::Ggx
+            })
         );
         for ti in [0.0, 20.0, 40.0, 60.0, 70.0, 80.0, 89.0] {
             let (a, err) = directional_albedo(&p, dir(ti, 0.0));

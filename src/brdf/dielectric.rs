@@ -179,7 +179,12 @@ impl Brdf for MicrofacetSurface {
             let label = format!("microfacet lobe ({})", describe_facets(&self.facets));
             vec![Term {
                 label: label.clone(),
-                kind: TermKind::Lobe(Lobe { slope_width: self.facets.alpha, medium_eta: 1.0, label }),
+                kind: TermKind::Lobe(Lobe {
+                    slope_width: self.facets.alpha,
+                    medium_eta: 1.0,
+                    label,
+                    heavy_tail: self.facets.distribution == Distribution::Ggx,
+                }),
             }]
         }
     }

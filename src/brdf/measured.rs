@@ -335,7 +335,12 @@ impl Brdf for MerlBrdf {
         let label = "measured (MERL)".to_string();
         vec![Term {
             label: format!("measured table (MERL, {} lookup)", self.interpolation.name()),
-            kind: TermKind::Lobe(Lobe { slope_width: self.resolution_slope(), medium_eta: 1.0, label }),
+            kind: TermKind::Lobe(Lobe {
+                slope_width: self.resolution_slope(),
+                medium_eta: 1.0,
+                label,
+                heavy_tail: true,
+            }),
         }]
     }
 

@@ -35,6 +35,10 @@ pub struct Lobe {
     pub medium_eta: f64,
     /// Short label for `--explain`, e.g. "metallic flakes".
     pub label: String,
+    /// True if the lobe falls off slower than a Gaussian (GGX: ∝ u⁻⁴; a measured table: unknown). A
+    /// Gaussian-tailed lobe (Beckmann, Phong, Ward) is below e⁻¹⁰⁰ of its peak beyond 10 widths, so the
+    /// integrator stops splitting there; a heavy tail is split geometrically out to the ends of the range.
+    pub heavy_tail: bool,
 }
 
 /// A term of a model, for the measurement plan's explanation: what is evaluated and how.

@@ -528,7 +528,12 @@ impl Brdf for Paint {
             None => t.push(Term { label: "clear coat (Fresnel, delta)".into(), kind: TermKind::Delta }),
             Some(mf) => t.push(Term {
                 label: "clear coat (rough, microfacet)".into(),
-                kind: TermKind::Lobe(Lobe { slope_width: mf.alpha, medium_eta: 1.0, label: "clear coat".into() }),
+                kind: TermKind::Lobe(Lobe {
+                    slope_width: mf.alpha,
+                    medium_eta: 1.0,
+                    label: "clear coat".into(),
+                    heavy_tail: mf.distribution == Distribution::Ggx,
+                }),
             }),
         }
         if self.body_weight > 0.0 {
@@ -542,7 +547,12 @@ impl Brdf for Paint {
             let kind = if fl.smooth {
                 TermKind::Delta
             } else {
-                TermKind::Lobe(Lobe { slope_width: fl.facets.alpha, medium_eta: medium, label: fl.label.into() })
+                TermKind::Lobe(Lobe {
+                    slope_width: fl.facets.alpha,
+                    medium_eta: medium,
+                    label: fl.label.into(),
+                    heavy_tail: false,
+                })
             };
             t.push(Term { label: fl.label.into(), kind });
         }

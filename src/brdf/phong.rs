@@ -104,7 +104,12 @@ impl Brdf for Phong {
         let label = format!("{} lobe (n = {})", self.name(), self.exponent);
         t.push(Term {
             label: label.clone(),
-            kind: TermKind::Lobe(Lobe { slope_width: self.equivalent_slope_width(), medium_eta: 1.0, label }),
+            kind: TermKind::Lobe(Lobe {
+                slope_width: self.equivalent_slope_width(),
+                medium_eta: 1.0,
+                label,
+                heavy_tail: false,
+            }),
         });
         t
     }

@@ -123,29 +123,33 @@ impl AxisMap {
 
     /// Split points of u: the range ends, the kinks of the overlap length, the lobe centre and multiples
     /// of each lobe width.
-    fn splits(&self, widths: &[f64]) -> Vec<f64> {
+    fn splits(&self, widths: &[(f64, bool)]) -> Vec<f64> {
         let [a, b] = self.range();
         let mut pts = vec![a, b, self.s[1] + self.r[0], self.s[0] + self.r[1]];
         // Lobes within a factor 3 of a narrower one share its splits: the splits are geometric (×3 apart),
-        // so they already resolve it, and each extra set multiplies the number of initial boxes.
-        let mut ws: Vec<f64> = widths.iter().copied().filter(|w| *w > 0.0).collect();
-        ws.sort_by(f64::total_cmp);
-        let mut kept: Vec<f64> = Vec::new();
-        for w in ws {
-            if kept.last().is_none_or(|k| w > 3.0 * k) {
-                kept.push(w);
+        // so they already resolve it, and each extra set multiplies the number of initial boxes. A shared
+        // set reaches as far as the heaviest tail among the lobes it serves.
+        let mut ws: Vec<(f64, bool)> = widths.iter().copied().filter(|(w, _)| *w > 0.0).collect();
+        ws.sort_by(|x, y| x.0.total_cmp(&y.0));
+        let mut kept: Vec<(f64, bool)> = Vec::new();
+        for (w, heavy) in ws {
+            match kept.last_mut() {
+                Some(k) if w <= 3.0 * k.0 => k.1 |= heavy,
+                _ => kept.push((w, heavy)),
             }
         }
-        // Geometric splits at ±w, ±3w, ±10w, ±30w, … out to the end of the range: no box spans more than a
-        // factor ≈ 3 in distance from the lobe centre, so even a heavy tail (GGX falls off as u⁻⁴ and holds
-        // ~1e-4 of its mass beyond 100 widths) is seen by the first samples of every box.
-        let reach = a.abs().max(b.abs());
-        for &w in &kept {
+        // Geometric splits at ±w, ±3w, ±10w, … For a heavy tail they go on (±30w, ±100w, …) to the end of the
+        // range, so that no box spans more than a factor ≈ 3 in distance from the lobe centre and a tail
+        // falling off as u⁻⁴ (GGX holds ~1e-4 of its mass beyond 100 widths) is seen by the first samples of
+        // every box. A Gaussian tail is below e⁻¹⁰⁰ of the peak beyond 10w: the splits stop there.
+        let range_reach = a.abs().max(b.abs());
+        for &(w, heavy) in &kept {
             if w > 0.0 && w < 0.5 * (b - a) {
                 pts.push(0.0);
+                let reach = if heavy { range_reach } else { range_reach.min(10.0 * w * (1.0 + 1e-12)) };
                 let mut k = 1.0;
                 let mut step = 3.0;
-                while k * w < reach {
+                while k * w <= reach {
                     pts.push(k * w);
                     pts.push(-k * w);
                     k *= step;
@@ -199,8 +203,8 @@ impl FluxProblem<'_> {
         let ap = AxisMap { s: src.p, r: rec.p };
         let aq = AxisMap { s: src.q, r: rec.q };
         let widths: Vec<[f64; 2]> = self.lobes.iter().map(|l| lobe_widths_uv(l, self.theta)).collect();
-        let up = ap.splits(&widths.iter().map(|w| w[0]).collect::<Vec<_>>());
-        let uq = aq.splits(&widths.iter().map(|w| w[1]).collect::<Vec<_>>());
+        let up = ap.splits(&widths.iter().zip(&self.lobes).map(|(w, l)| (w[0], l.heavy_tail)).collect::<Vec<_>>());
+        let uq = aq.splits(&widths.iter().zip(&self.lobes).map(|(w, l)| (w[1], l.heavy_tail)).collect::<Vec<_>>());
         let mut boxes = Vec::with_capacity((up.len() - 1) * (uq.len() - 1));
         for a in up.windows(2) {
             for b in uq.windows(2) {
@@ -364,7 +368,7 @@ mod tests {
     fn overlap_map_covers_the_product_exactly() {
         // ∫ du ∫ dt Jacobian = area of the product of the two intervals.
         let m = AxisMap { s: [-0.01, 0.02], r: [-0.03, 0.05] };
-        let sp = m.splits(&[1e-4]);
+        let sp = m.splits(&[(1e-4, true)]);
         let mut total = 0.0;
         for w in sp.windows(2) {
             // the overlap length is linear on each piece: the midpoint rule is exact
