@@ -35,6 +35,7 @@ pub const MODELS: &[&str] = &[
     "ward",
     "cook-torrance-lobes",
     "paint",
+    "merl",
 ];
 
 /// Descriptive fields allowed in every recipe: `name`, `description`, `provenance` (strings) and `notes`

@@ -214,6 +214,18 @@ pub fn schema() -> Value {
             &["kd", "lobes"],
         ),
         paint,
+        model(
+            "merl",
+            "A measured BRDF table in the MERL .binary format (Matusik et al. 2003); see docs/recipe-format.md §merl",
+            &[
+                (
+                    "file",
+                    json!({"type": "string", "description": "path of the table, relative to the recipe's directory"}),
+                ),
+                ("interpolation", json!({"enum": ["nearest", "trilinear"], "default": "nearest"})),
+            ],
+            &["file"],
+        ),
     ];
 
     json!({
