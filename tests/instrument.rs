@@ -1,12 +1,14 @@
 //! Acceptance tests of the virtual instrument (issue 3). Every reference here is computed independently
-//! of the engine: Lambert's closed form for the projected solid angle of a spherical polygon, or a
-//! separate nested Gauss–Legendre integration of the mirror overlap.
+//! of the engine (`glossmeter::instrument::reference`, which shares no code with the quadrature): Lambert's
+//! closed form for the projected solid angle of a spherical polygon, or a separate nested Gauss–Legendre
+//! integration of the mirror overlap.
 use std::sync::Arc;
 
 use glossmeter::brdf::{Brdf, Lobe, Term, TermKind};
 use glossmeter::instrument::flux::{FluxProblem, Spectral};
-use glossmeter::instrument::geometry::{Axes, Stop};
+use glossmeter::instrument::geometry::Axes;
 use glossmeter::instrument::plan::{Plan, PlanOptions, Reading};
+use glossmeter::instrument::reference::{mirror_flux_reference, projected_solid_angle};
 use glossmeter::instrument::standards;
 use glossmeter::optics::fresnel::fr_dielectric;
 use glossmeter::spectrum::Sampling;
@@ -98,68 +100,6 @@ impl Brdf for TestBeckmann {
     fn describe(&self) -> String {
         format!("test beckmann m = {}", self.m)
     }
-}
-
-/// Projected solid angle ∫ cos θ dω of the pyramid over a stop, by Lambert's formula for a spherical
-/// polygon: ½ |Σ_edges γ_e (n_e · z)|, γ_e the angle subtended by the edge, n_e the unit normal of the
-/// plane through the edge and the origin (Lambert 1760; e.g. Arvo 1995, "Applications of irradiance
-/// tensors", Eq. 3).
-fn projected_solid_angle(axis: Vec3, e_par: Vec3, stop: Stop) -> f64 {
-    let e_perp = Vec3::new(0.0, 1.0, 0.0);
-    let corners = [(stop.p[0], stop.q[0]), (stop.p[1], stop.q[0]), (stop.p[1], stop.q[1]), (stop.p[0], stop.q[1])];
-    let v: Vec<Vec3> = corners.iter().map(|(p, q)| (axis + *p * e_par + *q * e_perp).normalize()).collect();
-    let mut s = 0.0;
-    for i in 0..4 {
-        let (a, b) = (v[i], v[(i + 1) % 4]);
-        let gamma = a.cross(b).length().atan2(a.dot(b));
-        s += gamma * a.cross(b).normalize().z;
-    }
-    0.5 * s.abs()
-}
-
-fn gauss_legendre(n: usize) -> Vec<(f64, f64)> {
-    // Newton iteration on P_n (Golub–Welsch would do too); nodes on [-1, 1].
-    (0..n)
-        .map(|i| {
-            let mut x = (std::f64::consts::PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
-            let mut dp = 0.0;
-            for _ in 0..100 {
-                let (mut p0, mut p1) = (1.0, x);
-                for k in 2..=n {
-                    let p2 = ((2 * k - 1) as f64 * x * p1 - (k - 1) as f64 * p0) / k as f64;
-                    p0 = p1;
-                    p1 = p2;
-                }
-                dp = n as f64 * (x * p1 - p0) / (x * x - 1.0);
-                let dx = p1 / dp;
-                x -= dx;
-                if dx.abs() < 1e-16 {
-                    break;
-                }
-            }
-            (x, 2.0 / ((1.0 - x * x) * dp * dp))
-        })
-        .collect()
-}
-
-/// Independent mirror flux: ∫∫ over source points whose mirror is in the receptor of R(θi) cos θi dω,
-/// by a 48×48 Gauss–Legendre product rule (the integrand is smooth on the overlap box).
-fn mirror_flux_reference(theta: f64, src: Stop, rec: Stop, refl: &dyn Fn(f64) -> f64) -> f64 {
-    let gl = gauss_legendre(48);
-    let (p0, p1) = (src.p[0].max(-rec.p[1]), src.p[1].min(-rec.p[0]));
-    let (q0, q1) = (src.q[0].max(-rec.q[1]), src.q[1].min(-rec.q[0]));
-    let (c, s) = (theta.cos(), theta.sin());
-    let mut total = 0.0;
-    for (xp, wp) in &gl {
-        let p = 0.5 * (p0 + p1) + 0.5 * (p1 - p0) * xp;
-        for (xq, wq) in &gl {
-            let q = 0.5 * (q0 + q1) + 0.5 * (q1 - q0) * xq;
-            let r2 = 1.0 + p * p + q * q;
-            let cos_i = (c + p * s) / r2.sqrt();
-            total += wp * wq * refl(cos_i) * cos_i / (r2 * r2.sqrt());
-        }
-    }
-    total * 0.25 * (p1 - p0) * (q1 - q0)
 }
 
 fn geometry(id: &str) -> glossmeter::instrument::geometry::Geometry {

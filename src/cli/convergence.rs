@@ -7,7 +7,6 @@ use serde_json::json;
 
 use super::{emit, plot, Format};
 use crate::instrument::convergence::{self, ReferenceKind, Sweep, SweepOptions, DEFAULT_TOLERANCES};
-use crate::instrument::standards::{self, StandardGeometry};
 use crate::recipe::{self, Material};
 use crate::{Error, Result};
 
@@ -48,22 +47,6 @@ pub struct ConvergenceArgs {
     pub reference_run: bool,
 }
 
-fn resolve(ids: &[String], files: &[PathBuf]) -> Result<Vec<StandardGeometry>> {
-    let mut out = Vec::new();
-    if ids.is_empty() && files.is_empty() {
-        for id in DEFAULT_GEOMETRIES {
-            out.push(standards::find(id)?);
-        }
-    }
-    for id in ids {
-        out.push(standards::find(id)?);
-    }
-    for f in files {
-        out.push(standards::load_file(f)?);
-    }
-    Ok(out)
-}
-
 fn refuse_existing(p: &Path, what: &str) -> Result<()> {
     if p.exists() {
         return Err(Error::Usage(format!(
@@ -94,7 +77,7 @@ pub fn run(args: ConvergenceArgs) -> Result<()> {
         }
     }
     let material = recipe::load_file(&args.recipe)?;
-    let geometries = resolve(&args.geometries, &args.geometry_files)?;
+    let geometries = super::resolve_geometries_or(&args.geometries, &args.geometry_files, DEFAULT_GEOMETRIES)?;
     let options = SweepOptions {
         min_seconds: args.min_time_ms * 1e-3,
         max_repetitions: args.max_repetitions,
@@ -126,16 +109,6 @@ pub fn run(args: ConvergenceArgs) -> Result<()> {
     Ok(())
 }
 
-fn secs(s: f64) -> String {
-    if s < 1e-3 {
-        format!("{:.1} µs", s * 1e6)
-    } else if s < 1.0 {
-        format!("{:.2} ms", s * 1e3)
-    } else {
-        format!("{s:.2} s")
-    }
-}
-
 /// Decimals that show a value to one digit below its estimated error (2 to 14).
 fn decimals(err: Option<f64>) -> usize {
     match err {
@@ -159,7 +132,7 @@ fn reference_note(sweep: &Sweep) -> String {
         }
         ReferenceKind::Run { rtol } => format!(
             "Reference: the same engine at rtol = {rtol:e} (100× tighter than the tightest of the sweep; {}); an actual error below the reference's own estimate is not resolved.",
-            secs(sweep.reference_seconds)
+            super::format::secs(sweep.reference_seconds)
         ),
     }
 }
@@ -184,7 +157,7 @@ pub fn table(material: &Material, sweep: &Sweep) -> String {
             err_cell(r.error_estimate),
             err_cell(r.actual_error),
             format!("{}{mark}", r.evaluations),
-            secs(r.seconds),
+            super::format::secs(r.seconds),
             r.reference_kind.clone(),
         ]);
         if let Some(p) = &r.problem {

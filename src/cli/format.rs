@@ -14,7 +14,8 @@ fn decimals(error: f64) -> usize {
     (-error.log10().floor() as i64).clamp(2, 10) as usize
 }
 
-fn secs(s: f64) -> String {
+/// A duration for people: µs, ms or s.
+pub fn secs(s: f64) -> String {
     if s < 1e-3 {
         format!("{:.1} µs", s * 1e6)
     } else if s < 1.0 {

@@ -152,9 +152,18 @@ fn dispatch(cli: Cli) -> Result<()> {
 
 /// Builtin ids and user files, in the order given; the default panel if neither is given.
 pub fn resolve_geometries(ids: &[String], files: &[PathBuf]) -> Result<Vec<standards::StandardGeometry>> {
+    resolve_geometries_or(ids, files, DEFAULT_GEOMETRIES)
+}
+
+/// Builtin ids and user files, in the order given; `defaults` if neither is given.
+pub fn resolve_geometries_or(
+    ids: &[String],
+    files: &[PathBuf],
+    defaults: &[&str],
+) -> Result<Vec<standards::StandardGeometry>> {
     let mut out = Vec::new();
     if ids.is_empty() && files.is_empty() {
-        for id in DEFAULT_GEOMETRIES {
+        for id in defaults {
             out.push(standards::find(id)?);
         }
     }

@@ -56,6 +56,19 @@ pub struct Flux {
     pub variables: Variables,
 }
 
+/// Write the integrand: the per-sample values times the geometric factor `g`, either one component per
+/// sample (`separate`) or folded into the luminous sum Σ w_k f_k·g.
+#[inline]
+fn store(out: &mut [f64], values: &[f64], weights: &[f64], g: f64, separate: bool) {
+    if separate {
+        for (o, v) in out.iter_mut().zip(values) {
+            *o = v * g;
+        }
+    } else {
+        out[0] = weights.iter().zip(values).map(|(a, b)| a * b).sum::<f64>() * g;
+    }
+}
+
 /// Width in u (in-plane) and v (perpendicular) of a lobe at geometry angle θ.
 /// A facet/flake tilt δ inside a medium of index η turns the internal reflected ray by 2δ; leaving the
 /// medium, the in-plane deviation becomes 2δ·η cos θt / cos θ and the perpendicular one 2δ·η cos θt
@@ -267,14 +280,7 @@ impl FluxProblem<'_> {
                         if wi.z <= 0.0 || !brdf.delta_reflectance(wi, &mut scratch) {
                             return;
                         }
-                        let g = wi.z * solid_angle_density(x[0], x[1]);
-                        if separate {
-                            for k in 0..out.len() {
-                                out[k] = scratch[k] * g;
-                            }
-                        } else {
-                            out[0] = w.iter().zip(scratch.iter()).map(|(a, b)| a * b).sum::<f64>() * g;
-                        }
+                        store(out, &scratch, w, wi.z * solid_angle_density(x[0], x[1]), separate);
                     },
                     ncomp,
                     &[(lo, hi)],
@@ -329,13 +335,7 @@ impl FluxProblem<'_> {
                     }
                     brdf.eval(wi, wo, &mut scratch);
                     let g = wi.z * wo.z * solid_angle_density(ps, qs) * solid_angle_density(pr, qr) * jac;
-                    if separate {
-                        for k in 0..out.len() {
-                            out[k] = scratch[k] * g;
-                        }
-                    } else {
-                        out[0] = w.iter().zip(scratch.iter()).map(|(a, b)| a * b).sum::<f64>() * g;
-                    }
+                    store(out, &scratch, w, g, separate);
                 },
                 ncomp,
                 &boxes,
