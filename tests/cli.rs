@@ -10,7 +10,7 @@ fn tmp(name: &str) -> std::path::PathBuf {
 #[test]
 fn measure_succeeds_and_bad_input_exits_2() {
     assert_eq!(run(["glossmeter", "measure", "fixtures/recipes/glass-n1.5.json", "-g", "astm-d523-60"]), 0);
-    assert_eq!(run(["glossmeter", "measure", "fixtures/recipes/does-not-exist.json"]), 1);
+    assert_eq!(run(["glossmeter", "measure", "fixtures/recipes/does-not-exist.json"]), 2);
     assert_eq!(run(["glossmeter", "measure", "fixtures/recipes/glass-n1.5.json", "-g", "astm-d523-61"]), 2);
     for rtol in ["0", "-1e-6", "NaN", "1.5"] {
         assert_eq!(

@@ -1,6 +1,7 @@
 //! The command-line layer: argument parsing and output formatting only. Every computation lives in the
 //! library modules; this module turns their results into tables, JSON or CSV, and their errors into a
-//! message on stderr and a non-zero exit status (2 for bad input or usage, 1 for anything else).
+//! message on stderr and a non-zero exit status: 2 for bad input, unreadable files or usage; 1 when a reading has
+//! no finite value or a comparison fails.
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -96,7 +97,8 @@ where
         Err(e) => {
             eprintln!("error: {e}");
             match e {
-                Error::Input { .. } | Error::Usage(_) => 2,
+                // A file that cannot be read (missing, unreadable) is bad input like a malformed one.
+                Error::Input { .. } | Error::Usage(_) | Error::Io { .. } => 2,
                 _ => 1,
             }
         }
