@@ -756,7 +756,7 @@ fn where_the_evaluations_go(md: &mut String, cases: &[Case]) {
     let _ = writeln!(md, "\n## Where our evaluations go (rtol 1e-6)\n");
     let _ = writeln!(
         md,
-        "Evaluation points binned by x = max(|u|/w_u, |v|/w_v), (u, v) the lobe variables and (w_u, w_v) the lobe widths the engine uses for its splits (it splits at 0, ±1, ±3, ±10, ±30, ±100, … w out to the end of the range, and at the kinks of the overlap). For Beckmann the lobe is ≈ exp(−x²) there: beyond x = 10 it is below e⁻¹⁰⁰ of its peak.\n"
+        "Evaluation points binned by x = max(|u|/w_u, |v|/w_v), (u, v) the lobe variables and (w_u, w_v) the lobe widths the engine uses for its splits (it splits at 0, ±1, ±3, ±10 w for Gaussian-tailed lobes such as Beckmann, at ±30, ±100, … w out to the end of the range for heavy tails such as GGX, and at the kinks of the overlap). For Beckmann the lobe is ≈ exp(−x²) there: beyond x = 10 it is below e⁻¹⁰⁰ of its peak.\n"
     );
     let _ = writeln!(md, "| case | w_u | w_v | evaluations | x < 1 | 1–3 | 3–10 | 10–30 | 30–100 | ≥ 100 |");
     let _ = writeln!(md, "|---|---|---|---|---|---|---|---|---|---|");

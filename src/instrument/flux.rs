@@ -266,7 +266,9 @@ impl FluxProblem<'_> {
         let mut regions = 0;
         let mut converged = true;
 
-        // 1. The delta part: source points whose mirror (−p, −q) lies in the receptor.
+        // 1. The delta part: source points whose mirror (−p, −q) lies in the receptor. It gets DELTA_SHARE
+        // of the budget when a regular part follows, all of it otherwise (the gloss standard).
+        let delta_share = if self.include_regular { DELTA_SHARE } else { 1.0 };
         let (mut delta, mut delta_err) = (0.0, 0.0);
         if self.include_delta {
             let lo = [src.p[0].max(-rec.p[1]), src.q[0].max(-rec.q[1])];
@@ -285,8 +287,8 @@ impl FluxProblem<'_> {
                     ncomp,
                     &[(lo, hi)],
                     &Options {
-                        rtol: DELTA_SHARE * self.rtol,
-                        atol: DELTA_SHARE * self.atol,
+                        rtol: delta_share * self.rtol,
+                        atol: delta_share * self.atol,
                         max_evals: self.max_evals,
                     },
                 );
