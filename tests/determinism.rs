@@ -1,15 +1,15 @@
 //! Reproducibility (issue 4): the same readings, bit for bit, whatever the number of threads the plan runs
 //! on, and from one run to the next in the same thread. Compared: `f64::to_bits` of every value and error
 //! estimate, the evaluation counts and the convergence flags.
+mod common;
+use common::TestBeckmann;
 use std::path::Path;
 use std::sync::Arc;
 
-use glossmeter::brdf::{Brdf, Lobe, Term, TermKind};
+use glossmeter::brdf::Brdf;
 use glossmeter::instrument::plan::{Plan, PlanOptions, Reading};
 use glossmeter::instrument::standards::{self, StandardGeometry};
-use glossmeter::optics::fresnel::fr_dielectric;
 use glossmeter::spectrum::Sampling;
-use glossmeter::Vec3;
 
 /// The default panel of the CLI.
 const PANEL: &[&str] = glossmeter::cli::DEFAULT_GEOMETRIES;
@@ -64,58 +64,10 @@ fn recipe(name: &str) -> Arc<dyn Brdf> {
     glossmeter::recipe::load_file(&path).unwrap().brdf
 }
 
-/// A Beckmann dielectric written out in the test (F·D·G/(4 cos cos), Smith height-correlated), so this
-/// test exercises the plan and the integrator independently of the crate's microfacet model.
-#[derive(Debug)]
-struct TestBeckmann {
-    m: f64,
-    s: Sampling,
-}
-
-impl TestBeckmann {
-    fn lambda(&self, w: Vec3) -> f64 {
-        let t2 = (w.x * w.x + w.y * w.y) / (w.z * w.z);
-        if t2 == 0.0 {
-            return 0.0;
-        }
-        let a = 1.0 / (self.m * t2.sqrt());
-        0.5 * ((-a * a).exp() / (a * std::f64::consts::PI.sqrt()) - libm::erfc(a))
-    }
-}
-
-impl Brdf for TestBeckmann {
-    fn sampling(&self) -> &Sampling {
-        &self.s
-    }
-    fn eval(&self, wi: Vec3, wo: Vec3, out: &mut [f64]) {
-        let h = (wi + wo).normalize();
-        let t2 = (h.x * h.x + h.y * h.y) / (h.z * h.z);
-        let m2 = self.m * self.m;
-        let d = (-t2 / m2).exp() / (std::f64::consts::PI * m2 * h.z.powi(4));
-        let g = 1.0 / (1.0 + self.lambda(wi) + self.lambda(wo));
-        let f = fr_dielectric(wi.dot(h).clamp(0.0, 1.0), 1.5) * d * g / (4.0 * wi.z * wo.z);
-        out.iter_mut().for_each(|o| *o = f);
-    }
-    fn terms(&self) -> Vec<Term> {
-        vec![Term {
-            label: "beckmann".into(),
-            kind: TermKind::Lobe(Lobe {
-                slope_width: self.m,
-                medium_eta: 1.0,
-                label: "beckmann".into(),
-                heavy_tail: false,
-            }),
-        }]
-    }
-    fn describe(&self) -> String {
-        format!("test beckmann m = {}", self.m)
-    }
-}
-
 #[test]
 fn test_beckmann_panel_is_bitwise_reproducible_across_thread_counts() {
     for m in [0.1, 1e-3] {
-        check(Arc::new(TestBeckmann { m, s: Sampling::rgb() }), &format!("test Beckmann m = {m}"));
+        check(Arc::new(TestBeckmann { m, n: 1.5, s: Sampling::rgb() }), &format!("test Beckmann m = {m}"));
     }
 }
 

@@ -9,6 +9,7 @@
 //!
 //! Every case prints one line `STAB|test|case|value|estimate|actual|bound|ok` (run with `--nocapture`);
 //! `docs/stability.md` tabulates them.
+use glossmeter::instrument::reference::gauss_legendre;
 use std::f64::consts::PI;
 use std::sync::Arc;
 
@@ -138,30 +139,6 @@ fn check_against_tight(
 
 // ---------------------------------------------------------------------------------------------------------
 // Independent references
-
-fn gauss_legendre(n: usize) -> Vec<(f64, f64)> {
-    (0..n)
-        .map(|i| {
-            let mut x = (PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
-            let mut dp = 0.0;
-            for _ in 0..100 {
-                let (mut p0, mut p1) = (1.0, x);
-                for k in 2..=n {
-                    let p2 = ((2 * k - 1) as f64 * x * p1 - (k - 1) as f64 * p0) / k as f64;
-                    p0 = p1;
-                    p1 = p2;
-                }
-                dp = n as f64 * (x * p1 - p0) / (x * x - 1.0);
-                let dx = p1 / dp;
-                x -= dx;
-                if dx.abs() < 1e-16 {
-                    break;
-                }
-            }
-            (x, 2.0 / ((1.0 - x * x) * dp * dp))
-        })
-        .collect()
-}
 
 /// ∫_a^b f by n-point Gauss–Legendre.
 fn gl1(f: &dyn Fn(f64) -> f64, a: f64, b: f64, n: usize) -> f64 {
