@@ -472,17 +472,32 @@ impl Plan {
             let how = match j.target {
                 Target::Standard => "analytic (delta) only".to_string(),
                 Target::Specimen => {
-                    let vars = match (clip(j.source, j.theta, true), clip(j.receptor, j.theta, false)) {
+                    let clipped = (clip(j.source, j.theta, true), clip(j.receptor, j.theta, false));
+                    let vars = match clipped {
                         (Some(a), Some(b)) => match choose_variables(&self.lobes, j.theta, a, b) {
                             Variables::Plain => "plain variables (no lobe narrower than the stops)",
                             Variables::Lobe => "lobe variables",
                         },
                         _ => "stops below the horizon: zero",
                     };
+                    // Does the receptor see the mirror image of the source (a non-empty delta integral)?
+                    let sees_mirror = match clipped {
+                        (Some(a), Some(b)) => {
+                            a.p[0].max(-b.p[1]) < a.p[1].min(-b.p[0]) && a.q[0].max(-b.q[1]) < a.q[1].min(-b.q[0])
+                        }
+                        _ => false,
+                    };
+                    let delta = match (self.has_delta, sees_mirror) {
+                        (false, _) => "",
+                        (true, true) => "analytic delta + ",
+                        (true, false) => "no mirror image in this stop (delta skipped) + ",
+                    };
                     if self.has_regular {
-                        format!("{}{vars}", if self.has_delta { "analytic delta + " } else { "" })
-                    } else {
+                        format!("{delta}{vars}")
+                    } else if sees_mirror {
                         "analytic (delta) only".to_string()
+                    } else {
+                        "no mirror image in this stop and no regular part: zero".to_string()
                     }
                 }
             };
