@@ -314,24 +314,15 @@ fn raw_box_genz_malik(c: &Case, rtol: f64, max_evals: usize) -> glossmeter::quad
     )
 }
 
-/// Lambert's formula for the projected solid angle of the pyramid over a stop (as in tests/instrument.rs).
-fn projected_solid_angle(axis: Vec3, e_par: Vec3, stop: Stop) -> f64 {
-    let e_perp = Vec3::new(0.0, 1.0, 0.0);
-    let corners = [(stop.p[0], stop.q[0]), (stop.p[1], stop.q[0]), (stop.p[1], stop.q[1]), (stop.p[0], stop.q[1])];
-    let v: Vec<Vec3> = corners.iter().map(|(p, q)| (axis + *p * e_par + *q * e_perp).normalize()).collect();
-    let mut s = 0.0;
-    for i in 0..4 {
-        let (a, b) = (v[i], v[(i + 1) % 4]);
-        s += a.cross(b).length().atan2(a.dot(b)) * a.cross(b).normalize().z;
-    }
-    0.5 * s.abs()
-}
-
+/// The closed-form Lambertian flux (Lambert's polygon formula for each stop), from the crate's independent
+/// references (`instrument::reference`, which shares no code with the quadrature).
 fn lambert_exact(c: &Case, albedo: f64) -> f64 {
-    let t = c.theta;
-    let src = projected_solid_angle(Vec3::new(-t.sin(), 0.0, t.cos()), Vec3::new(t.cos(), 0.0, t.sin()), c.source);
-    let rec = projected_solid_angle(Vec3::new(t.sin(), 0.0, t.cos()), Vec3::new(t.cos(), 0.0, -t.sin()), c.receptor);
-    albedo / std::f64::consts::PI * src * rec
+    glossmeter::instrument::reference::lambertian_flux_reference(
+        c.theta,
+        c.source,
+        c.receptor,
+        albedo / std::f64::consts::PI,
+    )
 }
 
 // ---------------------------------------------------------------------------------------------------------
