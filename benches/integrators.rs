@@ -32,8 +32,8 @@ use glossmeter::optics::fresnel::fr_dielectric;
 use glossmeter::spectrum::Sampling;
 use glossmeter::Vec3;
 
-/// The default measurement panel (as `DEFAULT_GEOMETRIES` of the CLI).
-const PANEL: &[&str] = glossmeter::cli::DEFAULT_GEOMETRIES;
+/// The default measurement panel of `measure`.
+const PANEL: &[&str] = glossmeter::DEFAULT_PANEL;
 
 // ---------------------------------------------------------------------------------------------------------
 // Timing and random numbers.

@@ -9,8 +9,14 @@
 //! * [`spectrum`]: spectral sampling and the luminous (CIE illuminant C × V(λ)) weighting.
 //! * [`quadrature`]: the deterministic adaptive cubature with error estimates.
 //! * [`instrument`]: aperture geometry, the standards as data, the measurement plan and the readings.
-//! * [`cli`]: the thin command-line layer.
+//! * [`api`]: the one-call API ([`measure`], the default panel, geometry resolution).
+//! * `cli` (feature `cli`, on by default): the thin command-line layer. The library builds and works without
+//!   it and its dependencies (clap, plotters): `cargo build --lib --no-default-features`.
+#![forbid(unsafe_code)]
+
+pub mod api;
 pub mod brdf;
+#[cfg(feature = "cli")]
 pub mod cli;
 pub mod error;
 pub mod instrument;
@@ -19,7 +25,9 @@ pub mod quadrature;
 pub mod recipe;
 pub mod spectrum;
 
+pub use api::{measure, measure_file, resolve_geometries, resolve_geometries_or, DEFAULT_PANEL};
 pub use error::{Error, Result};
+pub use instrument::plan::{PlanOptions, Reading};
 
 /// Double-precision 3-vector used for directions. Local shading frame: z is the specimen normal,
 /// x–z is the plane of measurement, and every direction points away from the surface.

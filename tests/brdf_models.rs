@@ -120,7 +120,7 @@ fn white_furnace_fixtures() {
 
 #[test]
 fn lambert_albedo_is_rho() {
-    let b = Lambert::new(vec![0.2, 0.5, 0.9], Sampling::rgb());
+    let b = Lambert::new(vec![0.2, 0.5, 0.9], Sampling::rgb()).unwrap();
     for t in [0.0, 30.0, 60.0, 85.0, 89.0] {
         let (a, err) = directional_albedo(&b, dir(t, 20.0));
         for (x, rho) in a.iter().zip([0.2, 0.5, 0.9]) {
@@ -148,7 +148,7 @@ fn smooth_dielectric_albedo_is_fresnel() {
 }
 
 fn microfacet(dist: Distribution, alpha: f64, n: f64, shadowing: Shadowing) -> MicrofacetSurface {
-    MicrofacetSurface::new(Microfacet::new(dist, alpha), shadowing, vec![Ior::Dielectric(n)], Sampling::grey())
+    MicrofacetSurface::new(Microfacet::new(dist, alpha), shadowing, vec![Ior::Dielectric(n)], Sampling::grey()).unwrap()
 }
 
 /// At α = 1e-4 the lobe is a near-delta: its albedo is the Fresnel reflectance within 1e-3.
@@ -190,13 +190,13 @@ fn microfacet_smooth_switch_is_continuous() {
 fn phong_normalisation_closed_form() {
     for n in [0.0, 1.0, 10.0, 1e3, 1e6, 1e8] {
         for variant in [PhongVariant::Phong, PhongVariant::BlinnPhong] {
-            let b = Phong::new(variant, n, vec![0.0], vec![0.7], Sampling::grey());
+            let b = Phong::new(variant, n, vec![0.0], vec![0.7], Sampling::grey()).unwrap();
             let (a, err) = directional_albedo(&b, Vec3::Z);
             assert!((a[0] - 0.7).abs() < 1e-7, "{variant:?} n = {n}: albedo {} (err {err})", a[0]);
         }
     }
     // Blinn–Phong's normalisation vs its large-n approximation (n + 8)/(8π) (RTR 3rd ed. Eq. 7.49).
-    let b = Phong::new(PhongVariant::BlinnPhong, 1e4, vec![0.0], vec![1.0], Sampling::grey());
+    let b = Phong::new(PhongVariant::BlinnPhong, 1e4, vec![0.0], vec![1.0], Sampling::grey()).unwrap();
     assert!((b.normalisation() / ((1e4 + 8.0) / (8.0 * PI)) - 1.0).abs() < 1e-3);
 }
 
@@ -205,7 +205,7 @@ fn phong_normalisation_closed_form() {
 #[test]
 fn ward_normalisation_closed_form() {
     for alpha in [1e-4, 1e-3, 0.05, 0.2, 0.5, 1.0] {
-        let b = Ward::new(vec![0.1], vec![0.6], alpha, Sampling::grey());
+        let b = Ward::new(vec![0.1], vec![0.6], alpha, Sampling::grey()).unwrap();
         let (a, err) = directional_albedo(&b, Vec3::Z);
         let expected = 0.1 + 0.6 * (1.0 - alpha * alpha * (1.0 - (-1.0 / (alpha * alpha)).exp()));
         assert!((a[0] - expected).abs() < 1e-8, "α = {alpha}: {} vs {expected} (err {err})", a[0]);
@@ -215,7 +215,7 @@ fn ward_normalisation_closed_form() {
 /// A narrow lobe away from normal incidence is not missed: Ward α = 1e-4 at 60° reflects ≈ ρs.
 #[test]
 fn narrow_lobe_is_found_off_normal() {
-    let b = Ward::new(vec![0.0], vec![0.5], 1e-4, Sampling::grey());
+    let b = Ward::new(vec![0.0], vec![0.5], 1e-4, Sampling::grey()).unwrap();
     for t in [20.0, 60.0, 85.0] {
         let (a, err) = directional_albedo(&b, dir(t, 30.0));
         assert!((a[0] - 0.5).abs() < 1e-3, "{t}°: {} (err {err})", a[0]);
@@ -229,15 +229,17 @@ fn cook_torrance_lobes_linearity_and_smooth_limit() {
     let lobe = |ks: f64, r: f64, m: f64| CtLobe { ks: vec![ks], r, facets: Microfacet::new(Distribution::Beckmann, m) };
     let sh = Shadowing::SmithHeightCorrelated;
     let with =
-        CookTorranceLobes::new(vec![0.3], vec![lobe(0.2, 0.5, 0.1), lobe(0.1, 0.04, 0.01)], sh, Sampling::grey());
+        CookTorranceLobes::new(vec![0.3], vec![lobe(0.2, 0.5, 0.1), lobe(0.1, 0.04, 0.01)], sh, Sampling::grey())
+            .unwrap();
     let without =
-        CookTorranceLobes::new(vec![0.0], vec![lobe(0.2, 0.5, 0.1), lobe(0.1, 0.04, 0.01)], sh, Sampling::grey());
+        CookTorranceLobes::new(vec![0.0], vec![lobe(0.2, 0.5, 0.1), lobe(0.1, 0.04, 0.01)], sh, Sampling::grey())
+            .unwrap();
     for t in [0.0, 45.0, 80.0] {
         let (a, e1) = directional_albedo(&with, dir(t, 0.0));
         let (b, e2) = directional_albedo(&without, dir(t, 0.0));
         assert!((a[0] - b[0] - 0.3).abs() < 1e-8 + e1 + e2, "{t}°: {} vs {} + 0.3", a[0], b[0]);
     }
-    let smooth = CookTorranceLobes::new(vec![0.0], vec![lobe(0.25, 1.0, 0.0)], sh, Sampling::grey());
+    let smooth = CookTorranceLobes::new(vec![0.0], vec![lobe(0.25, 1.0, 0.0)], sh, Sampling::grey()).unwrap();
     assert_eq!(smooth.terms()[0].kind, TermKind::Delta);
     let (a, _) = directional_albedo(&smooth, dir(40.0, 0.0));
     assert!((a[0] - 0.25).abs() < 1e-15);
@@ -247,14 +249,14 @@ fn cook_torrance_lobes_linearity_and_smooth_limit() {
 #[test]
 fn terms_are_honest() {
     let b: Arc<dyn Brdf> =
-        Arc::new(Phong::new(PhongVariant::BlinnPhong, 100.0, vec![0.2], vec![0.1], Sampling::grey()));
+        Arc::new(Phong::new(PhongVariant::BlinnPhong, 100.0, vec![0.2], vec![0.1], Sampling::grey()).unwrap());
     assert!(b.has_regular() && !b.has_delta());
     let lobes = b.lobes();
     assert_eq!(lobes.len(), 1);
     assert!((lobes[0].slope_width - (2.0f64 / 102.0).sqrt()).abs() < 1e-15);
-    let l: Arc<dyn Brdf> = Arc::new(Lambert::new(vec![0.5], Sampling::grey()));
+    let l: Arc<dyn Brdf> = Arc::new(Lambert::new(vec![0.5], Sampling::grey()).unwrap());
     assert!(l.lobes().is_empty() && !l.has_delta());
-    let w: Arc<dyn Brdf> = Arc::new(Ward::new(vec![0.0], vec![0.1], 0.05, Sampling::grey()));
+    let w: Arc<dyn Brdf> = Arc::new(Ward::new(vec![0.0], vec![0.1], 0.05, Sampling::grey()).unwrap());
     assert_eq!(w.terms().len(), 1, "no diffuse term when ρd = 0");
     assert_eq!(w.lobes()[0].slope_width, 0.05);
 }
@@ -276,18 +278,18 @@ proptest! {
         let (kd, ks) = (rho * split, rho * (1.0 - split));
         let g = Sampling::grey;
         let b: Box<dyn Brdf> = match which {
-            0 => Box::new(Lambert::new(vec![rho], g())),
+            0 => Box::new(Lambert::new(vec![rho], g()).unwrap()),
             1 => Box::new(microfacet(Distribution::Beckmann, alpha, n, Shadowing::SmithHeightCorrelated)),
             2 => Box::new(microfacet(Distribution::Ggx, alpha, n, Shadowing::VCavity)),
-            3 => Box::new(Phong::new(PhongVariant::Phong, 2.0 / (alpha * alpha), vec![kd], vec![ks], g())),
-            4 => Box::new(Phong::new(PhongVariant::BlinnPhong, 2.0 / (alpha * alpha), vec![kd], vec![ks], g())),
-            5 => Box::new(Ward::new(vec![kd], vec![ks], alpha, g())),
+            3 => Box::new(Phong::new(PhongVariant::Phong, 2.0 / (alpha * alpha), vec![kd], vec![ks], g()).unwrap()),
+            4 => Box::new(Phong::new(PhongVariant::BlinnPhong, 2.0 / (alpha * alpha), vec![kd], vec![ks], g()).unwrap()),
+            5 => Box::new(Ward::new(vec![kd], vec![ks], alpha, g()).unwrap()),
             _ => Box::new(CookTorranceLobes::new(
                 vec![kd],
                 vec![CtLobe { ks: vec![ks], r: (n - 1.0) / 2.0, facets: Microfacet::new(Distribution::Beckmann, alpha) }],
                 Shadowing::SmithHeightCorrelated,
                 g(),
-            )),
+            ).unwrap()),
         };
         let (a, err) = directional_albedo(b.as_ref(), dir(theta, 0.0));
         prop_assert!(err < 1e-6, "{}: error estimate {}", b.describe(), err);
@@ -335,4 +337,15 @@ fn furnace_detects_an_unbounded_model() {
     assert!(a[0] < 1.0, "at normal incidence it conserves energy: {}", a[0]);
     let (a, err2) = directional_albedo(&b, dir(85.0, 0.0));
     assert!(a[0] > 1.0 + err + err2, "at 85° the albedo exceeds 1: {} ± {err2}", a[0]);
+}
+
+#[test]
+fn constructors_refuse_caller_data_with_an_error_not_a_panic() {
+    assert!(Lambert::new(vec![0.2, 0.5], Sampling::grey()).is_err(), "two albedos for one sample");
+    assert!(Lambert::new(vec![f64::NAN], Sampling::grey()).is_err());
+    assert!(Phong::new(PhongVariant::Phong, -1.0, vec![0.1], vec![0.1], Sampling::grey()).is_err());
+    assert!(Ward::new(vec![0.1], vec![0.1], 0.0, Sampling::grey()).is_err());
+    assert!(CookTorranceLobes::new(vec![0.1, 0.1, 0.1], vec![], Shadowing::VCavity, Sampling::grey()).is_err());
+    let e = Lambert::new(vec![0.2, 0.5], Sampling::rgb()).unwrap_err().to_string();
+    assert!(e.contains("albedo") && e.contains("2 value(s) for 3"), "{e}");
 }

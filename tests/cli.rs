@@ -1,6 +1,6 @@
 //! The binary's contract: exit statuses, errors that name the file, outputs that never overwrite.
+#![cfg(feature = "cli")]
 use glossmeter::cli::run;
-
 fn tmp(name: &str) -> std::path::PathBuf {
     let d = std::env::temp_dir().join(format!("glossmeter-cli-test-{}", std::process::id()));
     std::fs::create_dir_all(&d).unwrap();

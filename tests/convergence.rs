@@ -1,12 +1,12 @@
 //! Tests of `glossmeter convergence` (issue 4, item 1): the sweep on a Lambertian material, whose
 //! reference is an independent closed form, and the command line (JSON fields, the SVG plot, refusal to
 //! overwrite, refusal of bad tolerances).
-use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicUsize, Ordering};
-
+#![cfg(feature = "cli")]
 use glossmeter::instrument::convergence::{self, ReferenceKind, SweepOptions};
 use glossmeter::instrument::standards;
 use glossmeter::recipe;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// A fresh scratch directory per call (tests run in parallel).
 fn scratch() -> PathBuf {

@@ -12,7 +12,7 @@ use glossmeter::instrument::standards::{self, StandardGeometry};
 use glossmeter::spectrum::Sampling;
 
 /// The default panel of the CLI.
-const PANEL: &[&str] = glossmeter::cli::DEFAULT_GEOMETRIES;
+const PANEL: &[&str] = glossmeter::DEFAULT_PANEL;
 
 fn panel() -> Vec<StandardGeometry> {
     PANEL.iter().map(|id| standards::find(id).unwrap()).collect()

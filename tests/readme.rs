@@ -1,7 +1,7 @@
 //! The README shows the output of its main command; this test keeps that output true. The output is
 //! deterministic (everything but the time column, which `--no-timing` drops), so the comparison is exact.
+#![cfg(feature = "cli")]
 use std::path::PathBuf;
-
 #[test]
 fn readme_example_is_the_actual_output() {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));

@@ -16,10 +16,11 @@ pub struct SmoothConductor {
 }
 
 impl SmoothConductor {
-    /// Panics if `ior.len() != sampling.len()` (recipes are validated before this).
-    pub fn new(ior: Vec<Complex64>, sampling: Sampling) -> Self {
-        assert_eq!(ior.len(), sampling.len(), "one index per spectral sample");
-        SmoothConductor { ior, sampling }
+    /// One finite complex index per spectral sample, else an error.
+    pub fn new(ior: Vec<Complex64>, sampling: Sampling) -> crate::Result<Self> {
+        let parts: Vec<f64> = ior.iter().map(|c| c.re + c.im).collect();
+        super::per_sample("conductor index", &parts, &sampling)?;
+        Ok(SmoothConductor { ior, sampling })
     }
 }
 

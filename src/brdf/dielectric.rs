@@ -101,10 +101,17 @@ pub struct MicrofacetSurface {
 }
 
 impl MicrofacetSurface {
-    /// Panics if `ior.len() != sampling.len()` (recipes are validated before this).
-    pub fn new(facets: Microfacet, shadowing: Shadowing, ior: Vec<Ior>, sampling: Sampling) -> Self {
-        assert_eq!(ior.len(), sampling.len(), "one index per spectral sample");
-        MicrofacetSurface { facets, shadowing, ior, sampling }
+    /// One finite index per spectral sample, else an error.
+    pub fn new(facets: Microfacet, shadowing: Shadowing, ior: Vec<Ior>, sampling: Sampling) -> crate::Result<Self> {
+        let parts: Vec<f64> = ior
+            .iter()
+            .map(|i| match i {
+                Ior::Dielectric(n) => *n,
+                Ior::Conductor(c) => c.re + c.im,
+            })
+            .collect();
+        super::per_sample("index of refraction", &parts, &sampling)?;
+        Ok(MicrofacetSurface { facets, shadowing, ior, sampling })
     }
 }
 

@@ -17,10 +17,10 @@ pub struct Lambert {
 }
 
 impl Lambert {
-    /// Panics if the lengths disagree (a programming error; recipes are validated before this).
-    pub fn new(albedo: Vec<f64>, sampling: Sampling) -> Self {
-        assert_eq!(albedo.len(), sampling.len(), "one albedo per spectral sample");
-        Lambert { albedo, sampling }
+    /// One finite albedo per spectral sample, else an error.
+    pub fn new(albedo: Vec<f64>, sampling: Sampling) -> crate::Result<Self> {
+        super::per_sample("albedo", &albedo, &sampling)?;
+        Ok(Lambert { albedo, sampling })
     }
 }
 

@@ -10,7 +10,7 @@
 //! z > 0. `eval` returns the *regular* part of f_r in sr⁻¹ (no cosine factor); a delta component is reported
 //! separately by [`Brdf::delta_reflectance`].
 use crate::spectrum::Sampling;
-use crate::Vec3;
+use crate::{Error, Result, Vec3};
 
 pub mod albedo;
 pub mod conductor;
@@ -113,4 +113,19 @@ impl dyn Brdf {
 #[inline]
 pub fn mirror(w: Vec3) -> Vec3 {
     Vec3::new(-w.x, -w.y, w.z)
+}
+
+/// The check every model's constructor makes on caller data: one finite value per spectral sample.
+pub(crate) fn per_sample(what: &str, values: &[f64], sampling: &Sampling) -> Result<()> {
+    if values.len() != sampling.len() {
+        return Err(Error::Usage(format!(
+            "{what}: {} value(s) for {} spectral sample(s); give one per sample",
+            values.len(),
+            sampling.len()
+        )));
+    }
+    if let Some(v) = values.iter().find(|v| !v.is_finite()) {
+        return Err(Error::Usage(format!("{what}: {v} is not a finite number")));
+    }
+    Ok(())
 }

@@ -52,11 +52,13 @@ pub struct CookTorranceLobes {
 }
 
 impl CookTorranceLobes {
-    /// Panics if a length disagrees with the sampling (recipes are validated before this).
-    pub fn new(kd: Vec<f64>, lobes: Vec<CtLobe>, shadowing: Shadowing, sampling: Sampling) -> Self {
-        assert_eq!(kd.len(), sampling.len(), "one Kd per spectral sample");
-        assert!(lobes.iter().all(|l| l.ks.len() == sampling.len()), "one Ks per spectral sample");
-        CookTorranceLobes { kd, lobes, shadowing, sampling }
+    /// One finite Kd and, per lobe, one finite Ks per spectral sample, else an error.
+    pub fn new(kd: Vec<f64>, lobes: Vec<CtLobe>, shadowing: Shadowing, sampling: Sampling) -> crate::Result<Self> {
+        super::per_sample("kd", &kd, &sampling)?;
+        for (i, l) in lobes.iter().enumerate() {
+            super::per_sample(&format!("lobe {i} ks"), &l.ks, &sampling)?;
+        }
+        Ok(CookTorranceLobes { kd, lobes, shadowing, sampling })
     }
 }
 

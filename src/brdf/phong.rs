@@ -44,10 +44,20 @@ pub struct Phong {
 }
 
 impl Phong {
-    /// Panics if the lengths disagree with the sampling (recipes are validated before this).
-    pub fn new(variant: PhongVariant, exponent: f64, kd: Vec<f64>, ks: Vec<f64>, sampling: Sampling) -> Self {
-        assert!(kd.len() == sampling.len() && ks.len() == sampling.len(), "one value per spectral sample");
-        Phong { variant, exponent, kd, ks, sampling }
+    /// One finite kd and ks per spectral sample and a finite exponent ≥ 0, else an error.
+    pub fn new(
+        variant: PhongVariant,
+        exponent: f64,
+        kd: Vec<f64>,
+        ks: Vec<f64>,
+        sampling: Sampling,
+    ) -> crate::Result<Self> {
+        super::per_sample("kd", &kd, &sampling)?;
+        super::per_sample("ks", &ks, &sampling)?;
+        if !(exponent.is_finite() && exponent >= 0.0) {
+            return Err(crate::Error::Usage(format!("Phong exponent must be a finite number ≥ 0, got {exponent}")));
+        }
+        Ok(Phong { variant, exponent, kd, ks, sampling })
     }
 
     /// The normalisation constant of the lobe (see the module documentation).

@@ -35,10 +35,14 @@ pub struct Ward {
 }
 
 impl Ward {
-    /// Panics if the lengths disagree with the sampling (recipes are validated before this).
-    pub fn new(rho_d: Vec<f64>, rho_s: Vec<f64>, alpha: f64, sampling: Sampling) -> Self {
-        assert!(rho_d.len() == sampling.len() && rho_s.len() == sampling.len(), "one value per spectral sample");
-        Ward { rho_d, rho_s, alpha, sampling }
+    /// One finite ρd and ρs per spectral sample and a finite α > 0, else an error.
+    pub fn new(rho_d: Vec<f64>, rho_s: Vec<f64>, alpha: f64, sampling: Sampling) -> crate::Result<Self> {
+        super::per_sample("rho_d", &rho_d, &sampling)?;
+        super::per_sample("rho_s", &rho_s, &sampling)?;
+        if !(alpha.is_finite() && alpha > 0.0) {
+            return Err(crate::Error::Usage(format!("Ward alpha must be a finite number > 0, got {alpha}")));
+        }
+        Ok(Ward { rho_d, rho_s, alpha, sampling })
     }
 
     /// The closed-form specular albedo at normal incidence per unit ρs: 1 − α²(1 − e^(−1/α²)).

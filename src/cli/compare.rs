@@ -5,10 +5,10 @@ use std::path::PathBuf;
 
 use serde_json::json;
 
-use crate::cli::{emit, resolve_geometries, Format};
+use crate::cli::{check_rtol, emit, Format};
 use crate::instrument::plan::{Plan, PlanOptions, Reading};
 use crate::instrument::sheet::{self, SheetRow};
-use crate::{recipe, Error, Result};
+use crate::{recipe, resolve_geometries, Error, Result};
 
 #[derive(clap::Args, Debug)]
 pub struct CompareArgs {
@@ -63,6 +63,7 @@ pub fn run(a: CompareArgs) -> Result<()> {
             return Err(Error::Usage(format!("--tolerance must be a finite number ≥ 0, got {t}")));
         }
     }
+    check_rtol(a.rtol)?;
     let material = recipe::load_file(&a.recipe)?;
     let rows = sheet::load(&a.sheet)?;
     let mut ids: Vec<String> = Vec::new();
@@ -71,7 +72,7 @@ pub fn run(a: CompareArgs) -> Result<()> {
             ids.push(r.geometry.clone());
         }
     }
-    let geos = resolve_geometries(&ids, &[]).map_err(|e| match e {
+    let geos = resolve_geometries(&ids, &[] as &[&str]).map_err(|e| match e {
         Error::Usage(m) => Error::input(a.sheet.display().to_string(), "geometry", m),
         e => e,
     })?;

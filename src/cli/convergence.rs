@@ -60,7 +60,7 @@ fn refuse_existing(p: &Path, what: &str) -> Result<()> {
 pub fn run(args: ConvergenceArgs) -> Result<()> {
     // Every check that can fail cheaply comes before the (possibly long) sweep.
     let tolerances = if args.tolerances.is_empty() { DEFAULT_TOLERANCES.to_vec() } else { args.tolerances.clone() };
-    convergence::validate_tolerances(&tolerances)?;
+    convergence::validate_tolerances(&tolerances).map_err(|e| Error::Usage(format!("--tolerances: {e}")))?;
     if !(args.min_time_ms.is_finite() && args.min_time_ms >= 0.0) {
         return Err(Error::Usage(format!("--min-time-ms must be a number ≥ 0, got {}", args.min_time_ms)));
     }
@@ -77,7 +77,7 @@ pub fn run(args: ConvergenceArgs) -> Result<()> {
         }
     }
     let material = recipe::load_file(&args.recipe)?;
-    let geometries = super::resolve_geometries_or(&args.geometries, &args.geometry_files, DEFAULT_GEOMETRIES)?;
+    let geometries = crate::resolve_geometries_or(&args.geometries, &args.geometry_files, DEFAULT_GEOMETRIES)?;
     let options = SweepOptions {
         min_seconds: args.min_time_ms * 1e-3,
         max_repetitions: args.max_repetitions,

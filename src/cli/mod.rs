@@ -7,9 +7,9 @@ use std::path::{Path, PathBuf};
 
 use clap::{Parser, Subcommand, ValueEnum};
 
-use crate::instrument::plan::{Plan, PlanOptions, Reading};
+use crate::instrument::plan::{Plan, PlanOptions};
 use crate::instrument::standards;
-use crate::{recipe, Error, Result};
+use crate::{recipe, resolve_geometries, Error, Result};
 
 pub mod compare;
 pub mod convergence;
@@ -75,10 +75,6 @@ pub enum Command {
     Convergence(convergence::ConvergenceArgs),
 }
 
-/// The default panel of `measure`.
-pub const DEFAULT_GEOMETRIES: &[&str] =
-    &["astm-d523-20", "astm-d523-60", "astm-d523-85", "astm-e430-30", "iso-13803-20", "astm-d4039"];
-
 /// Run the CLI; returns the process exit status.
 pub fn run<I, T>(args: I) -> i32
 where
@@ -94,20 +90,38 @@ where
     };
     match dispatch(cli) {
         Ok(()) => 0,
+        // A reader that went away (`glossmeter standards | head -1`) is not an error: end quietly, as
+        // ripgrep does. Only standard output is treated so; a file that cannot be written is an error.
+        Err(Error::Io { file, source }) if file == STDOUT && source.kind() == std::io::ErrorKind::BrokenPipe => 0,
         Err(e) => {
-            eprintln!("error: {e}");
-            match e {
-                // A file that cannot be read (missing, unreadable) is bad input like a malformed one.
-                Error::Input { .. } | Error::Usage(_) | Error::Io { .. } => 2,
-                _ => 1,
-            }
+            let _ = writeln!(std::io::stderr(), "error: {e}");
+            exit_status(&e)
         }
     }
+}
+
+/// The exit status of an error (docs/instrument.md §Exit statuses): 2 for bad input, unreadable or unwritable
+/// files and usage; 1 for a result that is not one (no finite value, not converged, a failed check).
+pub fn exit_status(e: &Error) -> i32 {
+    match e {
+        Error::Input { .. } | Error::Usage(_) | Error::Io { .. } => 2,
+        Error::Numeric(_) | Error::Check(_) => 1,
+    }
+}
+
+/// How standard output is named in errors.
+pub const STDOUT: &str = "<stdout>";
+
+/// Write text to standard output; an error (a closed pipe, a full disk) is returned, never a panic.
+pub fn print(text: &str) -> Result<()> {
+    let mut out = std::io::stdout().lock();
+    out.write_all(text.as_bytes()).and_then(|_| out.flush()).map_err(|source| Error::Io { file: STDOUT.into(), source })
 }
 
 fn dispatch(cli: Cli) -> Result<()> {
     match cli.command {
         Command::Measure { recipe, geometries, geometry_files, rtol, format, explain, no_timing, output } => {
+            check_rtol(rtol)?;
             let material = recipe::load_file(&recipe)?;
             let geos = resolve_geometries(&geometries, &geometry_files)?;
             let plan = Plan::compile(material.brdf.clone(), geos, PlanOptions { rtol, ..PlanOptions::default() })?;
@@ -133,58 +147,34 @@ fn dispatch(cli: Cli) -> Result<()> {
             Ok(())
         }
         Command::Standards { id } => {
-            match id {
-                None => {
-                    for g in standards::builtin()? {
-                        println!("{}", standards::list_line(&g));
-                    }
-                }
-                Some(id) => println!("{}", standards::describe(&standards::find(&id)?)),
-            }
-            Ok(())
+            let text = match id {
+                None => standards::builtin()?.iter().map(|g| standards::list_line(g) + "\n").collect(),
+                Some(id) => standards::describe(&standards::find(&id)?) + "\n",
+            };
+            print(&text)
         }
         Command::Convergence(args) => convergence::run(args),
         Command::Compare(args) => compare::run(args),
         Command::Schema => {
-            println!("{}", serde_json::to_string_pretty(&recipe::schema::schema()).expect("schema serialises"));
-            Ok(())
+            let text = serde_json::to_string_pretty(&recipe::schema::schema())
+                .map_err(|e| Error::Numeric(format!("the schema does not serialise: {e}")))?;
+            print(&(text + "\n"))
         }
     }
 }
 
-/// Builtin ids and user files, in the order given; the default panel if neither is given.
-pub fn resolve_geometries(ids: &[String], files: &[PathBuf]) -> Result<Vec<standards::StandardGeometry>> {
-    resolve_geometries_or(ids, files, DEFAULT_GEOMETRIES)
-}
-
-/// Builtin ids and user files, in the order given; `defaults` if neither is given.
-pub fn resolve_geometries_or(
-    ids: &[String],
-    files: &[PathBuf],
-    defaults: &[&str],
-) -> Result<Vec<standards::StandardGeometry>> {
-    let mut out = Vec::new();
-    if ids.is_empty() && files.is_empty() {
-        for id in defaults {
-            out.push(standards::find(id)?);
-        }
+/// `--rtol` in (0, 1), checked before any work.
+pub fn check_rtol(rtol: f64) -> Result<()> {
+    if !(rtol.is_finite() && rtol > 0.0 && rtol < 1.0) {
+        return Err(Error::Usage(format!("--rtol must be a number in (0, 1), got {rtol}")));
     }
-    for id in ids {
-        out.push(standards::find(id)?);
-    }
-    for f in files {
-        out.push(standards::load_file(f)?);
-    }
-    Ok(out)
+    Ok(())
 }
 
 /// Write to stdout, or to a new file (never overwriting one).
 pub fn emit(text: &str, output: Option<&Path>) -> Result<()> {
     match output {
-        None => {
-            let mut out = std::io::stdout().lock();
-            out.write_all(text.as_bytes()).map_err(|e| Error::Io { file: "<stdout>".into(), source: e })
-        }
+        None => print(text),
         Some(p) => {
             let file = std::fs::OpenOptions::new().write(true).create_new(true).open(p).map_err(|e| {
                 if e.kind() == std::io::ErrorKind::AlreadyExists {
@@ -200,12 +190,4 @@ pub fn emit(text: &str, output: Option<&Path>) -> Result<()> {
             w.write_all(text.as_bytes()).map_err(|e| Error::Io { file: p.display().to_string(), source: e })
         }
     }
-}
-
-/// Readings as a list, for other modules (e.g. comparisons) that need the engine's output.
-pub fn measure(recipe_path: &Path, ids: &[String], rtol: f64) -> Result<(recipe::Material, Vec<Reading>)> {
-    let material = recipe::load_file(recipe_path)?;
-    let geos = resolve_geometries(ids, &[])?;
-    let plan = Plan::compile(material.brdf.clone(), geos, PlanOptions { rtol, ..PlanOptions::default() })?;
-    Ok((material, plan.execute()))
 }

@@ -148,12 +148,12 @@ pub struct Sweep {
 /// Check a list of tolerances: each finite, in (0, 1). Errors name the offending entry.
 pub fn validate_tolerances(tolerances: &[f64]) -> Result<()> {
     if tolerances.is_empty() {
-        return Err(Error::Usage("--tolerances: at least one tolerance is required".into()));
+        return Err(Error::Usage("at least one tolerance is required".into()));
     }
     for (i, t) in tolerances.iter().enumerate() {
         if !(t.is_finite() && *t > 0.0 && *t < 1.0) {
             return Err(Error::Usage(format!(
-                "--tolerances: entry {} is {t}; every tolerance must be a number in (0, 1), e.g. 1e-2,1e-4,1e-6",
+                "tolerance {} is {t}; every tolerance must be a number in (0, 1), e.g. 1e-2, 1e-4, 1e-6",
                 i + 1
             )));
         }

@@ -166,7 +166,10 @@ impl Plan {
     /// Compile a plan for `material` and the geometries (builtin ids resolved by the caller, or user files).
     pub fn compile(material: Arc<dyn Brdf>, geometries: Vec<StandardGeometry>, options: PlanOptions) -> Result<Plan> {
         if !(options.rtol.is_finite() && options.rtol > 0.0 && options.rtol < 1.0) {
-            return Err(Error::Usage(format!("--rtol must be a number in (0, 1), got {}", options.rtol)));
+            return Err(Error::Usage(format!(
+                "the relative tolerance (rtol) must be a number in (0, 1), got {}",
+                options.rtol
+            )));
         }
         if geometries.is_empty() {
             return Err(Error::Usage("no geometry to measure".into()));

@@ -52,8 +52,11 @@ impl<const D: usize> Default for Rule<D> {
 }
 
 impl<const D: usize> Rule<D> {
+    /// The rule exists for 2 ≤ D ≤ 8 (Genz & Malik 1980); another D is refused at compile time.
+    const DIMENSION_SUPPORTED: () = assert!(D >= 2 && D <= 8, "Genz–Malik needs 2 ≤ D ≤ 8");
+
     pub fn new() -> Self {
-        assert!((2..=8).contains(&D), "Genz–Malik needs 2 ≤ D ≤ 8");
+        let () = Self::DIMENSION_SUPPORTED;
         let d = D as f64;
         let mut points = Vec::new();
         points.push(([0.0; D], 0));

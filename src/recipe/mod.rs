@@ -128,13 +128,13 @@ pub fn parse_brdf(obj: &Obj) -> Result<Arc<dyn Brdf>> {
                     Ior::Dielectric(n) => Complex64::new(*n, 0.0),
                 })
                 .collect();
-            Arc::new(SmoothConductor::new(eta, sampling))
+            Arc::new(SmoothConductor::new(eta, sampling)?)
         }
         "lambert" => {
             obj.deny_unknown(&with_meta(&["albedo"]))?;
             let albedo = colour(obj, "albedo", "albedo")?;
             let sampling = sampling_of(&[&albedo]);
-            Arc::new(Lambert::new(albedo.expand(&sampling), sampling))
+            Arc::new(Lambert::new(albedo.expand(&sampling), sampling)?)
         }
         "microfacet" => {
             obj.deny_unknown(&with_meta(&["distribution", "roughness", "ior", "shadowing"]))?;
@@ -143,7 +143,7 @@ pub fn parse_brdf(obj: &Obj) -> Result<Arc<dyn Brdf>> {
             let shadowing = shadowing(obj)?;
             let ior = parse_ior(obj, "ior", true)?;
             let sampling = if ior.len() == 3 { Sampling::rgb() } else { Sampling::grey() };
-            Arc::new(MicrofacetSurface::new(Microfacet::new(distribution, alpha), shadowing, ior, sampling))
+            Arc::new(MicrofacetSurface::new(Microfacet::new(distribution, alpha), shadowing, ior, sampling)?)
         }
         "phong" | "blinn-phong" => {
             obj.deny_unknown(&with_meta(&["exponent", "kd", "ks"]))?;
@@ -154,7 +154,7 @@ pub fn parse_brdf(obj: &Obj) -> Result<Arc<dyn Brdf>> {
             let sampling = sampling_of(&[&kd, &ks]);
             let (kd, ks) = (kd.expand(&sampling), ks.expand(&sampling));
             energy_check(obj, "ks", &kd, &[&ks], "kd + ks")?;
-            Arc::new(Phong::new(variant, n, kd, ks, sampling))
+            Arc::new(Phong::new(variant, n, kd, ks, sampling)?)
         }
         "ward" => {
             obj.deny_unknown(&with_meta(&["alpha", "rho_d", "rho_s"]))?;
@@ -164,7 +164,7 @@ pub fn parse_brdf(obj: &Obj) -> Result<Arc<dyn Brdf>> {
             let sampling = sampling_of(&[&rho_d, &rho_s]);
             let (rho_d, rho_s) = (rho_d.expand(&sampling), rho_s.expand(&sampling));
             energy_check(obj, "rho_s", &rho_d, &[&rho_s], "rho_d + rho_s")?;
-            Arc::new(Ward::new(rho_d, rho_s, alpha, sampling))
+            Arc::new(Ward::new(rho_d, rho_s, alpha, sampling)?)
         }
         "cook-torrance-lobes" => parse_lobes(obj)?,
         "merl" => measured::parse_merl(obj)?,
@@ -345,5 +345,5 @@ fn parse_lobes(obj: &Obj) -> Result<Arc<dyn Brdf>> {
         .collect();
     let ks: Vec<&Vec<f64>> = lobes.iter().map(|l| &l.ks).collect();
     energy_check(obj, "lobes", &kd, &ks, "Kd + Σ Ks")?;
-    Ok(Arc::new(CookTorranceLobes::new(kd, lobes, shadowing, sampling)))
+    Ok(Arc::new(CookTorranceLobes::new(kd, lobes, shadowing, sampling)?))
 }
