@@ -5,10 +5,11 @@
 //!
 //! ```
 //! use glossmeter::{measure, recipe, resolve_geometries, PlanOptions};
-//! let material = recipe::parse_str(r#"{"model": "smooth-dielectric", "ior": 1.5}"#, "<inline>").unwrap();
+//! let material = recipe::parse_str(r#"{"model": "smooth-dielectric", "ior": 1.567}"#, "<inline>").unwrap();
 //! let geometries = resolve_geometries(&["astm-d523-60"], &[] as &[&str]).unwrap();
 //! let readings = measure(&material, &geometries, &PlanOptions::default()).unwrap();
-//! assert!((readings[0].value.unwrap() - 100.0).abs() < 1e-3); // n = 1.5 glass is the 60° standard
+//! // Glass of the standard's own index (1.567) reads 100 GU.
+//! assert!((readings[0].value.unwrap() - 100.0).abs() < 1e-6);
 //! ```
 use std::path::Path;
 
