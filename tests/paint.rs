@@ -6,7 +6,7 @@
 use glossmeter::brdf::albedo::directional_albedo;
 use glossmeter::brdf::paint::{
     internal_diffuse_reflectance, ClearCoat, Form, MetallicFlakes, Paint, PaintSpec, PearlescentFlakes, Pigment,
-    PigmentedLayer, MAX_SAMPLES,
+    PigmentedLayer, Spread, MAX_SAMPLES,
 };
 use glossmeter::brdf::{Brdf, TermKind};
 use glossmeter::optics::microfacet::Distribution;
@@ -25,7 +25,8 @@ use std::sync::Arc;
 // Helpers
 // ---------------------------------------------------------------------------------------------------------
 
-const FIXTURES: [&str; 3] = ["cerulean-blue-a", "cerulean-blue-b", "cerulean-blue-c"];
+const FIXTURES: [&str; 5] =
+    ["cerulean-blue-a", "cerulean-blue-b", "cerulean-blue-c", "cerulean-blue-b-literal", "cerulean-blue-c-literal"];
 
 fn fixture_json(name: &str) -> Value {
     let file = format!("{}/fixtures/recipes/{name}.json", env!("CARGO_MANIFEST_DIR"));
@@ -217,12 +218,12 @@ fn rgb_spec(eta: f64, x: f64, rg: [f64; 3], k: [f64; 3], s: [f64; 3]) -> PaintSp
 }
 
 fn metal(spread_deg: f64, area: f64, depth: f64) -> MetallicFlakes {
-    MetallicFlakes { n: vec![0.93; 3], k: vec![6.33; 3], spread_deg, area_ratio: area, depth_mm: depth }
+    MetallicFlakes { n: vec![0.93; 3], k: vec![6.33; 3], spread: Spread::Degrees(spread_deg), area_ratio: area, depth_mm: depth }
 }
 
 fn pearl(spread_deg: f64, area: f64, depth: f64) -> PearlescentFlakes {
     PearlescentFlakes {
-        spread_deg,
+        spread: Spread::Degrees(spread_deg),
         area_ratio: area,
         depth_mm: depth,
         tio2_thickness_nm: 135.0,
@@ -298,9 +299,13 @@ fn fixture_terms_list_only_what_the_recipe_has() {
     let c = load("cerulean-blue-c");
     let lobes = c.lobes();
     assert_eq!(lobes.len(), 2);
-    assert!((lobes[0].slope_width - 0.25f64.to_radians().tan()).abs() < 1e-15);
-    assert!((lobes[1].slope_width - 0.35f64.to_radians().tan()).abs() < 1e-15);
+    // spread_slope is the Beckmann slope itself; spread_deg is read as m = tan σ.
+    assert_eq!(lobes[0].slope_width, 0.25);
+    assert_eq!(lobes[1].slope_width, 0.35);
     assert!(lobes.iter().all(|l| l.medium_eta == 1.5));
+    let lit = load("cerulean-blue-c-literal").lobes();
+    assert!((lit[0].slope_width - 0.25f64.to_radians().tan()).abs() < 1e-15);
+    assert!((lit[1].slope_width - 0.35f64.to_radians().tan()).abs() < 1e-15);
 }
 
 #[test]
@@ -835,6 +840,26 @@ fn bad_recipes_are_refused_with_the_field_path() {
             &["metallic_flakes.spread", "unknown field", "spread_deg"],
         ),
         (
+            "both spread_deg and spread_slope",
+            |v| v["metallic_flakes"]["spread_slope"] = json!(0.25),
+            &["metallic_flakes.spread_slope", "exactly one of", "not both"],
+        ),
+        (
+            "neither spread_deg nor spread_slope",
+            |v| {
+                v["metallic_flakes"].as_object_mut().unwrap().remove("spread_deg");
+            },
+            &["metallic_flakes.spread_deg", "missing", "exactly one of"],
+        ),
+        (
+            "spread_slope out of range",
+            |v| {
+                v["metallic_flakes"].as_object_mut().unwrap().remove("spread_deg");
+                v["metallic_flakes"]["spread_slope"] = json!(2.5);
+            },
+            &["metallic_flakes.spread_slope", "out of range", "1.732"],
+        ),
+        (
             "X' > X",
             |v| v["metallic_flakes"]["depth_mm"] = json!(0.2),
             &["metallic_flakes.depth_mm", "deeper than the pigmented layer"],
@@ -877,7 +902,7 @@ fn bad_recipes_are_refused_with_the_field_path() {
         ("negative area ratio", |v| v["metallic_flakes"]["area_ratio"] = json!(-0.1), &["metallic_flakes.area_ratio"]),
     ];
     for (what, edit, needles) in cases {
-        let mut v = fixture_json("cerulean-blue-c");
+        let mut v = fixture_json("cerulean-blue-c-literal");
         edit(&mut v);
         let e = from_json(&v).expect_err(what).to_string();
         assert!(e.starts_with("test.json"), "{what}: {e}");

@@ -90,18 +90,49 @@ pub struct MetallicFlakes {
     /// Complex index n + ik of the metal per spectral sample.
     pub n: Vec<f64>,
     pub k: Vec<f64>,
-    /// Orientation spread σ in degrees; the Beckmann rms slope is m = tan σ.
-    pub spread_deg: f64,
+    /// Orientation spread: an angle σ (m = tan σ) or the Beckmann rms slope m itself.
+    pub spread: Spread,
     /// Visible area ratio Am.
     pub area_ratio: f64,
     /// Mean depth X' of the visible flakes in mm (0 ≤ X' ≤ X).
     pub depth_mm: f64,
 }
 
+/// How a recipe gives the flake orientation spread (`docs/model.md` §Two readings of the flake spread).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Spread {
+    /// `spread_deg`: an angle σ in degrees, read as the tilt whose tangent is the Beckmann rms slope, m = tan σ.
+    Degrees(f64),
+    /// `spread_slope`: the Cook–Torrance / Beckmann rms slope m itself (dimensionless).
+    Slope(f64),
+}
+
+impl Spread {
+    /// Largest accepted spread angle in degrees, and the slope it corresponds to (tan 60° = 1.732).
+    pub const MAX_DEG: f64 = 60.0;
+    pub const MAX_SLOPE: f64 = 1.732;
+
+    /// The Beckmann rms slope m.
+    pub fn slope(self) -> f64 {
+        match self {
+            Spread::Degrees(d) => spread_to_slope(d),
+            Spread::Slope(m) => m,
+        }
+    }
+
+    fn check(self, what: &str) -> Result<()> {
+        match self {
+            Spread::Degrees(d) => check_range(&format!("{what} spread (deg)"), d, 0.0, Self::MAX_DEG),
+            Spread::Slope(m) => check_range(&format!("{what} spread slope"), m, 0.0, Self::MAX_SLOPE),
+        }
+    }
+}
+
 /// Pearlescent flakes: TiO2 / mica / TiO2 platelets embedded in the resin.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PearlescentFlakes {
-    pub spread_deg: f64,
+    /// Orientation spread: an angle σ (m = tan σ) or the Beckmann rms slope m itself.
+    pub spread: Spread,
     /// Visible area ratio Ap.
     pub area_ratio: f64,
     /// Mean depth X'' of the visible flakes in mm (0 ≤ X'' ≤ X).
@@ -315,12 +346,12 @@ impl Paint {
         if let Some(m) = &spec.metallic {
             check_spectral("metallic flake n", &m.n, n, 1e-3, 100.0)?;
             check_spectral("metallic flake k", &m.k, n, 0.0, 100.0)?;
-            check_range("metallic flake spread (deg)", m.spread_deg, 0.0, 60.0)?;
+            m.spread.check("metallic flake")?;
             check_range("metallic flake area ratio", m.area_ratio, 0.0, 1.0)?;
             check_range("metallic flake depth (mm)", m.depth_mm, 0.0, l.thickness_mm)?;
         }
         if let Some(p) = &spec.pearlescent {
-            check_range("pearlescent flake spread (deg)", p.spread_deg, 0.0, 60.0)?;
+            p.spread.check("pearlescent flake")?;
             check_range("pearlescent flake area ratio", p.area_ratio, 0.0, 1.0)?;
             check_range("pearlescent flake depth (mm)", p.depth_mm, 0.0, l.thickness_mm)?;
             check_range("TiO2 thickness (nm)", p.tio2_thickness_nm, 0.0, 1e5)?;
@@ -359,8 +390,8 @@ impl Paint {
             (c.roughness >= Microfacet::SMOOTH_THRESHOLD).then(|| Microfacet::new(c.distribution, c.roughness));
         let cover =
             |depth: f64| -> Vec<Layer> { (0..n).map(|j| kubelka_munk::layer(k_mix[j], s_mix[j], depth)).collect() };
-        let flake = |label, spread_deg: f64, area, depth, optics| {
-            let facets = Microfacet::new(Distribution::Beckmann, spread_to_slope(spread_deg));
+        let flake = |label, spread: Spread, area, depth, optics| {
+            let facets = Microfacet::new(Distribution::Beckmann, spread.slope());
             let mut term = FlakeTerm {
                 label,
                 area,
@@ -375,7 +406,7 @@ impl Paint {
         };
         let metallic = spec.metallic.as_ref().filter(|m| m.area_ratio > 0.0).map(|m| {
             let rel = (0..n).map(|j| Complex64::new(m.n[j], m.k[j]) / eta).collect();
-            flake("metallic flakes", m.spread_deg, m.area_ratio, m.depth_mm, FlakeOptics::Metal(rel))
+            flake("metallic flakes", m.spread, m.area_ratio, m.depth_mm, FlakeOptics::Metal(rel))
         });
         let pearlescent = spec.pearlescent.as_ref().filter(|p| p.area_ratio > 0.0).map(|p| {
             let tio2 =
@@ -383,7 +414,7 @@ impl Paint {
             let mica =
                 FilmLayer { n: Complex64::new(p.mica_index, 0.0), thickness_nm: p.mica_thickness_nm, coherent: false };
             let optics = FlakeOptics::Pearl { layers: [tio2, mica, tio2], medium: eta };
-            flake("pearlescent flakes", p.spread_deg, p.area_ratio, p.depth_mm, optics)
+            flake("pearlescent flakes", p.spread, p.area_ratio, p.depth_mm, optics)
         });
         Ok(Paint { spec, body_weight, r_l, body, r_e, r_i, rough_coat, metallic, pearlescent })
     }

@@ -3,7 +3,7 @@
 //! the file, the field and what is allowed; [`Paint::new`] re-checks the same constraints for callers that
 //! build a [`PaintSpec`] in code.
 use crate::brdf::paint::{
-    ClearCoat, Form, MetallicFlakes, Paint, PaintSpec, PearlescentFlakes, Pigment, PigmentedLayer, MAX_SAMPLES,
+    ClearCoat, Form, MetallicFlakes, Paint, PaintSpec, PearlescentFlakes, Pigment, PigmentedLayer, Spread, MAX_SAMPLES,
 };
 use crate::brdf::Brdf;
 use crate::optics::kubelka_munk::invert_white_black;
@@ -177,19 +177,20 @@ fn parse_measured(m: &Obj, n: usize) -> Result<(Vec<f64>, Vec<f64>)> {
 }
 
 fn parse_metallic(o: &Obj, n: usize, x: f64) -> Result<MetallicFlakes> {
-    o.deny_unknown(&["n", "k", "spread_deg", "area_ratio", "depth_mm", "notes"])?;
+    o.deny_unknown(&["n", "k", "spread_deg", "spread_slope", "area_ratio", "depth_mm", "notes"])?;
     notes(o)?;
     let nn = spectral_or_scalar(o, "n", n, 1e-3, 100.0, "real part n of the metal's index")?;
     let kk = spectral_or_scalar(o, "k", n, 0.0, 100.0, "extinction k of the metal's index")?;
-    let spread_deg = o.num("spread_deg", 0.0, 60.0, "flake orientation spread in degrees (m = tan σ)")?;
+    let spread = spread(o)?;
     let area_ratio = o.num("area_ratio", 0.0, 1.0, "visible area ratio Am")?;
     let depth_mm = depth(o, x, "mean depth X' of the visible metallic flakes in mm")?;
-    Ok(MetallicFlakes { n: nn, k: kk, spread_deg, area_ratio, depth_mm })
+    Ok(MetallicFlakes { n: nn, k: kk, spread, area_ratio, depth_mm })
 }
 
 fn parse_pearl(o: &Obj, x: f64) -> Result<PearlescentFlakes> {
     o.deny_unknown(&[
         "spread_deg",
+        "spread_slope",
         "area_ratio",
         "depth_mm",
         "tio2_thickness_nm",
@@ -200,7 +201,7 @@ fn parse_pearl(o: &Obj, x: f64) -> Result<PearlescentFlakes> {
     ])?;
     notes(o)?;
     Ok(PearlescentFlakes {
-        spread_deg: o.num("spread_deg", 0.0, 60.0, "flake orientation spread in degrees (m = tan σ)")?,
+        spread: spread(o)?,
         area_ratio: o.num("area_ratio", 0.0, 1.0, "visible area ratio Ap")?,
         depth_mm: depth(o, x, "mean depth X'' of the visible pearlescent flakes in mm")?,
         tio2_thickness_nm: o.num("tio2_thickness_nm", 0.0, 1e5, "TiO2 film thickness in nm")?,
@@ -208,6 +209,33 @@ fn parse_pearl(o: &Obj, x: f64) -> Result<PearlescentFlakes> {
         mica_thickness_nm: o.num("mica_thickness_nm", 0.0, 1e6, "mica platelet thickness in nm")?,
         mica_index: o.opt_num("mica_index", 1.0, 3.0, "mica refractive index")?.unwrap_or(DEFAULT_MICA_INDEX),
     })
+}
+
+/// The flake spread: exactly one of `spread_deg` (an angle σ, m = tan σ) and `spread_slope` (the Beckmann rms
+/// slope m); `docs/model.md` §Two readings of the flake spread.
+fn spread(o: &Obj) -> Result<Spread> {
+    match (o.get("spread_deg").is_some(), o.get("spread_slope").is_some()) {
+        (true, false) => Ok(Spread::Degrees(o.num(
+            "spread_deg",
+            0.0,
+            Spread::MAX_DEG,
+            "flake orientation spread in degrees (m = tan σ)",
+        )?)),
+        (false, true) => Ok(Spread::Slope(o.num(
+            "spread_slope",
+            0.0,
+            Spread::MAX_SLOPE,
+            "flake orientation spread as the Beckmann rms slope m (dimensionless)",
+        )?)),
+        (true, true) => Err(o.err(
+            "spread_slope",
+            "give exactly one of `spread_deg` (an angle in degrees, m = tan σ) and `spread_slope` (the Beckmann rms slope m), not both",
+        )),
+        (false, false) => Err(o.err(
+            "spread_deg",
+            "missing: give exactly one of `spread_deg` (an angle in degrees, 0–60, m = tan σ) and `spread_slope` (the Beckmann rms slope m, 0–1.732)",
+        )),
+    }
 }
 
 fn depth(o: &Obj, x: f64, what: &str) -> Result<f64> {

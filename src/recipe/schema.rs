@@ -39,6 +39,13 @@ fn object(props: Value, required: &[&str]) -> Value {
     json!({"type": "object", "properties": props, "required": required, "additionalProperties": false})
 }
 
+/// [`object`] with a `oneOf` constraint (e.g. exactly one of two alternative fields).
+fn object_with(props: Value, required: &[&str], one_of: Value) -> Value {
+    let mut o = object(props, required);
+    o["oneOf"] = one_of;
+    o
+}
+
 /// The schema of a recipe file.
 pub fn schema() -> Value {
     let colour = json!({"$ref": "#/$defs/colour"});
@@ -48,6 +55,9 @@ pub fn schema() -> Value {
     let numbers = json!({"type": "array", "items": {"type": "number"}});
     let num_or_numbers = json!({"oneOf": [{"type": "number"}, {"type": "array", "items": {"type": "number"}}]});
     let notes = json!({"$ref": "#/$defs/notes"});
+    let spread_deg = range(0.0, 60.0, "flake orientation spread as an angle σ in degrees (m = tan σ)");
+    let spread_slope = range(0.0, 1.732, "flake orientation spread as the Beckmann rms slope m (dimensionless)");
+    let one_spread = json!([{"required": ["spread_deg"]}, {"required": ["spread_slope"]}]);
 
     let paint = model(
         "paint",
@@ -96,23 +106,26 @@ pub fn schema() -> Value {
             ),
             (
                 "metallic_flakes",
-                object(
+                object_with(
                     json!({
                         "n": num_or_numbers,
                         "k": num_or_numbers,
-                        "spread_deg": range(0.0, 60.0, "flake orientation spread in degrees"),
+                        "spread_deg": spread_deg.clone(),
+                        "spread_slope": spread_slope.clone(),
                         "area_ratio": range(0.0, 1.0, "visible area ratio"),
                         "depth_mm": {"type": "number", "minimum": 0},
                         "notes": notes
                     }),
-                    &["n", "k", "spread_deg", "area_ratio", "depth_mm"],
+                    &["n", "k", "area_ratio", "depth_mm"],
+                    one_spread.clone(),
                 ),
             ),
             (
                 "pearlescent_flakes",
-                object(
+                object_with(
                     json!({
-                        "spread_deg": range(0.0, 60.0, "flake orientation spread in degrees"),
+                        "spread_deg": spread_deg,
+                        "spread_slope": spread_slope,
                         "area_ratio": range(0.0, 1.0, "visible area ratio"),
                         "depth_mm": {"type": "number", "minimum": 0},
                         "tio2_thickness_nm": range(0.0, 1e5, "TiO2 film thickness in nm"),
@@ -121,7 +134,8 @@ pub fn schema() -> Value {
                         "mica_index": range(1.0, 3.0, "mica refractive index"),
                         "notes": notes
                     }),
-                    &["spread_deg", "area_ratio", "depth_mm", "tio2_thickness_nm", "mica_thickness_nm"],
+                    &["area_ratio", "depth_mm", "tio2_thickness_nm", "mica_thickness_nm"],
+                    one_spread,
                 ),
             ),
         ],
