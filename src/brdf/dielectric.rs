@@ -126,6 +126,7 @@ pub(crate) fn describe_facets(f: &Microfacet) -> String {
 pub(crate) fn describe_shadowing(s: Shadowing) -> &'static str {
     match s {
         Shadowing::SmithHeightCorrelated => "Smith height-correlated",
+        Shadowing::SmithSeparable => "Smith separable (G1·G1)",
         Shadowing::VCavity => "V-cavity",
     }
 }

@@ -25,6 +25,10 @@ pub enum Distribution {
 pub enum Shadowing {
     /// Smith, height-correlated: G = 1 / (1 + Λ(ωi) + Λ(ωo)) (Heitz 2014, Eq. 99). The default.
     SmithHeightCorrelated,
+    /// Smith, separable (uncorrelated): G = G1(ωi)·G1(ωo) = 1 / ((1 + Λ(ωi))(1 + Λ(ωo))) (Heitz 2014, Eq. 98;
+    /// Walter et al. 2007, Eq. 23). What Mitsuba 3 (`microfacet.h`, `G`) and most renderers evaluate; it is
+    /// ≤ the height-correlated form, so it reads less at grazing angles (`docs/optics.md` §4).
+    SmithSeparable,
     /// Cook & Torrance (1982) V-cavity: G = min(1, 2 cosθh cosθo / (ωo·h), 2 cosθh cosθi / (ωi·h)).
     VCavity,
 }
@@ -152,6 +156,7 @@ impl Microfacet {
     /// Masking-shadowing G(ωi, ωo) for the half vector `h` under the chosen shadowing model.
     ///
     /// * Smith height-correlated (Heitz 2014 Eq. 99): G = χ⁺(ωi·h) χ⁺(ωo·h) / (1 + Λ(ωi) + Λ(ωo)).
+    /// * Smith separable (Heitz 2014 Eq. 98): G = χ⁺(ωi·h) χ⁺(ωo·h) G1(ωi) G1(ωo).
     /// * V-cavity (Cook & Torrance 1982): G = min(1, 2 cosθh cosθo/(ωo·h), 2 cosθh cosθi/(ωi·h)), with
     ///   the same back-facing test (0 if ωi·h ≤ 0 or ωo·h ≤ 0). `h` need not be normalised (it is).
     ///
@@ -169,6 +174,8 @@ impl Microfacet {
         match shadowing {
             // Λi + Λo first: IEEE addition is commutative, so G is bitwise symmetric.
             Shadowing::SmithHeightCorrelated => 1.0 / (1.0 + (self.lambda_in_g(wi) + self.lambda_in_g(wo))),
+            // Multiplication is commutative in IEEE arithmetic too: bitwise symmetric.
+            Shadowing::SmithSeparable => 1.0 / ((1.0 + self.lambda_in_g(wi)) * (1.0 + self.lambda_in_g(wo))),
             Shadowing::VCavity => {
                 let k = 2.0 * h.z;
                 (k * wo.z / oh).min(k * wi.z / ih).min(1.0)
@@ -330,14 +337,17 @@ mod tests {
                 for (k, &wi) in dirs.iter().enumerate() {
                     for &wo in dirs.iter().skip(k % 5).step_by(5) {
                         let h = wi + wo;
-                        for sh in [Shadowing::SmithHeightCorrelated, Shadowing::VCavity] {
+                        for sh in [Shadowing::SmithHeightCorrelated, Shadowing::SmithSeparable, Shadowing::VCavity] {
                             let g = m.g(wi, wo, h, sh);
                             assert!((0.0..=1.0).contains(&g), "{g}");
                             assert_eq!(g, m.g(wo, wi, h, sh), "symmetry {sh:?}");
                             assert_eq!(m.g(wi, wo, -h, sh), 0.0);
                         }
                         let gs = m.g(wi, wo, h, Shadowing::SmithHeightCorrelated);
-                        assert!(gs >= m.g1(wi) * m.g1(wo) - 1e-15);
+                        let gsep = m.g(wi, wo, h, Shadowing::SmithSeparable);
+                        assert!(gs >= gsep - 1e-15, "{gs} < {gsep}");
+                        // The separable form is the plain product of the masking functions (Heitz Eq. 98).
+                        assert!((gsep - m.g1(wi) * m.g1(wo)).abs() <= 1e-15, "{gsep}");
                     }
                 }
                 // V-cavity at the specular configuration h = n: min(1, 2cosθ/cosθ) = 1.

@@ -308,10 +308,11 @@ fn distribution(obj: &Obj, required: bool) -> Result<Distribution> {
 fn shadowing(obj: &Obj) -> Result<Shadowing> {
     match obj.opt_str("shadowing")? {
         None | Some("smith") => Ok(Shadowing::SmithHeightCorrelated),
+        Some("smith-separable") => Ok(Shadowing::SmithSeparable),
         Some("v-cavity") => Ok(Shadowing::VCavity),
         Some(other) => Err(obj.err(
             "shadowing",
-            format!("unknown shadowing \"{other}\"; allowed: \"smith\" (height-correlated, the default), \"v-cavity\""),
+            format!("unknown shadowing \"{other}\"; allowed: \"smith\" (height-correlated, the default), \"smith-separable\" (G1·G1, as Mitsuba 3), \"v-cavity\""),
         )),
     }
 }

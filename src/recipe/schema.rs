@@ -51,7 +51,7 @@ pub fn schema() -> Value {
     let colour = json!({"$ref": "#/$defs/colour"});
     let roughness = range(ROUGHNESS.0, ROUGHNESS.1, "Beckmann rms slope m or GGX α (dimensionless); 0 = smooth");
     let distribution = json!({"enum": ["beckmann", "ggx"]});
-    let shadowing = json!({"enum": ["smith", "v-cavity"], "default": "smith"});
+    let shadowing = json!({"enum": ["smith", "smith-separable", "v-cavity"], "default": "smith"});
     let numbers = json!({"type": "array", "items": {"type": "number"}});
     let num_or_numbers = json!({"oneOf": [{"type": "number"}, {"type": "array", "items": {"type": "number"}}]});
     let notes = json!({"$ref": "#/$defs/notes"});
