@@ -14,9 +14,18 @@ use crate::{Error, Result};
 pub const ILLUMINANT_C_CSV: &str = include_str!("../standards/cie/illuminant-c.csv");
 pub const YBAR_CSV: &str = include_str!("../standards/cie/cie1931-ybar.csv");
 
-/// Luminance weights of linear RGB: the Y row of the sRGB / ITU-R BT.709 RGB→XYZ matrix (IEC 61966-2-1:1999,
-/// ITU-R BT.709-6 Item 1.4: Y = 0.2126 R + 0.7152 G + 0.0722 B).
-pub const RGB_LUMINANCE_WEIGHTS: [f64; 3] = [0.2126, 0.7152, 0.0722];
+/// Luminance weights of the RGB samples. The samples *are* the CIE 1931 RGB primaries ([`RGB_WAVELENGTHS_NM`]),
+/// so they are weighted by those primaries' luminances: the Y row of the CIE 1931 RGB→XYZ matrix,
+/// Y = 0.17697 R + 0.81240 G + 0.01063 B (CIE 1931; CIE 15:2004 §3; the luminance ratio 1 : 4.5907 : 0.0601 of
+/// Wright–Guild's primaries, Wyszecki & Stiles, *Color Science*, 2nd ed., §3.3.2). They sum to 1, so a grey
+/// material's reading does not depend on them. (Until issue 9 these were the sRGB / BT.709 weights
+/// 0.2126/0.7152/0.0722, which belong to different primaries; `docs/model.md` §Spectral gives the effect.)
+pub const RGB_LUMINANCE_WEIGHTS: [f64; 3] = [0.17697, 0.81240, 0.01063];
+
+/// Relative radiant powers of the CIE 1931 RGB primaries that match the equal-energy white, 72.0962 : 1.3791 : 1
+/// (Wyszecki & Stiles, *Color Science*, 2nd ed., §3.3.2). Their products with ȳ at the primaries' wavelengths
+/// are the luminances behind [`RGB_LUMINANCE_WEIGHTS`] (test `rgb_weights_are_the_cie_primaries_luminances`).
+pub const CIE_RGB_RADIANT_POWER_RATIOS: [f64; 3] = [72.0962, 1.3791, 1.0];
 
 /// Wavelengths at which an RGB material's wavelength-dependent optics (thin-film interference) are evaluated:
 /// the CIE 1931 RGB primaries 700 nm, 546.1 nm and 435.8 nm (CIE 15:2004 §3.1 / Wright–Guild primaries).
@@ -118,7 +127,7 @@ impl Sampling {
     pub fn describe(&self) -> String {
         match self.kind {
             SamplingKind::Grey => "grey (one sample)".to_string(),
-            SamplingKind::Rgb => "RGB (3 samples; luminance weights 0.2126/0.7152/0.0722)".to_string(),
+            SamplingKind::Rgb => "RGB (3 samples at the CIE 1931 primaries; luminance weights 0.17697/0.81240/0.01063)".to_string(),
             SamplingKind::Spectral => format!(
                 "spectral, {} samples {}–{} nm (weights CIE illuminant C × ȳ)",
                 self.len(),
@@ -196,6 +205,27 @@ mod tests {
             eprintln!("{}: ours {ours}, colour-science {y}, difference {:e}", case["name"], ours - y);
             assert!((ours - y).abs() < 1e-6, "{}: {ours} vs colour-science {y}", case["name"]);
         }
+    }
+
+    /// The RGB weights are the luminances of the CIE 1931 primaries: radiant power ratio × ȳ(λ) at 700, 546.1
+    /// and 435.8 nm, ȳ interpolated from the embedded 5 nm table (≈ 0.5 % off the 1 nm values at 435.8 nm,
+    /// hence the tolerance), normalised. Independent of the constants' source: only ȳ and the power ratios.
+    #[test]
+    fn rgb_weights_are_the_cie_primaries_luminances() {
+        let ybar = parse_table(YBAR_CSV, "ybar").unwrap();
+        let lum: Vec<f64> = (0..3)
+            .map(|k| CIE_RGB_RADIANT_POWER_RATIOS[k] * interp(&ybar, RGB_WAVELENGTHS_NM[k]).unwrap())
+            .collect();
+        let total: f64 = lum.iter().sum();
+        for k in 0..3 {
+            let w = lum[k] / total;
+            let rel = (w - RGB_LUMINANCE_WEIGHTS[k]).abs() / RGB_LUMINANCE_WEIGHTS[k];
+            assert!(rel < 6e-3, "primary {k}: ȳ-derived weight {w} vs {}", RGB_LUMINANCE_WEIGHTS[k]);
+        }
+        // The luminance ratio of the primaries, 1 : 4.5907 : 0.0601 (CIE 1931).
+        let w = RGB_LUMINANCE_WEIGHTS;
+        assert!((w[1] / w[0] - 4.5907).abs() < 1e-3 && (w[2] / w[0] - 0.0601).abs() < 1e-4);
+        assert_eq!(Sampling::rgb().luminous_weights, w.to_vec());
     }
 
     #[test]
