@@ -114,13 +114,13 @@ fn gloss_standard_reads_100_and_dielectric_15_reads_aperture_averaged_values() {
     let _ = Axes::new(0.1);
     for (id, expect_15) in [("astm-d523-20", 82.05), ("astm-d523-60", 89.14), ("astm-d523-85", 98.97)] {
         let g = geometry(id);
-        let std = gloss_of(Arc::new(TestMirror(Some(g.reference_index), Sampling::grey())), id, 1e-9);
+        let std = gloss_of(Arc::new(TestMirror(Some(g.scale.black_glass_index().unwrap()), Sampling::grey())), id, 1e-9);
         assert!((std.value.unwrap() - 100.0).abs() < 1e-9, "{id}: standard reads {:?}", std.value);
         let r = gloss_of(Arc::new(TestMirror(Some(1.5), Sampling::grey())), id, 1e-9);
         let v = r.value.unwrap();
         let rec = g.receptor("gloss").copied().unwrap();
         let reference = 100.0 * mirror_flux_reference(g.theta, g.source, rec, &|c| fr_dielectric(c, 1.5))
-            / mirror_flux_reference(g.theta, g.source, rec, &|c| fr_dielectric(c, g.reference_index));
+            / mirror_flux_reference(g.theta, g.source, rec, &|c| fr_dielectric(c, g.scale.black_glass_index().unwrap()));
         assert!((v - reference).abs() < 1e-9 * reference, "{id}: {v} vs independent {reference}");
         assert!(
             (v - reference).abs() <= r.error_estimate.max(1e-12),
@@ -131,7 +131,7 @@ fn gloss_standard_reads_100_and_dielectric_15_reads_aperture_averaged_values() {
         assert!((v - expect_15).abs() < 0.01, "{id}: {v} vs about {expect_15}");
         let mirror = gloss_of(Arc::new(TestMirror(None, Sampling::grey())), id, 1e-9).value.unwrap();
         let reference = 100.0 * mirror_flux_reference(g.theta, g.source, rec, &|_| 1.0)
-            / mirror_flux_reference(g.theta, g.source, rec, &|c| fr_dielectric(c, g.reference_index));
+            / mirror_flux_reference(g.theta, g.source, rec, &|c| fr_dielectric(c, g.scale.black_glass_index().unwrap()));
         assert!((mirror - reference).abs() < 1e-9 * reference, "{id}: mirror {mirror} vs {reference}");
     }
 }
@@ -147,7 +147,7 @@ fn perfect_mirror_reads_about_2038_999_162() {
 #[test]
 fn delta_limit_of_a_narrow_lobe_is_reached_monotonically() {
     for id in ["astm-d523-20", "astm-d523-60", "astm-d523-85"] {
-        let n = geometry(id).reference_index;
+        let n = geometry(id).scale.black_glass_index().unwrap();
         let smooth = gloss_of(Arc::new(TestMirror(Some(n), Sampling::grey())), id, 1e-10).value.unwrap();
         let mut last_gap = f64::INFINITY;
         for m in [1e-2, 1e-3, 1e-4, 1e-5, 1e-6] {
@@ -187,4 +187,24 @@ fn haze_index_alone_or_first_is_g60_minus_g20() {
     let h = g("astm-d4039");
     assert_eq!(h.to_bits(), alone[0].value.unwrap().to_bits());
     assert_eq!(h, g("astm-d523-60") - g("astm-d523-20"));
+}
+
+/// Issue 9 item 1: the 45° geometry is on C346's mirror scale (reflectance × 1000), so polished black glass of
+/// n = 1.540 reads 55.9 GU as on real 45° meters (BYK micro-gloss 45°), and a perfect mirror reads 1000.
+/// The reference is 1000 × the aperture-averaged Fresnel reflectance (Gauss–Legendre, no shared code).
+#[test]
+fn d2457_45_reads_on_the_mirror_scale() {
+    let id = "astm-d2457-45";
+    let g = geometry(id);
+    assert_eq!(g.scale, glossmeter::instrument::geometry::Scale::Mirror { value: 1000.0 });
+    let r = gloss_of(Arc::new(TestMirror(Some(1.54), Sampling::grey())), id, 1e-9);
+    let v = r.value.unwrap();
+    assert!((v - 55.9).abs() <= 0.1, "n = 1.540 glass reads {v} at 45°, want 55.9 ± 0.1");
+    let rec = g.receptor("gloss").copied().unwrap();
+    let reference = 1000.0 * mirror_flux_reference(g.theta, g.source, rec, &|c| fr_dielectric(c, 1.54))
+        / mirror_flux_reference(g.theta, g.source, rec, &|_| 1.0);
+    assert!((v - reference).abs() < 1e-9 * reference, "{v} vs {reference}");
+    assert!((v - 1000.0 * fr_dielectric(45f64.to_radians().cos(), 1.54)).abs() < 0.05, "{v}");
+    let mirror = gloss_of(Arc::new(TestMirror(None, Sampling::grey())), id, 1e-9).value.unwrap();
+    assert!((mirror - 1000.0).abs() < 1e-6, "a perfect mirror reads {mirror}");
 }

@@ -16,7 +16,7 @@ use std::sync::Arc;
 use glossmeter::brdf::albedo::directional_albedo;
 use glossmeter::brdf::{Brdf, TermKind};
 use glossmeter::instrument::flux::{FluxProblem, Spectral};
-use glossmeter::instrument::geometry::{Geometry, ReadingSpec, Stop};
+use glossmeter::instrument::geometry::{Geometry, ReadingSpec, Scale, Stop};
 use glossmeter::instrument::plan::{Plan, PlanOptions, Reading};
 use glossmeter::instrument::standards::{self, StandardGeometry};
 use glossmeter::optics::microfacet::Microfacet;
@@ -268,9 +268,16 @@ fn reference_reading(
 /// order `Plan::execute` reports them.
 fn references(gs: &[StandardGeometry], specimen: &dyn Fn(&Geometry, Stop) -> f64) -> Vec<(String, String, f64)> {
     let one = |g: &Geometry, spec: &ReadingSpec| -> f64 {
-        let n_ref = g.reference_index;
         let theta = g.theta;
-        let std = move |rec: Stop| mirror_flux(theta, g.source, rec, &|c| fresnel_real(c, n_ref));
+        // The scale written out: value × specimen / standard, the standard black glass or a perfect mirror.
+        let (n_ref, assigned) = match g.scale {
+            Scale::BlackGlass { index, value } => (Some(index), value),
+            Scale::Mirror { value } => (None, value),
+        };
+        let std = move |rec: Stop| {
+            let r = |c: f64| n_ref.map_or(1.0, |n| fresnel_real(c, n));
+            mirror_flux(theta, g.source, rec, &r) * 100.0 / assigned
+        };
         reference_reading(spec, g, &|s| specimen(g, s), &std)
     };
     let gloss_of = |id: &str| -> f64 {

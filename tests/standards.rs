@@ -1,6 +1,6 @@
 //! The standards as data: every builtin loads, ids and key numbers are as documented, stops match an
 //! independent closed form, user geometry files load, and bad files are refused with file + field.
-use glossmeter::instrument::geometry::{ReadingSpec, Stop};
+use glossmeter::instrument::geometry::{ReadingSpec, Scale, Stop};
 use glossmeter::instrument::standards::{self, BUILTIN};
 use glossmeter::Error;
 use std::collections::BTreeSet;
@@ -87,7 +87,7 @@ fn every_number_has_source_and_status() {
 fn d523_numbers() {
     let g60 = standards::find("astm-d523-60").unwrap().geometry;
     assert!((g60.theta - deg(60.0)).abs() < 1e-15);
-    assert_eq!(g60.reference_index, 1.567);
+    assert_eq!(g60.scale.black_glass_index().unwrap(), 1.567);
     assert_eq!(g60.receptor("gloss"), Some(&Stop::from_angles(deg(4.4), deg(11.7), 0.0)));
     let r = g60.receptor("gloss").unwrap();
     assert!((r.p[1].atan().to_degrees() * 2.0 - 4.4).abs() < 1e-12);
@@ -102,11 +102,11 @@ fn d523_numbers() {
         let d = standards::find(&format!("astm-d523-{a}")).unwrap().geometry;
         let i = standards::find(&format!("iso-2813-{a}")).unwrap().geometry;
         assert_eq!(
-            (d.theta, d.reference_index, d.source, &d.receptors),
-            (i.theta, i.reference_index, i.source, &i.receptors)
+            (d.theta, d.scale, d.source, &d.receptors),
+            (i.theta, i.scale, i.source, &i.receptors)
         );
     }
-    assert_eq!(standards::find("tappi-t480-75").unwrap().geometry.reference_index, 1.540);
+    assert_eq!(standards::find("tappi-t480-75").unwrap().geometry.scale.black_glass_index(), Some(1.540));
 }
 
 #[test]
@@ -273,4 +273,55 @@ fn range_checks() {
     assert_eq!(field(with("\"quantity\": \"gloss\"", "\"quantity\": \"sheen\"")), "readings[0].quantity");
     let missing_readings = standards::parse(&base.replacen("\"readings\"", "\"readingz\"", 1), "t.json");
     assert_eq!(field(missing_readings), "readingz");
+}
+
+/// Scales as data (issue 9 item 1): every shipped non-composite geometry states its scale; a user file may
+/// choose the mirror scale; unknown kinds and a doubly given scale are refused with the field named.
+#[test]
+fn scales_are_data_and_user_files_choose() {
+    for g in standards::builtin().unwrap() {
+        if g.geometry.is_composite() {
+            continue;
+        }
+        assert!(g.spec.get("scale").is_some(), "{}: no scale", g.geometry.id);
+        assert!(g.spec.get("reference_index").is_none(), "{}: old top-level reference_index", g.geometry.id);
+        assert!(standards::describe(&g).contains("scale: "), "{}", g.geometry.id);
+    }
+    let base = std::fs::read_to_string(fixture("user-e430-like.json")).unwrap();
+    assert!(base.contains("\"reference_index\""), "the user fixture keeps the older form");
+    let legacy = standards::parse(&base, "t.json").unwrap();
+    assert_eq!(legacy.geometry.scale, Scale::BlackGlass { index: 1.5, value: 100.0 });
+    let v: serde_json::Value = serde_json::from_str(&base).unwrap();
+    let with_scale = |scale: serde_json::Value, keep_old: bool| {
+        let mut v = v.clone();
+        if !keep_old {
+            v.as_object_mut().unwrap().remove("reference_index");
+        }
+        v["scale"] = scale;
+        standards::parse(&v.to_string(), "t.json")
+    };
+    let sourced = |x: f64| serde_json::json!({"value": x, "source": "test", "status": "assumed"});
+    let mirror = with_scale(serde_json::json!({"kind": "mirror", "assigned_gu": sourced(1000.0)}), false).unwrap();
+    assert_eq!(mirror.geometry.scale, Scale::Mirror { value: 1000.0 });
+    assert!(standards::describe(&mirror).contains("mirror scale: reflectance × 1000"));
+    let glass = serde_json::json!({"kind": "black-glass", "reference_index": sourced(1.54), "assigned_gu": sourced(100.0)});
+    assert_eq!(with_scale(glass.clone(), false).unwrap().geometry.scale, Scale::BlackGlass { index: 1.54, value: 100.0 });
+    let field = |r: glossmeter::Result<standards::StandardGeometry>| match r {
+        Err(Error::Input { field, message, .. }) => (field, message),
+        Ok(_) => panic!("accepted"),
+        Err(e) => panic!("{e}"),
+    };
+    let (f, m) = field(with_scale(serde_json::json!({"kind": "paper", "assigned_gu": sourced(1.0)}), false));
+    assert_eq!(f, "scale.kind");
+    assert!(m.contains("unknown scale kind") && m.contains("black-glass, mirror"), "{m}");
+    let (f, m) = field(with_scale(glass, true));
+    assert_eq!(f, "reference_index");
+    assert!(m.contains("not both"), "{m}");
+    let (f, _) = field(with_scale(serde_json::json!({"kind": "mirror"}), false));
+    assert_eq!(f, "scale.assigned_gu");
+    let mut none = v.clone();
+    none.as_object_mut().unwrap().remove("reference_index");
+    let (f, m) = field(standards::parse(&none.to_string(), "t.json"));
+    assert_eq!(f, "scale");
+    assert!(m.contains("missing"), "{m}");
 }

@@ -40,7 +40,6 @@ use crate::instrument::geometry::ReadingSpec;
 use crate::instrument::plan::{Job, Plan, PlanOptions, PlannedReading, Reading, Target};
 use crate::instrument::reference::{lambertian_flux_reference, mirror_flux_reference};
 use crate::instrument::standards::StandardGeometry;
-use crate::optics::fresnel::fr_dielectric;
 use crate::{Error, Result, Vec3};
 
 /// The default sweep: 1e-2, 1e-3, …, 1e-10.
@@ -205,8 +204,8 @@ fn closed_form_flux(job: &Job, f_lum: f64) -> f64 {
     match job.target {
         Target::Specimen => lambertian_flux_reference(job.theta, job.source, job.receptor, f_lum),
         Target::Standard => {
-            let n = job.reference_index;
-            mirror_flux_reference(job.theta, job.source, job.receptor, &|c| fr_dielectric(c, n))
+            let scale = job.scale;
+            mirror_flux_reference(job.theta, job.source, job.receptor, &|c| scale.standard_reflectance(c))
         }
     }
 }

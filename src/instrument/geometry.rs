@@ -109,6 +109,53 @@ impl ReadingSpec {
     }
 }
 
+/// The scale of a geometry's readings (`docs/instrument.md` §1.5): every reading is `value` × (specimen flux) /
+/// (flux of the standard) through the same stops.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Scale {
+    /// Polished black glass of refractive index `index` (a smooth, non-absorbing dielectric whose back is not
+    /// seen) is assigned `value` GU: ASTM D523 / ISO 2813 n = 1.567 → 100; TAPPI T480 n = 1.540 → 100.
+    BlackGlass { index: f64, value: f64 },
+    /// The mirror scale: specular reflectance × `value` (a perfect mirror is assigned `value`), as ASTM C346
+    /// and D2457's 45° procedure (× 1000).
+    Mirror { value: f64 },
+}
+
+impl Scale {
+    /// Reflectance at cos θ of the gloss standard rescaled to read 100: R_standard(θ)·100/value. The plan
+    /// integrates this standard and multiplies every ratio by 100, which puts readings on this scale.
+    pub fn standard_reflectance(&self, cos_theta: f64) -> f64 {
+        match *self {
+            Scale::BlackGlass { index, value } => crate::optics::fresnel::fr_dielectric(cos_theta, index) * 100.0 / value,
+            Scale::Mirror { value } => 100.0 / value,
+        }
+    }
+
+    /// The black glass's index, or None on the mirror scale.
+    pub fn black_glass_index(&self) -> Option<f64> {
+        match *self {
+            Scale::BlackGlass { index, .. } => Some(index),
+            Scale::Mirror { .. } => None,
+        }
+    }
+
+    /// Bits identifying the standard (for sharing integrals between geometries).
+    pub fn key(&self) -> [u64; 3] {
+        match *self {
+            Scale::BlackGlass { index, value } => [0, index.to_bits(), value.to_bits()],
+            Scale::Mirror { value } => [1, value.to_bits(), 0],
+        }
+    }
+
+    /// One line, e.g. "black glass n = 1.567 = 100 GU" or "mirror scale: reflectance × 1000".
+    pub fn describe(&self) -> String {
+        match *self {
+            Scale::BlackGlass { index, value } => format!("black glass n = {index} = {value} GU"),
+            Scale::Mirror { value } => format!("mirror scale: reflectance × {value}"),
+        }
+    }
+}
+
 /// A compiled instrument geometry: everything the engine needs, in radians and tangent coordinates.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Geometry {
@@ -116,8 +163,8 @@ pub struct Geometry {
     pub title: String,
     /// Angle of incidence = angle of reflection, radians (0 for purely composite geometries).
     pub theta: f64,
-    /// Refractive index of the gloss standard (a smooth, non-absorbing dielectric).
-    pub reference_index: f64,
+    /// The scale the readings are on: what the gloss standard is and what it is assigned.
+    pub scale: Scale,
     pub source: Stop,
     /// Named receptor stops (all on the receptor lens, offsets inside its focal plane).
     pub receptors: Vec<(String, Stop)>,

@@ -19,9 +19,8 @@ use rayon::prelude::*;
 
 use crate::brdf::{Brdf, Lobe, Term, TermKind};
 use crate::instrument::flux::{choose_variables, clip, lobe_widths_uv, Flux, FluxProblem, Spectral, Variables};
-use crate::instrument::geometry::{ReadingSpec, Stop};
+use crate::instrument::geometry::{ReadingSpec, Scale, Stop};
 use crate::instrument::standards::{self, StandardGeometry};
-use crate::optics::fresnel::fr_dielectric;
 use crate::spectrum::Sampling;
 use crate::{Error, Result, Vec3};
 
@@ -52,17 +51,18 @@ impl Default for PlanOptions {
     }
 }
 
-/// The gloss standard: a smooth, non-absorbing dielectric of the standard's reference index, black-backed
-/// (only its front-surface Fresnel reflection counts). Integrated by the same engine as any specimen.
+/// The gloss standard of a scale, rescaled to read 100 ([`Scale::standard_reflectance`]): black glass (a
+/// smooth, non-absorbing dielectric, black-backed: only its front-surface Fresnel reflection counts) or a
+/// perfect mirror. Integrated by the same engine as any specimen.
 #[derive(Debug)]
 pub struct GlossStandard {
-    pub index: f64,
+    pub scale: Scale,
     sampling: Sampling,
 }
 
 impl GlossStandard {
-    pub fn new(index: f64) -> Self {
-        GlossStandard { index, sampling: Sampling::grey() }
+    pub fn new(scale: Scale) -> Self {
+        GlossStandard { scale, sampling: Sampling::grey() }
     }
 }
 
@@ -74,7 +74,7 @@ impl Brdf for GlossStandard {
         out.iter_mut().for_each(|v| *v = 0.0);
     }
     fn delta_reflectance(&self, wi: Vec3, out: &mut [f64]) -> bool {
-        let r = fr_dielectric(wi.z.clamp(0.0, 1.0), self.index);
+        let r = self.scale.standard_reflectance(wi.z.clamp(0.0, 1.0));
         out.iter_mut().for_each(|v| *v = r);
         true
     }
@@ -82,7 +82,7 @@ impl Brdf for GlossStandard {
         vec![Term { label: "gloss standard (Fresnel, delta)".into(), kind: TermKind::Delta }]
     }
     fn describe(&self) -> String {
-        format!("gloss standard: smooth dielectric n = {}", self.index)
+        format!("gloss standard: {}", self.scale.describe())
     }
 }
 
@@ -98,7 +98,8 @@ pub enum Target {
 pub struct Job {
     pub target: Target,
     pub theta: f64,
-    pub reference_index: f64,
+    /// The scale of the standard (only used by `Target::Standard` jobs).
+    pub scale: Scale,
     pub source: Stop,
     pub receptor: Stop,
     /// Where it is used: "geometry-id/receptor".
@@ -154,7 +155,7 @@ pub struct Plan {
 fn key(j: &Job) -> Vec<u64> {
     let mut k = vec![j.target as u64, j.theta.to_bits()];
     if j.target == Target::Standard {
-        k.push(j.reference_index.to_bits());
+        k.extend(j.scale.key());
     }
     for s in [j.source, j.receptor] {
         k.extend([s.p[0], s.p[1], s.q[0], s.q[1]].iter().map(|x| x.to_bits()));
@@ -290,7 +291,7 @@ impl Plan {
                         Job {
                             target,
                             theta: g.theta,
-                            reference_index: g.reference_index,
+                            scale: g.scale,
                             source: g.source,
                             receptor: stop,
                             used_by: vec![format!("{}/{rx}", g.id)],
@@ -319,7 +320,7 @@ impl Plan {
     fn run_job(&self, job: &Job, atol: f64) -> Flux {
         match job.target {
             Target::Standard => {
-                let std = GlossStandard::new(job.reference_index);
+                let std = GlossStandard::new(job.scale);
                 FluxProblem {
                     brdf: &std,
                     theta: job.theta,
@@ -442,11 +443,11 @@ impl Plan {
                 continue;
             }
             s.push_str(&format!(
-                "Geometry {} ({}), θ = {:.4}°, standard n = {}\n",
+                "Geometry {} ({}), θ = {:.4}°, standard: {}\n",
                 geo.id,
                 geo.title,
                 geo.theta.to_degrees(),
-                geo.reference_index
+                geo.scale.describe()
             ));
             for l in &self.lobes {
                 let w = lobe_widths_uv(l, geo.theta);

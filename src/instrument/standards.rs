@@ -5,7 +5,7 @@
 //! Every number in a geometry file carries its provenance:
 //! `{"value": 1.8, "source": "…citation or reason…", "status": "verified" | "secondary" | "assumed"}`.
 //! Errors name the file, the field path and what is allowed.
-use crate::instrument::geometry::{Geometry, ReadingSpec, Stop};
+use crate::instrument::geometry::{Geometry, ReadingSpec, Scale, Stop};
 use crate::recipe::fields::{kind, parse_json, Obj};
 use crate::{Error, Result};
 use serde_json::Value;
@@ -44,8 +44,51 @@ pub struct StandardGeometry {
 }
 
 const TOP_FIELDS: &[&str] =
-    &["id", "title", "standards", "angle_deg", "reference_index", "source", "receptors", "readings", "notes"];
-const GEOMETRY_ONLY: &[&str] = &["angle_deg", "reference_index", "source", "receptors"];
+    &["id", "title", "standards", "angle_deg", "scale", "reference_index", "source", "receptors", "readings", "notes"];
+const GEOMETRY_ONLY: &[&str] = &["angle_deg", "scale", "reference_index", "source", "receptors"];
+
+/// The allowed `scale.kind` values.
+pub const SCALE_KINDS: &[&str] = &["black-glass", "mirror"];
+
+/// The geometry's scale: `"scale": {"kind": "black-glass", "reference_index": {…}, "assigned_gu": {…}}` or
+/// `{"kind": "mirror", "assigned_gu": {…}}`, each number sourced. A file that gives only the older top-level
+/// `reference_index` is on the black-glass scale with that glass assigned 100 GU (as D523).
+fn scale(o: &Obj) -> Result<Scale> {
+    let index_range = Range::Closed(1.3, 2.0);
+    let index_what = "the refractive index of the black-glass gloss standard";
+    match (o.get("scale").is_some(), o.get("reference_index").is_some()) {
+        (true, true) => Err(o.err(
+            "reference_index",
+            "give the scale once: `scale` (preferred) or the older top-level `reference_index`, not both",
+        )),
+        (false, false) => Err(o.err(
+            "scale",
+            format!("missing: give `scale` with `kind` one of {} (docs/instrument.md §2.2)", SCALE_KINDS.join(", ")),
+        )),
+        (false, true) => Ok(Scale::BlackGlass { index: sourced(o, "reference_index", index_range, index_what)?, value: 100.0 }),
+        (true, false) => {
+            let s = o.obj("scale")?;
+            let value_what = "the gloss units assigned to the standard";
+            match s.str("kind")? {
+                "black-glass" => {
+                    s.deny_unknown(&["kind", "reference_index", "assigned_gu", "notes"])?;
+                    let index = sourced(&s, "reference_index", index_range, index_what)?;
+                    let value = sourced(&s, "assigned_gu", Range::Open(0.0, 1e4), value_what)?;
+                    Ok(Scale::BlackGlass { index, value })
+                }
+                "mirror" => {
+                    s.deny_unknown(&["kind", "assigned_gu", "notes"])?;
+                    let value = sourced(&s, "assigned_gu", Range::Open(0.0, 1e4), value_what)?;
+                    Ok(Scale::Mirror { value })
+                }
+                other => Err(s.err(
+                    "kind",
+                    format!("unknown scale kind \"{other}\"; allowed: {}", SCALE_KINDS.join(", ")),
+                )),
+            }
+        }
+    }
+}
 
 /// Parse and validate every builtin geometry, and check that they are consistent with each other (each
 /// file's id equals its file name, ids are unique, composites name existing non-composite geometries).
@@ -136,7 +179,7 @@ pub fn parse(text: &str, origin: &str) -> Result<StandardGeometry> {
     }
     let composite = quantities.contains(&"haze-index");
 
-    let (theta, reference_index, source, receptors) = if composite {
+    let (theta, scale, source, receptors) = if composite {
         if let Some(i) = quantities.iter().position(|q| *q != "haze-index") {
             return Err(Error::input(
                 origin,
@@ -151,10 +194,10 @@ pub fn parse(text: &str, origin: &str) -> Result<StandardGeometry> {
                  they come from the geometries it names",
             ));
         }
-        (0.0, 0.0, Stop { p: [0.0, 0.0], q: [0.0, 0.0] }, Vec::new())
+        (0.0, Scale::Mirror { value: 100.0 }, Stop { p: [0.0, 0.0], q: [0.0, 0.0] }, Vec::new())
     } else {
         let angle = sourced(&o, "angle_deg", Range::Open(0.0, 90.0), "the angle of incidence in degrees")?;
-        let n = sourced(&o, "reference_index", Range::Closed(1.3, 2.0), "the refractive index of the gloss standard")?;
+        let n = scale(&o)?;
         let src = o.obj("source")?;
         let (s_in, s_perp) = aperture(&src, &["shape", "in_plane_deg", "perpendicular_deg"])?;
         if angle + 0.5 * s_in >= 90.0 {
@@ -218,7 +261,7 @@ pub fn parse(text: &str, origin: &str) -> Result<StandardGeometry> {
         readings.push(spec);
     }
 
-    let geometry = Geometry { id: id.to_string(), title, theta, reference_index, source, receptors, readings };
+    let geometry = Geometry { id: id.to_string(), title, theta, scale, source, receptors, readings };
     Ok(StandardGeometry { geometry, reading_names, spec, origin: origin.to_string() })
 }
 
@@ -407,7 +450,22 @@ pub fn describe(g: &StandardGeometry) -> String {
         out += "  composite geometry (no optics of its own)\n";
     } else {
         out += &format!("  angle of incidence: {}\n", sourced_text(s.get("angle_deg"), "°"));
-        out += &format!("  reference index (gloss standard): {}\n", sourced_text(s.get("reference_index"), ""));
+        out += &format!("  scale: {}\n", geo.scale.describe());
+        match s.get("scale") {
+            Some(sc) => {
+                if let Some(n) = sc.get("reference_index") {
+                    out += &format!("    reference index (black glass): {}\n", sourced_text(Some(n), ""));
+                }
+                out += &format!("    assigned to the standard: {}\n", sourced_text(sc.get("assigned_gu"), " GU"));
+                if let Some(n) = sc.get("notes").and_then(Value::as_str) {
+                    out += &format!("    {n}\n");
+                }
+            }
+            None => {
+                out += &format!("    reference index (black glass): {}\n", sourced_text(s.get("reference_index"), ""));
+                out += "    assigned to the standard: 100 GU (implied by a top-level reference_index)\n";
+            }
+        }
         if let Some(src) = s.get("source") {
             out += &format!(
                 "  source stop: {} (solid angle {:.4e} sr)\n",
@@ -479,10 +537,14 @@ pub fn list_line(g: &StandardGeometry) -> String {
         })
         .collect();
     format!(
-        "{:<15} {:>4.1}°  n={:<6}  receptors: {}  readings: {}",
+        "{:<15} {:>4.1}°  {:<9}  receptors: {}  readings: {}",
         geo.id,
         geo.theta.to_degrees(),
-        geo.reference_index,
+        match geo.scale {
+            Scale::BlackGlass { index, value } if value == 100.0 => format!("n={index}"),
+            Scale::BlackGlass { index, value } => format!("n={index}={value}"),
+            Scale::Mirror { value } => format!("mirror×{value}"),
+        },
         receptors.join(", "),
         readings
     )
