@@ -127,7 +127,9 @@ impl Sampling {
     pub fn describe(&self) -> String {
         match self.kind {
             SamplingKind::Grey => "grey (one sample)".to_string(),
-            SamplingKind::Rgb => "RGB (3 samples at the CIE 1931 primaries; luminance weights 0.17697/0.81240/0.01063)".to_string(),
+            SamplingKind::Rgb => {
+                "RGB (3 samples at the CIE 1931 primaries; luminance weights 0.17697/0.81240/0.01063)".to_string()
+            }
             SamplingKind::Spectral => format!(
                 "spectral, {} samples {}–{} nm (weights CIE illuminant C × ȳ)",
                 self.len(),
@@ -213,9 +215,8 @@ mod tests {
     #[test]
     fn rgb_weights_are_the_cie_primaries_luminances() {
         let ybar = parse_table(YBAR_CSV, "ybar").unwrap();
-        let lum: Vec<f64> = (0..3)
-            .map(|k| CIE_RGB_RADIANT_POWER_RATIOS[k] * interp(&ybar, RGB_WAVELENGTHS_NM[k]).unwrap())
-            .collect();
+        let lum: Vec<f64> =
+            (0..3).map(|k| CIE_RGB_RADIANT_POWER_RATIOS[k] * interp(&ybar, RGB_WAVELENGTHS_NM[k]).unwrap()).collect();
         let total: f64 = lum.iter().sum();
         for k in 0..3 {
             let w = lum[k] / total;

@@ -114,13 +114,16 @@ fn gloss_standard_reads_100_and_dielectric_15_reads_aperture_averaged_values() {
     let _ = Axes::new(0.1);
     for (id, expect_15) in [("astm-d523-20", 82.05), ("astm-d523-60", 89.14), ("astm-d523-85", 98.97)] {
         let g = geometry(id);
-        let std = gloss_of(Arc::new(TestMirror(Some(g.scale.black_glass_index().unwrap()), Sampling::grey())), id, 1e-9);
+        let std =
+            gloss_of(Arc::new(TestMirror(Some(g.scale.black_glass_index().unwrap()), Sampling::grey())), id, 1e-9);
         assert!((std.value.unwrap() - 100.0).abs() < 1e-9, "{id}: standard reads {:?}", std.value);
         let r = gloss_of(Arc::new(TestMirror(Some(1.5), Sampling::grey())), id, 1e-9);
         let v = r.value.unwrap();
         let rec = g.receptor("gloss").copied().unwrap();
         let reference = 100.0 * mirror_flux_reference(g.theta, g.source, rec, &|c| fr_dielectric(c, 1.5))
-            / mirror_flux_reference(g.theta, g.source, rec, &|c| fr_dielectric(c, g.scale.black_glass_index().unwrap()));
+            / mirror_flux_reference(g.theta, g.source, rec, &|c| {
+                fr_dielectric(c, g.scale.black_glass_index().unwrap())
+            });
         assert!((v - reference).abs() < 1e-9 * reference, "{id}: {v} vs independent {reference}");
         assert!(
             (v - reference).abs() <= r.error_estimate.max(1e-12),
@@ -131,7 +134,9 @@ fn gloss_standard_reads_100_and_dielectric_15_reads_aperture_averaged_values() {
         assert!((v - expect_15).abs() < 0.01, "{id}: {v} vs about {expect_15}");
         let mirror = gloss_of(Arc::new(TestMirror(None, Sampling::grey())), id, 1e-9).value.unwrap();
         let reference = 100.0 * mirror_flux_reference(g.theta, g.source, rec, &|_| 1.0)
-            / mirror_flux_reference(g.theta, g.source, rec, &|c| fr_dielectric(c, g.scale.black_glass_index().unwrap()));
+            / mirror_flux_reference(g.theta, g.source, rec, &|c| {
+                fr_dielectric(c, g.scale.black_glass_index().unwrap())
+            });
         assert!((mirror - reference).abs() < 1e-9 * reference, "{id}: mirror {mirror} vs {reference}");
     }
 }

@@ -218,7 +218,13 @@ fn rgb_spec(eta: f64, x: f64, rg: [f64; 3], k: [f64; 3], s: [f64; 3]) -> PaintSp
 }
 
 fn metal(spread_deg: f64, area: f64, depth: f64) -> MetallicFlakes {
-    MetallicFlakes { n: vec![0.93; 3], k: vec![6.33; 3], spread: Spread::Degrees(spread_deg), area_ratio: area, depth_mm: depth }
+    MetallicFlakes {
+        n: vec![0.93; 3],
+        k: vec![6.33; 3],
+        spread: Spread::Degrees(spread_deg),
+        area_ratio: area,
+        depth_mm: depth,
+    }
 }
 
 fn pearl(spread_deg: f64, area: f64, depth: f64) -> PearlescentFlakes {

@@ -101,10 +101,7 @@ fn d523_numbers() {
     for a in [20, 60, 85] {
         let d = standards::find(&format!("astm-d523-{a}")).unwrap().geometry;
         let i = standards::find(&format!("iso-2813-{a}")).unwrap().geometry;
-        assert_eq!(
-            (d.theta, d.scale, d.source, &d.receptors),
-            (i.theta, i.scale, i.source, &i.receptors)
-        );
+        assert_eq!((d.theta, d.scale, d.source, &d.receptors), (i.theta, i.scale, i.source, &i.receptors));
     }
     assert_eq!(standards::find("tappi-t480-75").unwrap().geometry.scale.black_glass_index(), Some(1.540));
 }
@@ -304,8 +301,12 @@ fn scales_are_data_and_user_files_choose() {
     let mirror = with_scale(serde_json::json!({"kind": "mirror", "assigned_gu": sourced(1000.0)}), false).unwrap();
     assert_eq!(mirror.geometry.scale, Scale::Mirror { value: 1000.0 });
     assert!(standards::describe(&mirror).contains("mirror scale: reflectance × 1000"));
-    let glass = serde_json::json!({"kind": "black-glass", "reference_index": sourced(1.54), "assigned_gu": sourced(100.0)});
-    assert_eq!(with_scale(glass.clone(), false).unwrap().geometry.scale, Scale::BlackGlass { index: 1.54, value: 100.0 });
+    let glass =
+        serde_json::json!({"kind": "black-glass", "reference_index": sourced(1.54), "assigned_gu": sourced(100.0)});
+    assert_eq!(
+        with_scale(glass.clone(), false).unwrap().geometry.scale,
+        Scale::BlackGlass { index: 1.54, value: 100.0 }
+    );
     let field = |r: glossmeter::Result<standards::StandardGeometry>| match r {
         Err(Error::Input { field, message, .. }) => (field, message),
         Ok(_) => panic!("accepted"),

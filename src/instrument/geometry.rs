@@ -126,7 +126,10 @@ impl Scale {
     /// integrates this standard and multiplies every ratio by 100, which puts readings on this scale.
     pub fn standard_reflectance(&self, cos_theta: f64) -> f64 {
         match *self {
-            Scale::BlackGlass { index, value } => crate::optics::fresnel::fr_dielectric(cos_theta, index) * 100.0 / value,
+            // 100/value is exactly 1 for the usual 100 GU, so those standards are bit-identical to plain glass.
+            Scale::BlackGlass { index, value } => {
+                crate::optics::fresnel::fr_dielectric(cos_theta, index) * (100.0 / value)
+            }
             Scale::Mirror { value } => 100.0 / value,
         }
     }

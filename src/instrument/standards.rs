@@ -65,7 +65,9 @@ fn scale(o: &Obj) -> Result<Scale> {
             "scale",
             format!("missing: give `scale` with `kind` one of {} (docs/instrument.md §2.2)", SCALE_KINDS.join(", ")),
         )),
-        (false, true) => Ok(Scale::BlackGlass { index: sourced(o, "reference_index", index_range, index_what)?, value: 100.0 }),
+        (false, true) => {
+            Ok(Scale::BlackGlass { index: sourced(o, "reference_index", index_range, index_what)?, value: 100.0 })
+        }
         (true, false) => {
             let s = o.obj("scale")?;
             let value_what = "the gloss units assigned to the standard";
@@ -81,10 +83,9 @@ fn scale(o: &Obj) -> Result<Scale> {
                     let value = sourced(&s, "assigned_gu", Range::Open(0.0, 1e4), value_what)?;
                     Ok(Scale::Mirror { value })
                 }
-                other => Err(s.err(
-                    "kind",
-                    format!("unknown scale kind \"{other}\"; allowed: {}", SCALE_KINDS.join(", ")),
-                )),
+                other => {
+                    Err(s.err("kind", format!("unknown scale kind \"{other}\"; allowed: {}", SCALE_KINDS.join(", "))))
+                }
             }
         }
     }
@@ -541,7 +542,7 @@ pub fn list_line(g: &StandardGeometry) -> String {
         geo.id,
         geo.theta.to_degrees(),
         match geo.scale {
-            Scale::BlackGlass { index, value } if value == 100.0 => format!("n={index}"),
+            Scale::BlackGlass { index, value: 100.0 } => format!("n={index}"),
             Scale::BlackGlass { index, value } => format!("n={index}={value}"),
             Scale::Mirror { value } => format!("mirror×{value}"),
         },
