@@ -24,8 +24,9 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use glossmeter::brdf::{Brdf, Lobe, Term, TermKind};
-use glossmeter::instrument::flux::{Flux, FluxProblem, Spectral};
+use glossmeter::instrument::flux::Flux;
 use glossmeter::instrument::geometry::{solid_angle_density, Axes, Stop};
+use glossmeter::instrument::method::Method;
 use glossmeter::instrument::plan::{Plan, PlanOptions, Reading};
 use glossmeter::instrument::standards::{self, StandardGeometry};
 use glossmeter::optics::fresnel::fr_dielectric;
@@ -211,21 +212,23 @@ fn case(id: &'static str, title: &str, brdf: Arc<dyn Brdf>, geometry: &str) -> C
     Case { id, title: title.into(), brdf, geometry: g, theta, source, receptor }
 }
 
-fn problem(c: &Case, rtol: f64) -> FluxProblem<'_> {
-    let b: &dyn Brdf = c.brdf.as_ref();
-    FluxProblem {
-        brdf: b,
-        theta: c.theta,
-        source: c.source,
-        receptor: c.receptor,
-        spectral: Spectral::Folded(b.sampling().luminous_weights.clone()),
-        lobes: b.lobes(),
-        include_delta: b.has_delta(),
-        include_regular: b.has_regular(),
-        rtol,
-        atol: 0.0,
-        max_evals: 200_000_000,
+/// The specimen flux of a case, as a method designed for its BRDF (executed with `solve`).
+struct Problem<'a> {
+    brdf: &'a dyn Brdf,
+    method: Method,
+}
+
+impl Problem<'_> {
+    fn solve(&self) -> Flux {
+        self.method.execute(self.brdf)
     }
+}
+
+fn problem(c: &Case, rtol: f64) -> Problem<'_> {
+    let b: &dyn Brdf = c.brdf.as_ref();
+    let method =
+        Method::for_material(b, c.theta, c.source, c.receptor, (rtol, 0.0), 200_000_000).expect("luminous weighting");
+    Problem { brdf: b, method }
 }
 
 /// The plain 4-D integrand in (p_s, q_s, p_r, q_r): luminous f · cos θi cos θo · both solid-angle densities.
@@ -239,7 +242,8 @@ struct Plain<'a> {
 impl<'a> Plain<'a> {
     fn new(c: &'a Case) -> Self {
         let b: &dyn Brdf = c.brdf.as_ref();
-        let weights = b.sampling().luminous_weights.clone();
+        let weights =
+            glossmeter::spectrum::Weighting::luminous(b.sampling()).expect("luminous weighting").rows[0].clone();
         Plain { brdf: b, axes: Axes::new(c.theta), scratch: vec![0.0; weights.len()], weights }
     }
     #[inline]
@@ -307,7 +311,7 @@ fn raw_box_genz_malik(c: &Case, rtol: f64, max_evals: usize) -> glossmeter::quad
     let mut p = Plain::new(c);
     let (s, r) = (c.source, c.receptor);
     glossmeter::quadrature::integrate::<4, _>(
-        |x, out| out[0] = p.f(x[0], x[1], x[2], x[3]),
+        glossmeter::quadrature::pointwise(1, |x: &[f64; 4], out: &mut [f64]| out[0] = p.f(x[0], x[1], x[2], x[3])),
         1,
         &[([s.p[0], s.q[0], r.p[0], r.q[0]], [s.p[1], s.q[1], r.p[1], r.q[1]])],
         &glossmeter::quadrature::Options { rtol, atol: 0.0, max_evals },
@@ -491,17 +495,17 @@ fn main() {
                 exact,
                 format!(
                     "closed form (Lambert's polygon formula); our rtol-1e-12 run differs by {:.1e}",
-                    (fine.value - exact).abs() / exact
+                    (fine.value[0] - exact).abs() / exact
                 ),
             )
         } else {
             (
-                fine.value,
+                fine.value[0],
                 format!(
                     "our engine at rtol 1e-12: {} evaluations, {}, est. rel. err {:.1e}, converged {}",
                     fine.evaluations,
                     fmt_time(fine_s),
-                    fine.error / fine.value,
+                    fine.error[0] / fine.value[0],
                     fine.converged
                 ),
             )
@@ -514,9 +518,9 @@ fn main() {
             rows.push(Row {
                 case: c.id,
                 method: format!("ours, rtol {rtol:.0e}"),
-                value: f.value,
-                claimed: f.error / f.value.abs(),
-                rel_err: (f.value - reference).abs() / reference,
+                value: f.value[0],
+                claimed: f.error[0] / f.value[0].abs(),
+                rel_err: (f.value[0] - reference).abs() / reference,
                 evals: f.evaluations,
                 seconds: secs,
                 runs,
@@ -533,9 +537,9 @@ fn main() {
                     rows.push(Row {
                         case: c.id,
                         method: "ours, recipe BRDF, rtol 1e-6".into(),
-                        value: f.value,
-                        claimed: f.error / f.value.abs(),
-                        rel_err: (f.value - reference).abs() / reference,
+                        value: f.value[0],
+                        claimed: f.error[0] / f.value[0].abs(),
+                        rel_err: (f.value[0] - reference).abs() / reference,
                         evals: f.evaluations,
                         seconds: secs,
                         runs,

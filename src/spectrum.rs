@@ -42,101 +42,210 @@ pub enum SamplingKind {
     Spectral,
 }
 
-/// The spectral samples of a material and the weights that turn them into a luminous quantity.
+/// The spectral samples of a material: where it is evaluated in wavelength, nothing more. How the samples are
+/// combined into what a reading reports (luminous Y for gloss; later X, Y, Z) is a [`Weighting`], chosen by
+/// the measurement plan from the readings asked for.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Sampling {
     pub kind: SamplingKind,
-    /// Wavelength of each sample in nm (for Grey, 560 nm; for RGB, [`RGB_WAVELENGTHS_NM`]).
+    /// Wavelength of each sample in nm (for Grey, 560 nm, the peak region of V(λ) (CIE 15:2004 Table T.1:
+    /// ȳ = 0.995 at 560 nm), where a wavelength-dependent optic of a grey material is evaluated; for RGB,
+    /// [`RGB_WAVELENGTHS_NM`]).
     pub wavelengths_nm: Vec<f64>,
-    /// Luminous weight of each sample; they sum to 1, so a perfectly white material has luminous value 1.
-    pub luminous_weights: Vec<f64>,
 }
 
 impl Sampling {
     pub fn grey() -> Self {
-        Sampling { kind: SamplingKind::Grey, wavelengths_nm: vec![560.0], luminous_weights: vec![1.0] }
+        Sampling { kind: SamplingKind::Grey, wavelengths_nm: vec![560.0] }
     }
 
     pub fn rgb() -> Self {
-        Sampling {
-            kind: SamplingKind::Rgb,
-            wavelengths_nm: RGB_WAVELENGTHS_NM.to_vec(),
-            luminous_weights: RGB_LUMINANCE_WEIGHTS.to_vec(),
-        }
+        Sampling { kind: SamplingKind::Rgb, wavelengths_nm: RGB_WAVELENGTHS_NM.to_vec() }
     }
 
-    /// A spectral grid. The weight of sample k is S_C(λk)·ȳ(λk)·Δλk (trapezoid widths), normalised to sum 1,
-    /// with S_C and ȳ linearly interpolated from the embedded tables. The grid must lie within 360–830 nm.
+    /// A spectral grid: strictly increasing, finite, within 360–830 nm (the CIE tables) and carrying some
+    /// luminous weight (so a gloss reading of it is defined).
     pub fn spectral(wavelengths_nm: &[f64]) -> Result<Self> {
-        let bad = |m: String| Error::Usage(format!("spectral grid: {m}"));
-        if wavelengths_nm.is_empty() {
-            return Err(bad("needs at least one wavelength".into()));
-        }
-        for w in wavelengths_nm.windows(2) {
-            if !(w[1] > w[0]) {
-                return Err(bad("wavelengths must be strictly increasing".into()));
-            }
-        }
-        let illum = parse_table(ILLUMINANT_C_CSV, "standards/cie/illuminant-c.csv")?;
-        let ybar = parse_table(YBAR_CSV, "standards/cie/cie1931-ybar.csv")?;
-        let n = wavelengths_nm.len();
-        let mut weights = Vec::with_capacity(n);
-        for (k, &lam) in wavelengths_nm.iter().enumerate() {
-            if !lam.is_finite() {
-                return Err(bad("wavelengths must be finite".into()));
-            }
-            let (Some(s), Some(y)) = (interp(&illum, lam), interp(&ybar, lam)) else {
-                return Err(bad(format!("{lam} nm is outside the CIE tables")));
-            };
-            let width = if n == 1 {
-                1.0
-            } else if k == 0 {
-                0.5 * (wavelengths_nm[1] - lam)
-            } else if k == n - 1 {
-                0.5 * (lam - wavelengths_nm[k - 1])
-            } else {
-                0.5 * (wavelengths_nm[k + 1] - wavelengths_nm[k - 1])
-            };
-            weights.push(s * y * width);
-        }
-        let total: f64 = weights.iter().sum();
-        if !(total > 0.0) {
-            return Err(bad("the grid carries no luminous weight".into()));
-        }
-        weights.iter_mut().for_each(|w| *w /= total);
-        Ok(Sampling {
-            kind: SamplingKind::Spectral,
-            wavelengths_nm: wavelengths_nm.to_vec(),
-            luminous_weights: weights,
-        })
+        luminous_grid_weights(wavelengths_nm)?;
+        Ok(Sampling { kind: SamplingKind::Spectral, wavelengths_nm: wavelengths_nm.to_vec() })
     }
 
     pub fn len(&self) -> usize {
-        self.luminous_weights.len()
+        self.wavelengths_nm.len()
     }
 
     pub fn is_empty(&self) -> bool {
-        self.luminous_weights.is_empty()
-    }
-
-    /// Σ w_k v_k.
-    pub fn luminous(&self, values: &[f64]) -> f64 {
-        self.luminous_weights.iter().zip(values).map(|(w, v)| w * v).sum()
+        self.wavelengths_nm.is_empty()
     }
 
     pub fn describe(&self) -> String {
         match self.kind {
             SamplingKind::Grey => "grey (one sample)".to_string(),
-            SamplingKind::Rgb => {
-                "RGB (3 samples at the CIE 1931 primaries; luminance weights 0.17697/0.81240/0.01063)".to_string()
-            }
+            SamplingKind::Rgb => "RGB (3 samples)".to_string(),
             SamplingKind::Spectral => format!(
-                "spectral, {} samples {}–{} nm (weights CIE illuminant C × ȳ)",
+                "spectral, {} samples {}–{} nm",
                 self.len(),
                 self.wavelengths_nm[0],
                 self.wavelengths_nm[self.len() - 1]
             ),
         }
+    }
+}
+
+/// A (wavelength nm, value) table.
+type Table = Vec<(f64, f64)>;
+
+/// The parsed CIE tables (illuminant C, ȳ), parsed once.
+fn cie_tables() -> Result<&'static (Table, Table)> {
+    static TABLES: std::sync::OnceLock<(Table, Table)> = std::sync::OnceLock::new();
+    if let Some(t) = TABLES.get() {
+        return Ok(t);
+    }
+    let illum = parse_table(ILLUMINANT_C_CSV, "standards/cie/illuminant-c.csv")?;
+    let ybar = parse_table(YBAR_CSV, "standards/cie/cie1931-ybar.csv")?;
+    Ok(TABLES.get_or_init(|| (illum, ybar)))
+}
+
+/// The luminous weights of a wavelength grid: the weight of sample k is S_C(λk)·ȳ(λk)·Δλk (trapezoid
+/// widths), normalised to sum 1, with S_C and ȳ linearly interpolated from the embedded tables (CIE 15:2004
+/// §7.1, the weighted-ordinate method). Errors name what is wrong with the grid.
+fn luminous_grid_weights(wavelengths_nm: &[f64]) -> Result<Vec<f64>> {
+    let bad = |m: String| Error::Usage(format!("spectral grid: {m}"));
+    if wavelengths_nm.is_empty() {
+        return Err(bad("needs at least one wavelength".into()));
+    }
+    for w in wavelengths_nm.windows(2) {
+        if !(w[1] > w[0]) {
+            return Err(bad("wavelengths must be strictly increasing".into()));
+        }
+    }
+    let (illum, ybar) = cie_tables()?;
+    let n = wavelengths_nm.len();
+    let mut weights = Vec::with_capacity(n);
+    for (k, &lam) in wavelengths_nm.iter().enumerate() {
+        if !lam.is_finite() {
+            return Err(bad("wavelengths must be finite".into()));
+        }
+        let (Some(s), Some(y)) = (interp(illum, lam), interp(ybar, lam)) else {
+            return Err(bad(format!("{lam} nm is outside the CIE tables")));
+        };
+        let width = if n == 1 {
+            1.0
+        } else if k == 0 {
+            0.5 * (wavelengths_nm[1] - lam)
+        } else if k == n - 1 {
+            0.5 * (lam - wavelengths_nm[k - 1])
+        } else {
+            0.5 * (wavelengths_nm[k + 1] - wavelengths_nm[k - 1])
+        };
+        weights.push(s * y * width);
+    }
+    let total: f64 = weights.iter().sum();
+    if !(total > 0.0) {
+        return Err(bad("the grid carries no luminous weight".into()));
+    }
+    weights.iter_mut().for_each(|w| *w /= total);
+    Ok(weights)
+}
+
+/// What a reading needs from the spectral samples. To add one (e.g. CIE X, Y, Z under an illuminant and
+/// observer): add a variant here, its rows in [`Weighting::rows_of`] (one row of n sample weights per
+/// component, with the source of the tables), and return it from `ReadingSpec::weighting` for the readings
+/// that use it; the plan stacks the rows of every kind its readings ask for and each reading reads its
+/// components at [`Weighting::offset`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum WeightingKind {
+    /// One component, the luminous value: CIE illuminant C × ȳ(λ) for a spectral grid (ISO 2813 / ASTM D523:
+    /// gloss is luminous), the luminances of the CIE 1931 primaries ([`RGB_LUMINANCE_WEIGHTS`]) for RGB, 1 for
+    /// grey. Rows sum to 1, so a
+    /// perfectly white material has luminous value 1.
+    Luminous,
+    /// One component per sample (no weighting): the fluxes per wavelength.
+    Identity,
+}
+
+/// A k × n weighting matrix: component c of a weighted flux is Σ_j W[c][j] Φ_j over the n samples.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Weighting {
+    /// The kinds stacked in this matrix, each with the index of its first row.
+    pub parts: Vec<(WeightingKind, usize)>,
+    /// k rows of n weights.
+    pub rows: Vec<Vec<f64>>,
+}
+
+impl Weighting {
+    /// The rows of one kind for this sampling.
+    pub fn rows_of(kind: WeightingKind, sampling: &Sampling) -> Result<Vec<Vec<f64>>> {
+        Ok(match kind {
+            WeightingKind::Luminous => vec![match sampling.kind {
+                SamplingKind::Grey => vec![1.0; sampling.len()],
+                SamplingKind::Rgb => RGB_LUMINANCE_WEIGHTS.to_vec(),
+                SamplingKind::Spectral => luminous_grid_weights(&sampling.wavelengths_nm)?,
+            }],
+            WeightingKind::Identity => (0..sampling.len())
+                .map(|i| (0..sampling.len()).map(|j| if i == j { 1.0 } else { 0.0 }).collect())
+                .collect(),
+        })
+    }
+
+    /// The kinds (each once, in the order given) stacked into one matrix.
+    pub fn stack(kinds: &[WeightingKind], sampling: &Sampling) -> Result<Weighting> {
+        let mut w = Weighting { parts: Vec::new(), rows: Vec::new() };
+        for &kind in kinds {
+            if w.parts.iter().all(|(k, _)| *k != kind) {
+                w.parts.push((kind, w.rows.len()));
+                w.rows.extend(Weighting::rows_of(kind, sampling)?);
+            }
+        }
+        Ok(w)
+    }
+
+    /// The luminous weighting alone (one component).
+    pub fn luminous(sampling: &Sampling) -> Result<Weighting> {
+        Weighting::stack(&[WeightingKind::Luminous], sampling)
+    }
+
+    /// Number of components k.
+    pub fn len(&self) -> usize {
+        self.rows.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.rows.is_empty()
+    }
+
+    /// Index of the first component of `kind`, if the matrix has it.
+    pub fn offset(&self, kind: WeightingKind) -> Option<usize> {
+        self.parts.iter().find(|(k, _)| *k == kind).map(|(_, o)| *o)
+    }
+
+    /// Component c of the weighted values: Σ_j W[c][j] v_j.
+    #[inline]
+    pub fn component(&self, c: usize, values: &[f64]) -> f64 {
+        self.rows[c].iter().zip(values).map(|(w, v)| w * v).sum()
+    }
+
+    /// An error bound of component c from per-sample error bounds: Σ_j |W[c][j]| e_j.
+    pub fn component_error(&self, c: usize, errors: &[f64]) -> f64 {
+        self.rows[c].iter().zip(errors).map(|(w, e)| w.abs() * e).sum()
+    }
+
+    /// All k components of the weighted values.
+    pub fn apply(&self, values: &[f64]) -> Vec<f64> {
+        (0..self.len()).map(|c| self.component(c, values)).collect()
+    }
+
+    pub fn describe(&self) -> String {
+        self.parts
+            .iter()
+            .map(|(k, _)| match k {
+                WeightingKind::Luminous => {
+                    "luminous (CIE illuminant C × ȳ; the CIE 1931 primaries' luminances for RGB; 1 for grey)"
+                }
+                WeightingKind::Identity => "identity (one component per sample)",
+            })
+            .collect::<Vec<_>>()
+            .join(" + ")
     }
 }
 
@@ -185,9 +294,10 @@ mod tests {
     #[test]
     fn weights_are_normalised() {
         for s in [Sampling::grey(), Sampling::rgb(), Sampling::spectral(&[400.0, 500.0, 600.0, 700.0]).unwrap()] {
-            let total: f64 = s.luminous_weights.iter().sum();
+            let w = Weighting::luminous(&s).unwrap();
+            let total: f64 = w.rows[0].iter().sum();
             assert!((total - 1.0).abs() < 1e-15, "{:?}", s.kind);
-            assert!((s.luminous(&vec![0.37; s.len()]) - 0.37).abs() < 1e-15);
+            assert!((w.component(0, &vec![0.37; s.len()]) - 0.37).abs() < 1e-15);
         }
     }
 
@@ -199,11 +309,11 @@ mod tests {
         let text = include_str!("../fixtures/reference/luminous.json");
         let v: serde_json::Value = serde_json::from_str(text).unwrap();
         let grid: Vec<f64> = v["wavelengths_nm"].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect();
-        let s = Sampling::spectral(&grid).unwrap();
+        let s = Weighting::luminous(&Sampling::spectral(&grid).unwrap()).unwrap();
         for case in v["cases"].as_array().unwrap() {
             let r: Vec<f64> = case["reflectance"].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect();
             let y = case["Y_over_100"].as_f64().unwrap();
-            let ours = s.luminous(&r);
+            let ours = s.component(0, &r);
             eprintln!("{}: ours {ours}, colour-science {y}, difference {:e}", case["name"], ours - y);
             assert!((ours - y).abs() < 1e-6, "{}: {ours} vs colour-science {y}", case["name"]);
         }
@@ -226,7 +336,7 @@ mod tests {
         // The luminance ratio of the primaries, 1 : 4.5907 : 0.0601 (CIE 1931).
         let w = RGB_LUMINANCE_WEIGHTS;
         assert!((w[1] / w[0] - 4.5907).abs() < 1e-3 && (w[2] / w[0] - 0.0601).abs() < 1e-4);
-        assert_eq!(Sampling::rgb().luminous_weights, w.to_vec());
+        assert_eq!(Weighting::luminous(&Sampling::rgb()).unwrap().rows, vec![w.to_vec()]);
     }
 
     #[test]
@@ -245,5 +355,18 @@ mod tests {
         assert_eq!(interp(&t, 399.0), None);
         assert!(parse_table("400,1\n400,2\n", "t.csv").is_err());
         assert!(parse_table("400,x\n", "t.csv").unwrap_err().to_string().contains("t.csv"));
+    }
+
+    #[test]
+    fn weightings_stack_and_identity_is_the_samples() {
+        let s = Sampling::rgb();
+        let w =
+            Weighting::stack(&[WeightingKind::Luminous, WeightingKind::Identity, WeightingKind::Luminous], &s).unwrap();
+        assert_eq!(w.len(), 4);
+        assert_eq!(w.offset(WeightingKind::Luminous), Some(0));
+        assert_eq!(w.offset(WeightingKind::Identity), Some(1));
+        let l = RGB_LUMINANCE_WEIGHTS;
+        assert_eq!(w.apply(&[0.2, 0.5, 0.7]), vec![l[0] * 0.2 + l[1] * 0.5 + l[2] * 0.7, 0.2, 0.5, 0.7]);
+        assert_eq!(w.component_error(0, &[1.0, 1.0, 1.0]), l[0] + l[1] + l[2]);
     }
 }

@@ -30,7 +30,10 @@ fn every_fixture_loads() {
         let m = recipe::load_file(&p).unwrap_or_else(|e| panic!("{e}"));
         assert_eq!(m.file, p.display().to_string());
         assert!(!m.name.is_empty());
-        assert_eq!(m.brdf.sampling().len(), m.brdf.sampling().luminous_weights.len());
+        assert_eq!(
+            m.brdf.sampling().len(),
+            glossmeter::spectrum::Weighting::luminous(m.brdf.sampling()).unwrap().rows[0].len()
+        );
     }
 }
 

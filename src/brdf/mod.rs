@@ -68,6 +68,27 @@ pub trait Brdf: Send + Sync + std::fmt::Debug {
     /// (`out.len() == self.sampling().len()`).
     fn eval(&self, wi: Vec3, wo: Vec3, out: &mut [f64]);
 
+    /// The regular part at many direction pairs in one call (the integrator hands over a whole quadrature
+    /// region's points, or a refinement step's). The contract:
+    ///
+    /// * `wi.len() == wo.len() == m` and `out.len() == m · n` with n = `self.sampling().len()`, point-major:
+    ///   the n sample values of pair i go to `out[i*n..(i+1)*n]`;
+    /// * every one of the m · n outputs must be written, zeros included (the buffer is reused between calls
+    ///   and its contents on entry are unspecified); a pair with `wi.z <= 0` or `wo.z <= 0` gets zeros, as
+    ///   from [`Brdf::eval`] (the instrument passes only pairs above the horizon, but a model must not rely
+    ///   on it);
+    /// * the values must be the same bits as m calls of [`Brdf::eval`]: the integrator's sums, and so every
+    ///   reading, must not depend on how the points were batched.
+    ///
+    /// The default loops over [`Brdf::eval`]; a model overrides it when it can do better per batch (a
+    /// Python callable crossing the interpreter boundary once per batch, SIMD, a GPU).
+    fn eval_batch(&self, wi: &[Vec3], wo: &[Vec3], out: &mut [f64]) {
+        let n = self.sampling().len();
+        for ((a, b), o) in wi.iter().zip(wo).zip(out.chunks_exact_mut(n)) {
+            self.eval(*a, *b, o);
+        }
+    }
+
     /// The ideal-mirror component: f_δ = R(ωi)·δ(ωo − mirror(ωi)) / cos θo. Writes R per sample and returns
     /// true if the model has one; returns false (and leaves `out` alone) otherwise.
     fn delta_reflectance(&self, _wi: Vec3, _out: &mut [f64]) -> bool {
@@ -87,7 +108,7 @@ pub trait Brdf: Send + Sync + std::fmt::Debug {
     fn describe(&self) -> String;
 }
 
-impl dyn Brdf {
+impl dyn Brdf + '_ {
     /// The lobes among [`Brdf::terms`].
     pub fn lobes(&self) -> Vec<Lobe> {
         self.terms()

@@ -16,8 +16,8 @@
 //!   whose mirror lies in the receptor, by a 64 × 64 Gauss–Legendre product rule on that overlap box
 //!   ([`mirror_flux_reference`]; the integrand is smooth there).
 //!
-//! The reading is then assembled from these fluxes by the definitions of the readings (gloss, haze,
-//! log-haze, DOI, haze index), written out again here. Every other material is compared with a run of the
+//! The reading is then assembled from these fluxes by the plan's own definitions of the readings
+//! (`plan::reading_value`, `plan::haze_index_value`), the one place they are written. Every other material is compared with a run of the
 //! same engine at a tolerance 100× tighter than the tightest of the sweep: each row says which reference
 //! it used ("closed form" or "rtol=1e-12 run"), and in the second case the reference's own error estimate
 //! is reported with it: an actual error below that estimate is not resolved.
@@ -37,9 +37,12 @@ use std::time::Instant;
 
 use crate::brdf::{Brdf, TermKind};
 use crate::instrument::geometry::ReadingSpec;
-use crate::instrument::plan::{Job, Plan, PlanOptions, PlannedReading, Reading, Target};
+use crate::instrument::plan::{
+    haze_index_value, reading_value, Job, Plan, PlanOptions, PlannedReading, Reading, Target,
+};
 use crate::instrument::reference::{lambertian_flux_reference, mirror_flux_reference};
 use crate::instrument::standards::StandardGeometry;
+use crate::spectrum::Weighting;
 use crate::{Error, Result, Vec3};
 
 /// The default sweep: 1e-2, 1e-3, …, 1e-10.
@@ -169,6 +172,7 @@ pub fn lambertian_value(brdf: &dyn Brdf) -> Option<f64> {
         return None;
     }
     let n = brdf.sampling().len();
+    let luminous = Weighting::luminous(brdf.sampling()).ok()?;
     let mut buf = vec![0.0; n];
     let dir = |theta: f64, phi: f64| Vec3::new(theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos());
     if brdf.delta_reflectance(dir(0.3, 0.0), &mut buf) {
@@ -186,7 +190,7 @@ pub fn lambertian_value(brdf: &dyn Brdf) -> Option<f64> {
     for (wi, wo) in pairs {
         buf.iter_mut().for_each(|v| *v = 0.0);
         brdf.eval(wi, wo, &mut buf);
-        let f = brdf.sampling().luminous(&buf);
+        let f = luminous.component(0, &buf);
         if !f.is_finite() {
             return None;
         }
@@ -201,29 +205,23 @@ pub fn lambertian_value(brdf: &dyn Brdf) -> Option<f64> {
 
 /// The reference flux of one job of the plan, for a Lambertian specimen of luminous value `f_lum`.
 fn closed_form_flux(job: &Job, f_lum: f64) -> f64 {
-    match job.target {
-        Target::Specimen => lambertian_flux_reference(job.theta, job.source, job.receptor, f_lum),
+    let m = &job.method;
+    match m.target {
+        Target::Specimen => lambertian_flux_reference(m.theta, m.source, m.receptor, f_lum),
         Target::Standard => {
             let scale = job.scale;
-            mirror_flux_reference(job.theta, job.source, job.receptor, &|c| scale.standard_reflectance(c))
+            mirror_flux_reference(m.theta, m.source, m.receptor, &|c| scale.standard_reflectance(c))
         }
     }
 }
 
-/// A reading from reference fluxes, by the definitions in `instrument::geometry::ReadingSpec`.
+/// A reading from reference fluxes, by the plan's definitions of the readings (with zero flux errors).
 fn closed_form_reading(r: &PlannedReading, flux: &[f64], done: &[Option<f64>]) -> Option<f64> {
-    let spec = |rx: &String| flux[r.specimen[rx]];
-    let std = |rx: &String| flux[r.standard[rx]];
-    let mean = |rxs: &[String]| rxs.iter().map(spec).sum::<f64>() / rxs.len() as f64;
+    let specimen = |rx: &str| (flux[r.specimen_jobs[rx]], 0.0);
+    let standard = |rx: &str| (flux[r.standard_jobs[rx]], 0.0);
     let v = match &r.spec {
-        ReadingSpec::Gloss { receptor } => 100.0 * spec(receptor) / std(receptor),
-        ReadingSpec::Haze { receptors, specular } => 100.0 * mean(receptors) / std(specular),
-        ReadingSpec::LogHaze { receptors, specular, k } => {
-            let h = 100.0 * mean(receptors) / std(specular);
-            k * (h / 20.0 + 1.0).log10()
-        }
-        ReadingSpec::Doi { specular, offset } => 100.0 * (1.0 - mean(offset) / spec(specular)),
-        ReadingSpec::HazeIndex { .. } => done[r.parts[0]]? - done[r.parts[1]]?,
+        ReadingSpec::HazeIndex { .. } => haze_index_value((done[r.parts[0]]?, 0.0), (done[r.parts[1]]?, 0.0)).0,
+        spec => reading_value(spec, &specimen, &standard).ok()?.0,
     };
     v.is_finite().then_some(v)
 }

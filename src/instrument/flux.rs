@@ -1,71 +1,66 @@
-//! The aperture integral Φ = ∫_source ∫_receptor f(ωi, ωo) cos θi cos θo dωi dωo for one source stop,
-//! one receptor stop and one BRDF: the hot path of the crate.
+//! The geometry of one aperture integral Φ = ∫_source ∫_receptor f(ωi, ωo) cos θi cos θo dωi dωo: the
+//! charts it can be integrated in, where their split points go, the clipping of the stops at the horizon,
+//! the mirror overlap of an ideal-mirror term, and the [`Flux`] an integral produces. The plan designs each
+//! integral from these pieces ([`crate::instrument::method`]); this module only answers questions about it.
 //!
-//! Why the change of variables: the glossy mass of a paint lies on the specular manifold p_s + p_r = 0,
+//! Why the lobe chart: the glossy mass of a paint lies on the specular manifold p_s + p_r = 0,
 //! q_s + q_r = 0, a 2-D ridge in the 4-D domain. Axis-aligned cubature over (p_s, q_s, p_r, q_r) cannot see
-//! a ridge narrower than its first sample spacing and returns 0 with a tiny error estimate
-//! (`../shared/reference/numerics-notes.md` §1.3). We integrate instead over the lobe variables
-//! u = p_s + p_r, v = q_s + q_r, and over the position t ∈ [0, 1] along the exact overlap of the stops for
-//! that u: per axis, p_s ∈ [max(s0, u − r1), min(s1, u − r0)], p_s = lo + t·(hi − lo), Jacobian hi − lo.
-//! The overlap length is piecewise linear in u with kinks at s0 + r0, s1 + r0, s0 + r1, s1 + r1: those are
-//! split points. Each lobe adds split points at 0 and ±k·w (k = 1, 3, 10, 30, … out to the range) with w its
-//! width in u,
-//! so a lobe of any width is resolved by the initial partition. An ideal-mirror (delta) component is
-//! integrated analytically in u (it sits at u = v = 0) as a 2-D integral over the stops' mirror overlap.
-use crate::brdf::{Brdf, Lobe};
-use crate::instrument::geometry::{solid_angle_density, Axes, Stop};
-use crate::quadrature::{integrate, Estimate, Options};
+//! a ridge narrower than its first sample spacing and returns 0 with a tiny error estimate (Genz & Malik's
+//! rule, like any fixed rule, samples a box at 57 points; a ridge between them is invisible: see
+//! `docs/instrument.md` §Quadrature). We integrate instead over the lobe variables u = p_s + p_r,
+//! v = q_s + q_r, and over the position t ∈ [0, 1] along the exact overlap of the stops for that u: per
+//! axis, p_s ∈ [max(s0, u − r1), min(s1, u − r0)], p_s = lo + t·(hi − lo), Jacobian hi − lo. The overlap
+//! length is piecewise linear in u with kinks at s0 + r0, s1 + r0, s0 + r1, s1 + r1: those are split points.
+//! Each lobe adds split points at 0 and ±k·w (k = 1, 3, 10, 30, …) with w its width in u, out to 10 w for a
+//! Gaussian tail and to the end of the range for a heavy one, so a lobe of any width is resolved by the
+//! initial partition. An ideal-mirror (delta) component is integrated analytically in u (it sits at
+//! u = v = 0) as a 2-D integral over the stops' mirror overlap.
+use crate::brdf::Lobe;
+use crate::instrument::geometry::Stop;
 
 /// Fraction of a flux's tolerance given to its delta part. The delta part is a smooth 2-D integral that
 /// converges to near machine precision in a few hundred evaluations, so it is asked for much more than its
 /// half and the expensive 4-D regular part gets the rest.
 pub const DELTA_SHARE: f64 = 0.01;
 
-/// How the spectral samples enter the integral.
-#[derive(Clone, Debug, PartialEq)]
-pub enum Spectral {
-    /// Integrate the luminous sum Σ w_k f_k: one component (the plan folds the weights in).
-    Folded(Vec<f64>),
-    /// Integrate every sample separately, then weight (costlier; kept to measure what folding saves).
-    Separate(Vec<f64>),
-}
-
-impl Spectral {
-    pub fn weights(&self) -> &[f64] {
-        match self {
-            Spectral::Folded(w) | Spectral::Separate(w) => w,
-        }
-    }
-}
-
-/// The result of one aperture integral, luminous.
+/// The result of one aperture integral: k components, one per row of the method's spectral weighting
+/// (one, the luminous flux, for gloss readings).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Flux {
-    /// Luminous flux (sr² units of the BRDF integral; the same units for specimen and standard).
-    pub value: f64,
-    /// Error estimate (absolute).
-    pub error: f64,
-    /// The analytic (delta) and numerical (regular) parts.
-    pub delta: f64,
-    pub regular: f64,
+    /// Weighted flux per component (sr² units of the BRDF integral; the same units for specimen and
+    /// standard).
+    pub value: Vec<f64>,
+    /// Error estimate per component (absolute).
+    pub error: Vec<f64>,
+    /// The analytic (delta) and numerical (regular) parts, per component.
+    pub delta: Vec<f64>,
+    pub regular: Vec<f64>,
+    /// Integrand evaluations spent (both parts).
     pub evaluations: usize,
+    /// Regions of the final partitions (both parts).
     pub regions: usize,
+    /// Whether both parts met their tolerances within the budget.
     pub converged: bool,
+    /// Wall time of the integral.
     pub seconds: f64,
-    /// The variables the regular part was integrated in.
-    pub variables: Variables,
+    /// The chart the regular part was integrated in (None: there was no regular part).
+    pub chart: Option<Chart>,
 }
 
-/// Write the integrand: the per-sample values times the geometric factor `g`, either one component per
-/// sample (`separate`) or folded into the luminous sum Σ w_k f_k·g.
-#[inline]
-fn store(out: &mut [f64], values: &[f64], weights: &[f64], g: f64, separate: bool) {
-    if separate {
-        for (o, v) in out.iter_mut().zip(values) {
-            *o = v * g;
+impl Flux {
+    /// The flux of an empty integral (stops below the horizon, or nothing to integrate), k components.
+    pub fn zero(k: usize) -> Flux {
+        Flux {
+            value: vec![0.0; k],
+            error: vec![0.0; k],
+            delta: vec![0.0; k],
+            regular: vec![0.0; k],
+            evaluations: 0,
+            regions: 0,
+            converged: true,
+            seconds: 0.0,
+            chart: None,
         }
-    } else {
-        out[0] = weights.iter().zip(values).map(|(a, b)| a * b).sum::<f64>() * g;
     }
 }
 
@@ -82,9 +77,9 @@ pub fn lobe_widths_uv(lobe: &Lobe, theta: f64) -> [f64; 2] {
     [2.0 * m * eta * ct / c, 2.0 * m * eta * ct]
 }
 
-/// The variables the regular part is integrated in, chosen per integral by [`choose_variables`].
+/// The variables (chart) a regular part is integrated in, chosen per integral by [`choose_chart`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Variables {
+pub enum Chart {
     /// The plain product of the stops, (p_s, q_s, p_r, q_r): one box, no kinks. Right when every lobe is at
     /// least as wide as the whole lobe-variable range on both axes (or there is none): the integrand is then
     /// smooth over the product and one 57-point Genz–Malik region may already meet the tolerance.
@@ -94,8 +89,8 @@ pub enum Variables {
     Lobe,
 }
 
-/// Choose the variables of the regular part for these (clipped) stops and lobes at angle θ.
-pub fn choose_variables(lobes: &[Lobe], theta: f64, source: Stop, receptor: Stop) -> Variables {
+/// Choose the chart of the regular part for these (clipped) stops and lobes at angle θ.
+pub fn choose_chart(lobes: &[Lobe], theta: f64, source: Stop, receptor: Stop) -> Chart {
     let range_u = (source.p[1] - source.p[0]) + (receptor.p[1] - receptor.p[0]);
     let range_v = (source.q[1] - source.q[0]) + (receptor.q[1] - receptor.q[0]);
     let wide = |l: &Lobe| {
@@ -103,30 +98,60 @@ pub fn choose_variables(lobes: &[Lobe], theta: f64, source: Stop, receptor: Stop
         w[0] >= range_u && w[1] >= range_v
     };
     if lobes.iter().all(wide) {
-        Variables::Plain
+        Chart::Plain
     } else {
-        Variables::Lobe
+        Chart::Lobe
     }
 }
 
-/// A list of boxes (lower corner, upper corner) in the 4-D lobe coordinates (u, t_p, v, t_q).
-type Boxes4 = Vec<([f64; 4], [f64; 4])>;
+/// The mirror overlap of two (clipped) stops: the box of source points (p, q) whose mirror image (−p, −q)
+/// lies in the receptor, as (lower, upper) corners; None if it is empty (the receptor does not see the
+/// mirror image of the source, so an ideal-mirror term contributes nothing). The one place this is computed
+/// (the independent reference in `instrument/reference.rs` keeps its own on purpose).
+pub fn mirror_overlap(source: Stop, receptor: Stop) -> Option<([f64; 2], [f64; 2])> {
+    let lo = [source.p[0].max(-receptor.p[1]), source.q[0].max(-receptor.q[1])];
+    let hi = [source.p[1].min(-receptor.p[0]), source.q[1].min(-receptor.q[0])];
+    (hi[0] > lo[0] && hi[1] > lo[1]).then_some((lo, hi))
+}
+
+/// The split points of the lobe chart on each axis (u, then v), from the stops and the lobes.
+pub fn lobe_splits(lobes: &[Lobe], theta: f64, source: Stop, receptor: Stop) -> [Vec<f64>; 2] {
+    let ap = AxisMap { s: source.p, r: receptor.p };
+    let aq = AxisMap { s: source.q, r: receptor.q };
+    let widths: Vec<[f64; 2]> = lobes.iter().map(|l| lobe_widths_uv(l, theta)).collect();
+    let up = ap.splits(&widths.iter().zip(lobes).map(|(w, l)| (w[0], l.heavy_tail)).collect::<Vec<_>>());
+    let uq = aq.splits(&widths.iter().zip(lobes).map(|(w, l)| (w[1], l.heavy_tail)).collect::<Vec<_>>());
+    [up, uq]
+}
+
+/// The initial boxes of the lobe chart in (u, t_p, v, t_q): the product of the split intervals, t ∈ [0, 1].
+pub fn lobe_boxes(splits: &[Vec<f64>; 2]) -> Vec<([f64; 4], [f64; 4])> {
+    let [up, uq] = splits;
+    let mut boxes = Vec::with_capacity((up.len().max(1) - 1) * (uq.len().max(1) - 1));
+    for a in up.windows(2) {
+        for b in uq.windows(2) {
+            boxes.push(([a[0], 0.0, b[0], 0.0], [a[1], 1.0, b[1], 1.0]));
+        }
+    }
+    boxes
+}
 
 /// One axis of the (source, receptor) pair in lobe coordinates.
 #[derive(Clone, Copy, Debug)]
-struct AxisMap {
-    s: [f64; 2],
-    r: [f64; 2],
+pub struct AxisMap {
+    /// The source's and the receptor's interval on this axis.
+    pub s: [f64; 2],
+    pub r: [f64; 2],
 }
 
 impl AxisMap {
-    fn range(&self) -> [f64; 2] {
+    pub fn range(&self) -> [f64; 2] {
         [self.s[0] + self.r[0], self.s[1] + self.r[1]]
     }
 
     /// (p_s, p_r, Jacobian) at lobe coordinate u and overlap position t.
     #[inline]
-    fn at(&self, u: f64, t: f64) -> (f64, f64, f64) {
+    pub fn at(&self, u: f64, t: f64) -> (f64, f64, f64) {
         let lo = self.s[0].max(u - self.r[1]);
         let hi = self.s[1].min(u - self.r[0]);
         let len = (hi - lo).max(0.0);
@@ -136,7 +161,7 @@ impl AxisMap {
 
     /// Split points of u: the range ends, the kinks of the overlap length, the lobe centre and multiples
     /// of each lobe width.
-    fn splits(&self, widths: &[(f64, bool)]) -> Vec<f64> {
+    pub fn splits(&self, widths: &[(f64, bool)]) -> Vec<f64> {
         let [a, b] = self.range();
         let mut pts = vec![a, b, self.s[1] + self.r[0], self.s[0] + self.r[1]];
         // Lobes within a factor 3 of a narrower one share its splits: the splits are geometric (×3 apart),
@@ -193,178 +218,10 @@ pub fn clip(stop: Stop, theta: f64, is_source: bool) -> Option<Stop> {
     (s.p[1] > s.p[0] && s.q[1] > s.q[0]).then_some(s)
 }
 
-/// Everything needed for one aperture integral.
-pub struct FluxProblem<'a> {
-    pub brdf: &'a dyn Brdf,
-    pub theta: f64,
-    pub source: Stop,
-    pub receptor: Stop,
-    pub spectral: Spectral,
-    /// Lobes of the BRDF (from `terms()`), for the split points.
-    pub lobes: Vec<Lobe>,
-    pub include_delta: bool,
-    pub include_regular: bool,
-    /// Relative tolerance on the flux, and an absolute floor.
-    pub rtol: f64,
-    pub atol: f64,
-    pub max_evals: usize,
-}
-
-impl FluxProblem<'_> {
-    /// The initial boxes of the regular integral in (u, t_p, v, t_q), and the axis maps.
-    fn partition(&self, src: Stop, rec: Stop) -> (AxisMap, AxisMap, Boxes4) {
-        let ap = AxisMap { s: src.p, r: rec.p };
-        let aq = AxisMap { s: src.q, r: rec.q };
-        let widths: Vec<[f64; 2]> = self.lobes.iter().map(|l| lobe_widths_uv(l, self.theta)).collect();
-        let up = ap.splits(&widths.iter().zip(&self.lobes).map(|(w, l)| (w[0], l.heavy_tail)).collect::<Vec<_>>());
-        let uq = aq.splits(&widths.iter().zip(&self.lobes).map(|(w, l)| (w[1], l.heavy_tail)).collect::<Vec<_>>());
-        let mut boxes = Vec::with_capacity((up.len() - 1) * (uq.len() - 1));
-        for a in up.windows(2) {
-            for b in uq.windows(2) {
-                boxes.push(([a[0], 0.0, b[0], 0.0], [a[1], 1.0, b[1], 1.0]));
-            }
-        }
-        (ap, aq, boxes)
-    }
-
-    /// Compute the flux.
-    pub fn solve(&self) -> Flux {
-        let start = std::time::Instant::now();
-        let weights = self.spectral.weights().to_vec();
-        let n = weights.len();
-        let axes = Axes::new(self.theta);
-        let (Some(src), Some(rec)) = (clip(self.source, self.theta, true), clip(self.receptor, self.theta, false))
-        else {
-            return Flux {
-                value: 0.0,
-                error: 0.0,
-                delta: 0.0,
-                regular: 0.0,
-                evaluations: 0,
-                regions: 0,
-                converged: true,
-                seconds: 0.0,
-                variables: Variables::Plain,
-            };
-        };
-        let (separate, ncomp) = match self.spectral {
-            Spectral::Folded(_) => (false, 1),
-            Spectral::Separate(_) => (true, n),
-        };
-        let lum = |e: &Estimate| -> (f64, f64) {
-            if separate {
-                (
-                    weights.iter().zip(&e.value).map(|(w, v)| w * v).sum(),
-                    weights.iter().zip(&e.error).map(|(w, v)| w * v).sum(),
-                )
-            } else {
-                (e.value[0], e.error[0])
-            }
-        };
-        let mut scratch = vec![0.0; n];
-        let mut evaluations = 0;
-        let mut regions = 0;
-        let mut converged = true;
-
-        // 1. The delta part: source points whose mirror (−p, −q) lies in the receptor. It gets DELTA_SHARE
-        // of the budget when a regular part follows, all of it otherwise (the gloss standard).
-        let delta_share = if self.include_regular { DELTA_SHARE } else { 1.0 };
-        let (mut delta, mut delta_err) = (0.0, 0.0);
-        if self.include_delta {
-            let lo = [src.p[0].max(-rec.p[1]), src.q[0].max(-rec.q[1])];
-            let hi = [src.p[1].min(-rec.p[0]), src.q[1].min(-rec.q[0])];
-            if hi[0] > lo[0] && hi[1] > lo[1] {
-                let brdf = self.brdf;
-                let w = &weights;
-                let est = integrate::<2, _>(
-                    |x, out| {
-                        let wi = axes.source_dir(x[0], x[1]);
-                        if wi.z <= 0.0 || !brdf.delta_reflectance(wi, &mut scratch) {
-                            return;
-                        }
-                        store(out, &scratch, w, wi.z * solid_angle_density(x[0], x[1]), separate);
-                    },
-                    ncomp,
-                    &[(lo, hi)],
-                    &Options {
-                        rtol: delta_share * self.rtol,
-                        atol: delta_share * self.atol,
-                        max_evals: self.max_evals,
-                    },
-                );
-                (delta, delta_err) = lum(&est);
-                evaluations += est.evaluations;
-                regions += est.regions;
-                converged &= est.converged;
-            }
-        }
-
-        // 2. The regular part, in the plain variables or in lobe coordinates (`choose_variables`).
-        let (mut regular, mut regular_err) = (0.0, 0.0);
-        let variables = choose_variables(&self.lobes, self.theta, src, rec);
-        if self.include_regular {
-            let (ap, aq, boxes) = match variables {
-                Variables::Lobe => self.partition(src, rec),
-                Variables::Plain => (
-                    AxisMap { s: src.p, r: rec.p },
-                    AxisMap { s: src.q, r: rec.q },
-                    vec![([src.p[0], src.q[0], rec.p[0], rec.q[0]], [src.p[1], src.q[1], rec.p[1], rec.q[1]])],
-                ),
-            };
-            let plain = variables == Variables::Plain;
-            let brdf = self.brdf;
-            let w = &weights;
-            // The regular part gets the rest of the budget: err_r ≤ max(atol, r·|Φ_δ|, r·|Φ_r|) with
-            // r = (1 − DELTA_SHARE)·rtol, so err_δ + err_r ≤ rtol·(|Φ_δ| + |Φ_r|) (+ the floor) as both parts are ≥ 0.
-            let share = 1.0 - DELTA_SHARE;
-            let atol = (share * self.atol).max(share * self.rtol * delta.abs());
-            let est = integrate::<4, _>(
-                |x, out| {
-                    let (ps, qs, pr, qr, jac) = if plain {
-                        (x[0], x[1], x[2], x[3], 1.0)
-                    } else {
-                        let (ps, pr, jp) = ap.at(x[0], x[1]);
-                        let (qs, qr, jq) = aq.at(x[2], x[3]);
-                        (ps, qs, pr, qr, jp * jq)
-                    };
-                    if jac <= 0.0 {
-                        return;
-                    }
-                    let wi = axes.source_dir(ps, qs);
-                    let wo = axes.receptor_dir(pr, qr);
-                    if wi.z <= 0.0 || wo.z <= 0.0 {
-                        return;
-                    }
-                    brdf.eval(wi, wo, &mut scratch);
-                    let g = wi.z * wo.z * solid_angle_density(ps, qs) * solid_angle_density(pr, qr) * jac;
-                    store(out, &scratch, w, g, separate);
-                },
-                ncomp,
-                &boxes,
-                &Options { rtol: share * self.rtol, atol, max_evals: self.max_evals },
-            );
-            (regular, regular_err) = lum(&est);
-            evaluations += est.evaluations;
-            regions += est.regions;
-            converged &= est.converged;
-        }
-        Flux {
-            value: delta + regular,
-            error: delta_err + regular_err,
-            delta,
-            regular,
-            evaluations,
-            regions,
-            converged,
-            seconds: start.elapsed().as_secs_f64(),
-            variables,
-        }
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::instrument::geometry::Axes;
 
     #[test]
     fn overlap_map_covers_the_product_exactly() {
@@ -387,5 +244,99 @@ mod tests {
         let wo = axes.receptor_dir(-0.013, 0.02);
         let m = crate::brdf::mirror(wi);
         assert!((m - wo).length() < 1e-15);
+    }
+
+    fn lobe(m: f64, eta: f64, heavy: bool) -> Lobe {
+        Lobe { slope_width: m, medium_eta: eta, label: "test".into(), heavy_tail: heavy }
+    }
+
+    /// The widths against a direct construction: tilt a flake by δ inside the medium (in the plane, then
+    /// perpendicular to it), reflect the internal ray off it, refract it out (tangential component × η), and
+    /// measure the deviation of the exit ray in the receptor's tangent coordinates.
+    #[test]
+    fn lobe_widths_follow_snell_for_a_tilted_flake() {
+        use crate::Vec3;
+        let delta: f64 = 1e-7;
+        for (theta, eta) in [(0.35f64, 1.0f64), (1.047, 1.5), (1.48, 1.5), (0.2, 2.0)] {
+            let st = theta.sin() / eta;
+            let ct = (1.0 - st * st).sqrt();
+            // The internal ray towards the flake and its mirror direction inside the medium.
+            let d = Vec3::new(st, 0.0, -ct);
+            let exit = |n: Vec3| {
+                let r = d - 2.0 * d.dot(n) * n;
+                // Leave the medium: tangential components × η, z from normalisation.
+                let (x, y) = (eta * r.x, eta * r.y);
+                Vec3::new(x, y, (1.0 - x * x - y * y).sqrt())
+            };
+            let axis = exit(Vec3::new(0.0, 0.0, 1.0));
+            assert!((axis.z - theta.cos()).abs() < 1e-12, "the untilted flake reflects specularly");
+            // Receptor tangent coordinates about `axis`: in-plane e_par = (cos θ, 0, −sin θ), perpendicular y.
+            let e_par = Vec3::new(theta.cos(), 0.0, -theta.sin());
+            let tangent = |w: Vec3| (w.dot(e_par) / w.dot(axis), w.y / w.dot(axis));
+            // Central differences in the tilt.
+            let (up, _) = tangent(exit(Vec3::new(delta.sin(), 0.0, delta.cos())));
+            let (um, _) = tangent(exit(Vec3::new(-delta.sin(), 0.0, delta.cos())));
+            let (_, vp) = tangent(exit(Vec3::new(0.0, delta.sin(), delta.cos())));
+            let (_, vm) = tangent(exit(Vec3::new(0.0, -delta.sin(), delta.cos())));
+            let (du, dv) = ((up - um).abs() / (2.0 * delta), (vp - vm).abs() / (2.0 * delta));
+            let w = lobe_widths_uv(&lobe(1.0, eta, false), theta);
+            assert!((du - w[0]).abs() < 1e-6 * w[0], "θ={theta} η={eta}: u {du} vs {}", w[0]);
+            assert!((dv - w[1]).abs() < 1e-6 * w[1], "θ={theta} η={eta}: v {dv} vs {}", w[1]);
+        }
+    }
+
+    #[test]
+    fn the_chart_is_plain_only_when_every_lobe_covers_the_range() {
+        let s = Stop { p: [-0.01, 0.01], q: [-0.02, 0.02] };
+        let theta = 0.35;
+        assert_eq!(choose_chart(&[], theta, s, s), Chart::Plain);
+        // Range in u: 0.04, in v: 0.08; a lobe of slope width m is ≈ 2m wide.
+        assert_eq!(choose_chart(&[lobe(0.5, 1.0, false)], theta, s, s), Chart::Plain);
+        assert_eq!(choose_chart(&[lobe(1e-3, 1.0, false)], theta, s, s), Chart::Lobe);
+        assert_eq!(choose_chart(&[lobe(0.5, 1.0, false), lobe(1e-3, 1.0, true)], theta, s, s), Chart::Lobe);
+        // Wide enough in u but not in v (0.03: 2m = 0.06 ≥ 0.04/cos θ... but 2m cos θ < 0.08).
+        let w = lobe_widths_uv(&lobe(0.03, 1.0, false), theta);
+        assert!(w[0] >= 0.04 && w[1] < 0.08);
+        assert_eq!(choose_chart(&[lobe(0.03, 1.0, false)], theta, s, s), Chart::Lobe);
+    }
+
+    #[test]
+    fn splits_sit_at_the_kinks_and_at_multiples_of_the_lobe_width() {
+        let src = Stop { p: [-0.01, 0.01], q: [-0.02, 0.02] };
+        let rec = Stop { p: [-0.03, 0.03], q: [-0.02, 0.02] };
+        let theta = 0.0;
+        let has = |v: &[f64], x: f64| v.iter().any(|y| (y - x).abs() <= 1e-15);
+        // A Gaussian lobe 2e-4 wide in u: 0, ±w, ±3w, ±10w, and no further.
+        let [u, v] = lobe_splits(&[lobe(1e-4, 1.0, false)], theta, src, rec);
+        let w = 2e-4;
+        for k in [0.0, 1.0, 3.0, 10.0, -1.0, -3.0, -10.0] {
+            assert!(has(&u, k * w), "{k}w missing from {u:?}");
+        }
+        assert!(!has(&u, 30.0 * w), "a Gaussian tail stops at 10 w: {u:?}");
+        // The range ends and the overlap kinks s1 + r0, s0 + r1.
+        for x in [-0.04, 0.04, 0.01 - 0.03, -0.01 + 0.03] {
+            assert!(has(&u, x), "{x} missing from {u:?}");
+        }
+        assert!(u.windows(2).all(|p| p[0] < p[1]), "sorted, no duplicates");
+        // A heavy tail goes on to the end of the range.
+        let [uh, _] = lobe_splits(&[lobe(1e-4, 1.0, true)], theta, src, rec);
+        assert!(has(&uh, 30.0 * w) && has(&uh, 100.0 * w) && has(&uh, -100.0 * w), "{uh:?}");
+        // Lobes within 3× of a narrower one share its splits.
+        let [u2, _] = lobe_splits(&[lobe(1e-4, 1.0, false), lobe(2.5e-4, 1.0, false)], theta, src, rec);
+        assert_eq!(u2, u);
+        // v gets the same treatment with the perpendicular width (2m cos θ = 2m here).
+        assert!(has(&v, 10.0 * w) && has(&v, -10.0 * w));
+        // The boxes tile the product of the split intervals.
+        let boxes = lobe_boxes(&[u.clone(), v.clone()]);
+        assert_eq!(boxes.len(), (u.len() - 1) * (v.len() - 1));
+    }
+
+    #[test]
+    fn the_mirror_overlap_is_the_source_box_whose_mirror_is_in_the_receptor() {
+        let src = Stop { p: [-0.01, 0.02], q: [-0.02, 0.02] };
+        let rec = Stop { p: [-0.005, 0.03], q: [-0.01, 0.04] };
+        assert_eq!(mirror_overlap(src, rec), Some(([-0.01, -0.02], [0.005, 0.01])));
+        let off = Stop { p: [0.02, 0.03], q: [-0.01, 0.01] };
+        assert_eq!(mirror_overlap(src, off), None, "a receptor offset past the mirror image sees none of it");
     }
 }

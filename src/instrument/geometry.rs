@@ -7,6 +7,7 @@
 //! is the direction normalize(axis + p·e∥ + q·e⊥) with e⊥ = (0, 1, 0), e∥ = e⊥ × axis, and solid-angle
 //! element dω = dp dq / (1 + p² + q²)^{3/2}. The mirror image of source point (p, q) is receptor point
 //! (−p, −q), so the specular manifold is p_s + p_r = 0, q_s + q_r = 0.
+use crate::spectrum::WeightingKind;
 use crate::Vec3;
 
 /// A rectangular field stop in tangent coordinates: p ∈ [p0, p1] in the plane of measurement (positive p
@@ -97,6 +98,13 @@ impl ReadingSpec {
             ReadingSpec::Doi { .. } => "doi",
             ReadingSpec::HazeIndex { .. } => "haze-index",
         }
+    }
+
+    /// The spectral weighting the reading's fluxes need (all of today's readings are luminous: ISO 2813 and
+    /// ASTM D523 weight the flux by V(λ) under CIE illuminant C). A colour reading returns its own kind and
+    /// the plan adds those rows to the fluxes (`spectrum::WeightingKind`).
+    pub fn weighting(&self) -> WeightingKind {
+        WeightingKind::Luminous
     }
 
     pub fn unit(&self) -> &'static str {

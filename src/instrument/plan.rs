@@ -1,27 +1,38 @@
 //! The measurement plan: (material, geometries, requested readings) compiled once into the cheapest list
-//! of aperture integrals that produces them, in the manner of RustFFT's planner. The plan
+//! of aperture integrals that produces them, in the manner of RustFFT's planner: step one designs a
+//! [`Method`] per integral (plain data: clipped stops, mirror visibility, chart, rule, initial partition,
+//! delta part, spectral weighting, tolerances, budget), step two executes the methods. The plan
 //!
-//! * keeps only the terms the material has (the model builds no flake term without flakes; the plan lists
-//!   what is there and how each term is integrated: a smooth coat as an analytic delta, a diffuse body with
-//!   no lobe splits, each lobe with splits at its own width);
-//! * folds the spectral dimension into one luminous component when only luminous readings are asked for;
+//! * keeps only the terms the material has (the model builds no flake term without flakes; the methods
+//!   integrate a smooth coat as an analytic delta, a diffuse body with no lobe splits, each lobe with splits
+//!   at its own width);
+//! * chooses the spectral weighting from the readings asked for (every reading says which it needs:
+//!   `ReadingSpec::weighting`) and folds it into the integrand, so a luminous flux is one component whatever
+//!   the number of samples;
 //! * computes each distinct flux once and shares it: the gloss standard's flux between gloss and haze
 //!   readings, a receptor between gloss and DOI, identical geometries (ASTM D523 and ISO 2813 at the same
 //!   angle) between themselves, and the gloss readings that a composite (ASTM D4039) needs;
-//! * runs the integrals in parallel, collecting results in plan order, so the numbers are the same bits
-//!   whatever the thread count.
+//! * computes the gloss standards' fluxes when it is compiled (they do not depend on the material; a
+//!   long-lived [`Planner`] keeps them for every plan it compiles);
+//! * runs the specimen integrals in parallel, collecting results in plan order, so the numbers are the same
+//!   bits whatever the thread count.
 //!
-//! `explain()` prints the plan in plain words (`glossmeter measure --explain`).
-use std::collections::HashMap;
-use std::sync::Arc;
+//! A compiled plan can be executed on another material of the same shape ([`Plan::with_material`]) and
+//! frozen after one adaptive execution ([`Plan::freeze`]); `explain()` prints the stored methods in plain
+//! words (`glossmeter measure --explain`).
+use std::collections::{BTreeMap, HashMap};
+use std::sync::{Arc, Mutex};
 
 use rayon::prelude::*;
 
 use crate::brdf::{Brdf, Lobe, Term, TermKind};
-use crate::instrument::flux::{choose_variables, clip, lobe_widths_uv, Flux, FluxProblem, Spectral, Variables};
+use crate::instrument::flux::{lobe_widths_uv, Chart, Flux, DELTA_SHARE};
 use crate::instrument::geometry::{ReadingSpec, Scale, Stop};
+pub use crate::instrument::method::Target;
+use crate::instrument::method::{Design, Method, Projection};
 use crate::instrument::standards::{self, StandardGeometry};
-use crate::spectrum::Sampling;
+use crate::quadrature::Refine;
+use crate::spectrum::{Sampling, Weighting, WeightingKind};
 use crate::{Error, Result, Vec3};
 
 /// Share of a reading's relative tolerance given to each specimen flux and to the gloss standard's flux. A
@@ -37,7 +48,8 @@ pub const STANDARD_SHARE: f64 = 0.05;
 pub struct PlanOptions {
     /// Relative tolerance of every reading.
     pub rtol: f64,
-    /// Fold the luminous weights into the integrand (one component instead of one per sample).
+    /// Apply the spectral weighting in the integrand (k components) rather than after integrating every
+    /// sample (n components).
     pub fold_spectral: bool,
     /// Compute each distinct flux once.
     pub share_fluxes: bool,
@@ -53,7 +65,9 @@ impl Default for PlanOptions {
 
 /// The gloss standard of a scale, rescaled to read 100 ([`Scale::standard_reflectance`]): black glass (a
 /// smooth, non-absorbing dielectric, black-backed: only its front-surface Fresnel reflection counts) or a
-/// perfect mirror. Integrated by the same engine as any specimen.
+/// perfect mirror. Integrated by the same engine as any specimen. (On the black-glass scale at 100 GU it is
+/// `brdf::dielectric::SmoothDielectric` of the glass's index, to the bit; it is its own type because of the
+/// scale's rescaling and the mirror scale.)
 #[derive(Debug)]
 pub struct GlossStandard {
     pub scale: Scale,
@@ -86,22 +100,12 @@ impl Brdf for GlossStandard {
     }
 }
 
-/// Which material a flux is taken on.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum Target {
-    Specimen,
-    Standard,
-}
-
-/// One aperture integral of the plan.
+/// One aperture integral of the plan: its method and where it is used.
 #[derive(Clone, Debug)]
 pub struct Job {
-    pub target: Target,
-    pub theta: f64,
-    /// The scale of the standard (only used by `Target::Standard` jobs).
+    pub method: Method,
+    /// The scale of the standard (used by standard jobs only).
     pub scale: Scale,
-    pub source: Stop,
-    pub receptor: Stop,
     /// Where it is used: "geometry-id/receptor".
     pub used_by: Vec<String>,
 }
@@ -112,9 +116,12 @@ pub struct PlannedReading {
     pub geometry: String,
     pub name: String,
     pub spec: ReadingSpec,
-    /// Specimen and standard flux job indices, by receptor name.
-    pub specimen: HashMap<String, usize>,
-    pub standard: HashMap<String, usize>,
+    /// Job index of each specimen flux and each standard flux, by receptor name.
+    pub specimen_jobs: BTreeMap<String, usize>,
+    pub standard_jobs: BTreeMap<String, usize>,
+    /// The component of the specimen fluxes this reading uses (its weighting's offset in the plan's
+    /// weighting; the standards' fluxes are luminous, component 0).
+    pub component: usize,
     /// For composites: indices of the gloss readings combined.
     pub parts: Vec<usize>,
     /// Whether the user asked for it (dependencies of composites are computed but not reported).
@@ -140,32 +147,107 @@ pub struct Reading {
     pub note: Option<String>,
 }
 
+/// The shape of a material, which a plan's methods depend on: its sampling and the kinds of its terms.
+#[derive(Clone, Debug, PartialEq)]
+struct Shape {
+    sampling: Sampling,
+    kinds: Vec<u8>,
+}
+
+fn shape(m: &dyn Brdf) -> Shape {
+    let kinds = m
+        .terms()
+        .iter()
+        .map(|t| match t.kind {
+            TermKind::Delta => 0,
+            TermKind::Diffuse => 1,
+            TermKind::Lobe(_) => 2,
+        })
+        .collect();
+    Shape { sampling: m.sampling().clone(), kinds }
+}
+
 /// The compiled plan.
+#[derive(Clone)]
 pub struct Plan {
     pub material: Arc<dyn Brdf>,
     pub options: PlanOptions,
     pub geometries: Vec<StandardGeometry>,
     pub jobs: Vec<Job>,
     pub readings: Vec<PlannedReading>,
-    lobes: Vec<Lobe>,
-    has_delta: bool,
-    has_regular: bool,
+    /// The spectral weighting of the specimen fluxes (stacked from the readings' kinds).
+    pub weighting: Weighting,
+    /// The material's terms, as the methods were designed for.
+    pub terms: Vec<Term>,
+    shape: Shape,
+    /// The standards' fluxes, computed at compile time (None for specimen jobs).
+    standard_flux: Vec<Option<Flux>>,
 }
 
-fn key(j: &Job) -> Vec<u64> {
-    let mut k = vec![j.target as u64, j.theta.to_bits()];
-    if j.target == Target::Standard {
-        k.extend(j.scale.key());
+/// The identity of a job for sharing: every input of its design, as bits.
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+struct JobKey(Vec<u64>);
+
+fn job_key(target: Target, theta: f64, scale: Scale, source: Stop, receptor: Stop) -> JobKey {
+    let mut k = vec![target as u64, theta.to_bits()];
+    if target == Target::Standard {
+        k.extend(scale.key());
     }
-    for s in [j.source, j.receptor] {
+    for s in [source, receptor] {
         k.extend([s.p[0], s.p[1], s.q[0], s.q[1]].iter().map(|x| x.to_bits()));
     }
-    k
+    JobKey(k)
 }
 
-impl Plan {
+/// A job before its method is designed.
+struct Draft {
+    target: Target,
+    theta: f64,
+    scale: Scale,
+    source: Stop,
+    receptor: Stop,
+    used_by: Vec<String>,
+}
+
+/// A long-lived planner: the builtin geometries parsed once, and the gloss standards' fluxes (which do not
+/// depend on the material) cached across the plans it compiles, for sweeps, fitting and bindings. It is
+/// `Sync`: plans can be compiled from several threads. The cache is keyed by every input of the standard's
+/// method (θ, index, stops, tolerance, budget), so a cached flux is the same bits as a recomputed one.
+pub struct Planner {
+    builtin: Vec<StandardGeometry>,
+    standards: Mutex<HashMap<JobKey, Flux>>,
+}
+
+impl Planner {
+    pub fn new() -> Result<Planner> {
+        Ok(Planner { builtin: standards::builtin()?, standards: Mutex::new(HashMap::new()) })
+    }
+
+    /// The builtin geometries.
+    pub fn builtin(&self) -> &[StandardGeometry] {
+        &self.builtin
+    }
+
+    /// The builtin geometry with this id; an unknown id is a usage error listing the known ids.
+    pub fn geometry(&self, id: &str) -> Result<StandardGeometry> {
+        self.builtin.iter().find(|g| g.geometry.id == id).cloned().ok_or_else(|| {
+            let ids: Vec<&str> = self.builtin.iter().map(|g| g.geometry.id.as_str()).collect();
+            Error::Usage(format!("unknown geometry id \"{id}\"; known ids: {}", ids.join(", ")))
+        })
+    }
+
+    /// Number of gloss-standard fluxes cached.
+    pub fn cached_standards(&self) -> usize {
+        self.standards.lock().map(|c| c.len()).unwrap_or(0)
+    }
+
     /// Compile a plan for `material` and the geometries (builtin ids resolved by the caller, or user files).
-    pub fn compile(material: Arc<dyn Brdf>, geometries: Vec<StandardGeometry>, options: PlanOptions) -> Result<Plan> {
+    pub fn compile(
+        &self,
+        material: Arc<dyn Brdf>,
+        geometries: Vec<StandardGeometry>,
+        options: PlanOptions,
+    ) -> Result<Plan> {
         if !(options.rtol.is_finite() && options.rtol > 0.0 && options.rtol < 1.0) {
             return Err(Error::Usage(format!(
                 "the relative tolerance (rtol) must be a number in (0, 1), got {}",
@@ -175,223 +257,308 @@ impl Plan {
         if geometries.is_empty() {
             return Err(Error::Usage("no geometry to measure".into()));
         }
-        let terms = material.terms();
-        let lobes: Vec<Lobe> = terms
-            .iter()
-            .filter_map(|t| match &t.kind {
-                TermKind::Lobe(l) => Some(l.clone()),
-                _ => None,
-            })
-            .collect();
-        let has_delta = terms.iter().any(|t| t.kind == TermKind::Delta);
-        let has_regular = terms.iter().any(|t| t.kind != TermKind::Delta);
-        let mut plan = Plan {
-            material,
-            options,
-            geometries: Vec::new(),
-            jobs: Vec::new(),
-            readings: Vec::new(),
-            lobes,
-            has_delta,
-            has_regular,
-        };
-        let mut index: HashMap<Vec<u64>, usize> = HashMap::new();
         // Requested geometries first, then the dependencies of composites.
         let mut queue: Vec<(StandardGeometry, bool)> = geometries.into_iter().map(|g| (g, true)).collect();
         let mut i = 0;
         while i < queue.len() {
-            let (g, reported) = queue[i].clone();
+            let g = queue[i].0.clone();
             for spec in &g.geometry.readings {
                 if let ReadingSpec::HazeIndex { minuend, subtrahend } = spec {
                     for id in [minuend, subtrahend] {
                         if !queue.iter().any(|(q, _)| &q.geometry.id == id) {
-                            queue.push((standards::find(id)?, false));
+                            queue.push((self.geometry(id)?, false));
                         }
                     }
                 }
             }
-            let _ = reported;
             i += 1;
         }
+        // The spectral weighting: the kinds the readings ask for, each once, in order of first use.
+        let kinds: Vec<WeightingKind> =
+            queue.iter().flat_map(|(g, _)| g.geometry.readings.iter().map(ReadingSpec::weighting)).collect();
+        let weighting = Weighting::stack(&kinds, material.sampling())?;
+        let mut drafts: Vec<Draft> = Vec::new();
+        let mut readings: Vec<PlannedReading> = Vec::new();
+        let mut index: HashMap<JobKey, usize> = HashMap::new();
         for (g, reported) in &queue {
-            plan.add_geometry(g, *reported, &mut index)?;
+            add_geometry(g, *reported, &weighting, options.share_fluxes, &mut drafts, &mut readings, &mut index)?;
         }
         // Composites: resolve their parts now that every gloss reading exists.
-        for r in 0..plan.readings.len() {
-            if let ReadingSpec::HazeIndex { minuend, subtrahend } = plan.readings[r].spec.clone() {
+        for r in 0..readings.len() {
+            if let ReadingSpec::HazeIndex { minuend, subtrahend } = readings[r].spec.clone() {
                 let mut parts = Vec::new();
                 for id in [&minuend, &subtrahend] {
-                    let part = plan
-                        .readings
+                    let part = readings
                         .iter()
                         .position(|x| &x.geometry == id && matches!(x.spec, ReadingSpec::Gloss { .. }))
                         .ok_or_else(|| {
-                            Error::Usage(format!("{}: geometry `{id}` has no gloss reading", plan.readings[r].geometry))
+                            Error::Usage(format!("{}: geometry `{id}` has no gloss reading", readings[r].geometry))
                         })?;
                     parts.push(part);
                 }
-                plan.readings[r].parts = parts;
+                readings[r].parts = parts;
             }
         }
-        plan.geometries = queue.into_iter().map(|(g, _)| g).collect();
-        Ok(plan)
-    }
 
-    fn job(&mut self, index: &mut HashMap<Vec<u64>, usize>, job: Job) -> usize {
-        let k = key(&job);
-        if self.options.share_fluxes {
-            if let Some(&i) = index.get(&k) {
-                let used = job.used_by[0].clone();
-                if !self.jobs[i].used_by.contains(&used) {
-                    self.jobs[i].used_by.push(used);
+        // Step 1a: the standards' methods, executed now (cached across plans).
+        let standard_weighting = Weighting::luminous(&Sampling::grey())?;
+        let standard_method = |d: &Draft| {
+            Method::design(Design {
+                target: Target::Standard,
+                theta: d.theta,
+                source: d.source,
+                receptor: d.receptor,
+                lobes: &[],
+                has_delta: true,
+                has_regular: false,
+                weighting: standard_weighting.clone(),
+                projection: Projection::Fold,
+                rtol: STANDARD_SHARE * options.rtol,
+                atol: 0.0,
+                max_evals: options.max_evals,
+            })
+        };
+        let std_idx: Vec<usize> = (0..drafts.len()).filter(|&j| drafts[j].target == Target::Standard).collect();
+        let std_methods: Vec<Method> = std_idx.iter().map(|&j| standard_method(&drafts[j])).collect();
+        let std_flux: Vec<Flux> =
+            std_idx.par_iter().zip(&std_methods).map(|(&j, m)| self.standard_flux(&drafts[j], m, &options)).collect();
+        // Absolute floor per geometry angle: 1e-4·rtol of the largest standard flux at that angle, i.e.
+        // 0.01·rtol GU on a gloss reading; it only matters for fluxes that are (nearly) zero.
+        let floor = |theta: f64| -> f64 {
+            let m = std_idx
+                .iter()
+                .zip(&std_flux)
+                .filter(|(&j, _)| drafts[j].theta == theta)
+                .map(|(_, f)| f.value[0])
+                .fold(0.0, f64::max);
+            1e-4 * options.rtol * m
+        };
+
+        // Step 1b: the specimen's methods.
+        let terms = material.terms();
+        let lobes: Vec<Lobe> = material.lobes();
+        let has_delta = material.has_delta();
+        let has_regular = material.has_regular();
+        let projection = if options.fold_spectral { Projection::Fold } else { Projection::Separate };
+        let mut jobs = Vec::with_capacity(drafts.len());
+        let mut standard_flux = vec![None; drafts.len()];
+        let mut std_results = std_methods.into_iter().zip(std_flux.iter().cloned());
+        for (j, d) in drafts.iter().enumerate() {
+            let method = match d.target {
+                Target::Standard => {
+                    let (m, f) = std_results.next().expect("one standard method per standard job");
+                    standard_flux[j] = Some(f);
+                    m
                 }
-                return i;
-            }
+                Target::Specimen => Method::design(Design {
+                    target: Target::Specimen,
+                    theta: d.theta,
+                    source: d.source,
+                    receptor: d.receptor,
+                    lobes: &lobes,
+                    has_delta,
+                    has_regular,
+                    weighting: weighting.clone(),
+                    projection,
+                    rtol: SPECIMEN_SHARE * options.rtol,
+                    atol: floor(d.theta),
+                    max_evals: options.max_evals,
+                }),
+            };
+            jobs.push(Job { method, scale: d.scale, used_by: d.used_by.clone() });
         }
-        self.jobs.push(job);
-        index.insert(k, self.jobs.len() - 1);
-        self.jobs.len() - 1
+        let shape = shape(material.as_ref());
+        Ok(Plan {
+            material,
+            options,
+            geometries: queue.into_iter().map(|(g, _)| g).collect(),
+            jobs,
+            readings,
+            weighting,
+            terms,
+            shape,
+            standard_flux,
+        })
     }
 
-    fn add_geometry(
-        &mut self,
-        sg: &StandardGeometry,
-        reported: bool,
-        index: &mut HashMap<Vec<u64>, usize>,
-    ) -> Result<()> {
-        let g = &sg.geometry;
-        for (ri, spec) in g.readings.iter().enumerate() {
-            let name = sg.reading_names.get(ri).cloned().unwrap_or_else(|| spec.quantity().to_string());
-            let (spec_rx, std_rx): (Vec<&String>, Vec<&String>) = match spec {
-                ReadingSpec::Gloss { receptor } => (vec![receptor], vec![receptor]),
-                ReadingSpec::Haze { receptors, specular } | ReadingSpec::LogHaze { receptors, specular, .. } => {
-                    (receptors.iter().collect(), vec![specular])
-                }
-                ReadingSpec::Doi { specular, offset } => {
-                    (std::iter::once(specular).chain(offset.iter()).collect(), vec![])
-                }
-                ReadingSpec::HazeIndex { .. } => (vec![], vec![]),
-            };
-            let mut pr = PlannedReading {
-                geometry: g.id.clone(),
-                name,
-                spec: spec.clone(),
-                specimen: HashMap::new(),
-                standard: HashMap::new(),
-                parts: vec![],
-                reported,
-            };
-            for (names, target) in [(spec_rx, Target::Specimen), (std_rx, Target::Standard)] {
-                for rx in names {
-                    let stop = *g.receptor(rx).ok_or_else(|| {
-                        Error::Usage(format!("{}: reading `{}` names unknown receptor `{rx}`", g.id, pr.name))
-                    })?;
-                    let j = self.job(
-                        index,
-                        Job {
+    /// The flux of a gloss standard, from the cache or computed (and cached). With sharing off, always
+    /// computed (the ablation measures what sharing saves).
+    fn standard_flux(&self, d: &Draft, method: &Method, options: &PlanOptions) -> Flux {
+        let std = GlossStandard::new(d.scale);
+        if !options.share_fluxes {
+            return method.execute(&std);
+        }
+        let mut key = job_key(Target::Standard, d.theta, d.scale, d.source, d.receptor);
+        key.0.extend([options.rtol.to_bits(), options.max_evals as u64]);
+        if let Some(f) = self.standards.lock().ok().and_then(|c| c.get(&key).cloned()) {
+            return f;
+        }
+        let f = method.execute(&std);
+        if let Ok(mut c) = self.standards.lock() {
+            c.insert(key, f.clone());
+        }
+        f
+    }
+}
+
+/// Add the readings of one geometry and the drafts of the jobs they need (shared by key when `share`).
+fn add_geometry(
+    sg: &StandardGeometry,
+    reported: bool,
+    weighting: &Weighting,
+    share: bool,
+    drafts: &mut Vec<Draft>,
+    readings: &mut Vec<PlannedReading>,
+    index: &mut HashMap<JobKey, usize>,
+) -> Result<()> {
+    let g = &sg.geometry;
+    for (ri, spec) in g.readings.iter().enumerate() {
+        let name = sg.reading_names.get(ri).cloned().unwrap_or_else(|| spec.quantity().to_string());
+        let (spec_rx, std_rx): (Vec<&String>, Vec<&String>) = match spec {
+            ReadingSpec::Gloss { receptor } => (vec![receptor], vec![receptor]),
+            ReadingSpec::Haze { receptors, specular } | ReadingSpec::LogHaze { receptors, specular, .. } => {
+                (receptors.iter().collect(), vec![specular])
+            }
+            ReadingSpec::Doi { specular, offset } => (std::iter::once(specular).chain(offset.iter()).collect(), vec![]),
+            ReadingSpec::HazeIndex { .. } => (vec![], vec![]),
+        };
+        let mut pr = PlannedReading {
+            geometry: g.id.clone(),
+            name,
+            spec: spec.clone(),
+            specimen_jobs: BTreeMap::new(),
+            standard_jobs: BTreeMap::new(),
+            component: weighting.offset(spec.weighting()).expect("the plan's weighting has every reading's kind"),
+            parts: vec![],
+            reported,
+        };
+        for (names, target) in [(spec_rx, Target::Specimen), (std_rx, Target::Standard)] {
+            for rx in names {
+                let stop = *g.receptor(rx).ok_or_else(|| {
+                    Error::Usage(format!("{}: reading `{}` names unknown receptor `{rx}`", g.id, pr.name))
+                })?;
+                let key = job_key(target, g.theta, g.scale, g.source, stop);
+                let used = format!("{}/{rx}", g.id);
+                let j = match index.get(&key) {
+                    Some(&i) if share => {
+                        if !drafts[i].used_by.contains(&used) {
+                            drafts[i].used_by.push(used);
+                        }
+                        i
+                    }
+                    _ => {
+                        drafts.push(Draft {
                             target,
                             theta: g.theta,
                             scale: g.scale,
                             source: g.source,
                             receptor: stop,
-                            used_by: vec![format!("{}/{rx}", g.id)],
-                        },
-                    );
-                    match target {
-                        Target::Specimen => pr.specimen.insert(rx.clone(), j),
-                        Target::Standard => pr.standard.insert(rx.clone(), j),
-                    };
-                }
+                            used_by: vec![used],
+                        });
+                        index.insert(key, drafts.len() - 1);
+                        drafts.len() - 1
+                    }
+                };
+                match target {
+                    Target::Specimen => pr.specimen_jobs.insert(rx.clone(), j),
+                    Target::Standard => pr.standard_jobs.insert(rx.clone(), j),
+                };
             }
-            self.readings.push(pr);
         }
-        Ok(())
+        readings.push(pr);
+    }
+    Ok(())
+}
+
+impl Plan {
+    /// Compile a plan with a fresh [`Planner`] (use one long-lived planner to share its caches).
+    pub fn compile(material: Arc<dyn Brdf>, geometries: Vec<StandardGeometry>, options: PlanOptions) -> Result<Plan> {
+        Planner::new()?.compile(material, geometries, options)
     }
 
-    fn spectral(&self, sampling: &Sampling) -> Spectral {
-        if self.options.fold_spectral {
-            Spectral::Folded(sampling.luminous_weights.clone())
-        } else {
-            Spectral::Separate(sampling.luminous_weights.clone())
+    /// The same plan (the same methods, partitions included, and the same standards' fluxes) for another
+    /// material of the same shape: the same spectral sampling and the same kinds of terms in the same order.
+    /// The split points stay those of the material the plan was compiled for: right for a nearby material
+    /// (a fitter's step, a sweep's neighbour); for a very different one compile a new plan.
+    pub fn with_material(&self, material: Arc<dyn Brdf>) -> Result<Plan> {
+        let s = shape(material.as_ref());
+        if s != self.shape {
+            return Err(Error::Usage(format!(
+                "the plan was compiled for a material of another shape ({} samples, terms {:?}); this one has {} \
+                 samples, terms {:?}",
+                self.shape.sampling.len(),
+                self.shape.kinds,
+                s.sampling.len(),
+                s.kinds
+            )));
         }
+        let mut p = self.clone();
+        p.material = material;
+        Ok(p)
     }
 
-    /// Run one job; `atol` is the absolute floor.
-    fn run_job(&self, job: &Job, atol: f64) -> Flux {
-        match job.target {
-            Target::Standard => {
-                let std = GlossStandard::new(job.scale);
-                FluxProblem {
-                    brdf: &std,
-                    theta: job.theta,
-                    source: job.source,
-                    receptor: job.receptor,
-                    spectral: Spectral::Folded(vec![1.0]),
-                    lobes: vec![],
-                    include_delta: true,
-                    include_regular: false,
-                    rtol: STANDARD_SHARE * self.options.rtol,
-                    atol: 0.0,
-                    max_evals: self.options.max_evals,
-                }
-                .solve()
-            }
-            Target::Specimen => FluxProblem {
-                brdf: self.material.as_ref(),
-                theta: job.theta,
-                source: job.source,
-                receptor: job.receptor,
-                spectral: self.spectral(self.material.sampling()),
-                lobes: self.lobes.clone(),
-                include_delta: self.has_delta,
-                include_regular: self.has_regular,
-                rtol: SPECIMEN_SHARE * self.options.rtol,
-                atol,
-                max_evals: self.options.max_evals,
-            }
-            .solve(),
-        }
+    /// Whether every specimen method is frozen.
+    pub fn is_frozen(&self) -> bool {
+        self.jobs.iter().all(|j| j.method.target == Target::Standard || j.method.is_frozen())
     }
 
-    /// Execute the plan: every flux once (in parallel, collected in plan order), then the readings.
-    pub fn execute(&self) -> Vec<Reading> {
-        // Phase 1: the standards (cheap, analytic); they set the scale of the absolute floors.
-        let std_jobs: Vec<usize> = (0..self.jobs.len()).filter(|&j| self.jobs[j].target == Target::Standard).collect();
-        let std_flux: Vec<Flux> = std_jobs.par_iter().map(|&j| self.run_job(&self.jobs[j], 0.0)).collect();
-        let mut flux: Vec<Option<Flux>> = vec![None; self.jobs.len()];
-        for (j, f) in std_jobs.iter().zip(std_flux) {
-            flux[*j] = Some(f);
-        }
-        // Absolute floor per geometry angle: 1e-4·rtol of the largest standard flux at that angle, i.e.
-        // 0.01·rtol GU on a gloss reading; it only matters for fluxes that are (nearly) zero.
-        let floor = |theta: f64| -> f64 {
-            let m = std_jobs
-                .iter()
-                .filter(|&&j| self.jobs[j].theta == theta)
-                .filter_map(|&j| flux[j].as_ref().map(|f| f.value))
-                .fold(0.0, f64::max);
-            1e-4 * self.options.rtol * m
-        };
-        let spec_jobs: Vec<(usize, f64)> = (0..self.jobs.len())
-            .filter(|&j| self.jobs[j].target == Target::Specimen)
-            .map(|j| (j, floor(self.jobs[j].theta)))
+    /// Execute the plan adaptively and return its readings together with the frozen plan: every specimen
+    /// method keeps its final partition and is re-executed with the same rule and no refinement. Executing
+    /// the frozen plan on the same material gives the same value and error bits (fewer evaluations: the
+    /// refined-away parents are not evaluated again); on a nearby material ([`Plan::with_material`]) the
+    /// readings move smoothly with the material's parameters, as finite differences need. A frozen plan's
+    /// error estimates are those of its fixed partition: check `converged` before trusting one far from
+    /// the material it was frozen on.
+    pub fn freeze(&self) -> (Vec<Reading>, Plan) {
+        let results: Vec<Option<(Flux, Method)>> = self
+            .jobs
+            .par_iter()
+            .map(|j| match j.method.target {
+                Target::Specimen => Some(j.method.execute_and_freeze(self.material.as_ref())),
+                Target::Standard => None,
+            })
             .collect();
-        let spec_flux: Vec<Flux> = spec_jobs.par_iter().map(|&(j, atol)| self.run_job(&self.jobs[j], atol)).collect();
-        for ((j, _), f) in spec_jobs.iter().zip(spec_flux) {
-            flux[*j] = Some(f);
+        let mut frozen = self.clone();
+        let mut flux = Vec::with_capacity(self.jobs.len());
+        for (j, r) in results.into_iter().enumerate() {
+            match r {
+                Some((f, m)) => {
+                    frozen.jobs[j].method = m;
+                    flux.push(f);
+                }
+                None => flux.push(self.standard_flux[j].clone().expect("standard fluxes are computed at compile")),
+            }
         }
-        let flux: Vec<Flux> = flux.into_iter().map(|f| f.expect("every job ran")).collect();
-        // Direct readings first, then composites, which combine direct readings (their parts may come
-        // later in plan order when the user asked for the composite before its parts, or only for it).
+        (self.readings_from(&flux), frozen)
+    }
+
+    /// Execute the plan: every specimen flux once (in parallel, collected in plan order), then the readings.
+    pub fn execute(&self) -> Vec<Reading> {
+        let flux: Vec<Flux> = self
+            .jobs
+            .par_iter()
+            .enumerate()
+            .map(|(j, job)| match &self.standard_flux[j] {
+                Some(f) => f.clone(),
+                None => job.method.execute(self.material.as_ref()),
+            })
+            .collect();
+        self.readings_from(&flux)
+    }
+
+    /// The readings from the fluxes of every job. Direct readings first, then composites, which combine
+    /// direct readings (their parts may come later in plan order when the user asked for the composite
+    /// before its parts, or only for it).
+    fn readings_from(&self, flux: &[Flux]) -> Vec<Reading> {
         let mut out: Vec<Option<Reading>> = vec![None; self.readings.len()];
         for (i, r) in self.readings.iter().enumerate() {
             if r.parts.is_empty() {
-                out[i] = Some(compute_reading(r, &flux, &out));
+                out[i] = Some(compute_reading(r, flux));
             }
         }
         for (i, r) in self.readings.iter().enumerate() {
             if !r.parts.is_empty() {
-                out[i] = Some(compute_reading(r, &flux, &out));
+                out[i] = Some(compose_reading(r, &out));
             }
         }
         out.into_iter()
@@ -401,19 +568,26 @@ impl Plan {
             .collect()
     }
 
-    /// The plan in plain words.
+    /// The plan in plain words: the stored methods, printed (nothing is worked out again here).
     pub fn explain(&self) -> String {
         let m = &self.material;
         let mut s = String::new();
         s.push_str(&format!("Material: {}\n", m.describe()));
         s.push_str(&format!("Spectral samples: {}\n", m.sampling().describe()));
-        if self.options.fold_spectral {
-            s.push_str("  Only luminous readings are asked for: the luminous weights are folded into the integrand,\n  so each aperture integral has one component instead of one per sample.\n");
-        } else {
-            s.push_str("  Spectral folding is off: each sample is integrated separately, then weighted.\n");
-        }
+        let projection = self.jobs.iter().find(|j| j.method.target == Target::Specimen).map(|j| j.method.projection);
+        s.push_str(&format!(
+            "Spectral weighting: {} ({} component(s) per flux, from {} sample(s)); {}\n",
+            self.weighting.describe(),
+            self.weighting.len(),
+            m.sampling().len(),
+            match projection {
+                Some(Projection::Fold) | None =>
+                    "applied in the integrand, so each aperture integral has one component per weighted quantity",
+                Some(Projection::Separate) => "folding off: each sample is integrated separately, then weighted",
+            }
+        ));
         s.push_str("Terms of the material, and how each is integrated:\n");
-        for t in m.terms() {
+        for t in &self.terms {
             let how = match &t.kind {
                 TermKind::Delta => {
                     "ideal mirror: analytic in the lobe variables, a 2-D integral over the stops' mirror overlap"
@@ -421,18 +595,25 @@ impl Plan {
                 }
                 TermKind::Diffuse => "smooth in direction: no lobe splits needed".to_string(),
                 TermKind::Lobe(l) => format!(
-                    "glossy lobe, slope width {:.3e}{}: lobe variables split at 0 and ±(1, 3, 10, 30, …)× its width out to the aperture range",
+                    "glossy lobe, slope width {:.3e}{}{}: lobe variables split at 0 and ±(1, 3, 10, 30, …)× its width, \
+                     {}",
                     l.slope_width,
-                    if l.medium_eta != 1.0 {
-                        format!(" inside a medium of index {}", l.medium_eta)
-                    } else {
-                        String::new()
-                    }
+                    if l.medium_eta != 1.0 { format!(" inside a medium of index {}", l.medium_eta) } else { String::new() },
+                    if l.heavy_tail { ", heavy tail" } else { "" },
+                    if l.heavy_tail { "out to the ends of the range" } else { "out to 10× its width (Gaussian tail)" }
                 ),
             };
             s.push_str(&format!("  - {}: {how}\n", t.label));
         }
         s.push_str("  Terms the material does not have are not built and cost nothing.\n");
+        let lobes: Vec<&Lobe> = self
+            .terms
+            .iter()
+            .filter_map(|t| match &t.kind {
+                TermKind::Lobe(l) => Some(l),
+                _ => None,
+            })
+            .collect();
         for g in &self.geometries {
             let geo = &g.geometry;
             if geo.is_composite() {
@@ -449,7 +630,7 @@ impl Plan {
                 geo.theta.to_degrees(),
                 geo.scale.describe()
             ));
-            for l in &self.lobes {
+            for l in &lobes {
                 let w = lobe_widths_uv(l, geo.theta);
                 s.push_str(&format!(
                     "  lobe '{}' is {:.3e} × {:.3e} wide in the lobe variables (u, v)\n",
@@ -457,9 +638,9 @@ impl Plan {
                 ));
             }
         }
-        let n_spec = self.jobs.iter().filter(|j| j.target == Target::Specimen).count();
+        let n_spec = self.jobs.iter().filter(|j| j.method.target == Target::Specimen).count();
         let n_std = self.jobs.len() - n_spec;
-        let uses: usize = self.readings.iter().map(|r| r.specimen.len() + r.standard.len()).sum();
+        let uses: usize = self.readings.iter().map(|r| r.specimen_jobs.len() + r.standard_jobs.len()).sum();
         s.push_str(&format!(
             "Aperture integrals: {} on the specimen, {} on gloss standards ({} uses by {} readings{})\n",
             n_spec,
@@ -473,51 +654,48 @@ impl Plan {
             }
         ));
         for (i, j) in self.jobs.iter().enumerate() {
-            let how = match j.target {
-                Target::Standard => "analytic (delta) only".to_string(),
-                Target::Specimen => {
-                    let clipped = (clip(j.source, j.theta, true), clip(j.receptor, j.theta, false));
-                    let vars = match clipped {
-                        (Some(a), Some(b)) => match choose_variables(&self.lobes, j.theta, a, b) {
-                            Variables::Plain => "plain variables (no lobe narrower than the stops)",
-                            Variables::Lobe => "lobe variables",
-                        },
-                        _ => "stops below the horizon: zero",
-                    };
-                    // Does the receptor see the mirror image of the source (a non-empty delta integral)?
-                    let sees_mirror = match clipped {
-                        (Some(a), Some(b)) => {
-                            a.p[0].max(-b.p[1]) < a.p[1].min(-b.p[0]) && a.q[0].max(-b.q[1]) < a.q[1].min(-b.q[0])
-                        }
-                        _ => false,
-                    };
-                    let delta = match (self.has_delta, sees_mirror) {
-                        (false, _) => "",
-                        (true, true) => "analytic delta + ",
-                        (true, false) => "no mirror image in this stop (delta skipped) + ",
-                    };
-                    if self.has_regular {
-                        format!("{delta}{vars}")
-                    } else if sees_mirror {
-                        "analytic (delta) only".to_string()
-                    } else {
-                        "no mirror image in this stop and no regular part: zero".to_string()
-                    }
-                }
-            };
             s.push_str(&format!(
-                "  #{i}: {:?} at {:.4}°, {how}; used by {}\n",
-                j.target,
-                j.theta.to_degrees(),
+                "  #{i}: {:?} at {:.4}°, {}; used by {}\n",
+                j.method.target,
+                j.method.theta.to_degrees(),
+                describe_method(&j.method, &self.terms),
                 j.used_by.join(", ")
             ));
         }
         s.push_str(&format!(
-            "Tolerance: relative {:e} on every reading; {} of it to each specimen flux (1 % of that to its analytic \
+            "Tolerance: relative {:e} on every reading; {} of it to each specimen flux ({} of that to its analytic \
              part), {} to the gloss standard.\n",
-            self.options.rtol, SPECIMEN_SHARE, STANDARD_SHARE
+            self.options.rtol, SPECIMEN_SHARE, DELTA_SHARE, STANDARD_SHARE
         ));
         s
+    }
+}
+
+/// One method in words, from its stored fields.
+fn describe_method(m: &Method, terms: &[Term]) -> String {
+    if m.clipped.is_none() {
+        return "stops below the horizon: zero".to_string();
+    }
+    let material_has_delta = m.target == Target::Standard || terms.iter().any(|t| t.kind == TermKind::Delta);
+    let frozen = |r: Refine| if r == Refine::Frozen { ", frozen" } else { "" };
+    let delta = match (&m.delta, material_has_delta, m.mirror.is_some()) {
+        (Some(p), _, _) => format!("analytic delta ({} box{})", p.cells.len(), frozen(p.refine)),
+        (None, true, false) => "no mirror image in this stop (delta skipped)".to_string(),
+        _ => String::new(),
+    };
+    let regular = m.regular.as_ref().map(|p| {
+        let chart = match p.chart {
+            Chart::Plain => "plain variables (no lobe narrower than the stops)".to_string(),
+            Chart::Lobe => format!("lobe variables, {} × {} split points", p.splits[0].len(), p.splits[1].len()),
+        };
+        format!("{chart}, Genz–Malik 7/5 on {} initial box(es){}", p.cells.len(), frozen(p.refine))
+    });
+    match (delta.is_empty(), regular) {
+        (true, None) => "nothing to integrate: zero".to_string(),
+        (false, None) if m.delta.is_none() => format!("{delta} and no regular part: zero"),
+        (false, None) => format!("{delta} only"),
+        (true, Some(r)) => r,
+        (false, Some(r)) => format!("{delta} + {r}"),
     }
 }
 
@@ -537,73 +715,66 @@ fn problem_reading(r: &PlannedReading, why: String) -> Reading {
     }
 }
 
-/// Combine fluxes into a reading, with first-order error propagation.
-fn compute_reading(r: &PlannedReading, flux: &[Flux], done: &[Option<Reading>]) -> Reading {
-    let spec = |rx: &String| &flux[r.specimen[rx]];
-    let std = |rx: &String| &flux[r.standard[rx]];
-    let used: Vec<&Flux> = r.specimen.values().chain(r.standard.values()).map(|&j| &flux[j]).collect();
-    let evaluations = used.iter().map(|f| f.evaluations).sum();
-    let seconds = used.iter().map(|f| f.seconds).sum();
-    let converged = used.iter().all(|f| f.converged);
+/// The value and first-order error of a direct (non-composite) reading from its fluxes, each given as
+/// (value, error) by receptor name: the definitions of the readings (`ReadingSpec`), in one place. Err says
+/// why there is no value (a zero reference flux).
+pub fn reading_value(
+    spec: &ReadingSpec,
+    specimen: &dyn Fn(&str) -> (f64, f64),
+    standard: &dyn Fn(&str) -> (f64, f64),
+) -> std::result::Result<(f64, f64), String> {
     let mean = |rxs: &[String]| -> (f64, f64) {
         let n = rxs.len() as f64;
-        (rxs.iter().map(|x| spec(x).value).sum::<f64>() / n, rxs.iter().map(|x| spec(x).error).sum::<f64>() / n)
+        (rxs.iter().map(|x| specimen(x).0).sum::<f64>() / n, rxs.iter().map(|x| specimen(x).1).sum::<f64>() / n)
     };
-    let result: std::result::Result<(f64, f64), String> = match &r.spec {
+    match spec {
         ReadingSpec::Gloss { receptor } => {
-            let (s, d) = (spec(receptor), std(receptor));
-            ratio(s.value, s.error, d.value, d.error).map(|(v, e)| (100.0 * v, 100.0 * e))
+            let ((s, se), (d, de)) = (specimen(receptor), standard(receptor));
+            ratio(s, se, d, de).map(|(v, e)| (100.0 * v, 100.0 * e))
         }
         ReadingSpec::Haze { receptors, specular } => {
             let (h, he) = mean(receptors);
-            let d = std(specular);
-            ratio(h, he, d.value, d.error).map(|(v, e)| (100.0 * v, 100.0 * e))
+            let (d, de) = standard(specular);
+            ratio(h, he, d, de).map(|(v, e)| (100.0 * v, 100.0 * e))
         }
         ReadingSpec::LogHaze { receptors, specular, k } => {
             let (h, he) = mean(receptors);
-            let d = std(specular);
-            ratio(h, he, d.value, d.error).map(|(v, e)| {
+            let (d, de) = standard(specular);
+            ratio(h, he, d, de).map(|(v, e)| {
                 let (h, he) = (100.0 * v, 100.0 * e);
                 (k * (h / 20.0 + 1.0).log10(), k * he / (std::f64::consts::LN_10 * (h + 20.0)))
             })
         }
         ReadingSpec::Doi { specular, offset } => {
-            let s = spec(specular);
+            let (s, se) = specimen(specular);
             let (o, oe) = mean(offset);
-            ratio(o, oe, s.value, s.error).map(|(v, e)| (100.0 * (1.0 - v), 100.0 * e))
+            ratio(o, oe, s, se).map(|(v, e)| (100.0 * (1.0 - v), 100.0 * e))
         }
-        ReadingSpec::HazeIndex { .. } => {
-            let (Some(a), Some(b)) = (&done[r.parts[0]], &done[r.parts[1]]) else {
-                return problem_reading(r, "a gloss reading it combines was not computed".into());
-            };
-            let mut rd = match (a.value, b.value) {
-                (Some(x), Some(y)) => Reading {
-                    geometry: r.geometry.clone(),
-                    name: r.name.clone(),
-                    quantity: r.spec.quantity().into(),
-                    unit: r.spec.unit().into(),
-                    value: Some(x - y),
-                    error_estimate: a.error_estimate + b.error_estimate,
-                    evaluations: a.evaluations + b.evaluations,
-                    seconds: a.seconds + b.seconds,
-                    converged: a.converged && b.converged,
-                    problem: None,
-                    note: (a.value.unwrap_or(0.0) <= 70.0 || x - y < 0.0).then(|| {
-                        "outside the scope of ASTM D4039, which is defined for non-metallic specimens with G60 > 70 \
-                         (a negative index means the 20° receptor gathers relatively more than the 60° one, as for \
-                         near-mirror flakes)"
-                            .to_string()
-                    }),
-                },
-                _ => problem_reading(r, "a gloss reading it combines has no value".into()),
-            };
-            if rd.value.is_some() && !(rd.value.unwrap().is_finite() && rd.error_estimate.is_finite()) {
-                rd = problem_reading(r, "non-finite result".into());
-            }
-            return rd;
-        }
+        ReadingSpec::HazeIndex { .. } => Err("a composite reading has no fluxes of its own".into()),
+    }
+}
+
+/// The value and error of a haze index (ASTM D4039) from its two gloss readings' (value, error).
+pub fn haze_index_value(minuend: (f64, f64), subtrahend: (f64, f64)) -> (f64, f64) {
+    (minuend.0 - subtrahend.0, minuend.1 + subtrahend.1)
+}
+
+/// Combine fluxes into a direct reading, with first-order error propagation.
+fn compute_reading(r: &PlannedReading, flux: &[Flux]) -> Reading {
+    let c = r.component;
+    let specimen = |rx: &str| {
+        let f = &flux[r.specimen_jobs[rx]];
+        (f.value[c], f.error[c])
     };
-    match result {
+    let standard = |rx: &str| {
+        let f = &flux[r.standard_jobs[rx]];
+        (f.value[0], f.error[0])
+    };
+    let used: Vec<&Flux> = r.specimen_jobs.values().chain(r.standard_jobs.values()).map(|&j| &flux[j]).collect();
+    let evaluations = used.iter().map(|f| f.evaluations).sum();
+    let seconds = used.iter().map(|f| f.seconds).sum();
+    let converged = used.iter().all(|f| f.converged);
+    match reading_value(&r.spec, &specimen, &standard) {
         Ok((v, e)) if v.is_finite() && e.is_finite() => Reading {
             geometry: r.geometry.clone(),
             name: r.name.clone(),
@@ -614,15 +785,42 @@ fn compute_reading(r: &PlannedReading, flux: &[Flux], done: &[Option<Reading>]) 
             evaluations,
             seconds,
             converged,
-            problem: if converged {
-                None
-            } else {
-                Some("evaluation budget exhausted before the tolerance was met".into())
-            },
+            problem: (!converged).then(|| "evaluation budget exhausted before the tolerance was met".into()),
             note: None,
         },
         Ok(_) => problem_reading(r, "non-finite result".into()),
         Err(why) => problem_reading(r, why),
+    }
+}
+
+/// A composite reading (haze index) from the readings it combines.
+fn compose_reading(r: &PlannedReading, done: &[Option<Reading>]) -> Reading {
+    let (Some(a), Some(b)) = (&done[r.parts[0]], &done[r.parts[1]]) else {
+        return problem_reading(r, "a gloss reading it combines was not computed".into());
+    };
+    let (Some(x), Some(y)) = (a.value, b.value) else {
+        return problem_reading(r, "a gloss reading it combines has no value".into());
+    };
+    let (v, e) = haze_index_value((x, a.error_estimate), (y, b.error_estimate));
+    if !(v.is_finite() && e.is_finite()) {
+        return problem_reading(r, "non-finite result".into());
+    }
+    Reading {
+        geometry: r.geometry.clone(),
+        name: r.name.clone(),
+        quantity: r.spec.quantity().into(),
+        unit: r.spec.unit().into(),
+        value: Some(v),
+        error_estimate: e,
+        evaluations: a.evaluations + b.evaluations,
+        seconds: a.seconds + b.seconds,
+        converged: a.converged && b.converged,
+        problem: None,
+        note: (x <= 70.0 || v < 0.0).then(|| {
+            "outside the scope of ASTM D4039, which is defined for non-metallic specimens with G60 > 70 (a negative \
+             index means the 20° receptor gathers relatively more than the 60° one, as for near-mirror flakes)"
+                .to_string()
+        }),
     }
 }
 
@@ -632,4 +830,84 @@ fn ratio(a: f64, ea: f64, b: f64, eb: f64) -> std::result::Result<(f64, f64), St
         return Err("the reference flux is zero: the stops do not see the mirror direction (below the horizon?)".into());
     }
     Ok((a / b, ea / b + a.abs() * eb / (b * b)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::brdf::lambert::Lambert;
+
+    fn geometries(ids: &[&str]) -> Vec<StandardGeometry> {
+        ids.iter().map(|id| standards::find(id).unwrap()).collect()
+    }
+
+    fn grey() -> Arc<dyn Brdf> {
+        Arc::new(Lambert::new(vec![0.5], Sampling::grey()).unwrap())
+    }
+
+    #[test]
+    fn identical_geometries_share_their_fluxes() {
+        // ASTM D523 and ISO 2813 at 60° have the same stops: one specimen and one standard flux for both.
+        let ids = ["astm-d523-60", "iso-2813-60"];
+        let plan = Plan::compile(grey(), geometries(&ids), PlanOptions::default()).unwrap();
+        let shared: Vec<&Job> = plan.jobs.iter().filter(|j| j.used_by.len() == 2).collect();
+        assert!(!shared.is_empty(), "{:?}", plan.jobs.iter().map(|j| &j.used_by).collect::<Vec<_>>());
+        let unshared =
+            Plan::compile(grey(), geometries(&ids), PlanOptions { share_fluxes: false, ..PlanOptions::default() })
+                .unwrap();
+        assert!(unshared.jobs.len() > plan.jobs.len());
+        assert!(unshared.jobs.iter().all(|j| j.used_by.len() == 1));
+    }
+
+    #[test]
+    fn a_composite_pulls_in_its_parts_without_reporting_them() {
+        let plan = Plan::compile(grey(), geometries(&["astm-d4039"]), PlanOptions::default()).unwrap();
+        let composite = plan.readings.iter().find(|r| r.geometry == "astm-d4039").unwrap();
+        assert_eq!(composite.parts.len(), 2);
+        for &p in &composite.parts {
+            assert!(!plan.readings[p].reported && matches!(plan.readings[p].spec, ReadingSpec::Gloss { .. }));
+        }
+        let out = plan.execute();
+        assert_eq!(out.len(), 1, "only the composite is reported");
+    }
+
+    #[test]
+    fn methods_are_designed_at_compile_time_and_explain_prints_them() {
+        let plan =
+            Plan::compile(grey(), geometries(&["astm-d523-60", "astm-e430-30"]), PlanOptions::default()).unwrap();
+        for j in &plan.jobs {
+            let m = &j.method;
+            assert!(m.clipped.is_some());
+            match m.target {
+                Target::Standard => {
+                    assert!(m.regular.is_none());
+                    assert_eq!(m.delta.is_some(), m.mirror.is_some());
+                }
+                Target::Specimen => {
+                    // A Lambertian body: no delta, the plain chart, one box, the luminous weighting (k = 1).
+                    assert!(m.delta.is_none());
+                    let r = m.regular.as_ref().unwrap();
+                    assert_eq!((r.chart, r.cells.len()), (Chart::Plain, 1));
+                    assert_eq!(m.weighting.len(), 1);
+                    assert!(r.atol > 0.0, "the floor from the standards is set at compile time");
+                }
+            }
+        }
+        let text = plan.explain();
+        for j in &plan.jobs {
+            assert!(text.contains(&j.used_by.join(", ")), "{text}");
+        }
+        assert!(text.contains("plain variables"), "{text}");
+        // The offset receptors of E430 do not see the mirror image: the standard's method says so.
+        assert!(plan.jobs.iter().any(|j| j.method.target == Target::Standard) && text.contains("Standard"));
+    }
+
+    #[test]
+    fn bad_options_are_refused() {
+        for rtol in [0.0, 1.0, f64::NAN, -1e-3] {
+            let e = Plan::compile(grey(), geometries(&["astm-d523-60"]), PlanOptions { rtol, ..Default::default() });
+            assert!(e.is_err(), "rtol {rtol}");
+        }
+        assert!(Plan::compile(grey(), vec![], PlanOptions::default()).is_err());
+    }
 }

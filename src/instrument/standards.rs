@@ -93,7 +93,18 @@ fn scale(o: &Obj) -> Result<Scale> {
 
 /// Parse and validate every builtin geometry, and check that they are consistent with each other (each
 /// file's id equals its file name, ids are unique, composites name existing non-composite geometries).
+/// Parsed once per process (the files are embedded, so the result cannot change); an error is returned
+/// again on every call.
 pub fn builtin() -> Result<Vec<StandardGeometry>> {
+    static PARSED: std::sync::OnceLock<Vec<StandardGeometry>> = std::sync::OnceLock::new();
+    if let Some(all) = PARSED.get() {
+        return Ok(all.clone());
+    }
+    let all = parse_builtin()?;
+    Ok(PARSED.get_or_init(|| all).clone())
+}
+
+fn parse_builtin() -> Result<Vec<StandardGeometry>> {
     let mut out = Vec::with_capacity(BUILTIN.len());
     for (file, text) in BUILTIN {
         let label = format!("<builtin:{file}>");
@@ -138,8 +149,8 @@ fn ids(gs: &[StandardGeometry]) -> String {
 /// The builtin geometry with this id; an unknown id is a usage error listing the known ids.
 pub fn find(id: &str) -> Result<StandardGeometry> {
     let all = builtin()?;
-    match all.iter().position(|g| g.geometry.id == id) {
-        Some(i) => Ok(all.into_iter().nth(i).expect("index from position")),
+    match all.iter().find(|g| g.geometry.id == id) {
+        Some(g) => Ok(g.clone()),
         None => Err(Error::Usage(format!("unknown geometry id \"{id}\"; known ids: {}", ids(&all)))),
     }
 }

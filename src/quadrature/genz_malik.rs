@@ -35,8 +35,9 @@ pub struct Estimate {
 /// The Genz–Malik point set and weights for dimension `D` (2 ≤ D ≤ 8).
 #[derive(Clone, Debug)]
 pub struct Rule<const D: usize> {
-    /// Points of the unit cube [−1, 1]^D with their weight index (0..5).
-    points: Vec<([f64; D], usize)>,
+    /// Points of the unit cube [−1, 1]^D with their weight index (0..5) and, for the axial points
+    /// (classes 1 and 2), their axis (0 otherwise).
+    points: Vec<([f64; D], usize, usize)>,
     w7: [f64; 5],
     w5: [f64; 5],
 }
@@ -59,19 +60,19 @@ impl<const D: usize> Rule<D> {
         let () = Self::DIMENSION_SUPPORTED;
         let d = D as f64;
         let mut points = Vec::new();
-        points.push(([0.0; D], 0));
+        points.push(([0.0; D], 0, 0));
         for i in 0..D {
             for s in [-1.0, 1.0] {
                 let mut x = [0.0; D];
                 x[i] = s * L2;
-                points.push((x, 1));
+                points.push((x, 1, i));
             }
         }
         for i in 0..D {
             for s in [-1.0, 1.0] {
                 let mut x = [0.0; D];
                 x[i] = s * L4;
-                points.push((x, 2));
+                points.push((x, 2, i));
             }
         }
         for i in 0..D {
@@ -80,7 +81,7 @@ impl<const D: usize> Rule<D> {
                     let mut x = [0.0; D];
                     x[i] = si * L4;
                     x[j] = sj * L4;
-                    points.push((x, 3));
+                    points.push((x, 3, 0));
                 }
             }
         }
@@ -89,7 +90,7 @@ impl<const D: usize> Rule<D> {
             for (k, xk) in x.iter_mut().enumerate() {
                 *xk = if mask >> k & 1 == 1 { L5 } else { -L5 };
             }
-            points.push((x, 4));
+            points.push((x, 4, 0));
         }
         // Weights for the average over [-1,1]^D (they sum to 1 with multiplicities).
         let w7 = [
@@ -119,9 +120,47 @@ impl<const D: usize> Rule<D> {
     }
 }
 
+/// One box of a partition, as its centre and half-widths (the form the rule is applied in). A partition kept
+/// from an adaptive run ([`integrate_partition`] with `keep: true`) re-applies the rule at exactly the same
+/// points, so a frozen re-run of the same integrand gives the same bits.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Cell<const D: usize> {
+    pub center: [f64; D],
+    pub half: [f64; D],
+}
+
+impl<const D: usize> Cell<D> {
+    /// The box [lo, hi] as a cell; None if it is degenerate (a zero or negative width on some axis).
+    pub fn from_box(lo: &[f64; D], hi: &[f64; D]) -> Option<Cell<D>> {
+        let mut c = [0.0; D];
+        let mut h = [0.0; D];
+        for k in 0..D {
+            c[k] = 0.5 * (lo[k] + hi[k]);
+            h[k] = 0.5 * (hi[k] - lo[k]);
+            if !(h[k] > 0.0) {
+                return None;
+            }
+        }
+        Some(Cell { center: c, half: h })
+    }
+
+    /// The cells of a list of boxes, degenerate ones dropped.
+    pub fn from_boxes(boxes: &[([f64; D], [f64; D])]) -> Vec<Cell<D>> {
+        boxes.iter().filter_map(|(lo, hi)| Cell::from_box(lo, hi)).collect()
+    }
+}
+
+/// Whether the driver refines the partition.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Refine {
+    /// Globally adaptive: bisect the worst cell until the tolerance or the budget is met.
+    Adaptive,
+    /// Apply the rule once to every given cell and stop (a frozen partition).
+    Frozen,
+}
+
 struct Region<const D: usize> {
-    center: [f64; D],
-    half: [f64; D],
+    cell: Cell<D>,
     value: Vec<f64>,
     error: Vec<f64>,
     /// Largest component error: the priority.
@@ -149,16 +188,49 @@ impl<const D: usize> Ord for Region<D> {
     }
 }
 
-/// Apply the rule to one box; `f(x, out)` writes `ncomp` values at point x.
-fn apply<const D: usize, F: FnMut(&[f64; D], &mut [f64])>(
+/// Scratch of the batched driver: the points of one call and the integrand values they receive.
+struct Batch<const D: usize> {
+    points: Vec<[f64; D]>,
+    values: Vec<f64>,
+}
+
+/// Apply the rule to the cells in one integrand call: all their points (57 per 4-D cell) are passed to `f`
+/// together, `values` zeroed, and each cell's sums are then formed in the rule's point order (the same
+/// order, hence the same bits, as one call per point).
+fn apply<const D: usize, F: FnMut(&[[f64; D]], &mut [f64])>(
     rule: &Rule<D>,
     f: &mut F,
-    center: [f64; D],
-    half: [f64; D],
+    cells: &[Cell<D>],
     ncomp: usize,
-    buf: &mut Vec<f64>,
-    id: usize,
-) -> Region<D> {
+    batch: &mut Batch<D>,
+    first_id: usize,
+) -> Vec<Region<D>> {
+    let npts = rule.len();
+    batch.points.clear();
+    for cell in cells {
+        for (x, _, _) in &rule.points {
+            let mut pt = [0.0; D];
+            for k in 0..D {
+                pt[k] = cell.center[k] + cell.half[k] * x[k];
+            }
+            batch.points.push(pt);
+        }
+    }
+    batch.values.clear();
+    batch.values.resize(batch.points.len() * ncomp, 0.0);
+    f(&batch.points, &mut batch.values);
+    cells
+        .iter()
+        .enumerate()
+        .map(|(i, cell)| {
+            summarise(rule, *cell, &batch.values[i * npts * ncomp..(i + 1) * npts * ncomp], ncomp, first_id + i)
+        })
+        .collect()
+}
+
+/// The degree-7 and degree-5 sums of one cell from its integrand values (`npts × ncomp`, point-major).
+fn summarise<const D: usize>(rule: &Rule<D>, cell: Cell<D>, values: &[f64], ncomp: usize, id: usize) -> Region<D> {
+    let half = cell.half;
     let vol: f64 = half.iter().map(|h| 2.0 * h).product();
     let mut s7 = vec![0.0; ncomp];
     let mut s5 = vec![0.0; ncomp];
@@ -166,32 +238,19 @@ fn apply<const D: usize, F: FnMut(&[f64; D], &mut [f64])>(
     let mut d2 = [0.0f64; D];
     let mut d4 = [0.0f64; D];
     let mut f0 = 0.0;
-    buf.resize(ncomp, 0.0);
-    for (x, class) in &rule.points {
-        let mut pt = [0.0; D];
-        for k in 0..D {
-            pt[k] = center[k] + half[k] * x[k];
-        }
-        buf.iter_mut().for_each(|v| *v = 0.0);
-        f(&pt, buf);
+    for ((_, class, axis), v) in rule.points.iter().zip(values.chunks_exact(ncomp)) {
         let (w7, w5) = (rule.w7[*class], rule.w5[*class]);
         let mut norm1 = 0.0;
         for c in 0..ncomp {
-            let v = if buf[c].is_finite() { buf[c] } else { 0.0 };
+            let v = if v[c].is_finite() { v[c] } else { 0.0 };
             s7[c] += w7 * v;
             s5[c] += w5 * v;
             norm1 += v.abs();
         }
         match class {
             0 => f0 = norm1,
-            1 | 2 => {
-                let axis = (0..D).find(|&k| x[k] != 0.0).unwrap_or(0);
-                if *class == 1 {
-                    d2[axis] += norm1;
-                } else {
-                    d4[axis] += norm1;
-                }
-            }
+            1 => d2[*axis] += norm1,
+            2 => d4[*axis] += norm1,
             _ => {}
         }
     }
@@ -209,65 +268,82 @@ fn apply<const D: usize, F: FnMut(&[f64; D], &mut [f64])>(
             split_axis = k;
         }
     }
-    Region { center, half, value, error, worst, split_axis, id }
+    Region { cell, value, error, worst, split_axis, id }
 }
 
 /// Integrate `f` (ncomp components) over the union of the boxes `initial` (each `(lo, hi)`), adaptively,
 /// until every component's summed error is ≤ max(atol, rtol·|I|) or `max_evals` is reached.
-/// Non-finite integrand values are counted as 0 (callers never produce them on purpose; a test guards it).
-pub fn integrate<const D: usize, F: FnMut(&[f64; D], &mut [f64])>(
-    mut f: F,
+///
+/// The integrand contract (batched): `f(points, values)` receives a slice of m points and a slice of
+/// m × ncomp values, point-major (point i's components are `values[i*ncomp..(i+1)*ncomp]`), **zeroed before
+/// every call**. It writes the values of the points it has values for and may leave the others alone: they
+/// count as 0 (points below the horizon, outside the overlap, …). One call receives all the points of one
+/// region (the 2^D + 2D² + 2D + 1 of the rule) or of the two halves of a split region. Non-finite values are
+/// counted as 0 (callers never produce them on purpose; a test guards it).
+pub fn integrate<const D: usize, F: FnMut(&[[f64; D]], &mut [f64])>(
+    f: F,
     ncomp: usize,
     initial: &[([f64; D], [f64; D])],
     opts: &Options,
 ) -> Estimate {
+    integrate_partition(f, ncomp, &Cell::from_boxes(initial), opts, Refine::Adaptive, false).0
+}
+
+/// [`integrate`] on a partition given as cells, adaptively or frozen; with `keep`, the final partition is
+/// returned (in creation order, the order its values are summed in) so that it can be re-run frozen: with
+/// [`Refine::Frozen`] the rule is applied once to each cell and nothing is refined, so the result is a
+/// smooth function of the integrand (no partition jumps between nearby integrands) and, for the same
+/// integrand, the same bits as the adaptive run the partition came from.
+pub fn integrate_partition<const D: usize, F: FnMut(&[[f64; D]], &mut [f64])>(
+    mut f: F,
+    ncomp: usize,
+    cells: &[Cell<D>],
+    opts: &Options,
+    refine: Refine,
+    keep: bool,
+) -> (Estimate, Vec<Cell<D>>) {
     let rule = Rule::<D>::new();
     let npts = rule.len();
-    let mut buf = Vec::with_capacity(ncomp);
+    let mut batch = Batch { points: Vec::new(), values: Vec::new() };
     let mut heap = BinaryHeap::new();
     let mut total = vec![0.0; ncomp];
     let mut err = vec![0.0; ncomp];
     let mut evals = 0usize;
     let mut next_id = 0usize;
-    for (lo, hi) in initial {
-        let mut c = [0.0; D];
-        let mut h = [0.0; D];
-        let mut degenerate = false;
-        for k in 0..D {
-            c[k] = 0.5 * (lo[k] + hi[k]);
-            h[k] = 0.5 * (hi[k] - lo[k]);
-            if !(h[k] > 0.0) {
-                degenerate = true;
+    // The initial cells, in batches of a bounded size (one call per cell in the adaptive case, as the
+    // refinement steps; a frozen partition may hold many cells).
+    let chunk = match refine {
+        Refine::Adaptive => 1,
+        Refine::Frozen => 64,
+    };
+    for group in cells.chunks(chunk) {
+        for r in apply(&rule, &mut f, group, ncomp, &mut batch, next_id) {
+            next_id += 1;
+            evals += npts;
+            for k in 0..ncomp {
+                total[k] += r.value[k];
+                err[k] += r.error[k];
             }
+            heap.push(r);
         }
-        if degenerate {
-            continue;
-        }
-        let r = apply(&rule, &mut f, c, h, ncomp, &mut buf, next_id);
-        next_id += 1;
-        evals += npts;
-        for k in 0..ncomp {
-            total[k] += r.value[k];
-            err[k] += r.error[k];
-        }
-        heap.push(r);
     }
     let done =
         |total: &[f64], err: &[f64]| total.iter().zip(err).all(|(t, e)| *e <= opts.atol.max(opts.rtol * t.abs()));
     let mut converged = done(&total, &err);
-    while !converged && evals + 2 * npts <= opts.max_evals {
+    while refine == Refine::Adaptive && !converged && evals + 2 * npts <= opts.max_evals {
         let Some(r) = heap.pop() else { break };
         let ax = r.split_axis;
-        let mut half = r.half;
+        let mut half = r.cell.half;
         half[ax] *= 0.5;
-        let mut c1 = r.center;
-        let mut c2 = r.center;
+        let mut c1 = r.cell.center;
+        let mut c2 = r.cell.center;
         c1[ax] -= half[ax];
         c2[ax] += half[ax];
-        let a = apply(&rule, &mut f, c1, half, ncomp, &mut buf, next_id);
-        let b = apply(&rule, &mut f, c2, half, ncomp, &mut buf, next_id + 1);
+        let children = [Cell { center: c1, half }, Cell { center: c2, half }];
+        let mut ab = apply(&rule, &mut f, &children, ncomp, &mut batch, next_id);
         next_id += 2;
         evals += 2 * npts;
+        let (b, a) = (ab.pop().expect("two children"), ab.pop().expect("two children"));
         for k in 0..ncomp {
             total[k] += a.value[k] + b.value[k] - r.value[k];
             err[k] += a.error[k] + b.error[k] - r.error[k];
@@ -286,7 +362,21 @@ pub fn integrate<const D: usize, F: FnMut(&[f64; D], &mut [f64])>(
         error[k] = neumaier(regions.iter().map(|r| r.error[k]));
     }
     let converged = done(&value, &error);
-    Estimate { value, error, evaluations: evals, regions: regions.len(), converged }
+    let kept = if keep { regions.iter().map(|r| r.cell).collect() } else { Vec::new() };
+    (Estimate { value, error, evaluations: evals, regions: regions.len(), converged }, kept)
+}
+
+/// A batched integrand from a pointwise one, `f(x, out)` writing the `ncomp` values at one point (into a
+/// zeroed `out`), for callers with nothing to gain from batching.
+pub fn pointwise<const D: usize, F: FnMut(&[f64; D], &mut [f64])>(
+    ncomp: usize,
+    mut f: F,
+) -> impl FnMut(&[[f64; D]], &mut [f64]) {
+    move |points, values| {
+        for (x, out) in points.iter().zip(values.chunks_exact_mut(ncomp)) {
+            f(x, out);
+        }
+    }
 }
 
 /// Neumaier's compensated sum.
@@ -314,7 +404,7 @@ mod tests {
         fn check<const D: usize>() {
             let r = Rule::<D>::new();
             let (mut s7, mut s5) = (0.0, 0.0);
-            for (_, c) in &r.points {
+            for (_, c, _) in &r.points {
                 s7 += r.w7[*c];
                 s5 += r.w5[*c];
             }
@@ -333,7 +423,7 @@ mod tests {
     fn degree_seven_exact() {
         // x0^6 x1 ... the rule integrates polynomials of degree 7 exactly on one region.
         let est = integrate::<4, _>(
-            |x, o| o[0] = x[0].powi(6) + x[1].powi(4) * x[2].powi(2) + x[3].powi(7) + 1.0,
+            pointwise(1, |x, o| o[0] = x[0].powi(6) + x[1].powi(4) * x[2].powi(2) + x[3].powi(7) + 1.0),
             1,
             &[([-1.0; 4], [1.0; 4])],
             &Options { rtol: 1.0, atol: 1.0, max_evals: 57 },
@@ -347,7 +437,7 @@ mod tests {
         // ∫∫ exp(-(x²+y²)/(2σ²)) over [-1,1]² = 2πσ² erf(1/(σ√2))²
         for sigma in [0.3, 0.05] {
             let est = integrate::<2, _>(
-                |x, o| o[0] = (-(x[0] * x[0] + x[1] * x[1]) / (2.0 * sigma * sigma)).exp(),
+                pointwise(1, |x, o| o[0] = (-(x[0] * x[0] + x[1] * x[1]) / (2.0 * sigma * sigma)).exp()),
                 1,
                 &[
                     ([-1.0, -1.0], [0.0, 0.0]),
@@ -370,10 +460,10 @@ mod tests {
     fn deterministic_bits() {
         let run = || {
             integrate::<4, _>(
-                |x, o| {
+                pointwise(2, |x, o| {
                     o[0] = (x[0] * x[1] + x[2]).sin().powi(2) / (1.0 + x[3] * x[3]);
                     o[1] = (-x[0] * x[0] * 30.0).exp();
-                },
+                }),
                 2,
                 &[([0.0; 4], [1.0; 4])],
                 &Options { rtol: 1e-7, atol: 0.0, max_evals: 2_000_000 },
@@ -388,12 +478,53 @@ mod tests {
     #[test]
     fn reports_non_convergence() {
         let est = integrate::<2, _>(
-            |x, o| o[0] = if x[0] > 0.3 { 1.0 } else { 0.0 },
+            pointwise(1, |x, o| o[0] = if x[0] > 0.3 { 1.0 } else { 0.0 }),
             1,
             &[([0.0, 0.0], [1.0, 1.0])],
             &Options { rtol: 1e-14, atol: 0.0, max_evals: 1000 },
         );
         assert!(!est.converged);
         assert!(est.evaluations <= 1000);
+    }
+
+    #[test]
+    fn a_frozen_rerun_gives_the_same_bits_and_no_refinement() {
+        let f = |a: f64| {
+            pointwise(1, move |x: &[f64; 2], o: &mut [f64]| o[0] = (-a * (x[0] * x[0] + 3.0 * x[1] * x[1])).exp())
+        };
+        let opts = Options { rtol: 1e-9, atol: 0.0, max_evals: 1_000_000 };
+        let start = Cell::from_boxes(&[([-1.0, -1.0], [1.0, 1.0])]);
+        let (adaptive, cells) = integrate_partition(f(20.0), 1, &start, &opts, Refine::Adaptive, true);
+        assert!(adaptive.regions > 1 && cells.len() == adaptive.regions);
+        let (frozen, again) = integrate_partition(f(20.0), 1, &cells, &opts, Refine::Frozen, true);
+        assert_eq!(frozen.value[0].to_bits(), adaptive.value[0].to_bits());
+        assert_eq!(frozen.error[0].to_bits(), adaptive.error[0].to_bits());
+        assert_eq!(again, cells, "a frozen run refines nothing");
+        assert_eq!(frozen.evaluations, 17 * cells.len());
+        // A frozen run even at a tolerance it cannot meet stops after one pass.
+        let tight = Options { rtol: 1e-15, ..opts };
+        let (f2, _) = integrate_partition(f(20.0), 1, &cells, &tight, Refine::Frozen, false);
+        assert_eq!(f2.evaluations, 17 * cells.len());
+    }
+
+    #[test]
+    fn one_call_per_region_or_split() {
+        // The driver hands the integrand a whole region's points (17 in 2-D) or both halves' (34).
+        let mut sizes = Vec::new();
+        let est = integrate::<2, _>(
+            |pts: &[[f64; 2]], out: &mut [f64]| {
+                sizes.push(pts.len());
+                assert!(out.iter().all(|v| *v == 0.0), "values are zeroed before each call");
+                for (x, o) in pts.iter().zip(out.iter_mut()) {
+                    *o = (-30.0 * x[0] * x[0]).exp();
+                }
+            },
+            1,
+            &[([-1.0, -1.0], [1.0, 1.0])],
+            &Options { rtol: 1e-8, atol: 0.0, max_evals: 100_000 },
+        );
+        assert!(est.converged && sizes.len() > 2);
+        assert_eq!(sizes[0], 17);
+        assert!(sizes[1..].iter().all(|&n| n == 34), "{sizes:?}");
     }
 }

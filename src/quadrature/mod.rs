@@ -15,4 +15,4 @@
 //! |I₇ − I₅|, the worst region is bisected along the axis with the largest fourth difference.
 mod genz_malik;
 
-pub use genz_malik::{integrate, Estimate, Options, Rule};
+pub use genz_malik::{integrate, integrate_partition, pointwise, Cell, Estimate, Options, Refine, Rule};

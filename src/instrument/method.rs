@@ -1,0 +1,391 @@
+//! A method: how one aperture integral is done, as plain data, and the executor that does it.
+//!
+//! Why: the plan (`instrument::plan`) decides everything about an integral once — the clipped stops,
+//! whether the receptor sees the mirror image, the chart and rule of the regular part, its initial
+//! partition, the delta part's box, the spectral weighting, the tolerances and the budget — and stores the
+//! decision here. [`Method::execute`] then only executes it; `--explain` prints the stored methods and never
+//! works a choice out again. A method does not hold the material: it can be executed on any material of the
+//! same shape (same sampling length, same kinds of terms), which is what sweeps and the fitter need; and
+//! after one adaptive run it can be *frozen* ([`Method::execute_and_freeze`]): the final partitions are kept
+//! and re-executed with the same rule and no refinement, so a fitter's finite differences do not see the
+//! partition jump (the result is then a smooth function of the material's parameters).
+//!
+//! The tolerance split inside a flux: the delta part gets [`DELTA_SHARE`] of the relative tolerance and of
+//! the absolute floor (all of them when there is no regular part); the regular part gets the rest,
+//! err_r ≤ max(atol_r, r·|Φ_δ|, r·|Φ_r|) with r = (1 − DELTA_SHARE)·rtol, so err_δ + err_r ≤ rtol·(|Φ_δ| +
+//! |Φ_r|) (+ the floor) as both parts are ≥ 0. The r·|Φ_δ| term needs the delta part's value, so it is the
+//! one quantity formed at run time (the smallest |Φ_δ| component, which keeps every component within its
+//! tolerance).
+use crate::brdf::{Brdf, Lobe};
+use crate::instrument::flux::{
+    choose_chart, clip, lobe_boxes, lobe_splits, mirror_overlap, AxisMap, Chart, Flux, DELTA_SHARE,
+};
+use crate::instrument::geometry::{solid_angle_density, Axes, Stop};
+use crate::quadrature::{integrate_partition, Cell, Estimate, Options, Refine};
+use crate::spectrum::Weighting;
+use crate::Vec3;
+
+/// Which material a flux is taken on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Target {
+    Specimen,
+    Standard,
+}
+
+/// The cubature rule of a part. One today; the enum is where Gauss–Hermite (narrow Gaussian lobes) and
+/// tensor-product rules go when the plan learns to choose them.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Rule {
+    /// Genz & Malik's degree-7 rule with its embedded degree-5 rule for the error estimate
+    /// (`quadrature::Rule`), globally adaptive.
+    GenzMalik75,
+}
+
+/// When the spectral weighting is applied.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Projection {
+    /// In the integrand: the cubature integrates the k weighted components (cheapest when k < n).
+    Fold,
+    /// After: the cubature integrates the n samples and the weighting is applied to the results
+    /// (kept to measure what folding saves; `PlanOptions::fold_spectral`).
+    Separate,
+}
+
+/// The ideal-mirror part: a 2-D integral of R(θi) cos θi dω over the mirror overlap.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DeltaPart {
+    pub rule: Rule,
+    /// The partition: the overlap box at design time, the final partition of a frozen method.
+    pub cells: Vec<Cell<2>>,
+    pub refine: Refine,
+    pub rtol: f64,
+    pub atol: f64,
+}
+
+/// The regular part: a 4-D integral in the chart's variables.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RegularPart {
+    pub chart: Chart,
+    pub rule: Rule,
+    /// The split points of the lobe chart on u and v (empty for the plain chart).
+    pub splits: [Vec<f64>; 2],
+    /// The partition: the initial boxes at design time, the final partition of a frozen method.
+    pub cells: Vec<Cell<4>>,
+    pub refine: Refine,
+    pub rtol: f64,
+    /// Absolute floor; raised at run time to rtol·|Φ_δ| (see the module documentation).
+    pub atol: f64,
+}
+
+/// One aperture integral, designed.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Method {
+    pub target: Target,
+    /// Geometry angle θ.
+    pub theta: f64,
+    /// The stops as the geometry gives them.
+    pub source: Stop,
+    pub receptor: Stop,
+    /// The stops clipped to the upper hemisphere; None: one is entirely below the horizon (the flux is 0).
+    pub clipped: Option<(Stop, Stop)>,
+    /// The mirror overlap of the clipped stops (whether the receptor sees the mirror image of the source),
+    /// whether or not the material has a delta term.
+    pub mirror: Option<([f64; 2], [f64; 2])>,
+    /// The delta part, if the material has one and the receptor sees the mirror image.
+    pub delta: Option<DeltaPart>,
+    /// The regular part, if the material has one and the stops are above the horizon.
+    pub regular: Option<RegularPart>,
+    /// The k × n spectral weighting of the flux.
+    pub weighting: Weighting,
+    pub projection: Projection,
+    /// Evaluation budget of each part.
+    pub max_evals: usize,
+}
+
+/// What the designer needs to know about an integral.
+#[derive(Clone, Debug)]
+pub struct Design<'a> {
+    pub target: Target,
+    pub theta: f64,
+    pub source: Stop,
+    pub receptor: Stop,
+    /// The material's lobes (for the chart and the split points).
+    pub lobes: &'a [Lobe],
+    /// Whether the material has a delta term and a regular (diffuse or lobe) term.
+    pub has_delta: bool,
+    pub has_regular: bool,
+    pub weighting: Weighting,
+    pub projection: Projection,
+    /// Relative tolerance of the flux and its absolute floor.
+    pub rtol: f64,
+    pub atol: f64,
+    pub max_evals: usize,
+}
+
+impl Method {
+    /// Design the method of one integral.
+    pub fn design(d: Design<'_>) -> Method {
+        let clipped = match (clip(d.source, d.theta, true), clip(d.receptor, d.theta, false)) {
+            (Some(s), Some(r)) => Some((s, r)),
+            _ => None,
+        };
+        let mirror = clipped.and_then(|(s, r)| mirror_overlap(s, r));
+        let delta_share = if d.has_regular { DELTA_SHARE } else { 1.0 };
+        let delta = match (d.has_delta, mirror) {
+            (true, Some((lo, hi))) => Some(DeltaPart {
+                rule: Rule::GenzMalik75,
+                cells: Cell::from_boxes(&[(lo, hi)]),
+                refine: Refine::Adaptive,
+                rtol: delta_share * d.rtol,
+                atol: delta_share * d.atol,
+            }),
+            _ => None,
+        };
+        let regular = match (d.has_regular, clipped) {
+            (true, Some((src, rec))) => {
+                let chart = choose_chart(d.lobes, d.theta, src, rec);
+                let (splits, boxes) = match chart {
+                    Chart::Lobe => {
+                        let splits = lobe_splits(d.lobes, d.theta, src, rec);
+                        let boxes = lobe_boxes(&splits);
+                        (splits, boxes)
+                    }
+                    Chart::Plain => (
+                        [vec![], vec![]],
+                        vec![([src.p[0], src.q[0], rec.p[0], rec.q[0]], [src.p[1], src.q[1], rec.p[1], rec.q[1]])],
+                    ),
+                };
+                let share = 1.0 - DELTA_SHARE;
+                Some(RegularPart {
+                    chart,
+                    rule: Rule::GenzMalik75,
+                    splits,
+                    cells: Cell::from_boxes(&boxes),
+                    refine: Refine::Adaptive,
+                    rtol: share * d.rtol,
+                    atol: share * d.atol,
+                })
+            }
+            _ => None,
+        };
+        Method {
+            target: d.target,
+            theta: d.theta,
+            source: d.source,
+            receptor: d.receptor,
+            clipped,
+            mirror,
+            delta,
+            regular,
+            weighting: d.weighting,
+            projection: d.projection,
+            max_evals: d.max_evals,
+        }
+    }
+
+    /// A one-off method for the specimen flux of `brdf` alone (no plan): its own terms, the luminous weighting
+    /// applied in the integrand.
+    pub fn for_material(
+        brdf: &dyn Brdf,
+        theta: f64,
+        source: Stop,
+        receptor: Stop,
+        tolerance: (f64, f64),
+        max_evals: usize,
+    ) -> crate::Result<Method> {
+        Ok(Method::design(Design {
+            target: Target::Specimen,
+            theta,
+            source,
+            receptor,
+            lobes: &brdf.lobes(),
+            has_delta: brdf.has_delta(),
+            has_regular: brdf.has_regular(),
+            weighting: Weighting::luminous(brdf.sampling())?,
+            projection: Projection::Fold,
+            rtol: tolerance.0,
+            atol: tolerance.1,
+            max_evals,
+        }))
+    }
+
+    /// Whether the method was frozen (its parts re-run a kept partition without refinement).
+    pub fn is_frozen(&self) -> bool {
+        self.delta.iter().all(|p| p.refine == Refine::Frozen) && self.regular.iter().all(|p| p.refine == Refine::Frozen)
+    }
+
+    /// Execute the method on `brdf` (whose sampling has as many samples as the weighting has columns).
+    pub fn execute(&self, brdf: &dyn Brdf) -> Flux {
+        self.run(brdf, false).0
+    }
+
+    /// Execute the method and return, with the flux, the frozen method: the same method with each part's
+    /// final partition and `Refine::Frozen`. Executing the frozen method on the same material gives the same
+    /// value and error bits; on a nearby material it gives a smooth function of the change.
+    pub fn execute_and_freeze(&self, brdf: &dyn Brdf) -> (Flux, Method) {
+        let (flux, frozen) = self.run(brdf, true);
+        (flux, frozen.expect("kept"))
+    }
+
+    fn run(&self, brdf: &dyn Brdf, keep: bool) -> (Flux, Option<Method>) {
+        let start = std::time::Instant::now();
+        let k = self.weighting.len();
+        let n = brdf.sampling().len();
+        let mut frozen = keep.then(|| self.clone());
+        let Some((src, rec)) = self.clipped else {
+            return (Flux::zero(k), frozen);
+        };
+        let axes = Axes::new(self.theta);
+        let ncomp = match self.projection {
+            Projection::Fold => k,
+            Projection::Separate => n,
+        };
+        let weighting = &self.weighting;
+        let projection = self.projection;
+        // The k weighted components of an estimate, and their error bounds.
+        let weighted = |e: &Estimate| -> (Vec<f64>, Vec<f64>) {
+            match projection {
+                Projection::Fold => (e.value.clone(), e.error.clone()),
+                Projection::Separate => (
+                    (0..k).map(|c| weighting.component(c, &e.value)).collect(),
+                    (0..k).map(|c| weighting.component_error(c, &e.error)).collect(),
+                ),
+            }
+        };
+        let mut flux = Flux::zero(k);
+
+        // 1. The delta part: source points whose mirror (−p, −q) lies in the receptor.
+        if let Some(part) = &self.delta {
+            let mut scratch = vec![0.0; n];
+            let (est, cells) = integrate_partition::<2, _>(
+                |pts, out| {
+                    for (x, o) in pts.iter().zip(out.chunks_exact_mut(ncomp)) {
+                        let wi = axes.source_dir(x[0], x[1]);
+                        if wi.z <= 0.0 || !brdf.delta_reflectance(wi, &mut scratch) {
+                            continue;
+                        }
+                        store(o, &scratch, weighting, wi.z * solid_angle_density(x[0], x[1]), projection);
+                    }
+                },
+                ncomp,
+                &part.cells,
+                &Options { rtol: part.rtol, atol: part.atol, max_evals: self.max_evals },
+                part.refine,
+                keep,
+            );
+            (flux.delta, flux.error) = weighted(&est);
+            flux.evaluations += est.evaluations;
+            flux.regions += est.regions;
+            flux.converged &= est.converged;
+            if let Some(m) = frozen.as_mut() {
+                let p = m.delta.as_mut().expect("the same parts");
+                p.cells = cells;
+                p.refine = Refine::Frozen;
+            }
+        }
+
+        // 2. The regular part, in its chart.
+        if let Some(part) = &self.regular {
+            let ap = AxisMap { s: src.p, r: rec.p };
+            let aq = AxisMap { s: src.q, r: rec.q };
+            let plain = part.chart == Chart::Plain;
+            let delta_min = flux.delta.iter().map(|d| d.abs()).fold(f64::INFINITY, f64::min);
+            let atol = part.atol.max(part.rtol * delta_min);
+            let mut batch = PairBatch::default();
+            let (est, cells) = integrate_partition::<4, _>(
+                |pts, out| {
+                    batch.clear();
+                    for (i, x) in pts.iter().enumerate() {
+                        let (ps, qs, pr, qr, jac) = if plain {
+                            (x[0], x[1], x[2], x[3], 1.0)
+                        } else {
+                            let (ps, pr, jp) = ap.at(x[0], x[1]);
+                            let (qs, qr, jq) = aq.at(x[2], x[3]);
+                            (ps, qs, pr, qr, jp * jq)
+                        };
+                        if jac <= 0.0 {
+                            continue;
+                        }
+                        let wi = axes.source_dir(ps, qs);
+                        let wo = axes.receptor_dir(pr, qr);
+                        if wi.z <= 0.0 || wo.z <= 0.0 {
+                            continue;
+                        }
+                        let g = wi.z * wo.z * solid_angle_density(ps, qs) * solid_angle_density(pr, qr) * jac;
+                        batch.push(i, wi, wo, g);
+                    }
+                    batch.values.clear();
+                    batch.values.resize(batch.wi.len() * n, 0.0);
+                    brdf.eval_batch(&batch.wi, &batch.wo, &mut batch.values);
+                    for ((&i, &g), v) in batch.index.iter().zip(&batch.g).zip(batch.values.chunks_exact(n)) {
+                        store(&mut out[i * ncomp..(i + 1) * ncomp], v, weighting, g, projection);
+                    }
+                },
+                ncomp,
+                &part.cells,
+                &Options { rtol: part.rtol, atol, max_evals: self.max_evals },
+                part.refine,
+                keep,
+            );
+            let (regular, regular_err) = weighted(&est);
+            flux.regular = regular;
+            flux.error = flux.error.iter().zip(&regular_err).map(|(a, b)| a + b).collect();
+            flux.evaluations += est.evaluations;
+            flux.regions += est.regions;
+            flux.converged &= est.converged;
+            flux.chart = Some(part.chart);
+            if let Some(m) = frozen.as_mut() {
+                let p = m.regular.as_mut().expect("the same parts");
+                p.cells = cells;
+                p.refine = Refine::Frozen;
+            }
+        }
+        flux.value = flux.delta.iter().zip(&flux.regular).map(|(a, b)| a + b).collect();
+        flux.seconds = start.elapsed().as_secs_f64();
+        (flux, frozen)
+    }
+}
+
+/// The direction pairs of one batch above the horizon, with the point index and geometric factor of each.
+#[derive(Default)]
+struct PairBatch {
+    index: Vec<usize>,
+    wi: Vec<Vec3>,
+    wo: Vec<Vec3>,
+    g: Vec<f64>,
+    values: Vec<f64>,
+}
+
+impl PairBatch {
+    fn clear(&mut self) {
+        self.index.clear();
+        self.wi.clear();
+        self.wo.clear();
+        self.g.clear();
+    }
+
+    fn push(&mut self, i: usize, wi: Vec3, wo: Vec3, g: f64) {
+        self.index.push(i);
+        self.wi.push(wi);
+        self.wo.push(wo);
+        self.g.push(g);
+    }
+}
+
+/// Write the integrand at one point: the per-sample values times the geometric factor `g`, either one
+/// component per sample ([`Projection::Separate`]) or the k weighted sums Σ_j W[c][j] f_j·g (Fold).
+#[inline]
+fn store(out: &mut [f64], values: &[f64], weighting: &Weighting, g: f64, projection: Projection) {
+    match projection {
+        Projection::Separate => {
+            for (o, v) in out.iter_mut().zip(values) {
+                *o = v * g;
+            }
+        }
+        Projection::Fold => {
+            for (c, o) in out.iter_mut().enumerate() {
+                *o = weighting.component(c, values) * g;
+            }
+        }
+    }
+}

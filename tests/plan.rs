@@ -1,0 +1,132 @@
+//! The measurement plan as a designer (issue 7): its switches give the same readings, a long-lived planner
+//! caches the standards, a plan is reused on another material of the same shape, and a frozen plan re-runs
+//! the same partition (same bits on the same material; a smooth function of the material's parameters).
+mod common;
+use common::TestBeckmann;
+use std::sync::Arc;
+
+use glossmeter::brdf::Brdf;
+use glossmeter::instrument::plan::{Plan, PlanOptions, Planner, Reading};
+use glossmeter::instrument::standards::{self, StandardGeometry};
+use glossmeter::spectrum::Sampling;
+
+fn panel() -> Vec<StandardGeometry> {
+    glossmeter::DEFAULT_PANEL.iter().map(|id| standards::find(id).unwrap()).collect()
+}
+
+fn fixture(name: &str) -> Arc<dyn Brdf> {
+    glossmeter::recipe::load_file(std::path::Path::new(&format!("fixtures/recipes/{name}"))).unwrap().brdf
+}
+
+fn run(brdf: Arc<dyn Brdf>, options: PlanOptions) -> Vec<Reading> {
+    Plan::compile(brdf, panel(), options).unwrap().execute()
+}
+
+fn bits(r: &Reading) -> (Option<u64>, u64, usize, bool) {
+    (r.value.map(f64::to_bits), r.error_estimate.to_bits(), r.evaluations, r.converged)
+}
+
+/// Sharing on and off: every flux has the same method either way, so every reading is the same bits (value,
+/// error estimate, evaluation count, converged flag). Folding on and off: the cubature integrates one
+/// luminous component or one per sample, so its partitions differ; the two readings must agree within the
+/// sum of their error estimates, |a − b| ≤ e_a + e_b, on every reading of every fixture below (grey,
+/// RGB, 21-sample spectral; delta, diffuse and lobe terms).
+#[test]
+fn folding_and_sharing_switches_give_the_same_readings() {
+    for name in ["cerulean-blue-c.json", "white-pearl-spectral.json", "rgb-lambert.json", "rough-conductor-ggx.json"] {
+        let brdf = fixture(name);
+        let base = run(brdf.clone(), PlanOptions::default());
+        let unshared = run(brdf.clone(), PlanOptions { share_fluxes: false, ..PlanOptions::default() });
+        let unfolded = run(brdf.clone(), PlanOptions { fold_spectral: false, ..PlanOptions::default() });
+        assert_eq!(base.len(), unshared.len());
+        assert_eq!(base.len(), unfolded.len());
+        for ((a, b), c) in base.iter().zip(&unshared).zip(&unfolded) {
+            assert_eq!((&a.geometry, &a.name), (&b.geometry, &b.name));
+            assert_eq!(bits(a), bits(b), "{name} {} {}: sharing changed the reading", a.geometry, a.name);
+            let (x, y) = (a.value.unwrap(), c.value.unwrap());
+            assert!(
+                (x - y).abs() <= a.error_estimate + c.error_estimate,
+                "{name} {} {}: folded {x} ± {:e} vs separate {y} ± {:e}",
+                a.geometry,
+                a.name,
+                a.error_estimate,
+                c.error_estimate
+            );
+        }
+    }
+}
+
+#[test]
+fn a_long_lived_planner_caches_the_standards_across_materials() {
+    let planner = Planner::new().unwrap();
+    let a = planner.compile(fixture("cerulean-blue-c.json"), panel(), PlanOptions::default()).unwrap();
+    let cached = planner.cached_standards();
+    assert!(cached > 0);
+    let b = planner.compile(fixture("black-glass.json"), panel(), PlanOptions::default()).unwrap();
+    assert_eq!(planner.cached_standards(), cached, "the second material needs no new standard flux");
+    // The cached standards give the same bits as a fresh planner's.
+    for (p, name) in [(a, "cerulean-blue-c.json"), (b, "black-glass.json")] {
+        let fresh = run(fixture(name), PlanOptions::default());
+        let here = p.execute();
+        assert_eq!(here.iter().map(bits).collect::<Vec<_>>(), fresh.iter().map(bits).collect::<Vec<_>>());
+    }
+    // Another tolerance is another standard flux.
+    planner
+        .compile(fixture("black-glass.json"), panel(), PlanOptions { rtol: 1e-4, ..PlanOptions::default() })
+        .unwrap();
+    assert!(planner.cached_standards() > cached);
+}
+
+fn beckmann(m: f64) -> Arc<dyn Brdf> {
+    Arc::new(TestBeckmann { m, n: 1.5, s: Sampling::grey() })
+}
+
+#[test]
+fn a_plan_is_reused_on_a_material_of_the_same_shape_only() {
+    let plan = Plan::compile(beckmann(0.1), panel(), PlanOptions::default()).unwrap();
+    // The same material through with_material: the same bits.
+    let again = plan.with_material(beckmann(0.1)).unwrap().execute();
+    assert_eq!(plan.execute().iter().map(bits).collect::<Vec<_>>(), again.iter().map(bits).collect::<Vec<_>>());
+    // Another sampling, or other terms: refused with a message.
+    let rgb: Arc<dyn Brdf> = Arc::new(TestBeckmann { m: 0.1, n: 1.5, s: Sampling::rgb() });
+    let e = plan.with_material(rgb).err().expect("another sampling is another shape").to_string();
+    assert!(e.contains("another shape"), "{e}");
+    assert!(plan.with_material(fixture("black-glass.json")).is_err());
+}
+
+/// A frozen plan: on the material it was frozen on, the same value and error bits as the adaptive run; on
+/// nearby materials (Beckmann m = 0.1·(1 + k·h), h = 1e-5, k = −2…2) the gloss readings are a smooth
+/// function of m: the third difference is below 1e-6 of the first (a partition jump would show up as a
+/// third difference of the size of the tolerance, 1e-6 relative, against a first difference of ~1e-5).
+#[test]
+fn a_frozen_plan_repeats_its_bits_and_moves_smoothly() {
+    let plan = Plan::compile(beckmann(0.1), panel(), PlanOptions::default()).unwrap();
+    let adaptive = plan.execute();
+    let (readings, frozen) = plan.freeze();
+    assert!(frozen.is_frozen() && !plan.is_frozen());
+    assert_eq!(
+        readings.iter().map(bits).collect::<Vec<_>>(),
+        adaptive.iter().map(bits).collect::<Vec<_>>(),
+        "freezing executes the same adaptive run"
+    );
+    let again = frozen.execute();
+    for (a, f) in adaptive.iter().zip(&again) {
+        assert_eq!(a.value.map(f64::to_bits), f.value.map(f64::to_bits), "{} {}", a.geometry, a.name);
+        assert_eq!(a.error_estimate.to_bits(), f.error_estimate.to_bits(), "{} {}", a.geometry, a.name);
+        assert!(f.evaluations <= a.evaluations, "a frozen run refines nothing");
+    }
+    let h = 1e-5;
+    let values: Vec<Vec<f64>> = (-2..=2)
+        .map(|k| {
+            let m = 0.1 * (1.0 + k as f64 * h);
+            frozen.with_material(beckmann(m)).unwrap().execute().iter().map(|r| r.value.unwrap()).collect()
+        })
+        .collect();
+    for (i, r) in adaptive.iter().enumerate().filter(|(_, r)| r.quantity == "gloss") {
+        let v: Vec<f64> = values.iter().map(|x| x[i]).collect();
+        let d1 = (v[3] - v[1]) / 2.0;
+        let d3 = (v[4] - 2.0 * v[3] + 2.0 * v[1] - v[0]) / 2.0;
+        assert!(d1.abs() > 0.0, "{}: the reading moves with m", r.geometry);
+        assert!(d3.abs() <= 1e-6 * d1.abs(), "{}: third difference {d3:e} vs first {d1:e}: {v:?}", r.geometry);
+    }
+}
