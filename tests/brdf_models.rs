@@ -1,6 +1,5 @@
 //! Tests of the simple BRDF models and of the directional albedo integrator (`src/brdf/albedo.rs`):
-//! closed forms, limits, reciprocity and the white furnace. Models needing the microfacet optics fail until
-//! `src/optics/microfacet.rs` is implemented.
+//! closed forms, limits, reciprocity and the white furnace.
 use glossmeter::brdf::albedo::directional_albedo;
 use glossmeter::brdf::dielectric::{Ior, MicrofacetSurface, SmoothDielectric};
 use glossmeter::brdf::lambert::Lambert;

@@ -1,7 +1,8 @@
 //! The stiff and extreme suite (issue 4, item 2). For every case: every reading has a finite value, its
 //! actual error lies within its error estimate, and results are continuous across every internal switch.
 //!
-//! "Actual error" is measured against an independent reference written in this file: a closed form
+//! "Actual error" is measured against an independent reference written in this file (it shares only the
+//! Gauss–Legendre nodes of `instrument::reference`, itself independent of the engine's quadrature): a closed form
 //! (Lambert's projected solid angle of a spherical polygon, Kubelka–Munk in hyperbolic form, Fresnel in
 //! complex form) combined with nested Gauss–Legendre integrals of smooth 2-D integrands, or, where no
 //! closed form exists (lobes), a run of the engine at a relative tolerance 100× tighter. Continuity: the two

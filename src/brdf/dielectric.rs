@@ -185,15 +185,7 @@ impl Brdf for MicrofacetSurface {
             }]
         } else {
             let label = format!("microfacet lobe ({})", describe_facets(&self.facets));
-            vec![Term {
-                label: label.clone(),
-                kind: TermKind::Lobe(Lobe {
-                    slope_width: self.facets.alpha,
-                    medium_eta: 1.0,
-                    label,
-                    heavy_tail: self.facets.distribution == Distribution::Ggx,
-                }),
-            }]
+            vec![Term { label: label.clone(), kind: TermKind::Lobe(Lobe::of_facets(&self.facets, 1.0, label)) }]
         }
     }
 

@@ -9,6 +9,7 @@
 //! `wi` points from the surface towards the source, `wo` towards the receptor; both are unit vectors with
 //! z > 0. `eval` returns the *regular* part of f_r in sr⁻¹ (no cosine factor); a delta component is reported
 //! separately by [`Brdf::delta_reflectance`].
+use crate::optics::microfacet::Microfacet;
 use crate::spectrum::Sampling;
 use crate::{Error, Result, Vec3};
 
@@ -39,6 +40,15 @@ pub struct Lobe {
     /// Gaussian-tailed lobe (Beckmann, Phong, Ward) is below e⁻¹⁰⁰ of its peak beyond 10 widths, so the
     /// integrator stops splitting there; a heavy tail is split geometrically out to the ends of the range.
     pub heavy_tail: bool,
+}
+
+impl Lobe {
+    /// The lobe of a microfacet distribution formed in a medium of index `medium_eta`: its width is the
+    /// roughness, its tail the distribution's own (`Microfacet::heavy_tail`). (It lives here rather than on
+    /// `Microfacet` because `optics` sits below `brdf` and knows nothing of lobes.)
+    pub fn of_facets(facets: &Microfacet, medium_eta: f64, label: String) -> Lobe {
+        Lobe { slope_width: facets.alpha, medium_eta, label, heavy_tail: facets.heavy_tail() }
+    }
 }
 
 /// A term of a model, for the measurement plan's explanation: what is evaluated and how.

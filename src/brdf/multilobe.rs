@@ -20,7 +20,7 @@
 use super::dielectric::{describe_facets, describe_shadowing, microfacet_factor};
 use super::lambert::fmt_values;
 use super::{Brdf, Lobe, Term, TermKind};
-use crate::optics::microfacet::{Distribution, Microfacet, Shadowing};
+use crate::optics::microfacet::{Microfacet, Shadowing};
 use crate::spectrum::Sampling;
 use crate::Vec3;
 use std::f64::consts::PI;
@@ -112,15 +112,7 @@ impl Brdf for CookTorranceLobes {
                 t.push(Term { label: format!("lobe {} (smooth limit)", i + 1), kind: TermKind::Delta });
             } else {
                 let label = format!("Cook–Torrance lobe {} ({})", i + 1, describe_facets(&lobe.facets));
-                t.push(Term {
-                    label: label.clone(),
-                    kind: TermKind::Lobe(Lobe {
-                        slope_width: lobe.facets.alpha,
-                        medium_eta: 1.0,
-                        label,
-                        heavy_tail: lobe.facets.distribution == Distribution::Ggx,
-                    }),
-                });
+                t.push(Term { label: label.clone(), kind: TermKind::Lobe(Lobe::of_facets(&lobe.facets, 1.0, label)) });
             }
         }
         t

@@ -26,6 +26,7 @@ use crate::optics::kubelka_munk::{self, Layer};
 use crate::optics::microfacet::{Distribution, Microfacet, Shadowing};
 use crate::optics::tabulated::ChebTable;
 use crate::optics::thin_film::{stack, FilmLayer};
+use crate::quadrature::gauss_legendre;
 use crate::spectrum::Sampling;
 use crate::{Error, Result, Vec3};
 use num_complex::Complex64;
@@ -239,40 +240,6 @@ pub struct Paint {
     rough_coat: Option<Microfacet>,
     metallic: Option<FlakeTerm>,
     pearlescent: Option<FlakeTerm>,
-}
-
-/// Nodes and weights of the n-point Gauss–Legendre rule on [−1, 1] (Newton iteration on P_n from the
-/// Tricomi initial guesses; Abramowitz & Stegun 25.4.29; Press et al., Numerical Recipes §4.6 `gauleg`).
-pub fn gauss_legendre(n: usize) -> (Vec<f64>, Vec<f64>) {
-    let mut x = vec![0.0; n];
-    let mut w = vec![0.0; n];
-    let nf = n as f64;
-    for i in 0..n.div_ceil(2) {
-        let mut z = (PI * (i as f64 + 0.75) / (nf + 0.5)).cos();
-        let mut dp = 1.0;
-        for _ in 0..100 {
-            // P_n(z) and P_{n−1}(z) by the three-term recurrence.
-            let (mut p_prev, mut p) = (0.0, 1.0);
-            for j in 0..n {
-                let jf = j as f64;
-                let p_next = ((2.0 * jf + 1.0) * z * p - jf * p_prev) / (jf + 1.0);
-                p_prev = p;
-                p = p_next;
-            }
-            dp = nf * (z * p - p_prev) / (z * z - 1.0);
-            let dz = p / dp;
-            z -= dz;
-            if dz.abs() <= 1e-15 {
-                break;
-            }
-        }
-        x[i] = -z;
-        x[n - 1 - i] = z;
-        let wi = 2.0 / ((1.0 - z * z) * dp * dp);
-        w[i] = wi;
-        w[n - 1 - i] = wi;
-    }
-    (x, w)
 }
 
 /// Diffuse (hemispherical) reflectance of the air → coat interface for light incident from air,
@@ -559,12 +526,7 @@ impl Brdf for Paint {
             None => t.push(Term { label: "clear coat (Fresnel, delta)".into(), kind: TermKind::Delta }),
             Some(mf) => t.push(Term {
                 label: "clear coat (rough, microfacet)".into(),
-                kind: TermKind::Lobe(Lobe {
-                    slope_width: mf.alpha,
-                    medium_eta: 1.0,
-                    label: "clear coat".into(),
-                    heavy_tail: mf.distribution == Distribution::Ggx,
-                }),
+                kind: TermKind::Lobe(Lobe::of_facets(mf, 1.0, "clear coat".into())),
             }),
         }
         if self.body_weight > 0.0 {

@@ -1,12 +1,12 @@
 //! Independent references for the instrument integral: closed forms and plain Gauss–Legendre rules that
-//! share no code with the engine's quadrature (`flux.rs`, `quadrature/`). Used by `glossmeter convergence`
+//! share no code with the engine's quadrature (`flux.rs`, `method.rs`, `quadrature/`): they keep their own
+//! Gauss–Legendre generator, horizon clipping and mirror overlap on purpose. Used by `glossmeter convergence`
 //! to measure the actual error of Lambertian readings, and by the tests. (The stiff and extreme suite,
 //! `tests/stability.rs`, keeps its own copy on purpose, with its own horizon clipping.)
 //!
 //! * [`projected_solid_angle`]: ∫ cos θ dω over a stop, by Lambert's formula for a spherical polygon;
 //! * [`lambertian_flux_reference`]: f·P_s·P_r for a constant BRDF f;
 //! * [`mirror_flux_reference`]: ∫ R(θi) cos θi dω over the mirror overlap of the stops, 64 × 64 Gauss–Legendre.
-use crate::instrument::flux::clip;
 use crate::instrument::geometry::Stop;
 use crate::Vec3;
 
@@ -31,6 +31,21 @@ pub fn projected_solid_angle(axis: Vec3, e_par: Vec3, stop: Stop) -> f64 {
         s += gamma * c.z / len;
     }
     0.5 * s.abs()
+}
+
+/// The part of a stop above the horizon (this module's own copy of the clipping): a source direction has
+/// z ∝ cos θ + p sin θ and a receptor direction z ∝ cos θ − p sin θ, so the horizon is the line p = ∓cot θ.
+fn clip(stop: Stop, theta: f64, is_source: bool) -> Option<Stop> {
+    let mut s = stop;
+    if theta > 0.0 {
+        let limit = theta.cos() / theta.sin();
+        if is_source {
+            s.p[0] = s.p[0].max(-limit);
+        } else {
+            s.p[1] = s.p[1].min(limit);
+        }
+    }
+    (s.p[0] < s.p[1] && s.q[0] < s.q[1]).then_some(s)
 }
 
 /// Gauss–Legendre nodes and weights on [−1, 1], by Newton's iteration on P_n.

@@ -121,7 +121,7 @@ pub fn fr_conductor(cos_i: f64, eta: Complex64) -> f64 {
 /// Byrnes arXiv:1603.02720 Eq. 3). Of the two square roots the one with Im ≥ 0 is the wave decaying
 /// along +z (e^{i k₀ n₂ cos θ₂ z}); if Im = 0 the one with Re ≥ 0 propagates forward. `Complex64::sqrt` is
 /// principal and honours signed zero (√(−a − 0i) = −i√a, the growing branch), so the branch is fixed
-/// after the root: negate if Im < 0, or Im = 0 and Re < 0 (numerics-notes §4.2).
+/// after the root: negate if Im < 0, or Im = 0 and Re < 0 (the decaying-wave branch, Im ≥ 0 under n + ik: Byrnes, "Multilayer optical calculations", arXiv:1603.02720, App. D).
 /// If n₂ = 0 the cosine is undefined; the function then returns NaN (not a physical medium).
 pub fn complex_cos_transmitted(n1: Complex64, cos1: Complex64, n2: Complex64) -> Complex64 {
     let one = Complex64::new(1.0, 0.0);
@@ -282,7 +282,8 @@ mod tests {
         assert!((v.x - 1e-9 / 1.5).abs() < 1e-24);
     }
 
-    /// Reference value from numerics-notes §4.2 (tmm, Python and num-complex agree): R_s(air → 0.2 + 3i, 60°).
+    /// Reference value computed with tmm (Byrnes, arXiv:1603.02720) and independently in Python complex
+    /// arithmetic, which agree: R_s(air → 0.2 + 3i, 60°).
     #[test]
     fn conductor_reference_value() {
         let f = fresnel_conductor(60f64.to_radians().cos(), c(0.2, 3.0));

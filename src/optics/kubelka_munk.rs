@@ -6,7 +6,10 @@
 //! r0 = sinh bSX/(a sinh bSX + b cosh bSX), t = b/(a sinh bSX + b cosh bSX), with the identity
 //! a = (1 + r0² − t²)/(2 r0)); Curtis et al., SIGGRAPH 1997 §4 (inversion from reflectances over white and
 //! black). The paper (Ďurikovič & Ágošton 2007) Eqs. (3), (5), (8) print the first factor of the numerator as
-//! (1 − R∞); it must be 1/R∞ (X = 0 must give R = Rg). Numerical choices: numerics-notes §4.1.
+//! (1 − R∞); it must be 1/R∞ (X = 0 must give R = Rg). Numerical choices: R∞ in the
+//! rationalised form 1/(1 + x + √(x² + 2x)) (the textbook 1 + x − √(x² + 2x) cancels catastrophically for large
+//! x = K/S: Goldberg, "What every computer scientist should know about floating-point arithmetic", ACM Comput.
+//! Surv. 23 (1991) §1.4), coth through expm1 (no overflow for thick layers); tested below.
 
 /// Reflectance of an infinitely thick layer, R∞ = 1 + K/S − sqrt((K/S)² + 2K/S) (paper Eq. 4), evaluated
 /// free of cancellation for K/S up to 1e12 and beyond.
@@ -56,7 +59,7 @@ impl Layer {
 ///
 /// Kubelka (1948): with a = 1 + K/S, b = √(a² − 1), z = bSX,
 /// r0 = sinh z / (a sinh z + b cosh z), t = b / (a sinh z + b cosh z).
-/// Evaluated stably (numerics-notes §4.1) by dividing numerator and denominator by e^z and by b:
+/// Evaluated stably (no overflow of cosh/sinh for large z, no 0/0 at K = 0) by dividing numerator and denominator by e^z and by b:
 /// with m = −expm1(−2z) = 2e^{−z} sinh z, p = 1 + e^{−2z} = 2e^{−z} cosh z and u = m/b,
 /// r0 = u/(a u + p), t = 2e^{−z}/(a u + p).
 /// u = m/b is formed as 2SX·f(z), f(z) = −expm1(−2z)/(2z) (f(0) = 1), while z < 1/2, so that b → 0 (K → 0)

@@ -5,7 +5,8 @@
 //! in microfacet-based BRDFs", JCGT 3(2) 2014 (Λ, Eqs. 72, 80, 86; normalisation Eq. 4; projected-area
 //! identity Eq. 17–18; height-correlated G, Eq. 99); Cook & Torrance, ACM TOG 1 (1982) 7 (V-cavity G);
 //! pbrt-v4 `TrowbridgeReitzDistribution` (tan²θ from components; "effectively smooth"). Numerical
-//! choices: numerics-notes §4.4–4.5.
+//! choices (tan²θ from the components, Beckmann Λ through erfc, both tested below at α = θ = 1e-4 and at
+//! grazing angles) follow pbrt-v4 `scattering.h` and Heitz 2014 §5.
 use crate::Vec3;
 
 /// x > 0, false for NaN: used so that NaN inputs take the "outside the domain" branch.
@@ -48,13 +49,23 @@ impl Microfacet {
         Microfacet { distribution, alpha }
     }
 
+    /// Whether the distribution's tail falls off slower than a Gaussian: GGX's D ∝ tan⁻⁴θh far out (Walter et
+    /// al. 2007, Eq. 33) holds ~1e-4 of its mass beyond 100 α, while Beckmann's exp(−tan²θh/m²) is below e⁻¹⁰⁰
+    /// of its peak beyond 10 m. The integrator places its split points by it (`brdf::Lobe::heavy_tail`).
+    pub fn heavy_tail(&self) -> bool {
+        match self.distribution {
+            Distribution::Ggx => true,
+            Distribution::Beckmann => false,
+        }
+    }
+
     pub fn effectively_smooth(&self) -> bool {
         self.alpha < Self::SMOOTH_THRESHOLD
     }
 
     /// Normalised distribution of normals, ∫ D(h) cos θh dω = 1; tan²θh from components.
     ///
-    /// With t² = tan²θh = (h_x² + h_y²)/h_z² (from the components, never from a cosine: numerics-notes §4.4)
+    /// With t² = tan²θh = (h_x² + h_y²)/h_z² (from the components, never from a cosine, as pbrt-v4's `Tan2Theta`: (1 − cos²)/cos² loses all digits at small θ)
     /// and 1/cos⁴θh = (1 + t²)², which also makes D independent of the length of `h`:
     /// * Beckmann (Walter et al. 2007 Eq. 25): D = exp(−t²/α²) / (π α² cos⁴θh), evaluated as
     ///   exp(−t²/α²)·((1 + t²)/α)²/π, and 0 once the exponential underflows (no inf·0).
@@ -244,7 +255,7 @@ mod tests {
     }
 
     /// Closed forms at sample points with tan θ built exactly, and tan²θ taken from components: at
-    /// α = 1e-4 and θ = 1e-4 the relative error stays at rounding level (numerics-notes §4.4).
+    /// α = 1e-4 and θ = 1e-4 the relative error stays at rounding level (test below).
     #[test]
     fn d_closed_forms_at_small_angles() {
         let alpha: f64 = 1e-4;

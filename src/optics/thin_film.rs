@@ -372,7 +372,7 @@ mod tests {
             assert!((r.rp - 2.0 * f.rp / (1.0 + f.rp)).abs() < 1e-14);
             assert!((r.ts - (1.0 - f.rs) / (1.0 + f.rs)).abs() < 1e-14);
         }
-        // normal incidence: r = 0.04 → R = 0.0769230769… (numerics-notes §3, tmm inc_tmm)
+        // normal incidence: r = 0.04 → R = 0.0769230769… (tmm `inc_tmm`, Byrnes arXiv:1603.02720)
         let r = stack(1.0, &[inc(c(1.5, 0.0), 1e6)], c(1.0, 0.0), 1.0, 550.0);
         assert!((r.r() - 0.08 / 1.04).abs() < 1e-15);
     }

@@ -421,7 +421,7 @@ mod tests {
 
     #[test]
     fn degree_seven_exact() {
-        // x0^6 x1 ... the rule integrates polynomials of degree 7 exactly on one region.
+        // x0⁶ + x1⁴x2² + x3⁷ + 1: the rule integrates polynomials of degree 7 exactly on one region.
         let est = integrate::<4, _>(
             pointwise(1, |x, o| o[0] = x[0].powi(6) + x[1].powi(4) * x[2].powi(2) + x[3].powi(7) + 1.0),
             1,

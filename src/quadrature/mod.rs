@@ -3,16 +3,22 @@
 //! Why our own: the instrument integral is 4-D and vector-valued, its mass sits on thin ridges that the
 //! caller knows in advance, and it must be reproducible bit for bit. What it needs from an integrator is
 //! (a) an initial partition supplied by the caller (the splits at lobe centres, widths and kinks that keep
-//! a near-specular lobe from being silently missed: `../shared/reference/numerics-notes.md` §1), (b) one
+//! a near-specular lobe from being silently missed: an automatic rule sampling a box at a few points cannot
+//! see a peak between them, Lyness & Kaganove, "Comments on the nature of automatic quadrature routines",
+//! ACM TOMS 2 (1976) 65–81; `benches/integrators.rs` B3 shows it on the raw box), (b) one
 //! global absolute/relative tolerance across all pieces, (c) vector values with a stated error norm, and
 //! (d) a fixed, single-threaded order of work. The Rust crates looked at (bilby 0.3: scalar only, no initial
-//! split; scirs2-integrate: very heavy) offer none of (a)–(c) together, so the rule is implemented here,
-//! ~200 lines, and tested against closed forms in `tests/quadrature.rs`.
+//! split; scirs2-integrate: very heavy) offer none of (a)–(c) together, so the rule is implemented here
+//! (`genz_malik.rs`, tested against closed forms in its own test module). `gauss.rs` holds the crate's
+//! one-dimensional Gauss–Legendre and Gauss–Kronrod rules.
 //!
 //! The rule is Genz & Malik's degree-7 rule with an embedded degree-5 rule (A. C. Genz, A. A. Malik,
 //! "An adaptive algorithm for numerical integration over an n-dimensional rectangular region",
 //! J. Comput. Appl. Math. 6 (1980) 295–302), as used by Johnson's `hcubature`: the error of a region is
 //! |I₇ − I₅|, the worst region is bisected along the axis with the largest fourth difference.
+mod gauss;
 mod genz_malik;
+
+pub use gauss::{adaptive as gauss_kronrod_adaptive, gauss_legendre};
 
 pub use genz_malik::{integrate, integrate_partition, pointwise, Cell, Estimate, Options, Refine, Rule};
