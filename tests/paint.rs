@@ -5,8 +5,8 @@
 //! amplitudes of the paper's §5.1, Snell's law, Simpson's rule, and Kubelka–Munk's Eq. (3)/(4) transcribed.
 use glossmeter::brdf::albedo::directional_albedo;
 use glossmeter::brdf::paint::{
-    internal_diffuse_reflectance, ClearCoat, Form, MetallicFlakes, Paint, PaintSpec, PearlescentFlakes, Pigment,
-    PigmentedLayer, Spread, MAX_SAMPLES,
+    internal_diffuse_reflectance, ClearCoat, FlakeLight, Form, MetallicFlakes, Paint, PaintSpec, PearlescentFlakes,
+    Pigment, PigmentedLayer, Spread, MAX_SAMPLES,
 };
 use glossmeter::brdf::{Brdf, TermKind};
 use glossmeter::optics::microfacet::Distribution;
@@ -213,6 +213,7 @@ fn rgb_spec(eta: f64, x: f64, rg: [f64; 3], k: [f64; 3], s: [f64; 3]) -> PaintSp
         metallic: None,
         pearlescent: None,
         form: Form::Physical,
+        flake_light: FlakeLight::Split,
         internal_reflection: true,
     }
 }
@@ -291,13 +292,20 @@ fn fixture_terms_list_only_what_the_recipe_has() {
     assert_eq!(labels("cerulean-blue-a"), ["clear coat (Fresnel, delta)", "pigmented layer (Kubelka–Munk, diffuse)"]);
     assert_eq!(
         labels("cerulean-blue-b"),
-        ["clear coat (Fresnel, delta)", "pigmented layer (Kubelka–Munk, diffuse)", "metallic flakes"]
+        [
+            "clear coat (Fresnel, delta)",
+            "pigmented layer (Kubelka–Munk, diffuse)",
+            "metallic flakes, light scattered by the pigment above them (diffuse)",
+            "metallic flakes"
+        ]
     );
     assert_eq!(
         labels("cerulean-blue-c"),
         [
             "clear coat (Fresnel, delta)",
             "pigmented layer (Kubelka–Munk, diffuse)",
+            "metallic flakes, light scattered by the pigment above them (diffuse)",
+            "pearlescent flakes, light scattered by the pigment above them (diffuse)",
             "metallic flakes",
             "pearlescent flakes"
         ]
@@ -689,6 +697,7 @@ fn flake_delta_switch_is_continuous_and_is_eq5_corrected() {
         spec.metallic = Some(metal(spread, 0.6, 0.05));
         spec.pearlescent = Some(pearl(spread, 0.4, 0.1));
         spec.form = form;
+        spec.flake_light = FlakeLight::PaperEq5;
         Paint::new(spec).unwrap()
     };
     let smooth = build(1e-6, Form::Physical);
@@ -734,6 +743,87 @@ fn flake_delta_switch_is_continuous_and_is_eq5_corrected() {
             }
         }
     }
+}
+
+/// Split flake light (default, docs/model.md §Flake light through the pigment): the mirror weight of aligned
+/// flakes is T(θi)²·A·ρ(θi')·exp(−2εX'/cos θi'), ε = (K + S)/2, written out here; the scattered part is a
+/// diffuse term, which the paper's Eq. (5) instead puts into the lobe.
+#[test]
+fn split_flake_light_delta_weight_and_diffuse_part() {
+    let (k, s) = ([0.608, 0.128, 0.1], [0.024, 0.1, 0.16]);
+    let build = |light: FlakeLight, spread: f64| {
+        let mut spec = rgb_spec(1.5, 0.15, [0.7; 3], k, s);
+        spec.metallic = Some(metal(spread, 0.4, 0.075));
+        spec.flake_light = light;
+        Paint::new(spec).unwrap()
+    };
+    let split = build(FlakeLight::Split, 1e-6);
+    let paper = build(FlakeLight::PaperEq5, 1e-6);
+    let labels: Vec<String> = split.terms().into_iter().map(|t| t.label).collect();
+    assert!(labels.iter().any(|l| l.contains("scattered by the pigment") && l.starts_with("metallic")), "{labels:?}");
+    assert!(!paper.terms().iter().any(|t| t.label.contains("scattered")));
+    for ti in [0.0, 40.0, 75.0] {
+        let wi = dir(ti, 0.0);
+        let ct_in = refract_in(wi, 1.5).z;
+        let eta_rel = Complex64::new(0.93, 6.33) / 1.5;
+        let st = (1.0 - ct_in * ct_in) / (eta_rel * eta_rel);
+        let ct_t = (Complex64::new(1.0, 0.0) - st).sqrt();
+        let rs = ((ct_in - eta_rel * ct_t) / (ct_in + eta_rel * ct_t)).norm_sqr();
+        let rp = ((eta_rel * ct_in - ct_t) / (eta_rel * ct_in + ct_t)).norm_sqr();
+        let rho_m = 0.5 * (rs + rp);
+        let t = fresnel_t(wi.z, 1.5);
+        let (mut d, mut dp) = ([0.0; 3], [0.0; 3]);
+        split.delta_reflectance(wi, &mut d);
+        paper.delta_reflectance(wi, &mut dp);
+        for j in 0..3 {
+            let eps_x = 0.5 * (k[j] + s[j]) * 0.075;
+            let want = fresnel_r(wi.z, 1.5) + t * t * 0.4 * rho_m * (-2.0 * eps_x / ct_in).exp();
+            assert!(rel(d[j], want) < 1e-9, "θi {ti} sample {j}: {} vs {want}", d[j]);
+            // The paper's form: the KM reflectance of the cover over ρ_m (diffuse back-scatter r₀ included,
+            // the flake light attenuated along diffuse paths), written out.
+            let want_paper = fresnel_r(wi.z, 1.5) + t * t * 0.4 * km_eq3(k[j], s[j], 0.075, rho_m, false);
+            assert!(rel(dp[j], want_paper) < 1e-9, "θi {ti} sample {j}: {} vs {want_paper}", dp[j]);
+        }
+        // The diffuse part is symmetric in the two directions and vanishes for the paper's form.
+        let wo = dir(33.0, 120.0);
+        let (a, b) = (eval(&split, wi, wo), eval(&split, wo, wi));
+        for j in 0..3 {
+            assert!(rel(a[j], b[j]) < 1e-12, "{} vs {}", a[j], b[j]);
+        }
+        let body = eval(&paper, wi, wo);
+        assert!((0..3).all(|j| a[j] > body[j]), "split adds the scattered light to the body: {a:?} vs {body:?}");
+    }
+    // A cover that neither scatters nor absorbs: the two forms are the same paint (τ = 1, R_m = ρ).
+    let clear = |light: FlakeLight| {
+        let mut spec = rgb_spec(1.5, 0.15, [0.7; 3], [0.0; 3], [0.0; 3]);
+        spec.metallic = Some(metal(0.25f64.atan().to_degrees(), 0.4, 0.075));
+        spec.flake_light = light;
+        Paint::new(spec).unwrap()
+    };
+    let (c1, c2) = (clear(FlakeLight::Split), clear(FlakeLight::PaperEq5));
+    assert_eq!(c1.terms().len(), c2.terms().len());
+    for (ti, to, po) in [(20.0, 20.0, 180.0), (60.0, 50.0, 170.0), (10.0, 70.0, 30.0)] {
+        let (f1, f2) = (eval(&c1, dir(ti, 0.0), dir(to, po)), eval(&c2, dir(ti, 0.0), dir(to, po)));
+        for j in 0..3 {
+            assert!(rel(f1[j], f2[j]) < 1e-12, "({ti},{to},{po}) {j}: {} vs {}", f1[j], f2[j]);
+        }
+    }
+}
+
+/// `"flake_light"` selects the paper's Eq. (5); the default is the split form; anything else is refused.
+#[test]
+fn flake_light_is_selectable_in_recipes() {
+    let mut v = fixture_json("cerulean-blue-b");
+    let split = from_json(&v).unwrap();
+    assert!(split.describe().contains("flake light split"), "{}", split.describe());
+    v["flake_light"] = json!("paper");
+    let paper = from_json(&v).unwrap();
+    assert!(paper.describe().contains("paper's Eq. 5"), "{}", paper.describe());
+    let (wi, wo) = (dir(20.0, 0.0), dir(25.0, 180.0));
+    assert_ne!(eval(&*split, wi, wo), eval(&*paper, wi, wo));
+    v["flake_light"] = json!("both");
+    let e = from_json(&v).unwrap_err().to_string();
+    assert!(e.contains("flake_light") && e.contains("\"split\"") && e.contains("\"paper\""), "{e}");
 }
 
 #[test]

@@ -51,6 +51,19 @@ pub enum Form {
     PaperEq1,
 }
 
+/// Where the light that a flake's covering pigment scatters goes (`docs/model.md` §Flake light through the
+/// pigment). Only the physical form uses it; the paper-literal form keeps Eq. (5) as printed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FlakeLight {
+    /// Physically split (default): the flake lobe carries ρ·τ(θi')·τ(θo'), the flake's reflectance
+    /// attenuated by the unscattered (collimated) transmission of the pigment above it along the refracted
+    /// paths in and out; the light the pigment scatters joins the diffuse body as a reciprocal diffuse term.
+    Split,
+    /// The paper's Eq. (5): the Kubelka–Munk reflectance R of the pigment over the flake (diffuse back-scatter
+    /// included) inside the flake's narrow lobe.
+    PaperEq5,
+}
+
 /// The clear coat: a non-absorbing resin over the pigmented layer.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ClearCoat {
@@ -156,6 +169,8 @@ pub struct PaintSpec {
     pub metallic: Option<MetallicFlakes>,
     pub pearlescent: Option<PearlescentFlakes>,
     pub form: Form,
+    /// How the flake light is split between the lobe and the diffuse body (physical form only).
+    pub flake_light: FlakeLight,
     /// Apply the Saunderson multiple-internal-reflection factor 1/(1 − r_i R_l) to the body term.
     pub internal_reflection: bool,
 }
@@ -180,9 +195,16 @@ struct FlakeTerm {
     /// KM operator of the pigment above the flake (thickness X' or X''), per sample.
     cover: Vec<Layer>,
     optics: FlakeOptics,
-    /// R_m or R_p per sample as a verified Chebyshev table over the local cosine ∈ [0, 1] (max deviation
-    /// from the direct evaluation ≤ `TABLE_TOLERANCE` at check points), or None when no table met it.
+    /// R_m or R_p (paper Eq. 5) — or, for the split flake light, the bare flake reflectance ρ — per sample as a
+    /// verified Chebyshev table over the local cosine ∈ [0, 1] (max deviation from the direct evaluation ≤
+    /// `TABLE_TOLERANCE` at check points), or None when no table met it.
     table: Option<Vec<ChebTable>>,
+    /// Split flake light: per sample, the optical depth ε·X' of the cover for collimated light, ε = (K + S)/2.
+    depth: Vec<f64>,
+    /// Split flake light: per sample, the diffuse part's weight R_d/(π(1 − τ̄)): R_d = KM cover over the
+    /// flake's hemispherical reflectance, τ̄ = 2∫τ(μ)μ dμ. 0 where the cover does not scatter or absorb.
+    diffuse: Vec<f64>,
+    split: bool,
 }
 
 /// Largest accepted deviation of a flake-reflectance table from the direct evaluation (absolute, on a
@@ -211,9 +233,58 @@ impl FlakeTerm {
         }
     }
 
-    /// R_m or R_p evaluated directly (no table).
+    /// What the lobe carries per unit D·G/(4 cos cos), evaluated directly (no table): R_m or R_p (paper Eq. 5),
+    /// or the bare flake reflectance ρ for the split flake light (the cover's attenuation is applied by the
+    /// caller, it depends on both directions).
     fn reflectance_direct(&self, k: usize, cos_local: f64, wavelength_nm: f64) -> f64 {
-        self.cover[k].over(self.rho(k, cos_local, wavelength_nm).clamp(0.0, 1.0))
+        let rho = self.rho(k, cos_local, wavelength_nm).clamp(0.0, 1.0);
+        if self.split {
+            rho
+        } else {
+            self.cover[k].over(rho)
+        }
+    }
+
+    /// Unscattered transmission τ = exp(−ε X'/μ) of the cover along an interior direction of cosine μ.
+    #[inline]
+    fn tau(&self, k: usize, mu: f64) -> f64 {
+        if mu <= 0.0 {
+            0.0
+        } else {
+            (-self.depth[k] / mu).exp()
+        }
+    }
+
+    /// 1 − τ without cancellation.
+    #[inline]
+    fn one_minus_tau(&self, k: usize, mu: f64) -> f64 {
+        if mu <= 0.0 {
+            1.0
+        } else {
+            -(-self.depth[k] / mu).exp_m1()
+        }
+    }
+
+    /// Precompute the split flake light's per-sample constants (`depth`, `diffuse`).
+    fn split_constants(&mut self, k_mix: &[f64], s_mix: &[f64], depth_mm: f64, wavelengths_nm: &[f64]) {
+        let (x, w) = gauss_legendre(DIFFUSE_FRESNEL_NODES);
+        let n = self.cover.len();
+        self.depth = (0..n).map(|j| 0.5 * (k_mix[j] + s_mix[j]) * depth_mm).collect();
+        self.diffuse = (0..n)
+            .map(|j| {
+                // ρ_d = 2∫ρ(μ)μ dμ and 1 − τ̄ = 2∫(1 − τ(μ))μ dμ by Gauss–Legendre in μ (both smooth on [0, 1]).
+                let (mut rho_d, mut one_minus_tau_bar) = (0.0, 0.0);
+                for (&xi, &wi) in x.iter().zip(&w) {
+                    let mu = 0.5 * (xi + 1.0);
+                    rho_d += wi * mu * self.rho(j, mu, wavelengths_nm[j]).clamp(0.0, 1.0);
+                    one_minus_tau_bar += wi * mu * self.one_minus_tau(j, mu);
+                }
+                if one_minus_tau_bar <= 0.0 {
+                    return 0.0;
+                }
+                self.cover[j].over(rho_d.clamp(0.0, 1.0)) / (PI * one_minus_tau_bar)
+            })
+            .collect();
     }
 
     /// Build the per-sample tables; all or none.
@@ -357,6 +428,7 @@ impl Paint {
             (c.roughness >= Microfacet::SMOOTH_THRESHOLD).then(|| Microfacet::new(c.distribution, c.roughness));
         let cover =
             |depth: f64| -> Vec<Layer> { (0..n).map(|j| kubelka_munk::layer(k_mix[j], s_mix[j], depth)).collect() };
+        let split = spec.form == Form::Physical && spec.flake_light == FlakeLight::Split;
         let flake = |label, spread: Spread, area, depth, optics| {
             let facets = Microfacet::new(Distribution::Beckmann, spread.slope());
             let mut term = FlakeTerm {
@@ -367,8 +439,14 @@ impl Paint {
                 cover: cover(depth),
                 optics,
                 table: None,
+                depth: vec![0.0; n],
+                diffuse: vec![0.0; n],
+                split,
             };
             term.tabulate(&spec.sampling.wavelengths_nm);
+            if split {
+                term.split_constants(&k_mix, &s_mix, depth, &spec.sampling.wavelengths_nm);
+            }
             term
         };
         let metallic = spec.metallic.as_ref().filter(|m| m.area_ratio > 0.0).map(|m| {
@@ -448,7 +526,18 @@ impl Brdf for Paint {
                 }
                 let h = (wi_in + wo_in).normalize();
                 let cos_local = wi_in.dot(h).clamp(0.0, 1.0);
-                for fl in self.flakes().filter(|f| !f.smooth) {
+                for fl in self.flakes() {
+                    if fl.split {
+                        // The light the cover scatters: a reciprocal diffuse term whose interior albedo is
+                        // A·R_d·(1 − τ(θi')) (docs/model.md §Flake light through the pigment).
+                        let w = factor * fl.area;
+                        for (k, o) in out.iter_mut().enumerate() {
+                            *o += w * fl.diffuse[k] * fl.one_minus_tau(k, wi_in.z) * fl.one_minus_tau(k, wo_in.z);
+                        }
+                    }
+                    if fl.smooth {
+                        continue;
+                    }
                     let geo = fl.facets.d(h) * fl.facets.g(wi_in, wo_in, h, Shadowing::SmithHeightCorrelated)
                         / (4.0 * wi_in.z * wo_in.z);
                     if !geo.is_finite() || geo <= 0.0 {
@@ -456,7 +545,8 @@ impl Brdf for Paint {
                     }
                     let w = factor * fl.area * geo;
                     for (k, o) in out.iter_mut().enumerate() {
-                        *o += w * fl.reflectance(k, cos_local, lambdas[k]);
+                        let att = if fl.split { fl.tau(k, wi_in.z) * fl.tau(k, wo_in.z) } else { 1.0 };
+                        *o += w * att * fl.reflectance(k, cos_local, lambdas[k]);
                     }
                 }
             }
@@ -514,7 +604,9 @@ impl Brdf for Paint {
                 Form::PaperEq1 => (4.0 * t_i * fl.area, cos_i),
             };
             for (k, o) in out.iter_mut().enumerate() {
-                *o += w * fl.reflectance(k, cos_local, lambdas[k]);
+                // Split flake light: the mirror path goes in and out at θi', attenuated τ(θi')² by the cover.
+                let att = if fl.split { fl.tau(k, cos_local).powi(2) } else { 1.0 };
+                *o += w * att * fl.reflectance(k, cos_local, lambdas[k]);
             }
         }
         true
@@ -536,6 +628,12 @@ impl Brdf for Paint {
             Form::Physical => self.spec.coat.index,
             Form::PaperEq1 => 1.0,
         };
+        for fl in self.flakes().filter(|f| f.split && f.diffuse.iter().any(|&d| d > 0.0)) {
+            t.push(Term {
+                label: format!("{}, light scattered by the pigment above them (diffuse)", fl.label),
+                kind: TermKind::Diffuse,
+            });
+        }
         for fl in self.flakes() {
             let kind = if fl.smooth {
                 TermKind::Delta
@@ -578,6 +676,12 @@ impl Brdf for Paint {
         );
         if s.internal_reflection && s.form == Form::Physical {
             d.push_str(&format!(", Saunderson r_i = {:.4}", self.r_i));
+        }
+        if s.form == Form::Physical && self.flakes().next().is_some() {
+            d.push_str(match s.flake_light {
+                FlakeLight::Split => ", flake light split (lobe × cover transmission, scattered part diffuse)",
+                FlakeLight::PaperEq5 => ", flake light as the paper's Eq. 5 (cover reflectance in the lobe)",
+            });
         }
         for fl in self.flakes() {
             let table = match &fl.table {

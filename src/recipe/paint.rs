@@ -3,7 +3,8 @@
 //! the file, the field and what is allowed; [`Paint::new`] re-checks the same constraints for callers that
 //! build a [`PaintSpec`] in code.
 use crate::brdf::paint::{
-    ClearCoat, Form, MetallicFlakes, Paint, PaintSpec, PearlescentFlakes, Pigment, PigmentedLayer, Spread, MAX_SAMPLES,
+    ClearCoat, FlakeLight, Form, MetallicFlakes, Paint, PaintSpec, PearlescentFlakes, Pigment, PigmentedLayer, Spread,
+    MAX_SAMPLES,
 };
 use crate::brdf::Brdf;
 use crate::optics::kubelka_munk::invert_white_black;
@@ -23,6 +24,7 @@ pub const DEFAULT_MICA_INDEX: f64 = 1.58;
 /// Root fields of a paint recipe besides the descriptive ones (`crate::recipe::META_FIELDS`).
 const ROOT_FIELDS: &[&str] = &[
     "form",
+    "flake_light",
     "internal_reflection",
     "wavelengths_nm",
     "clear_coat",
@@ -60,6 +62,17 @@ pub fn parse_paint_spec(obj: &Obj) -> Result<PaintSpec> {
             )
         }
     };
+    let flake_light =
+        match obj.opt_str("flake_light")? {
+            None | Some("split") => FlakeLight::Split,
+            Some("paper") => FlakeLight::PaperEq5,
+            Some(other) => return Err(obj.err(
+                "flake_light",
+                format!(
+                    "unknown flake_light \"{other}\"; allowed: \"split\" (default), \"paper\" (Eq. 5 as in the paper)"
+                ),
+            )),
+        };
     let internal_reflection = opt_bool(obj, "internal_reflection")?.unwrap_or(true);
     let sampling = match obj.get("wavelengths_nm") {
         None => Sampling::rgb(),
@@ -90,7 +103,7 @@ pub fn parse_paint_spec(obj: &Obj) -> Result<PaintSpec> {
             format!("metallic + pearlescent area ratios Am + Ap = {am} + {ap} = {} exceed 1 (the flakes and the pigmented layer share the visible area)", am + ap),
         ));
     }
-    Ok(PaintSpec { sampling, coat, layer, metallic, pearlescent, form, internal_reflection })
+    Ok(PaintSpec { sampling, coat, layer, metallic, pearlescent, form, flake_light, internal_reflection })
 }
 
 fn parse_coat(o: &Obj) -> Result<ClearCoat> {

@@ -64,6 +64,7 @@ pub fn schema() -> Value {
         "Layered automotive paint after Ďurikovič & Ágošton (2007); fields documented in docs/recipe-format.md §Paint (see src/recipe/paint.rs)",
         &[
             ("form", json!({"enum": ["physical", "paper-eq1"], "default": "physical"})),
+            ("flake_light", json!({"enum": ["split", "paper"], "default": "split"})),
             ("internal_reflection", json!({"type": "boolean", "default": true})),
             ("wavelengths_nm", json!({"type": "array", "items": {"type": "number", "minimum": 360, "maximum": 830}, "minItems": 1})),
             (
