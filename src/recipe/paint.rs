@@ -62,17 +62,18 @@ pub fn parse_paint_spec(obj: &Obj) -> Result<PaintSpec> {
             )
         }
     };
-    let flake_light =
-        match obj.opt_str("flake_light")? {
-            None | Some("split") => FlakeLight::Split,
-            Some("paper") => FlakeLight::PaperEq5,
-            Some(other) => return Err(obj.err(
+    let flake_light = match obj.opt_str("flake_light")? {
+        None | Some("split") => FlakeLight::Split,
+        Some("paper") => FlakeLight::PaperEq5,
+        Some(other) => {
+            return Err(obj.err(
                 "flake_light",
                 format!(
                     "unknown flake_light \"{other}\"; allowed: \"split\" (default), \"paper\" (Eq. 5 as in the paper)"
                 ),
-            )),
-        };
+            ))
+        }
+    };
     let internal_reflection = opt_bool(obj, "internal_reflection")?.unwrap_or(true);
     let sampling = match obj.get("wavelengths_nm") {
         None => Sampling::rgb(),
