@@ -1020,3 +1020,25 @@ fn paint_new_refuses_bad_specs_without_panicking() {
     s.layer.primer_reflectance = vec![0.5; 2];
     assert!(Paint::new(s).unwrap_err().to_string().contains("sampling has 3"));
 }
+
+/// The realistic paints (docs/model.md §Paints that read like paints) and the shipped Cerulean (b), (c) read
+/// inside the real-meter ranges cited there: 70–100 GU at 20° (high-gloss automotive finishes) and 71–97 GU
+/// at 60° (ISO 2813's "gloss" and "high gloss" classes); the literal Cerulean variants do not.
+#[test]
+fn realistic_paints_read_in_the_real_meter_ranges() {
+    let options = glossmeter::instrument::plan::PlanOptions { rtol: 1e-6, ..Default::default() };
+    let read = |name: &str| {
+        let path = std::path::PathBuf::from(format!("{}/fixtures/recipes/{name}.json", env!("CARGO_MANIFEST_DIR")));
+        let (_, r) = glossmeter::measure_file(&path, &["astm-d523-20", "astm-d523-60"], &options).unwrap();
+        (r[0].value.unwrap(), r[1].value.unwrap())
+    };
+    for name in ["solid-white", "solid-black", "silver-metallic", "white-pearl", "cerulean-blue-b", "cerulean-blue-c"] {
+        let (g20, g60) = read(name);
+        assert!((70.0..=100.0).contains(&g20), "{name}: 20° reads {g20}");
+        assert!((71.0..=97.0).contains(&g60), "{name}: 60° reads {g60}");
+    }
+    for name in ["cerulean-blue-b-literal", "cerulean-blue-c-literal"] {
+        let (g20, _) = read(name);
+        assert!(g20 > 500.0, "{name}: the literal flake spread reads {g20} at 20°");
+    }
+}
