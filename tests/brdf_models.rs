@@ -371,3 +371,25 @@ fn constructors_refuse_caller_data_with_an_error_not_a_panic() {
     let e = Lambert::new(vec![0.2, 0.5], Sampling::rgb()).unwrap_err().to_string();
     assert!(e.contains("albedo") && e.contains("2 value(s) for 3"), "{e}");
 }
+
+/// `cook-torrance-lobes` with `"clear_coat"`: a Fresnel mirror ρ(θi) on top, the lobes and Kd weighted by
+/// T(θi)·T(θo) (T = 1 − ρ), written out here from the closed-form Fresnel reflectance.
+#[test]
+fn lobes_under_a_clear_coat() {
+    let text = r#"{"model": "cook-torrance-lobes", "kd": 0.2, "lobes": [{"ks": 0.3, "r": 0.9, "m": 0.2}]"#;
+    let bare = recipe::parse_str(&format!("{text}}}"), "bare.json").unwrap();
+    let coated = recipe::parse_str(&format!(r#"{text}, "clear_coat": {{"index": 1.5}}}}"#), "coat.json").unwrap();
+    assert_eq!(coated.brdf.terms()[0].label, "clear coat (Fresnel, delta)");
+    for (ti, to, po) in [(20.0, 20.0, 180.0), (60.0, 45.0, 150.0), (85.0, 80.0, 180.0)] {
+        let (wi, wo) = (dir(ti, 0.0), dir(to, po));
+        let tt = (1.0 - fresnel_closed_form(wi.z, 1.5)) * (1.0 - fresnel_closed_form(wo.z, 1.5));
+        let (f, g) = (eval(&*coated.brdf, wi, wo)[0], eval(&*bare.brdf, wi, wo)[0]);
+        assert!((f - tt * g).abs() <= 1e-12 * g, "({ti},{to},{po}): {f} vs {}", tt * g);
+        let mut d = [0.0];
+        assert!(coated.brdf.delta_reflectance(wi, &mut d));
+        assert!((d[0] - fresnel_closed_form(wi.z, 1.5)).abs() < 1e-12);
+        assert!(coated.brdf.is_reciprocal());
+    }
+    let bad = recipe::parse_str(&format!(r#"{text}, "clear_coat": {{"index": 2.5}}}}"#), "bad.json").unwrap_err();
+    assert!(bad.to_string().contains("clear_coat.index"), "{bad}");
+}

@@ -20,6 +20,7 @@
 use super::dielectric::{describe_facets, describe_shadowing, microfacet_factor};
 use super::lambert::fmt_values;
 use super::{Brdf, Lobe, Term, TermKind};
+use crate::optics::fresnel::fr_dielectric;
 use crate::optics::microfacet::{Microfacet, Shadowing};
 use crate::spectrum::Sampling;
 use crate::Vec3;
@@ -49,6 +50,9 @@ pub struct CookTorranceLobes {
     pub lobes: Vec<CtLobe>,
     pub shadowing: Shadowing,
     pub sampling: Sampling,
+    /// A smooth clear coat of this index on top (`"clear_coat": {"index": n}`): a Fresnel mirror ρ(θi), the
+    /// lobes and Kd seen through it weighted by T(θi)·T(θo), T = 1 − ρ (energy-conserving and reciprocal).
+    pub clear_coat: Option<f64>,
 }
 
 impl CookTorranceLobes {
@@ -58,7 +62,18 @@ impl CookTorranceLobes {
         for (i, l) in lobes.iter().enumerate() {
             super::per_sample(&format!("lobe {i} ks"), &l.ks, &sampling)?;
         }
-        Ok(CookTorranceLobes { kd, lobes, shadowing, sampling })
+        Ok(CookTorranceLobes { kd, lobes, shadowing, sampling, clear_coat: None })
+    }
+
+    /// Put a smooth clear coat of index `index` on top (docs/recipe-format.md §cook-torrance-lobes).
+    pub fn with_clear_coat(mut self, index: f64) -> Self {
+        self.clear_coat = Some(index);
+        self
+    }
+
+    /// T(θ) = 1 − ρ(θ) of the clear coat (1 without one).
+    fn coat_t(&self, cos_theta: f64) -> f64 {
+        self.clear_coat.map_or(1.0, |n| 1.0 - fr_dielectric(cos_theta.clamp(0.0, 1.0), n))
     }
 }
 
@@ -85,25 +100,38 @@ impl Brdf for CookTorranceLobes {
                 }
             }
         }
+        if self.clear_coat.is_some() {
+            let tt = self.coat_t(wi.z) * self.coat_t(wo.z);
+            out.iter_mut().for_each(|o| *o *= tt);
+        }
     }
 
     fn delta_reflectance(&self, wi: Vec3, out: &mut [f64]) -> bool {
         let smooth: Vec<&CtLobe> = self.lobes.iter().filter(|l| l.facets.effectively_smooth()).collect();
-        if smooth.is_empty() {
+        if smooth.is_empty() && self.clear_coat.is_none() {
             return false;
         }
         out.fill(0.0);
+        // The mirror direction has θo = θi: a smooth lobe under the coat is weighted T(θi)².
+        let tt = self.coat_t(wi.z).powi(2);
         for lobe in smooth {
-            let f = schlick_fresnel(lobe.r, wi.z);
+            let f = schlick_fresnel(lobe.r, wi.z) * tt;
             for (o, ks) in out.iter_mut().zip(&lobe.ks) {
                 *o += ks * f;
             }
+        }
+        if let Some(n) = self.clear_coat {
+            let rho = fr_dielectric(wi.z.clamp(0.0, 1.0), n);
+            out.iter_mut().for_each(|o| *o += rho);
         }
         true
     }
 
     fn terms(&self) -> Vec<Term> {
         let mut t = Vec::new();
+        if self.clear_coat.is_some() {
+            t.push(Term { label: "clear coat (Fresnel, delta)".into(), kind: TermKind::Delta });
+        }
         if self.kd.iter().any(|&k| k > 0.0) {
             t.push(Term { label: "Lambertian".into(), kind: TermKind::Diffuse });
         }
@@ -124,8 +152,12 @@ impl Brdf for CookTorranceLobes {
             .iter()
             .map(|l| format!("Ks = {}, R = {}, {}", fmt_values(&l.ks), l.r, describe_facets(&l.facets)))
             .collect();
+        let coat = match self.clear_coat {
+            Some(n) => format!("; under a smooth clear coat η = {n} (Fresnel mirror on top, T(θi)T(θo) below)"),
+            None => String::new(),
+        };
         format!(
-            "Cook–Torrance lobes (Kd = {}; {}; Schlick F; {})",
+            "Cook–Torrance lobes (Kd = {}; {}; Schlick F; {}{coat})",
             fmt_values(&self.kd),
             lobes.join("; "),
             describe_shadowing(self.shadowing)

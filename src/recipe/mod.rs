@@ -319,7 +319,14 @@ fn shadowing(obj: &Obj) -> Result<Shadowing> {
 
 /// `cook-torrance-lobes`: kd, lobes[{ks, r, m}], optional distribution and shadowing.
 fn parse_lobes(obj: &Obj) -> Result<Arc<dyn Brdf>> {
-    obj.deny_unknown(&with_meta(&["kd", "lobes", "distribution", "shadowing"]))?;
+    obj.deny_unknown(&with_meta(&["kd", "lobes", "distribution", "shadowing", "clear_coat"]))?;
+    let clear_coat = match obj.opt_obj("clear_coat")? {
+        None => None,
+        Some(c) => {
+            c.deny_unknown(&["index", "notes"])?;
+            Some(c.num("index", 1.3, 1.8, "refractive index of the smooth clear coat on top of the lobes")?)
+        }
+    };
     let kd = colour(obj, "kd", "diffuse albedo Kd")?;
     let distribution = distribution(obj, false)?;
     let shadowing = shadowing(obj)?;
@@ -346,5 +353,9 @@ fn parse_lobes(obj: &Obj) -> Result<Arc<dyn Brdf>> {
         .collect();
     let ks: Vec<&Vec<f64>> = lobes.iter().map(|l| &l.ks).collect();
     energy_check(obj, "lobes", &kd, &ks, "Kd + Σ Ks")?;
-    Ok(Arc::new(CookTorranceLobes::new(kd, lobes, shadowing, sampling)?))
+    let model = CookTorranceLobes::new(kd, lobes, shadowing, sampling)?;
+    Ok(Arc::new(match clear_coat {
+        Some(n) => model.with_clear_coat(n),
+        None => model,
+    }))
 }

@@ -224,6 +224,13 @@ pub fn schema() -> Value {
                     }),
                 ),
                 ("distribution", distribution),
+                (
+                    "clear_coat",
+                    object(
+                        json!({"index": range(1.3, 1.8, "index of a smooth clear coat on top"), "notes": {"$ref": "#/$defs/notes"}}),
+                        &["index"],
+                    ),
+                ),
                 ("shadowing", shadowing),
             ],
             &["kd", "lobes"],
