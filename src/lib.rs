@@ -6,6 +6,7 @@
 //! * [`brdf`]: the [`brdf::Brdf`] trait and the reflectance models built from the optics, including the
 //!   paint model of Ďurikovič & Ágošton (2007).
 //! * [`recipe`]: JSON recipes → validated BRDFs, with errors that name the file and the field.
+//! * [`input`]: input files read as text with a size limit.
 //! * [`spectrum`]: spectral sampling and the luminous (CIE illuminant C × V(λ)) weighting.
 //! * [`quadrature`]: the deterministic adaptive cubature with error estimates.
 //! * [`instrument`]: aperture geometry, the standards as data, the measurement plan and the readings.
@@ -19,6 +20,7 @@ pub mod brdf;
 #[cfg(feature = "cli")]
 pub mod cli;
 pub mod error;
+pub mod input;
 pub mod instrument;
 pub mod optics;
 pub mod quadrature;

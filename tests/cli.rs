@@ -107,3 +107,127 @@ fn compare_passes_within_and_fails_outside_the_sheet() {
     std::fs::write(&sheet, "geometry,value\nastm-d523-99,80\n").unwrap();
     assert_eq!(run(["glossmeter", "compare", "fixtures/recipes/black-glass.json", sheet.to_str().unwrap()]), 2);
 }
+
+fn stderr_of(args: &[&str]) -> (Option<i32>, String, String) {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_glossmeter"))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .args(args)
+        .output()
+        .unwrap();
+    (
+        out.status.code(),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+fn write(name: &str, text: &str) -> String {
+    let p = tmp(name);
+    std::fs::write(&p, text).unwrap();
+    p.to_str().unwrap().to_string()
+}
+
+/// Issue 8 item 1: a row whose prediction has no value was "—", no note, exit 0.
+#[test]
+fn compare_fails_a_check_it_could_not_make() {
+    let black = write("black-lambert.json", r#"{"model":"lambert","albedo":0}"#);
+    let sheet = write("doi.csv", "geometry,quantity,value,uncertainty\nastm-e430-30,doi,50,0.01\n");
+    let (code, out, _) = stderr_of(&["compare", &black, &sheet]);
+    assert_eq!(code, Some(1), "{out}");
+    assert!(out.contains("unchecked") && out.contains("not checked: the prediction has no value"), "{out}");
+    // A row with neither an uncertainty nor --tolerance cannot be checked either.
+    let sheet = write("no-allowance.csv", "geometry,value\nastm-d523-60,100\n");
+    let glass = "fixtures/recipes/black-glass.json";
+    let (code, out, _) = stderr_of(&["compare", glass, &sheet]);
+    assert_eq!(code, Some(1), "{out}");
+    assert!(out.contains("no allowed difference"), "{out}");
+    assert_eq!(run(["glossmeter", "compare", glass, &sheet, "--tolerance", "0.01"]), 0);
+}
+
+/// Issue 8 items 6 and 7: an unconverged reading exits 1 unless --allow-unconverged; DOI of a black
+/// specimen says that the specimen's specular flux is zero, not that the stops miss the mirror direction.
+#[test]
+fn unconverged_readings_exit_1_and_reasons_say_what_is_zero() {
+    let rough = "fixtures/recipes/rough-dielectric-beckmann.json";
+    let base = ["measure", rough, "-g", "astm-d523-60", "--max-evals", "200", "--no-timing"];
+    let (code, out, err) = stderr_of(&base);
+    assert_eq!(code, Some(1), "{out}{err}");
+    assert!(err.contains("did not converge") && out.contains("* not converged"), "{out}{err}");
+    let allowed: Vec<&str> = base.iter().copied().chain(["--allow-unconverged"]).collect();
+    assert_eq!(stderr_of(&allowed).0, Some(0));
+    for recipe in [r#"{"model":"lambert","albedo":0}"#, r#"{"model":"smooth-dielectric","ior":1.0}"#] {
+        let p = write("zero-specular.json", recipe);
+        let (code, out, _) = stderr_of(&["measure", &p, "-g", "astm-e430-30"]);
+        assert_eq!(code, Some(1), "{out}");
+        assert!(out.contains("the specimen reflects no flux into the specular receptor"), "{out}");
+        assert!(!out.contains("below the horizon"), "{out}");
+    }
+    // Albedo 1e-300: the ratio's error propagation underflowed into "non-finite result".
+    let p = write("tiny.json", r#"{"model":"lambert","albedo":1e-300}"#);
+    let (code, out, err) = stderr_of(&["measure", &p, "-g", "astm-e430-30", "--format", "json"]);
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(code, Some(0), "{out}{err}");
+    assert!(v["readings"].as_array().unwrap().iter().all(|r| r["value"].is_number()), "{out}");
+}
+
+/// Issue 8: `-o` naming an existing file is refused before any work (here: before the recipe is even read).
+#[test]
+fn output_is_checked_before_the_work() {
+    let existing = write("existing.txt", "user data");
+    let (code, _, err) = stderr_of(&["measure", "fixtures/recipes/does-not-exist.json", "-o", &existing]);
+    assert_eq!(code, Some(2));
+    assert!(err.contains("already exists") && !err.contains("does-not-exist"), "{err}");
+    let sheet = "fixtures/sheets/black-glass-check.csv";
+    let (code, _, err) = stderr_of(&["compare", "fixtures/recipes/does-not-exist.json", sheet, "-o", &existing]);
+    assert_eq!(code, Some(2));
+    assert!(err.contains("already exists"), "{err}");
+    assert_eq!(std::fs::read_to_string(&existing).unwrap(), "user data");
+}
+
+/// Issue 8 item 3: a table cell longer than 65 535 characters panicked in `format!`'s width.
+#[test]
+fn a_huge_table_cell_does_not_panic() {
+    let name = "s".repeat(70_000);
+    let sheet = write("long-cell.csv", &format!("sample,geometry,value,uncertainty\n{name},astm-d523-60,100,0.01\n"));
+    let (code, out, err) = stderr_of(&["compare", "fixtures/recipes/black-glass.json", &sheet]);
+    assert_eq!(code, Some(0), "{err}");
+    assert!(out.contains(&name) && out.contains("predicted − measured"));
+}
+
+/// Issue 8: CSV numbers are plain decimals and the notes are kept.
+#[test]
+fn csv_has_plain_decimals_and_notes() {
+    let (code, out, _) =
+        stderr_of(&["measure", "fixtures/recipes/cerulean-blue-c.json", "--format", "csv", "--no-timing"]);
+    assert_eq!(code, Some(0));
+    let mut r = csv::Reader::from_reader(out.as_bytes());
+    let head: Vec<String> = r.headers().unwrap().iter().map(String::from).collect();
+    assert_eq!(head.last().map(String::as_str), Some("note"));
+    let mut notes = 0;
+    for rec in r.records() {
+        let rec = rec.unwrap();
+        for c in [3, 5] {
+            let cell = &rec[c];
+            assert!(!cell.contains('e') && cell.parse::<f64>().unwrap().is_finite(), "{cell}");
+        }
+        notes += usize::from(rec[head.len() - 1].contains("ASTM D4039"));
+    }
+    assert_eq!(notes, 1, "the D4039 scope note is kept");
+}
+
+/// Issue 8 item 8 (smaller): duplicate keys, a BOM, a user geometry reusing a shipped id.
+#[test]
+fn smaller_input_cases_exit_2_naming_file_and_field() {
+    let dup = write("dup.json", r#"{"model":"lambert","albedo":0.5,"albedo":0.9}"#);
+    let (code, _, err) = stderr_of(&["measure", &dup, "-g", "astm-d523-60"]);
+    assert_eq!(code, Some(2));
+    assert!(err.contains("dup.json") && err.contains("`albedo`") && err.contains("twice"), "{err}");
+    let bom = write("bom.json", "\u{feff}{\"model\":\"lambert\",\"albedo\":0.5}");
+    assert_eq!(run(["glossmeter", "measure", &bom, "-g", "astm-d523-60"]), 0);
+    let (code, _, err) = stderr_of(&["measure", &bom, "--geometry-file", "fixtures/geometry/bad-shipped-id.json"]);
+    assert_eq!(code, Some(2));
+    assert!(err.contains("bad-shipped-id.json") && err.contains("`id`"), "{err}");
+    let (code, _, err) = stderr_of(&["measure", "/dev/zero"]);
+    assert_eq!(code, Some(2));
+    assert!(err.contains("/dev/zero") && err.contains("MiB"), "{err}");
+}

@@ -232,6 +232,14 @@ fn bad_geometry_files_name_file_and_field() {
     expect_input_error(&fixture("bad-unknown-field.json"), "source.in_plane", "unknown field");
     expect_input_error(&fixture("bad-below-horizon.json"), "receptors[0].offset_deg", "below");
     expect_input_error(&fixture("bad-empty-source.json"), "angle_deg.source", "must not be empty");
+    // Issue 8: a composite naming an unknown id was an error with neither file nor field; a user file could
+    // take a shipped id.
+    expect_input_error(
+        &fixture("bad-composite-unknown-part.json"),
+        "readings[0].minuend",
+        "\"astm-d523-61\" is not a shipped non-composite geometry id",
+    );
+    expect_input_error(&fixture("bad-shipped-id.json"), "id", "is the id of a shipped geometry");
 }
 
 #[test]

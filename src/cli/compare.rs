@@ -5,7 +5,8 @@ use std::path::PathBuf;
 
 use serde_json::json;
 
-use crate::cli::{check_rtol, emit, Format};
+use crate::cli::format::plain;
+use crate::cli::{check_rtol, readings_status, Format, Target};
 use crate::instrument::plan::{Plan, PlanOptions, Reading};
 use crate::instrument::sheet::{self, SheetRow};
 use crate::{recipe, resolve_geometries, Error, Result};
@@ -24,9 +25,12 @@ pub struct CompareArgs {
     pub rtol: f64,
     #[arg(long, value_enum, default_value_t = Format::Table)]
     pub format: Format,
-    /// Write to this file instead of stdout (never overwrites).
+    /// Write to this new file instead of stdout (an existing file is refused before any work).
     #[arg(long, short = 'o')]
     pub output: Option<PathBuf>,
+    /// Exit 0 even if a prediction did not converge within its budget (the comparison is still made).
+    #[arg(long)]
+    pub allow_unconverged: bool,
 }
 
 /// One row of the comparison.
@@ -36,8 +40,29 @@ pub struct Comparison {
     pub predicted: Option<Reading>,
     /// Allowed difference (uncertainty of the row, else --tolerance), plus the prediction's error estimate.
     pub allowed: Option<f64>,
-    /// Some(true) inside, Some(false) outside, None when no allowance is known or no prediction exists.
+    /// Some(true) inside, Some(false) outside, None when the row cannot be checked ([`Comparison::why_unchecked`]).
     pub inside: Option<bool>,
+}
+
+impl Comparison {
+    /// predicted − measured, when there is a prediction.
+    pub fn difference(&self) -> Option<f64> {
+        self.predicted.as_ref().and_then(|p| p.value).map(|v| v - self.row.value)
+    }
+
+    /// Why the row could not be checked (exit status 1), if it could not.
+    pub fn why_unchecked(&self) -> Option<String> {
+        if self.inside.is_some() {
+            return None;
+        }
+        match &self.predicted {
+            None => Some("no prediction for this reading".into()),
+            Some(p) if p.value.is_none() => {
+                Some(format!("the prediction has no value ({})", p.problem.as_deref().unwrap_or("no finite value")))
+            }
+            _ => Some("no allowed difference: the row has no uncertainty and no --tolerance was given".into()),
+        }
+    }
 }
 
 pub fn compare(rows: Vec<SheetRow>, readings: &[Reading], tolerance: Option<f64>) -> Vec<Comparison> {
@@ -64,6 +89,7 @@ pub fn run(a: CompareArgs) -> Result<()> {
         }
     }
     check_rtol(a.rtol)?;
+    let target = Target::new(a.output.as_deref(), "--output")?;
     let material = recipe::load_file(&a.recipe)?;
     let rows = sheet::load(&a.sheet)?;
     let mut ids: Vec<String> = Vec::new();
@@ -91,23 +117,47 @@ pub fn run(a: CompareArgs) -> Result<()> {
         Format::Json => json_text(&material.name, &cmp),
         Format::Csv => csv_text(&cmp)?,
     };
-    emit(&text, a.output.as_deref())?;
+    target.write(&text)?;
     let outside = cmp.iter().filter(|c| c.inside == Some(false)).count();
     if outside > 0 {
         return Err(Error::Check(format!("{outside} of {} reading(s) outside the allowed difference", cmp.len())));
     }
-    Ok(())
+    let unchecked = cmp.iter().filter(|c| c.inside.is_none()).count();
+    if unchecked > 0 {
+        return Err(Error::Check(format!(
+            "{unchecked} of {} reading(s) could not be checked (see the notes in the output)",
+            cmp.len()
+        )));
+    }
+    let predicted: Vec<Reading> = cmp.iter().filter_map(|c| c.predicted.clone()).collect();
+    readings_status(&predicted, a.allow_unconverged)
 }
 
 fn fmt(v: Option<f64>) -> String {
     v.filter(|x| x.is_finite()).map(|x| format!("{x:.3}")).unwrap_or_else(|| "—".into())
 }
 
+/// `v` right-aligned in `width` characters (by hand: `format!`'s width is limited to 65 535).
+fn right(v: &str, width: usize) -> String {
+    let n = v.chars().count();
+    format!("{}{v}", " ".repeat(width.saturating_sub(n)))
+}
+
 fn table(name: &str, cmp: &[Comparison]) -> String {
-    let mut rows =
-        vec![["sample", "geometry", "reading", "measured", "predicted", "± est.", "difference", "allowed", "verdict"]
-            .map(String::from)
-            .to_vec()];
+    let mut rows = vec![[
+        "sample",
+        "geometry",
+        "reading",
+        "measured",
+        "predicted",
+        "numerical error",
+        "predicted − measured",
+        "allowed",
+        "verdict",
+    ]
+    .map(String::from)
+    .to_vec()];
+    let mut notes = Vec::new();
     for c in cmp {
         let p = c.predicted.as_ref();
         let v = p.and_then(|p| p.value);
@@ -118,25 +168,32 @@ fn table(name: &str, cmp: &[Comparison]) -> String {
             format!("{:.3}", c.row.value),
             fmt(v),
             p.filter(|p| p.value.is_some()).map(|p| format!("{:.1e}", p.error_estimate)).unwrap_or("—".into()),
-            fmt(v.map(|v| v - c.row.value)),
+            fmt(c.difference()),
             fmt(c.allowed),
             match c.inside {
                 Some(true) => "ok".into(),
                 Some(false) => "OUTSIDE".into(),
-                None => "—".into(),
+                None => "unchecked".into(),
             },
         ]);
+        if let Some(why) = c.why_unchecked() {
+            notes.push(format!("line {} ({} {}): not checked: {why}", c.row.line, c.row.geometry, c.row.reading));
+        }
     }
-    let w: Vec<usize> = (0..rows[0].len()).map(|i| rows.iter().map(|r| r[i].chars().count()).max().unwrap()).collect();
+    let w: Vec<usize> =
+        (0..rows[0].len()).map(|i| rows.iter().map(|r| r[i].chars().count()).max().unwrap_or(0)).collect();
     let mut s = format!("{name}: predictions against the sheet\n\n");
     for (k, r) in rows.iter().enumerate() {
-        let line: Vec<String> = r.iter().enumerate().map(|(i, v)| format!("{v:>w$}", w = w[i])).collect();
+        let line: Vec<String> = r.iter().enumerate().map(|(i, v)| right(v, w[i])).collect();
         s.push_str(line.join("  ").trim_end());
         s.push('\n');
         if k == 0 {
             s.push_str(&w.iter().map(|n| "-".repeat(*n)).collect::<Vec<_>>().join("  "));
             s.push('\n');
         }
+    }
+    for n in notes {
+        s.push_str(&format!("note: {n}\n"));
     }
     s
 }
@@ -151,7 +208,8 @@ fn json_text(name: &str, cmp: &[Comparison]) -> String {
                 "measured": c.row.value, "uncertainty": c.row.uncertainty,
                 "predicted": p.and_then(|p| p.value),
                 "error_estimate": p.filter(|p| p.value.is_some()).map(|p| p.error_estimate),
-                "allowed": c.allowed, "inside": c.inside,
+                "difference": c.difference(),
+                "allowed": c.allowed, "inside": c.inside, "unchecked": c.why_unchecked(),
             })
         })
         .collect();
@@ -169,8 +227,10 @@ fn csv_text(cmp: &[Comparison]) -> Result<String> {
         "measured",
         "predicted",
         "error_estimate",
+        "difference",
         "allowed",
         "inside",
+        "note",
     ])
     .map_err(err)?;
     for c in cmp {
@@ -181,11 +241,13 @@ fn csv_text(cmp: &[Comparison]) -> Result<String> {
             c.row.sample.clone(),
             c.row.geometry.clone(),
             c.row.reading.clone(),
-            format!("{:e}", c.row.value),
-            v.map(|v| format!("{v:e}")).unwrap_or_default(),
-            v.and(p).map(|p| format!("{:e}", p.error_estimate)).unwrap_or_default(),
-            c.allowed.map(|a| format!("{a:e}")).unwrap_or_default(),
+            plain(c.row.value),
+            v.map(plain).unwrap_or_default(),
+            v.and(p).map(|p| plain(p.error_estimate)).unwrap_or_default(),
+            c.difference().map(plain).unwrap_or_default(),
+            c.allowed.map(plain).unwrap_or_default(),
             c.inside.map(|b| b.to_string()).unwrap_or_default(),
+            c.why_unchecked().map(|w| format!("not checked: {w}")).unwrap_or_default(),
         ])
         .map_err(err)?;
     }

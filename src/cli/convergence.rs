@@ -1,11 +1,12 @@
 //! `glossmeter convergence`: value, estimated error, actual error, evaluations and time of every reading
 //! over a sweep of tolerances, as a table, CSV or JSON, and optionally a log–log plot of error against
 //! time (SVG). The computation is `instrument::convergence::sweep`; this module parses, formats and writes.
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use serde_json::json;
 
-use super::{emit, plot, Format};
+use super::format::plain;
+use super::{plot, Format, Target};
 use crate::instrument::convergence::{self, ReferenceKind, Sweep, SweepOptions, DEFAULT_TOLERANCES};
 use crate::recipe::{self, Material};
 use crate::{Error, Result};
@@ -47,16 +48,6 @@ pub struct ConvergenceArgs {
     pub reference_run: bool,
 }
 
-fn refuse_existing(p: &Path, what: &str) -> Result<()> {
-    if p.exists() {
-        return Err(Error::Usage(format!(
-            "{what} {}: already exists; glossmeter never overwrites a file (choose another name)",
-            p.display()
-        )));
-    }
-    Ok(())
-}
-
 pub fn run(args: ConvergenceArgs) -> Result<()> {
     // Every check that can fail cheaply comes before the (possibly long) sweep.
     let tolerances = if args.tolerances.is_empty() { DEFAULT_TOLERANCES.to_vec() } else { args.tolerances.clone() };
@@ -67,9 +58,7 @@ pub fn run(args: ConvergenceArgs) -> Result<()> {
     if args.max_repetitions == 0 {
         return Err(Error::Usage("--max-repetitions must be at least 1".into()));
     }
-    if let Some(p) = &args.output {
-        refuse_existing(p, "--output")?;
-    }
+    let target = Target::new(args.output.as_deref(), "--output")?;
     if let Some(p) = &args.plot {
         plot::check_plot_path(p)?;
         if args.output.as_deref() == Some(p.as_path()) {
@@ -102,7 +91,7 @@ pub fn run(args: ConvergenceArgs) -> Result<()> {
             s.clamped_estimated
         );
     }
-    emit(&text, args.output.as_deref())?;
+    target.write(&text)?;
     if sweep.rows.iter().any(|r| r.value.is_none()) {
         return Err(Error::Numeric("some readings have no value (see the rows' problem)".into()));
     }
@@ -226,10 +215,10 @@ pub fn csv(sweep: &Sweep) -> Result<String> {
         "problem",
     ])
     .map_err(err)?;
-    let opt = |x: Option<f64>| x.map(|v| format!("{v:e}")).unwrap_or_default();
+    let opt = |x: Option<f64>| x.map(plain).unwrap_or_default();
     for r in &sweep.rows {
         w.write_record([
-            format!("{:e}", r.rtol),
+            plain(r.rtol),
             r.geometry.clone(),
             r.reading.clone(),
             r.quantity.clone(),
@@ -241,8 +230,8 @@ pub fn csv(sweep: &Sweep) -> Result<String> {
             opt(r.reference_error),
             r.reference_kind.clone(),
             r.evaluations.to_string(),
-            format!("{:e}", r.seconds),
-            format!("{:e}", r.plan_seconds),
+            plain(r.seconds),
+            plain(r.plan_seconds),
             r.repetitions.to_string(),
             r.converged.to_string(),
             r.problem.clone().unwrap_or_default(),

@@ -6,12 +6,20 @@ use crate::recipe::Material;
 use crate::{Error, Result};
 use serde_json::json;
 
-/// Decimal places that show the error estimate's leading digit (between 2 and 10).
-fn decimals(error: f64) -> usize {
-    if !(error > 0.0) || !error.is_finite() {
-        return 4;
+/// Decimal places of a reading in the table: one, i.e. 0.1 of the instrument's unit (GU, HU, DOI), as a
+/// glossmeter displays it (ASTM D523 reports gloss to 0.1 GU); none if the numerical error is larger than
+/// half of that. Full precision is in the JSON and CSV output; the numerical error has its own column.
+pub fn decimals(error: f64) -> usize {
+    if error.is_finite() && error > 0.05 {
+        0
+    } else {
+        1
     }
-    (-error.log10().floor() as i64).clamp(2, 10) as usize
+}
+
+/// A number for CSV: plain decimal digits, the shortest that read back to the same double (never `1e2`).
+pub fn plain(v: f64) -> String {
+    format!("{v}")
 }
 
 /// A duration for people: µs, ms or s.
@@ -27,7 +35,7 @@ pub fn secs(s: f64) -> String {
 
 pub fn table(material: &Material, readings: &[Reading], timing: bool) -> String {
     let mut rows: Vec<Vec<String>> = vec![];
-    let mut head = vec!["geometry", "reading", "value", "unit", "± error", "evaluations"];
+    let mut head = vec!["geometry", "reading", "value", "unit", "numerical error", "evaluations"];
     if timing {
         head.push("time");
     }
@@ -47,7 +55,7 @@ pub fn table(material: &Material, readings: &[Reading], timing: bool) -> String 
                 row.push("—".into());
             }
         }
-        row.push(r.evaluations.to_string());
+        row.push(if r.converged { r.evaluations.to_string() } else { format!("{} *", r.evaluations) });
         if timing {
             row.push(secs(r.seconds));
         }
@@ -82,6 +90,12 @@ pub fn table(material: &Material, readings: &[Reading], timing: bool) -> String 
             s.push_str(&widths.iter().map(|w| "-".repeat(*w)).collect::<Vec<_>>().join("  "));
             s.push('\n');
         }
+    }
+    if readings.iter().any(|r| !r.converged) {
+        s.push_str("* not converged: the evaluation budget ran out before the tolerance was met\n");
+    }
+    if readings.iter().any(|r| r.value.is_some()) {
+        s.push_str("numerical error: the integration's error estimate, not the uncertainty of the prediction\n");
     }
     for n in notes {
         s.push_str(&format!("note: {n}\n"));
@@ -131,6 +145,7 @@ pub fn csv(readings: &[Reading], timing: bool) -> Result<String> {
         head.push("seconds");
     }
     head.push("problem");
+    head.push("note");
     let err = |e: csv::Error| Error::Io { file: "<csv>".into(), source: std::io::Error::other(e) };
     w.write_record(&head).map_err(err)?;
     for r in readings {
@@ -138,16 +153,17 @@ pub fn csv(readings: &[Reading], timing: bool) -> Result<String> {
             r.geometry.clone(),
             r.name.clone(),
             r.quantity.clone(),
-            r.value.map(|v| format!("{v:e}")).unwrap_or_default(),
+            r.value.map(plain).unwrap_or_default(),
             r.unit.clone(),
-            r.value.map(|_| format!("{:e}", r.error_estimate)).unwrap_or_default(),
+            r.value.map(|_| plain(r.error_estimate)).unwrap_or_default(),
             r.evaluations.to_string(),
             r.converged.to_string(),
         ];
         if timing {
-            rec.push(format!("{:e}", r.seconds));
+            rec.push(plain(r.seconds));
         }
         rec.push(r.problem.clone().unwrap_or_default());
+        rec.push(r.note.clone().unwrap_or_default());
         w.write_record(&rec).map_err(err)?;
     }
     let bytes =

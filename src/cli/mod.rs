@@ -3,7 +3,7 @@
 //! message on stderr and a non-zero exit status: 2 for bad input, unreadable files or usage; 1 when a reading has
 //! no finite value or a comparison fails.
 use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use clap::{Parser, Subcommand, ValueEnum};
 
@@ -14,7 +14,10 @@ use crate::{recipe, resolve_geometries, Error, Result};
 pub mod compare;
 pub mod convergence;
 pub mod format;
+pub mod output;
 pub mod plot;
+
+pub use output::{print, Target, STDOUT};
 
 #[derive(Parser, Debug)]
 #[command(
@@ -58,9 +61,15 @@ pub enum Command {
         /// Leave the wall-time column out (everything else is reproducible bit for bit).
         #[arg(long)]
         no_timing: bool,
-        /// Write the result to this file instead of stdout (refuses to overwrite an existing file).
+        /// Write the result to this new file instead of stdout (an existing file is refused before any work).
         #[arg(long, short = 'o')]
         output: Option<PathBuf>,
+        /// Exit 0 even if a reading did not converge within its budget (it is still marked in the output).
+        #[arg(long)]
+        allow_unconverged: bool,
+        /// Evaluation budget of each aperture integral; a reading whose integral runs out is "not converged".
+        #[arg(long, default_value_t = PlanOptions::default().max_evals)]
+        max_evals: usize,
     },
     /// List the shipped geometries, or show one with the provenance of every number.
     Standards {
@@ -109,22 +118,29 @@ pub fn exit_status(e: &Error) -> i32 {
     }
 }
 
-/// How standard output is named in errors.
-pub const STDOUT: &str = "<stdout>";
-
-/// Write text to standard output; an error (a closed pipe, a full disk) is returned, never a panic.
-pub fn print(text: &str) -> Result<()> {
-    let mut out = std::io::stdout().lock();
-    out.write_all(text.as_bytes()).and_then(|_| out.flush()).map_err(|source| Error::Io { file: STDOUT.into(), source })
-}
-
 fn dispatch(cli: Cli) -> Result<()> {
     match cli.command {
-        Command::Measure { recipe, geometries, geometry_files, rtol, format, explain, no_timing, output } => {
+        Command::Measure {
+            recipe,
+            geometries,
+            geometry_files,
+            rtol,
+            format,
+            explain,
+            no_timing,
+            output,
+            allow_unconverged,
+            max_evals,
+        } => {
             check_rtol(rtol)?;
+            if max_evals == 0 {
+                return Err(Error::Usage("--max-evals must be at least 1".into()));
+            }
+            let target = Target::new(output.as_deref(), "--output")?;
             let material = recipe::load_file(&recipe)?;
             let geos = resolve_geometries(&geometries, &geometry_files)?;
-            let plan = Plan::compile(material.brdf.clone(), geos, PlanOptions { rtol, ..PlanOptions::default() })?;
+            let plan =
+                Plan::compile(material.brdf.clone(), geos, PlanOptions { rtol, max_evals, ..PlanOptions::default() })?;
             let mut text = String::new();
             if explain {
                 let e = plan.explain();
@@ -140,11 +156,8 @@ fn dispatch(cli: Cli) -> Result<()> {
                 Format::Json => format::json(&material, &readings, !no_timing),
                 Format::Csv => format::csv(&readings, !no_timing)?,
             });
-            emit(&text, output.as_deref())?;
-            if readings.iter().any(|r| r.value.is_none()) {
-                return Err(Error::Numeric("some readings have no finite value (see the notes in the output)".into()));
-            }
-            Ok(())
+            target.write(&text)?;
+            readings_status(&readings, allow_unconverged)
         }
         Command::Standards { id } => {
             let text = match id {
@@ -163,31 +176,31 @@ fn dispatch(cli: Cli) -> Result<()> {
     }
 }
 
+/// The verdict on a set of readings (docs/instrument.md §Exit statuses): an error (exit 1) if one has no
+/// finite value, or did not converge (unless allowed).
+pub fn readings_status(readings: &[crate::Reading], allow_unconverged: bool) -> Result<()> {
+    let missing = readings.iter().filter(|r| r.value.is_none()).count();
+    if missing > 0 {
+        return Err(Error::Numeric(format!(
+            "{missing} of {} reading(s) have no finite value (see the notes in the output)",
+            readings.len()
+        )));
+    }
+    let unconverged = readings.iter().filter(|r| !r.converged).count();
+    if unconverged > 0 && !allow_unconverged {
+        return Err(Error::Check(format!(
+            "{unconverged} of {} reading(s) did not converge to the tolerance within the evaluation budget \
+             (their values are best estimates; --allow-unconverged exits 0 anyway)",
+            readings.len()
+        )));
+    }
+    Ok(())
+}
+
 /// `--rtol` in (0, 1), checked before any work.
 pub fn check_rtol(rtol: f64) -> Result<()> {
     if !(rtol.is_finite() && rtol > 0.0 && rtol < 1.0) {
         return Err(Error::Usage(format!("--rtol must be a number in (0, 1), got {rtol}")));
     }
     Ok(())
-}
-
-/// Write to stdout, or to a new file (never overwriting one).
-pub fn emit(text: &str, output: Option<&Path>) -> Result<()> {
-    match output {
-        None => print(text),
-        Some(p) => {
-            let file = std::fs::OpenOptions::new().write(true).create_new(true).open(p).map_err(|e| {
-                if e.kind() == std::io::ErrorKind::AlreadyExists {
-                    Error::Usage(format!(
-                        "{}: already exists; glossmeter never overwrites a file (choose another name)",
-                        p.display()
-                    ))
-                } else {
-                    Error::Io { file: p.display().to_string(), source: e }
-                }
-            })?;
-            let mut w = std::io::BufWriter::new(file);
-            w.write_all(text.as_bytes()).map_err(|e| Error::Io { file: p.display().to_string(), source: e })
-        }
-    }
 }

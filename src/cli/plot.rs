@@ -4,7 +4,6 @@
 //!
 //! An error of exactly 0, or below the floor of the chart, cannot be drawn on a log axis: it is drawn at
 //! the floor as a hollow point, and the caption under the chart says so and gives the floor.
-use std::io::Write;
 use std::path::Path;
 
 use plotters::prelude::*;
@@ -38,13 +37,7 @@ pub fn check_plot_path(path: &Path) -> Result<()> {
         }
         _ => return Err(Error::Usage(format!("--plot {}: the plot file name must end in .svg", path.display()))),
     }
-    if path.exists() {
-        return Err(Error::Usage(format!(
-            "{}: already exists; glossmeter never overwrites a file (choose another name)",
-            path.display()
-        )));
-    }
-    Ok(())
+    super::output::check_new_file(path, "--plot")
 }
 
 fn plot_err(e: impl std::fmt::Display) -> Error {
@@ -205,19 +198,6 @@ fn tolerance_span(t: &[f64]) -> String {
 pub fn write_svg(sweep: &Sweep, title: &str, path: &Path) -> Result<PlotSummary> {
     check_plot_path(path)?;
     let (svg, summary) = render_svg(sweep, title)?;
-    let file = std::fs::OpenOptions::new().write(true).create_new(true).open(path).map_err(|e| {
-        if e.kind() == std::io::ErrorKind::AlreadyExists {
-            Error::Usage(format!(
-                "{}: already exists; glossmeter never overwrites a file (choose another name)",
-                path.display()
-            ))
-        } else {
-            Error::Io { file: path.display().to_string(), source: e }
-        }
-    })?;
-    let mut w = std::io::BufWriter::new(file);
-    w.write_all(svg.as_bytes())
-        .and_then(|_| w.flush())
-        .map_err(|e| Error::Io { file: path.display().to_string(), source: e })?;
+    super::output::write_new_file(path, svg.as_bytes())?;
     Ok(summary)
 }

@@ -730,17 +730,17 @@ pub fn reading_value(
     match spec {
         ReadingSpec::Gloss { receptor } => {
             let ((s, se), (d, de)) = (specimen(receptor), standard(receptor));
-            ratio(s, se, d, de).map(|(v, e)| (100.0 * v, 100.0 * e))
+            ratio(s, se, d, de, Denominator::Standard).map(|(v, e)| (100.0 * v, 100.0 * e))
         }
         ReadingSpec::Haze { receptors, specular } => {
             let (h, he) = mean(receptors);
             let (d, de) = standard(specular);
-            ratio(h, he, d, de).map(|(v, e)| (100.0 * v, 100.0 * e))
+            ratio(h, he, d, de, Denominator::Standard).map(|(v, e)| (100.0 * v, 100.0 * e))
         }
         ReadingSpec::LogHaze { receptors, specular, k } => {
             let (h, he) = mean(receptors);
             let (d, de) = standard(specular);
-            ratio(h, he, d, de).map(|(v, e)| {
+            ratio(h, he, d, de, Denominator::Standard).map(|(v, e)| {
                 let (h, he) = (100.0 * v, 100.0 * e);
                 (k * (h / 20.0 + 1.0).log10(), k * he / (std::f64::consts::LN_10 * (h + 20.0)))
             })
@@ -748,7 +748,7 @@ pub fn reading_value(
         ReadingSpec::Doi { specular, offset } => {
             let (s, se) = specimen(specular);
             let (o, oe) = mean(offset);
-            ratio(o, oe, s, se).map(|(v, e)| (100.0 * (1.0 - v), 100.0 * e))
+            ratio(o, oe, s, se, Denominator::SpecimenSpecular).map(|(v, e)| (100.0 * (1.0 - v), 100.0 * e))
         }
         ReadingSpec::HazeIndex { .. } => Err("a composite reading has no fluxes of its own".into()),
     }
@@ -788,7 +788,10 @@ fn compute_reading(r: &PlannedReading, flux: &[Flux]) -> Reading {
             problem: (!converged).then(|| "evaluation budget exhausted before the tolerance was met".into()),
             note: None,
         },
-        Ok(_) => problem_reading(r, "non-finite result".into()),
+        Ok((v, e)) => problem_reading(
+            r,
+            format!("the reading's arithmetic overflowed (value {v}, error estimate {e}); the fluxes are out of range"),
+        ),
         Err(why) => problem_reading(r, why),
     }
 }
@@ -824,12 +827,33 @@ fn compose_reading(r: &PlannedReading, done: &[Option<Reading>]) -> Reading {
     }
 }
 
-/// a/b with first-order error |a/b|·(ea/|a| + eb/|b|) written without dividing by a.
-fn ratio(a: f64, ea: f64, b: f64, eb: f64) -> std::result::Result<(f64, f64), String> {
+/// What the denominator of a reading's ratio is, for the message when it is zero.
+#[derive(Clone, Copy)]
+enum Denominator {
+    /// The gloss standard's specular flux (gloss, haze, log-haze).
+    Standard,
+    /// The specimen's own specular flux (DOI).
+    SpecimenSpecular,
+}
+
+/// a/b with first-order error |a/b|·(ea/|a| + eb/|b|) written without dividing by a. The error term is
+/// computed as a·eb/b² and, where b² underflows (fluxes near 1e-160 and below), as (a/b)·(eb/b), which has
+/// no underflow; the first form is kept where it is finite so that no reading's bits move.
+fn ratio(a: f64, ea: f64, b: f64, eb: f64, den: Denominator) -> std::result::Result<(f64, f64), String> {
     if !(b > 0.0) {
-        return Err("the reference flux is zero: the stops do not see the mirror direction (below the horizon?)".into());
+        return Err(match den {
+            Denominator::Standard => {
+                "the gloss standard's flux is zero: the stops do not see the mirror direction (below the horizon?)"
+                    .into()
+            }
+            Denominator::SpecimenSpecular => "the specimen reflects no flux into the specular receptor, so DOI = \
+                 100·(1 − offset/specular) is undefined (a black or mirror-less specimen has no image to be distinct)"
+                .into(),
+        });
     }
-    Ok((a / b, ea / b + a.abs() * eb / (b * b)))
+    let e = ea / b + a.abs() * eb / (b * b);
+    let e = if e.is_finite() { e } else { ea / b + (a.abs() / b) * (eb / b) };
+    Ok((a / b, e))
 }
 
 #[cfg(test)]

@@ -27,7 +27,7 @@ pub struct SheetRow {
 
 pub fn load(path: &Path) -> Result<Vec<SheetRow>> {
     let file = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| Error::Io { file: file.clone(), source: e })?;
+    let text = crate::input::read_text(path, "sheet")?;
     parse(&text, &file)
 }
 
@@ -43,7 +43,17 @@ fn wide_angle(header: &str) -> Option<&'static str> {
     }
 }
 
+/// The 1-based line of the record that starts at byte `at` (the CSV reader's position is where it began
+/// reading, before any blank lines it skipped).
+fn line_at(body: &str, at: u64) -> usize {
+    let at = (at as usize).min(body.len());
+    let skipped_blank = body[at..].bytes().take_while(|b| *b == b'\n' || *b == b'\r').filter(|b| *b == b'\n').count();
+    1 + body.as_bytes()[..at].iter().filter(|b| **b == b'\n').count() + skipped_blank
+}
+
 pub fn parse(text: &str, file: &str) -> Result<Vec<SheetRow>> {
+    // A byte-order mark (spreadsheet exports write one) is not part of the first line.
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     // Drop comment lines but keep line numbers right.
     let skipped = text.lines().take_while(|l| l.trim_start().starts_with('#') || l.trim().is_empty()).count();
     let body: String = text.lines().skip(skipped).collect::<Vec<_>>().join("\n");
@@ -73,9 +83,13 @@ pub fn parse(text: &str, file: &str) -> Result<Vec<SheetRow>> {
         ));
     }
     let mut rows = Vec::new();
-    for (i, rec) in rdr.records().enumerate() {
-        let line = skipped + 2 + i;
-        let rec = rec.map_err(|e| Error::input(file, format!("line {line}"), format!("malformed CSV row: {e}")))?;
+    for rec in rdr.records() {
+        // Lines, not records: blank lines and quoted newlines make the two differ.
+        let rec = rec.map_err(|e| {
+            let line = skipped + e.position().map(|p| line_at(&body, p.byte())).unwrap_or(1);
+            Error::input(file, format!("line {line}"), format!("malformed CSV row: {e}"))
+        })?;
+        let line = skipped + rec.position().map(|p| line_at(&body, p.byte())).unwrap_or(1);
         let get = |c: Option<usize>| c.and_then(|c| rec.get(c)).unwrap_or("").to_string();
         let num = |c: usize, what: &str, nonneg: bool| -> Result<f64> {
             let s = rec.get(c).unwrap_or("");
@@ -158,5 +172,21 @@ mod tests {
         assert!(e.contains("geometry"), "{e}");
         let e = parse("geometry,value\nastm-d523-60,1,3\n", "bad.csv").unwrap_err().to_string();
         assert!(e.contains("malformed"), "{e}");
+    }
+
+    #[test]
+    fn errors_count_lines_not_records() {
+        // A blank line and a quoted newline before the bad row: it is on line 6 (the 3rd record).
+        let text = "sample,geometry,value\np1,astm-d523-60,1\n\n\"p\n2\",astm-d523-60,2\np3,astm-d523-60,x\n";
+        let e = parse(text, "bad.csv").unwrap_err().to_string();
+        assert!(e.contains("line 6"), "{e}");
+        let r = parse("# c\nsample,geometry,value\n\np1,astm-d523-60,1\n", "ok.csv").unwrap();
+        assert_eq!(r[0].line, 4);
+    }
+
+    #[test]
+    fn a_byte_order_mark_then_a_comment_is_read() {
+        let r = parse("\u{feff}# BYK export\ngeometry,value\nastm-d523-60,89.1\n", "bom.csv").unwrap();
+        assert_eq!((r[0].line, r[0].value), (3, 89.1));
     }
 }

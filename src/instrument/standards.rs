@@ -158,8 +158,38 @@ pub fn find(id: &str) -> Result<StandardGeometry> {
 /// Load a user geometry file (same format as the builtin ones).
 pub fn load_file(path: &Path) -> Result<StandardGeometry> {
     let name = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|source| Error::Io { file: name.clone(), source })?;
-    parse(&text, &name)
+    let text = crate::input::read_text(path, "geometry file")?;
+    let g = parse(&text, &name)?;
+    check_user(&g, &builtin()?)?;
+    Ok(g)
+}
+
+/// A user geometry may not take a shipped id (a reading would be labelled as the standard's while measuring
+/// something else), and its composite readings must name shipped non-composite geometries (they are the
+/// ones the plan can look up).
+pub fn check_user(g: &StandardGeometry, shipped: &[StandardGeometry]) -> Result<()> {
+    let id = &g.geometry.id;
+    if shipped.iter().any(|s| &s.geometry.id == id) {
+        return Err(Error::input(
+            &g.origin,
+            "id",
+            format!("\"{id}\" is the id of a shipped geometry; give a user geometry an id of its own"),
+        ));
+    }
+    for (i, r) in g.geometry.readings.iter().enumerate() {
+        if let ReadingSpec::HazeIndex { minuend, subtrahend } = r {
+            for (key, part) in [("minuend", minuend), ("subtrahend", subtrahend)] {
+                if !shipped.iter().any(|o| &o.geometry.id == part && !o.geometry.is_composite()) {
+                    return Err(Error::input(
+                        &g.origin,
+                        format!("readings[{i}].{key}"),
+                        format!("\"{part}\" is not a shipped non-composite geometry id; known: {}", ids(shipped)),
+                    ));
+                }
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Parse and validate a geometry from JSON text; `origin` names the file in errors and in `origin`.

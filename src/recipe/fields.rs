@@ -37,6 +37,15 @@ impl<'a> Obj<'a> {
     pub fn deny_unknown(&self, allowed: &[&str]) -> Result<()> {
         for k in self.map.keys() {
             if !allowed.contains(&k.as_str()) {
+                if k.is_empty() {
+                    // An empty key would print as no field at all.
+                    let at = if self.path.is_empty() { "the top level" } else { self.path.as_str() };
+                    return Err(Error::input(
+                        self.file,
+                        self.field("\"\""),
+                        format!("an empty key \"\" at {at} is not a field; allowed here: {}", allowed.join(", ")),
+                    ));
+                }
                 return Err(self.err(k, format!("unknown field; allowed here: {}", allowed.join(", "))));
             }
         }
@@ -112,9 +121,19 @@ pub fn number(file: &str, path: &str, v: &Value, lo: f64, hi: f64, what: &str) -
     match x {
         Some(x) if x.is_finite() && x >= lo && x <= hi => Ok(x),
         Some(x) if x.is_finite() => {
-            Err(Error::input(file, path, format!("{x} is out of range: {what} must be {range}")))
+            Err(Error::input(file, path, format!("{} is out of range: {what} must be {range}", show(x))))
         }
         _ => Err(Error::input(file, path, format!("expected a finite number ({what}, {range}), got {}", kind(v)))),
+    }
+}
+
+/// A number for a message: plain digits in the everyday range, scientific notation outside it, so that
+/// 1e300 is not printed with all its 301 digits.
+pub fn show(x: f64) -> String {
+    if x != 0.0 && !(1e-6..1e15).contains(&x.abs()) {
+        format!("{x:e}")
+    } else {
+        format!("{x}")
     }
 }
 
@@ -131,8 +150,130 @@ pub fn kind(v: &Value) -> String {
     }
 }
 
-/// Parse JSON text, reporting the line and column of a syntax error.
+/// Parse JSON text, reporting the line and column of a syntax error. A leading byte-order mark (some
+/// editors write one) is skipped; a key that appears twice in an object is refused (JSON parsers disagree on
+/// which one wins, so a file that says both is ambiguous).
 pub fn parse_json(text: &str, file: &str) -> Result<Value> {
-    serde_json::from_str(text)
-        .map_err(|e| Error::input(file, "", format!("malformed JSON at line {}, column {}: {e}", e.line(), e.column())))
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    let value = serde_json::from_str(text).map_err(|e| {
+        Error::input(file, "", format!("malformed JSON at line {}, column {}: {e}", e.line(), e.column()))
+    })?;
+    let duplicate = std::cell::RefCell::new(None);
+    let mut de = serde_json::Deserializer::from_str(text);
+    if let Err(e) =
+        serde::de::DeserializeSeed::deserialize(NoDuplicates { path: String::new(), duplicate: &duplicate }, &mut de)
+    {
+        let field = duplicate.into_inner().unwrap_or_default();
+        return Err(Error::input(
+            file,
+            field,
+            format!(
+                "a key appears twice in one object (line {}, column {}); give each field once",
+                e.line(),
+                e.column()
+            ),
+        ));
+    }
+    Ok(value)
+}
+
+/// A pass over the JSON text that fails at the first key repeated within one object, recording its path.
+struct NoDuplicates<'a> {
+    path: String,
+    duplicate: &'a std::cell::RefCell<Option<String>>,
+}
+
+impl NoDuplicates<'_> {
+    fn child(&self, key: &str) -> Self {
+        let path = if self.path.is_empty() { key.to_string() } else { format!("{}.{key}", self.path) };
+        NoDuplicates { path, duplicate: self.duplicate }
+    }
+}
+
+impl<'de> serde::de::DeserializeSeed<'de> for NoDuplicates<'_> {
+    type Value = ();
+    fn deserialize<D: serde::Deserializer<'de>>(self, d: D) -> std::result::Result<(), D::Error> {
+        d.deserialize_any(self)
+    }
+}
+
+impl<'de> serde::de::Visitor<'de> for NoDuplicates<'_> {
+    type Value = ();
+    fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        f.write_str("a JSON value")
+    }
+    fn visit_bool<E>(self, _: bool) -> std::result::Result<(), E> {
+        Ok(())
+    }
+    fn visit_i64<E>(self, _: i64) -> std::result::Result<(), E> {
+        Ok(())
+    }
+    fn visit_u64<E>(self, _: u64) -> std::result::Result<(), E> {
+        Ok(())
+    }
+    fn visit_f64<E>(self, _: f64) -> std::result::Result<(), E> {
+        Ok(())
+    }
+    fn visit_str<E>(self, _: &str) -> std::result::Result<(), E> {
+        Ok(())
+    }
+    fn visit_unit<E>(self) -> std::result::Result<(), E> {
+        Ok(())
+    }
+    fn visit_seq<A: serde::de::SeqAccess<'de>>(self, mut a: A) -> std::result::Result<(), A::Error> {
+        let mut i = 0;
+        while a
+            .next_element_seed(NoDuplicates { path: format!("{}[{i}]", self.path), duplicate: self.duplicate })?
+            .is_some()
+        {
+            i += 1;
+        }
+        Ok(())
+    }
+    fn visit_map<A: serde::de::MapAccess<'de>>(self, mut m: A) -> std::result::Result<(), A::Error> {
+        let mut seen = std::collections::HashSet::new();
+        while let Some(k) = m.next_key::<String>()? {
+            if !seen.insert(k.clone()) {
+                *self.duplicate.borrow_mut() = Some(self.child(&k).path);
+                return Err(serde::de::Error::custom("duplicate key"));
+            }
+            m.next_value_seed(self.child(&k))?;
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn duplicate_keys_are_refused_with_their_path() {
+        let e = parse_json(r#"{"model": "lambert", "albedo": 0.5, "albedo": 0.9}"#, "r.json").unwrap_err().to_string();
+        assert!(e.contains("r.json") && e.contains("`albedo`") && e.contains("twice"), "{e}");
+        let e = parse_json(r#"{"a": [{"k": 1}, {"k": 2, "k": 3}]}"#, "r.json").unwrap_err().to_string();
+        assert!(e.contains("`a[1].k`"), "{e}");
+        assert!(parse_json(r#"{"a": {"k": 1}, "b": {"k": 2}}"#, "r.json").is_ok(), "same key in two objects");
+    }
+
+    #[test]
+    fn a_byte_order_mark_is_skipped() {
+        assert_eq!(parse_json("\u{feff}{\"x\": 1}", "r.json").unwrap()["x"], 1);
+    }
+
+    #[test]
+    fn an_empty_key_is_named() {
+        let v = parse_json(r#"{"": 1}"#, "r.json").unwrap();
+        let e = Obj::new("r.json", "", &v).unwrap().deny_unknown(&["model"]).unwrap_err().to_string();
+        assert!(e.contains("empty key") && e.contains("field `\"\"`"), "{e}");
+    }
+
+    #[test]
+    fn huge_numbers_are_printed_in_scientific_notation() {
+        let v = parse_json("1e300", "r.json").unwrap();
+        let e = number("r.json", "ior", &v, 1.0, 4.0, "the index").unwrap_err().to_string();
+        assert!(e.contains("1e300 is out of range") && e.len() < 120, "{e}");
+        assert_eq!(show(1.5), "1.5");
+        assert_eq!(show(0.0), "0");
+    }
 }

@@ -78,7 +78,7 @@ pub struct Material {
 /// Read and validate a recipe file. I/O errors name the file.
 pub fn load_file(path: &std::path::Path) -> Result<Material> {
     let file = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|source| Error::Io { file: file.clone(), source })?;
+    let text = crate::input::read_text(path, "recipe")?;
     parse_str(&text, &file)
 }
 

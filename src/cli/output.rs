@@ -1,0 +1,168 @@
+//! Where results go: standard output, or a new file that appears whole or not at all. It exists because a
+//! result file is evidence: a failed write (a full disk) must never leave a truncated or empty file behind,
+//! and an existing file must never be overwritten.
+//!
+//! A file is written to a temporary file in the same directory, flushed and synced, then hard-linked to its
+//! name (`link(2)` fails if the name exists, so nothing is ever clobbered, even by a file that appeared during
+//! the run), and the temporary name is removed. The target is checked before any work is done
+//! ([`Target::new`]), so a long computation is not wasted on a name that would be refused.
+use std::fs::{File, OpenOptions};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use crate::{Error, Result};
+
+/// How standard output is named in errors.
+pub const STDOUT: &str = "<stdout>";
+
+/// Standard output, or a file that must not exist yet.
+#[derive(Clone, Debug)]
+pub struct Target {
+    path: Option<PathBuf>,
+}
+
+impl Target {
+    /// `None` is standard output. A path is refused now if it exists or its directory does not.
+    pub fn new(path: Option<&Path>, option: &str) -> Result<Target> {
+        if let Some(p) = path {
+            check_new_file(p, option)?;
+        }
+        Ok(Target { path: path.map(Path::to_path_buf) })
+    }
+
+    pub fn path(&self) -> Option<&Path> {
+        self.path.as_deref()
+    }
+
+    /// Write everything, or fail without leaving a file.
+    pub fn write(&self, text: &str) -> Result<()> {
+        match &self.path {
+            None => print(text),
+            Some(p) => write_new_file(p, text.as_bytes()),
+        }
+    }
+}
+
+/// Refuse an existing path (never overwritten) and a path whose directory does not exist.
+pub fn check_new_file(p: &Path, option: &str) -> Result<()> {
+    if p.symlink_metadata().is_ok() {
+        return Err(Error::Usage(format!(
+            "{option} {}: already exists; glossmeter never overwrites a file (choose another name)",
+            p.display()
+        )));
+    }
+    let dir = parent(p);
+    if !dir.is_dir() {
+        return Err(Error::Usage(format!("{option} {}: the directory {} does not exist", p.display(), dir.display())));
+    }
+    Ok(())
+}
+
+/// Write text to standard output; an error (a closed pipe, a full disk) is returned, never a panic.
+pub fn print(text: &str) -> Result<()> {
+    let mut out = std::io::stdout().lock();
+    out.write_all(text.as_bytes()).and_then(|_| out.flush()).map_err(|source| Error::Io { file: STDOUT.into(), source })
+}
+
+fn parent(p: &Path) -> &Path {
+    match p.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    }
+}
+
+/// Write `bytes` to the new file `path`, atomically (see the module documentation).
+pub fn write_new_file(path: &Path, bytes: &[u8]) -> Result<()> {
+    write_new_file_with(path, bytes, |f, b| f.write_all(b))
+}
+
+/// [`write_new_file`] with the writing step given, so that tests can make it fail like a full disk.
+pub fn write_new_file_with(
+    path: &Path,
+    bytes: &[u8],
+    write: impl FnOnce(&mut File, &[u8]) -> std::io::Result<()>,
+) -> Result<()> {
+    static COUNTER: AtomicUsize = AtomicUsize::new(0);
+    let io = |source| Error::Io { file: path.display().to_string(), source };
+    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| "output".into());
+    let (tmp, mut file) = loop {
+        let n = COUNTER.fetch_add(1, Ordering::Relaxed);
+        let tmp = parent(path).join(format!(".{name}.glossmeter-{}-{n}.tmp", std::process::id()));
+        match OpenOptions::new().write(true).create_new(true).open(&tmp) {
+            Ok(f) => break (tmp, f),
+            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
+            Err(e) => return Err(io(e)),
+        }
+    };
+    let result = write(&mut file, bytes).and_then(|_| file.flush()).and_then(|_| file.sync_all());
+    drop(file);
+    let result = result.map_err(io).and_then(|_| {
+        std::fs::hard_link(&tmp, path).map_err(|e| {
+            if e.kind() == std::io::ErrorKind::AlreadyExists {
+                Error::Usage(format!(
+                    "{}: already exists; glossmeter never overwrites a file (choose another name)",
+                    path.display()
+                ))
+            } else {
+                io(e)
+            }
+        })
+    });
+    let _ = std::fs::remove_file(&tmp);
+    result
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn dir(name: &str) -> PathBuf {
+        let d = std::env::temp_dir().join(format!("glossmeter-output-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&d);
+        std::fs::create_dir_all(&d).unwrap();
+        d
+    }
+
+    fn entries(d: &Path) -> Vec<String> {
+        let mut v: Vec<String> =
+            std::fs::read_dir(d).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+        v.sort();
+        v
+    }
+
+    #[test]
+    fn a_failed_write_leaves_no_file_and_an_error() {
+        let d = dir("full");
+        let p = d.join("readings.json");
+        // A disk that fills after half the bytes: the old `BufWriter` path left a 0-byte file and exit 0.
+        let r = write_new_file_with(&p, b"0123456789", |f, b| {
+            f.write_all(&b[..5])?;
+            Err(std::io::Error::from(std::io::ErrorKind::StorageFull))
+        });
+        let e = r.unwrap_err().to_string();
+        assert!(e.contains("readings.json"), "{e}");
+        assert!(entries(&d).is_empty(), "no target and no temporary file: {:?}", entries(&d));
+    }
+
+    #[test]
+    fn an_existing_file_is_never_overwritten_even_if_it_appears_during_the_run() {
+        let d = dir("race");
+        let p = d.join("out.txt");
+        assert!(Target::new(Some(&p), "-o").is_ok());
+        std::fs::write(&p, "user data").unwrap();
+        assert!(Target::new(Some(&p), "-o").is_err(), "checked before the work");
+        let e = write_new_file(&p, b"new").unwrap_err().to_string();
+        assert!(e.contains("already exists"), "{e}");
+        assert_eq!(std::fs::read_to_string(&p).unwrap(), "user data");
+        assert_eq!(entries(&d), vec!["out.txt".to_string()]);
+        write_new_file(&d.join("fresh.txt"), b"whole").unwrap();
+        assert_eq!(std::fs::read_to_string(d.join("fresh.txt")).unwrap(), "whole");
+    }
+
+    #[test]
+    fn a_missing_directory_is_refused_before_the_work() {
+        let e = Target::new(Some(Path::new("/nonexistent-dir-glossmeter/x.json")), "-o").unwrap_err();
+        assert!(e.to_string().contains("does not exist"), "{e}");
+    }
+}

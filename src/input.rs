@@ -1,0 +1,67 @@
+//! Input files (recipes, geometry files, sheets) read as text with a size limit. It exists so that a file
+//! that is not a recipe at all (`/dev/zero`, a multi-gigabyte log given by mistake) is refused with a clear
+//! message instead of being read until memory runs out. (MERL tables are binary and checked against their
+//! own header in `brdf::measured`.)
+use std::io::Read;
+use std::path::Path;
+
+use crate::{Error, Result};
+
+/// The largest text input file: 16 MiB. A recipe or a geometry file is a few kB; a sheet of 16 MiB holds
+/// some 300 000 readings.
+pub const MAX_TEXT_BYTES: u64 = 16 * 1024 * 1024;
+
+/// Read a UTF-8 text file of at most [`MAX_TEXT_BYTES`]; `what` names the kind of file in messages.
+pub fn read_text(path: &Path, what: &str) -> Result<String> {
+    read_text_limited(path, what, MAX_TEXT_BYTES)
+}
+
+/// [`read_text`] with the limit given.
+pub fn read_text_limited(path: &Path, what: &str, limit: u64) -> Result<String> {
+    let file = path.display().to_string();
+    let io = |source| Error::Io { file: file.clone(), source };
+    let f = std::fs::File::open(path).map_err(io)?;
+    let mut bytes = Vec::new();
+    f.take(limit + 1).read_to_end(&mut bytes).map_err(io)?;
+    if bytes.len() as u64 > limit {
+        return Err(Error::input(
+            &file,
+            "",
+            format!("larger than {} MiB, the limit for a {what} (is this the right file?)", limit / (1024 * 1024)),
+        ));
+    }
+    String::from_utf8(bytes).map_err(|e| {
+        Error::input(
+            &file,
+            "",
+            format!(
+                "not UTF-8 text (invalid byte at offset {}); a {what} is JSON or CSV text",
+                e.utf8_error().valid_up_to()
+            ),
+        )
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn dev_zero_is_refused_at_the_limit() {
+        if !Path::new("/dev/zero").exists() {
+            return;
+        }
+        let e = read_text_limited(Path::new("/dev/zero"), "recipe", 1024 * 1024).unwrap_err().to_string();
+        assert!(e.contains("/dev/zero") && e.contains("larger than 1 MiB"), "{e}");
+    }
+
+    #[test]
+    fn binary_and_missing_files_are_errors_naming_the_file() {
+        let p = std::env::temp_dir().join(format!("glossmeter-input-{}.bin", std::process::id()));
+        std::fs::write(&p, [0x7b, 0xff, 0xfe]).unwrap();
+        let e = read_text(&p, "recipe").unwrap_err().to_string();
+        assert!(e.contains("not UTF-8") && e.contains("offset 1"), "{e}");
+        let _ = std::fs::remove_file(&p);
+        assert!(matches!(read_text(Path::new("/nonexistent/x.json"), "recipe"), Err(Error::Io { .. })));
+    }
+}
