@@ -63,7 +63,7 @@ impl Sampling {
         Sampling { kind: SamplingKind::Rgb, wavelengths_nm: RGB_WAVELENGTHS_NM.to_vec() }
     }
 
-    /// A spectral grid: strictly increasing, finite, within 360–830 nm (the CIE tables) and carrying some
+    /// A spectral grid: strictly increasing, finite, within [`SPECTRAL_RANGE_NM`], 360–830 nm (the CIE 1931 ȳ table; illuminant C is held at its 780 nm value beyond 780 nm, where the CIE does not tabulate it), and carrying some
     /// luminous weight (so a gloss reading of it is defined).
     pub fn spectral(wavelengths_nm: &[f64]) -> Result<Self> {
         luminous_grid_weights(wavelengths_nm)?;
@@ -106,6 +106,20 @@ fn cie_tables() -> Result<&'static (Table, Table)> {
     Ok(TABLES.get_or_init(|| (illum, ybar)))
 }
 
+/// The wavelengths a spectral grid may use: those of the CIE 1931 ȳ table (`standards/cie/cie1931-ybar.csv`).
+pub const SPECTRAL_RANGE_NM: (f64, f64) = (360.0, 830.0);
+
+/// Illuminant C at `lam`. CIE 15:2004 Table T.1 tabulates C only to 780 nm; from 780 to 830 nm its 780 nm
+/// value is held. This cannot move a luminous weight by more than about 2e-5 of the total: ȳ there is at
+/// most 1.5e-5 of its peak, and C changes by a few per cent per 10 nm near 780 nm.
+fn illuminant_c(table: &[(f64, f64)], lam: f64) -> Option<f64> {
+    let last = table.last()?;
+    if lam > last.0 && lam <= SPECTRAL_RANGE_NM.1 {
+        return Some(last.1);
+    }
+    interp(table, lam)
+}
+
 /// The luminous weights of a wavelength grid: the weight of sample k is S_C(λk)·ȳ(λk)·Δλk (trapezoid
 /// widths), normalised to sum 1, with S_C and ȳ linearly interpolated from the embedded tables (CIE 15:2004
 /// §7.1, the weighted-ordinate method). Errors name what is wrong with the grid.
@@ -126,8 +140,11 @@ fn luminous_grid_weights(wavelengths_nm: &[f64]) -> Result<Vec<f64>> {
         if !lam.is_finite() {
             return Err(bad("wavelengths must be finite".into()));
         }
-        let (Some(s), Some(y)) = (interp(illum, lam), interp(ybar, lam)) else {
-            return Err(bad(format!("{lam} nm is outside the CIE tables")));
+        let (Some(s), Some(y)) = (illuminant_c(illum, lam), interp(ybar, lam)) else {
+            return Err(bad(format!(
+                "{lam} nm is outside {}–{} nm, the range of the CIE 1931 observer table",
+                SPECTRAL_RANGE_NM.0, SPECTRAL_RANGE_NM.1
+            )));
         };
         let width = if n == 1 {
             1.0
@@ -290,6 +307,19 @@ pub fn interp(table: &[(f64, f64)], x: f64) -> Option<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Issue 8 item 4: 781–830 nm were allowed by the docs and the schema but refused by the tables.
+    #[test]
+    fn the_whole_documented_range_is_accepted() {
+        let grid: Vec<f64> = (0..=94).map(|k| 360.0 + 5.0 * k as f64).collect();
+        assert_eq!(*grid.last().unwrap(), 830.0);
+        let w = luminous_grid_weights(&grid).unwrap();
+        let beyond: f64 = grid.iter().zip(&w).filter(|(l, _)| **l > 780.0).map(|(_, w)| w).sum();
+        assert!(beyond > 0.0 && beyond < 2e-5, "{beyond}");
+        assert!(Sampling::spectral(&[781.0, 830.0]).is_ok());
+        let e = Sampling::spectral(&[500.0, 831.0]).unwrap_err().to_string();
+        assert!(e.contains("831 nm is outside 360–830 nm"), "{e}");
+    }
 
     #[test]
     fn weights_are_normalised() {

@@ -198,7 +198,7 @@ fn a_huge_table_cell_does_not_panic() {
 #[test]
 fn csv_has_plain_decimals_and_notes() {
     let (code, out, _) =
-        stderr_of(&["measure", "fixtures/recipes/cerulean-blue-c.json", "--format", "csv", "--no-timing"]);
+        stderr_of(&["measure", "fixtures/recipes/cerulean-blue-c-literal.json", "--format", "csv", "--no-timing"]);
     assert_eq!(code, Some(0));
     let mut r = csv::Reader::from_reader(out.as_bytes());
     let head: Vec<String> = r.headers().unwrap().iter().map(String::from).collect();

@@ -228,3 +228,12 @@ fn schema_ranges_agree_with_validator() {
     assert!(load(hi) && !load(hi * 1.0001));
     assert!(Path::new(&root().join("docs/recipe-format.md")).exists(), "docs/recipe-format.md documents the format");
 }
+
+/// Issue 8 item 4: the schema stated 360–830 nm but not the validator's limit of 128 wavelengths.
+#[test]
+fn schema_states_the_wavelength_count_limit() {
+    let s = schema();
+    let w = resolve(&s, &subschema(&s, "paint")["properties"]["wavelengths_nm"]);
+    assert_eq!(w["maxItems"].as_u64(), Some(glossmeter::brdf::paint::MAX_SAMPLES as u64), "{w}");
+    assert_eq!((w["items"]["minimum"].as_f64(), w["items"]["maximum"].as_f64()), (Some(360.0), Some(830.0)));
+}

@@ -5,8 +5,10 @@ Run by hand (not by CI):  python3 tools/export_cie_tables.py
 Requires: colour-science 0.4.7 (pip install colour-science==0.4.7).
 
 Tables written:
-  standards/cie/illuminant-c.csv   CIE illuminant C relative SPD, 5 nm, 360-780 nm
-  standards/cie/cie1931-ybar.csv   CIE 1931 2-degree ybar(lambda) = V(lambda), 5 nm, 360-780 nm
+  standards/cie/illuminant-c.csv   CIE illuminant C relative SPD, 5 nm, 360-780 nm (CIE 15 tabulates C only
+                                   to 780 nm; src/spectrum.rs holds the 780 nm value beyond, and says so)
+  standards/cie/cie1931-ybar.csv   CIE 1931 2-degree ybar(lambda) = V(lambda), 5 nm, 360-830 nm (the whole
+                                   range of the CIE 1931 table)
 colour-science takes them from CIE 15:2004 (illuminant C, Table T.1) and CIE 018:2019 / the CIE
 1931 2-degree standard observer (cvrl.org / CIE S 014-1). We copy values, not code.
 """
@@ -18,9 +20,11 @@ import colour  # noqa: E402
 
 OUT = pathlib.Path(__file__).resolve().parent.parent / "standards" / "cie"
 OUT.mkdir(parents=True, exist_ok=True)
-GRID = range(360, 781, 5)
+GRID_C = range(360, 781, 5)  # illuminant C is tabulated by the CIE to 780 nm
+GRID_YBAR = range(360, 831, 5)  # the CIE 1931 observer to 830 nm
 
 c = colour.SDS_ILLUMINANTS["C"]
+assert c.wavelengths[-1] == 780, "illuminant C ends at 780 nm in CIE 15 (and colour-science)"
 cmfs = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"]
 
 header_common = (
@@ -34,7 +38,7 @@ with open(OUT / "illuminant-c.csv", "w") as f:
     f.write("# colour.SDS_ILLUMINANTS['C'] (5 nm steps). Used as the source spectrum of ASTM D523 / ISO 2813.\n")
     f.write(header_common)
     f.write("wavelength_nm,value\n")
-    for w in GRID:
+    for w in GRID_C:
         f.write(f"{w},{c[w]:.6g}\n")
 
 with open(OUT / "cie1931-ybar.csv", "w") as f:
@@ -43,6 +47,6 @@ with open(OUT / "cie1931-ybar.csv", "w") as f:
     f.write("# colour-science colour.MSDS_CMFS['CIE 1931 2 Degree Standard Observer'].\n")
     f.write(header_common)
     f.write("wavelength_nm,value\n")
-    for w in GRID:
+    for w in GRID_YBAR:
         f.write(f"{w},{cmfs[w][1]:.6g}\n")
 print("wrote", OUT)

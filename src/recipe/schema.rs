@@ -66,7 +66,7 @@ pub fn schema() -> Value {
             ("form", json!({"enum": ["physical", "paper-eq1"], "default": "physical"})),
             ("flake_light", json!({"enum": ["split", "paper"], "default": "split"})),
             ("internal_reflection", json!({"type": "boolean", "default": true})),
-            ("wavelengths_nm", json!({"type": "array", "items": {"type": "number", "minimum": 360, "maximum": 830}, "minItems": 1})),
+            ("wavelengths_nm", json!({"type": "array", "items": {"type": "number", "minimum": 360, "maximum": 830}, "minItems": 1, "maxItems": crate::brdf::paint::MAX_SAMPLES})),
             (
                 "clear_coat",
                 object(
