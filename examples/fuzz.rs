@@ -66,7 +66,7 @@ fn main() {
                     if accepted_recipes % every == 0 {
                         t.measured += 1;
                         let t0 = Instant::now();
-                        let r = std::panic::catch_unwind(|| measure(&m, &panel, &opts));
+                        let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| measure(&m, &panel, &opts)));
                         let secs = t0.elapsed().as_secs_f64();
                         let verdict = match r {
                             Err(_) => Err("panic while measuring".to_string()),
