@@ -130,3 +130,52 @@ fn a_frozen_plan_repeats_its_bits_and_moves_smoothly() {
         assert!(d3.abs() <= 1e-6 * d1.abs(), "{}: third difference {d3:e} vs first {d1:e}: {v:?}", r.geometry);
     }
 }
+
+/// Issue 8, bounded work: the paper-eq1 pearl that ran 80 s to the 50 M budget without converging.
+fn pearl() -> Arc<dyn Brdf> {
+    let recipe = r#"{"model": "paint", "form": "paper-eq1",
+        "clear_coat": {"index": 1.5},
+        "pigmented_layer": {"thickness_mm": 0.1, "primer_reflectance": [0.5, 0.5, 0.5], "pigments": []},
+        "pearlescent_flakes": {"spread_deg": 0.35, "area_ratio": 0.5, "depth_mm": 0, "tio2_thickness_nm": 100000,
+                               "tio2_index": 1.0, "mica_thickness_nm": 400, "mica_index": 1.58}}"#;
+    glossmeter::recipe::parse_str(recipe, "<pearl>").unwrap().brdf
+}
+
+#[test]
+fn a_budget_ends_in_not_converged_with_the_best_estimate() {
+    let g20 = vec![standards::find("astm-d523-20").unwrap()];
+    // The evaluation budget (deterministic): hit, reported, a finite best estimate.
+    let budget = 300_000;
+    let opts = PlanOptions { max_evals: budget, max_seconds: None, ..PlanOptions::default() };
+    let r = &Plan::compile(pearl(), g20.clone(), opts).unwrap().execute()[0];
+    assert!(!r.converged && r.value.is_some_and(f64::is_finite) && r.error_estimate.is_finite(), "{r:?}");
+    assert!(r.problem.as_deref().unwrap().contains("evaluation budget"), "{r:?}");
+    // The budget is per part of each integral: the specimen's delta and regular parts and the standard.
+    assert!(r.evaluations <= 3 * budget, "{r:?}");
+    // The wall-clock budget: the same case with the evaluation budget out of reach stops at the deadline.
+    let opts = PlanOptions { max_seconds: Some(0.2), ..PlanOptions::default() };
+    let r = &Plan::compile(pearl(), g20, opts).unwrap().execute()[0];
+    assert!(!r.converged && r.value.is_some_and(f64::is_finite), "{r:?}");
+    assert!(r.problem.as_deref().unwrap().contains("wall-clock budget"), "{r:?}");
+    assert!(r.evaluations < PlanOptions::default().max_evals, "{r:?}");
+}
+
+#[test]
+fn the_tolerance_floor_is_stated_and_enforced() {
+    let g = vec![standards::find("astm-d523-60").unwrap()];
+    let glass = fixture("black-glass.json");
+    for rtol in [1e-300, 1e-13] {
+        let e = Plan::compile(glass.clone(), g.clone(), PlanOptions { rtol, ..PlanOptions::default() })
+            .err()
+            .expect("below the floor")
+            .to_string();
+        assert!(e.contains("1e-12") && e.contains("double precision"), "{e}");
+    }
+    let r =
+        &Plan::compile(glass, g, PlanOptions { rtol: glossmeter::instrument::plan::MIN_RTOL, ..Default::default() })
+            .unwrap()
+            .execute()[0];
+    assert!(r.converged, "the floor itself is reachable: {r:?}");
+    assert!(glossmeter::instrument::convergence::validate_tolerances(&[1e-6, 1e-11]).is_err());
+    assert!(glossmeter::instrument::convergence::validate_tolerances(&[1e-6, 1e-10]).is_ok());
+}

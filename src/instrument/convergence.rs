@@ -38,7 +38,7 @@ use std::time::Instant;
 use crate::brdf::{Brdf, TermKind};
 use crate::instrument::geometry::ReadingSpec;
 use crate::instrument::plan::{
-    haze_index_value, reading_value, Job, Plan, PlanOptions, PlannedReading, Reading, Target,
+    haze_index_value, reading_value, Job, Plan, PlanOptions, PlannedReading, Reading, Target, MIN_RTOL,
 };
 use crate::instrument::reference::{lambertian_flux_reference, mirror_flux_reference};
 use crate::instrument::standards::StandardGeometry;
@@ -157,6 +157,14 @@ pub fn validate_tolerances(tolerances: &[f64]) -> Result<()> {
             return Err(Error::Usage(format!(
                 "tolerance {} is {t}; every tolerance must be a number in (0, 1), e.g. 1e-2, 1e-4, 1e-6",
                 i + 1
+            )));
+        }
+        if *t < MIN_RTOL * REFERENCE_FACTOR {
+            return Err(Error::Usage(format!(
+                "tolerance {} is {t:e}; the tightest a sweep accepts is {:e} (its reference runs {REFERENCE_FACTOR}× \
+                 tighter, and {MIN_RTOL:e} is the tightest double precision reaches: `plan::MIN_RTOL`)",
+                i + 1,
+                MIN_RTOL * REFERENCE_FACTOR
             )));
         }
     }
@@ -310,7 +318,8 @@ pub fn sweep(
     tols.sort_by(|a, b| b.total_cmp(a));
     tols.dedup();
     let tightest = *tols.last().expect("validated non-empty");
-    let plan_options = |rtol: f64| PlanOptions { rtol, max_evals: options.max_evals, ..PlanOptions::default() };
+    let plan_options =
+        |rtol: f64| PlanOptions { rtol, max_evals: options.max_evals, max_seconds: None, ..PlanOptions::default() };
 
     // The reference.
     let probe = Plan::compile(material.clone(), geometries.clone(), plan_options(tightest))?;

@@ -41,6 +41,8 @@ pub struct Flux {
     pub regions: usize,
     /// Whether both parts met their tolerances within the budget.
     pub converged: bool,
+    /// Whether a part stopped at the wall-clock budget (`Method::max_seconds`).
+    pub out_of_time: bool,
     /// Wall time of the integral.
     pub seconds: f64,
     /// The chart the regular part was integrated in (None: there was no regular part).
@@ -58,6 +60,7 @@ impl Flux {
             evaluations: 0,
             regions: 0,
             converged: true,
+            out_of_time: false,
             seconds: 0.0,
             chart: None,
         }

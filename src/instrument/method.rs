@@ -100,6 +100,9 @@ pub struct Method {
     pub projection: Projection,
     /// Evaluation budget of each part.
     pub max_evals: usize,
+    /// Wall-clock budget of the whole integral, seconds (None: none). When it runs out the flux is the best
+    /// estimate so far, marked not converged and `out_of_time` (and then depends on the machine's speed).
+    pub max_seconds: Option<f64>,
 }
 
 /// What the designer needs to know about an integral.
@@ -120,6 +123,7 @@ pub struct Design<'a> {
     pub rtol: f64,
     pub atol: f64,
     pub max_evals: usize,
+    pub max_seconds: Option<f64>,
 }
 
 impl Method {
@@ -180,6 +184,7 @@ impl Method {
             weighting: d.weighting,
             projection: d.projection,
             max_evals: d.max_evals,
+            max_seconds: d.max_seconds,
         }
     }
 
@@ -206,6 +211,7 @@ impl Method {
             rtol: tolerance.0,
             atol: tolerance.1,
             max_evals,
+            max_seconds: None,
         }))
     }
 
@@ -229,6 +235,7 @@ impl Method {
 
     fn run(&self, brdf: &dyn Brdf, keep: bool) -> (Flux, Option<Method>) {
         let start = std::time::Instant::now();
+        let deadline = self.max_seconds.map(|s| start + std::time::Duration::from_secs_f64(s));
         let k = self.weighting.len();
         let n = brdf.sampling().len();
         let mut frozen = keep.then(|| self.clone());
@@ -269,7 +276,7 @@ impl Method {
                 },
                 ncomp,
                 &part.cells,
-                &Options { rtol: part.rtol, atol: part.atol, max_evals: self.max_evals },
+                &Options { rtol: part.rtol, atol: part.atol, max_evals: self.max_evals, deadline },
                 part.refine,
                 keep,
             );
@@ -277,6 +284,7 @@ impl Method {
             flux.evaluations += est.evaluations;
             flux.regions += est.regions;
             flux.converged &= est.converged;
+            flux.out_of_time |= est.out_of_time;
             if let Some(m) = frozen.as_mut() {
                 let p = m.delta.as_mut().expect("the same parts");
                 p.cells = cells;
@@ -323,7 +331,7 @@ impl Method {
                 },
                 ncomp,
                 &part.cells,
-                &Options { rtol: part.rtol, atol, max_evals: self.max_evals },
+                &Options { rtol: part.rtol, atol, max_evals: self.max_evals, deadline },
                 part.refine,
                 keep,
             );
@@ -333,6 +341,7 @@ impl Method {
             flux.evaluations += est.evaluations;
             flux.regions += est.regions;
             flux.converged &= est.converged;
+            flux.out_of_time |= est.out_of_time;
             flux.chart = Some(part.chart);
             if let Some(m) = frozen.as_mut() {
                 let p = m.regular.as_mut().expect("the same parts");

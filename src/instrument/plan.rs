@@ -42,6 +42,19 @@ use crate::{Error, Result, Vec3};
 pub const SPECIMEN_SHARE: f64 = 0.9;
 pub const STANDARD_SHARE: f64 = 0.05;
 
+/// The smallest relative tolerance a plan accepts. A reading's tolerance is split down to 0.05 % of it for
+/// the analytic part of a specimen flux (DELTA_SHARE × SPECIMEN_SHARE) and 5 % for the standard, so at 1e-12
+/// those parts are asked for ~1e-15 relative: a few units of the double-precision rounding (2.2e-16) of
+/// their sums. Below that the error estimates are rounding noise and the cubature refines to its budget
+/// without ever meeting the tolerance (`--rtol 1e-300` ran for minutes on black glass). The convergence
+/// reference runs at this tolerance (`instrument::convergence`).
+pub const MIN_RTOL: f64 = 1e-12;
+
+/// The default wall-clock budget of one aperture integral, seconds: far above what any shipped fixture needs
+/// (the golden suite of 396 readings runs in about a second), so that no valid input hangs; an integral that
+/// hits it reports its best estimate, not converged.
+pub const DEFAULT_MAX_SECONDS: f64 = 60.0;
+
 /// Knobs of the planner. The defaults are what `measure` uses; the others exist to measure what each
 /// optimisation saves (`docs/performance.md`).
 #[derive(Clone, Debug, PartialEq)]
@@ -53,13 +66,23 @@ pub struct PlanOptions {
     pub fold_spectral: bool,
     /// Compute each distinct flux once.
     pub share_fluxes: bool,
-    /// Evaluation budget per flux integral.
+    /// Evaluation budget per flux integral (deterministic: a reading that hits it is the same bits on every
+    /// machine).
     pub max_evals: usize,
+    /// Wall-clock budget per flux integral, seconds (None: none). A reading whose integral hits it has the
+    /// best estimate as its value, is marked not converged, and depends on the machine's speed.
+    pub max_seconds: Option<f64>,
 }
 
 impl Default for PlanOptions {
     fn default() -> Self {
-        PlanOptions { rtol: 1e-6, fold_spectral: true, share_fluxes: true, max_evals: 50_000_000 }
+        PlanOptions {
+            rtol: 1e-6,
+            fold_spectral: true,
+            share_fluxes: true,
+            max_evals: 50_000_000,
+            max_seconds: Some(DEFAULT_MAX_SECONDS),
+        }
     }
 }
 
@@ -254,6 +277,19 @@ impl Planner {
                 options.rtol
             )));
         }
+        if options.rtol < MIN_RTOL {
+            return Err(Error::Usage(format!(
+                "the relative tolerance (rtol) {} is below {MIN_RTOL:e}, the tightest that double precision can \
+                 reach here (below it the error estimates are rounding noise and the work never ends)",
+                options.rtol
+            )));
+        }
+        if options.max_seconds.is_some_and(|s| !(s.is_finite() && s > 0.0)) || options.max_evals == 0 {
+            return Err(Error::Usage(format!(
+                "the budgets must be positive: max_evals {}, max_seconds {:?}",
+                options.max_evals, options.max_seconds
+            )));
+        }
         if geometries.is_empty() {
             return Err(Error::Usage("no geometry to measure".into()));
         }
@@ -316,6 +352,7 @@ impl Planner {
                 rtol: STANDARD_SHARE * options.rtol,
                 atol: 0.0,
                 max_evals: options.max_evals,
+                max_seconds: options.max_seconds,
             })
         };
         let std_idx: Vec<usize> = (0..drafts.len()).filter(|&j| drafts[j].target == Target::Standard).collect();
@@ -363,6 +400,7 @@ impl Planner {
                     rtol: SPECIMEN_SHARE * options.rtol,
                     atol: floor(d.theta),
                     max_evals: options.max_evals,
+                    max_seconds: options.max_seconds,
                 }),
             };
             jobs.push(Job { method, scale: d.scale, used_by: d.used_by.clone() });
@@ -390,6 +428,7 @@ impl Planner {
         }
         let mut key = job_key(Target::Standard, d.theta, d.scale, d.source, d.receptor);
         key.0.extend([options.rtol.to_bits(), options.max_evals as u64]);
+        key.0.extend(options.max_seconds.map(f64::to_bits));
         if let Some(f) = self.standards.lock().ok().and_then(|c| c.get(&key).cloned()) {
             return f;
         }
@@ -774,6 +813,7 @@ fn compute_reading(r: &PlannedReading, flux: &[Flux]) -> Reading {
     let evaluations = used.iter().map(|f| f.evaluations).sum();
     let seconds = used.iter().map(|f| f.seconds).sum();
     let converged = used.iter().all(|f| f.converged);
+    let out_of_time = used.iter().any(|f| f.out_of_time);
     match reading_value(&r.spec, &specimen, &standard) {
         Ok((v, e)) if v.is_finite() && e.is_finite() => Reading {
             geometry: r.geometry.clone(),
@@ -785,7 +825,15 @@ fn compute_reading(r: &PlannedReading, flux: &[Flux]) -> Reading {
             evaluations,
             seconds,
             converged,
-            problem: (!converged).then(|| "evaluation budget exhausted before the tolerance was met".into()),
+            problem: (!converged).then(|| {
+                if out_of_time {
+                    "wall-clock budget exhausted before the tolerance was met (the value is the best estimate so \
+                     far and depends on the machine's speed)"
+                        .into()
+                } else {
+                    "evaluation budget exhausted before the tolerance was met (the value is the best estimate)".into()
+                }
+            }),
             note: None,
         },
         Ok((v, e)) => problem_reading(

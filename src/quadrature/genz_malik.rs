@@ -11,11 +11,15 @@ pub struct Options {
     pub atol: f64,
     /// Hard limit on integrand evaluations; the result then says `converged: false`.
     pub max_evals: usize,
+    /// Wall-clock limit: no refinement step starts after this instant (the result then says
+    /// `converged: false` and `out_of_time: true`). None: no limit (the default; results are then the same
+    /// bits on every machine).
+    pub deadline: Option<std::time::Instant>,
 }
 
 impl Default for Options {
     fn default() -> Self {
-        Options { rtol: 1e-6, atol: 0.0, max_evals: 20_000_000 }
+        Options { rtol: 1e-6, atol: 0.0, max_evals: 20_000_000, deadline: None }
     }
 }
 
@@ -30,6 +34,8 @@ pub struct Estimate {
     pub regions: usize,
     /// True when every component met max(atol, rtol·|I|) before `max_evals`.
     pub converged: bool,
+    /// True when the refinement stopped at the wall-clock deadline.
+    pub out_of_time: bool,
 }
 
 /// The Genz–Malik point set and weights for dimension `D` (2 ≤ D ≤ 8).
@@ -330,7 +336,12 @@ pub fn integrate_partition<const D: usize, F: FnMut(&[[f64; D]], &mut [f64])>(
     let done =
         |total: &[f64], err: &[f64]| total.iter().zip(err).all(|(t, e)| *e <= opts.atol.max(opts.rtol * t.abs()));
     let mut converged = done(&total, &err);
+    let mut out_of_time = false;
     while refine == Refine::Adaptive && !converged && evals + 2 * npts <= opts.max_evals {
+        if opts.deadline.is_some_and(|d| std::time::Instant::now() >= d) {
+            out_of_time = true;
+            break;
+        }
         let Some(r) = heap.pop() else { break };
         let ax = r.split_axis;
         let mut half = r.cell.half;
@@ -363,7 +374,7 @@ pub fn integrate_partition<const D: usize, F: FnMut(&[[f64; D]], &mut [f64])>(
     }
     let converged = done(&value, &error);
     let kept = if keep { regions.iter().map(|r| r.cell).collect() } else { Vec::new() };
-    (Estimate { value, error, evaluations: evals, regions: regions.len(), converged }, kept)
+    (Estimate { value, error, evaluations: evals, regions: regions.len(), converged, out_of_time }, kept)
 }
 
 /// A batched integrand from a pointwise one, `f(x, out)` writing the `ncomp` values at one point (into a
@@ -426,7 +437,7 @@ mod tests {
             pointwise(1, |x, o| o[0] = x[0].powi(6) + x[1].powi(4) * x[2].powi(2) + x[3].powi(7) + 1.0),
             1,
             &[([-1.0; 4], [1.0; 4])],
-            &Options { rtol: 1.0, atol: 1.0, max_evals: 57 },
+            &Options { rtol: 1.0, atol: 1.0, max_evals: 57, deadline: None },
         );
         let exact = 16.0 * (1.0 / 7.0 + 1.0 / 5.0 / 3.0 + 0.0 + 1.0);
         assert!((est.value[0] - exact).abs() < 1e-13, "{} vs {exact}", est.value[0]);
@@ -445,7 +456,7 @@ mod tests {
                     ([-1.0, 0.0], [0.0, 1.0]),
                     ([0.0, 0.0], [1.0, 1.0]),
                 ],
-                &Options { rtol: 1e-9, atol: 0.0, max_evals: 10_000_000 },
+                &Options { rtol: 1e-9, atol: 0.0, max_evals: 10_000_000, deadline: None },
             );
             let e = libm::erf(1.0 / (sigma * 2f64.sqrt()));
             let exact = 2.0 * std::f64::consts::PI * sigma * sigma * e * e;
@@ -466,7 +477,7 @@ mod tests {
                 }),
                 2,
                 &[([0.0; 4], [1.0; 4])],
-                &Options { rtol: 1e-7, atol: 0.0, max_evals: 2_000_000 },
+                &Options { rtol: 1e-7, atol: 0.0, max_evals: 2_000_000, deadline: None },
             )
         };
         let (a, b) = (run(), run());
@@ -481,7 +492,7 @@ mod tests {
             pointwise(1, |x, o| o[0] = if x[0] > 0.3 { 1.0 } else { 0.0 }),
             1,
             &[([0.0, 0.0], [1.0, 1.0])],
-            &Options { rtol: 1e-14, atol: 0.0, max_evals: 1000 },
+            &Options { rtol: 1e-14, atol: 0.0, max_evals: 1000, deadline: None },
         );
         assert!(!est.converged);
         assert!(est.evaluations <= 1000);
@@ -492,7 +503,7 @@ mod tests {
         let f = |a: f64| {
             pointwise(1, move |x: &[f64; 2], o: &mut [f64]| o[0] = (-a * (x[0] * x[0] + 3.0 * x[1] * x[1])).exp())
         };
-        let opts = Options { rtol: 1e-9, atol: 0.0, max_evals: 1_000_000 };
+        let opts = Options { rtol: 1e-9, atol: 0.0, max_evals: 1_000_000, deadline: None };
         let start = Cell::from_boxes(&[([-1.0, -1.0], [1.0, 1.0])]);
         let (adaptive, cells) = integrate_partition(f(20.0), 1, &start, &opts, Refine::Adaptive, true);
         assert!(adaptive.regions > 1 && cells.len() == adaptive.regions);
@@ -521,10 +532,24 @@ mod tests {
             },
             1,
             &[([-1.0, -1.0], [1.0, 1.0])],
-            &Options { rtol: 1e-8, atol: 0.0, max_evals: 100_000 },
+            &Options { rtol: 1e-8, atol: 0.0, max_evals: 100_000, deadline: None },
         );
         assert!(est.converged && sizes.len() > 2);
         assert_eq!(sizes[0], 17);
         assert!(sizes[1..].iter().all(|&n| n == 34), "{sizes:?}");
+    }
+
+    #[test]
+    fn a_passed_deadline_stops_refinement_with_the_estimate_so_far() {
+        let opts = Options { rtol: 1e-12, atol: 0.0, max_evals: 1_000_000, deadline: Some(std::time::Instant::now()) };
+        let est = integrate::<2, _>(
+            pointwise(1, |x, o| o[0] = (-50.0 * x[0] * x[0]).exp()),
+            1,
+            &[([-1.0, -1.0], [1.0, 1.0])],
+            &opts,
+        );
+        assert!(est.out_of_time && !est.converged);
+        assert_eq!(est.evaluations, 17, "only the initial region");
+        assert!(est.value[0].is_finite() && est.value[0] > 0.0);
     }
 }
