@@ -9,7 +9,7 @@
 
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::PathBuf;
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
 use glossmeter::instrument::plan::{Plan, PlanOptions, Reading};
 use glossmeter::instrument::standards::{self as stds, StandardGeometry};
@@ -94,6 +94,25 @@ fn load_recipe(py: Python<'_>, recipe: &Bound<'_, PyAny>) -> PyResult<Material> 
     }
 }
 
+/// The builtin geometries, parsed and validated once per process (the library parses them on every lookup,
+/// which costs more than measuring a simple recipe).
+fn builtin() -> PyResult<&'static [StandardGeometry]> {
+    static BUILTIN: OnceLock<Vec<StandardGeometry>> = OnceLock::new();
+    if let Some(b) = BUILTIN.get() {
+        return Ok(b);
+    }
+    let all = stds::builtin().map_err(to_py_err)?;
+    Ok(BUILTIN.get_or_init(|| all))
+}
+
+/// A builtin geometry by id, with the library's message for an unknown one.
+fn find_builtin(id: &str) -> PyResult<StandardGeometry> {
+    match builtin()?.iter().find(|g| g.geometry.id == id) {
+        Some(g) => Ok(g.clone()),
+        None => stds::find(id).map_err(to_py_err),
+    }
+}
+
 /// One geometry: a builtin id, a path to a geometry file (str ending in ".json" or os.PathLike), or a dict in
 /// the standards format.
 fn load_geometry(py: Python<'_>, g: &Bound<'_, PyAny>) -> PyResult<StandardGeometry> {
@@ -102,7 +121,7 @@ fn load_geometry(py: Python<'_>, g: &Bound<'_, PyAny>) -> PyResult<StandardGeome
         if s.ends_with(".json") || s.contains(std::path::MAIN_SEPARATOR) {
             return stds::load_file(std::path::Path::new(s)).map_err(to_py_err);
         }
-        return stds::find(s).map_err(to_py_err);
+        return find_builtin(s);
     }
     if g.is_instance_of::<PyDict>() {
         let text = json_text(py, g)?;
@@ -122,9 +141,12 @@ fn load_geometry(py: Python<'_>, g: &Bound<'_, PyAny>) -> PyResult<StandardGeome
 }
 
 /// `None` → the CLI's default panel; a str → one geometry; a list → each in order.
-pub(crate) fn load_geometries(py: Python<'_>, geometries: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<StandardGeometry>> {
+pub(crate) fn load_geometries(
+    py: Python<'_>,
+    geometries: Option<&Bound<'_, PyAny>>,
+) -> PyResult<Vec<StandardGeometry>> {
     match geometries {
-        None => glossmeter::cli::resolve_geometries(&[], &[]).map_err(to_py_err),
+        None => glossmeter::cli::DEFAULT_GEOMETRIES.iter().map(|id| find_builtin(id)).collect(),
         Some(g) if g.is_instance_of::<PyString>() || g.is_instance_of::<PyDict>() => Ok(vec![load_geometry(py, g)?]),
         Some(g) => {
             let mut out = Vec::new();
@@ -153,17 +175,32 @@ pub(crate) fn readings_to_py<'py>(
 }
 
 /// Compile and run the plan without holding the GIL (the BRDF of `measure_brdf` takes it back per batch).
+/// `one_thread`: run the integrals on one thread, for a BRDF that calls Python: every evaluation takes the
+/// GIL, so several threads only hand it back and forth (measured ≈ 30× slower per call on 2 cores). The
+/// readings are the same bits whatever the thread count.
 pub(crate) fn run_plan(
     py: Python<'_>,
     brdf: Arc<dyn glossmeter::brdf::Brdf>,
     geos: Vec<StandardGeometry>,
     rtol: f64,
+    one_thread: bool,
 ) -> PyResult<Vec<Reading>> {
-    py.detach(|| {
+    let run = move || {
         guarded(|| {
             let plan = Plan::compile(brdf, geos, PlanOptions { rtol, ..PlanOptions::default() }).map_err(to_py_err)?;
             Ok(plan.execute())
         })
+    };
+    py.detach(|| {
+        if one_thread {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(1)
+                .build()
+                .map_err(|e| PyRuntimeError::new_err(format!("cannot start the integration thread: {e}")))?;
+            pool.install(run)
+        } else {
+            run()
+        }
     })
 }
 
@@ -184,7 +221,7 @@ fn measure<'py>(
 ) -> PyResult<Bound<'py, PyList>> {
     let material = guarded(|| load_recipe(py, recipe))?;
     let geos = guarded(|| load_geometries(py, geometries))?;
-    let readings = run_plan(py, material.brdf.clone(), geos, rtol)?;
+    let readings = run_plan(py, material.brdf.clone(), geos, rtol, false)?;
     guarded(|| readings_to_py(py, &material, &readings, timing))
 }
 
@@ -193,9 +230,8 @@ fn measure<'py>(
 #[pyfunction]
 fn standards(py: Python<'_>) -> PyResult<Bound<'_, PyList>> {
     guarded(|| {
-        let all = stds::builtin().map_err(to_py_err)?;
         let out = PyList::empty(py);
-        for g in &all {
+        for g in builtin()? {
             out.append(from_json(py, &g.spec)?)?;
         }
         Ok(out)

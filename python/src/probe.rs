@@ -136,8 +136,7 @@ pub fn conclude(found: &[(f64, Found)]) -> (Vec<Lobe>, String) {
                      has a mirror component, pass it as delta=",
                 );
             }
-            let lobe =
-                Lobe { slope_width: m, medium_eta: 1.0, label: "lobe of f (probed)".into(), heavy_tail: true };
+            let lobe = Lobe { slope_width: m, medium_eta: 1.0, label: "lobe of f (probed)".into(), heavy_tail: true };
             (vec![lobe], note)
         }
     }

@@ -249,7 +249,10 @@ fn parse_lobes(lobes: &Bound<'_, PyAny>) -> PyResult<Vec<Lobe>> {
             for k in d.keys() {
                 let k: String = k.extract()?;
                 if !["slope", "tail", "eta", "label"].contains(&k.as_str()) {
-                    return Err(bad(i, format!("unknown key \"{k}\"; allowed: \"slope\", \"tail\", \"eta\", \"label\"")));
+                    return Err(bad(
+                        i,
+                        format!("unknown key \"{k}\"; allowed: \"slope\", \"tail\", \"eta\", \"label\""),
+                    ));
                 }
             }
             let slope: f64 = match d.get_item("slope")? {
@@ -421,16 +424,12 @@ pub fn measure_brdf<'py>(
         asarray: asarray.unbind(),
         error: Mutex::new(None),
     });
-    let readings = run_plan(py, brdf.clone(), geos, rtol)?;
+    let readings = run_plan(py, brdf.clone(), geos, rtol, true)?;
     if let Some(e) = brdf.take_error() {
         return Err(e);
     }
-    let material = Material {
-        name: name.clone(),
-        file: "<python>".into(),
-        brdf: brdf.clone(),
-        json: serde_json::Value::Null,
-    };
+    let material =
+        Material { name: name.clone(), file: "<python>".into(), brdf: brdf.clone(), json: serde_json::Value::Null };
     let list = guarded(|| readings_to_py(py, &material, &readings, timing))?;
     if let Some(note) = probe_note {
         for d in list.iter() {
