@@ -11,7 +11,7 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::PathBuf;
 use std::sync::{Arc, OnceLock};
 
-use glossmeter::instrument::plan::{Plan, PlanOptions, Reading};
+use glossmeter::instrument::plan::{PlanOptions, Reading};
 use glossmeter::instrument::standards::{self as stds, StandardGeometry};
 use glossmeter::recipe::{self, Material};
 use glossmeter::Error;
@@ -146,7 +146,7 @@ pub(crate) fn load_geometries(
     geometries: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<Vec<StandardGeometry>> {
     match geometries {
-        None => glossmeter::cli::DEFAULT_GEOMETRIES.iter().map(|id| find_builtin(id)).collect(),
+        None => glossmeter::api::DEFAULT_PANEL.iter().map(|id| find_builtin(id)).collect(),
         Some(g) if g.is_instance_of::<PyString>() || g.is_instance_of::<PyDict>() => Ok(vec![load_geometry(py, g)?]),
         Some(g) => {
             let mut out = Vec::new();
@@ -187,8 +187,9 @@ pub(crate) fn run_plan(
 ) -> PyResult<Vec<Reading>> {
     let run = move || {
         guarded(|| {
-            let plan = Plan::compile(brdf, geos, PlanOptions { rtol, ..PlanOptions::default() }).map_err(to_py_err)?;
-            Ok(plan.execute())
+            let material = Material { name: String::new(), file: String::new(), brdf, json: serde_json::Value::Null };
+            glossmeter::api::measure(&material, &geos, &PlanOptions { rtol, ..PlanOptions::default() })
+                .map_err(to_py_err)
         })
     };
     py.detach(|| {
@@ -283,6 +284,6 @@ fn _glossmeter(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(_panic, m)?)?;
     m.add_function(wrap_pyfunction!(pybrdf::measure_brdf, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
-    m.add("DEFAULT_GEOMETRIES", glossmeter::cli::DEFAULT_GEOMETRIES.to_vec())?;
+    m.add("DEFAULT_GEOMETRIES", glossmeter::api::DEFAULT_PANEL.to_vec())?;
     Ok(())
 }
