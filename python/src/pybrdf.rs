@@ -13,7 +13,7 @@ use std::sync::Mutex;
 use glossmeter::brdf::{Brdf, Lobe, Term, TermKind};
 use glossmeter::instrument::plan::{Plan, PlanOptions, Target};
 use glossmeter::recipe::Material;
-use glossmeter::spectrum::Sampling;
+use glossmeter::spectrum::{Sampling, Weighting};
 use glossmeter::Vec3;
 use numpy::{PyArray1, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyTypeError, PyValueError};
@@ -136,8 +136,12 @@ impl PyBrdf {
         check_values("delta", out, s, |i| format!("wi = {}", fmt_dir(wi[i])))
     }
 
-    /// Evaluate a batch, keeping the first error; zeros once f has failed.
-    fn eval_batch(&self, wi: &[Vec3], wo: &[Vec3], out: &mut [f64]) {
+    /// Evaluate a batch in one call of f, keeping the first error; zeros once f has failed, and for pairs
+    /// below the horizon (as `Brdf::eval_batch` requires; the instrument passes none).
+    fn eval_points(&self, wi: &[Vec3], wo: &[Vec3], out: &mut [f64]) {
+        if wi.is_empty() {
+            return;
+        }
         if self.failed() {
             out.fill(0.0);
             return;
@@ -145,7 +149,15 @@ impl PyBrdf {
         let mut buf = Vec::with_capacity(out.len());
         let r = Python::attach(|py| self.call_f(py, wi, wo, &mut buf));
         match r {
-            Ok(()) => out.copy_from_slice(&buf),
+            Ok(()) => {
+                out.copy_from_slice(&buf);
+                let n = self.sampling.len();
+                for (i, o) in out.chunks_exact_mut(n).enumerate() {
+                    if !(wi[i].z > 0.0 && wo[i].z > 0.0) {
+                        o.fill(0.0);
+                    }
+                }
+            }
             Err(e) => {
                 self.keep(e);
                 out.fill(0.0);
@@ -164,7 +176,12 @@ impl Brdf for PyBrdf {
     }
 
     fn eval(&self, wi: Vec3, wo: Vec3, out: &mut [f64]) {
-        self.eval_batch(&[wi], &[wo], out);
+        self.eval_points(&[wi], &[wo], out);
+    }
+
+    /// One call of f per batch: the interpreter boundary is crossed once for the whole batch.
+    fn eval_batch(&self, wi: &[Vec3], wo: &[Vec3], out: &mut [f64]) {
+        self.eval_points(wi, wo, out);
     }
 
     fn delta_reflectance(&self, wi: Vec3, out: &mut [f64]) -> bool {
@@ -231,8 +248,8 @@ fn specimen_angles(geos: &[glossmeter::instrument::standards::StandardGeometry])
         .map_err(to_py_err)?;
     let mut out: Vec<f64> = Vec::new();
     for j in &plan.jobs {
-        if j.target == Target::Specimen && !out.iter().any(|t| t.to_bits() == j.theta.to_bits()) {
-            out.push(j.theta);
+        if j.method.target == Target::Specimen && !out.iter().any(|t| t.to_bits() == j.method.theta.to_bits()) {
+            out.push(j.method.theta);
         }
     }
     Ok(out)
@@ -355,13 +372,13 @@ pub fn measure_brdf<'py>(
         Some(l) => (l, None),
         None => {
             let per = probe::points(0.0).len();
+            let lum = Weighting::luminous(&sampling).map_err(to_py_err)?;
             let found: Vec<(f64, probe::Found)> = angles
                 .iter()
                 .enumerate()
                 .map(|(a, t)| {
-                    let lum: Vec<f64> = (0..per)
-                        .map(|i| sampling.luminous(&values[(a * per + i) * s..(a * per + i + 1) * s]))
-                        .collect();
+                    let lum: Vec<f64> =
+                        (0..per).map(|i| lum.component(0, &values[(a * per + i) * s..(a * per + i + 1) * s])).collect();
                     (*t, probe::analyse(*t, &lum))
                 })
                 .collect();

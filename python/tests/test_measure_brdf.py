@@ -155,8 +155,6 @@ def test_bad_values_from_f_are_value_errors():
     assert r[0]["value"] > 0
 
 
-@pytest.mark.xfail(strict=True, reason="the engine evaluates one point per call until batched Brdf evaluation "
-                   "(issue 7, branch arch) lands; strict, so this fails as soon as batching works and must be unmarked")
 def test_f_is_called_in_batches():
     f = Counting(lambda wi, wo: np.full(len(wi), 0.5 / np.pi))
     glossmeter.measure_brdf(f, geometries=["astm-d523-60"], lobes=[0.05])
