@@ -1,0 +1,289 @@
+//! Python bindings of glossmeter: a thin layer over the library, like the CLI.
+//!
+//! Why it exists: rendering and appearance engineers work in Python (Mitsuba, NumPy, notebooks) and want to
+//! read *their* BRDF, a Python function, through the instrument apertures; paint designers want to spread
+//! sweeps over a Dask cluster. Everything that computes lives in the library; this crate converts arguments,
+//! turns library errors into Python exceptions (the CLI's messages, `ValueError` for bad input), catches
+//! panics at the boundary, and adapts a Python callable to the `Brdf` trait ([`pybrdf`]). See `docs/python.md`.
+#![forbid(unsafe_code)]
+
+use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::path::PathBuf;
+use std::sync::{Arc, OnceLock};
+
+use glossmeter::instrument::plan::{PlanOptions, Reading};
+use glossmeter::instrument::standards::{self as stds, StandardGeometry};
+use glossmeter::recipe::{self, Material};
+use glossmeter::Error;
+use pyo3::exceptions::{PyFileNotFoundError, PyOSError, PyRuntimeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList, PyString};
+
+mod probe;
+mod pybrdf;
+
+/// A library error as the Python exception a caller expects, with the message the CLI prints after
+/// "error: ". Bad input and bad requests are `ValueError`; files that cannot be read are `OSError`
+/// (`FileNotFoundError` when missing); a computation without a finite result is `RuntimeError`.
+pub(crate) fn to_py_err(e: Error) -> PyErr {
+    let msg = e.to_string();
+    match &e {
+        Error::Input { .. } | Error::Usage(_) => PyValueError::new_err(msg),
+        Error::Io { source, .. } if source.kind() == std::io::ErrorKind::NotFound => PyFileNotFoundError::new_err(msg),
+        Error::Io { .. } => PyOSError::new_err(msg),
+        Error::Numeric(_) | Error::Check(_) => PyRuntimeError::new_err(msg),
+    }
+}
+
+/// Run `f` and turn a panic into a `RuntimeError` instead of unwinding into Python.
+pub(crate) fn guarded<T>(f: impl FnOnce() -> PyResult<T>) -> PyResult<T> {
+    match catch_unwind(AssertUnwindSafe(f)) {
+        Ok(r) => r,
+        Err(payload) => {
+            let what = payload
+                .downcast_ref::<String>()
+                .cloned()
+                .or_else(|| payload.downcast_ref::<&str>().map(|s| s.to_string()))
+                .unwrap_or_else(|| "unknown panic".into());
+            Err(PyRuntimeError::new_err(format!(
+                "internal error in glossmeter (a bug; please report it with the input): {what}"
+            )))
+        }
+    }
+}
+
+/// A Python object as JSON text: a `str` as is, anything else through `json.dumps`.
+fn json_text(py: Python<'_>, obj: &Bound<'_, PyAny>) -> PyResult<String> {
+    if let Ok(s) = obj.cast::<PyString>() {
+        return Ok(s.to_str()?.to_string());
+    }
+    let json = py.import("json")?;
+    json.call_method1("dumps", (obj,))?.extract()
+}
+
+/// JSON text as Python objects (`json.loads`).
+fn from_json<'py>(py: Python<'py>, v: &serde_json::Value) -> PyResult<Bound<'py, PyAny>> {
+    let text = serde_json::to_string(v).map_err(|e| PyRuntimeError::new_err(e.to_string()))?;
+    py.import("json")?.call_method1("loads", (text,))
+}
+
+/// A recipe given as a dict, a JSON string or a path (str or os.PathLike).
+fn load_recipe(py: Python<'_>, recipe: &Bound<'_, PyAny>) -> PyResult<Material> {
+    if let Ok(s) = recipe.cast::<PyString>() {
+        let s = s.to_str()?;
+        let t = s.trim_start();
+        if t.starts_with('{') {
+            return recipe::parse_str(s, "<string>").map_err(to_py_err);
+        }
+        return recipe::load_file(std::path::Path::new(s)).map_err(to_py_err);
+    }
+    if recipe.is_instance_of::<PyDict>() {
+        let text = json_text(py, recipe)?;
+        return recipe::parse_str(&text, "<dict>").map_err(to_py_err);
+    }
+    let os = py.import("os")?;
+    match os.call_method1("fspath", (recipe,)) {
+        Ok(p) => {
+            let p: PathBuf = p.extract()?;
+            recipe::load_file(&p).map_err(to_py_err)
+        }
+        Err(_) => Err(PyValueError::new_err(format!(
+            "recipe: expected a dict, a JSON string or a path, got {}",
+            recipe.get_type().name()?
+        ))),
+    }
+}
+
+/// The builtin geometries, parsed and validated once per process (the library parses them on every lookup,
+/// which costs more than measuring a simple recipe).
+fn builtin() -> PyResult<&'static [StandardGeometry]> {
+    static BUILTIN: OnceLock<Vec<StandardGeometry>> = OnceLock::new();
+    if let Some(b) = BUILTIN.get() {
+        return Ok(b);
+    }
+    let all = stds::builtin().map_err(to_py_err)?;
+    Ok(BUILTIN.get_or_init(|| all))
+}
+
+/// A builtin geometry by id, with the library's message for an unknown one.
+fn find_builtin(id: &str) -> PyResult<StandardGeometry> {
+    match builtin()?.iter().find(|g| g.geometry.id == id) {
+        Some(g) => Ok(g.clone()),
+        None => stds::find(id).map_err(to_py_err),
+    }
+}
+
+/// One geometry: a builtin id, a path to a geometry file (str ending in ".json" or os.PathLike), or a dict in
+/// the standards format.
+fn load_geometry(py: Python<'_>, g: &Bound<'_, PyAny>) -> PyResult<StandardGeometry> {
+    if let Ok(s) = g.cast::<PyString>() {
+        let s = s.to_str()?;
+        if s.ends_with(".json") || s.contains(std::path::MAIN_SEPARATOR) {
+            return stds::load_file(std::path::Path::new(s)).map_err(to_py_err);
+        }
+        return find_builtin(s);
+    }
+    if g.is_instance_of::<PyDict>() {
+        let text = json_text(py, g)?;
+        return stds::parse(&text, "<dict>").map_err(to_py_err);
+    }
+    let os = py.import("os")?;
+    match os.call_method1("fspath", (g,)) {
+        Ok(p) => {
+            let p: PathBuf = p.extract()?;
+            stds::load_file(&p).map_err(to_py_err)
+        }
+        Err(_) => Err(PyValueError::new_err(format!(
+            "geometries: expected a geometry id, a path or a dict, got {}",
+            g.get_type().name()?
+        ))),
+    }
+}
+
+/// `None` → the CLI's default panel; a str → one geometry; a list → each in order.
+pub(crate) fn load_geometries(
+    py: Python<'_>,
+    geometries: Option<&Bound<'_, PyAny>>,
+) -> PyResult<Vec<StandardGeometry>> {
+    match geometries {
+        None => glossmeter::api::DEFAULT_PANEL.iter().map(|id| find_builtin(id)).collect(),
+        Some(g) if g.is_instance_of::<PyString>() || g.is_instance_of::<PyDict>() => Ok(vec![load_geometry(py, g)?]),
+        Some(g) => {
+            let mut out = Vec::new();
+            for item in g.try_iter()? {
+                out.push(load_geometry(py, &item?)?);
+            }
+            if out.is_empty() {
+                return Err(PyValueError::new_err("geometries: an empty list; give None for the default panel"));
+            }
+            Ok(out)
+        }
+    }
+}
+
+/// The readings as the list of dicts of `measure --format json` (through the CLI's own formatter, so the
+/// fields cannot drift apart).
+pub(crate) fn readings_to_py<'py>(
+    py: Python<'py>,
+    material: &Material,
+    readings: &[Reading],
+    timing: bool,
+) -> PyResult<Bound<'py, PyList>> {
+    let text = glossmeter::cli::format::json(material, readings, timing);
+    let doc = py.import("json")?.call_method1("loads", (text,))?;
+    Ok(doc.get_item("readings")?.cast_into::<PyList>()?)
+}
+
+/// Compile and run the plan without holding the GIL (the BRDF of `measure_brdf` takes it back per batch).
+/// `one_thread`: run the integrals on one thread, for a BRDF that calls Python: every evaluation takes the
+/// GIL, so several threads only hand it back and forth (measured ≈ 30× slower per call on 2 cores). The
+/// readings are the same bits whatever the thread count.
+pub(crate) fn run_plan(
+    py: Python<'_>,
+    brdf: Arc<dyn glossmeter::brdf::Brdf>,
+    geos: Vec<StandardGeometry>,
+    rtol: f64,
+    one_thread: bool,
+) -> PyResult<Vec<Reading>> {
+    let run = move || {
+        guarded(|| {
+            let material = Material { name: String::new(), file: String::new(), brdf, json: serde_json::Value::Null };
+            glossmeter::api::measure(&material, &geos, &PlanOptions { rtol, ..PlanOptions::default() })
+                .map_err(to_py_err)
+        })
+    };
+    py.detach(|| {
+        if one_thread {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(1)
+                .build()
+                .map_err(|e| PyRuntimeError::new_err(format!("cannot start the integration thread: {e}")))?;
+            pool.install(run)
+        } else {
+            run()
+        }
+    })
+}
+
+/// measure(recipe, geometries=None, rtol=1e-6, timing=True) -> list[dict]
+///
+/// Read a recipe (a dict, a JSON string or a path) through instrument geometries (None: the default panel of
+/// `glossmeter measure`; or a list of builtin ids, geometry files or geometry dicts). Returns one dict per
+/// reading with the fields of `glossmeter measure --format json`. Bad input raises ValueError with the
+/// message the CLI prints; a reading without a finite value has value None and a "problem".
+#[pyfunction]
+#[pyo3(signature = (recipe, geometries=None, rtol=1e-6, timing=true))]
+fn measure<'py>(
+    py: Python<'py>,
+    recipe: &Bound<'py, PyAny>,
+    geometries: Option<&Bound<'py, PyAny>>,
+    rtol: f64,
+    timing: bool,
+) -> PyResult<Bound<'py, PyList>> {
+    let material = guarded(|| load_recipe(py, recipe))?;
+    let geos = guarded(|| load_geometries(py, geometries))?;
+    let readings = run_plan(py, material.brdf.clone(), geos, rtol, false)?;
+    guarded(|| readings_to_py(py, &material, &readings, timing))
+}
+
+/// standards() -> list[dict]: every shipped geometry, as in `standards/*.json` (with the provenance of
+/// every number).
+#[pyfunction]
+fn standards(py: Python<'_>) -> PyResult<Bound<'_, PyList>> {
+    guarded(|| {
+        let out = PyList::empty(py);
+        for g in builtin()? {
+            out.append(from_json(py, &g.spec)?)?;
+        }
+        Ok(out)
+    })
+}
+
+/// geometry(id) -> dict: one geometry (a builtin id, a geometry file's path, or a dict to validate), in the
+/// standards format.
+#[pyfunction]
+fn geometry<'py>(py: Python<'py>, id: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+    guarded(|| {
+        let g = load_geometry(py, id)?;
+        from_json(py, &g.spec)
+    })
+}
+
+/// describe_geometry(id) -> str: the text of `glossmeter standards ID`.
+#[pyfunction]
+fn describe_geometry(py: Python<'_>, id: &Bound<'_, PyAny>) -> PyResult<String> {
+    guarded(|| Ok(stds::describe(&load_geometry(py, id)?)))
+}
+
+/// schema() -> dict: the JSON Schema of the recipe format (`glossmeter schema`).
+#[pyfunction]
+fn schema(py: Python<'_>) -> PyResult<Bound<'_, PyAny>> {
+    guarded(|| from_json(py, &recipe::schema::schema()))
+}
+
+/// describe(recipe) -> str: the one-line description of the model a recipe builds.
+#[pyfunction]
+fn describe<'py>(py: Python<'py>, recipe: &Bound<'py, PyAny>) -> PyResult<String> {
+    guarded(|| Ok(load_recipe(py, recipe)?.brdf.describe()))
+}
+
+/// _panic(): raise a Rust panic inside the boundary (for the test that panics become RuntimeError).
+#[pyfunction]
+fn _panic() -> PyResult<()> {
+    guarded(|| -> PyResult<()> { panic!("deliberate panic for the bindings' test") })
+}
+
+#[pymodule]
+fn _glossmeter(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(measure, m)?)?;
+    m.add_function(wrap_pyfunction!(standards, m)?)?;
+    m.add_function(wrap_pyfunction!(geometry, m)?)?;
+    m.add_function(wrap_pyfunction!(describe_geometry, m)?)?;
+    m.add_function(wrap_pyfunction!(schema, m)?)?;
+    m.add_function(wrap_pyfunction!(describe, m)?)?;
+    m.add_function(wrap_pyfunction!(_panic, m)?)?;
+    m.add_function(wrap_pyfunction!(pybrdf::measure_brdf, m)?)?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    m.add("DEFAULT_GEOMETRIES", glossmeter::api::DEFAULT_PANEL.to_vec())?;
+    Ok(())
+}

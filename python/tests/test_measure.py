@@ -1,0 +1,135 @@
+"""measure(), standards(), geometry() and errors: the bindings against the library and the CLI."""
+import json
+import pathlib
+import subprocess
+import struct
+
+import pytest
+
+import glossmeter
+from conftest import RECIPES, ROOT, cli_binary
+
+FIELDS = {"geometry", "name", "quantity", "value", "unit", "error_estimate", "evaluations", "converged"}
+
+
+def bits(x):
+    return struct.pack(">d", x).hex()
+
+
+def test_recipe_as_path_dict_and_json_string_read_the_same():
+    path = RECIPES / "black-glass.json"
+    text = path.read_text()
+    a = glossmeter.measure(str(path), timing=False)
+    b = glossmeter.measure(path, timing=False)  # os.PathLike
+    c = glossmeter.measure(json.loads(text), timing=False)
+    d = glossmeter.measure(text, timing=False)
+    assert a == b == c == d
+    assert [r["geometry"] for r in a][:3] == ["astm-d523-20", "astm-d523-60", "astm-d523-85"]
+    for r in a:
+        assert FIELDS <= set(r) and "seconds" not in r
+    assert all("seconds" in r for r in glossmeter.measure(path, geometries=["astm-d523-60"]))
+
+
+@pytest.mark.parametrize("fixture", ["bench-b2-beckmann-0.1", "rough-dielectric-ggx-vcavity", "grey-lambert"])
+def test_readings_are_the_golden_bits(fixture):
+    """The same bits as tests/golden.rs stores for the CLI's engine, on every builtin geometry."""
+    golden = json.loads((ROOT / "fixtures" / "golden" / "readings.json").read_text())
+    ids = [g["id"] for g in glossmeter.standards()]
+    readings = glossmeter.measure(RECIPES / f"{fixture}.json", geometries=ids, rtol=1e-6, timing=False)
+    checked = 0
+    for r in readings:
+        key = f"{fixture}|{r['geometry']}|{r['name']}"
+        if key not in golden:
+            continue
+        value, err, evals, conv = golden[key].split()
+        assert bits(r["value"]) == value, key
+        assert bits(r["error_estimate"]) == err, key
+        assert r["evaluations"] == int(evals) and str(r["converged"]).lower() == conv, key
+        checked += 1
+    assert checked == len(readings) > 10
+
+
+def test_the_dicts_are_the_cli_json():
+    exe = cli_binary()
+    if exe is None:
+        pytest.skip("the release CLI is not built (cargo build --release); .ci/run builds it first")
+    path = RECIPES / "ward.json"
+    out = subprocess.run([exe, "measure", str(path), "--format", "json", "--no-timing"], capture_output=True,
+                         text=True, check=True)
+    assert json.loads(out.stdout)["readings"] == glossmeter.measure(str(path), timing=False)
+
+
+def cli_error(args):
+    exe = cli_binary()
+    if exe is None:
+        return None
+    p = subprocess.run([exe, *args], capture_output=True, text=True)
+    assert p.returncode == 2
+    return p.stderr.strip().removeprefix("error: ")
+
+
+def test_bad_input_raises_value_error_with_the_cli_message(tmp_path):
+    bad = tmp_path / "bad.json"
+    bad.write_text('{"model": "microfacet", "distribution": "beckmann", "roughness": -1, "ior": 1.5}')
+    with pytest.raises(ValueError) as e:
+        glossmeter.measure(str(bad))
+    msg = str(e.value)
+    assert "roughness" in msg and str(bad) in msg
+    expected = cli_error(["measure", str(bad)])
+    if expected is not None:
+        assert msg == expected
+    with pytest.raises(ValueError, match="roughness"):
+        glossmeter.measure({"model": "microfacet", "distribution": "beckmann", "roughness": -1, "ior": 1.5})
+    with pytest.raises(ValueError, match="<string>"):
+        glossmeter.measure('{"model": "lambert", "albedo": 0.5,')
+    with pytest.raises(ValueError, match="model"):
+        glossmeter.measure({"albedo": 0.5})
+
+
+def test_unknown_geometry_bad_rtol_and_missing_file():
+    lam = {"model": "lambert", "albedo": 0.5}
+    with pytest.raises(ValueError, match="unknown geometry id \"nope\"") as e:
+        glossmeter.measure(lam, geometries=["nope"])
+    expected = cli_error(["measure", str(RECIPES / "grey-lambert.json"), "-g", "nope"])
+    if expected is not None:
+        assert str(e.value) == expected
+    with pytest.raises(ValueError, match="rtol"):
+        glossmeter.measure(lam, rtol=0.0)
+    with pytest.raises(ValueError, match="rtol"):
+        glossmeter.measure(lam, rtol=float("nan"))
+    with pytest.raises(FileNotFoundError, match="no-such-recipe.json"):
+        glossmeter.measure("no-such-recipe.json")
+    with pytest.raises(ValueError, match="expected a dict"):
+        glossmeter.measure(42)
+
+
+def test_a_panic_is_a_runtime_error_not_a_crash():
+    with pytest.raises(RuntimeError, match="internal error"):
+        glossmeter._glossmeter._panic()
+    # the interpreter goes on working
+    assert glossmeter.measure({"model": "lambert", "albedo": 0.5}, geometries="astm-d523-60")[0]["value"] > 0
+
+
+def test_standards_and_one_geometry():
+    all_ = glossmeter.standards()
+    ids = [g["id"] for g in all_]
+    for i in glossmeter.DEFAULT_GEOMETRIES:
+        assert i in ids
+    g = glossmeter.geometry("astm-d523-60")
+    assert g == all_[ids.index("astm-d523-60")]
+    assert g["angle_deg"]["value"] == 60 if isinstance(g["angle_deg"], dict) else g["angle_deg"] == 60
+    assert "astm-d523-60" in glossmeter.describe_geometry("astm-d523-60")
+    # a geometry given as a dict is validated like a file and measured like a builtin one
+    lam = {"model": "lambert", "albedo": 0.5}
+    assert glossmeter.measure(lam, geometries=[g], timing=False) == glossmeter.measure(
+        lam, geometries=["astm-d523-60"], timing=False)
+    broken = dict(g)
+    del broken["angle_deg"]
+    with pytest.raises(ValueError, match="angle_deg"):
+        glossmeter.geometry(broken)
+
+
+def test_schema_and_describe():
+    assert "properties" in json.dumps(glossmeter.schema())
+    assert "Beckmann" in glossmeter.describe(RECIPES / "bench-b2-beckmann-0.1.json") or "beckmann" in \
+        glossmeter.describe(RECIPES / "bench-b2-beckmann-0.1.json").lower()
