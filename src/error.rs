@@ -9,7 +9,8 @@ pub enum Error {
     Input {
         /// The file (or `<stdin>`, `<builtin:...>`) the value came from.
         file: String,
-        /// Path of the field, e.g. `pigmented_layer.pigments[1].k`; empty if the whole file is at fault.
+        /// The field as an RFC 6901 JSON Pointer, e.g. `/pigmented_layer/pigments/1/k_per_mm`; empty if the
+        /// whole file is at fault (for sheets: `line N`).
         field: String,
         /// What is wrong and what is allowed.
         message: String,

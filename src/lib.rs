@@ -7,6 +7,8 @@
 //!   paint model of Ďurikovič & Ágošton (2007).
 //! * [`recipe`]: JSON recipes → validated BRDFs, with errors that name the file and the field.
 //! * [`input`]: input files read as text with a size limit.
+//! * [`registry`]: every recipe parameter's JSON Pointer, type, unit, range and meaning, shared by the
+//!   validator, the schema, the docs and the fitter.
 //! * [`spectrum`]: spectral sampling and the luminous (CIE illuminant C × V(λ)) weighting.
 //! * [`quadrature`]: the deterministic adaptive cubature with error estimates.
 //! * [`instrument`]: aperture geometry, the standards as data, the measurement plan and the readings.
@@ -25,6 +27,7 @@ pub mod instrument;
 pub mod optics;
 pub mod quadrature;
 pub mod recipe;
+pub mod registry;
 pub mod spectrum;
 
 pub use api::{measure, measure_file, resolve_geometries, resolve_geometries_or, DEFAULT_PANEL};

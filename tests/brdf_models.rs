@@ -391,5 +391,5 @@ fn lobes_under_a_clear_coat() {
         assert!(coated.brdf.is_reciprocal());
     }
     let bad = recipe::parse_str(&format!(r#"{text}, "clear_coat": {{"index": 2.5}}}}"#), "bad.json").unwrap_err();
-    assert!(bad.to_string().contains("clear_coat.index"), "{bad}");
+    assert!(bad.to_string().contains("/clear_coat/index"), "{bad}");
 }

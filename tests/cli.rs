@@ -221,12 +221,12 @@ fn smaller_input_cases_exit_2_naming_file_and_field() {
     let dup = write("dup.json", r#"{"model":"lambert","albedo":0.5,"albedo":0.9}"#);
     let (code, _, err) = stderr_of(&["measure", &dup, "-g", "astm-d523-60"]);
     assert_eq!(code, Some(2));
-    assert!(err.contains("dup.json") && err.contains("`albedo`") && err.contains("twice"), "{err}");
+    assert!(err.contains("dup.json") && err.contains("`/albedo`") && err.contains("twice"), "{err}");
     let bom = write("bom.json", "\u{feff}{\"model\":\"lambert\",\"albedo\":0.5}");
     assert_eq!(run(["glossmeter", "measure", &bom, "-g", "astm-d523-60"]), 0);
     let (code, _, err) = stderr_of(&["measure", &bom, "--geometry-file", "fixtures/geometry/bad-shipped-id.json"]);
     assert_eq!(code, Some(2));
-    assert!(err.contains("bad-shipped-id.json") && err.contains("`id`"), "{err}");
+    assert!(err.contains("bad-shipped-id.json") && err.contains("`/id`"), "{err}");
     let (code, _, err) = stderr_of(&["measure", "/dev/zero"]);
     assert_eq!(code, Some(2));
     assert!(err.contains("/dev/zero") && err.contains("MiB"), "{err}");

@@ -412,7 +412,7 @@ fn bad_tables_and_recipes_are_refused_with_the_file_named() {
     // Truncated.
     std::fs::write(d.join("short.binary"), &bytes[..bytes.len() - 8]).unwrap();
     let e = refusal(&d, "r1.json", r#"{"model": "merl", "file": "short.binary"}"#);
-    assert!(e.contains("field `file`") && e.contains("short.binary") && e.contains("truncated"), "{e}");
+    assert!(e.contains("field `/file`") && e.contains("short.binary") && e.contains("truncated"), "{e}");
     // Trailing bytes.
     let mut long = bytes.clone();
     long.extend_from_slice(&[0; 4]);
@@ -440,19 +440,19 @@ fn bad_tables_and_recipes_are_refused_with_the_file_named() {
     assert!(e.contains("tiny.binary") && e.contains("too short"), "{e}");
     // Missing file: the recipe, the field and the OS error.
     let e = refusal(&d, "r7.json", r#"{"model": "merl", "file": "nowhere.binary"}"#);
-    assert!(e.contains("field `file`") && e.contains("nowhere.binary") && e.contains("os error"), "{e}");
+    assert!(e.contains("field `/file`") && e.contains("nowhere.binary") && e.contains("os error"), "{e}");
     // A directory is not a table.
     let e = refusal(&d, "r8.json", &format!(r#"{{"model": "merl", "file": "{}"}}"#, d.display()));
-    assert!(e.contains("field `file`"), "{e}");
+    assert!(e.contains("field `/file`"), "{e}");
     // Recipe-level refusals.
     let e = refusal(&d, "r9.json", r#"{"model": "merl", "file": "good.binary", "interp": "nearest"}"#);
-    assert!(e.contains("field `interp`") && e.contains("unknown field"), "{e}");
+    assert!(e.contains("field `/interp`") && e.contains("unknown field"), "{e}");
     let e = refusal(&d, "r10.json", r#"{"model": "merl", "file": "good.binary", "interpolation": "cubic"}"#);
-    assert!(e.contains("field `interpolation`") && e.contains("trilinear"), "{e}");
+    assert!(e.contains("field `/interpolation`") && e.contains("trilinear"), "{e}");
     let e = refusal(&d, "r11.json", r#"{"model": "merl"}"#);
-    assert!(e.contains("field `file`") && e.contains("missing"), "{e}");
+    assert!(e.contains("field `/file`") && e.contains("missing"), "{e}");
     let e = refusal(&d, "r12.json", r#"{"model": "merl", "file": 3}"#);
-    assert!(e.contains("field `file`") && e.contains("string"), "{e}");
+    assert!(e.contains("field `/file`") && e.contains("string"), "{e}");
     // Direct loading names the table file.
     let e = MerlBrdf::load(&d.join("short.binary"), Interpolation::Nearest).unwrap_err().to_string();
     assert!(e.starts_with(&d.join("short.binary").display().to_string()), "{e}");

@@ -872,7 +872,7 @@ fn spectral_recipe_samples_and_interference_colour() {
     // Wrong length refused with the field path.
     v["pigmented_layer"]["primer_reflectance"] = json!(vec![0.7; 3]);
     let e = from_json(&v).unwrap_err().to_string();
-    assert!(e.contains("pigmented_layer.primer_reflectance") && e.contains("expected 5 values"), "{e}");
+    assert!(e.contains("/pigmented_layer/primer_reflectance") && e.contains("expected 5 values"), "{e}");
 }
 
 fn argsort(v: &[f64]) -> Vec<usize> {
@@ -913,39 +913,39 @@ fn bad_recipes_are_refused_with_the_field_path() {
         (
             "negative thickness",
             |v| v["pigmented_layer"]["thickness_mm"] = json!(-0.1),
-            &["pigmented_layer.thickness_mm", "≥ 0"],
+            &["/pigmented_layer/thickness_mm", "≥ 0"],
         ),
         (
             "Am + Ap > 1",
             |v| v["pearlescent_flakes"]["area_ratio"] = json!(0.7),
-            &["pearlescent_flakes.area_ratio", "exceed 1"],
+            &["/pearlescent_flakes/area_ratio", "exceed 1"],
         ),
         (
             "wrong spectral length",
             |v| v["pigmented_layer"]["pigments"][0]["k_per_mm"] = json!([1.0, 2.0]),
-            &["pigmented_layer.pigments[0].k_per_mm", "expected 3 values"],
+            &["/pigmented_layer/pigments/0/k_per_mm", "expected 3 values"],
         ),
         (
             "NaN as a string",
             |v| v["clear_coat"]["index"] = json!("NaN"),
-            &["clear_coat.index", "expected a finite number"],
+            &["/clear_coat/index", "expected a finite number"],
         ),
         (
             "unknown field",
             |v| v["metallic_flakes"]["spread"] = json!(0.25),
-            &["metallic_flakes.spread", "unknown field", "spread_deg"],
+            &["/metallic_flakes/spread", "unknown field", "spread_deg"],
         ),
         (
             "both spread_deg and spread_slope",
             |v| v["metallic_flakes"]["spread_slope"] = json!(0.25),
-            &["metallic_flakes.spread_slope", "exactly one of", "not both"],
+            &["/metallic_flakes/spread_slope", "exactly one of", "not both"],
         ),
         (
             "neither spread_deg nor spread_slope",
             |v| {
                 v["metallic_flakes"].as_object_mut().unwrap().remove("spread_deg");
             },
-            &["metallic_flakes.spread_deg", "missing", "exactly one of"],
+            &["/metallic_flakes/spread_deg", "missing", "exactly one of"],
         ),
         (
             "spread_slope out of range",
@@ -953,24 +953,24 @@ fn bad_recipes_are_refused_with_the_field_path() {
                 v["metallic_flakes"].as_object_mut().unwrap().remove("spread_deg");
                 v["metallic_flakes"]["spread_slope"] = json!(2.5);
             },
-            &["metallic_flakes.spread_slope", "out of range", "1.732"],
+            &["/metallic_flakes/spread_slope", "out of range", "1.732"],
         ),
         (
             "X' > X",
             |v| v["metallic_flakes"]["depth_mm"] = json!(0.2),
-            &["metallic_flakes.depth_mm", "deeper than the pigmented layer"],
+            &["/metallic_flakes/depth_mm", "deeper than the pigmented layer"],
         ),
-        ("coat index out of range", |v| v["clear_coat"]["index"] = json!(2.0), &["clear_coat.index", "[1.3, 1.8]"]),
+        ("coat index out of range", |v| v["clear_coat"]["index"] = json!(2.0), &["/clear_coat/index", "[1.3, 1.8]"]),
         ("bad form", |v| v["form"] = json!("paper"), &["form", "paper-eq1"]),
         (
             "negative K",
             |v| v["pigmented_layer"]["pigments"][0]["s_per_mm"] = json!([0.1, -1.0, 0.2]),
-            &["pigmented_layer.pigments[0].s_per_mm[1]"],
+            &["/pigmented_layer/pigments/0/s_per_mm/1"],
         ),
         (
             "Rg > 1",
             |v| v["pigmented_layer"]["primer_reflectance"] = json!([0.7, 1.2, 0.7]),
-            &["pigmented_layer.primer_reflectance[1]"],
+            &["/pigmented_layer/primer_reflectance/1"],
         ),
         (
             "missing layer",
@@ -979,11 +979,15 @@ fn bad_recipes_are_refused_with_the_field_path() {
             },
             &["pigmented_layer", "missing"],
         ),
-        ("bad distribution", |v| v["clear_coat"]["distribution"] = json!("phong"), &["clear_coat.distribution", "ggx"]),
+        (
+            "bad distribution",
+            |v| v["clear_coat"]["distribution"] = json!("phong"),
+            &["/clear_coat/distribution", "ggx"],
+        ),
         (
             "both K/S and measured",
             |v| v["pigmented_layer"]["pigments"][0]["measured"] = json!({}),
-            &["pigmented_layer.pigments[0].measured", "not both"],
+            &["/pigmented_layer/pigments/0/measured", "not both"],
         ),
         (
             "internal_reflection not a bool",
@@ -995,7 +999,7 @@ fn bad_recipes_are_refused_with_the_field_path() {
             |v| v["wavelengths_nm"] = json!((0..=MAX_SAMPLES).map(|i| 400.0 + i as f64).collect::<Vec<_>>()),
             &["wavelengths_nm", "at most"],
         ),
-        ("negative area ratio", |v| v["metallic_flakes"]["area_ratio"] = json!(-0.1), &["metallic_flakes.area_ratio"]),
+        ("negative area ratio", |v| v["metallic_flakes"]["area_ratio"] = json!(-0.1), &["/metallic_flakes/area_ratio"]),
     ];
     for (what, edit, needles) in cases {
         let mut v = fixture_json("cerulean-blue-c-literal");

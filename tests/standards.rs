@@ -220,26 +220,26 @@ fn expect_input_error(path: &Path, field: &str, words: &str) {
 #[test]
 fn bad_geometry_files_name_file_and_field() {
     expect_input_error(&fixture("bad-malformed.json"), "", "malformed JSON");
-    expect_input_error(&fixture("bad-missing-angle.json"), "angle_deg", "missing");
-    expect_input_error(&fixture("bad-negative-aperture.json"), "receptors[0].in_plane_deg.value", "out of range");
+    expect_input_error(&fixture("bad-missing-angle.json"), "/angle_deg", "missing");
+    expect_input_error(&fixture("bad-negative-aperture.json"), "/receptors/0/in_plane_deg/value", "out of range");
     expect_input_error(
         &fixture("bad-unknown-receptor.json"),
-        "readings[1].receptors[1]",
+        "/readings/1/receptors/1",
         "unknown receptor \"haze-far\"",
     );
-    expect_input_error(&fixture("bad-unknown-status.json"), "reference_index.status", "verified, secondary, assumed");
-    expect_input_error(&fixture("bad-circle.json"), "receptors[0].shape", "circular stops are not supported yet");
-    expect_input_error(&fixture("bad-unknown-field.json"), "source.in_plane", "unknown field");
-    expect_input_error(&fixture("bad-below-horizon.json"), "receptors[0].offset_deg", "below");
-    expect_input_error(&fixture("bad-empty-source.json"), "angle_deg.source", "must not be empty");
+    expect_input_error(&fixture("bad-unknown-status.json"), "/reference_index/status", "verified, secondary, assumed");
+    expect_input_error(&fixture("bad-circle.json"), "/receptors/0/shape", "circular stops are not supported yet");
+    expect_input_error(&fixture("bad-unknown-field.json"), "/source/in_plane", "unknown field");
+    expect_input_error(&fixture("bad-below-horizon.json"), "/receptors/0/offset_deg", "below");
+    expect_input_error(&fixture("bad-empty-source.json"), "/angle_deg/source", "must not be empty");
     // Issue 8: a composite naming an unknown id was an error with neither file nor field; a user file could
     // take a shipped id.
     expect_input_error(
         &fixture("bad-composite-unknown-part.json"),
-        "readings[0].minuend",
+        "/readings/0/minuend",
         "\"astm-d523-61\" is not a shipped non-composite geometry id",
     );
-    expect_input_error(&fixture("bad-shipped-id.json"), "id", "is the id of a shipped geometry");
+    expect_input_error(&fixture("bad-shipped-id.json"), "/id", "is the id of a shipped geometry");
 }
 
 #[test]
@@ -268,16 +268,16 @@ fn range_checks() {
         Ok(_) => "accepted".to_string(),
         Err(e) => panic!("{e}"),
     };
-    assert_eq!(field(with("\"value\": 89", "\"value\": 90")), "angle_deg.value");
-    assert_eq!(field(with("\"value\": 89", "\"value\": 0")), "angle_deg.value");
-    assert_eq!(field(with("\"value\": 1.567", "\"value\": 2.1")), "reference_index.value");
+    assert_eq!(field(with("\"value\": 89", "\"value\": 90")), "/angle_deg/value");
+    assert_eq!(field(with("\"value\": 89", "\"value\": 0")), "/angle_deg/value");
+    assert_eq!(field(with("\"value\": 1.567", "\"value\": 2.1")), "/reference_index/value");
     assert_eq!(field(with("\"value\": 1.567", "\"value\": 1.3")), "accepted");
-    assert_eq!(field(with("\"value\": 0.5,", "\"value\": 20,")), "source.in_plane_deg.value");
-    assert_eq!(field(with("\"value\": 0.5,", "\"value\": 0,")), "source.in_plane_deg.value");
-    assert_eq!(field(with("\"status\": \"assumed\"", "\"status\": \"guess\"")), "angle_deg.status");
-    assert_eq!(field(with("\"quantity\": \"gloss\"", "\"quantity\": \"sheen\"")), "readings[0].quantity");
+    assert_eq!(field(with("\"value\": 0.5,", "\"value\": 20,")), "/source/in_plane_deg/value");
+    assert_eq!(field(with("\"value\": 0.5,", "\"value\": 0,")), "/source/in_plane_deg/value");
+    assert_eq!(field(with("\"status\": \"assumed\"", "\"status\": \"guess\"")), "/angle_deg/status");
+    assert_eq!(field(with("\"quantity\": \"gloss\"", "\"quantity\": \"sheen\"")), "/readings/0/quantity");
     let missing_readings = standards::parse(&base.replacen("\"readings\"", "\"readingz\"", 1), "t.json");
-    assert_eq!(field(missing_readings), "readingz");
+    assert_eq!(field(missing_readings), "/readingz");
 }
 
 /// Scales as data (issue 9 item 1): every shipped non-composite geometry states its scale; a user file may
@@ -321,16 +321,16 @@ fn scales_are_data_and_user_files_choose() {
         Err(e) => panic!("{e}"),
     };
     let (f, m) = field(with_scale(serde_json::json!({"kind": "paper", "assigned_gu": sourced(1.0)}), false));
-    assert_eq!(f, "scale.kind");
+    assert_eq!(f, "/scale/kind");
     assert!(m.contains("unknown scale kind") && m.contains("black-glass, mirror"), "{m}");
     let (f, m) = field(with_scale(glass, true));
-    assert_eq!(f, "reference_index");
+    assert_eq!(f, "/reference_index");
     assert!(m.contains("not both"), "{m}");
     let (f, _) = field(with_scale(serde_json::json!({"kind": "mirror"}), false));
-    assert_eq!(f, "scale.assigned_gu");
+    assert_eq!(f, "/scale/assigned_gu");
     let mut none = v.clone();
     none.as_object_mut().unwrap().remove("reference_index");
     let (f, m) = field(standards::parse(&none.to_string(), "t.json"));
-    assert_eq!(f, "scale");
+    assert_eq!(f, "/scale");
     assert!(m.contains("missing"), "{m}");
 }

@@ -27,6 +27,7 @@ use crate::optics::microfacet::{Distribution, Microfacet, Shadowing};
 use crate::optics::tabulated::ChebTable;
 use crate::optics::thin_film::{stack, FilmLayer};
 use crate::quadrature::gauss_legendre;
+use crate::registry::{self as reg, Param, Range};
 use crate::spectrum::Sampling;
 use crate::{Error, Result, Vec3};
 use num_complex::Complex64;
@@ -122,9 +123,10 @@ pub enum Spread {
 }
 
 impl Spread {
-    /// Largest accepted spread angle in degrees, and the slope it corresponds to (tan 60° = 1.732).
-    pub const MAX_DEG: f64 = 60.0;
-    pub const MAX_SLOPE: f64 = 1.732;
+    /// Largest accepted spread angle in degrees, and the slope it corresponds to (tan 60° = 1.732); the
+    /// registry's ranges (`crate::registry::SPREAD_DEG_RANGE`, `SPREAD_SLOPE_RANGE`).
+    pub const MAX_DEG: f64 = reg::SPREAD_DEG_RANGE.hi;
+    pub const MAX_SLOPE: f64 = reg::SPREAD_SLOPE_RANGE.hi;
 
     /// The Beckmann rms slope m.
     pub fn slope(self) -> f64 {
@@ -134,10 +136,11 @@ impl Spread {
         }
     }
 
-    fn check(self, what: &str) -> Result<()> {
+    /// Check against the registry entries of the two forms.
+    fn check(self, deg: &Param, slope: &Param) -> Result<()> {
         match self {
-            Spread::Degrees(d) => check_range(&format!("{what} spread (deg)"), d, 0.0, Self::MAX_DEG),
-            Spread::Slope(m) => check_range(&format!("{what} spread slope"), m, 0.0, Self::MAX_SLOPE),
+            Spread::Degrees(d) => check_range(deg, d),
+            Spread::Slope(m) => check_range(slope, m),
         }
     }
 }
@@ -337,20 +340,25 @@ fn usage(msg: impl Into<String>) -> Error {
     Error::Usage(format!("paint: {}", msg.into()))
 }
 
-fn check_range(what: &str, v: f64, lo: f64, hi: f64) -> Result<()> {
-    if v.is_finite() && v >= lo && v <= hi {
+/// `v` against the range of registry entry `p`; the message names the entry's JSON Pointer.
+fn check_range(p: &Param, v: f64) -> Result<()> {
+    check_in(p.pointer, v, p.range())
+}
+
+fn check_in(what: &str, v: f64, r: Range) -> Result<()> {
+    if r.contains(v) {
         Ok(())
     } else {
-        Err(usage(format!("{what} = {v} must be a finite number in [{lo}, {hi}]")))
+        Err(usage(format!("{what} = {v} must be a finite number {}", r.describe())))
     }
 }
 
-fn check_spectral(what: &str, v: &[f64], n: usize, lo: f64, hi: f64) -> Result<()> {
+fn check_spectral(p: &Param, v: &[f64], n: usize) -> Result<()> {
     if v.len() != n {
-        return Err(usage(format!("{what} has {} values; the sampling has {n}", v.len())));
+        return Err(usage(format!("{} has {} values; the sampling has {n}", p.pointer, v.len())));
     }
     for (i, &x) in v.iter().enumerate() {
-        check_range(&format!("{what}[{i}]"), x, lo, hi)?;
+        check_in(&format!("{}/{i}", p.pointer), x, p.range())?;
     }
     Ok(())
 }
@@ -367,35 +375,37 @@ impl Paint {
         if n == 0 || n > MAX_SAMPLES {
             return Err(usage(format!("{n} spectral samples; a paint takes 1 to {MAX_SAMPLES}")));
         }
+        // The ranges are the registry's (`crate::registry`), the same the recipe parser checks.
         let c = &spec.coat;
-        check_range("clear coat index", c.index, 1.3, 1.8)?;
-        check_range("clear coat thickness (µm)", c.thickness_um, 0.0, f64::INFINITY)?;
-        check_range("clear coat roughness", c.roughness, 0.0, 1.0)?;
+        check_range(&reg::COAT_INDEX, c.index)?;
+        check_range(&reg::COAT_THICKNESS, c.thickness_um)?;
+        check_range(&reg::COAT_ROUGHNESS, c.roughness)?;
         let l = &spec.layer;
-        check_range("pigmented layer thickness (mm)", l.thickness_mm, 0.0, f64::INFINITY)?;
-        check_spectral("primer reflectance", &l.primer_reflectance, n, 0.0, 1.0)?;
+        check_range(&reg::LAYER_THICKNESS, l.thickness_mm)?;
+        check_spectral(&reg::LAYER_PRIMER, &l.primer_reflectance, n)?;
         for p in &l.pigments {
-            check_range("pigment concentration", p.concentration, 0.0, f64::INFINITY)?;
-            check_spectral("pigment K (per mm)", &p.k_per_mm, n, 0.0, f64::INFINITY)?;
-            check_spectral("pigment S (per mm)", &p.s_per_mm, n, 0.0, f64::INFINITY)?;
+            check_range(&reg::PIGMENT_CONCENTRATION, p.concentration)?;
+            check_spectral(&reg::PIGMENT_K, &p.k_per_mm, n)?;
+            check_spectral(&reg::PIGMENT_S, &p.s_per_mm, n)?;
         }
         let am = spec.metallic.as_ref().map_or(0.0, |m| m.area_ratio);
         let ap = spec.pearlescent.as_ref().map_or(0.0, |p| p.area_ratio);
+        let depth = |p: &Param, d: f64| check_in(p.pointer, d, Range::closed(0.0, l.thickness_mm));
         if let Some(m) = &spec.metallic {
-            check_spectral("metallic flake n", &m.n, n, 1e-3, 100.0)?;
-            check_spectral("metallic flake k", &m.k, n, 0.0, 100.0)?;
-            m.spread.check("metallic flake")?;
-            check_range("metallic flake area ratio", m.area_ratio, 0.0, 1.0)?;
-            check_range("metallic flake depth (mm)", m.depth_mm, 0.0, l.thickness_mm)?;
+            check_spectral(&reg::METALLIC_N, &m.n, n)?;
+            check_spectral(&reg::METALLIC_K, &m.k, n)?;
+            m.spread.check(&reg::METALLIC_SPREAD, &reg::METALLIC_SPREAD_SLOPE)?;
+            check_range(&reg::METALLIC_AREA, m.area_ratio)?;
+            depth(&reg::METALLIC_DEPTH, m.depth_mm)?;
         }
         if let Some(p) = &spec.pearlescent {
-            p.spread.check("pearlescent flake")?;
-            check_range("pearlescent flake area ratio", p.area_ratio, 0.0, 1.0)?;
-            check_range("pearlescent flake depth (mm)", p.depth_mm, 0.0, l.thickness_mm)?;
-            check_range("TiO2 thickness (nm)", p.tio2_thickness_nm, 0.0, 1e5)?;
-            check_range("TiO2 index", p.tio2_index, 1.0, 4.0)?;
-            check_range("mica thickness (nm)", p.mica_thickness_nm, 0.0, 1e6)?;
-            check_range("mica index", p.mica_index, 1.0, 3.0)?;
+            p.spread.check(&reg::PEARL_SPREAD, &reg::PEARL_SPREAD_SLOPE)?;
+            check_range(&reg::PEARL_AREA, p.area_ratio)?;
+            depth(&reg::PEARL_DEPTH, p.depth_mm)?;
+            check_range(&reg::PEARL_TIO2_THICKNESS, p.tio2_thickness_nm)?;
+            check_range(&reg::PEARL_TIO2_INDEX, p.tio2_index)?;
+            check_range(&reg::PEARL_MICA_THICKNESS, p.mica_thickness_nm)?;
+            check_range(&reg::PEARL_MICA_INDEX, p.mica_index)?;
         }
         if am + ap > 1.0 {
             return Err(usage(format!("area ratios Am + Ap = {} exceed 1", am + ap)));

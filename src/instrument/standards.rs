@@ -118,7 +118,7 @@ fn parse_builtin() -> Result<Vec<StandardGeometry>> {
             ));
         }
         if out.iter().any(|o: &StandardGeometry| o.geometry.id == g.geometry.id) {
-            return Err(Error::input(label, "id", format!("duplicate id \"{}\"", g.geometry.id)));
+            return Err(Error::input(label, "/id", format!("duplicate id \"{}\"", g.geometry.id)));
         }
         g.origin = "builtin".to_string();
         out.push(g);
@@ -131,7 +131,7 @@ fn parse_builtin() -> Result<Vec<StandardGeometry>> {
                     if !ok {
                         return Err(Error::input(
                             format!("<builtin:{}.json>", g.geometry.id),
-                            format!("readings[{i}].{key}"),
+                            format!("/readings/{i}/{key}"),
                             format!("\"{id}\" is not a builtin non-composite geometry id; known: {}", ids(&out)),
                         ));
                     }
@@ -172,7 +172,7 @@ pub fn check_user(g: &StandardGeometry, shipped: &[StandardGeometry]) -> Result<
     if shipped.iter().any(|s| &s.geometry.id == id) {
         return Err(Error::input(
             &g.origin,
-            "id",
+            "/id",
             format!("\"{id}\" is the id of a shipped geometry; give a user geometry an id of its own"),
         ));
     }
@@ -182,7 +182,7 @@ pub fn check_user(g: &StandardGeometry, shipped: &[StandardGeometry]) -> Result<
                 if !shipped.iter().any(|o| &o.geometry.id == part && !o.geometry.is_composite()) {
                     return Err(Error::input(
                         &g.origin,
-                        format!("readings[{i}].{key}"),
+                        format!("/readings/{i}/{key}"),
                         format!("\"{part}\" is not a shipped non-composite geometry id; known: {}", ids(shipped)),
                     ));
                 }
@@ -216,7 +216,7 @@ pub fn parse(text: &str, origin: &str) -> Result<StandardGeometry> {
     }
     let mut quantities = Vec::with_capacity(readings_v.len());
     for (i, v) in readings_v.iter().enumerate() {
-        let r = Obj::new(origin, format!("readings[{i}]"), v)?;
+        let r = Obj::new(origin, format!("/readings/{i}"), v)?;
         quantities.push(r.str("quantity")?);
     }
     let composite = quantities.contains(&"haze-index");
@@ -225,7 +225,7 @@ pub fn parse(text: &str, origin: &str) -> Result<StandardGeometry> {
         if let Some(i) = quantities.iter().position(|q| *q != "haze-index") {
             return Err(Error::input(
                 origin,
-                format!("readings[{i}].quantity"),
+                format!("/readings/{i}/quantity"),
                 "a composite geometry (one with haze-index readings) may only have haze-index readings",
             ));
         }
@@ -259,7 +259,7 @@ pub fn parse(text: &str, origin: &str) -> Result<StandardGeometry> {
         }
         let mut receptors: Vec<(String, Stop)> = Vec::with_capacity(rec_v.len());
         for (i, v) in rec_v.iter().enumerate() {
-            let r = Obj::new(origin, format!("receptors[{i}]"), v)?;
+            let r = Obj::new(origin, format!("/receptors/{i}"), v)?;
             let name = nonempty_str(&r, "name")?;
             if receptors.iter().any(|(n, _)| *n == name) {
                 return Err(r.err("name", format!("duplicate receptor name \"{name}\"")));
@@ -290,7 +290,7 @@ pub fn parse(text: &str, origin: &str) -> Result<StandardGeometry> {
     let mut readings = Vec::with_capacity(readings_v.len());
     let mut reading_names: Vec<String> = Vec::with_capacity(readings_v.len());
     for (i, v) in readings_v.iter().enumerate() {
-        let r = Obj::new(origin, format!("readings[{i}]"), v)?;
+        let r = Obj::new(origin, format!("/readings/{i}"), v)?;
         let (spec, name) = reading(&r, &names, id)?;
         let display = name.unwrap_or_else(|| spec.quantity().to_string());
         if reading_names.contains(&display) {
@@ -379,11 +379,7 @@ fn string_list(o: &Obj, key: &str) -> Result<Vec<String>> {
         .enumerate()
         .map(|(i, v)| match v.as_str() {
             Some(s) if !s.trim().is_empty() => Ok(s.to_string()),
-            _ => Err(Error::input(
-                o.file,
-                format!("{}[{i}]", o.field(key)),
-                format!("expected a non-empty string, got {}", kind(v)),
-            )),
+            _ => Err(Error::input(o.file, o.element(key, i), format!("expected a non-empty string, got {}", kind(v)))),
         })
         .collect()
 }
@@ -397,7 +393,7 @@ fn receptor_ref(o: &Obj, key: &str, names: &[&str]) -> Result<String> {
 fn receptor_list(o: &Obj, key: &str, names: &[&str]) -> Result<Vec<String>> {
     let list = string_list(o, key)?;
     for (i, s) in list.iter().enumerate() {
-        check_receptor(o, &format!("{}[{i}]", o.field(key)), s, names)?;
+        check_receptor(o, &o.element(key, i), s, names)?;
     }
     Ok(list)
 }

@@ -1,17 +1,22 @@
-//! Typed access to JSON fields with errors that name the file, the field path and what is allowed.
+//! Typed access to JSON fields with errors that name the file, the field and what is allowed.
 //! Every recipe and geometry parser goes through this, so every bad value is reported the same way.
+//! Fields are named by RFC 6901 JSON Pointers (`/lobes/0/ks/2`), which can be pasted into a command; recipe
+//! parameters are read through their [`crate::registry`] entry (`Obj::param`), which supplies the key, the
+//! range and the description.
+use crate::registry::{self, Param, Range};
 use crate::{Error, Result};
 use serde_json::{Map, Value};
 
-/// A JSON object being read, with the file name and the path of the object inside the file.
+/// A JSON object being read, with the file name and the JSON Pointer of the object inside the file.
 pub struct Obj<'a> {
     pub file: &'a str,
+    /// RFC 6901 pointer of this object (`""` for the root).
     pub path: String,
     pub map: &'a Map<String, Value>,
 }
 
 impl<'a> Obj<'a> {
-    /// View `v` as an object at `path` (empty for the root).
+    /// View `v` as an object at the JSON Pointer `path` (empty for the root).
     pub fn new(file: &'a str, path: impl Into<String>, v: &'a Value) -> Result<Self> {
         let path = path.into();
         match v.as_object() {
@@ -20,13 +25,14 @@ impl<'a> Obj<'a> {
         }
     }
 
-    /// Full path of a child field.
+    /// JSON Pointer of a child field (the key escaped per RFC 6901).
     pub fn field(&self, key: &str) -> String {
-        if self.path.is_empty() {
-            key.to_string()
-        } else {
-            format!("{}.{key}", self.path)
-        }
+        registry::child(&self.path, key)
+    }
+
+    /// JSON Pointer of element `i` of the array at `key`.
+    pub fn element(&self, key: &str, i: usize) -> String {
+        format!("{}/{i}", self.field(key))
     }
 
     pub fn err(&self, key: &str, message: impl Into<String>) -> Error {
@@ -42,7 +48,7 @@ impl<'a> Obj<'a> {
                     let at = if self.path.is_empty() { "the top level" } else { self.path.as_str() };
                     return Err(Error::input(
                         self.file,
-                        self.field("\"\""),
+                        self.field(""),
                         format!("an empty key \"\" at {at} is not a field; allowed here: {}", allowed.join(", ")),
                     ));
                 }
@@ -50,6 +56,51 @@ impl<'a> Obj<'a> {
             }
         }
         Ok(())
+    }
+
+    /// Refuse any key that the registry does not list at this object's pointer for `model`.
+    pub fn deny_unknown_in(&self, model: &str) -> Result<()> {
+        let allowed = registry::children(model, &self.path);
+        let allowed: Vec<&str> = allowed.iter().map(String::as_str).collect();
+        self.deny_unknown(&allowed)
+    }
+
+    /// The key of `p` after checking that `p` names a child of this object (a parser reading an entry at
+    /// the wrong place is a bug, caught by every test that loads a recipe).
+    fn key_of(&self, p: &Param) -> String {
+        let key = p.key();
+        debug_assert!(p.matches(&self.field(&key)), "registry entry {} read at {}", p.pointer, self.field(&key));
+        key
+    }
+
+    /// A required number of the registry entry `p`, within its range.
+    pub fn param(&self, p: &Param) -> Result<f64> {
+        let key = self.key_of(p);
+        let v = self.required(&key)?;
+        param_number(self.file, &self.field(&key), v, p)
+    }
+
+    /// An optional number of the registry entry `p`.
+    pub fn opt_param(&self, p: &Param) -> Result<Option<f64>> {
+        let key = self.key_of(p);
+        self.get(&key).map(|v| param_number(self.file, &self.field(&key), v, p)).transpose()
+    }
+
+    /// The array of numbers of entry `p`, each within its range; of length `len` if given.
+    pub fn param_array(&self, p: &Param, len: Option<usize>) -> Result<Vec<f64>> {
+        let key = self.key_of(p);
+        let a = self.array(&key)?;
+        if let Some(n) = len {
+            if a.len() != n {
+                return Err(self.err(&key, format!("expected {n} values, got {}", a.len())));
+            }
+        }
+        a.iter().enumerate().map(|(i, v)| param_number(self.file, &self.element(&key, i), v, p)).collect()
+    }
+
+    /// The registry entry `p` as a key of this object (for values read by hand, e.g. colours).
+    pub fn param_key(&self, p: &Param) -> String {
+        self.key_of(p)
     }
 
     pub fn get(&self, key: &str) -> Option<&'a Value> {
@@ -103,27 +154,53 @@ impl<'a> Obj<'a> {
                 return Err(self.err(key, format!("expected {n} values, got {}", a.len())));
             }
         }
-        a.iter()
-            .enumerate()
-            .map(|(i, v)| number(self.file, &format!("{}[{i}]", self.field(key)), v, lo, hi, what))
-            .collect()
+        a.iter().enumerate().map(|(i, v)| number(self.file, &self.element(key, i), v, lo, hi, what)).collect()
     }
 }
 
 /// Check that `v` is a finite number in [lo, hi]. JSON has no NaN, but a string "NaN" or a huge exponent
 /// (which parses to infinity) must be refused too.
 pub fn number(file: &str, path: &str, v: &Value, lo: f64, hi: f64, what: &str) -> Result<f64> {
+    let range = if hi.is_infinite() { Range::at_least(lo) } else { Range::closed(lo, hi) };
+    number_in(file, path, v, range, what)
+}
+
+/// Check that `v` is a finite number in `range`.
+pub fn number_in(file: &str, path: &str, v: &Value, range: Range, what: &str) -> Result<f64> {
     let x = match v {
         Value::Number(n) => n.as_f64(),
         _ => None,
     };
-    let range = if hi.is_infinite() { format!("≥ {lo}") } else { format!("in [{lo}, {hi}]") };
+    let allowed = range.describe();
     match x {
-        Some(x) if x.is_finite() && x >= lo && x <= hi => Ok(x),
+        Some(x) if range.contains(x) => Ok(x),
         Some(x) if x.is_finite() => {
-            Err(Error::input(file, path, format!("{} is out of range: {what} must be {range}", show(x))))
+            Err(Error::input(file, path, format!("{} is out of range: {what} must be {allowed}", show(x))))
         }
-        _ => Err(Error::input(file, path, format!("expected a finite number ({what}, {range}), got {}", kind(v)))),
+        _ => Err(Error::input(file, path, format!("expected a finite number ({what}, {allowed}), got {}", kind(v)))),
+    }
+}
+
+/// Check that `v` is a finite number in the range of registry entry `p` (message from its description).
+pub fn param_number(file: &str, path: &str, v: &Value, p: &Param) -> Result<f64> {
+    let range = p.range();
+    let allowed = range.describe();
+    let allowed = allowed.trim_start_matches("in ");
+    match v {
+        Value::Number(n) => match n.as_f64() {
+            Some(x) if range.contains(x) => Ok(x),
+            Some(x) if x.is_finite() => Err(Error::input(
+                file,
+                path,
+                format!("{} is out of range; allowed: {allowed} ({})", show(x), p.description),
+            )),
+            _ => Err(Error::input(file, path, format!("{n} is not a finite number; allowed: {allowed}"))),
+        },
+        _ => Err(Error::input(
+            file,
+            path,
+            format!("expected a finite number {allowed} ({}), got {}", p.description, kind(v)),
+        )),
     }
 }
 
@@ -185,8 +262,7 @@ struct NoDuplicates<'a> {
 
 impl NoDuplicates<'_> {
     fn child(&self, key: &str) -> Self {
-        let path = if self.path.is_empty() { key.to_string() } else { format!("{}.{key}", self.path) };
-        NoDuplicates { path, duplicate: self.duplicate }
+        NoDuplicates { path: registry::child(&self.path, key), duplicate: self.duplicate }
     }
 }
 
@@ -223,7 +299,7 @@ impl<'de> serde::de::Visitor<'de> for NoDuplicates<'_> {
     fn visit_seq<A: serde::de::SeqAccess<'de>>(self, mut a: A) -> std::result::Result<(), A::Error> {
         let mut i = 0;
         while a
-            .next_element_seed(NoDuplicates { path: format!("{}[{i}]", self.path), duplicate: self.duplicate })?
+            .next_element_seed(NoDuplicates { path: format!("{}/{i}", self.path), duplicate: self.duplicate })?
             .is_some()
         {
             i += 1;
@@ -250,9 +326,9 @@ mod tests {
     #[test]
     fn duplicate_keys_are_refused_with_their_path() {
         let e = parse_json(r#"{"model": "lambert", "albedo": 0.5, "albedo": 0.9}"#, "r.json").unwrap_err().to_string();
-        assert!(e.contains("r.json") && e.contains("`albedo`") && e.contains("twice"), "{e}");
+        assert!(e.contains("r.json") && e.contains("`/albedo`") && e.contains("twice"), "{e}");
         let e = parse_json(r#"{"a": [{"k": 1}, {"k": 2, "k": 3}]}"#, "r.json").unwrap_err().to_string();
-        assert!(e.contains("`a[1].k`"), "{e}");
+        assert!(e.contains("`/a/1/k`"), "{e}");
         assert!(parse_json(r#"{"a": {"k": 1}, "b": {"k": 2}}"#, "r.json").is_ok(), "same key in two objects");
     }
 
@@ -265,7 +341,7 @@ mod tests {
     fn an_empty_key_is_named() {
         let v = parse_json(r#"{"": 1}"#, "r.json").unwrap();
         let e = Obj::new("r.json", "", &v).unwrap().deny_unknown(&["model"]).unwrap_err().to_string();
-        assert!(e.contains("empty key") && e.contains("field `\"\"`"), "{e}");
+        assert!(e.contains("empty key") && e.contains("field `/`"), "{e}");
     }
 
     #[test]

@@ -2,7 +2,7 @@
 //! path from the recipe. A relative path is resolved against the recipe file's directory, so that a recipe
 //! and its table can be moved together; for a label that is not a path (`<stdin>`, `<builtin:…>`) against
 //! the current directory.
-use super::{with_meta, Obj};
+use super::Obj;
 use crate::brdf::measured::{Interpolation, MerlBrdf};
 use crate::brdf::Brdf;
 use crate::{Error, Result};
@@ -23,12 +23,12 @@ pub fn resolve(recipe_file: &str, file: &str) -> PathBuf {
 
 /// `{"model": "merl", "file": "…", "interpolation": "nearest" | "trilinear"}`.
 pub fn parse_merl(obj: &Obj) -> Result<Arc<dyn Brdf>> {
-    obj.deny_unknown(&with_meta(&["file", "interpolation"]))?;
-    let file = obj.str("file")?;
+    obj.deny_unknown_in("merl")?;
+    let file = obj.str(&obj.param_key(&crate::registry::MERL_FILE))?;
     if file.is_empty() {
         return Err(obj.err("file", "empty path; expected the path of a MERL .binary table"));
     }
-    let interpolation = match obj.opt_str("interpolation")? {
+    let interpolation = match obj.opt_str(&obj.param_key(&crate::registry::MERL_INTERPOLATION))? {
         None | Some("nearest") => Interpolation::Nearest,
         Some("trilinear") => Interpolation::Trilinear,
         Some(other) => {

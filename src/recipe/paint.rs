@@ -9,7 +9,8 @@ use crate::brdf::paint::{
 use crate::brdf::Brdf;
 use crate::optics::kubelka_munk::invert_white_black;
 use crate::optics::microfacet::Distribution;
-use crate::recipe::fields::{kind, number, Obj};
+use crate::recipe::fields::{kind, param_number, Obj};
+use crate::registry::{self as reg, Param};
 use crate::spectrum::Sampling;
 use crate::{Error, Result};
 use serde_json::Value;
@@ -21,17 +22,7 @@ pub const DEFAULT_TIO2_INDEX: f64 = 2.5;
 /// Default mica (muscovite) index: n ≈ 1.55–1.61 (CRC Handbook); Pfaff & Reynders, Chem. Rev. 99, 1963 (1999).
 pub const DEFAULT_MICA_INDEX: f64 = 1.58;
 
-/// Root fields of a paint recipe besides the descriptive ones (`crate::recipe::META_FIELDS`).
-const ROOT_FIELDS: &[&str] = &[
-    "form",
-    "flake_light",
-    "internal_reflection",
-    "wavelengths_nm",
-    "clear_coat",
-    "pigmented_layer",
-    "metallic_flakes",
-    "pearlescent_flakes",
-];
+const PAINT: &str = "paint";
 
 /// Parse a paint recipe (the root object of the file) into a validated BRDF.
 pub fn parse_paint(obj: &Obj) -> Result<Arc<dyn Brdf>> {
@@ -42,8 +33,7 @@ pub fn parse_paint(obj: &Obj) -> Result<Arc<dyn Brdf>> {
 
 /// Parse a paint recipe into its [`PaintSpec`] (validated field by field).
 pub fn parse_paint_spec(obj: &Obj) -> Result<PaintSpec> {
-    let allowed: Vec<&str> = crate::recipe::META_FIELDS.iter().chain(ROOT_FIELDS).copied().collect();
-    obj.deny_unknown(&allowed)?;
+    obj.deny_unknown_in(PAINT)?;
     if let Some(m) = obj.opt_str("model")? {
         if m != "paint" {
             return Err(obj.err("model", format!("expected \"paint\", got \"{m}\"")));
@@ -78,7 +68,7 @@ pub fn parse_paint_spec(obj: &Obj) -> Result<PaintSpec> {
     let sampling = match obj.get("wavelengths_nm") {
         None => Sampling::rgb(),
         Some(_) => {
-            let wl = obj.num_array("wavelengths_nm", None, 360.0, 830.0, "wavelength in nm")?;
+            let wl = obj.param_array(&reg::PAINT_WAVELENGTHS, None)?;
             if wl.len() > MAX_SAMPLES {
                 return Err(
                     obj.err("wavelengths_nm", format!("{} wavelengths; at most {MAX_SAMPLES} allowed", wl.len()))
@@ -97,10 +87,10 @@ pub fn parse_paint_spec(obj: &Obj) -> Result<PaintSpec> {
     let am = metallic.as_ref().map_or(0.0, |m| m.area_ratio);
     let ap = pearlescent.as_ref().map_or(0.0, |p| p.area_ratio);
     if am + ap > 1.0 {
-        let what = if pearlescent.is_some() { "pearlescent_flakes.area_ratio" } else { "metallic_flakes.area_ratio" };
+        let what = if pearlescent.is_some() { reg::PEARL_AREA.pointer } else { reg::METALLIC_AREA.pointer };
         return Err(Error::input(
             obj.file,
-            obj.field(what),
+            what,
             format!("metallic + pearlescent area ratios Am + Ap = {am} + {ap} = {} exceed 1 (the flakes and the pigmented layer share the visible area)", am + ap),
         ));
     }
@@ -108,13 +98,11 @@ pub fn parse_paint_spec(obj: &Obj) -> Result<PaintSpec> {
 }
 
 fn parse_coat(o: &Obj) -> Result<ClearCoat> {
-    o.deny_unknown(&["index", "thickness_um", "roughness", "distribution", "notes"])?;
+    o.deny_unknown_in(PAINT)?;
     notes(o)?;
-    let index = o.num("index", 1.3, 1.8, "clear-coat refractive index")?;
-    let thickness_um = o.opt_num("thickness_um", 0.0, f64::INFINITY, "clear-coat thickness in µm")?.unwrap_or(0.0);
-    let roughness = o
-        .opt_num("roughness", 0.0, 1.0, "clear-coat roughness (Beckmann rms slope or GGX α; 0 = smooth)")?
-        .unwrap_or(0.0);
+    let index = o.param(&reg::COAT_INDEX)?;
+    let thickness_um = o.opt_param(&reg::COAT_THICKNESS)?.unwrap_or(0.0);
+    let roughness = o.opt_param(&reg::COAT_ROUGHNESS)?.unwrap_or(0.0);
     let distribution = match o.opt_str("distribution")? {
         None | Some("beckmann") => Distribution::Beckmann,
         Some("ggx") => Distribution::Ggx,
@@ -129,23 +117,24 @@ fn parse_coat(o: &Obj) -> Result<ClearCoat> {
 }
 
 fn parse_layer(o: &Obj, n: usize) -> Result<PigmentedLayer> {
-    o.deny_unknown(&["thickness_mm", "primer_reflectance", "pigments", "notes"])?;
+    o.deny_unknown_in(PAINT)?;
     notes(o)?;
-    let thickness_mm = o.num("thickness_mm", 0.0, f64::INFINITY, "pigmented-layer thickness X in mm")?;
-    let primer_reflectance = o.num_array("primer_reflectance", Some(n), 0.0, 1.0, "primer reflectance Rg")?;
+    let thickness_mm = o.param(&reg::LAYER_THICKNESS)?;
+    let primer_reflectance = o.param_array(&reg::LAYER_PRIMER, Some(n))?;
     let mut pigments = Vec::new();
-    for (i, v) in o.array("pigments")?.iter().enumerate() {
-        let p = Obj::new(o.file, format!("{}[{i}]", o.field("pigments")), v)?;
+    let key = o.param_key(&reg::LAYER_PIGMENTS);
+    for (i, v) in o.array(&key)?.iter().enumerate() {
+        let p = Obj::new(o.file, o.element(&key, i), v)?;
         pigments.push(parse_pigment(&p, n, i)?);
     }
     Ok(PigmentedLayer { thickness_mm, primer_reflectance, pigments })
 }
 
 fn parse_pigment(o: &Obj, n: usize, i: usize) -> Result<Pigment> {
-    o.deny_unknown(&["name", "concentration", "k_per_mm", "s_per_mm", "measured", "notes"])?;
+    o.deny_unknown_in(PAINT)?;
     notes(o)?;
     let name = opt_string(o, "name")?.unwrap_or_else(|| format!("pigment {i}"));
-    let concentration = o.num("concentration", 0.0, f64::INFINITY, "pigment concentration C")?;
+    let concentration = o.param(&reg::PIGMENT_CONCENTRATION)?;
     let has_ks = o.get("k_per_mm").is_some() || o.get("s_per_mm").is_some();
     let (k_per_mm, s_per_mm) = match (has_ks, o.opt_obj("measured")?) {
         (true, Some(_)) => {
@@ -156,10 +145,7 @@ fn parse_pigment(o: &Obj, n: usize, i: usize) -> Result<Pigment> {
                 o.err("k_per_mm", "missing: give `k_per_mm` and `s_per_mm` (per mm, one per sample) or `measured`")
             );
         }
-        (true, None) => (
-            o.num_array("k_per_mm", Some(n), 0.0, f64::INFINITY, "absorption K per mm")?,
-            o.num_array("s_per_mm", Some(n), 0.0, f64::INFINITY, "scattering S per mm")?,
-        ),
+        (true, None) => (o.param_array(&reg::PIGMENT_K, Some(n))?, o.param_array(&reg::PIGMENT_S, Some(n))?),
         (false, Some(m)) => parse_measured(&m, n)?,
     };
     Ok(Pigment { name, concentration, k_per_mm, s_per_mm })
@@ -167,12 +153,12 @@ fn parse_pigment(o: &Obj, n: usize, i: usize) -> Result<Pigment> {
 
 /// K and S from a drawdown of thickness X over white and over black (paper §5.2, Curtis et al. 1997 §4).
 fn parse_measured(m: &Obj, n: usize) -> Result<(Vec<f64>, Vec<f64>)> {
-    m.deny_unknown(&["thickness_mm", "over_white", "over_black", "white_background", "notes"])?;
+    m.deny_unknown_in(PAINT)?;
     notes(m)?;
-    let x = m.num("thickness_mm", f64::MIN_POSITIVE, f64::INFINITY, "drawdown thickness in mm (> 0)")?;
-    let rw = m.num_array("over_white", Some(n), 0.0, 1.0, "reflectance over the white background")?;
-    let rb = m.num_array("over_black", Some(n), 0.0, 1.0, "reflectance over the black background")?;
-    let wb = spectral_or_scalar(m, "white_background", n, 0.0, 1.0, "white-background reflectance")?;
+    let x = m.param(&reg::MEASURED_THICKNESS)?;
+    let rw = m.param_array(&reg::MEASURED_OVER_WHITE, Some(n))?;
+    let rb = m.param_array(&reg::MEASURED_OVER_BLACK, Some(n))?;
+    let wb = spectral_or_scalar(m, &reg::MEASURED_WHITE_BACKGROUND, n)?;
     let mut k = Vec::with_capacity(n);
     let mut s = Vec::with_capacity(n);
     for j in 0..n {
@@ -191,83 +177,74 @@ fn parse_measured(m: &Obj, n: usize) -> Result<(Vec<f64>, Vec<f64>)> {
 }
 
 fn parse_metallic(o: &Obj, n: usize, x: f64) -> Result<MetallicFlakes> {
-    o.deny_unknown(&["n", "k", "spread_deg", "spread_slope", "area_ratio", "depth_mm", "notes"])?;
+    o.deny_unknown_in(PAINT)?;
     notes(o)?;
-    let nn = spectral_or_scalar(o, "n", n, 1e-3, 100.0, "real part n of the metal's index")?;
-    let kk = spectral_or_scalar(o, "k", n, 0.0, 100.0, "extinction k of the metal's index")?;
-    let spread = spread(o)?;
-    let area_ratio = o.num("area_ratio", 0.0, 1.0, "visible area ratio Am")?;
-    let depth_mm = depth(o, x, "mean depth X' of the visible metallic flakes in mm")?;
+    let nn = spectral_or_scalar(o, &reg::METALLIC_N, n)?;
+    let kk = spectral_or_scalar(o, &reg::METALLIC_K, n)?;
+    let spread = spread(o, &reg::METALLIC_SPREAD, &reg::METALLIC_SPREAD_SLOPE)?;
+    let area_ratio = o.param(&reg::METALLIC_AREA)?;
+    let depth_mm = depth(o, x, &reg::METALLIC_DEPTH)?;
     Ok(MetallicFlakes { n: nn, k: kk, spread, area_ratio, depth_mm })
 }
 
 fn parse_pearl(o: &Obj, x: f64) -> Result<PearlescentFlakes> {
-    o.deny_unknown(&[
-        "spread_deg",
-        "spread_slope",
-        "area_ratio",
-        "depth_mm",
-        "tio2_thickness_nm",
-        "tio2_index",
-        "mica_thickness_nm",
-        "mica_index",
-        "notes",
-    ])?;
+    o.deny_unknown_in(PAINT)?;
     notes(o)?;
     Ok(PearlescentFlakes {
-        spread: spread(o)?,
-        area_ratio: o.num("area_ratio", 0.0, 1.0, "visible area ratio Ap")?,
-        depth_mm: depth(o, x, "mean depth X'' of the visible pearlescent flakes in mm")?,
-        tio2_thickness_nm: o.num("tio2_thickness_nm", 0.0, 1e5, "TiO2 film thickness in nm")?,
-        tio2_index: o.opt_num("tio2_index", 1.0, 4.0, "TiO2 refractive index")?.unwrap_or(DEFAULT_TIO2_INDEX),
-        mica_thickness_nm: o.num("mica_thickness_nm", 0.0, 1e6, "mica platelet thickness in nm")?,
-        mica_index: o.opt_num("mica_index", 1.0, 3.0, "mica refractive index")?.unwrap_or(DEFAULT_MICA_INDEX),
+        spread: spread(o, &reg::PEARL_SPREAD, &reg::PEARL_SPREAD_SLOPE)?,
+        area_ratio: o.param(&reg::PEARL_AREA)?,
+        depth_mm: depth(o, x, &reg::PEARL_DEPTH)?,
+        tio2_thickness_nm: o.param(&reg::PEARL_TIO2_THICKNESS)?,
+        tio2_index: o.opt_param(&reg::PEARL_TIO2_INDEX)?.unwrap_or(DEFAULT_TIO2_INDEX),
+        mica_thickness_nm: o.param(&reg::PEARL_MICA_THICKNESS)?,
+        mica_index: o.opt_param(&reg::PEARL_MICA_INDEX)?.unwrap_or(DEFAULT_MICA_INDEX),
     })
 }
 
-/// The flake spread: exactly one of `spread_deg` (an angle σ, m = tan σ) and `spread_slope` (the Beckmann rms
-/// slope m); `docs/model.md` §Two readings of the flake spread.
-fn spread(o: &Obj) -> Result<Spread> {
-    match (o.get("spread_deg").is_some(), o.get("spread_slope").is_some()) {
-        (true, false) => Ok(Spread::Degrees(o.num(
-            "spread_deg",
-            0.0,
-            Spread::MAX_DEG,
-            "flake orientation spread in degrees (m = tan σ)",
-        )?)),
-        (false, true) => Ok(Spread::Slope(o.num(
-            "spread_slope",
-            0.0,
-            Spread::MAX_SLOPE,
-            "flake orientation spread as the Beckmann rms slope m (dimensionless)",
-        )?)),
+/// The flake spread: exactly one of `spread_deg` (an angle σ, m = tan σ; entry `deg`) and `spread_slope` (the
+/// Beckmann rms slope m; entry `slope`); `docs/model.md` §Two readings of the flake spread.
+fn spread(o: &Obj, deg: &Param, slope: &Param) -> Result<Spread> {
+    let (kd, ks) = (o.param_key(deg), o.param_key(slope));
+    match (o.get(&kd).is_some(), o.get(&ks).is_some()) {
+        (true, false) => Ok(Spread::Degrees(o.param(deg)?)),
+        (false, true) => Ok(Spread::Slope(o.param(slope)?)),
         (true, true) => Err(o.err(
-            "spread_slope",
+            &ks,
             "give exactly one of `spread_deg` (an angle in degrees, m = tan σ) and `spread_slope` (the Beckmann rms slope m), not both",
         )),
         (false, false) => Err(o.err(
-            "spread_deg",
-            "missing: give exactly one of `spread_deg` (an angle in degrees, 0–60, m = tan σ) and `spread_slope` (the Beckmann rms slope m, 0–1.732)",
+            &kd,
+            format!(
+                "missing: give exactly one of `spread_deg` (an angle in degrees, {}, m = tan σ) and `spread_slope` (the Beckmann rms slope m, {})",
+                deg.range().describe_short().trim_start_matches("in "),
+                slope.range().describe_short().trim_start_matches("in ")
+            ),
         )),
     }
 }
 
-fn depth(o: &Obj, x: f64, what: &str) -> Result<f64> {
-    let d = o.num("depth_mm", 0.0, f64::INFINITY, what)?;
+/// A flake depth (entry `p`), at most the layer thickness `x`.
+fn depth(o: &Obj, x: f64, p: &Param) -> Result<f64> {
+    let d = o.param(p)?;
     if d > x {
         return Err(o.err(
-            "depth_mm",
-            format!("{d} mm is deeper than the pigmented layer (pigmented_layer.thickness_mm = {x}); {what} must be in [0, {x}]"),
+            &o.param_key(p),
+            format!(
+                "{d} mm is deeper than the pigmented layer ({} = {x}); {} must be in [0, {x}]",
+                reg::LAYER_THICKNESS.pointer,
+                p.description
+            ),
         ));
     }
     Ok(d)
 }
 
-/// A number (the same for every sample) or an array with one value per sample.
-fn spectral_or_scalar(o: &Obj, key: &str, n: usize, lo: f64, hi: f64, what: &str) -> Result<Vec<f64>> {
-    match o.required(key)? {
-        Value::Array(_) => o.num_array(key, Some(n), lo, hi, what),
-        v => Ok(vec![number(o.file, &o.field(key), v, lo, hi, what)?; n]),
+/// A number (the same for every sample) or an array with one value per sample (entry `p`).
+fn spectral_or_scalar(o: &Obj, p: &Param, n: usize) -> Result<Vec<f64>> {
+    let key = o.param_key(p);
+    match o.required(&key)? {
+        Value::Array(_) => o.param_array(p, Some(n)),
+        v => Ok(vec![param_number(o.file, &o.field(&key), v, p)?; n]),
     }
 }
 
