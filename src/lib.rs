@@ -24,6 +24,7 @@ pub mod cli;
 pub mod error;
 pub mod input;
 pub mod instrument;
+pub mod measured;
 pub mod optics;
 pub mod quadrature;
 pub mod recipe;

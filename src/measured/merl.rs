@@ -1,0 +1,270 @@
+//! Measured isotropic BRDF tables in the MERL `.binary` format (Matusik, Pfister, Brand & McMillan, "A
+//! data-driven reflectance model", SIGGRAPH 2003), so that glossmeter can read a measured material through
+//! the instrument, not only analytic models.
+//!
+//! The format, as read by MERL's own `BRDFRead.cpp` and the loaders derived from it (wdas/brdf
+//! `BRDFMeasuredMERL.cpp`, dj_brdf, nbonneel/pathtracer `MERLBRDFRead.h`):
+//!
+//! * a header of three little-endian `i32`: the table dimensions (n_θh, n_θd, n_φd) = (90, 90, 180);
+//! * then 3·n little-endian `f64` (n = n_θh·n_θd·n_φd) as three channel blocks, R then G then B;
+//! * the stored values are scaled on lookup by R × 1/1500, G × 1.15/1500, B × 1.66/1500 (f_r in sr⁻¹);
+//! * index = φd_idx + θd_idx·n_φd + θh_idx·n_φd·n_θd, in the half/difference angles of Rusinkiewicz (1998,
+//!   "A new change of variables for efficient BRDF representation");
+//! * θh bins are non-linear: idx = ⌊√(θh/(π/2)·n_θh·n_θh)⌋ (finer near the specular peak); θd bins are
+//!   linear over [0, π/2); φd bins are linear over [0, π), φd folded by reciprocity (φd ↦ φd + π);
+//! * negative values mark cells that were not measured ("below horizon").
+//!
+//! Lookup: nearest bin (the bin that contains the point: MERL's `lookup_brdf_val`, the default) or trilinear
+//! in (θh index coordinate, θd, φd) with the samples at the bins' lower edges and φd periodic with period π.
+//! This file only decodes the bytes and chooses those coordinates; the table and its interpolation are the
+//! shared layer in `table.rs`. `docs/model.md` §Measured tables (MERL) gives the details and the known limits
+//! of the data.
+use super::table::{floor_index, Axis, Edge, Table};
+pub use super::table::{fold_phi_d, half_diff, HalfDiff};
+use crate::brdf::{Brdf, Lobe, Term, TermKind};
+use crate::spectrum::Sampling;
+use crate::{Error, Result, Vec3};
+use std::f64::consts::{FRAC_PI_2, PI};
+use std::io::Read;
+use std::path::Path;
+
+/// The dimensions of every table in the MERL database: (n_θh, n_θd, n_φd).
+pub const MERL_DIMS: [usize; 3] = [90, 90, 180];
+/// The per-channel scales applied on lookup (MERL `RED_SCALE`, `GREEN_SCALE`, `BLUE_SCALE`).
+pub const MERL_SCALE: [f64; 3] = [1.0 / 1500.0, 1.15 / 1500.0, 1.66 / 1500.0];
+/// Largest dimension accepted from a header (a guard against nonsense headers; MERL uses ≤ 180).
+pub const MAX_DIM: usize = 4096;
+/// Size of the header in bytes.
+const HEADER_BYTES: usize = 12;
+
+/// How the table is evaluated between its samples.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Interpolation {
+    /// The value of the bin that contains the point (MERL's own lookup): piecewise constant.
+    Nearest,
+    /// Trilinear in (θh index coordinate u = n_θh·√(θh/(π/2)), θd, φd), samples at the bins' lower edges,
+    /// φd periodic with period π, clamped at the upper ends of θh and θd.
+    Trilinear,
+}
+
+impl Interpolation {
+    pub fn name(self) -> &'static str {
+        match self {
+            Interpolation::Nearest => "nearest",
+            Interpolation::Trilinear => "trilinear",
+        }
+    }
+}
+
+/// A measured BRDF table in the MERL format, RGB.
+#[derive(Clone, Debug)]
+pub struct MerlBrdf {
+    /// The file as given (for messages and `describe`).
+    file: String,
+    /// (n_θh, n_θd, n_φd).
+    dims: [usize; 3],
+    /// f_r in sr⁻¹ per cell (already scaled), invalid channels set to 0; axes (θh index, θd index, φd index).
+    table: Table,
+    /// Number of cells with at least one negative or non-finite channel.
+    invalid: usize,
+    interpolation: Interpolation,
+    sampling: Sampling,
+}
+
+impl MerlBrdf {
+    /// Read a MERL `.binary` file. Errors (`Error::Io` for a file that cannot be read, `Error::Input` for a
+    /// wrong header or size) name the file; nothing here panics on bad data.
+    pub fn load(path: &Path, interpolation: Interpolation) -> Result<Self> {
+        let file = path.display().to_string();
+        let io = |source| Error::Io { file: file.clone(), source };
+        let mut f = std::fs::File::open(path).map_err(io)?;
+        let size = f.metadata().map_err(io)?.len();
+        let mut header = [0u8; HEADER_BYTES];
+        if size < HEADER_BYTES as u64 {
+            return Err(Error::input(
+                &file,
+                "",
+                format!(
+                    "{size} bytes: too short for a MERL table (a 12-byte header of 3 × i32 dimensions, then 3·n f64)"
+                ),
+            ));
+        }
+        f.read_exact(&mut header).map_err(io)?;
+        let dims = parse_dims(&header, &file)?;
+        let n = dims[0] * dims[1] * dims[2];
+        check_size(size, n, dims, &file)?;
+        let mut body = Vec::with_capacity(3 * n * 8);
+        f.read_to_end(&mut body).map_err(io)?;
+        // The file may have changed between the size check and the read.
+        check_size((HEADER_BYTES + body.len()) as u64, n, dims, &file)?;
+        Ok(Self::from_parts(file, dims, &body, interpolation))
+    }
+
+    /// Parse a whole MERL file held in memory; `file` names it in messages.
+    pub fn from_bytes(bytes: &[u8], file: &str, interpolation: Interpolation) -> Result<Self> {
+        if bytes.len() < HEADER_BYTES {
+            return Err(Error::input(file, "", format!("{} bytes: too short for a MERL table", bytes.len())));
+        }
+        let dims = parse_dims(&bytes[..HEADER_BYTES], file)?;
+        let n = dims[0] * dims[1] * dims[2];
+        check_size(bytes.len() as u64, n, dims, file)?;
+        Ok(Self::from_parts(file.to_string(), dims, &bytes[HEADER_BYTES..], interpolation))
+    }
+
+    /// `body` holds exactly 3·n·8 bytes (checked by the callers).
+    fn from_parts(file: String, dims: [usize; 3], body: &[u8], interpolation: Interpolation) -> Self {
+        let n = dims[0] * dims[1] * dims[2];
+        let mut table = vec![[0.0; 3]; n];
+        let mut bad = vec![false; n];
+        for (c, block) in body.chunks_exact(8 * n).take(3).enumerate() {
+            for (i, b) in block.chunks_exact(8).enumerate() {
+                let raw = f64::from_le_bytes(b.try_into().expect("chunks of 8 bytes"));
+                if raw.is_finite() && raw >= 0.0 {
+                    table[i][c] = raw * MERL_SCALE[c];
+                } else {
+                    bad[i] = true;
+                }
+            }
+        }
+        let invalid = bad.iter().filter(|b| **b).count();
+        let [nh, nd, np] = dims;
+        let axes = vec![Axis::index(nh, Edge::Clamp), Axis::index(nd, Edge::Clamp), Axis::index(np, Edge::Periodic)];
+        let table = Table::new(axes, 3, table.into_iter().flatten().collect());
+        MerlBrdf { file, dims, table, invalid, interpolation, sampling: Sampling::rgb() }
+    }
+
+    /// (n_θh, n_θd, n_φd).
+    pub fn dims(&self) -> [usize; 3] {
+        self.dims
+    }
+
+    /// Number of cells with a negative (unmeasured) or non-finite value in at least one channel; those
+    /// channels read as 0.
+    pub fn invalid_entries(&self) -> usize {
+        self.invalid
+    }
+
+    pub fn interpolation(&self) -> Interpolation {
+        self.interpolation
+    }
+
+    /// The scaled value (sr⁻¹, R G B) of cell (θh index, θd index, φd index); None outside the table.
+    pub fn cell(&self, ih: usize, id: usize, ip: usize) -> Option<[f64; 3]> {
+        let [nh, nd, np] = self.dims;
+        (ih < nh && id < nd && ip < np).then(|| {
+            let c = self.table.cell(&[ih, id, ip]);
+            [c[0], c[1], c[2]]
+        })
+    }
+
+    /// The cell MERL's nearest-bin lookup uses for these angles (φd already folded or not: it is folded
+    /// here). The same arithmetic as MERL's `theta_half_index`, `theta_diff_index`, `phi_diff_index`.
+    pub fn bin(&self, theta_h: f64, theta_d: f64, phi_d: f64) -> (usize, usize, usize) {
+        let [nh, nd, np] = self.dims;
+        let ih =
+            if theta_h <= 0.0 { 0 } else { floor_index(((theta_h / FRAC_PI_2) * nh as f64 * nh as f64).sqrt(), nh) };
+        let id = floor_index(theta_d / FRAC_PI_2 * nd as f64, nd);
+        let ip = floor_index(fold_phi_d(phi_d) / PI * np as f64, np);
+        (ih, id, ip)
+    }
+
+    /// Slope width reported to the integrator: the tangent of the first θh bin edge, (π/2)/n_θh², the
+    /// table's angular resolution at the specular direction (≈ 1.94e-4 for 90 bins).
+    pub fn resolution_slope(&self) -> f64 {
+        let nh = self.dims[0] as f64;
+        (FRAC_PI_2 / (nh * nh)).tan()
+    }
+
+    fn nearest(&self, hd: &HalfDiff) -> [f64; 3] {
+        let (ih, id, ip) = self.bin(hd.theta_h, hd.theta_d, hd.phi_d);
+        let c = self.table.cell(&[ih, id, ip]);
+        [c[0], c[1], c[2]]
+    }
+
+    fn trilinear(&self, hd: &HalfDiff) -> [f64; 3] {
+        let [nh, nd, np] = self.dims;
+        let uh = nh as f64 * (hd.theta_h.max(0.0) / FRAC_PI_2).sqrt();
+        let ud = hd.theta_d.max(0.0) / FRAC_PI_2 * nd as f64;
+        let up = fold_phi_d(hd.phi_d) / PI * np as f64;
+        let mut out = [0.0; 3];
+        self.table.linear(&[uh, ud, up], &mut out);
+        out
+    }
+}
+
+fn parse_dims(header: &[u8], file: &str) -> Result<[usize; 3]> {
+    let mut raw = [0i32; 3];
+    for (k, r) in raw.iter_mut().enumerate() {
+        *r = i32::from_le_bytes(header[4 * k..4 * k + 4].try_into().expect("4 bytes"));
+    }
+    if raw.iter().any(|&d| d < 1 || d as usize > MAX_DIM) {
+        return Err(Error::input(
+            file,
+            "",
+            format!(
+                "header dimensions {} × {} × {} (θh × θd × φd) are not a MERL table: each must be 1 – {MAX_DIM} \
+                 (MERL: 90 × 90 × 180); is this a MERL .binary file?",
+                raw[0], raw[1], raw[2]
+            ),
+        ));
+    }
+    Ok([raw[0] as usize, raw[1] as usize, raw[2] as usize])
+}
+
+fn check_size(size: u64, n: usize, dims: [usize; 3], file: &str) -> Result<()> {
+    let expected = HEADER_BYTES as u64 + 3 * 8 * n as u64;
+    if size != expected {
+        let what = if size < expected { "truncated" } else { "trailing data" };
+        return Err(Error::input(
+            file,
+            "",
+            format!(
+                "{size} bytes, but a MERL table of {} × {} × {} needs 12 + 3·{n}·8 = {expected} bytes ({what})",
+                dims[0], dims[1], dims[2]
+            ),
+        ));
+    }
+    Ok(())
+}
+
+impl Brdf for MerlBrdf {
+    fn sampling(&self) -> &Sampling {
+        &self.sampling
+    }
+
+    fn eval(&self, wi: Vec3, wo: Vec3, out: &mut [f64]) {
+        if !(wi.z > 0.0 && wo.z > 0.0) {
+            out.fill(0.0);
+            return;
+        }
+        let hd = half_diff(wi, wo);
+        let v = match self.interpolation {
+            Interpolation::Nearest => self.nearest(&hd),
+            Interpolation::Trilinear => self.trilinear(&hd),
+        };
+        out.copy_from_slice(&v);
+    }
+
+    fn terms(&self) -> Vec<Term> {
+        let label = "measured (MERL)".to_string();
+        vec![Term {
+            label: format!("measured table (MERL, {} lookup)", self.interpolation.name()),
+            kind: TermKind::Lobe(Lobe {
+                slope_width: self.resolution_slope(),
+                medium_eta: 1.0,
+                label,
+                heavy_tail: true,
+            }),
+        }]
+    }
+
+    fn describe(&self) -> String {
+        let name = Path::new(&self.file).file_name().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+        let [nh, nd, np] = self.dims;
+        format!(
+            "measured MERL table {name} ({nh} × {nd} × {np} θh × θd × φd, {} lookup, {} invalid entries read as 0)",
+            self.interpolation.name(),
+            self.invalid
+        )
+    }
+}

@@ -1,0 +1,317 @@
+//! The table layer shared by every measured format: sample nodes along an axis, the neighbours and weights
+//! of a point between them (linear, clamped or periodic), and N-dimensional tables of several channels
+//! interpolated multilinearly. The file readers (`merl.rs`, `rgl.rs`, `inplane.rs`) only decode bytes or
+//! text into such tables and choose the coordinates; the interpolation is written once, here.
+//!
+//! Also here: the half/difference angles of Rusinkiewicz (1998, "A new change of variables for efficient
+//! BRDF representation"), used by the MERL lookup and by the in-plane tables' isotropic extension.
+use crate::Vec3;
+use std::f64::consts::PI;
+
+/// Where the samples of an axis sit, in the axis' coordinate.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Nodes {
+    /// Samples at 0, 1, …, n − 1 (an index coordinate; MERL's bins, a unit square scaled by n − 1).
+    Index(usize),
+    /// Samples at strictly increasing values (angles of a goniometer, pbrt's parameter grids).
+    Values(Vec<f64>),
+}
+
+/// What happens beyond the last sample.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Edge {
+    /// The value of the nearest end sample (weights clamped to [0, 1]).
+    Clamp,
+    /// Period n (index nodes only): sample n is sample 0.
+    Periodic,
+}
+
+/// One axis of a table.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Axis {
+    pub nodes: Nodes,
+    pub edge: Edge,
+}
+
+impl Axis {
+    pub fn index(n: usize, edge: Edge) -> Self {
+        Axis { nodes: Nodes::Index(n), edge }
+    }
+
+    pub fn values(v: Vec<f64>) -> Self {
+        Axis { nodes: Nodes::Values(v), edge: Edge::Clamp }
+    }
+
+    pub fn len(&self) -> usize {
+        match &self.nodes {
+            Nodes::Index(n) => *n,
+            Nodes::Values(v) => v.len(),
+        }
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The two neighbouring samples of `u` and the weight t of the second: the value is
+    /// (1 − t)·v[i0] + t·v[i1]. NaN reads as the first sample.
+    pub fn linear(&self, u: f64) -> (usize, usize, f64) {
+        match (&self.nodes, self.edge) {
+            (Nodes::Index(n), Edge::Clamp) => clamped_index_pair(u, *n),
+            (Nodes::Index(n), Edge::Periodic) => periodic_index_pair(u, *n),
+            (Nodes::Values(v), _) => value_pair(v, u),
+        }
+    }
+
+    /// The sample at or below `u` (the cell that contains it), clamped to the axis; NaN → 0.
+    pub fn floor(&self, u: f64) -> usize {
+        match &self.nodes {
+            Nodes::Index(n) => floor_index(u, *n),
+            Nodes::Values(v) => value_pair(v, u).0,
+        }
+    }
+
+    /// The smallest spacing between neighbouring samples (in the axis' coordinate); infinite for one sample.
+    pub fn min_spacing(&self) -> f64 {
+        match &self.nodes {
+            Nodes::Index(n) if *n > 1 => 1.0,
+            Nodes::Values(v) if v.len() > 1 => v.windows(2).map(|w| w[1] - w[0]).fold(f64::INFINITY, f64::min),
+            _ => f64::INFINITY,
+        }
+    }
+}
+
+/// ⌊u⌋ clamped to 0..n−1 (NaN → 0), as MERL's index functions.
+pub fn floor_index(u: f64, n: usize) -> usize {
+    if !(u > 0.0) {
+        return 0;
+    }
+    (u as usize).min(n - 1)
+}
+
+/// Samples at 0, 1, …, n−1, clamped at both ends.
+fn clamped_index_pair(u: f64, n: usize) -> (usize, usize, f64) {
+    if n == 1 || !(u > 0.0) {
+        return (0, 0, 0.0);
+    }
+    let top = (n - 1) as f64;
+    if u >= top {
+        return (n - 1, n - 1, 0.0);
+    }
+    let i = u.floor() as usize;
+    (i, i + 1, u - i as f64)
+}
+
+/// Samples at 0, …, n−1 with period n, for u in [0, n).
+fn periodic_index_pair(u: f64, n: usize) -> (usize, usize, f64) {
+    if !(u > 0.0) {
+        return (0, 0, 0.0);
+    }
+    let f = u.floor();
+    let i = (f as usize) % n;
+    (i, (i + 1) % n, (u - f).clamp(0.0, 1.0))
+}
+
+/// Samples at increasing values, clamped: the interval [v[i], v[i+1]] with the largest i such that
+/// v[i] ≤ u (i ≤ n − 2; pbrt-v4's `FindInterval`), and the weight clamped to [0, 1].
+fn value_pair(v: &[f64], u: f64) -> (usize, usize, f64) {
+    let n = v.len();
+    if n < 2 {
+        return (0, 0, 0.0);
+    }
+    if !(u > v[0]) {
+        return (0, 1, 0.0);
+    }
+    // Largest i in 0..=n−2 with v[i] ≤ u.
+    let i = v[..n - 1].partition_point(|&x| x <= u).saturating_sub(1);
+    let t = ((u - v[i]) / (v[i + 1] - v[i])).clamp(0.0, 1.0);
+    (i, i + 1, t)
+}
+
+/// An N-dimensional table of `channels` values per cell, stored row-major (last axis fastest), channels
+/// innermost.
+#[derive(Clone, Debug)]
+pub struct Table {
+    axes: Vec<Axis>,
+    strides: Vec<usize>,
+    channels: usize,
+    data: Vec<f64>,
+}
+
+impl Table {
+    /// `data.len()` must be channels × Π axis lengths (the readers check their files before this).
+    pub fn new(axes: Vec<Axis>, channels: usize, data: Vec<f64>) -> Self {
+        let mut strides = vec![0; axes.len()];
+        let mut s = channels;
+        for (k, a) in axes.iter().enumerate().rev() {
+            strides[k] = s;
+            s *= a.len();
+        }
+        assert_eq!(s, data.len(), "table size does not match its axes");
+        Table { axes, strides, channels, data }
+    }
+
+    pub fn axes(&self) -> &[Axis] {
+        &self.axes
+    }
+
+    pub fn channels(&self) -> usize {
+        self.channels
+    }
+
+    /// The channels of one cell.
+    pub fn cell(&self, idx: &[usize]) -> &[f64] {
+        let o: usize = idx.iter().zip(&self.strides).map(|(i, s)| i * s).sum();
+        &self.data[o..o + self.channels]
+    }
+
+    /// The cell that contains the point (each axis' `floor`): piecewise constant lookup.
+    pub fn nearest(&self, coords: &[f64], out: &mut [f64]) {
+        let mut o = 0;
+        for (k, a) in self.axes.iter().enumerate() {
+            o += a.floor(coords[k]) * self.strides[k];
+        }
+        out.copy_from_slice(&self.data[o..o + self.channels]);
+    }
+
+    /// Multilinear interpolation: the 2^N corners in order (first axis outermost), each weighted by the
+    /// product of its axes' weights taken in axis order; corners of weight 0 are skipped.
+    pub fn linear(&self, coords: &[f64], out: &mut [f64]) {
+        out.fill(0.0);
+        let pairs: Vec<(usize, usize, f64)> = self.axes.iter().zip(coords).map(|(a, &u)| a.linear(u)).collect();
+        self.accumulate(&pairs, 0, 0, None, out);
+    }
+
+    fn accumulate(&self, pairs: &[(usize, usize, f64)], k: usize, offset: usize, w: Option<f64>, out: &mut [f64]) {
+        if k == pairs.len() {
+            let w = w.unwrap_or(1.0);
+            if w != 0.0 {
+                let v = &self.data[offset..offset + self.channels];
+                for c in 0..self.channels {
+                    out[c] += w * v[c];
+                }
+            }
+            return;
+        }
+        let (i0, i1, t) = pairs[k];
+        for (i, wk) in [(i0, 1.0 - t), (i1, t)] {
+            let w = Some(match w {
+                None => wk,
+                Some(w) => w * wk,
+            });
+            self.accumulate(pairs, k + 1, offset + i * self.strides[k], w, out);
+        }
+    }
+}
+
+/// Rusinkiewicz half/difference angles of a pair of directions.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HalfDiff {
+    /// Polar angle of the half vector h = normalize(ωi + ωo), in [0, π].
+    pub theta_h: f64,
+    /// Azimuth of h, in (−π, π].
+    pub phi_h: f64,
+    /// Polar angle of ωi in the frame where h is the pole, in [0, π].
+    pub theta_d: f64,
+    /// Azimuth of ωi in that frame, in (−π, π] (not yet folded by reciprocity).
+    pub phi_d: f64,
+}
+
+/// Half/difference angles of (ωi, ωo) (Rusinkiewicz 1998): h = normalize(ωi + ωo); the difference vector is ωi
+/// rotated by −φh about z and then by −θh about y, which brings h onto the pole. Polar angles are computed
+/// with `atan2` (accurate near 0, where `acos` loses half the digits). If ωi + ωo = 0 the half vector is
+/// undefined and h = z is used.
+pub fn half_diff(wi: Vec3, wo: Vec3) -> HalfDiff {
+    let s = wi + wo;
+    let len = s.length();
+    let h = if len > 0.0 && len.is_finite() { s / len } else { Vec3::Z };
+    let theta_h = (h.x * h.x + h.y * h.y).sqrt().atan2(h.z);
+    let phi_h = h.y.atan2(h.x);
+    let (sp, cp) = phi_h.sin_cos();
+    // Rotation by −φh about z.
+    let t = Vec3::new(wi.x * cp + wi.y * sp, -wi.x * sp + wi.y * cp, wi.z);
+    // Rotation by −θh about y: x' = x cos θh − z sin θh, z' = x sin θh + z cos θh.
+    let (st, ct) = theta_h.sin_cos();
+    let d = Vec3::new(t.x * ct - t.z * st, t.y, t.x * st + t.z * ct);
+    let theta_d = (d.x * d.x + d.y * d.y).sqrt().atan2(d.z);
+    let phi_d = d.y.atan2(d.x);
+    HalfDiff { theta_h, phi_h, theta_d, phi_d }
+}
+
+/// Fold φd into [0, π) by reciprocity (f(φd) = f(φd + π) for an isotropic reciprocal BRDF). MERL's loaders
+/// add π when φd < 0; here φd = π (which `atan2` returns for in-plane pairs, the sign of a zero deciding
+/// between ±π) also maps to 0, so that the in-plane geometry does not depend on the sign of a rounding.
+pub fn fold_phi_d(phi_d: f64) -> f64 {
+    if !phi_d.is_finite() {
+        return 0.0;
+    }
+    // For atan2's range [−π, π] this is MERL's "add π if negative", plus π ↦ 0.
+    let p = phi_d.rem_euclid(PI);
+    if p >= PI {
+        0.0
+    } else {
+        p
+    }
+}
+
+/// The polar angle of a unit vector, accurate near the pole: 2·asin(|d − z|/2) (Mitsuba 3's `elevation`).
+pub fn elevation(d: Vec3) -> f64 {
+    let dist = (d.x * d.x + d.y * d.y + (d.z - 1.0) * (d.z - 1.0)).sqrt();
+    2.0 * (0.5 * dist).min(1.0).asin()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn value_axis_brackets_and_clamps() {
+        let a = Axis::values(vec![0.0, 1.0, 3.0]);
+        assert_eq!(a.linear(-1.0), (0, 1, 0.0));
+        assert_eq!(a.linear(0.5), (0, 1, 0.5));
+        assert_eq!(a.linear(2.0), (1, 2, 0.5));
+        assert_eq!(a.linear(3.0), (1, 2, 1.0));
+        assert_eq!(a.linear(9.0), (1, 2, 1.0));
+        assert_eq!(a.linear(f64::NAN), (0, 1, 0.0));
+        assert_eq!(a.floor(2.5), 1);
+        assert_eq!(a.min_spacing(), 1.0);
+    }
+
+    #[test]
+    fn index_axes() {
+        let c = Axis::index(4, Edge::Clamp);
+        assert_eq!(c.linear(1.25), (1, 2, 0.25));
+        assert_eq!(c.linear(7.0), (3, 3, 0.0));
+        let p = Axis::index(4, Edge::Periodic);
+        assert_eq!(p.linear(3.5), (3, 0, 0.5));
+        assert_eq!(c.floor(3.9), 3);
+    }
+
+    #[test]
+    fn bilinear_reproduces_a_bilinear_function() {
+        let ax = Axis::values(vec![0.0, 1.0, 2.0]);
+        let ay = Axis::values(vec![0.0, 2.0]);
+        let f = |x: f64, y: f64| 1.0 + 2.0 * x + 3.0 * y + 0.5 * x * y;
+        let mut data = Vec::new();
+        for x in [0.0, 1.0, 2.0] {
+            for y in [0.0, 2.0] {
+                data.push(f(x, y));
+                data.push(-f(x, y));
+            }
+        }
+        let t = Table::new(vec![ax, ay], 2, data);
+        let mut out = [0.0; 2];
+        t.linear(&[1.5, 0.5], &mut out);
+        assert!((out[0] - f(1.5, 0.5)).abs() < 1e-14 && (out[1] + f(1.5, 0.5)).abs() < 1e-14);
+        t.nearest(&[1.5, 0.5], &mut out);
+        assert_eq!(out, [f(1.0, 0.0), -f(1.0, 0.0)]);
+    }
+
+    #[test]
+    fn elevation_matches_acos() {
+        for t in [0.0f64, 1e-6, 0.3, 1.2, 1.5] {
+            let d = Vec3::new(t.sin(), 0.0, t.cos());
+            assert!((elevation(d) - t).abs() < 1e-15);
+        }
+    }
+}
