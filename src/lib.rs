@@ -10,6 +10,7 @@
 //! * [`registry`]: every recipe parameter's JSON Pointer, type, unit, range and meaning, shared by the
 //!   validator, the schema, the docs and the fitter.
 //! * [`spectrum`]: spectral sampling and the luminous (CIE illuminant C × V(λ)) weighting.
+//! * [`colorimetry`]: CIE tristimulus weights (CIE 15 / ASTM E308), CIELAB and CIEDE2000.
 //! * [`quadrature`]: the deterministic adaptive cubature with error estimates.
 //! * [`instrument`]: aperture geometry, the standards as data, the measurement plan and the readings.
 //! * [`api`]: the one-call API ([`measure`], the default panel, geometry resolution).
@@ -21,6 +22,7 @@ pub mod api;
 pub mod brdf;
 #[cfg(feature = "cli")]
 pub mod cli;
+pub mod colorimetry;
 pub mod error;
 pub mod input;
 pub mod instrument;

@@ -268,18 +268,31 @@ impl Weighting {
 
 /// Parse a two-column CSV table `wavelength_nm,value`; lines starting with `#` are comments (provenance).
 pub fn parse_table(text: &str, file: &str) -> Result<Vec<(f64, f64)>> {
+    Ok(parse_columns(text, file, 1)?.into_iter().map(|(l, v)| (l, v[0])).collect())
+}
+
+/// Parse a CSV table `wavelength_nm,v1,…,vn` with `ncols` value columns: the one format of every table under
+/// `standards/cie/` (`#` lines are provenance, a line starting with `wavelength` is the header). Wavelengths must
+/// increase strictly; every value must be a finite number.
+pub fn parse_columns(text: &str, file: &str, ncols: usize) -> Result<Vec<(f64, Vec<f64>)>> {
     let mut rows = Vec::new();
     for (i, line) in text.lines().enumerate() {
         let line = line.trim();
         if line.is_empty() || line.starts_with('#') || line.starts_with("wavelength") {
             continue;
         }
-        let mut it = line.split(',');
-        let parse = |s: Option<&str>| s.and_then(|v| v.trim().parse::<f64>().ok()).filter(|v| v.is_finite());
-        match (parse(it.next()), parse(it.next())) {
-            (Some(l), Some(v)) => rows.push((l, v)),
-            _ => return Err(Error::input(file, format!("line {}", i + 1), "expected `wavelength_nm,value`")),
+        let cells: Vec<Option<f64>> =
+            line.split(',').map(|v| v.trim().parse::<f64>().ok().filter(|v| v.is_finite())).collect();
+        if cells.len() != ncols + 1 || cells.iter().any(Option::is_none) {
+            let cols = if ncols == 1 {
+                "`wavelength_nm,value`".to_string()
+            } else {
+                format!("wavelength_nm and {ncols} values")
+            };
+            return Err(Error::input(file, format!("line {}", i + 1), format!("expected {cols}")));
         }
+        let cells: Vec<f64> = cells.into_iter().flatten().collect();
+        rows.push((cells[0], cells[1..].to_vec()));
     }
     if rows.len() < 2 || rows.windows(2).any(|w| !(w[1].0 > w[0].0)) {
         return Err(Error::input(file, "", "table needs at least two rows with increasing wavelengths"));
