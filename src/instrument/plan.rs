@@ -738,6 +738,29 @@ fn describe_method(m: &Method, terms: &[Term]) -> String {
     }
 }
 
+/// A reading with a value `(v, e)`, no problem and no note (callers override those with struct update).
+fn valued_reading(
+    r: &PlannedReading,
+    (v, e): (f64, f64),
+    evaluations: usize,
+    seconds: f64,
+    converged: bool,
+) -> Reading {
+    Reading {
+        geometry: r.geometry.clone(),
+        name: r.name.clone(),
+        quantity: r.spec.quantity().into(),
+        unit: r.spec.unit().into(),
+        value: Some(v),
+        error_estimate: e,
+        evaluations,
+        seconds,
+        converged,
+        problem: None,
+        note: None,
+    }
+}
+
 fn problem_reading(r: &PlannedReading, why: String) -> Reading {
     Reading {
         geometry: r.geometry.clone(),
@@ -816,15 +839,6 @@ fn compute_reading(r: &PlannedReading, flux: &[Flux]) -> Reading {
     let out_of_time = used.iter().any(|f| f.out_of_time);
     match reading_value(&r.spec, &specimen, &standard) {
         Ok((v, e)) if v.is_finite() && e.is_finite() => Reading {
-            geometry: r.geometry.clone(),
-            name: r.name.clone(),
-            quantity: r.spec.quantity().into(),
-            unit: r.spec.unit().into(),
-            value: Some(v),
-            error_estimate: e,
-            evaluations,
-            seconds,
-            converged,
             problem: (!converged).then(|| {
                 if out_of_time {
                     "wall-clock budget exhausted before the tolerance was met (the value is the best estimate so \
@@ -834,7 +848,7 @@ fn compute_reading(r: &PlannedReading, flux: &[Flux]) -> Reading {
                     "evaluation budget exhausted before the tolerance was met (the value is the best estimate)".into()
                 }
             }),
-            note: None,
+            ..valued_reading(r, (v, e), evaluations, seconds, converged)
         },
         Ok((v, e)) => problem_reading(
             r,
@@ -857,21 +871,12 @@ fn compose_reading(r: &PlannedReading, done: &[Option<Reading>]) -> Reading {
         return problem_reading(r, "non-finite result".into());
     }
     Reading {
-        geometry: r.geometry.clone(),
-        name: r.name.clone(),
-        quantity: r.spec.quantity().into(),
-        unit: r.spec.unit().into(),
-        value: Some(v),
-        error_estimate: e,
-        evaluations: a.evaluations + b.evaluations,
-        seconds: a.seconds + b.seconds,
-        converged: a.converged && b.converged,
-        problem: None,
         note: (x <= 70.0 || v < 0.0).then(|| {
             "outside the scope of ASTM D4039, which is defined for non-metallic specimens with G60 > 70 (a negative \
              index means the 20° receptor gathers relatively more than the 60° one, as for near-mirror flakes)"
                 .to_string()
         }),
+        ..valued_reading(r, (v, e), a.evaluations + b.evaluations, a.seconds + b.seconds, a.converged && b.converged)
     }
 }
 
