@@ -16,8 +16,12 @@ pub fn read_text(path: &Path, what: &str) -> Result<String> {
     read_text_limited(path, what, MAX_TEXT_BYTES)
 }
 
-/// [`read_text`] with the limit given.
-pub fn read_text_limited(path: &Path, what: &str, limit: u64) -> Result<String> {
+/// The bytes of a file of at most [`MAX_TEXT_BYTES`] (for sheets, whose encoding is decided after reading).
+pub fn read_bytes(path: &Path, what: &str) -> Result<Vec<u8>> {
+    read_bytes_limited(path, what, MAX_TEXT_BYTES)
+}
+
+fn read_bytes_limited(path: &Path, what: &str, limit: u64) -> Result<Vec<u8>> {
     let file = path.display().to_string();
     let io = |source| Error::Io { file: file.clone(), source };
     let f = std::fs::File::open(path).map_err(io)?;
@@ -30,6 +34,13 @@ pub fn read_text_limited(path: &Path, what: &str, limit: u64) -> Result<String> 
             format!("larger than {} MiB, the limit for a {what} (is this the right file?)", limit / (1024 * 1024)),
         ));
     }
+    Ok(bytes)
+}
+
+/// [`read_text`] with the limit given.
+pub fn read_text_limited(path: &Path, what: &str, limit: u64) -> Result<String> {
+    let file = path.display().to_string();
+    let bytes = read_bytes_limited(path, what, limit)?;
     String::from_utf8(bytes).map_err(|e| {
         Error::input(
             &file,

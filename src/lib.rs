@@ -14,6 +14,7 @@
 //! * [`quadrature`]: the deterministic adaptive cubature with error estimates.
 //! * [`instrument`]: aperture geometry, the standards as data, the measurement plan and the readings.
 //! * [`api`]: the one-call API ([`measure`], the default panel, geometry resolution).
+//! * [`comparison`]: predictions beside instrument sheets: statistics, verdicts, many samples, baselines.
 //! * `cli` (feature `cli`, on by default): the thin command-line layer. The library builds and works without
 //!   it and its dependencies (clap, plotters): `cargo build --lib --no-default-features`.
 #![forbid(unsafe_code)]
@@ -23,6 +24,7 @@ pub mod brdf;
 #[cfg(feature = "cli")]
 pub mod cli;
 pub mod colorimetry;
+pub mod comparison;
 pub mod error;
 pub mod input;
 pub mod instrument;

@@ -1,30 +1,58 @@
-//! `glossmeter compare`: predictions set beside a glossmeter sheet (CSV), and a pass/fail verdict where
-//! the sheet (or `--tolerance`) gives an uncertainty: the command exits 1 when any reading falls outside,
-//! so it doubles as a CI check of a BRDF against the standards.
+//! `glossmeter compare`: predictions set beside an instrument sheet, one table, one summary and one exit
+//! status for all its samples. The reading of the sheet, the statistics, the verdicts and the baseline checks
+//! are library functions (`instrument::sheet`, `comparison`); this module parses the arguments and formats.
 use std::path::PathBuf;
 
 use serde_json::json;
 
 use crate::cli::format::plain;
-use crate::cli::{check_rtol, readings_status, Format, Target};
-use crate::instrument::plan::{Plan, PlanOptions, Reading};
-use crate::instrument::sheet::{self, SheetRow};
-use crate::{recipe, resolve_geometries, Error, Result};
+use crate::cli::{check_rtol, junit, pad_table, readings_status, Target};
+use crate::comparison::{self, Comparison, Drift, Recipes, Rule, Verdict};
+use crate::instrument::plan::PlanOptions;
+use crate::instrument::sheet::{self, Sheet, SheetOptions};
+use crate::{Error, Result};
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum CompareFormat {
+    Table,
+    Json,
+    Csv,
+    /// JUnit XML, one test case per (sample, reading), for CI servers.
+    Junit,
+}
 
 #[derive(clap::Args, Debug)]
 pub struct CompareArgs {
-    /// The recipe (JSON).
-    pub recipe: PathBuf,
-    /// The sheet (CSV, long or wide layout; see docs/instrument.md §Sheets).
-    pub sheet: PathBuf,
-    /// Allowed |measured − predicted| in the reading's unit, for rows without an `uncertainty`.
+    /// `[RECIPE] SHEET`: the recipe (JSON) for every sample, then the sheet (CSV; see docs/instrument.md
+    /// §Sheets). Without RECIPE, samples take theirs from --recipe-dir / --recipe.
+    #[arg(num_args = 1..=2, required = true, value_name = "[RECIPE] SHEET")]
+    pub paths: Vec<PathBuf>,
+    /// Take each sample's recipe from DIR/<sample>.json.
+    #[arg(long, value_name = "DIR")]
+    pub recipe_dir: Option<PathBuf>,
+    /// The recipe of one sample (repeatable); takes precedence over --recipe-dir.
+    #[arg(long = "recipe", value_name = "SAMPLE=FILE")]
+    pub recipes: Vec<String>,
+    /// The separator: `,`, `;` or `tab` (default: detected from the header line).
+    #[arg(long)]
+    pub delimiter: Option<String>,
+    /// Skip a column the reader does not know (repeatable; case and spaces do not matter).
+    #[arg(long = "ignore-column", value_name = "HEADER")]
+    pub ignore_columns: Vec<String>,
+    /// Standard errors of the mean allowed for repeated readings (k·s/√n).
+    #[arg(short = 'k', long = "k", default_value_t = 2.0)]
+    pub k: f64,
+    /// Allowed |predicted − measured| in the reading's unit, for rows without an `uncertainty`.
     #[arg(long)]
     pub tolerance: Option<f64>,
+    /// A previous `measure` or `compare` JSON: fail any prediction that moved by more than both error estimates.
+    #[arg(long, value_name = "PREVIOUS.json")]
+    pub baseline: Option<PathBuf>,
     /// Relative tolerance of the predictions.
     #[arg(long, default_value_t = 1e-6)]
     pub rtol: f64,
-    #[arg(long, value_enum, default_value_t = Format::Table)]
-    pub format: Format,
+    #[arg(long, value_enum, default_value_t = CompareFormat::Table)]
+    pub format: CompareFormat,
     /// Write to this new file instead of stdout (an existing file is refused before any work).
     #[arg(long, short = 'o')]
     pub output: Option<PathBuf>,
@@ -33,103 +61,77 @@ pub struct CompareArgs {
     pub allow_unconverged: bool,
 }
 
-/// One row of the comparison.
-#[derive(Clone, Debug)]
-pub struct Comparison {
-    pub row: SheetRow,
-    pub predicted: Option<Reading>,
-    /// Allowed difference (uncertainty of the row, else --tolerance), plus the prediction's error estimate.
-    pub allowed: Option<f64>,
-    /// Some(true) inside, Some(false) outside, None when the row cannot be checked ([`Comparison::why_unchecked`]).
-    pub inside: Option<bool>,
-}
-
-impl Comparison {
-    /// predicted − measured, when there is a prediction.
-    pub fn difference(&self) -> Option<f64> {
-        self.predicted.as_ref().and_then(|p| p.value).map(|v| v - self.row.value)
+/// `,`, `;`, `tab` (or a literal tab).
+pub fn parse_delimiter(s: &str) -> Result<u8> {
+    match s {
+        "," => Ok(b','),
+        ";" => Ok(b';'),
+        "tab" | "\t" | "\\t" => Ok(b'\t'),
+        _ => Err(Error::Usage(format!("--delimiter must be `,`, `;` or `tab`, got `{s}`"))),
     }
-
-    /// Why the row could not be checked (exit status 1), if it could not.
-    pub fn why_unchecked(&self) -> Option<String> {
-        if self.inside.is_some() {
-            return None;
-        }
-        match &self.predicted {
-            None => Some("no prediction for this reading".into()),
-            Some(p) if p.value.is_none() => {
-                Some(format!("the prediction has no value ({})", p.problem.as_deref().unwrap_or("no finite value")))
-            }
-            _ => Some("no allowed difference: the row has no uncertainty and no --tolerance was given".into()),
-        }
-    }
-}
-
-pub fn compare(rows: Vec<SheetRow>, readings: &[Reading], tolerance: Option<f64>) -> Vec<Comparison> {
-    rows.into_iter()
-        .map(|row| {
-            let predicted = readings
-                .iter()
-                .find(|r| r.geometry == row.geometry && (r.name == row.reading || r.quantity == row.reading))
-                .cloned();
-            let allowed = row.uncertainty.or(tolerance);
-            let inside = match (&predicted, allowed) {
-                (Some(p), Some(a)) => p.value.map(|v| (v - row.value).abs() <= a + p.error_estimate),
-                _ => None,
-            };
-            Comparison { row, predicted, allowed, inside }
-        })
-        .collect()
 }
 
 pub fn run(a: CompareArgs) -> Result<()> {
-    if let Some(t) = a.tolerance {
-        if !(t.is_finite() && t >= 0.0) {
-            return Err(Error::Usage(format!("--tolerance must be a finite number ≥ 0, got {t}")));
-        }
-    }
+    let rule = Rule { k: a.k, tolerance: a.tolerance };
+    rule.check()?;
     check_rtol(a.rtol)?;
     let target = Target::new(a.output.as_deref(), "--output")?;
-    let material = recipe::load_file(&a.recipe)?;
-    let rows = sheet::load(&a.sheet)?;
-    let mut ids: Vec<String> = Vec::new();
-    for r in &rows {
-        if !ids.contains(&r.geometry) {
-            ids.push(r.geometry.clone());
-        }
-    }
-    let geos = resolve_geometries(&ids, &[] as &[&str]).map_err(|e| match e {
-        Error::Usage(m) => Error::input(a.sheet.display().to_string(), "geometry", m),
-        e => e,
-    })?;
-    let plan = Plan::compile(material.brdf.clone(), geos, PlanOptions { rtol: a.rtol, ..PlanOptions::default() })?;
-    let readings = plan.execute();
-    let cmp = compare(rows, &readings, a.tolerance);
-    if let Some(c) = cmp.iter().find(|c| c.predicted.is_none()) {
-        return Err(Error::input(
-            a.sheet.display().to_string(),
-            format!("line {}", c.row.line),
-            format!("geometry `{}` has no reading `{}`", c.row.geometry, c.row.reading),
+    let (default, sheet_path) = match a.paths.as_slice() {
+        [s] => (None, s.clone()),
+        [r, s] => (Some(r.clone()), s.clone()),
+        _ => return Err(Error::Usage("give [RECIPE] SHEET".into())),
+    };
+    if default.is_none() && a.recipe_dir.is_none() && a.recipes.is_empty() {
+        return Err(Error::Usage(
+            "no recipe: give RECIPE SHEET, or SHEET with --recipe-dir DIR or --recipe SAMPLE=FILE".into(),
         ));
     }
+    let mut per_sample = vec![];
+    for r in &a.recipes {
+        let Some((s, f)) = r.split_once('=') else {
+            return Err(Error::Usage(format!("--recipe takes SAMPLE=FILE, got `{r}`")));
+        };
+        per_sample.push((s.to_string(), PathBuf::from(f)));
+    }
+    if let Some(d) = &a.recipe_dir {
+        if !d.is_dir() {
+            return Err(Error::Usage(format!("--recipe-dir {}: not a directory", d.display())));
+        }
+    }
+    let recipes = Recipes { default, dir: a.recipe_dir.clone(), per_sample };
+    let options = SheetOptions {
+        delimiter: a.delimiter.as_deref().map(parse_delimiter).transpose()?,
+        ignore_columns: a.ignore_columns.clone(),
+    };
+    let baseline = a.baseline.as_deref().map(comparison::load_baseline).transpose()?;
+    let sheet = sheet::load(&sheet_path, &options)?;
+    let plan_options = PlanOptions { rtol: a.rtol, ..PlanOptions::default() };
+    let cmp = comparison::compare_sheet(&sheet, &recipes, &rule, &plan_options)?;
+    let drift = match &baseline {
+        Some(b) => comparison::check_baseline(
+            cmp.iter().filter_map(|c| c.predicted.as_ref().map(|p| (c.material.as_str(), p))),
+            b,
+        ),
+        None => vec![],
+    };
     let text = match a.format {
-        Format::Table => table(&material.name, &cmp),
-        Format::Json => json_text(&material.name, &cmp),
-        Format::Csv => csv_text(&cmp)?,
+        CompareFormat::Table => table(&sheet, &cmp, &rule, &drift, baseline.is_some()),
+        CompareFormat::Json => json_text(&sheet, &cmp, &rule, &drift, a.baseline.as_ref()),
+        CompareFormat::Csv => csv_text(&cmp)?,
+        CompareFormat::Junit => junit::compare(&sheet, &cmp, &drift)?,
     };
     target.write(&text)?;
-    let outside = cmp.iter().filter(|c| c.inside == Some(false)).count();
-    if outside > 0 {
-        return Err(Error::Check(format!("{outside} of {} reading(s) outside the allowed difference", cmp.len())));
-    }
-    let unchecked = cmp.iter().filter(|c| c.inside.is_none()).count();
-    if unchecked > 0 {
+    let outside = cmp.iter().filter(|c| c.verdict == Verdict::Outside).count();
+    let unchecked = cmp.iter().filter(|c| c.verdict.why_unchecked().is_some()).count();
+    let moved = drift.iter().filter(|d| d.moved).count();
+    if outside + unchecked + moved > 0 {
         return Err(Error::Check(format!(
-            "{unchecked} of {} reading(s) could not be checked (see the notes in the output)",
+            "of {} reading(s), {outside} outside the allowance, {unchecked} could not be checked (see the notes in \
+             the output); {moved} moved from the baseline",
             cmp.len()
         )));
     }
-    let predicted: Vec<Reading> = cmp.iter().filter_map(|c| c.predicted.clone()).collect();
+    let predicted: Vec<_> = cmp.iter().filter_map(|c| c.predicted.clone()).collect();
     readings_status(&predicted, a.allow_unconverged)
 }
 
@@ -137,83 +139,155 @@ fn fmt(v: Option<f64>) -> String {
     v.filter(|x| x.is_finite()).map(|x| format!("{x:.3}")).unwrap_or_else(|| "—".into())
 }
 
-/// `v` right-aligned in `width` characters (by hand: `format!`'s width is limited to 65 535).
-fn right(v: &str, width: usize) -> String {
-    let n = v.chars().count();
-    format!("{}{v}", " ".repeat(width.saturating_sub(n)))
+/// Counts of the verdicts, for the summary line.
+pub fn summary(cmp: &[Comparison]) -> String {
+    let count = |f: &dyn Fn(&Verdict) -> bool| cmp.iter().filter(|c| f(&c.verdict)).count();
+    format!(
+        "{} reading(s) of {} sample(s): {} ok, {} outside, {} unchecked (no value), {} unchecked (no allowance), {} not predicted",
+        cmp.len(),
+        {
+            let mut s: Vec<&str> = cmp.iter().map(|c| c.group.sample.as_str()).collect();
+            s.sort();
+            s.dedup();
+            s.len()
+        },
+        count(&|v| *v == Verdict::Inside),
+        count(&|v| *v == Verdict::Outside),
+        count(&|v| matches!(v, Verdict::NoValue(_))),
+        count(&|v| *v == Verdict::NoAllowance),
+        count(&|v| matches!(v, Verdict::NotPredicted(_))),
+    )
 }
 
-fn table(name: &str, cmp: &[Comparison]) -> String {
-    let mut rows = vec![[
+fn table(sheet: &Sheet, cmp: &[Comparison], rule: &Rule, drift: &[Drift], with_baseline: bool) -> String {
+    let head = [
         "sample",
+        "material",
         "geometry",
         "reading",
-        "measured",
+        "n",
+        "mean",
+        "std",
+        "min",
+        "max",
         "predicted",
         "numerical error",
         "predicted − measured",
-        "allowed",
+        "allowance",
         "verdict",
-    ]
-    .map(String::from)
-    .to_vec()];
-    let mut notes = Vec::new();
+    ];
+    let mut rows = vec![head.map(String::from).to_vec()];
+    let mut notes = vec![];
     for c in cmp {
         let p = c.predicted.as_ref();
         let v = p.and_then(|p| p.value);
+        let s = c.group.stats;
         rows.push(vec![
-            c.row.sample.clone(),
-            c.row.geometry.clone(),
-            c.row.reading.clone(),
-            format!("{:.3}", c.row.value),
+            c.group.sample.clone(),
+            c.material.clone(),
+            c.group.geometry.clone(),
+            c.group.reading.clone(),
+            s.n.to_string(),
+            format!("{:.3}", s.mean),
+            if s.n > 1 { format!("{:.3}", s.std) } else { "—".into() },
+            format!("{:.3}", s.min),
+            format!("{:.3}", s.max),
             fmt(v),
             p.filter(|p| p.value.is_some()).map(|p| format!("{:.1e}", p.error_estimate)).unwrap_or("—".into()),
             fmt(c.difference()),
-            fmt(c.allowed),
-            match c.inside {
-                Some(true) => "ok".into(),
-                Some(false) => "OUTSIDE".into(),
-                None => "unchecked".into(),
-            },
+            fmt(c.allowance.map(|a| a.total())),
+            c.verdict.label().into(),
         ]);
-        if let Some(why) = c.why_unchecked() {
-            notes.push(format!("line {} ({} {}): not checked: {why}", c.row.line, c.row.geometry, c.row.reading));
+        let why = match &c.verdict {
+            Verdict::NotPredicted(why) => Some(format!("not predicted: {why}")),
+            v => v.why_unchecked().map(|w| format!("not checked: {w}")),
+        };
+        if let Some(why) = why {
+            notes.push(format!(
+                "line {} ({} {} {}): {why}",
+                c.group.lines[0], c.group.sample, c.group.geometry, c.group.reading
+            ));
         }
     }
-    let w: Vec<usize> =
-        (0..rows[0].len()).map(|i| rows.iter().map(|r| r[i].chars().count()).max().unwrap_or(0)).collect();
-    let mut s = format!("{name}: predictions against the sheet\n\n");
-    for (k, r) in rows.iter().enumerate() {
-        let line: Vec<String> = r.iter().enumerate().map(|(i, v)| right(v, w[i])).collect();
-        s.push_str(line.join("  ").trim_end());
-        s.push('\n');
-        if k == 0 {
-            s.push_str(&w.iter().map(|n| "-".repeat(*n)).collect::<Vec<_>>().join("  "));
-            s.push('\n');
-        }
+    let mut s = format!("{}: predictions against the sheet\n", sheet.file);
+    for (k, v) in &sheet.metadata {
+        s.push_str(&format!("# {k}: {v}\n"));
     }
+    s.push('\n');
+    s.push_str(&pad_table(&rows, &[4, 5, 6, 7, 8, 9, 10, 11, 12]));
+    s.push_str(&format!(
+        "\nallowance = {}·s/√n + stated uncertainty + the prediction's error estimate\n{}\n",
+        rule.k,
+        summary(cmp)
+    ));
     for n in notes {
         s.push_str(&format!("note: {n}\n"));
+    }
+    if with_baseline {
+        let moved: Vec<&Drift> = drift.iter().filter(|d| d.moved).collect();
+        s.push_str(&format!("baseline: {} prediction(s) checked, {} moved\n", drift.len(), moved.len()));
+        for d in moved {
+            s.push_str(&format!(
+                "moved: {} {} {}: {} then, {} now (allowed {:.1e})\n",
+                d.material, d.geometry, d.reading, d.then, d.now, d.allowed
+            ));
+        }
     }
     s
 }
 
-fn json_text(name: &str, cmp: &[Comparison]) -> String {
-    let rows: Vec<_> = cmp
-        .iter()
-        .map(|c| {
-            let p = c.predicted.as_ref();
-            json!({
-                "line": c.row.line, "sample": c.row.sample, "geometry": c.row.geometry, "reading": c.row.reading,
-                "measured": c.row.value, "uncertainty": c.row.uncertainty,
-                "predicted": p.and_then(|p| p.value),
-                "error_estimate": p.filter(|p| p.value.is_some()).map(|p| p.error_estimate),
-                "difference": c.difference(),
-                "allowed": c.allowed, "inside": c.inside, "unchecked": c.why_unchecked(),
-            })
-        })
-        .collect();
-    serde_json::to_string_pretty(&json!({"material": name, "comparisons": rows})).expect("finite") + "\n"
+pub fn comparison_json(c: &Comparison) -> serde_json::Value {
+    let p = c.predicted.as_ref();
+    let s = c.group.stats;
+    json!({
+        "sample": c.group.sample, "material": c.material, "recipe": c.recipe,
+        "geometry": c.group.geometry, "reading": c.group.reading,
+        "predicted_reading": p.map(|p| p.name.clone()),
+        "lines": c.group.lines, "columns": c.group.columns,
+        "values": c.group.values,
+        "n": s.n, "mean": s.mean, "std": s.std, "min": s.min, "max": s.max,
+        "uncertainty": c.group.uncertainty,
+        "predicted": p.and_then(|p| p.value),
+        "error_estimate": p.filter(|p| p.value.is_some()).map(|p| p.error_estimate),
+        "difference": c.difference(),
+        "allowance": c.allowance.map(|a| json!({
+            "statistical": a.statistical, "stated": a.stated, "prediction": a.prediction, "total": a.total()
+        })),
+        "verdict": c.verdict.label(),
+        "inside": match c.verdict { Verdict::Inside => Some(true), Verdict::Outside => Some(false), _ => None },
+        "reason": match &c.verdict { Verdict::NotPredicted(w) | Verdict::NoValue(w) => Some(w.clone()), _ => None },
+        "unchecked": c.verdict.why_unchecked(),
+    })
+}
+
+pub fn drift_json(d: &Drift) -> serde_json::Value {
+    json!({"material": d.material, "geometry": d.geometry, "reading": d.reading,
+           "now": d.now, "then": d.then, "allowed": d.allowed, "moved": d.moved})
+}
+
+fn json_text(sheet: &Sheet, cmp: &[Comparison], rule: &Rule, drift: &[Drift], baseline: Option<&PathBuf>) -> String {
+    let mut doc = json!({
+        "sheet": {
+            "file": sheet.file, "encoding": sheet.encoding, "delimiter": (sheet.delimiter as char).to_string(),
+            "layout": match sheet.layout { sheet::Layout::Long => "long", sheet::Layout::Wide => "wide" },
+            "metadata": sheet.metadata_json(), "ignored_columns": sheet.ignored_columns,
+        },
+        "rule": {"k": rule.k, "tolerance": rule.tolerance},
+        "comparisons": cmp.iter().map(comparison_json).collect::<Vec<_>>(),
+        "summary": {
+            "readings": cmp.len(),
+            "inside": cmp.iter().filter(|c| c.verdict == Verdict::Inside).count(),
+            "outside": cmp.iter().filter(|c| c.verdict == Verdict::Outside).count(),
+            "no_value": cmp.iter().filter(|c| matches!(c.verdict, Verdict::NoValue(_))).count(),
+            "no_allowance": cmp.iter().filter(|c| c.verdict == Verdict::NoAllowance).count(),
+            "not_predicted": cmp.iter().filter(|c| matches!(c.verdict, Verdict::NotPredicted(_))).count(),
+        },
+    });
+    if let Some(b) = baseline {
+        doc["baseline"] = json!({"file": b.display().to_string(), "checks": drift.iter().map(drift_json).collect::<Vec<_>>(),
+                                 "moved": drift.iter().filter(|d| d.moved).count()});
+    }
+    serde_json::to_string_pretty(&doc).expect("finite") + "\n"
 }
 
 fn csv_text(cmp: &[Comparison]) -> Result<String> {
@@ -222,32 +296,46 @@ fn csv_text(cmp: &[Comparison]) -> Result<String> {
     w.write_record([
         "line",
         "sample",
+        "material",
         "geometry",
         "reading",
-        "measured",
+        "n",
+        "mean",
+        "std",
+        "min",
+        "max",
         "predicted",
         "error_estimate",
         "difference",
-        "allowed",
-        "inside",
+        "allowance",
+        "verdict",
         "note",
     ])
     .map_err(err)?;
+    let e = |v: Option<f64>| v.map(plain).unwrap_or_default();
     for c in cmp {
         let p = c.predicted.as_ref();
-        let v = p.and_then(|p| p.value);
+        let s = c.group.stats;
         w.write_record([
-            c.row.line.to_string(),
-            c.row.sample.clone(),
-            c.row.geometry.clone(),
-            c.row.reading.clone(),
-            plain(c.row.value),
-            v.map(plain).unwrap_or_default(),
-            v.and(p).map(|p| plain(p.error_estimate)).unwrap_or_default(),
-            c.difference().map(plain).unwrap_or_default(),
-            c.allowed.map(plain).unwrap_or_default(),
-            c.inside.map(|b| b.to_string()).unwrap_or_default(),
-            c.why_unchecked().map(|w| format!("not checked: {w}")).unwrap_or_default(),
+            c.group.lines[0].to_string(),
+            c.group.sample.clone(),
+            c.material.clone(),
+            c.group.geometry.clone(),
+            c.group.reading.clone(),
+            s.n.to_string(),
+            e(Some(s.mean)),
+            e(Some(s.std)),
+            e(Some(s.min)),
+            e(Some(s.max)),
+            e(p.and_then(|p| p.value)),
+            e(p.filter(|p| p.value.is_some()).map(|p| p.error_estimate)),
+            e(c.difference()),
+            e(c.allowance.map(|a| a.total())),
+            c.verdict.label().to_string(),
+            match &c.verdict {
+                Verdict::NotPredicted(why) => format!("not predicted: {why}"),
+                v => v.why_unchecked().map(|w| format!("not checked: {w}")).unwrap_or_default(),
+            },
         ])
         .map_err(err)?;
     }

@@ -14,6 +14,7 @@ use crate::{recipe, resolve_geometries, Error, Result};
 pub mod compare;
 pub mod convergence;
 pub mod format;
+pub mod junit;
 pub mod output;
 pub mod plot;
 
@@ -203,4 +204,32 @@ pub fn check_rtol(rtol: f64) -> Result<()> {
         return Err(Error::Usage(format!("--rtol must be a number in (0, 1), got {rtol}")));
     }
     Ok(())
+}
+/// A text table: a header row, a rule, then the rows; columns listed in `right` are right-aligned. Padding
+/// is done by hand (a `format!` width is limited to 65 535).
+pub fn pad_table(rows: &[Vec<String>], right: &[usize]) -> String {
+    let ncol = rows.first().map(|r| r.len()).unwrap_or(0);
+    let w: Vec<usize> = (0..ncol).map(|i| rows.iter().map(|r| r[i].chars().count()).max().unwrap_or(0)).collect();
+    let mut s = String::new();
+    for (k, r) in rows.iter().enumerate() {
+        let cells: Vec<String> = r
+            .iter()
+            .enumerate()
+            .map(|(i, v)| {
+                let pad = " ".repeat(w[i] - v.chars().count());
+                if right.contains(&i) {
+                    format!("{pad}{v}")
+                } else {
+                    format!("{v}{pad}")
+                }
+            })
+            .collect();
+        s.push_str(cells.join("  ").trim_end());
+        s.push('\n');
+        if k == 0 {
+            s.push_str(&w.iter().map(|n| "-".repeat(*n)).collect::<Vec<_>>().join("  "));
+            s.push('\n');
+        }
+    }
+    s
 }

@@ -1,192 +1,810 @@
-//! Glossmeter sheets: readings taken with real instruments, as CSV, to compare predictions against.
+//! Instrument sheets: readings taken with real glossmeters, as the instruments and spreadsheets write them,
+//! to compare predictions against (`compare`, `fit --sheet`).
 //!
-//! Two layouts are read (both allow `#` comment lines before the header, e.g. for the instrument and date):
+//! Real sheets are not tidy, so the reader accepts what instruments and Excel actually write
+//! (docs/instrument.md §Sheets has the full table):
 //!
-//! * **long**: one reading per row, header with `geometry` and `value` (required), and optionally `quantity`
-//!   (or a reading name such as `haze-narrow`; default `gloss`), `uncertainty` (same unit as the value) and
-//!   `sample`;
-//! * **wide** (what tri-angle glossmeters export): a `sample` column and one column per angle named `20`,
-//!   `60`, `85` (optionally `20°`, `G20`, `gloss 20°`, …), read as ASTM D523 gloss at that angle.
+//! * UTF-8 with or without a byte-order mark, UTF-16 with a BOM, and anything else as Windows-1252
+//!   (older exports write `°` as the single byte 0xB0), decoded with `encoding_rs`;
+//! * `,`, `;` or tab separators, detected from the header line (or given), CRLF or LF line ends, quoted
+//!   fields (also across lines), decimal commas (`89,1`);
+//! * `#` comment lines anywhere; `# key: value` lines are kept as the sheet's metadata;
+//! * two layouts: **long** (a `geometry` and a `value` column, one reading per row) and **wide** (one column
+//!   per reading, named as instruments name them: `20°`, `Gloss 60`, `Haze`, `HU_LOG`, `DOI`, `Rspec`, ...;
+//!   the aliases are the table [`READING_COLUMNS`] plus the gloss-angle pattern of [`gloss_angle`]);
+//! * repeated readings: several rows for the same sample, or columns with a repeat suffix (`60° #2`,
+//!   `60° (2)`, `60° [2]`).
 //!
-//! Every error names the file, the line and the column.
+//! A column the reader does not recognise is an error (unless the caller ignores it by name), so that no reading
+//! is silently dropped. Every error names the file, the line and the column.
 use std::path::Path;
 
 use crate::{Error, Result};
 
-/// One measured reading.
+/// A reading column an instrument writes, and the glossmeter reading it stands for. `not_predicted` is set for
+/// readings whose formula is not public (they are reported as "not predicted", never dropped).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ReadingColumn {
+    /// Normalised header names (lower case, only letters and digits; see [`normalise`]).
+    pub names: &'static [&'static str],
+    /// The geometry id and the reading (a reading name or a quantity of that geometry).
+    pub geometry: &'static str,
+    pub reading: &'static str,
+    pub not_predicted: Option<&'static str>,
+    /// Where the mapping comes from (shown in the docs table).
+    pub source: &'static str,
+}
+
+const NOT_PUBLIC: &str = "the maker's formula is not public";
+
+/// Header aliases of the readings other than plain gloss (for gloss see [`gloss_angle`]). To add a reading
+/// (e.g. colour columns), add a row; the docs table in docs/instrument.md §Sheets lists the same rows.
+pub const READING_COLUMNS: &[ReadingColumn] = &[
+    ReadingColumn {
+        names: &["haze", "hu", "haze20", "20haze", "hazehu"],
+        geometry: "iso-13803-20",
+        reading: "haze",
+        not_predicted: None,
+        source: "BYK haze-gloss and Rhopoint IQ report haze at 20° (ISO 13803 / ASTM E430)",
+    },
+    ReadingColumn {
+        names: &["loghaze", "hulog", "hazelog", "loghu", "loghaze20", "hazeloghu"],
+        geometry: "iso-13803-20",
+        reading: "log-haze",
+        not_predicted: None,
+        source: "log haze of the BYK haze-gloss / Rhopoint IQ (docs/instrument.md §1.6)",
+    },
+    ReadingColumn {
+        names: &["hazenarrow", "narrowhaze", "hazen"],
+        geometry: "astm-e430-30",
+        reading: "haze-narrow",
+        not_predicted: None,
+        source: "ASTM E430 narrow-angle haze at 30°",
+    },
+    ReadingColumn {
+        names: &["hazewide", "widehaze", "hazew"],
+        geometry: "astm-e430-30",
+        reading: "haze-wide",
+        not_predicted: None,
+        source: "ASTM E430 wide-angle haze at 30°",
+    },
+    ReadingColumn {
+        names: &["doi", "distinctnessofimage", "doi30"],
+        geometry: "astm-e430-30",
+        reading: "doi",
+        not_predicted: None,
+        source: "ASTM E430 DOI (Hunter/Dorigon form) at 30°",
+    },
+    ReadingColumn {
+        names: &["hazeindex", "d4039", "hazeindexgu"],
+        geometry: "astm-d4039",
+        reading: "haze-index",
+        not_predicted: None,
+        source: "ASTM D4039 haze index G60 − G20",
+    },
+    ReadingColumn {
+        names: &["rspec", "rspec20"],
+        geometry: "rspec-20",
+        reading: "rspec",
+        not_predicted: None,
+        source: "Rhopoint IQ peak specular reflectance at 20° (predicted where the `rspec-20` geometry is shipped)",
+    },
+    ReadingColumn {
+        names: &["riq", "reflectedimagequality"],
+        geometry: "rspec-20",
+        reading: "riq",
+        not_predicted: Some(NOT_PUBLIC),
+        source: "Rhopoint IQ reflected image quality",
+    },
+    ReadingColumn {
+        names: &["doic", "doicomp", "doicompensated", "compensateddoi", "doicomp20"],
+        geometry: "astm-e430-30",
+        reading: "doi-compensated",
+        not_predicted: Some(NOT_PUBLIC),
+        source: "makers' compensated DOI",
+    },
+];
+
+/// Columns that say which sample a row is.
+pub const SAMPLE_COLUMNS: &[&str] =
+    &["sample", "samplename", "sampleid", "specimen", "name", "id", "panel", "probe", "probenname", "muster"];
+/// Columns kept by the reader but not compared (bookkeeping that instruments add to each row).
+pub const INFO_COLUMNS: &[&str] = &[
+    "date",
+    "datum",
+    "time",
+    "datetime",
+    "timestamp",
+    "operator",
+    "user",
+    "comment",
+    "comments",
+    "note",
+    "notes",
+    "no",
+    "nr",
+    "number",
+    "index",
+    "unit",
+    "units",
+];
+/// The long layout's columns.
+pub const GEOMETRY_COLUMNS: &[&str] = &["geometry", "geometryid"];
+pub const QUANTITY_COLUMNS: &[&str] = &["quantity", "reading", "readingname"];
+pub const VALUE_COLUMNS: &[&str] = &["value", "measured", "measurement"];
+pub const UNCERTAINTY_COLUMNS: &[&str] = &["uncertainty", "u", "unc"];
+
+/// The gloss angles instruments write, and the shipped geometry read at each.
+pub const GLOSS_ANGLES: &[(&str, &str)] = &[
+    ("20", "astm-d523-20"),
+    ("45", "astm-d2457-45"),
+    ("60", "astm-d523-60"),
+    ("75", "tappi-t480-75"),
+    ("85", "astm-d523-85"),
+];
+
+/// What the reader was asked to do differently from its defaults.
+#[derive(Clone, Debug, Default)]
+pub struct SheetOptions {
+    /// The separator (`,`, `;` or tab); detected from the header line when None.
+    pub delimiter: Option<u8>,
+    /// Column headers to skip (matched like aliases: case, spaces and punctuation do not matter).
+    pub ignore_columns: Vec<String>,
+}
+
+/// One measured value.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SheetRow {
+    /// The line of the file the row starts on (1-based, counting comment and blank lines).
     pub line: usize,
+    /// The header of the column the value came from.
+    pub column: String,
     pub sample: String,
     pub geometry: String,
     /// A quantity (`gloss`, `haze`, `doi`, …) or a reading name (`haze-narrow`, …).
     pub reading: String,
     pub value: f64,
     pub uncertainty: Option<f64>,
+    /// Set when the sheet's column is recognised but the reading's formula is not public.
+    pub not_predicted: Option<String>,
 }
 
-pub fn load(path: &Path) -> Result<Vec<SheetRow>> {
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Layout {
+    Long,
+    Wide,
+}
+
+/// A parsed sheet: its rows and what the reader found out about the file.
+#[derive(Clone, Debug)]
+pub struct Sheet {
+    pub file: String,
+    /// `UTF-8`, `UTF-8 with BOM`, `UTF-16LE with BOM`, `windows-1252`, ...
+    pub encoding: String,
+    pub delimiter: u8,
+    pub layout: Layout,
+    /// `# key: value` lines, in file order.
+    pub metadata: Vec<(String, String)>,
+    /// Columns skipped on request.
+    pub ignored_columns: Vec<String>,
+    /// The header line, the headers, and the columns of the sample and the geometry (0-based), for messages.
+    pub header_line: usize,
+    pub headers: Vec<String>,
+    pub sample_column: Option<usize>,
+    pub geometry_column: Option<usize>,
+    pub quantity_column: Option<usize>,
+    pub rows: Vec<SheetRow>,
+}
+
+impl Sheet {
+    /// The metadata as a JSON object (a key given twice keeps both values, joined by "; ").
+    pub fn metadata_json(&self) -> serde_json::Value {
+        let mut m = serde_json::Map::new();
+        for (k, v) in &self.metadata {
+            match m.get_mut(k) {
+                Some(serde_json::Value::String(old)) => {
+                    old.push_str("; ");
+                    old.push_str(v);
+                }
+                _ => {
+                    m.insert(k.clone(), serde_json::Value::String(v.clone()));
+                }
+            }
+        }
+        serde_json::Value::Object(m)
+    }
+
+    /// `line L, column C (header)` of a row's sample or geometry cell.
+    pub fn cell(&self, line: usize, column: Option<usize>, what: &str) -> String {
+        match column {
+            Some(c) => at(line, c, &self.headers[c]),
+            None => format!("line {line} (no {what} column)"),
+        }
+    }
+
+    /// The distinct geometry ids of the rows, in order of appearance.
+    pub fn geometry_ids(&self) -> Vec<String> {
+        let mut ids: Vec<String> = Vec::new();
+        for r in &self.rows {
+            if !ids.contains(&r.geometry) {
+                ids.push(r.geometry.clone());
+            }
+        }
+        ids
+    }
+}
+
+pub fn load(path: &Path, options: &SheetOptions) -> Result<Sheet> {
     let file = path.display().to_string();
-    let text = crate::input::read_text(path, "sheet")?;
-    parse(&text, &file)
+    let bytes = crate::input::read_bytes(path, "sheet")?;
+    parse_bytes(&bytes, &file, options)
 }
 
-/// The D523 angle a wide-layout column stands for, if any.
-fn wide_angle(header: &str) -> Option<&'static str> {
-    let h: String = header.to_lowercase().chars().filter(|c| c.is_ascii_alphanumeric()).collect();
-    let h = h.trim_start_matches("gloss").trim_start_matches('g').trim_end_matches("deg");
-    match h {
-        "20" => Some("astm-d523-20"),
-        "60" => Some("astm-d523-60"),
-        "85" => Some("astm-d523-85"),
-        _ => None,
+/// Decode a sheet's bytes: a BOM decides; else UTF-8 if it is valid UTF-8; else Windows-1252.
+pub fn decode(bytes: &[u8], file: &str) -> Result<(String, String)> {
+    if let Some((enc, bom)) = encoding_rs::Encoding::for_bom(bytes) {
+        let (text, had_errors) = enc.decode_without_bom_handling(&bytes[bom..]);
+        if had_errors {
+            return Err(Error::input(file, "", format!("not valid {} although it starts with a BOM", enc.name())));
+        }
+        return Ok((text.into_owned(), format!("{} with BOM", enc.name())));
     }
-}
-
-/// The 1-based line of the record that starts at byte `at` (the CSV reader's position is where it began
-/// reading, before any blank lines it skipped).
-fn line_at(body: &str, at: u64) -> usize {
-    let at = (at as usize).min(body.len());
-    let skipped_blank = body[at..].bytes().take_while(|b| *b == b'\n' || *b == b'\r').filter(|b| *b == b'\n').count();
-    1 + body.as_bytes()[..at].iter().filter(|b| **b == b'\n').count() + skipped_blank
-}
-
-pub fn parse(text: &str, file: &str) -> Result<Vec<SheetRow>> {
-    // A byte-order mark (spreadsheet exports write one) is not part of the first line.
-    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
-    // Drop comment lines but keep line numbers right.
-    let skipped = text.lines().take_while(|l| l.trim_start().starts_with('#') || l.trim().is_empty()).count();
-    let body: String = text.lines().skip(skipped).collect::<Vec<_>>().join("\n");
-    let mut rdr = csv::ReaderBuilder::new().trim(csv::Trim::All).flexible(false).from_reader(body.as_bytes());
-    let headers: Vec<String> = rdr
-        .headers()
-        .map_err(|e| Error::input(file, format!("line {}", skipped + 1), format!("unreadable CSV header: {e}")))?
-        .iter()
-        .map(|h| h.to_string())
-        .collect();
-    let col = |name: &str| headers.iter().position(|h| h.eq_ignore_ascii_case(name));
-    let long = col("geometry").is_some();
-    let wide_cols: Vec<(usize, &'static str)> =
-        headers.iter().enumerate().filter_map(|(i, h)| wide_angle(h).map(|g| (i, g))).collect();
-    if !long && wide_cols.is_empty() {
+    if bytes.contains(&0) {
         return Err(Error::input(
             file,
-            format!("line {} (header)", skipped + 1),
-            "expected a `geometry` and a `value` column (long layout) or columns named 20, 60, 85 (wide layout)",
+            "",
+            "contains NUL bytes: not a text sheet (UTF-16 needs a BOM; allowed: UTF-8, UTF-16 with BOM, Windows-1252)",
         ));
     }
-    if long && col("value").is_none() {
-        return Err(Error::input(
-            file,
-            format!("line {} (header)", skipped + 1),
-            "the long layout needs a `value` column",
-        ));
+    match std::str::from_utf8(bytes) {
+        Ok(s) => Ok((s.to_string(), "UTF-8".into())),
+        Err(_) => {
+            let (text, _) = encoding_rs::WINDOWS_1252.decode_without_bom_handling(bytes);
+            Ok((text.into_owned(), "windows-1252".into()))
+        }
     }
-    let mut rows = Vec::new();
-    for rec in rdr.records() {
-        // Lines, not records: blank lines and quoted newlines make the two differ.
-        let rec = rec.map_err(|e| {
-            let line = skipped + e.position().map(|p| line_at(&body, p.byte())).unwrap_or(1);
-            Error::input(file, format!("line {line}"), format!("malformed CSV row: {e}"))
-        })?;
-        let line = skipped + rec.position().map(|p| line_at(&body, p.byte())).unwrap_or(1);
-        let get = |c: Option<usize>| c.and_then(|c| rec.get(c)).unwrap_or("").to_string();
-        let num = |c: usize, what: &str, nonneg: bool| -> Result<f64> {
-            let s = rec.get(c).unwrap_or("");
-            let field = format!("line {line}, column `{}`", headers[c]);
-            let v: f64 = s
-                .parse()
-                .map_err(|_| Error::input(file, &field, format!("expected a number ({what}), got \"{s}\"")))?;
-            if !v.is_finite() || (nonneg && v < 0.0) {
+}
+
+pub fn parse_bytes(bytes: &[u8], file: &str, options: &SheetOptions) -> Result<Sheet> {
+    let (text, encoding) = decode(bytes, file)?;
+    let mut sheet = parse(&text, file, options)?;
+    sheet.encoding = encoding;
+    Ok(sheet)
+}
+
+/// A header as the alias tables spell it: without parenthesised units, lower case, only letters and
+/// digits, without a trailing `deg`/`degree(s)`. `Gloss 60° (GU)` → `gloss60`, `HU_LOG` → `hulog`.
+pub fn normalise(header: &str) -> String {
+    let mut s = String::new();
+    let mut depth = 0usize;
+    for c in header.chars() {
+        match c {
+            '(' | '[' => depth += 1,
+            ')' | ']' => depth = depth.saturating_sub(1),
+            c if depth == 0 && c.is_alphanumeric() => s.extend(c.to_lowercase()),
+            _ => {}
+        }
+    }
+    for suffix in ["degrees", "degree", "deg"] {
+        if let Some(t) = s.strip_suffix(suffix) {
+            if t.ends_with(|c: char| c.is_ascii_digit()) {
+                return t.to_string();
+            }
+        }
+    }
+    s
+}
+
+/// The gloss geometry of a header such as `20`, `20°`, `G60`, `Gloss 85°`, `60 gloss`, `GU 20`.
+pub fn gloss_angle(normalised: &str) -> Option<&'static str> {
+    let mut h = normalised;
+    for p in ["gloss", "gu", "g"] {
+        if let Some(t) = h.strip_prefix(p) {
+            h = t;
+            break;
+        }
+    }
+    for s in ["gloss", "gu"] {
+        if let Some(t) = h.strip_suffix(s) {
+            h = t;
+            break;
+        }
+    }
+    GLOSS_ANGLES.iter().find(|(a, _)| *a == h).map(|(_, g)| *g)
+}
+
+/// A repeat suffix `#N`, `(N)` or `[N]` at the end of a header, and the header without it.
+fn split_repeat(header: &str) -> (&str, Option<u32>) {
+    let t = header.trim_end();
+    let try_num = |inner: &str| inner.trim().parse::<u32>().ok();
+    if let Some(i) = t.rfind('#') {
+        if let Some(n) = try_num(&t[i + 1..]) {
+            return (t[..i].trim_end(), Some(n));
+        }
+    }
+    for (open, close) in [('(', ')'), ('[', ']')] {
+        if t.ends_with(close) {
+            if let Some(i) = t.rfind(open) {
+                if let Some(n) = try_num(&t[i + 1..t.len() - 1]) {
+                    return (t[..i].trim_end(), Some(n));
+                }
+            }
+        }
+    }
+    (t, None)
+}
+
+/// What a header column is.
+#[derive(Clone, Debug, PartialEq)]
+enum Role {
+    Sample,
+    Info,
+    Geometry,
+    Quantity,
+    Value,
+    Uncertainty,
+    /// A reading column of the wide layout: geometry, reading, repeat index, not-predicted reason.
+    Reading {
+        geometry: &'static str,
+        reading: &'static str,
+        repeat: Option<u32>,
+        not_predicted: Option<&'static str>,
+    },
+    Ignored,
+}
+
+fn role(header: &str, ignore: &[String]) -> Option<Role> {
+    let n = normalise(header);
+    if ignore.iter().any(|i| normalise(i) == n) {
+        return Some(Role::Ignored);
+    }
+    let is = |list: &[&str]| list.contains(&n.as_str());
+    if is(SAMPLE_COLUMNS) {
+        return Some(Role::Sample);
+    }
+    if is(INFO_COLUMNS) {
+        return Some(Role::Info);
+    }
+    if is(GEOMETRY_COLUMNS) {
+        return Some(Role::Geometry);
+    }
+    if is(QUANTITY_COLUMNS) {
+        return Some(Role::Quantity);
+    }
+    if is(VALUE_COLUMNS) {
+        return Some(Role::Value);
+    }
+    if is(UNCERTAINTY_COLUMNS) {
+        return Some(Role::Uncertainty);
+    }
+    let (base, repeat) = split_repeat(header);
+    let b = normalise(base);
+    if let Some(g) = gloss_angle(&b) {
+        return Some(Role::Reading { geometry: g, reading: "gloss", repeat, not_predicted: None });
+    }
+    READING_COLUMNS.iter().find(|c| c.names.contains(&b.as_str())).map(|c| Role::Reading {
+        geometry: c.geometry,
+        reading: c.reading,
+        repeat,
+        not_predicted: c.not_predicted,
+    })
+}
+
+/// The separator of the header line: the most frequent of `;`, `,` and tab outside quotes (`,` on a tie).
+pub fn detect_delimiter(header_line: &str) -> u8 {
+    let mut counts = [(b',', 0usize), (b';', 0), (b'\t', 0)];
+    let mut quoted = false;
+    for c in header_line.bytes() {
+        if c == b'"' {
+            quoted = !quoted;
+        } else if !quoted {
+            for k in counts.iter_mut() {
+                if k.0 == c {
+                    k.1 += 1;
+                }
+            }
+        }
+    }
+    let best = counts.iter().max_by_key(|k| k.1).expect("three candidates");
+    if best.1 == 0 || counts[0].1 == best.1 {
+        b','
+    } else {
+        best.0
+    }
+}
+
+/// A number as sheets write it: `89.1`, `89,1` (decimal comma), `-1.5e-3`. A field with both `.` and `,`
+/// (a thousands separator?) is refused rather than guessed.
+pub fn parse_number(s: &str) -> std::result::Result<f64, String> {
+    let t = s.trim();
+    let t = if t.contains(',') {
+        if t.contains('.') || t.matches(',').count() > 1 {
+            return Err(format!("\"{s}\" mixes `.` and `,` (thousands separators are not read)"));
+        }
+        t.replace(',', ".")
+    } else {
+        t.to_string()
+    };
+    // Rust's parser reads "inf" and "NaN": they are not readings.
+    if !t.bytes().all(|c| c.is_ascii_digit() || matches!(c, b'.' | b'-' | b'+' | b'e' | b'E')) {
+        return Err(format!("expected a number, got \"{s}\""));
+    }
+    t.parse::<f64>().map_err(|_| format!("expected a number, got \"{s}\"")).and_then(|v| {
+        if v.is_finite() {
+            Ok(v)
+        } else {
+            Err(format!("\"{s}\" is not a finite number"))
+        }
+    })
+}
+
+/// Metadata of a comment line `# key: value` (a short key of at most four words).
+fn metadata_line(line: &str) -> Option<(String, String)> {
+    let body = line.trim_start().strip_prefix('#')?.trim();
+    let (k, v) = body.split_once(':')?;
+    let k = k.trim();
+    let ok = !k.is_empty()
+        && k.len() <= 40
+        && k.split_whitespace().count() <= 4
+        && k.chars().all(|c| c.is_alphanumeric() || " _-.".contains(c));
+    ok.then(|| (k.to_lowercase(), v.trim().to_string()))
+}
+
+fn at(line: usize, col: usize, header: &str) -> String {
+    format!("line {line}, column {} ({header})", col + 1)
+}
+
+pub fn parse(text: &str, file: &str, options: &SheetOptions) -> Result<Sheet> {
+    let metadata: Vec<(String, String)> = text.lines().filter_map(metadata_line).collect();
+    let header_line = text.lines().find(|l| !l.trim().is_empty() && !l.trim_start().starts_with('#'));
+    let Some(header_line) = header_line else {
+        return Err(Error::input(file, "", "the sheet is empty (no header line)"));
+    };
+    let delimiter = options.delimiter.unwrap_or_else(|| detect_delimiter(header_line));
+    let mut rdr = csv::ReaderBuilder::new()
+        .delimiter(delimiter)
+        .has_headers(false)
+        .flexible(true)
+        .comment(Some(b'#'))
+        .trim(csv::Trim::All)
+        .from_reader(text.as_bytes());
+    let lines = Lines::new(text);
+    let mut records = rdr.records();
+    let mut header: Option<(usize, Vec<String>)> = None;
+    // The first record that is not blank is the header.
+    for rec in records.by_ref() {
+        let rec = rec.map_err(|e| csv_error(file, &lines, &e))?;
+        if rec.iter().all(|f| f.is_empty()) {
+            continue;
+        }
+        let line = lines.line_of(&rec);
+        header = Some((line, rec.iter().map(str::to_string).collect()));
+        break;
+    }
+    let Some((hline, headers)) = header else {
+        return Err(Error::input(file, "", "the sheet is empty (no header line)"));
+    };
+    let mut roles = Vec::new();
+    for (j, h) in headers.iter().enumerate() {
+        if h.is_empty() {
+            return Err(Error::input(file, at(hline, j, "empty"), "empty column header"));
+        }
+        match role(h, &options.ignore_columns) {
+            Some(r) => roles.push(r),
+            None => {
                 return Err(Error::input(
                     file,
-                    &field,
-                    format!("{what} must be a finite number{}", if nonneg { " ≥ 0" } else { "" }),
+                    at(hline, j, h),
+                    format!(
+                        "unrecognised column `{h}` (the columns glossmeter reads are listed in docs/instrument.md \
+                         §Sheets; pass --ignore-column '{h}' to skip it)"
+                    ),
+                ))
+            }
+        }
+    }
+    // Duplicate headers: two columns of the same role (other than info/ignored) are ambiguous.
+    for j in 0..roles.len() {
+        for i in 0..j {
+            if roles[i] == roles[j] && !matches!(roles[j], Role::Info | Role::Ignored) {
+                return Err(Error::input(
+                    file,
+                    at(hline, j, &headers[j]),
+                    format!(
+                        "duplicate column: `{}` means the same as column {} (`{}`); number repeated readings \
+                         as `60° #1`, `60° #2`",
+                        headers[j],
+                        i + 1,
+                        headers[i]
+                    ),
                 ));
+            }
+        }
+    }
+    let find = |r: &Role| roles.iter().position(|x| x == r);
+    let (geo_c, val_c) = (find(&Role::Geometry), find(&Role::Value));
+    let reading_cols: Vec<usize> = (0..roles.len()).filter(|&j| matches!(roles[j], Role::Reading { .. })).collect();
+    let layout = match (geo_c, val_c) {
+        (Some(_), Some(_)) => Layout::Long,
+        (Some(_), None) => {
+            return Err(Error::input(file, format!("line {hline} (header)"), "the long layout needs a `value` column"))
+        }
+        (None, Some(v)) => {
+            return Err(Error::input(file, at(hline, v, &headers[v]), "the long layout needs a `geometry` column"))
+        }
+        (None, None) if reading_cols.is_empty() => {
+            return Err(Error::input(
+                file,
+                format!("line {hline} (header)"),
+                "no reading columns: expected `geometry` and `value` (long layout) or reading columns such as \
+                 20°, 60°, 85°, Haze, DOI (wide layout)",
+            ))
+        }
+        (None, None) => Layout::Wide,
+    };
+    if layout == Layout::Long {
+        if let Some(&j) = reading_cols.first() {
+            return Err(Error::input(
+                file,
+                at(hline, j, &headers[j]),
+                "a reading column in a long-layout sheet (one with `geometry` and `value`): use one layout",
+            ));
+        }
+    } else if let Some(j) = roles.iter().position(|r| matches!(r, Role::Quantity | Role::Uncertainty)) {
+        return Err(Error::input(
+            file,
+            at(hline, j, &headers[j]),
+            "`quantity` and `uncertainty` belong to the long layout (with `geometry` and `value`)",
+        ));
+    }
+    let sample_c = find(&Role::Sample);
+    let ignored_columns = (0..roles.len()).filter(|&j| roles[j] == Role::Ignored).map(|j| headers[j].clone()).collect();
+    let mut rows = Vec::new();
+    for rec in records {
+        let rec = rec.map_err(|e| csv_error(file, &lines, &e))?;
+        if rec.iter().all(|f| f.is_empty()) {
+            continue;
+        }
+        let line = lines.line_of(&rec);
+        if rec.len() != headers.len() {
+            let j = rec.len().min(headers.len());
+            return Err(Error::input(
+                file,
+                format!("line {line}, column {}", j + 1),
+                format!("{} fields, but the header (line {hline}) has {}", rec.len(), headers.len()),
+            ));
+        }
+        let get = |c: Option<usize>| c.and_then(|c| rec.get(c)).unwrap_or("").to_string();
+        let num = |c: usize, what: &str, nonneg: bool| -> Result<f64> {
+            let v = parse_number(&rec[c])
+                .map_err(|m| Error::input(file, at(line, c, &headers[c]), format!("{what}: {m}")))?;
+            if nonneg && v < 0.0 {
+                return Err(Error::input(file, at(line, c, &headers[c]), format!("{what} must be ≥ 0, got {v}")));
             }
             Ok(v)
         };
-        let sample = get(col("sample"));
-        if long {
-            let geometry = get(col("geometry"));
-            if geometry.is_empty() {
-                return Err(Error::input(file, format!("line {line}, column `geometry`"), "empty geometry id"));
-            }
-            let reading = match get(col("quantity")) {
-                q if q.is_empty() => "gloss".to_string(),
-                q => q,
-            };
-            let value = num(col("value").expect("checked"), "the measured value", false)?;
-            let uncertainty = match col("uncertainty") {
-                Some(c) if !rec.get(c).unwrap_or("").is_empty() => Some(num(c, "the uncertainty", true)?),
-                _ => None,
-            };
-            rows.push(SheetRow { line, sample, geometry, reading, value, uncertainty });
-        } else {
-            for &(c, g) in &wide_cols {
-                if rec.get(c).unwrap_or("").is_empty() {
-                    continue;
+        let sample = get(sample_c);
+        match layout {
+            Layout::Long => {
+                let (g, v) = (geo_c.expect("long"), val_c.expect("long"));
+                let geometry = get(Some(g));
+                if geometry.is_empty() {
+                    return Err(Error::input(file, at(line, g, &headers[g]), "empty geometry id"));
                 }
-                let value = num(c, "the measured gloss", false)?;
+                let reading = match get(find(&Role::Quantity)) {
+                    q if q.is_empty() => "gloss".to_string(),
+                    q => q.to_lowercase().split_whitespace().collect::<Vec<_>>().join("-"),
+                };
+                let not_predicted = READING_COLUMNS
+                    .iter()
+                    .find(|c| c.reading == reading && c.geometry == geometry)
+                    .and_then(|c| c.not_predicted)
+                    .map(String::from);
+                let value = num(v, "the measured value", false)?;
+                let uncertainty = match find(&Role::Uncertainty) {
+                    Some(c) if !rec[c].is_empty() => Some(num(c, "the uncertainty", true)?),
+                    _ => None,
+                };
                 rows.push(SheetRow {
                     line,
-                    sample: sample.clone(),
-                    geometry: g.to_string(),
-                    reading: "gloss".into(),
+                    column: headers[v].clone(),
+                    sample,
+                    geometry,
+                    reading,
                     value,
-                    uncertainty: None,
+                    uncertainty,
+                    not_predicted,
                 });
+            }
+            Layout::Wide => {
+                for &c in &reading_cols {
+                    if rec[c].is_empty() {
+                        continue;
+                    }
+                    let Role::Reading { geometry, reading, not_predicted, .. } = &roles[c] else { unreachable!() };
+                    let value = num(c, "the measured value", false)?;
+                    rows.push(SheetRow {
+                        line,
+                        column: headers[c].clone(),
+                        sample: sample.clone(),
+                        geometry: geometry.to_string(),
+                        reading: reading.to_string(),
+                        value,
+                        uncertainty: None,
+                        not_predicted: not_predicted.map(String::from),
+                    });
+                }
             }
         }
     }
     if rows.is_empty() {
-        return Err(Error::input(file, "", "the sheet has no readings"));
+        return Err(Error::input(file, format!("line {hline} (header)"), "the sheet has a header but no readings"));
     }
-    Ok(rows)
+    Ok(Sheet {
+        file: file.to_string(),
+        encoding: "UTF-8".into(),
+        delimiter,
+        layout,
+        metadata,
+        ignored_columns,
+        header_line: hline,
+        headers,
+        sample_column: sample_c,
+        geometry_column: geo_c,
+        quantity_column: find(&Role::Quantity),
+        rows,
+    })
+}
+
+/// Line numbers of records. The `csv` crate's own line count is off after comment and blank lines, and its
+/// byte position is where it started reading (before the blank and comment lines it skipped), so the record's
+/// first line is found from that position by skipping line ends and `#` lines.
+struct Lines<'a> {
+    text: &'a [u8],
+    starts: Vec<usize>,
+}
+
+impl<'a> Lines<'a> {
+    fn new(text: &'a str) -> Self {
+        let b = text.as_bytes();
+        let starts =
+            std::iter::once(0).chain(b.iter().enumerate().filter(|(_, &c)| c == b'\n').map(|(i, _)| i + 1)).collect();
+        Lines { text: b, starts }
+    }
+
+    fn line_of(&self, rec: &csv::StringRecord) -> usize {
+        self.line_at(rec.position().map(|p| p.byte() as usize).unwrap_or(0))
+    }
+
+    fn line_at(&self, byte: usize) -> usize {
+        let mut p = byte.min(self.text.len());
+        loop {
+            while p < self.text.len() && matches!(self.text[p], b'\r' | b'\n') {
+                p += 1;
+            }
+            let at_line_start = p == 0 || self.text[p - 1] == b'\n';
+            if p < self.text.len() && at_line_start && self.text[p] == b'#' {
+                while p < self.text.len() && self.text[p] != b'\n' {
+                    p += 1;
+                }
+                continue;
+            }
+            break;
+        }
+        // The number of line starts at or before p.
+        self.starts.partition_point(|&s| s <= p)
+    }
+}
+
+fn csv_error(file: &str, lines: &Lines, e: &csv::Error) -> Error {
+    let field = e.position().map(|p| format!("line {}", lines.line_at(p.byte() as usize))).unwrap_or_default();
+    Error::input(file, field, format!("malformed CSV: {e}"))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
+    fn p(text: &str) -> Result<Sheet> {
+        parse(text, "s.csv", &SheetOptions::default())
+    }
+
     #[test]
     fn long_and_wide_layouts() {
         let long = "# BYK micro-TRI-gloss\nsample,geometry,quantity,value,uncertainty\np1,astm-d523-60,gloss,89.1,0.5\np1,astm-e430-30,haze-narrow,3.2,\n";
-        let r = parse(long, "s.csv").unwrap();
+        let r = p(long).unwrap().rows;
         assert_eq!(r.len(), 2);
         assert_eq!((r[0].line, r[0].uncertainty), (3, Some(0.5)));
         assert_eq!((r[1].reading.as_str(), r[1].uncertainty), ("haze-narrow", None));
         let wide = "sample,20°,60°,85°\np1,82.0,89.1,99.0\np2,,90,\n";
-        let r = parse(wide, "w.csv").unwrap();
+        let r = p(wide).unwrap().rows;
         assert_eq!(r.len(), 4);
         assert_eq!(r[3].geometry, "astm-d523-60");
     }
 
     #[test]
+    fn aliases() {
+        for (h, g, r) in [
+            ("Gloss 20°", "astm-d523-20", "gloss"),
+            ("G60", "astm-d523-60", "gloss"),
+            ("85 deg", "astm-d523-85", "gloss"),
+            ("60° (GU)", "astm-d523-60", "gloss"),
+            ("HU", "iso-13803-20", "haze"),
+            ("Haze", "iso-13803-20", "haze"),
+            ("Log Haze", "iso-13803-20", "log-haze"),
+            ("HU_LOG", "iso-13803-20", "log-haze"),
+            ("HULog", "iso-13803-20", "log-haze"),
+            ("DOI", "astm-e430-30", "doi"),
+            ("Rspec", "rspec-20", "rspec"),
+            ("RIQ", "rspec-20", "riq"),
+        ] {
+            match role(h, &[]) {
+                Some(Role::Reading { geometry, reading, .. }) => assert_eq!((geometry, reading), (g, r), "{h}"),
+                other => panic!("{h}: {other:?}"),
+            }
+        }
+        assert!(matches!(role("60° #2", &[]), Some(Role::Reading { repeat: Some(2), .. })));
+        assert!(matches!(role("60 (3)", &[]), Some(Role::Reading { repeat: Some(3), .. })));
+        assert_eq!(role("Sample Name", &[]), Some(Role::Sample));
+        assert_eq!(role("Colour", &[]), None);
+        assert_eq!(role("colour ", &["COLOUR".into()]), Some(Role::Ignored));
+    }
+
+    #[test]
+    fn dialects() {
+        let semi = "# instrument: BYK micro-TRI-gloss\r\n# batch: 42\r\nProbe;20°;60°\r\n\"A; 1\";82,5;89,1\r\n";
+        let s = p(semi).unwrap();
+        assert_eq!(s.delimiter, b';');
+        assert_eq!(
+            s.metadata,
+            vec![("instrument".into(), "BYK micro-TRI-gloss".into()), ("batch".into(), "42".into())]
+        );
+        assert_eq!(s.rows[0].value, 82.5);
+        assert_eq!(s.rows[1].sample, "A; 1");
+        assert_eq!((s.rows[1].line, s.rows[1].column.as_str()), (4, "60°"));
+        // Blank lines (also CRLF ones) and comments between rows.
+        let s = p("\r\n\r\nsample;60\r\n\r\n# x\r\np;1\r\n").unwrap();
+        assert_eq!(s.rows[0].line, 6);
+        // Windows-1252: ° is 0xB0.
+        let bytes = b"sample,20\xb0,60\xb0\np,1,2\n";
+        let s = parse_bytes(bytes, "w.csv", &SheetOptions::default()).unwrap();
+        assert_eq!((s.encoding.as_str(), s.rows[1].column.as_str()), ("windows-1252", "60°"));
+        // BOM then a comment line.
+        let s = parse_bytes(b"\xef\xbb\xbf# a: b\nsample,60\np,1\n", "b.csv", &SheetOptions::default()).unwrap();
+        assert_eq!((s.encoding.as_str(), s.rows[0].line), ("UTF-8 with BOM", 3));
+    }
+
+    #[test]
+    fn line_numbers_count_lines_not_records() {
+        let t = "sample,60\n\n# c\n\"a\nb\",1\np,x\n";
+        let e = p(t).unwrap_err().to_string();
+        assert!(e.contains("line 6, column 2 (60)"), "{e}");
+    }
+
+    #[test]
+    fn numbers() {
+        assert_eq!(parse_number("89,1"), Ok(89.1));
+        assert_eq!(parse_number("-1.5e-3"), Ok(-1.5e-3));
+        for bad in ["1.234,5", "inf", "NaN", "1,2,3", "abc", ""] {
+            assert!(parse_number(bad).is_err(), "{bad}");
+        }
+    }
+
+    #[test]
     fn errors_name_file_line_and_column() {
-        let e = parse("geometry,value\nastm-d523-60,abc\n", "bad.csv").unwrap_err().to_string();
-        assert!(e.contains("bad.csv") && e.contains("line 2") && e.contains("`value`"), "{e}");
-        let e = parse("geometry,value,uncertainty\nastm-d523-60,1,-2\n", "bad.csv").unwrap_err().to_string();
+        let e = p("geometry,value\nastm-d523-60,abc\n").unwrap_err().to_string();
+        assert!(e.contains("s.csv") && e.contains("line 2, column 2 (value)"), "{e}");
+        let e = p("geometry,value,uncertainty\nastm-d523-60,1,-2\n").unwrap_err().to_string();
         assert!(e.contains("uncertainty") && e.contains("≥ 0"), "{e}");
-        let e = parse("foo,bar\n1,2\n", "bad.csv").unwrap_err().to_string();
-        assert!(e.contains("geometry"), "{e}");
-        let e = parse("geometry,value\nastm-d523-60,1,3\n", "bad.csv").unwrap_err().to_string();
-        assert!(e.contains("malformed"), "{e}");
-    }
-
-    #[test]
-    fn errors_count_lines_not_records() {
-        // A blank line and a quoted newline before the bad row: it is on line 6 (the 3rd record).
-        let text = "sample,geometry,value\np1,astm-d523-60,1\n\n\"p\n2\",astm-d523-60,2\np3,astm-d523-60,x\n";
-        let e = parse(text, "bad.csv").unwrap_err().to_string();
-        assert!(e.contains("line 6"), "{e}");
-        let r = parse("# c\nsample,geometry,value\n\np1,astm-d523-60,1\n", "ok.csv").unwrap();
-        assert_eq!(r[0].line, 4);
-    }
-
-    #[test]
-    fn a_byte_order_mark_then_a_comment_is_read() {
-        let r = parse("\u{feff}# BYK export\ngeometry,value\nastm-d523-60,89.1\n", "bom.csv").unwrap();
-        assert_eq!((r[0].line, r[0].value), (3, 89.1));
+        let e = p("foo,bar\n1,2\n").unwrap_err().to_string();
+        assert!(e.contains("line 1, column 1 (foo)") && e.contains("--ignore-column"), "{e}");
+        let e = p("geometry,value\nastm-d523-60,1,3\n").unwrap_err().to_string();
+        assert!(e.contains("line 2, column 3") && e.contains("3 fields"), "{e}");
+        let e = p("sample,20°,G20\np,1,2\n").unwrap_err().to_string();
+        assert!(e.contains("column 3 (G20)") && e.contains("duplicate"), "{e}");
+        let e = p("").unwrap_err().to_string();
+        assert!(e.contains("empty"), "{e}");
+        let e = p("# only a comment\nsample,60\n").unwrap_err().to_string();
+        assert!(e.contains("no readings"), "{e}");
     }
 }

@@ -68,7 +68,8 @@ fn texts(dir: &str, ext: &str) -> Vec<String> {
         .filter(|p| p.extension().is_some_and(|e| e == ext))
         .collect();
     files.sort();
-    files.iter().map(|p| std::fs::read_to_string(p).unwrap()).collect()
+    // Windows-1252 sheets are seeds too (as text, their one non-UTF-8 byte replaced).
+    files.iter().map(|p| String::from_utf8_lossy(&std::fs::read(p).unwrap()).into_owned()).collect()
 }
 
 /// The shipped inputs the mutations start from.
@@ -365,8 +366,9 @@ pub fn run_case(cat: Category, text: &str) -> Result<Outcome, String> {
                 Err(e) => check_error(&e, "fuzz-geometry.json").map(|_| Outcome::Refused),
             }
         }
-        Category::Sheet => match sheet::parse(text, "fuzz.csv") {
-            Ok(rows) => {
+        Category::Sheet => match sheet::parse(text, "fuzz.csv", &sheet::SheetOptions::default()) {
+            Ok(sheet) => {
+                let rows = sheet.rows;
                 if rows.iter().any(|r| !r.value.is_finite() || r.uncertainty.is_some_and(|u| !u.is_finite())) {
                     return Err("a sheet row holds a non-finite number".into());
                 }

@@ -1,0 +1,574 @@
+//! Predictions set beside instrument sheets: repeated readings reduced to statistics, the verdict rule, many
+//! samples with their own recipes measured in parallel, and baselines (a previous run's JSON) that guard
+//! presets against silent drift. The command line (`compare`, `measure --baseline`) only formats these
+//! results, so programs (and the Python bindings) get the same checks.
+//!
+//! **The verdict** (docs/instrument.md §Sheets). A sample's n readings of one reading have mean x̄ and sample
+//! standard deviation s (n − 1 in the denominator; 0 for n = 1). The prediction P has the error estimate e_P.
+//! The allowance is
+//!
+//!     A = k·s/√n + u,      inside ⇔ |P − x̄| ≤ A + e_P,
+//!
+//! k·s/√n being k standard errors of the mean (k = 2 by default, about 95 % for a normal mean) and u the
+//! stated uncertainty (the largest of the rows' `uncertainty`, else `--tolerance`). With n = 1 and no stated
+//! uncertainty there is no allowance: the row is unchecked, which fails the check like an outside row.
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+use rayon::prelude::*;
+
+use crate::instrument::plan::{Plan, PlanOptions, Reading};
+use crate::instrument::sheet::{Layout, Sheet, SheetRow};
+use crate::instrument::standards::{self, StandardGeometry};
+use crate::recipe::{self, Material};
+use crate::{Error, Result};
+
+/// n, mean, sample standard deviation, min and max of repeated readings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Statistics {
+    pub n: usize,
+    pub mean: f64,
+    /// Sample standard deviation (denominator n − 1); 0 when n = 1.
+    pub std: f64,
+    pub min: f64,
+    pub max: f64,
+}
+
+/// Statistics of a non-empty list of finite values (two-pass: mean first, then squared deviations).
+pub fn statistics(values: &[f64]) -> Statistics {
+    assert!(!values.is_empty(), "statistics of no values");
+    let n = values.len();
+    let mean = values.iter().sum::<f64>() / n as f64;
+    let ss: f64 = values.iter().map(|v| (v - mean) * (v - mean)).sum();
+    let std = if n > 1 { (ss / (n - 1) as f64).sqrt() } else { 0.0 };
+    let min = values.iter().copied().fold(f64::INFINITY, f64::min);
+    let max = values.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    Statistics { n, mean, std, min, max }
+}
+
+/// All rows of one sample for one reading.
+#[derive(Clone, Debug)]
+pub struct Group {
+    pub sample: String,
+    pub geometry: String,
+    pub reading: String,
+    /// The sheet's lines and columns the values came from (in file order).
+    pub lines: Vec<usize>,
+    pub columns: Vec<String>,
+    pub values: Vec<f64>,
+    /// The largest uncertainty stated on the rows.
+    pub uncertainty: Option<f64>,
+    pub not_predicted: Option<String>,
+    pub stats: Statistics,
+}
+
+/// Rows grouped by (sample, geometry, reading), in order of first appearance.
+pub fn group_rows(rows: &[SheetRow]) -> Vec<Group> {
+    let mut index: HashMap<(&str, &str, &str), usize> = HashMap::new();
+    let mut groups: Vec<Group> = Vec::new();
+    for r in rows {
+        let key = (r.sample.as_str(), r.geometry.as_str(), r.reading.as_str());
+        let i = *index.entry(key).or_insert_with(|| {
+            groups.push(Group {
+                sample: r.sample.clone(),
+                geometry: r.geometry.clone(),
+                reading: r.reading.clone(),
+                lines: vec![],
+                columns: vec![],
+                values: vec![],
+                uncertainty: None,
+                not_predicted: r.not_predicted.clone(),
+                stats: statistics(&[r.value]),
+            });
+            groups.len() - 1
+        });
+        let g = &mut groups[i];
+        g.lines.push(r.line);
+        if !g.columns.contains(&r.column) {
+            g.columns.push(r.column.clone());
+        }
+        g.values.push(r.value);
+        g.uncertainty = match (g.uncertainty, r.uncertainty) {
+            (Some(a), Some(b)) => Some(a.max(b)),
+            (a, b) => a.or(b),
+        };
+    }
+    for g in &mut groups {
+        g.stats = statistics(&g.values);
+    }
+    groups
+}
+
+/// How verdicts are reached.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Rule {
+    /// Standard errors of the mean allowed (default 2).
+    pub k: f64,
+    /// The uncertainty of rows that state none.
+    pub tolerance: Option<f64>,
+}
+
+impl Default for Rule {
+    fn default() -> Self {
+        Rule { k: 2.0, tolerance: None }
+    }
+}
+
+impl Rule {
+    pub fn check(&self) -> Result<()> {
+        if !(self.k.is_finite() && self.k >= 0.0) {
+            return Err(Error::Usage(format!("-k must be a finite number ≥ 0, got {}", self.k)));
+        }
+        if let Some(t) = self.tolerance {
+            if !(t.is_finite() && t >= 0.0) {
+                return Err(Error::Usage(format!("--tolerance must be a finite number ≥ 0, got {t}")));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The parts of the allowed difference.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Allowance {
+    /// k·s/√n.
+    pub statistical: f64,
+    /// The stated uncertainty (or the tolerance).
+    pub stated: f64,
+    /// The prediction's error estimate.
+    pub prediction: f64,
+}
+
+impl Allowance {
+    pub fn total(&self) -> f64 {
+        self.statistical + self.stated + self.prediction
+    }
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum Verdict {
+    Inside,
+    Outside,
+    /// Neither repeated readings nor a stated uncertainty: nothing to check against.
+    NoAllowance,
+    /// The reading was predicted but has no finite value (the reason).
+    NoValue(String),
+    /// glossmeter does not predict this reading (the reason).
+    NotPredicted(String),
+}
+
+impl Verdict {
+    pub fn label(&self) -> &'static str {
+        match self {
+            Verdict::Inside => "ok",
+            Verdict::Outside => "OUTSIDE",
+            Verdict::NoAllowance | Verdict::NoValue(_) => "unchecked",
+            Verdict::NotPredicted(_) => "not predicted",
+        }
+    }
+    /// Whether the verdict fails a check (exit status 1): outside, or a check that could not be made
+    /// (docs/instrument.md §Exit statuses). "Not predicted" is reported, not failed.
+    pub fn fails(&self) -> bool {
+        matches!(self, Verdict::Outside | Verdict::NoValue(_) | Verdict::NoAllowance)
+    }
+    /// Why the row could not be checked, if it could not.
+    pub fn why_unchecked(&self) -> Option<String> {
+        match self {
+            Verdict::NoValue(why) => Some(format!("the prediction has no value ({why})")),
+            Verdict::NoAllowance => {
+                Some("no allowed difference: a single reading with no uncertainty, and no --tolerance was given".into())
+            }
+            _ => None,
+        }
+    }
+}
+
+/// One (sample, reading) of the sheet beside its prediction.
+#[derive(Clone, Debug)]
+pub struct Comparison {
+    /// The material's name and recipe file.
+    pub material: String,
+    pub recipe: String,
+    pub group: Group,
+    pub predicted: Option<Reading>,
+    pub allowance: Option<Allowance>,
+    pub verdict: Verdict,
+}
+
+impl Comparison {
+    /// predicted − measured mean.
+    pub fn difference(&self) -> Option<f64> {
+        self.predicted.as_ref().and_then(|p| p.value).map(|v| v - self.group.stats.mean)
+    }
+}
+
+/// The verdict of one group against the readings of its material.
+pub fn judge(group: Group, material: &Material, readings: &[Reading], rule: &Rule) -> Comparison {
+    let mk = |predicted, allowance, verdict| Comparison {
+        material: material.name.clone(),
+        recipe: material.file.clone(),
+        group: group.clone(),
+        predicted,
+        allowance,
+        verdict,
+    };
+    if let Some(why) = &group.not_predicted {
+        return mk(None, None, Verdict::NotPredicted(why.clone()));
+    }
+    let found = readings
+        .iter()
+        .find(|r| r.geometry == group.geometry && (r.name == group.reading || r.quantity == group.reading))
+        .cloned();
+    let Some(p) = found else {
+        return mk(
+            None,
+            None,
+            Verdict::NotPredicted(format!("`{}` has no reading `{}`", group.geometry, group.reading)),
+        );
+    };
+    let s = group.stats;
+    let stated = group.uncertainty.or(rule.tolerance);
+    let Some(v) = p.value else {
+        let why = p.problem.clone().unwrap_or_else(|| "no finite value".into());
+        return mk(Some(p), None, Verdict::NoValue(why));
+    };
+    if s.n < 2 && stated.is_none() {
+        return mk(Some(p), None, Verdict::NoAllowance);
+    }
+    let a = Allowance {
+        statistical: rule.k * s.std / (s.n as f64).sqrt(),
+        stated: stated.unwrap_or(0.0),
+        prediction: p.error_estimate,
+    };
+    let verdict = if (v - s.mean).abs() <= a.total() { Verdict::Inside } else { Verdict::Outside };
+    mk(Some(p), Some(a), verdict)
+}
+
+/// Where each sample's recipe comes from: `--recipe SAMPLE=FILE` first, then `DIR/<sample>.json`, then the
+/// one recipe given for all samples.
+#[derive(Clone, Debug, Default)]
+pub struct Recipes {
+    pub default: Option<PathBuf>,
+    pub dir: Option<PathBuf>,
+    pub per_sample: Vec<(String, PathBuf)>,
+}
+
+impl Recipes {
+    /// The recipe file of a sample, or None.
+    pub fn path_of(&self, sample: &str) -> Option<PathBuf> {
+        if let Some((_, p)) = self.per_sample.iter().find(|(s, _)| s == sample) {
+            return Some(p.clone());
+        }
+        if let Some(d) = &self.dir {
+            // A sample name is used as a file name only if it is one (no separators, not `.`/`..`).
+            let plain = !sample.is_empty()
+                && !sample.contains(['/', '\\'])
+                && sample != "."
+                && sample != ".."
+                && !sample.contains('\0');
+            if plain {
+                let p = d.join(format!("{sample}.json"));
+                if p.is_file() {
+                    return Some(p);
+                }
+            }
+        }
+        self.default.clone()
+    }
+}
+
+/// Compare a sheet with the predictions for every sample: each sample's recipe is found through `recipes`,
+/// each distinct recipe is measured once (in parallel) through the geometries its rows name.
+pub fn compare_sheet(sheet: &Sheet, recipes: &Recipes, rule: &Rule, options: &PlanOptions) -> Result<Vec<Comparison>> {
+    rule.check()?;
+    let groups = group_rows(&sheet.rows);
+    // Geometries: a shipped id, else "not predicted" for a recognised column, else an error at its row.
+    let mut geometries: HashMap<String, StandardGeometry> = HashMap::new();
+    let mut missing: HashMap<String, String> = HashMap::new();
+    for id in sheet.geometry_ids() {
+        match standards::find(&id) {
+            Ok(g) => {
+                geometries.insert(id, g);
+            }
+            Err(e) => {
+                let row = sheet.rows.iter().find(|r| r.geometry == id).expect("id from rows");
+                if sheet.layout == Layout::Long {
+                    return Err(Error::input(
+                        &sheet.file,
+                        sheet.cell(row.line, sheet.geometry_column, "geometry"),
+                        e.to_string(),
+                    ));
+                }
+                missing.insert(id.clone(), format!("geometry `{id}` is not shipped in this version"));
+            }
+        }
+    }
+    // Recipes per sample, in order of first appearance.
+    let mut samples: Vec<(String, PathBuf)> = Vec::new();
+    for g in &groups {
+        if samples.iter().any(|(s, _)| *s == g.sample) {
+            continue;
+        }
+        let Some(p) = recipes.path_of(&g.sample) else {
+            let row = sheet.rows.iter().find(|r| r.sample == g.sample).expect("sample from rows");
+            let where_ = match &recipes.dir {
+                Some(d) => format!("no {}/{}.json", d.display(), g.sample),
+                None => "no recipe given".into(),
+            };
+            return Err(Error::input(
+                &sheet.file,
+                sheet.cell(row.line, sheet.sample_column, "sample"),
+                format!("sample `{}` has no recipe ({where_}; give one with --recipe '{}=FILE')", g.sample, g.sample),
+            ));
+        };
+        samples.push((g.sample.clone(), p));
+    }
+    let mut paths: Vec<PathBuf> = samples.iter().map(|(_, p)| p.clone()).collect();
+    paths.sort();
+    paths.dedup();
+    let materials: Vec<Material> = paths.iter().map(|p| recipe::load_file(p)).collect::<Result<_>>()?;
+    // Each recipe through the geometries of all the rows of its samples.
+    let geometry_ids_of = |path: &Path| -> Vec<String> {
+        let mut ids: Vec<String> = Vec::new();
+        for g in &groups {
+            let p = samples.iter().find(|(s, _)| *s == g.sample).map(|(_, p)| p.as_path());
+            if p == Some(path) && geometries.contains_key(&g.geometry) && !ids.contains(&g.geometry) {
+                ids.push(g.geometry.clone());
+            }
+        }
+        ids
+    };
+    let readings: Vec<Vec<Reading>> = paths
+        .par_iter()
+        .zip(materials.par_iter())
+        .map(|(p, m)| {
+            let geos: Vec<StandardGeometry> = geometry_ids_of(p).iter().map(|id| geometries[id].clone()).collect();
+            if geos.is_empty() {
+                return Ok(vec![]);
+            }
+            Ok(Plan::compile(m.brdf.clone(), geos, options.clone())?.execute())
+        })
+        .collect::<Result<_>>()?;
+    let mut out = Vec::with_capacity(groups.len());
+    for mut g in groups {
+        let path = &samples.iter().find(|(s, _)| *s == g.sample).expect("every sample has a recipe").1;
+        let i = paths.binary_search(path).expect("path listed");
+        if let Some(why) = missing.get(&g.geometry) {
+            g.not_predicted.get_or_insert_with(|| why.clone());
+        }
+        // A long-layout row names its reading by hand: one its geometry does not have is bad input.
+        let known = |r: &Reading| r.geometry == g.geometry && (r.name == g.reading || r.quantity == g.reading);
+        if sheet.layout == Layout::Long && g.not_predicted.is_none() && !readings[i].iter().any(known) {
+            let have: Vec<&str> =
+                readings[i].iter().filter(|r| r.geometry == g.geometry).map(|r| r.name.as_str()).collect();
+            return Err(Error::input(
+                &sheet.file,
+                sheet.cell(g.lines[0], sheet.quantity_column.or(sheet.geometry_column), "quantity"),
+                format!(
+                    "geometry `{}` has no reading `{}` (it has: {})",
+                    g.geometry,
+                    g.reading,
+                    if have.is_empty() { "none".to_string() } else { have.join(", ") }
+                ),
+            ));
+        }
+        out.push(judge(g, &materials[i], &readings[i], rule));
+    }
+    Ok(out)
+}
+
+/// One reading of a baseline (a previous `measure` or `compare` JSON).
+#[derive(Clone, Debug, PartialEq)]
+pub struct BaselineEntry {
+    pub material: String,
+    pub geometry: String,
+    pub reading: String,
+    pub value: f64,
+    pub error_estimate: f64,
+}
+
+/// Read a baseline file: the JSON of `measure` (one or many recipes) or of `compare`.
+pub fn load_baseline(path: &Path) -> Result<Vec<BaselineEntry>> {
+    let file = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|source| Error::Io { file: file.clone(), source })?;
+    let doc: serde_json::Value =
+        serde_json::from_str(&text).map_err(|e| Error::input(&file, "", format!("not JSON: {e}")))?;
+    parse_baseline(&doc, &file)
+}
+
+pub fn parse_baseline(doc: &serde_json::Value, file: &str) -> Result<Vec<BaselineEntry>> {
+    let bad = |ptr: String, m: &str| Error::input(file, ptr, m.to_string());
+    let mut out = vec![];
+    let str_at = |v: &serde_json::Value, k: &str, ptr: &str| -> Result<String> {
+        v.get(k)
+            .and_then(|x| x.as_str())
+            .map(String::from)
+            .ok_or_else(|| bad(format!("{ptr}/{k}"), "expected a string"))
+    };
+    if let Some(rs) = doc.get("readings").and_then(|r| r.as_array()) {
+        // measure: one material at /material/name, or many with a `material` on each reading.
+        let top = doc.pointer("/material/name").and_then(|n| n.as_str()).map(String::from);
+        for (i, r) in rs.iter().enumerate() {
+            let ptr = format!("/readings/{i}");
+            let material = match r.get("material").and_then(|m| m.as_str()) {
+                Some(m) => m.to_string(),
+                None => top.clone().ok_or_else(|| bad(format!("{ptr}/material"), "no material name"))?,
+            };
+            let (Some(value), Some(e)) =
+                (r.get("value").and_then(|v| v.as_f64()), r.get("error_estimate").and_then(|v| v.as_f64()))
+            else {
+                continue; // a reading without a value then: nothing to compare with
+            };
+            out.push(BaselineEntry {
+                material,
+                geometry: str_at(r, "geometry", &ptr)?,
+                reading: str_at(r, "name", &ptr)?,
+                value,
+                error_estimate: e,
+            });
+        }
+    } else if let Some(cs) = doc.get("comparisons").and_then(|r| r.as_array()) {
+        for (i, c) in cs.iter().enumerate() {
+            let ptr = format!("/comparisons/{i}");
+            let (Some(value), Some(e)) =
+                (c.get("predicted").and_then(|v| v.as_f64()), c.get("error_estimate").and_then(|v| v.as_f64()))
+            else {
+                continue;
+            };
+            out.push(BaselineEntry {
+                material: str_at(c, "material", &ptr)?,
+                geometry: str_at(c, "geometry", &ptr)?,
+                reading: str_at(c, "predicted_reading", &ptr)?,
+                value,
+                error_estimate: e,
+            });
+        }
+    } else {
+        return Err(bad(String::new(), "neither a `measure` JSON (`readings`) nor a `compare` JSON (`comparisons`)"));
+    }
+    Ok(out)
+}
+
+/// A reading checked against its baseline: it moved if |now − then| > e_now + e_then.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Drift {
+    pub material: String,
+    pub geometry: String,
+    pub reading: String,
+    pub now: f64,
+    pub then: f64,
+    pub allowed: f64,
+    pub moved: bool,
+}
+
+/// Check readings (material, reading) against a baseline; readings the baseline lacks are not checked.
+pub fn check_baseline<'a>(
+    now: impl IntoIterator<Item = (&'a str, &'a Reading)>,
+    baseline: &[BaselineEntry],
+) -> Vec<Drift> {
+    let mut out = vec![];
+    for (material, r) in now {
+        let Some(v) = r.value else { continue };
+        let Some(b) =
+            baseline.iter().find(|b| b.material == material && b.geometry == r.geometry && b.reading == r.name)
+        else {
+            continue;
+        };
+        let allowed = r.error_estimate + b.error_estimate;
+        out.push(Drift {
+            material: material.to_string(),
+            geometry: r.geometry.clone(),
+            reading: r.name.clone(),
+            now: v,
+            then: b.value,
+            allowed,
+            moved: (v - b.value).abs() > allowed,
+        });
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn statistics_of_known_values() {
+        // 2, 4, 4, 4, 5, 5, 7, 9: mean 5, population sd 2, sample sd sqrt(32/7).
+        let s = statistics(&[2.0, 4.0, 4.0, 4.0, 5.0, 5.0, 7.0, 9.0]);
+        assert_eq!((s.n, s.mean, s.min, s.max), (8, 5.0, 2.0, 9.0));
+        assert!((s.std - (32.0f64 / 7.0).sqrt()).abs() < 1e-15);
+        assert_eq!(statistics(&[3.0]).std, 0.0);
+    }
+
+    fn reading(value: Option<f64>, e: f64) -> Reading {
+        Reading {
+            geometry: "astm-d523-60".into(),
+            name: "gloss".into(),
+            quantity: "gloss".into(),
+            unit: "GU".into(),
+            value,
+            error_estimate: e,
+            evaluations: 1,
+            seconds: 0.0,
+            converged: true,
+            problem: value.is_none().then(|| "zero flux".into()),
+            note: None,
+        }
+    }
+
+    fn group(values: &[f64], u: Option<f64>) -> Group {
+        let rows: Vec<SheetRow> = values
+            .iter()
+            .enumerate()
+            .map(|(i, &v)| SheetRow {
+                line: i + 2,
+                column: "60".into(),
+                sample: "p".into(),
+                geometry: "astm-d523-60".into(),
+                reading: "gloss".into(),
+                value: v,
+                uncertainty: u,
+                not_predicted: None,
+            })
+            .collect();
+        group_rows(&rows).remove(0)
+    }
+
+    #[test]
+    fn verdict_rule() {
+        let m = recipe::parse_str(r#"{"model": "lambert", "albedo": 0.5}"#, "m.json").unwrap();
+        let rule = Rule::default();
+        // mean 90, s = 1, n = 4: k s/√n = 1; + e 0.1 → inside up to 1.1.
+        let g = group(&[89.0, 91.0, 89.0, 91.0], None);
+        assert!((g.stats.std - (4.0f64 / 3.0).sqrt()).abs() < 1e-15);
+        let s = g.stats.std;
+        let c = judge(g.clone(), &m, &[reading(Some(90.0 + 2.0 * s / 2.0 + 0.1 - 1e-9), 0.1)], &rule);
+        assert_eq!(c.verdict, Verdict::Inside);
+        let c = judge(g.clone(), &m, &[reading(Some(90.0 + 2.0 * s / 2.0 + 0.1 + 1e-9), 0.1)], &rule);
+        assert_eq!(c.verdict, Verdict::Outside);
+        // The stated uncertainty adds.
+        let c = judge(group(&[90.0], Some(0.5)), &m, &[reading(Some(90.55), 0.1)], &rule);
+        assert_eq!((c.verdict, c.allowance.unwrap().total()), (Verdict::Inside, 0.6));
+        assert_eq!(judge(group(&[90.0], None), &m, &[reading(Some(99.0), 0.1)], &rule).verdict, Verdict::NoAllowance);
+        // A check that cannot be made fails.
+        assert!(judge(group(&[90.0], Some(1.0)), &m, &[reading(None, 0.0)], &rule).verdict.fails());
+        assert!(matches!(judge(group(&[90.0], Some(1.0)), &m, &[], &rule).verdict, Verdict::NotPredicted(_)));
+    }
+
+    #[test]
+    fn baseline_drift() {
+        let b = vec![BaselineEntry {
+            material: "m".into(),
+            geometry: "astm-d523-60".into(),
+            reading: "gloss".into(),
+            value: 90.0,
+            error_estimate: 0.1,
+        }];
+        let r1 = reading(Some(90.15), 0.1);
+        let r2 = reading(Some(90.25), 0.1);
+        assert!(!check_baseline([("m", &r1)], &b)[0].moved);
+        assert!(check_baseline([("m", &r2)], &b)[0].moved);
+        assert!(check_baseline([("other", &r2)], &b).is_empty());
+    }
+}
