@@ -7,7 +7,9 @@
 //! standard deviation s (n − 1 in the denominator; 0 for n = 1). The prediction P has the error estimate e_P.
 //! The allowance is
 //!
-//!     A = k·s/√n + u,      inside ⇔ |P − x̄| ≤ A + e_P,
+//! ```text
+//! A = k·s/√n + u,      inside ⇔ |P − x̄| ≤ A + e_P,
+//! ```
 //!
 //! k·s/√n being k standard errors of the mean (k = 2 by default, about 95 % for a normal mean) and u the
 //! stated uncertainty (the largest of the rows' `uncertainty`, else `--tolerance`). With n = 1 and no stated
