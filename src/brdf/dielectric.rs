@@ -53,17 +53,34 @@ fn describe_iors(ior: &[Ior]) -> String {
     }
 }
 
-/// An ideally smooth, opaque (black-backed) dielectric: a delta reflection of weight R = F(cos θi, n).
+/// An ideally smooth, opaque (black-backed) dielectric: a delta reflection of weight gain·F(cos θi, n).
+///
+/// The one smooth-dielectric type: a specimen (`"model": "smooth-dielectric"`, gain 1) and every gloss
+/// standard (`instrument::geometry::Scale::standard`): polished black glass of the scale's index with gain
+/// 100/V when the scale assigns it V GU (gain 1 for the usual 100 GU, so that standard is the specimen of the
+/// same index to the bit), or the perfect mirror of the mirror scale, n = ∞ (the n → ∞ limit of Fresnel,
+/// R = 1 at every angle) with gain 100/V.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SmoothDielectric {
-    /// Real refractive index n relative to air.
+    /// Real refractive index n relative to air; `f64::INFINITY` is the perfect mirror.
     pub ior: f64,
+    /// Factor on the Fresnel reflectance: 1 for a physical surface, 100/V for a gloss standard assigned V.
+    pub gain: f64,
     pub sampling: Sampling,
 }
 
 impl SmoothDielectric {
     pub fn new(ior: f64) -> Self {
-        SmoothDielectric { ior, sampling: Sampling::grey() }
+        SmoothDielectric { ior, gain: 1.0, sampling: Sampling::grey() }
+    }
+
+    /// The delta reflection's weight at cos θi = `cos_i`: gain·F(cos θi, n), gain for the perfect mirror.
+    pub fn reflectance(&self, cos_i: f64) -> f64 {
+        if self.ior == f64::INFINITY {
+            self.gain
+        } else {
+            Ior::Dielectric(self.ior).reflectance(cos_i) * self.gain
+        }
     }
 }
 
@@ -77,7 +94,7 @@ impl Brdf for SmoothDielectric {
     }
 
     fn delta_reflectance(&self, wi: Vec3, out: &mut [f64]) -> bool {
-        out.fill(Ior::Dielectric(self.ior).reflectance(wi.z));
+        out.fill(self.reflectance(wi.z));
         true
     }
 
@@ -86,7 +103,16 @@ impl Brdf for SmoothDielectric {
     }
 
     fn describe(&self) -> String {
-        format!("smooth dielectric (n = {}, black-backed)", self.ior)
+        let surface = if self.ior == f64::INFINITY {
+            "perfect mirror".to_string()
+        } else {
+            format!("smooth dielectric (n = {}, black-backed)", self.ior)
+        };
+        if self.gain == 1.0 {
+            surface
+        } else {
+            format!("{surface} × {}", self.gain)
+        }
     }
 }
 

@@ -130,16 +130,24 @@ pub enum Scale {
 }
 
 impl Scale {
-    /// Reflectance at cos θ of the gloss standard rescaled to read 100: R_standard(θ)·100/value. The plan
-    /// integrates this standard and multiplies every ratio by 100, which puts readings on this scale.
-    pub fn standard_reflectance(&self, cos_theta: f64) -> f64 {
-        match *self {
-            // 100/value is exactly 1 for the usual 100 GU, so those standards are bit-identical to plain glass.
-            Scale::BlackGlass { index, value } => {
-                crate::optics::fresnel::fr_dielectric(cos_theta, index) * (100.0 / value)
-            }
-            Scale::Mirror { value } => 100.0 / value,
+    /// The gloss standard of this scale, rescaled to read 100: black glass of the scale's index, or the perfect
+    /// mirror, with gain 100/value (exactly 1 for the usual 100 GU, so those standards are bit-identical to
+    /// plain glass). The plan integrates it by the same engine as any specimen and multiplies every ratio by
+    /// 100, which puts readings on this scale.
+    pub fn standard(&self) -> crate::brdf::dielectric::SmoothDielectric {
+        let (ior, value) = match *self {
+            Scale::BlackGlass { index, value } => (index, value),
+            Scale::Mirror { value } => (f64::INFINITY, value),
+        };
+        crate::brdf::dielectric::SmoothDielectric {
+            gain: 100.0 / value,
+            ..crate::brdf::dielectric::SmoothDielectric::new(ior)
         }
+    }
+
+    /// Reflectance at cos θ of the gloss standard rescaled to read 100: R_standard(θ)·100/value.
+    pub fn standard_reflectance(&self, cos_theta: f64) -> f64 {
+        self.standard().reflectance(cos_theta)
     }
 
     /// The black glass's index, or None on the mirror scale.
@@ -190,5 +198,32 @@ impl Geometry {
     /// True if this geometry only combines readings of other geometries (ASTM D4039).
     pub fn is_composite(&self) -> bool {
         self.readings.iter().all(|r| matches!(r, ReadingSpec::HazeIndex { .. }))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Scale;
+    use crate::brdf::dielectric::SmoothDielectric;
+
+    #[test]
+    fn the_standard_of_a_100_gu_scale_is_the_smooth_dielectric_specimen_itself() {
+        let s = Scale::BlackGlass { index: 1.567, value: 100.0 };
+        assert_eq!(s.standard(), SmoothDielectric::new(1.567));
+        for c in [0.05, 0.5, 0.94, 1.0] {
+            assert_eq!(s.standard_reflectance(c).to_bits(), SmoothDielectric::new(1.567).reflectance(c).to_bits());
+        }
+    }
+
+    #[test]
+    fn the_mirror_scale_standard_is_a_perfect_mirror_rescaled() {
+        let s = Scale::Mirror { value: 1000.0 };
+        for c in [0.0, 0.3, 0.7071, 1.0] {
+            assert_eq!(s.standard_reflectance(c), 0.1);
+        }
+        // A black-glass scale assigning 50 GU doubles the standard's reflectance.
+        let g = Scale::BlackGlass { index: 1.54, value: 50.0 };
+        let plain = SmoothDielectric::new(1.54).reflectance(0.8);
+        assert!((g.standard_reflectance(0.8) - 2.0 * plain).abs() <= 1e-16);
     }
 }

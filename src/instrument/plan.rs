@@ -33,7 +33,7 @@ use crate::instrument::method::{Design, Method, Projection};
 use crate::instrument::standards::{self, StandardGeometry};
 use crate::quadrature::Refine;
 use crate::spectrum::{Sampling, Weighting, WeightingKind};
-use crate::{Error, Result, Vec3};
+use crate::{Error, Result};
 
 /// Share of a reading's relative tolerance given to each specimen flux and to the gloss standard's flux. A
 /// gloss reading's propagated relative error is at most the sum of its two fluxes' (first order), so
@@ -83,43 +83,6 @@ impl Default for PlanOptions {
             max_evals: 50_000_000,
             max_seconds: Some(DEFAULT_MAX_SECONDS),
         }
-    }
-}
-
-/// The gloss standard of a scale, rescaled to read 100 ([`Scale::standard_reflectance`]): black glass (a
-/// smooth, non-absorbing dielectric, black-backed: only its front-surface Fresnel reflection counts) or a
-/// perfect mirror. Integrated by the same engine as any specimen. (On the black-glass scale at 100 GU it is
-/// `brdf::dielectric::SmoothDielectric` of the glass's index, to the bit; it is its own type because of the
-/// scale's rescaling and the mirror scale.)
-#[derive(Debug)]
-pub struct GlossStandard {
-    pub scale: Scale,
-    sampling: Sampling,
-}
-
-impl GlossStandard {
-    pub fn new(scale: Scale) -> Self {
-        GlossStandard { scale, sampling: Sampling::grey() }
-    }
-}
-
-impl Brdf for GlossStandard {
-    fn sampling(&self) -> &Sampling {
-        &self.sampling
-    }
-    fn eval(&self, _wi: Vec3, _wo: Vec3, out: &mut [f64]) {
-        out.iter_mut().for_each(|v| *v = 0.0);
-    }
-    fn delta_reflectance(&self, wi: Vec3, out: &mut [f64]) -> bool {
-        let r = self.scale.standard_reflectance(wi.z.clamp(0.0, 1.0));
-        out.iter_mut().for_each(|v| *v = r);
-        true
-    }
-    fn terms(&self) -> Vec<Term> {
-        vec![Term { label: "gloss standard (Fresnel, delta)".into(), kind: TermKind::Delta }]
-    }
-    fn describe(&self) -> String {
-        format!("gloss standard: {}", self.scale.describe())
     }
 }
 
@@ -422,7 +385,7 @@ impl Planner {
     /// The flux of a gloss standard, from the cache or computed (and cached). With sharing off, always
     /// computed (the ablation measures what sharing saves).
     fn standard_flux(&self, d: &Draft, method: &Method, options: &PlanOptions) -> Flux {
-        let std = GlossStandard::new(d.scale);
+        let std = d.scale.standard();
         if !options.share_fluxes {
             return method.execute(&std);
         }
