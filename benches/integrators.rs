@@ -470,6 +470,11 @@ fn main() {
             "astm-d523-85",
         ),
     ];
+    // BENCH_CASES=B1,B2 runs only those cases (for side-by-side runs of two commits on a busy machine).
+    let cases: Vec<_> = match std::env::var("BENCH_CASES") {
+        Ok(list) => cases.into_iter().filter(|c| list.split(',').any(|id| id.trim() == c.id)).collect(),
+        Err(_) => cases,
+    };
     let mc_sizes: Vec<usize> =
         if quick { vec![1_000, 10_000, 100_000] } else { vec![1_000, 10_000, 100_000, 1_000_000, 10_000_000] };
     let grid_sizes: Vec<usize> = if quick { vec![4, 8, 16] } else { vec![4, 8, 16, 32, 48] };

@@ -302,7 +302,7 @@ impl Method {
             let mut batch = PairBatch::default();
             let (est, cells) = integrate_partition::<4, _>(
                 |pts, out| {
-                    batch.clear();
+                    batch.clear(pts.len());
                     for (i, x) in pts.iter().enumerate() {
                         let (ps, qs, pr, qr, jac) = if plain {
                             (x[0], x[1], x[2], x[3], 1.0)
@@ -366,11 +366,16 @@ struct PairBatch {
 }
 
 impl PairBatch {
-    fn clear(&mut self) {
+    /// Empty, with room for `m` pairs (so the hot loop never grows a vector).
+    fn clear(&mut self, m: usize) {
         self.index.clear();
         self.wi.clear();
         self.wo.clear();
         self.g.clear();
+        self.index.reserve(m);
+        self.wi.reserve(m);
+        self.wo.reserve(m);
+        self.g.reserve(m);
     }
 
     fn push(&mut self, i: usize, wi: Vec3, wo: Vec3, g: f64) {

@@ -512,40 +512,43 @@ impl Plan {
     /// error estimates are those of its fixed partition: check `converged` before trusting one far from
     /// the material it was frozen on.
     pub fn freeze(&self) -> (Vec<Reading>, Plan) {
-        let results: Vec<Option<(Flux, Method)>> = self
-            .jobs
-            .par_iter()
-            .map(|j| match j.method.target {
-                Target::Specimen => Some(j.method.execute_and_freeze(self.material.as_ref())),
-                Target::Standard => None,
-            })
-            .collect();
+        let todo = self.specimen_jobs();
+        let results: Vec<(Flux, Method)> =
+            todo.par_iter().map(|&j| self.jobs[j].method.execute_and_freeze(self.material.as_ref())).collect();
         let mut frozen = self.clone();
-        let mut flux = Vec::with_capacity(self.jobs.len());
-        for (j, r) in results.into_iter().enumerate() {
-            match r {
-                Some((f, m)) => {
-                    frozen.jobs[j].method = m;
-                    flux.push(f);
-                }
-                None => flux.push(self.standard_flux[j].clone().expect("standard fluxes are computed at compile")),
-            }
+        let mut flux = self.known_fluxes();
+        for (&j, (f, m)) in todo.iter().zip(results) {
+            frozen.jobs[j].method = m;
+            flux[j] = Some(f);
         }
+        let flux: Vec<Flux> = flux.into_iter().map(|f| f.expect("every job ran")).collect();
         (self.readings_from(&flux), frozen)
     }
 
-    /// Execute the plan: every specimen flux once (in parallel, collected in plan order), then the readings.
+    /// Execute the plan: every specimen method on the material (the standards' fluxes were computed when the
+    /// plan was compiled), then the readings.
     pub fn execute(&self) -> Vec<Reading> {
-        let flux: Vec<Flux> = self
-            .jobs
-            .par_iter()
-            .enumerate()
-            .map(|(j, job)| match &self.standard_flux[j] {
-                Some(f) => f.clone(),
-                None => job.method.execute(self.material.as_ref()),
-            })
-            .collect();
+        let todo = self.specimen_jobs();
+        let computed: Vec<Flux> =
+            todo.par_iter().map(|&j| self.jobs[j].method.execute(self.material.as_ref())).collect();
+        let mut flux = self.known_fluxes();
+        for (&j, f) in todo.iter().zip(computed) {
+            flux[j] = Some(f);
+        }
+        let flux: Vec<Flux> = flux.into_iter().map(|f| f.expect("every job ran")).collect();
         self.readings_from(&flux)
+    }
+
+    /// The jobs to run on the material, in plan order. Only these go to the thread pool: a plan with one
+    /// specimen integral runs it on the calling thread (rayon runs a one-item parallel iterator in place),
+    /// which spares a one-off small plan the hand-over to the pool and back (tens of µs).
+    fn specimen_jobs(&self) -> Vec<usize> {
+        (0..self.jobs.len()).filter(|&j| self.standard_flux[j].is_none()).collect()
+    }
+
+    /// The fluxes known before execution: the standards', by job index.
+    fn known_fluxes(&self) -> Vec<Option<Flux>> {
+        self.standard_flux.clone()
     }
 
     /// The readings from the fluxes of every job. Direct readings first, then composites, which combine

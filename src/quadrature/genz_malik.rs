@@ -65,7 +65,7 @@ impl<const D: usize> Rule<D> {
     pub fn new() -> Self {
         let () = Self::DIMENSION_SUPPORTED;
         let d = D as f64;
-        let mut points = Vec::new();
+        let mut points = Vec::with_capacity(1 + 4 * D + 2 * D * (D - 1) + (1 << D));
         points.push(([0.0; D], 0, 0));
         for i in 0..D {
             for s in [-1.0, 1.0] {
@@ -260,8 +260,12 @@ fn summarise<const D: usize>(rule: &Rule<D>, cell: Cell<D>, values: &[f64], ncom
             _ => {}
         }
     }
-    let value: Vec<f64> = s7.iter().map(|s| s * vol).collect();
-    let error: Vec<f64> = s7.iter().zip(&s5).map(|(a, b)| ((a - b) * vol).abs()).collect();
+    // The value and error in place of the two sums (no allocation per region beyond these two).
+    let (mut value, mut error) = (s7, s5);
+    for (v, e) in value.iter_mut().zip(error.iter_mut()) {
+        *e = ((*v - *e) * vol).abs();
+        *v *= vol;
+    }
     let worst = error.iter().cloned().fold(0.0, f64::max);
     // Fourth difference along each axis (ratio λ2²/λ4² = 1/7); ties → the widest axis.
     let mut split_axis = 0;
@@ -310,7 +314,7 @@ pub fn integrate_partition<const D: usize, F: FnMut(&[[f64; D]], &mut [f64])>(
 ) -> (Estimate, Vec<Cell<D>>) {
     let rule = Rule::<D>::new();
     let npts = rule.len();
-    let mut batch = Batch { points: Vec::new(), values: Vec::new() };
+    let mut batch = Batch { points: Vec::with_capacity(2 * npts), values: Vec::with_capacity(2 * npts * ncomp) };
     let mut heap = BinaryHeap::new();
     let mut total = vec![0.0; ncomp];
     let mut err = vec![0.0; ncomp];
