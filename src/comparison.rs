@@ -574,3 +574,61 @@ mod tests {
         assert!(check_baseline([("other", &r2)], &b).is_empty());
     }
 }
+
+/// CIEDE2000 between a sample's measured L*, a*, b* (the means of its rows) and the predicted ones, on one colour
+/// geometry (`docs/colour.md`).
+#[derive(Clone, Debug)]
+pub struct ColourDifference {
+    pub sample: String,
+    pub geometry: String,
+    /// First line of the sheet's L* rows.
+    pub line: usize,
+    pub measured: crate::colorimetry::Lab,
+    pub predicted: crate::colorimetry::Lab,
+    /// ΔE00 with kL = kC = kH = 1.
+    pub de00: f64,
+    /// Some(ΔE00 ≤ the maximum) when a maximum is given.
+    pub inside: Option<bool>,
+}
+
+/// ΔE00 for every (sample, geometry) with measured and predicted L*, a*, b*. With a maximum, the ΔE00 verdict
+/// becomes the verdict of those L*, a*, b* comparisons that had no allowance of their own (their check is the
+/// colour difference, not a per-coordinate tolerance).
+pub fn colour_differences(cmp: &mut [Comparison], max_de00: Option<f64>) -> Vec<ColourDifference> {
+    use crate::colorimetry::{ciede2000, Lab};
+    let mut out: Vec<ColourDifference> = Vec::new();
+    for c in cmp.iter().filter(|c| c.group.reading == "L*") {
+        let find = |q: &str| {
+            cmp.iter().find(|d| {
+                d.group.sample == c.group.sample && d.group.geometry == c.group.geometry && d.group.reading == q
+            })
+        };
+        let (Some(a), Some(b)) = (find("a*"), find("b*")) else { continue };
+        let pv = |d: &Comparison| d.predicted.as_ref().and_then(|p| p.value);
+        let (Some(pl), Some(pa), Some(pb)) = (pv(c), pv(a), pv(b)) else { continue };
+        let measured = Lab { l: c.group.stats.mean, a: a.group.stats.mean, b: b.group.stats.mean };
+        let predicted = Lab { l: pl, a: pa, b: pb };
+        let de00 = ciede2000(measured, predicted);
+        out.push(ColourDifference {
+            sample: c.group.sample.clone(),
+            geometry: c.group.geometry.clone(),
+            line: c.group.lines[0],
+            measured,
+            predicted,
+            de00,
+            inside: max_de00.map(|m| de00 <= m),
+        });
+    }
+    for d in &out {
+        let Some(inside) = d.inside else { continue };
+        for c in cmp.iter_mut().filter(|c| {
+            c.group.sample == d.sample
+                && c.group.geometry == d.geometry
+                && ["L*", "a*", "b*"].contains(&c.group.reading.as_str())
+                && c.verdict == Verdict::NoAllowance
+        }) {
+            c.verdict = if inside { Verdict::Inside } else { Verdict::Outside };
+        }
+    }
+    out
+}

@@ -403,8 +403,24 @@ pub const CONDUCTOR_K_RGB: Param = p(
     "conductor k of channel * when ior is [[n, k] ×3]",
 );
 
-pub const LAMBERT_ALBEDO: Param =
-    p("/albedo", &["lambert"], Type::Colour, "", UNIT, Req, "directional-hemispherical reflectance ρ");
+pub const LAMBERT_ALBEDO: Param = p(
+    "/albedo",
+    &["lambert"],
+    Type::NumberOrSpectral,
+    "",
+    UNIT,
+    Req,
+    "directional-hemispherical reflectance ρ: one number (grey), [r, g, b], or with wavelengths_nm one per wavelength",
+);
+pub const LAMBERT_WAVELENGTHS: Param = p(
+    "/wavelengths_nm",
+    &["lambert"],
+    Type::Numbers,
+    "nm",
+    Some(Range::closed(360.0, 830.0)),
+    Opt("grey or RGB"),
+    "a spectral albedo: albedo[k] is ρ at wavelengths_nm[k] (strictly increasing, at most 128); needed for colour readings",
+);
 
 pub const MICROFACET_DISTRIBUTION: Param =
     p("/distribution", &["microfacet"], Type::Choice(&["beckmann", "ggx"]), "", NONE, Req, "facet-normal distribution");
@@ -822,6 +838,7 @@ pub static PARAMS: &[&Param] = &[
     &CONDUCTOR_K_RGB,
     // lambert
     &LAMBERT_ALBEDO,
+    &LAMBERT_WAVELENGTHS,
     // microfacet
     &MICROFACET_DISTRIBUTION,
     &MICROFACET_ROUGHNESS,
@@ -1024,7 +1041,10 @@ mod tests {
 
     #[test]
     fn children_follow_the_registry() {
-        assert_eq!(children("lambert", ""), ["model", "name", "description", "provenance", "notes", "albedo"]);
+        assert_eq!(
+            children("lambert", ""),
+            ["model", "name", "description", "provenance", "notes", "albedo", "wavelengths_nm"]
+        );
         assert_eq!(children("cook-torrance-lobes", "/lobes/0"), ["ks", "r", "m"]);
         assert_eq!(children("paint", "/pigmented_layer/pigments/1/measured").len(), 5);
         assert!(children("conductor", "").contains(&"ior".to_string()));

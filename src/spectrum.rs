@@ -179,6 +179,10 @@ pub enum WeightingKind {
     Luminous,
     /// One component per sample (no weighting): the fluxes per wavelength.
     Identity,
+    /// Three components, the CIE tristimulus values X, Y, Z under an illuminant and observer (CIE 15:2004 /
+    /// ASTM E308 weights, `colorimetry::weights`; the perfect reflecting diffuser has Y = 100): what colour
+    /// readings need. An RGB material has none (its samples are not a spectrum) and is refused with a message.
+    Xyz(crate::colorimetry::Conditions),
 }
 
 /// A k × n weighting matrix: component c of a weighted flux is Σ_j W[c][j] Φ_j over the n samples.
@@ -202,6 +206,7 @@ impl Weighting {
             WeightingKind::Identity => (0..sampling.len())
                 .map(|i| (0..sampling.len()).map(|j| if i == j { 1.0 } else { 0.0 }).collect())
                 .collect(),
+            WeightingKind::Xyz(c) => crate::colorimetry::weights(sampling, c)?.rows.to_vec(),
         })
     }
 
@@ -258,8 +263,14 @@ impl Weighting {
             .map(|(k, _)| match k {
                 WeightingKind::Luminous => {
                     "luminous (CIE illuminant C × ȳ; the CIE 1931 primaries' luminances for RGB; 1 for grey)"
+                        .to_string()
                 }
-                WeightingKind::Identity => "identity (one component per sample)",
+                WeightingKind::Identity => "identity (one component per sample)".to_string(),
+                WeightingKind::Xyz(c) => format!(
+                    "CIE X, Y, Z ({}; 1 nm summation, docs/colour.md): three components, the spectrum is not folded \
+                     into one luminous value",
+                    c.describe()
+                ),
             })
             .collect::<Vec<_>>()
             .join(" + ")

@@ -4,12 +4,15 @@
 //! `GLOSSMETER_BLESS=1 cargo test --test golden` and explains every moved reading in its commit and the docs.
 //!
 //! Compared per reading: the value and the error estimate as `f64::to_bits`, the evaluation count and the
-//! convergence flag (rtol 1e-6, the default). Builtin geometries are measured one plan per recipe.
+//! convergence flag (rtol 1e-6, the default). Builtin geometries are measured one plan per recipe; the colour
+//! geometries (`standards/colour`, D65 and the 10° observer) join that plan for every recipe that is not RGB
+//! (their fluxes carry only their own X, Y, Z rows, so the gloss readings are the same bits with or without them).
 use std::collections::BTreeMap;
 use std::path::Path;
 
 use glossmeter::instrument::plan::{Plan, PlanOptions};
-use glossmeter::instrument::standards;
+use glossmeter::instrument::{colour, standards};
+use glossmeter::spectrum::SamplingKind;
 
 const GOLDEN: &str = "fixtures/golden/readings.json";
 
@@ -25,11 +28,14 @@ fn recipes() -> Vec<std::path::PathBuf> {
 
 /// One line per reading: "recipe|geometry|name" → "value-bits error-bits evaluations converged".
 fn current() -> BTreeMap<String, String> {
-    let geos = standards::builtin().unwrap();
+    let gloss = standards::builtin().unwrap();
+    let mut all = gloss.clone();
+    all.extend(colour::builtin().unwrap());
     let mut out = BTreeMap::new();
     for path in recipes() {
         let m = glossmeter::recipe::load_file(&path).unwrap();
         let stem = path.file_stem().unwrap().to_string_lossy().into_owned();
+        let geos = if m.brdf.sampling().kind == SamplingKind::Rgb { &gloss } else { &all };
         let plan = Plan::compile(m.brdf.clone(), geos.clone(), PlanOptions::default()).unwrap();
         for r in plan.execute() {
             let v = match r.value {

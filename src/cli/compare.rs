@@ -1,13 +1,15 @@
 //! `glossmeter compare`: predictions set beside an instrument sheet, one table, one summary and one exit
 //! status for all its samples. The reading of the sheet, the statistics, the verdicts and the baseline checks
 //! are library functions (`instrument::sheet`, `comparison`); this module parses the arguments and formats.
+//! Colour sheets (L*, a*, b* on colour geometries) are predicted by the same plan, and each (sample, geometry)
+//! gets its CIEDE2000 ΔE00 (`comparison::colour_differences`; `--max-de00` makes it the check).
 use std::path::PathBuf;
 
 use serde_json::json;
 
 use crate::cli::format::plain;
-use crate::cli::{check_rtol, junit, pad_table, readings_status, Target};
-use crate::comparison::{self, Comparison, Drift, Recipes, Rule, Verdict};
+use crate::cli::{check_rtol, junit, pad_table, readings_status, ColourArgs, Target};
+use crate::comparison::{self, ColourDifference, Comparison, Drift, Recipes, Rule, Verdict};
 use crate::instrument::plan::PlanOptions;
 use crate::instrument::sheet::{self, Sheet, SheetOptions};
 use crate::{Error, Result};
@@ -59,6 +61,12 @@ pub struct CompareArgs {
     /// Exit 0 even if a prediction did not converge within its budget (the comparison is still made).
     #[arg(long)]
     pub allow_unconverged: bool,
+    /// Largest allowed CIEDE2000 ΔE00 between a sample's L*, a*, b* and the prediction (exit 1 above it); it is
+    /// then the verdict of those rows when they have no allowance of their own.
+    #[arg(long)]
+    pub max_de00: Option<f64>,
+    #[command(flatten)]
+    pub colour: ColourArgs,
 }
 
 /// `,`, `;`, `tab` (or a literal tab).
@@ -75,6 +83,12 @@ pub fn run(a: CompareArgs) -> Result<()> {
     let rule = Rule { k: a.k, tolerance: a.tolerance };
     rule.check()?;
     check_rtol(a.rtol)?;
+    if let Some(m) = a.max_de00 {
+        if !(m.is_finite() && m >= 0.0) {
+            return Err(Error::Usage(format!("--max-de00 must be a finite number ≥ 0, got {m}")));
+        }
+    }
+    let colour = a.colour.conditions()?;
     let target = Target::new(a.output.as_deref(), "--output")?;
     let (default, sheet_path) = match a.paths.as_slice() {
         [s] => (None, s.clone()),
@@ -105,8 +119,9 @@ pub fn run(a: CompareArgs) -> Result<()> {
     };
     let baseline = a.baseline.as_deref().map(comparison::load_baseline).transpose()?;
     let sheet = sheet::load(&sheet_path, &options)?;
-    let plan_options = PlanOptions { rtol: a.rtol, ..PlanOptions::default() };
-    let cmp = comparison::compare_sheet(&sheet, &recipes, &rule, &plan_options)?;
+    let plan_options = PlanOptions { rtol: a.rtol, colour, ..PlanOptions::default() };
+    let mut cmp = comparison::compare_sheet(&sheet, &recipes, &rule, &plan_options)?;
+    let des = comparison::colour_differences(&mut cmp, a.max_de00);
     let drift = match &baseline {
         Some(b) => comparison::check_baseline(
             cmp.iter().filter_map(|c| c.predicted.as_ref().map(|p| (c.material.as_str(), p))),
@@ -115,8 +130,8 @@ pub fn run(a: CompareArgs) -> Result<()> {
         None => vec![],
     };
     let text = match a.format {
-        CompareFormat::Table => table(&sheet, &cmp, &rule, &drift, baseline.is_some()),
-        CompareFormat::Json => json_text(&sheet, &cmp, &rule, &drift, a.baseline.as_ref()),
+        CompareFormat::Table => table(&sheet, &cmp, &rule, &drift, baseline.is_some()) + &de_table(&des),
+        CompareFormat::Json => json_text(&sheet, &cmp, &rule, &drift, a.baseline.as_ref(), &des),
         CompareFormat::Csv => csv_text(&cmp)?,
         CompareFormat::Junit => junit::compare(&sheet, &cmp, &drift)?,
     };
@@ -124,6 +139,10 @@ pub fn run(a: CompareArgs) -> Result<()> {
     let outside = cmp.iter().filter(|c| c.verdict == Verdict::Outside).count();
     let unchecked = cmp.iter().filter(|c| c.verdict.why_unchecked().is_some()).count();
     let moved = drift.iter().filter(|d| d.moved).count();
+    let de_outside = des.iter().filter(|d| d.inside == Some(false)).count();
+    if de_outside > 0 {
+        return Err(Error::Check(format!("{de_outside} of {} colour(s) with ΔE00 above --max-de00", des.len())));
+    }
     if outside + unchecked + moved > 0 {
         return Err(Error::Check(format!(
             "of {} reading(s), {outside} outside the allowance, {unchecked} could not be checked (see the notes in \
@@ -265,11 +284,50 @@ pub fn drift_json(d: &Drift) -> serde_json::Value {
            "now": d.now, "then": d.then, "allowed": d.allowed, "moved": d.moved})
 }
 
-fn json_text(sheet: &Sheet, cmp: &[Comparison], rule: &Rule, drift: &[Drift], baseline: Option<&PathBuf>) -> String {
+fn de_table(des: &[ColourDifference]) -> String {
+    if des.is_empty() {
+        return String::new();
+    }
+    let mut s = String::from("\nColour differences (CIEDE2000, kL = kC = kH = 1):\n");
+    for d in des {
+        s.push_str(&format!(
+            "  {} {} (line {}): measured L*a*b* ({:.2}, {:.2}, {:.2}), predicted ({:.2}, {:.2}, {:.2}): ΔE00 = {:.3}{}\n",
+            if d.sample.is_empty() { "-" } else { &d.sample },
+            d.geometry,
+            d.line,
+            d.measured.l,
+            d.measured.a,
+            d.measured.b,
+            d.predicted.l,
+            d.predicted.a,
+            d.predicted.b,
+            d.de00,
+            match d.inside {
+                Some(true) => "  ok",
+                Some(false) => "  OUTSIDE",
+                None => "",
+            }
+        ));
+    }
+    s
+}
+
+fn json_text(
+    sheet: &Sheet,
+    cmp: &[Comparison],
+    rule: &Rule,
+    drift: &[Drift],
+    baseline: Option<&PathBuf>,
+    des: &[ColourDifference],
+) -> String {
     let mut doc = json!({
         "sheet": {
             "file": sheet.file, "encoding": sheet.encoding, "delimiter": (sheet.delimiter as char).to_string(),
-            "layout": match sheet.layout { sheet::Layout::Long => "long", sheet::Layout::Wide => "wide" },
+            "layout": match sheet.layout {
+                sheet::Layout::Long => "long",
+                sheet::Layout::Wide => "wide",
+                sheet::Layout::Colour => "colour",
+            },
             "metadata": sheet.metadata_json(), "ignored_columns": sheet.ignored_columns,
         },
         "rule": {"k": rule.k, "tolerance": rule.tolerance},
@@ -283,6 +341,18 @@ fn json_text(sheet: &Sheet, cmp: &[Comparison], rule: &Rule, drift: &[Drift], ba
             "not_predicted": cmp.iter().filter(|c| matches!(c.verdict, Verdict::NotPredicted(_))).count(),
         },
     });
+    doc["colour_differences"] = des
+        .iter()
+        .map(|d| {
+            json!({
+                "sample": d.sample, "geometry": d.geometry, "line": d.line,
+                "measured": [d.measured.l, d.measured.a, d.measured.b],
+                "predicted": [d.predicted.l, d.predicted.a, d.predicted.b],
+                "de00": d.de00, "inside": d.inside,
+            })
+        })
+        .collect::<Vec<_>>()
+        .into();
     if let Some(b) = baseline {
         doc["baseline"] = json!({"file": b.display().to_string(), "checks": drift.iter().map(drift_json).collect::<Vec<_>>(),
                                  "moved": drift.iter().filter(|d| d.moved).count()});

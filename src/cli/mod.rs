@@ -7,6 +7,7 @@ use std::path::PathBuf;
 
 use clap::{Parser, Subcommand, ValueEnum};
 
+use crate::colorimetry::{Conditions, Illuminant, Observer};
 use crate::instrument::plan::{Plan, PlanOptions};
 use crate::instrument::standards;
 use crate::{recipe, resolve_geometries, Error, Result};
@@ -36,6 +37,23 @@ pub enum Format {
     Table,
     Json,
     Csv,
+}
+
+/// The conditions of colour readings (colour geometries only; gloss is luminous whatever they say).
+#[derive(clap::Args, Debug, Clone)]
+pub struct ColourArgs {
+    /// Illuminant of colour readings: D65, D50, A or C.
+    #[arg(long, default_value = "D65")]
+    pub illuminant: String,
+    /// Observer of colour readings: 10 (CIE 1964 10°) or 2 (CIE 1931 2°).
+    #[arg(long, default_value = "10")]
+    pub observer: String,
+}
+
+impl ColourArgs {
+    pub fn conditions(&self) -> Result<Conditions> {
+        Ok(Conditions { illuminant: Illuminant::parse(&self.illuminant)?, observer: Observer::parse(&self.observer)? })
+    }
 }
 
 #[derive(Subcommand, Debug)]
@@ -71,6 +89,8 @@ pub enum Command {
         /// Evaluation budget of each aperture integral; a reading whose integral runs out is "not converged".
         #[arg(long, default_value_t = PlanOptions::default().max_evals)]
         max_evals: usize,
+        #[command(flatten)]
+        colour: ColourArgs,
     },
     /// List the shipped geometries, or show one with the provenance of every number.
     Standards {
@@ -132,16 +152,21 @@ fn dispatch(cli: Cli) -> Result<()> {
             output,
             allow_unconverged,
             max_evals,
+            colour,
         } => {
             check_rtol(rtol)?;
+            let colour = colour.conditions()?;
             if max_evals == 0 {
                 return Err(Error::Usage("--max-evals must be at least 1".into()));
             }
             let target = Target::new(output.as_deref(), "--output")?;
             let material = recipe::load_file(&recipe)?;
             let geos = resolve_geometries(&geometries, &geometry_files)?;
-            let plan =
-                Plan::compile(material.brdf.clone(), geos, PlanOptions { rtol, max_evals, ..PlanOptions::default() })?;
+            let plan = Plan::compile(
+                material.brdf.clone(),
+                geos,
+                PlanOptions { rtol, max_evals, colour, ..PlanOptions::default() },
+            )?;
             let mut text = String::new();
             if explain {
                 let e = plan.explain();
@@ -162,8 +187,8 @@ fn dispatch(cli: Cli) -> Result<()> {
         }
         Command::Standards { id } => {
             let text = match id {
-                None => standards::builtin()?.iter().map(|g| standards::list_line(g) + "\n").collect(),
-                Some(id) => standards::describe(&standards::find(&id)?) + "\n",
+                None => standards::builtin_all()?.iter().map(|g| standards::list_line_any(g) + "\n").collect(),
+                Some(id) => standards::describe_any(&standards::find(&id)?) + "\n",
             };
             print(&text)
         }
@@ -180,7 +205,9 @@ fn dispatch(cli: Cli) -> Result<()> {
 /// The verdict on a set of readings (docs/instrument.md §Exit statuses): an error (exit 1) if one has no
 /// finite value, or did not converge (unless allowed).
 pub fn readings_status(readings: &[crate::Reading], allow_unconverged: bool) -> Result<()> {
-    let missing = readings.iter().filter(|r| r.value.is_none()).count();
+    // The hue of a neutral colour has no value by definition, not by failure.
+    let neutral_hue = |r: &crate::Reading| r.problem.as_deref().is_some_and(|p| p.starts_with(NEUTRAL_HUE));
+    let missing = readings.iter().filter(|r| r.value.is_none() && !neutral_hue(r)).count();
     if missing > 0 {
         return Err(Error::Numeric(format!(
             "{missing} of {} reading(s) have no finite value (see the notes in the output)",
@@ -197,6 +224,9 @@ pub fn readings_status(readings: &[crate::Reading], allow_unconverged: bool) -> 
     }
     Ok(())
 }
+
+/// How the hue reading of a neutral colour (C*ab = 0) explains its missing value (`plan::colour_value`).
+pub const NEUTRAL_HUE: &str = "neutral colour";
 
 /// `--rtol` in (0, 1), checked before any work.
 pub fn check_rtol(rtol: f64) -> Result<()> {

@@ -45,7 +45,7 @@ pub const SUM_START_NM: u32 = 360;
 pub const SUM_END_NM: u32 = 780;
 
 /// A CIE standard colorimetric observer.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub enum Observer {
     /// CIE 1931 2°.
     Cie1931,
@@ -88,7 +88,7 @@ impl Observer {
 }
 
 /// A CIE illuminant.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub enum Illuminant {
     D65,
     D50,
@@ -129,7 +129,7 @@ impl Illuminant {
 }
 
 /// An illuminant/observer pair: what a colour reading is computed under.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub struct Conditions {
     pub illuminant: Illuminant,
     pub observer: Observer,

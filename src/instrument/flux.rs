@@ -207,15 +207,17 @@ impl AxisMap {
 }
 
 /// Clip a stop to the upper hemisphere. For the source, z ∝ cos θ + p sin θ; for the receptor,
-/// z ∝ cos θ − p sin θ: the horizon is the line p = ∓cot θ, independent of q, so clipping is exact.
+/// z ∝ cos θ − p sin θ: the horizon is the line p = ∓cot θ, independent of q, so clipping is exact. A negative
+/// θ (a multi-angle colour receptor on the illuminator's side) keeps the other side of that line.
 pub fn clip(stop: Stop, theta: f64, is_source: bool) -> Option<Stop> {
     let mut s = stop;
-    if theta > 0.0 {
+    if theta != 0.0 {
         let cot = theta.cos() / theta.sin();
-        if is_source {
-            s.p[0] = s.p[0].max(-cot);
-        } else {
-            s.p[1] = s.p[1].min(cot);
+        match (is_source, theta > 0.0) {
+            (true, true) => s.p[0] = s.p[0].max(-cot),
+            (false, true) => s.p[1] = s.p[1].min(cot),
+            (true, false) => s.p[1] = s.p[1].min(-cot),
+            (false, false) => s.p[0] = s.p[0].max(cot),
         }
     }
     (s.p[1] > s.p[0] && s.q[1] > s.q[0]).then_some(s)

@@ -7,6 +7,7 @@
 //! is the direction normalize(axis + p·e∥ + q·e⊥) with e⊥ = (0, 1, 0), e∥ = e⊥ × axis, and solid-angle
 //! element dω = dp dq / (1 + p² + q²)^{3/2}. The mirror image of source point (p, q) is receptor point
 //! (−p, −q), so the specular manifold is p_s + p_r = 0, q_s + q_r = 0.
+use crate::colorimetry::Conditions;
 use crate::spectrum::WeightingKind;
 use crate::Vec3;
 
@@ -87,6 +88,65 @@ pub enum ReadingSpec {
     Doi { specular: String, offset: Vec<String> },
     /// Haze index (ASTM D4039): gloss of one geometry minus the gloss of another.
     HazeIndex { minuend: String, subtrahend: String },
+    /// A colour reading (`docs/colour.md`): from X, Y, Z = Σ sign·Φ_XYZ(integral) / `white` over the named
+    /// integrals (a directional geometry's receptor; a sphere's hemisphere, minus its specular port for SCE),
+    /// `white` being the same sum for the perfect reflecting diffuser (so it reads Y = 100).
+    Colour { quantity: ColourQuantity, terms: Vec<(String, f64)>, white: f64 },
+}
+
+/// What a colour reading reports.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ColourQuantity {
+    X,
+    Y,
+    Z,
+    L,
+    A,
+    B,
+    C,
+    H,
+}
+
+impl ColourQuantity {
+    /// Every colour quantity, in output order.
+    pub const ALL: [ColourQuantity; 8] = [
+        ColourQuantity::X,
+        ColourQuantity::Y,
+        ColourQuantity::Z,
+        ColourQuantity::L,
+        ColourQuantity::A,
+        ColourQuantity::B,
+        ColourQuantity::C,
+        ColourQuantity::H,
+    ];
+
+    /// The reading's name: X, Y, Z, L*, a*, b*, C* (C*ab), h (hab).
+    pub fn name(self) -> &'static str {
+        match self {
+            ColourQuantity::X => "X",
+            ColourQuantity::Y => "Y",
+            ColourQuantity::Z => "Z",
+            ColourQuantity::L => "L*",
+            ColourQuantity::A => "a*",
+            ColourQuantity::B => "b*",
+            ColourQuantity::C => "C*",
+            ColourQuantity::H => "h",
+        }
+    }
+}
+
+/// What kind of integral a named receptor of a geometry is.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Integral {
+    /// The aperture integral over source stop × receptor stop (gloss, and multi-angle colour with the receptor
+    /// lens on its own axis).
+    Aperture,
+    /// A d/8 sphere's directional–hemispherical reflectance at the viewing angle (uniform diffuse illumination
+    /// viewed along one direction; per sample, `instrument::sphere`).
+    Hemisphere,
+    /// The light a d/8 sphere's specular port (a cone of this half-angle, radians, about the mirror of the
+    /// viewing direction) takes away: the delta reflectance plus ∫_cone f cos θ dω.
+    Port { half_angle: f64 },
 }
 
 impl ReadingSpec {
@@ -97,14 +157,18 @@ impl ReadingSpec {
             ReadingSpec::LogHaze { .. } => "log-haze",
             ReadingSpec::Doi { .. } => "doi",
             ReadingSpec::HazeIndex { .. } => "haze-index",
+            ReadingSpec::Colour { quantity, .. } => quantity.name(),
         }
     }
 
-    /// The spectral weighting the reading's fluxes need (all of today's readings are luminous: ISO 2813 and
-    /// ASTM D523 weight the flux by V(λ) under CIE illuminant C). A colour reading returns its own kind and
-    /// the plan adds those rows to the fluxes (`spectrum::WeightingKind`).
-    pub fn weighting(&self) -> WeightingKind {
-        WeightingKind::Luminous
+    /// The spectral weighting the reading's fluxes need: gloss, haze and DOI are luminous (ISO 2813 and
+    /// ASTM D523 weight the flux by V(λ) under CIE illuminant C); a colour reading needs X, Y, Z under the
+    /// plan's colour conditions (`spectrum::WeightingKind::Xyz`).
+    pub fn weighting(&self, colour: Conditions) -> WeightingKind {
+        match self {
+            ReadingSpec::Colour { .. } => WeightingKind::Xyz(colour),
+            _ => WeightingKind::Luminous,
+        }
     }
 
     pub fn unit(&self) -> &'static str {
@@ -113,6 +177,8 @@ impl ReadingSpec {
             ReadingSpec::Haze { .. } => "HU",
             ReadingSpec::LogHaze { .. } => "HU(log)",
             ReadingSpec::Doi { .. } => "DOI",
+            ReadingSpec::Colour { quantity: ColourQuantity::H, .. } => "°",
+            ReadingSpec::Colour { .. } => "",
         }
     }
 }
@@ -180,19 +246,36 @@ impl Scale {
 pub struct Geometry {
     pub id: String,
     pub title: String,
-    /// Angle of incidence = angle of reflection, radians (0 for purely composite geometries).
+    /// Angle of incidence = angle of reflection, radians (0 for purely composite geometries); the
+    /// illumination angle of a multi-angle colour geometry, the viewing angle of a sphere.
     pub theta: f64,
+    /// The receptor lens axis, radians from the normal, signed (positive on the specular side): θ for gloss
+    /// geometries (the receptor looks at the mirror direction), θ − aspecular for multi-angle colour.
+    pub viewing: f64,
     /// The scale the readings are on: what the gloss standard is and what it is assigned.
     pub scale: Scale,
     pub source: Stop,
     /// Named receptor stops (all on the receptor lens, offsets inside its focal plane).
     pub receptors: Vec<(String, Stop)>,
+    /// Named integrals that are not aperture integrals (a sphere's hemisphere and specular port); empty for
+    /// gloss and multi-angle colour geometries.
+    pub integrals: Vec<(String, Integral)>,
     pub readings: Vec<ReadingSpec>,
 }
 
 impl Geometry {
     pub fn receptor(&self, name: &str) -> Option<&Stop> {
         self.receptors.iter().find(|(n, _)| n == name).map(|(_, s)| s)
+    }
+
+    /// The non-aperture integral of this name, if any.
+    pub fn integral(&self, name: &str) -> Option<Integral> {
+        self.integrals.iter().find(|(n, _)| n == name).map(|(_, i)| *i)
+    }
+
+    /// True if the geometry reads colour (its readings are X, Y, Z, L*, a*, b*, C*, h).
+    pub fn is_colour(&self) -> bool {
+        self.readings.iter().any(|r| matches!(r, ReadingSpec::Colour { .. }))
     }
 
     /// True if this geometry only combines readings of other geometries (ASTM D4039).

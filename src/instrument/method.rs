@@ -20,7 +20,8 @@ use crate::brdf::{Brdf, Lobe};
 use crate::instrument::flux::{
     choose_chart, clip, lobe_boxes, lobe_splits, mirror_overlap, AxisMap, Chart, Flux, DELTA_SHARE,
 };
-use crate::instrument::geometry::{solid_angle_density, Axes, Stop};
+use crate::instrument::geometry::{solid_angle_density, Axes, Integral, Stop};
+use crate::instrument::sphere;
 use crate::quadrature::{integrate_partition, Cell, Estimate, Options, Refine};
 use crate::spectrum::Weighting;
 use crate::Vec3;
@@ -81,8 +82,14 @@ pub struct RegularPart {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Method {
     pub target: Target,
-    /// Geometry angle θ.
+    /// What is integrated: an aperture integral, or a d/8 sphere's hemisphere or specular port (then the
+    /// stops, parts and partitions below are unused and the sphere's own integrators run, `instrument::sphere`).
+    pub integral: Integral,
+    /// Geometry angle θ (the source lens axis; a sphere's viewing angle).
     pub theta: f64,
+    /// The receptor lens axis, radians, signed: θ for gloss; θ − aspecular for multi-angle colour, whose
+    /// receptor never sees the mirror image (no delta part, the plain chart).
+    pub viewing: f64,
     /// The stops as the geometry gives them.
     pub source: Stop,
     pub receptor: Stop,
@@ -98,6 +105,9 @@ pub struct Method {
     /// The k × n spectral weighting of the flux.
     pub weighting: Weighting,
     pub projection: Projection,
+    /// Relative tolerance of the whole flux, as designed (the parts carry their shares; a sphere's integrals
+    /// use it directly).
+    pub rtol: f64,
     /// Evaluation budget of each part.
     pub max_evals: usize,
     /// Wall-clock budget of the whole integral, seconds (None: none). When it runs out the flux is the best
@@ -109,7 +119,9 @@ pub struct Method {
 #[derive(Clone, Debug)]
 pub struct Design<'a> {
     pub target: Target,
+    pub integral: Integral,
     pub theta: f64,
+    pub viewing: f64,
     pub source: Stop,
     pub receptor: Stop,
     /// The material's lobes (for the chart and the split points).
@@ -129,11 +141,14 @@ pub struct Design<'a> {
 impl Method {
     /// Design the method of one integral.
     pub fn design(d: Design<'_>) -> Method {
-        let clipped = match (clip(d.source, d.theta, true), clip(d.receptor, d.theta, false)) {
-            (Some(s), Some(r)) => Some((s, r)),
+        let aperture = d.integral == Integral::Aperture;
+        let clipped = match (clip(d.source, d.theta, true), clip(d.receptor, d.viewing, false)) {
+            (Some(s), Some(r)) if aperture => Some((s, r)),
             _ => None,
         };
-        let mirror = clipped.and_then(|(s, r)| mirror_overlap(s, r));
+        // The mirror image is only ever seen by a receptor on the mirror axis.
+        let on_mirror_axis = d.viewing == d.theta;
+        let mirror = clipped.filter(|_| on_mirror_axis).and_then(|(s, r)| mirror_overlap(s, r));
         let delta_share = if d.has_regular { DELTA_SHARE } else { 1.0 };
         let delta = match (d.has_delta, mirror) {
             (true, Some((lo, hi))) => Some(DeltaPart {
@@ -147,7 +162,8 @@ impl Method {
         };
         let regular = match (d.has_regular, clipped) {
             (true, Some((src, rec))) => {
-                let chart = choose_chart(d.lobes, d.theta, src, rec);
+                // Off the mirror axis no lobe is centred in the stops: the plain variables.
+                let chart = if on_mirror_axis { choose_chart(d.lobes, d.theta, src, rec) } else { Chart::Plain };
                 let (splits, boxes) = match chart {
                     Chart::Lobe => {
                         let splits = lobe_splits(d.lobes, d.theta, src, rec);
@@ -174,7 +190,9 @@ impl Method {
         };
         Method {
             target: d.target,
+            integral: d.integral,
             theta: d.theta,
+            viewing: d.viewing,
             source: d.source,
             receptor: d.receptor,
             clipped,
@@ -183,6 +201,7 @@ impl Method {
             regular,
             weighting: d.weighting,
             projection: d.projection,
+            rtol: d.rtol,
             max_evals: d.max_evals,
             max_seconds: d.max_seconds,
         }
@@ -200,7 +219,9 @@ impl Method {
     ) -> crate::Result<Method> {
         Ok(Method::design(Design {
             target: Target::Specimen,
+            integral: Integral::Aperture,
             theta,
+            viewing: theta,
             source,
             receptor,
             lobes: &brdf.lobes(),
@@ -239,10 +260,30 @@ impl Method {
         let k = self.weighting.len();
         let n = brdf.sampling().len();
         let mut frozen = keep.then(|| self.clone());
+        if self.integral != Integral::Aperture {
+            // A sphere's integrals: per sample, then weighted (their integrators have no partition to freeze,
+            // so the frozen method is the method).
+            let r = match self.integral {
+                Integral::Hemisphere => sphere::hemisphere_reflectance(brdf, self.theta),
+                Integral::Port { half_angle } => {
+                    sphere::port_reflectance(brdf, self.theta, half_angle, self.rtol, self.max_evals)
+                }
+                Integral::Aperture => unreachable!("handled below"),
+            };
+            let mut flux = Flux::zero(k);
+            flux.regular = self.weighting.apply(&r.value);
+            flux.error = (0..k).map(|c| self.weighting.component_error(c, &r.error)).collect();
+            flux.value = flux.regular.clone();
+            flux.evaluations = r.evaluations;
+            flux.converged = r.converged;
+            flux.seconds = start.elapsed().as_secs_f64();
+            return (flux, frozen);
+        }
         let Some((src, rec)) = self.clipped else {
             return (Flux::zero(k), frozen);
         };
         let axes = Axes::new(self.theta);
+        let rec_axes = Axes::new(self.viewing);
         let ncomp = match self.projection {
             Projection::Fold => k,
             Projection::Separate => n,
@@ -315,7 +356,7 @@ impl Method {
                             continue;
                         }
                         let wi = axes.source_dir(ps, qs);
-                        let wo = axes.receptor_dir(pr, qr);
+                        let wo = rec_axes.receptor_dir(pr, qr);
                         if wi.z <= 0.0 || wo.z <= 0.0 {
                             continue;
                         }

@@ -7,6 +7,7 @@
 //! cheapest set of methods and combines their fluxes into readings; `reference` gives independent closed forms to check them against; `convergence` measures
 //! error against run time; `sheet` reads real instruments' readings for comparison. The contract is
 //! written out in `docs/instrument.md`.
+pub mod colour;
 pub mod convergence;
 pub mod flux;
 pub mod geometry;
@@ -14,4 +15,5 @@ pub mod method;
 pub mod plan;
 pub mod reference;
 pub mod sheet;
+pub mod sphere;
 pub mod standards;

@@ -26,8 +26,9 @@ use std::sync::{Arc, Mutex};
 use rayon::prelude::*;
 
 use crate::brdf::{Brdf, Lobe, Term, TermKind};
+use crate::colorimetry::{cielab, Conditions};
 use crate::instrument::flux::{lobe_widths_uv, Chart, Flux, DELTA_SHARE};
-use crate::instrument::geometry::{ReadingSpec, Scale, Stop};
+use crate::instrument::geometry::{ColourQuantity, Integral, ReadingSpec, Scale, Stop};
 pub use crate::instrument::method::Target;
 use crate::instrument::method::{Design, Method, Projection};
 use crate::instrument::standards::{self, StandardGeometry};
@@ -72,6 +73,9 @@ pub struct PlanOptions {
     /// Wall-clock budget per flux integral, seconds (None: none). A reading whose integral hits it has the
     /// best estimate as its value, is marked not converged, and depends on the machine's speed.
     pub max_seconds: Option<f64>,
+    /// Illuminant and observer of colour readings (default D65 and the CIE 1964 10° observer, as colour QC
+    /// uses; gloss readings are luminous whatever this says).
+    pub colour: Conditions,
 }
 
 impl Default for PlanOptions {
@@ -82,6 +86,7 @@ impl Default for PlanOptions {
             share_fluxes: true,
             max_evals: 50_000_000,
             max_seconds: Some(DEFAULT_MAX_SECONDS),
+            colour: Conditions::default(),
         }
     }
 }
@@ -105,9 +110,10 @@ pub struct PlannedReading {
     /// Job index of each specimen flux and each standard flux, by receptor name.
     pub specimen_jobs: BTreeMap<String, usize>,
     pub standard_jobs: BTreeMap<String, usize>,
-    /// The component of the specimen fluxes this reading uses (its weighting's offset in the plan's
-    /// weighting; the standards' fluxes are luminous, component 0).
-    pub component: usize,
+    /// The spectral weighting this reading uses; it reads its components from that kind's offset in each of
+    /// its specimen jobs' weighting (a job carries the kinds of the readings that use it; the standards'
+    /// fluxes are luminous, component 0).
+    pub kind: WeightingKind,
     /// For composites: indices of the gloss readings combined.
     pub parts: Vec<usize>,
     /// Whether the user asked for it (dependencies of composites are computed but not reported).
@@ -168,14 +174,30 @@ pub struct Plan {
     shape: Shape,
     /// The standards' fluxes, computed at compile time (None for specimen jobs).
     standard_flux: Vec<Option<Flux>>,
+    /// X, Y, Z of the perfect reflecting diffuser under the colour conditions, from the material's own grid
+    /// (the row sums of its weights, so a white diffuser reads L* = 100 exactly); None without colour readings.
+    white_point: Option<(Conditions, [f64; 3])>,
 }
 
 /// The identity of a job for sharing: every input of its design, as bits.
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
 struct JobKey(Vec<u64>);
 
-fn job_key(target: Target, theta: f64, scale: Scale, source: Stop, receptor: Stop) -> JobKey {
-    let mut k = vec![target as u64, theta.to_bits()];
+fn job_key(
+    target: Target,
+    integral: Integral,
+    theta: f64,
+    viewing: f64,
+    scale: Scale,
+    source: Stop,
+    receptor: Stop,
+) -> JobKey {
+    let (kind, half_angle) = match integral {
+        Integral::Aperture => (0, 0.0),
+        Integral::Hemisphere => (1, 0.0),
+        Integral::Port { half_angle } => (2, half_angle),
+    };
+    let mut k = vec![target as u64, theta.to_bits(), kind, half_angle.to_bits(), viewing.to_bits()];
     if target == Target::Standard {
         k.extend(scale.key());
     }
@@ -188,7 +210,13 @@ fn job_key(target: Target, theta: f64, scale: Scale, source: Stop, receptor: Sto
 /// A job before its method is designed.
 struct Draft {
     target: Target,
+    integral: Integral,
     theta: f64,
+    viewing: f64,
+    /// The weightings of the readings that use it (each once, sorted: the job's k × n matrix stacks them).
+    kinds: Vec<WeightingKind>,
+    /// The smallest perfect-diffuser flux of the colour readings that use it (their absolute floor).
+    colour_white: Option<f64>,
     scale: Scale,
     source: Stop,
     receptor: Stop,
@@ -273,14 +301,22 @@ impl Planner {
             i += 1;
         }
         // The spectral weighting: the kinds the readings ask for, each once, in order of first use.
+        let colour = options.colour;
         let kinds: Vec<WeightingKind> =
-            queue.iter().flat_map(|(g, _)| g.geometry.readings.iter().map(ReadingSpec::weighting)).collect();
-        let weighting = Weighting::stack(&kinds, material.sampling())?;
+            queue.iter().flat_map(|(g, _)| g.geometry.readings.iter().map(|r| r.weighting(colour))).collect();
+        let weighting = Weighting::stack(&kinds, material.sampling()).map_err(|e| {
+            let ids: Vec<&str> =
+                queue.iter().filter(|(g, _)| g.geometry.is_colour()).map(|(g, _)| g.geometry.id.as_str()).collect();
+            match e {
+                Error::Usage(m) if !ids.is_empty() => Error::Usage(format!("{}: {m}", ids.join(", "))),
+                e => e,
+            }
+        })?;
         let mut drafts: Vec<Draft> = Vec::new();
         let mut readings: Vec<PlannedReading> = Vec::new();
         let mut index: HashMap<JobKey, usize> = HashMap::new();
         for (g, reported) in &queue {
-            add_geometry(g, *reported, &weighting, options.share_fluxes, &mut drafts, &mut readings, &mut index)?;
+            add_geometry(g, *reported, colour, options.share_fluxes, &mut drafts, &mut readings, &mut index)?;
         }
         // Composites: resolve their parts now that every gloss reading exists.
         for r in 0..readings.len() {
@@ -304,7 +340,9 @@ impl Planner {
         let standard_method = |d: &Draft| {
             Method::design(Design {
                 target: Target::Standard,
+                integral: d.integral,
                 theta: d.theta,
+                viewing: d.viewing,
                 source: d.source,
                 receptor: d.receptor,
                 lobes: &[],
@@ -323,7 +361,9 @@ impl Planner {
         let std_flux: Vec<Flux> =
             std_idx.par_iter().zip(&std_methods).map(|(&j, m)| self.standard_flux(&drafts[j], m, &options)).collect();
         // Absolute floor per geometry angle: 1e-4·rtol of the largest standard flux at that angle, i.e.
-        // 0.01·rtol GU on a gloss reading; it only matters for fluxes that are (nearly) zero.
+        // 0.01·rtol GU on a gloss reading; it only matters for fluxes that are (nearly) zero. A colour flux's
+        // floor is 1e-4·rtol of the perfect diffuser's Y flux (100·white), 0.01·rtol on X, Y, Z; a flux that
+        // both use gets the smaller.
         let floor = |theta: f64| -> f64 {
             let m = std_idx
                 .iter()
@@ -332,6 +372,14 @@ impl Planner {
                 .map(|(_, f)| f.value[0])
                 .fold(0.0, f64::max);
             1e-4 * options.rtol * m
+        };
+        let specimen_floor = |d: &Draft| -> f64 {
+            let gloss = d.kinds.contains(&WeightingKind::Luminous).then(|| floor(d.theta));
+            let colour = d.colour_white.map(|w| 1e-2 * options.rtol * w);
+            match (gloss, colour) {
+                (Some(a), Some(b)) => a.min(b),
+                (a, b) => a.or(b).unwrap_or(0.0),
+            }
         };
 
         // Step 1b: the specimen's methods.
@@ -352,16 +400,20 @@ impl Planner {
                 }
                 Target::Specimen => Method::design(Design {
                     target: Target::Specimen,
+                    integral: d.integral,
                     theta: d.theta,
+                    viewing: d.viewing,
                     source: d.source,
                     receptor: d.receptor,
                     lobes: &lobes,
                     has_delta,
                     has_regular,
-                    weighting: weighting.clone(),
+                    // Only the kinds of the readings that use this flux: a gloss flux stays one luminous
+                    // component (and the same bits) whatever colour readings share the plan.
+                    weighting: Weighting::stack(&d.kinds, material.sampling())?,
                     projection,
                     rtol: SPECIMEN_SHARE * options.rtol,
-                    atol: floor(d.theta),
+                    atol: specimen_floor(d),
                     max_evals: options.max_evals,
                     max_seconds: options.max_seconds,
                 }),
@@ -369,7 +421,12 @@ impl Planner {
             jobs.push(Job { method, scale: d.scale, used_by: d.used_by.clone() });
         }
         let shape = shape(material.as_ref());
+        let white_point = match weighting.parts.iter().any(|(k, _)| matches!(k, WeightingKind::Xyz(_))) {
+            true => Some((options.colour, crate::colorimetry::weights(material.sampling(), options.colour)?.white)),
+            false => None,
+        };
         Ok(Plan {
+            white_point,
             material,
             options,
             geometries: queue.into_iter().map(|(g, _)| g).collect(),
@@ -389,7 +446,7 @@ impl Planner {
         if !options.share_fluxes {
             return method.execute(&std);
         }
-        let mut key = job_key(Target::Standard, d.theta, d.scale, d.source, d.receptor);
+        let mut key = job_key(Target::Standard, d.integral, d.theta, d.viewing, d.scale, d.source, d.receptor);
         key.0.extend([options.rtol.to_bits(), options.max_evals as u64]);
         key.0.extend(options.max_seconds.map(f64::to_bits));
         if let Some(f) = self.standards.lock().ok().and_then(|c| c.get(&key).cloned()) {
@@ -407,7 +464,7 @@ impl Planner {
 fn add_geometry(
     sg: &StandardGeometry,
     reported: bool,
-    weighting: &Weighting,
+    colour: Conditions,
     share: bool,
     drafts: &mut Vec<Draft>,
     readings: &mut Vec<PlannedReading>,
@@ -423,6 +480,12 @@ fn add_geometry(
             }
             ReadingSpec::Doi { specular, offset } => (std::iter::once(specular).chain(offset.iter()).collect(), vec![]),
             ReadingSpec::HazeIndex { .. } => (vec![], vec![]),
+            ReadingSpec::Colour { terms, .. } => (terms.iter().map(|(n, _)| n).collect(), vec![]),
+        };
+        let kind = spec.weighting(colour);
+        let colour_white = match spec {
+            ReadingSpec::Colour { white, .. } => Some(*white),
+            _ => None,
         };
         let mut pr = PlannedReading {
             geometry: g.id.clone(),
@@ -430,30 +493,50 @@ fn add_geometry(
             spec: spec.clone(),
             specimen_jobs: BTreeMap::new(),
             standard_jobs: BTreeMap::new(),
-            component: weighting.offset(spec.weighting()).expect("the plan's weighting has every reading's kind"),
+            kind,
             parts: vec![],
             reported,
         };
         for (names, target) in [(spec_rx, Target::Specimen), (std_rx, Target::Standard)] {
             for rx in names {
-                let stop = *g.receptor(rx).ok_or_else(|| {
-                    Error::Usage(format!("{}: reading `{}` names unknown receptor `{rx}`", g.id, pr.name))
-                })?;
-                let key = job_key(target, g.theta, g.scale, g.source, stop);
+                // A named sphere integral, or an aperture integral through a receptor stop.
+                let (integral, viewing, source, stop) = match g.integral(rx) {
+                    Some(i) => (i, g.theta, Stop { p: [0.0; 2], q: [0.0; 2] }, Stop { p: [0.0; 2], q: [0.0; 2] }),
+                    None => {
+                        let stop = *g.receptor(rx).ok_or_else(|| {
+                            Error::Usage(format!("{}: reading `{}` names unknown receptor `{rx}`", g.id, pr.name))
+                        })?;
+                        (Integral::Aperture, g.viewing, g.source, stop)
+                    }
+                };
+                let key = job_key(target, integral, g.theta, viewing, g.scale, source, stop);
                 let used = format!("{}/{rx}", g.id);
+                let job_kind = if target == Target::Standard { WeightingKind::Luminous } else { kind };
                 let j = match index.get(&key) {
                     Some(&i) if share => {
                         if !drafts[i].used_by.contains(&used) {
                             drafts[i].used_by.push(used);
+                        }
+                        let d = &mut drafts[i];
+                        if !d.kinds.contains(&job_kind) {
+                            d.kinds.push(job_kind);
+                            d.kinds.sort();
+                        }
+                        if let Some(w) = colour_white {
+                            d.colour_white = Some(d.colour_white.map_or(w, |x| x.min(w)));
                         }
                         i
                     }
                     _ => {
                         drafts.push(Draft {
                             target,
+                            integral,
                             theta: g.theta,
+                            viewing,
+                            kinds: vec![job_kind],
+                            colour_white,
                             scale: g.scale,
-                            source: g.source,
+                            source,
                             receptor: stop,
                             used_by: vec![used],
                         });
@@ -558,7 +641,7 @@ impl Plan {
         let mut out: Vec<Option<Reading>> = vec![None; self.readings.len()];
         for (i, r) in self.readings.iter().enumerate() {
             if r.parts.is_empty() {
-                out[i] = Some(compute_reading(r, flux));
+                out[i] = Some(compute_reading(r, flux, &self.jobs, self.white_point));
             }
         }
         for (i, r) in self.readings.iter().enumerate() {
@@ -628,6 +711,17 @@ impl Plan {
                 ));
                 continue;
             }
+            if geo.is_colour() {
+                s.push_str(&format!(
+                    "Geometry {} ({}): colour, X, Y, Z under {} relative to the perfect reflecting diffuser \
+                     (the spectral dimension is not folded into one luminous component: three components per \
+                     flux), then L*, a*, b*, C*, h\n",
+                    geo.id,
+                    geo.title,
+                    self.options.colour.describe()
+                ));
+                continue;
+            }
             s.push_str(&format!(
                 "Geometry {} ({}), θ = {:.4}°, standard: {}\n",
                 geo.id,
@@ -659,10 +753,16 @@ impl Plan {
             }
         ));
         for (i, j) in self.jobs.iter().enumerate() {
+            let viewing = if j.method.viewing != j.method.theta {
+                format!(", receptor axis {:.4}° (off specular: no mirror image)", j.method.viewing.to_degrees())
+            } else {
+                String::new()
+            };
             s.push_str(&format!(
-                "  #{i}: {:?} at {:.4}°, {}; used by {}\n",
+                "  #{i}: {:?} at {:.4}°{viewing}, {} component(s), {}; used by {}\n",
                 j.method.target,
                 j.method.theta.to_degrees(),
+                j.method.weighting.len(),
                 describe_method(&j.method, &self.terms),
                 j.used_by.join(", ")
             ));
@@ -678,6 +778,21 @@ impl Plan {
 
 /// One method in words, from its stored fields.
 fn describe_method(m: &Method, terms: &[Term]) -> String {
+    match m.integral {
+        Integral::Hemisphere => {
+            return "d/8 sphere: directional–hemispherical reflectance at the viewing angle per sample (brdf::albedo of \
+                    the transposed BRDF, Gauss–Kronrod in half-vector coordinates), delta included, then weighted"
+                .to_string()
+        }
+        Integral::Port { half_angle } => {
+            return format!(
+                "d/8 specular port: delta + ∫ f cos θ dω over a {:.1}° cone about the mirror of the viewing \
+                 direction per sample (Genz–Malik, polar tangent coordinates), then weighted",
+                half_angle.to_degrees()
+            )
+        }
+        Integral::Aperture => {}
+    }
     if m.clipped.is_none() {
         return "stops below the horizon: zero".to_string();
     }
@@ -779,6 +894,7 @@ pub fn reading_value(
             ratio(o, oe, s, se, Denominator::SpecimenSpecular).map(|(v, e)| (100.0 * (1.0 - v), 100.0 * e))
         }
         ReadingSpec::HazeIndex { .. } => Err("a composite reading has no fluxes of its own".into()),
+        ReadingSpec::Colour { .. } => Err("a colour reading needs X, Y, Z (plan::colour_xyz)".into()),
     }
 }
 
@@ -787,12 +903,68 @@ pub fn haze_index_value(minuend: (f64, f64), subtrahend: (f64, f64)) -> (f64, f6
     (minuend.0 - subtrahend.0, minuend.1 + subtrahend.1)
 }
 
+/// The offset of a reading's weighting kind in job j's weighting.
+fn component_of(r: &PlannedReading, jobs: &[Job], j: usize) -> usize {
+    jobs[j].method.weighting.offset(r.kind).expect("a job's weighting has the kinds of the readings that use it")
+}
+
+/// X, Y, Z of a colour reading: Σ sign·Φ_XYZ over its integrals, ÷ the perfect diffuser's flux, with the
+/// summed error bounds (a difference's bound is the sum of the bounds).
+pub fn colour_xyz(
+    terms: &[(String, f64)],
+    white: f64,
+    flux: &dyn Fn(&str, usize) -> (f64, f64),
+) -> ([f64; 3], [f64; 3]) {
+    let mut xyz = [0.0; 3];
+    let mut err = [0.0; 3];
+    for (name, sign) in terms {
+        for c in 0..3 {
+            let (v, e) = flux(name, c);
+            xyz[c] += sign * v;
+            err[c] += e;
+        }
+    }
+    (xyz.map(|x| x / white), err.map(|e| e / white))
+}
+
+/// A colour quantity and its error bound from X, Y, Z (`docs/colour.md`: L*, a*, b* by intervals, C*ab and
+/// hab from the a*b* box). Err for the hue of a neutral colour (C*ab = 0), which is undefined.
+pub fn colour_value(
+    q: ColourQuantity,
+    xyz: [f64; 3],
+    err: [f64; 3],
+    white: [f64; 3],
+) -> std::result::Result<(f64, f64), String> {
+    let lab = cielab::xyz_to_lab(xyz, white);
+    let le = cielab::lab_errors(xyz, err, white);
+    let lch = cielab::lab_to_lch(lab);
+    let (ec, eh) = cielab::lch_errors(lab, le[1], le[2]);
+    Ok(match q {
+        ColourQuantity::X => (xyz[0], err[0]),
+        ColourQuantity::Y => (xyz[1], err[1]),
+        ColourQuantity::Z => (xyz[2], err[2]),
+        ColourQuantity::L => (lab.l, le[0]),
+        ColourQuantity::A => (lab.a, le[1]),
+        ColourQuantity::B => (lab.b, le[2]),
+        ColourQuantity::C => (lch.c, ec),
+        ColourQuantity::H => match lch.h {
+            Some(h) => (h, eh),
+            None => return Err("neutral colour (C*ab = 0): the hue angle is undefined".into()),
+        },
+    })
+}
+
 /// Combine fluxes into a direct reading, with first-order error propagation.
-fn compute_reading(r: &PlannedReading, flux: &[Flux]) -> Reading {
-    let c = r.component;
+fn compute_reading(
+    r: &PlannedReading,
+    flux: &[Flux],
+    jobs: &[Job],
+    white_point: Option<(Conditions, [f64; 3])>,
+) -> Reading {
     let specimen = |rx: &str| {
-        let f = &flux[r.specimen_jobs[rx]];
-        (f.value[c], f.error[c])
+        let j = r.specimen_jobs[rx];
+        let c = component_of(r, jobs, j);
+        (flux[j].value[c], flux[j].error[c])
     };
     let standard = |rx: &str| {
         let f = &flux[r.standard_jobs[rx]];
@@ -803,7 +975,21 @@ fn compute_reading(r: &PlannedReading, flux: &[Flux]) -> Reading {
     let seconds = used.iter().map(|f| f.seconds).sum();
     let converged = used.iter().all(|f| f.converged);
     let out_of_time = used.iter().any(|f| f.out_of_time);
-    match reading_value(&r.spec, &specimen, &standard) {
+    let value = match (&r.spec, r.kind) {
+        (ReadingSpec::Colour { quantity, terms, white }, WeightingKind::Xyz(cond)) => {
+            let (xyz, err) = colour_xyz(terms, *white, &|rx, k| {
+                let j = r.specimen_jobs[rx];
+                let c = component_of(r, jobs, j) + k;
+                (flux[j].value[c], flux[j].error[c])
+            });
+            match white_point {
+                Some((c, w)) if c == cond => colour_value(*quantity, xyz, err, w),
+                _ => Err("no white point for these colour conditions".into()),
+            }
+        }
+        _ => reading_value(&r.spec, &specimen, &standard),
+    };
+    match value {
         Ok((v, e)) if v.is_finite() && e.is_finite() => Reading {
             problem: (!converged).then(|| {
                 if out_of_time {

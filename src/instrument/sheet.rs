@@ -9,7 +9,8 @@
 //! * `,`, `;` or tab separators, detected from the header line (or given), CRLF or LF line ends, quoted
 //!   fields (also across lines), decimal commas (`89,1`);
 //! * `#` comment lines anywhere; `# key: value` lines are kept as the sheet's metadata;
-//! * two layouts: **long** (a `geometry` and a `value` column, one reading per row) and **wide** (one column
+//! * three layouts: **colour** (a `geometry` column with `L*`, `a*`, `b*` columns, as multi-angle
+//!   spectrophotometers export; each row three readings), **long** (a `geometry` and a `value` column, one reading per row) and **wide** (one column
 //!   per reading, named as instruments name them: `20°`, `Gloss 60`, `Haze`, `HU_LOG`, `DOI`, `Rspec`, ...;
 //!   the aliases are the table [`READING_COLUMNS`] plus the gloss-angle pattern of [`gloss_angle`]);
 //! * repeated readings: several rows for the same sample, or columns with a repeat suffix (`60° #2`,
@@ -133,6 +134,12 @@ pub const GEOMETRY_COLUMNS: &[&str] = &["geometry", "geometryid"];
 pub const QUANTITY_COLUMNS: &[&str] = &["quantity", "reading", "readingname"];
 pub const VALUE_COLUMNS: &[&str] = &["value", "measured", "measurement"];
 pub const UNCERTAINTY_COLUMNS: &[&str] = &["uncertainty", "u", "unc"];
+/// The colour layout's columns (normalised) and the readings they give: L*, a*, b*.
+pub const LAB_COLUMNS: &[(&[&str], &str)] =
+    &[(&["l", "lstar", "cielabl"], "L*"), (&["a", "astar", "cielaba"], "a*"), (&["b", "bstar", "cielabb"], "b*")];
+/// A colour reading as a long-layout `quantity` (lower-cased) and its reading name.
+const COLOUR_QUANTITIES: &[(&str, &str)] =
+    &[("x", "X"), ("y", "Y"), ("z", "Z"), ("l*", "L*"), ("a*", "a*"), ("b*", "b*"), ("c*", "C*"), ("h", "h")];
 
 /// The gloss angles instruments write, and the shipped geometry read at each.
 pub const GLOSS_ANGLES: &[(&str, &str)] = &[
@@ -173,6 +180,8 @@ pub struct SheetRow {
 pub enum Layout {
     Long,
     Wide,
+    /// A `geometry` column and `L*`, `a*`, `b*` columns (multi-angle spectrophotometers).
+    Colour,
 }
 
 /// A parsed sheet: its rows and what the reader found out about the file.
@@ -343,6 +352,8 @@ enum Role {
     Quantity,
     Value,
     Uncertainty,
+    /// An L*, a*, b* column of the colour layout (0, 1, 2).
+    Lab(usize),
     /// A reading column of the wide layout: geometry, reading, repeat index, not-predicted reason.
     Reading {
         geometry: &'static str,
@@ -376,6 +387,9 @@ fn role(header: &str, ignore: &[String]) -> Option<Role> {
     }
     if is(UNCERTAINTY_COLUMNS) {
         return Some(Role::Uncertainty);
+    }
+    if let Some(i) = LAB_COLUMNS.iter().position(|(names, _)| is(names)) {
+        return Some(Role::Lab(i));
     }
     let (base, repeat) = split_repeat(header);
     let b = normalise(base);
@@ -524,7 +538,9 @@ pub fn parse(text: &str, file: &str, options: &SheetOptions) -> Result<Sheet> {
     let find = |r: &Role| roles.iter().position(|x| x == r);
     let (geo_c, val_c) = (find(&Role::Geometry), find(&Role::Value));
     let reading_cols: Vec<usize> = (0..roles.len()).filter(|&j| matches!(roles[j], Role::Reading { .. })).collect();
+    let lab_cols: Vec<Option<usize>> = (0..3).map(|i| find(&Role::Lab(i))).collect();
     let layout = match (geo_c, val_c) {
+        (Some(_), None) if lab_cols.iter().all(Option::is_some) => Layout::Colour,
         (Some(_), Some(_)) => Layout::Long,
         (Some(_), None) => {
             return Err(Error::input(file, format!("line {hline} (header)"), "the long layout needs a `value` column"))
@@ -542,7 +558,27 @@ pub fn parse(text: &str, file: &str, options: &SheetOptions) -> Result<Sheet> {
         }
         (None, None) => Layout::Wide,
     };
-    if layout == Layout::Long {
+    if layout != Layout::Colour {
+        if let Some(j) = roles.iter().position(|r| matches!(r, Role::Lab(_))) {
+            return Err(Error::input(
+                file,
+                at(hline, j, &headers[j]),
+                "an L*, a* or b* column belongs to the colour layout: a `geometry` column with all three of `L*`, \
+                 `a*`, `b*` and no `value` column",
+            ));
+        }
+    }
+    if layout == Layout::Colour {
+        if let Some(j) =
+            roles.iter().position(|r| matches!(r, Role::Quantity | Role::Uncertainty | Role::Reading { .. }))
+        {
+            return Err(Error::input(
+                file,
+                at(hline, j, &headers[j]),
+                "a colour-layout sheet (`geometry` with `L*`, `a*`, `b*`) has no other reading, quantity or uncertainty columns",
+            ));
+        }
+    } else if layout == Layout::Long {
         if let Some(&j) = reading_cols.first() {
             return Err(Error::input(
                 file,
@@ -595,6 +631,11 @@ pub fn parse(text: &str, file: &str, options: &SheetOptions) -> Result<Sheet> {
                     q if q.is_empty() => "gloss".to_string(),
                     q => q.to_lowercase().split_whitespace().collect::<Vec<_>>().join("-"),
                 };
+                let reading = COLOUR_QUANTITIES
+                    .iter()
+                    .find(|(q, _)| *q == reading)
+                    .map(|(_, name)| name.to_string())
+                    .unwrap_or(reading);
                 let not_predicted = READING_COLUMNS
                     .iter()
                     .find(|c| c.reading == reading && c.geometry == geometry)
@@ -615,6 +656,28 @@ pub fn parse(text: &str, file: &str, options: &SheetOptions) -> Result<Sheet> {
                     uncertainty,
                     not_predicted,
                 });
+            }
+            Layout::Colour => {
+                let g = geo_c.expect("colour");
+                let geometry = get(Some(g));
+                if geometry.is_empty() {
+                    return Err(Error::input(file, at(line, g, &headers[g]), "empty geometry id"));
+                }
+                for (i, c) in lab_cols.iter().enumerate() {
+                    let c = c.expect("colour layout has all three");
+                    let reading = LAB_COLUMNS[i].1;
+                    let value = num(c, &format!("the measured {reading}"), false)?;
+                    rows.push(SheetRow {
+                        line,
+                        column: headers[c].clone(),
+                        sample: sample.clone(),
+                        geometry: geometry.clone(),
+                        reading: reading.to_string(),
+                        value,
+                        uncertainty: None,
+                        not_predicted: None,
+                    });
+                }
             }
             Layout::Wide => {
                 for &c in &reading_cols {
@@ -704,6 +767,23 @@ fn csv_error(file: &str, lines: &Lines, e: &csv::Error) -> Error {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn colour_layout_and_colour_quantities() {
+        let o = SheetOptions::default();
+        let t = "sample;geometry;L*;a*;b*\np1;astm-e2194-15;81,4;-7,3;-10,0\n";
+        let sh = parse(t, "c.csv", &o).unwrap();
+        assert_eq!(sh.layout, Layout::Colour);
+        assert_eq!(sh.rows.len(), 3);
+        assert_eq!((sh.rows[1].reading.as_str(), sh.rows[1].value, sh.rows[1].line), ("a*", -7.3, 2));
+        let e = parse("geometry,L*,a*,b*\nastm-e2194-15,81,x,1\n", "c.csv", &o).unwrap_err().to_string();
+        assert!(e.contains("c.csv") && e.contains("line 2") && e.contains("a*"), "{e}");
+        // L* without a* and b*, or beside a value column, is not the colour layout.
+        assert!(parse("geometry,value,L*\nastm-e2194-15,1,2\n", "c.csv", &o).is_err());
+        // Colour readings one per row in the long layout.
+        let sh = parse("geometry,quantity,value\nd8-sce,L*,50\nd8-sce,h,200\n", "l.csv", &o).unwrap();
+        assert_eq!((sh.rows[0].reading.as_str(), sh.rows[1].reading.as_str()), ("L*", "h"));
+    }
 
     fn p(text: &str) -> Result<Sheet> {
         parse(text, "s.csv", &SheetOptions::default())

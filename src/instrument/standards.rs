@@ -146,22 +146,58 @@ fn ids(gs: &[StandardGeometry]) -> String {
     gs.iter().map(|g| g.geometry.id.as_str()).collect::<Vec<_>>().join(", ")
 }
 
-/// The builtin geometry with this id; an unknown id is a usage error listing the known ids.
+/// The builtin geometry (gloss, or colour: `instrument::colour`) with this id; an unknown id is a usage error
+/// listing the known ids.
 pub fn find(id: &str) -> Result<StandardGeometry> {
     let all = builtin()?;
-    match all.iter().find(|g| g.geometry.id == id) {
+    if let Some(g) = all.iter().find(|g| g.geometry.id == id) {
+        return Ok(g.clone());
+    }
+    let colour = crate::instrument::colour::builtin()?;
+    match colour.iter().find(|g| g.geometry.id == id) {
         Some(g) => Ok(g.clone()),
-        None => Err(Error::Usage(format!("unknown geometry id \"{id}\"; known ids: {}", ids(&all)))),
+        None => Err(Error::Usage(format!(
+            "unknown geometry id \"{id}\"; known ids: {}; colour: {}",
+            ids(&all),
+            ids(&colour)
+        ))),
     }
 }
 
-/// Load a user geometry file (same format as the builtin ones).
+/// Every builtin geometry: the gloss ones, then the colour ones (`standards/colour/`).
+pub fn builtin_all() -> Result<Vec<StandardGeometry>> {
+    let mut all = builtin()?;
+    all.extend(crate::instrument::colour::builtin()?);
+    Ok(all)
+}
+
+/// Load a user geometry file (same format as the builtin ones: a gloss geometry, or a colour geometry when it
+/// has a `kind`, `docs/colour.md`).
 pub fn load_file(path: &Path) -> Result<StandardGeometry> {
     let name = path.display().to_string();
     let text = crate::input::read_text(path, "geometry file")?;
-    let g = parse(&text, &name)?;
-    check_user(&g, &builtin()?)?;
+    let is_colour = parse_json(&text, &name).map(|v| crate::instrument::colour::is_colour_spec(&v)).unwrap_or(false);
+    let g = if is_colour { crate::instrument::colour::parse(&text, &name)? } else { parse(&text, &name)? };
+    check_user(&g, &builtin_all()?)?;
     Ok(g)
+}
+
+/// [`describe`] for gloss geometries, `colour::describe` for colour ones.
+pub fn describe_any(g: &StandardGeometry) -> String {
+    if g.geometry.is_colour() {
+        crate::instrument::colour::describe(g)
+    } else {
+        describe(g)
+    }
+}
+
+/// [`list_line`] for gloss geometries, `colour::list_line` for colour ones.
+pub fn list_line_any(g: &StandardGeometry) -> String {
+    if g.geometry.is_colour() {
+        crate::instrument::colour::list_line(g)
+    } else {
+        list_line(g)
+    }
 }
 
 /// A user geometry may not take a shipped id (a reading would be labelled as the standard's while measuring
@@ -303,13 +339,23 @@ pub fn parse(text: &str, origin: &str) -> Result<StandardGeometry> {
         readings.push(spec);
     }
 
-    let geometry = Geometry { id: id.to_string(), title, theta, scale, source, receptors, readings };
+    let geometry = Geometry {
+        id: id.to_string(),
+        title,
+        theta,
+        viewing: theta,
+        scale,
+        source,
+        receptors,
+        integrals: vec![],
+        readings,
+    };
     Ok(StandardGeometry { geometry, reading_names, spec, origin: origin.to_string() })
 }
 
 /// Allowed range of a sourced number.
 #[derive(Clone, Copy)]
-enum Range {
+pub(crate) enum Range {
     /// lo < x < hi
     Open(f64, f64),
     /// lo ≤ x ≤ hi
@@ -317,7 +363,7 @@ enum Range {
 }
 
 /// The value of a `{"value", "source", "status"}` object at `o.key`, with its provenance checked.
-fn sourced(o: &Obj, key: &str, range: Range, what: &str) -> Result<f64> {
+pub(crate) fn sourced(o: &Obj, key: &str, range: Range, what: &str) -> Result<f64> {
     let s = o.obj(key)?;
     s.deny_unknown(&["value", "source", "status"])?;
     let (lo, hi) = match range {
@@ -342,7 +388,7 @@ fn sourced(o: &Obj, key: &str, range: Range, what: &str) -> Result<f64> {
 
 /// The shape and size of a stop: (in-plane, perpendicular) full angles in degrees. The shape is checked
 /// before unknown fields, so a circle's `diameter_deg` gets the circle message, not "unknown field".
-fn aperture(o: &Obj, allowed: &[&str]) -> Result<(f64, f64)> {
+pub(crate) fn aperture(o: &Obj, allowed: &[&str]) -> Result<(f64, f64)> {
     let shape = o.str("shape")?;
     match shape {
         "rectangle" => {}
@@ -361,7 +407,7 @@ fn aperture(o: &Obj, allowed: &[&str]) -> Result<(f64, f64)> {
     Ok((a, b))
 }
 
-fn nonempty_str(o: &Obj, key: &str) -> Result<String> {
+pub(crate) fn nonempty_str(o: &Obj, key: &str) -> Result<String> {
     let s = o.str(key)?;
     if s.trim().is_empty() {
         return Err(o.err(key, "must not be empty"));
@@ -370,7 +416,7 @@ fn nonempty_str(o: &Obj, key: &str) -> Result<String> {
 }
 
 /// A non-empty array of non-empty strings.
-fn string_list(o: &Obj, key: &str) -> Result<Vec<String>> {
+pub(crate) fn string_list(o: &Obj, key: &str) -> Result<Vec<String>> {
     let a = o.array(key)?;
     if a.is_empty() {
         return Err(o.err(key, "must list at least one entry"));
@@ -552,6 +598,11 @@ fn reading_summary(r: &ReadingSpec) -> String {
             format!("100·(Φ({specular}) − mean Φ({})) / Φ({specular})", offset.join(", "))
         }
         ReadingSpec::HazeIndex { minuend, subtrahend } => format!("gloss({minuend}) − gloss({subtrahend})"),
+        ReadingSpec::Colour { quantity, terms, .. } => {
+            let t: Vec<String> =
+                terms.iter().map(|(n, s)| format!("{}Φ_XYZ({n})", if *s < 0.0 { "− " } else { "" })).collect();
+            format!("{} of ({}) / Φ_white", quantity.name(), t.join(" "))
+        }
     }
 }
 

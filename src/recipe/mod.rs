@@ -103,11 +103,26 @@ pub fn parse_brdf(obj: &Obj) -> Result<Arc<dyn Brdf>> {
                 .collect();
             Arc::new(SmoothConductor::new(eta, sampling)?)
         }
-        "lambert" => {
-            let albedo = colour(obj, &reg::LAMBERT_ALBEDO)?;
-            let sampling = sampling_of(&[&albedo]);
-            Arc::new(Lambert::new(albedo.expand(&sampling), sampling)?)
-        }
+        "lambert" => match obj.get("wavelengths_nm") {
+            // A spectral albedo: one value per wavelength, as the paint's spectral recipes.
+            Some(_) => {
+                let wl = obj.param_array(&reg::LAMBERT_WAVELENGTHS, None)?;
+                if wl.len() > crate::brdf::paint::MAX_SAMPLES {
+                    return Err(obj.err(
+                        "wavelengths_nm",
+                        format!("{} wavelengths; at most {} allowed", wl.len(), crate::brdf::paint::MAX_SAMPLES),
+                    ));
+                }
+                let sampling = Sampling::spectral(&wl).map_err(|e| obj.err("wavelengths_nm", e.to_string()))?;
+                let albedo = obj.param_array(&reg::LAMBERT_ALBEDO, Some(wl.len()))?;
+                Arc::new(Lambert::new(albedo, sampling)?)
+            }
+            None => {
+                let albedo = colour(obj, &reg::LAMBERT_ALBEDO)?;
+                let sampling = sampling_of(&[&albedo]);
+                Arc::new(Lambert::new(albedo.expand(&sampling), sampling)?)
+            }
+        },
         "microfacet" => {
             let distribution = distribution(obj, &reg::MICROFACET_DISTRIBUTION)?;
             let alpha = obj.param(&reg::MICROFACET_ROUGHNESS)?;

@@ -1,0 +1,269 @@
+//! Colour readings against independent references: colour-science's `sd_to_XYZ` / `XYZ_to_Lab` for Lambertian
+//! ColorChecker spectra on the d/8 sphere (after the SCE aperture factor), the white diffuser's L* = 100, the flop
+//! of a metallic, the refusal of RGB materials, sharing with gloss, and the CLI. Colour readings go through the
+//! same plan as gloss (the X, Y, Z rows of the k × n weighting folded into the integrand).
+use std::sync::Arc;
+
+use glossmeter::brdf::Brdf;
+use glossmeter::colorimetry::{Conditions, Illuminant, Observer};
+use glossmeter::instrument::colour::{self, ColourKind};
+use glossmeter::instrument::plan::{Plan, PlanOptions, Reading};
+use glossmeter::instrument::standards::{self, StandardGeometry};
+use glossmeter::recipe;
+use serde_json::Value;
+
+fn geos(ids: &[&str]) -> Vec<StandardGeometry> {
+    ids.iter().map(|id| standards::find(id).unwrap()).collect()
+}
+
+fn options(colour: Conditions, rtol: f64) -> PlanOptions {
+    PlanOptions { rtol, colour, ..PlanOptions::default() }
+}
+
+fn measure(m: Arc<dyn Brdf>, ids: &[&str], colour: Conditions, rtol: f64) -> Vec<Reading> {
+    Plan::compile(m, geos(ids), options(colour, rtol)).unwrap().execute()
+}
+
+fn brdf(json: &str) -> Arc<dyn Brdf> {
+    recipe::parse_str(json, "<test>").unwrap().brdf
+}
+
+fn value(rs: &[Reading], geometry: &str, q: &str) -> (f64, f64) {
+    let r = rs.iter().find(|r| r.geometry == geometry && r.quantity == q).unwrap();
+    (r.value.unwrap(), r.error_estimate)
+}
+
+fn nums(v: &Value) -> Vec<f64> {
+    v.as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect()
+}
+
+/// The SCE aperture factor of a Lambertian: 1 − P_port/π = 1 − sin²β cos 8° (projected solid angle of a cone of
+/// half-angle β whose axis is 8° from the normal: π sin²β cos 8°).
+fn aperture_factor() -> f64 {
+    let g = standards::find("d8-sce").unwrap();
+    let Some(ColourKind::Sphere { viewing, port: Some(beta) }) = colour::colour_kind(&g.geometry) else {
+        panic!("d8-sce is a sphere with a port")
+    };
+    1.0 - beta.sin().powi(2) * viewing.cos()
+}
+
+#[test]
+fn lambertian_colorchecker_on_d8_matches_colour_science() {
+    let v: Value = serde_json::from_str(include_str!("../fixtures/reference/colorimetry.json")).unwrap();
+    let grid = nums(&v["wavelengths_nm"]);
+    let factor = aperture_factor();
+    let mut worst: f64 = 0.0;
+    for case in v["cases"].as_array().unwrap().iter().filter(|c| c["illuminant"] == "D65" || c["patch"] == "red") {
+        let r = nums(&case["reflectance"]);
+        let json = serde_json::json!({"model": "lambert", "wavelengths_nm": grid, "albedo": r}).to_string();
+        let cond = Conditions {
+            illuminant: Illuminant::parse(case["illuminant"].as_str().unwrap()).unwrap(),
+            observer: Observer::parse(case["observer"].as_str().unwrap()).unwrap(),
+        };
+        let rs = measure(brdf(&json), &["d8-sci", "d8-sce"], cond, 1e-8);
+        let theirs = nums(&case["XYZ"]);
+        for (i, q) in ["X", "Y", "Z"].iter().enumerate() {
+            let (sci, esci) = value(&rs, "d8-sci", q);
+            let (sce, esce) = value(&rs, "d8-sce", q);
+            let rel_sci = (sci - theirs[i]).abs() / theirs[i];
+            let rel_sce = (sce / factor - theirs[i]).abs() / theirs[i];
+            worst = worst.max(rel_sci).max(rel_sce);
+            assert!(rel_sci < 1e-6, "{} {q} SCI {sci} vs colour-science {}", case["patch"], theirs[i]);
+            assert!(rel_sce < 1e-6, "{} {q} SCE {sce}/{factor} vs colour-science {}", case["patch"], theirs[i]);
+            // The error estimates cover the actual differences (beyond the reference's own rounding).
+            assert!((sci - theirs[i]).abs() <= esci + 1e-12 * theirs[i], "{} {q}: error {esci}", case["patch"]);
+            assert!(
+                (sce - factor * theirs[i]).abs() <= esce + 1e-12 * theirs[i],
+                "{} {q}: error {esce}",
+                case["patch"]
+            );
+        }
+        let lab = nums(&case["Lab"]);
+        for (i, q) in ["L*", "a*", "b*"].iter().enumerate() {
+            let (ours, _) = value(&rs, "d8-sci", q);
+            assert!((ours - lab[i]).abs() < 1e-6, "{} {q}: {ours} vs colour-science {}", case["patch"], lab[i]);
+        }
+    }
+    eprintln!("worst relative difference from colour-science on d/8: {worst:e}");
+}
+
+#[test]
+fn white_diffuser_reads_l_100_on_d8() {
+    let rs =
+        measure(brdf(r#"{"model": "lambert", "albedo": 1.0}"#), &["d8-sci", "d8-sce"], Conditions::default(), 1e-6);
+    let (l, e) = value(&rs, "d8-sci", "L*");
+    assert!((l - 100.0).abs() < 1e-6 && (l - 100.0).abs() <= e + 1e-12, "L* = {l} ± {e}");
+    for q in ["a*", "b*", "C*"] {
+        assert!(value(&rs, "d8-sci", q).0.abs() < 1e-6, "{q}");
+    }
+    // SCE: the port removes sin²β cos 8° of the light; L* below 100 by exactly that in Y.
+    let y = value(&rs, "d8-sce", "Y").0;
+    assert!((y / 100.0 - aperture_factor()).abs() < 1e-7, "Y_SCE = {y}");
+    // The hue of a neutral is undefined: not printed as a number.
+    let h = rs.iter().find(|r| r.geometry == "d8-sci" && r.quantity == "h").unwrap();
+    assert!(h.value.is_none() || value(&rs, "d8-sci", "C*").0 > 0.0);
+}
+
+#[test]
+fn lambertian_on_multi_angle_geometries_reads_its_albedo() {
+    // A Lambertian's reflectance factor is ρ in every geometry: X, Y, Z = ρ × white point.
+    let rs = measure(
+        brdf(r#"{"model": "lambert", "wavelengths_nm": [400, 550, 700], "albedo": [0.5, 0.5, 0.5]}"#),
+        &["astm-e2194-15", "astm-e2194-45", "astm-e2194-110", "astm-e2539-m15"],
+        Conditions::default(),
+        1e-8,
+    );
+    for id in ["astm-e2194-15", "astm-e2194-45", "astm-e2194-110", "astm-e2539-m15"] {
+        let (y, e) = value(&rs, id, "Y");
+        assert!((y - 50.0).abs() < 1e-6 && (y - 50.0).abs() <= e + 1e-12, "{id}: Y = {y} ± {e}");
+    }
+}
+
+#[test]
+fn metallic_flop_goes_light_to_dark() {
+    let m = recipe::load_file(std::path::Path::new("fixtures/recipes/blue-metallic-spectral.json")).unwrap();
+    let ids = ["astm-e2194-15", "astm-e2194-45", "astm-e2194-110"];
+    let rs = measure(m.brdf, &ids, Conditions::default(), 1e-5);
+    let l: Vec<(f64, f64)> = ids.iter().map(|id| value(&rs, id, "L*")).collect();
+    eprintln!("L* at 15°, 45°, 110°: {l:?}");
+    assert!(l[0].0 - l[0].1 > l[1].0 + l[1].1, "L*15 > L*45: {l:?}");
+    assert!(l[1].0 - l[1].1 > l[2].0 + l[2].1, "L*45 > L*110: {l:?}");
+    // A blue: b* < 0 at every angle.
+    for id in ids {
+        assert!(value(&rs, id, "b*").0 < 0.0, "{id}");
+    }
+}
+
+#[test]
+fn rgb_materials_are_refused_with_the_reason() {
+    let m = recipe::load_file(std::path::Path::new("fixtures/recipes/cerulean-blue-a.json")).unwrap();
+    let e = Plan::compile(m.brdf, geos(&["d8-sci"]), PlanOptions::default()).err().expect("RGB refused").to_string();
+    assert!(e.contains("RGB") && e.contains("wavelengths_nm") && e.contains("d8-sci"), "{e}");
+}
+
+#[test]
+fn identical_geometries_share_their_integral_and_gloss_keeps_its_bits() {
+    let m = brdf(r#"{"model": "lambert", "albedo": 0.5}"#);
+    let ids = ["astm-e2194-15", "astm-e2539-15", "d8-sci", "d8-sce", "astm-d523-60"];
+    let plan = Plan::compile(m.clone(), geos(&ids), PlanOptions::default()).unwrap();
+    let used: Vec<String> = plan.jobs.iter().map(|j| j.used_by.join(", ")).collect();
+    assert!(used.contains(&"astm-e2194-15/receptor, astm-e2539-15/receptor".to_string()), "{used:?}");
+    assert!(used.contains(&"d8-sci/hemisphere, d8-sce/hemisphere".to_string()), "{used:?}");
+    // Colour fluxes have the three components X, Y, Z; the gloss flux stays one luminous component.
+    for j in &plan.jobs {
+        let k = j.method.weighting.len();
+        if j.used_by.iter().any(|u| u.starts_with("astm-d523")) {
+            assert_eq!(k, 1, "{:?}", j.used_by);
+        } else {
+            assert_eq!(k, 3, "{:?}", j.used_by);
+        }
+    }
+    let e = plan.explain();
+    assert!(e.contains("not folded"), "{e}");
+    // The gloss reading is the same bits with or without colour geometries in the plan.
+    let with = plan.execute();
+    let alone = Plan::compile(m, geos(&["astm-d523-60"]), PlanOptions::default()).unwrap().execute();
+    let g = with.iter().find(|r| r.geometry == "astm-d523-60").unwrap();
+    assert_eq!(g.value.unwrap().to_bits(), alone[0].value.unwrap().to_bits());
+    assert_eq!(g.evaluations, alone[0].evaluations);
+}
+
+#[test]
+fn a_frozen_colour_plan_reproduces_its_bits() {
+    // What `fit` needs: the frozen plan re-runs the kept partitions and gives the same bits on the same material.
+    let m = brdf(r#"{"model": "lambert", "wavelengths_nm": [400, 550, 700], "albedo": [0.2, 0.5, 0.4]}"#);
+    let plan = Plan::compile(m, geos(&["astm-e2194-45"]), PlanOptions::default()).unwrap();
+    let (frozen_readings, frozen) = plan.freeze();
+    let again = frozen.execute();
+    for (a, b) in frozen_readings.iter().zip(&again) {
+        assert_eq!(a.value.map(f64::to_bits), b.value.map(f64::to_bits), "{} {}", a.geometry, a.name);
+    }
+}
+
+#[test]
+fn cli_measures_colour_and_refuses_bad_options() {
+    let bin = env!("CARGO_BIN_EXE_glossmeter");
+    let out = std::process::Command::new(bin)
+        .args(["measure", "fixtures/recipes/white-pearl-spectral.json", "-g", "d8-sce", "-g", "astm-e2539-m15"])
+        .args(["--format", "json", "--no-timing", "--rtol", "1e-4", "--observer", "2", "--illuminant", "D50"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let text = v.to_string();
+    for q in ["\"X\"", "\"L*\"", "\"C*\"", "\"h\""] {
+        assert!(text.contains(q), "{q} missing: {text}");
+    }
+    let bad = std::process::Command::new(bin)
+        .args(["measure", "fixtures/recipes/white-pearl-spectral.json", "-g", "d8-sce", "--illuminant", "F11"])
+        .output()
+        .unwrap();
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("D65"));
+    let rgb = std::process::Command::new(bin)
+        .args(["measure", "fixtures/recipes/cerulean-blue-a.json", "-g", "astm-e2194-15"])
+        .output()
+        .unwrap();
+    assert_eq!(rgb.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&rgb.stderr).contains("wavelengths_nm"));
+}
+
+#[test]
+fn error_estimates_cover_the_actual_error() {
+    // The readings at rtol 1e-5 against the same readings at rtol 1e-11 (the reference): every difference is
+    // within the coarse run's error estimate.
+    for path in ["fixtures/recipes/blue-metallic-spectral.json", "fixtures/recipes/white-pearl-spectral.json"] {
+        let m = recipe::load_file(std::path::Path::new(path)).unwrap();
+        let ids = colour::builtin_ids();
+        let coarse = measure(m.brdf.clone(), &ids, Conditions::default(), 1e-5);
+        let fine = measure(m.brdf.clone(), &ids, Conditions::default(), 1e-11);
+        for (c, f) in coarse.iter().zip(&fine) {
+            let (Some(cv), Some(fv)) = (c.value, f.value) else { continue };
+            let actual = (cv - fv).abs();
+            assert!(
+                actual <= c.error_estimate + f.error_estimate + 1e-12 * fv.abs(),
+                "{path} {} {}: {cv} ± {} vs {fv}: actual error {actual:e}",
+                c.geometry,
+                c.quantity,
+                c.error_estimate
+            );
+        }
+    }
+}
+
+#[test]
+fn compare_reports_de00_for_colour_sheets() {
+    let bin = env!("CARGO_BIN_EXE_glossmeter");
+    let run = |extra: &[&str]| {
+        std::process::Command::new(bin)
+            .args([
+                "compare",
+                "fixtures/recipes/blue-metallic-spectral.json",
+                "fixtures/sheets/colour-blue-metallic.csv",
+            ])
+            .args(["--format", "json", "--rtol", "1e-5"])
+            .args(extra)
+            .output()
+            .unwrap()
+    };
+    let out = run(&["--max-de00", "100"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let des = v["colour_differences"].as_array().unwrap();
+    assert_eq!(des.len(), 3);
+    for d in des {
+        let (m, p) = (nums(&d["measured"]), nums(&d["predicted"]));
+        let lab = |x: &[f64]| glossmeter::colorimetry::Lab { l: x[0], a: x[1], b: x[2] };
+        let de = glossmeter::colorimetry::ciede2000(lab(&m), lab(&p));
+        assert!((d["de00"].as_f64().unwrap() - de).abs() < 1e-12);
+        assert!(de > 0.0 && de < 100.0, "{d}");
+        assert_eq!(d["inside"], Value::Bool(true));
+    }
+    // Each L*, a*, b* row was predicted by the colour plan.
+    for c in v["comparisons"].as_array().unwrap() {
+        assert!(c["predicted"].is_number(), "{c}");
+    }
+    let strict = run(&["--max-de00", "0"]);
+    assert_eq!(strict.status.code(), Some(1), "{}", String::from_utf8_lossy(&strict.stderr));
+    assert!(String::from_utf8_lossy(&strict.stderr).contains("ΔE00"));
+}
