@@ -267,3 +267,13 @@ fn compare_reports_de00_for_colour_sheets() {
     assert_eq!(strict.status.code(), Some(1), "{}", String::from_utf8_lossy(&strict.stderr));
     assert!(String::from_utf8_lossy(&strict.stderr).contains("ΔE00"));
 }
+
+#[test]
+fn a_long_lived_planner_knows_the_colour_geometries() {
+    // `fit` and the bindings look geometries up through a Planner.
+    let p = glossmeter::instrument::plan::Planner::new().unwrap();
+    for id in colour::builtin_ids() {
+        assert!(p.geometry(id).unwrap().geometry.is_colour(), "{id}");
+    }
+    assert!(!p.geometry("astm-d523-60").unwrap().geometry.is_colour());
+}

@@ -234,10 +234,10 @@ pub struct Planner {
 
 impl Planner {
     pub fn new() -> Result<Planner> {
-        Ok(Planner { builtin: standards::builtin()?, standards: Mutex::new(HashMap::new()) })
+        Ok(Planner { builtin: standards::builtin_all()?, standards: Mutex::new(HashMap::new()) })
     }
 
-    /// The builtin geometries.
+    /// The builtin geometries: gloss, then colour (`standards::builtin_all`).
     pub fn builtin(&self) -> &[StandardGeometry] {
         &self.builtin
     }
