@@ -7,6 +7,8 @@
 //!   paint model of Ďurikovič & Ágošton (2007).
 //! * [`recipe`]: JSON recipes → validated BRDFs, with errors that name the file and the field.
 //! * [`input`]: input files read as text with a size limit.
+//! * [`fit`]: the inverse problem (recipe parameters from readings) with standard errors and an
+//!   identifiability verdict.
 //! * [`registry`]: every recipe parameter's JSON Pointer, type, unit, range and meaning, shared by the
 //!   validator, the schema, the docs and the fitter.
 //! * [`spectrum`]: spectral sampling and the luminous (CIE illuminant C × V(λ)) weighting.
@@ -26,6 +28,7 @@ pub mod cli;
 pub mod colorimetry;
 pub mod comparison;
 pub mod error;
+pub mod fit;
 pub mod input;
 pub mod instrument;
 pub mod measured;

@@ -14,6 +14,7 @@ use crate::{recipe, resolve_geometries, Error, Result};
 
 pub mod compare;
 pub mod convergence;
+pub mod fit;
 pub mod format;
 pub mod junit;
 pub mod output;
@@ -103,6 +104,9 @@ pub enum Command {
     Compare(compare::CompareArgs),
     /// Error against run time over a sweep of tolerances (table, CSV, JSON, and a log–log plot).
     Convergence(convergence::ConvergenceArgs),
+    /// Fit recipe parameters (JSON Pointers) to readings, with standard errors and an identifiability
+    /// verdict; exits 1 if the fit did not converge, hit a bound or is not identifiable (docs/inverse.md).
+    Fit(fit::FitArgs),
 }
 
 /// Run the CLI; returns the process exit status.
@@ -194,6 +198,7 @@ fn dispatch(cli: Cli) -> Result<()> {
         }
         Command::Convergence(args) => convergence::run(args),
         Command::Compare(args) => compare::run(args),
+        Command::Fit(args) => fit::run(args),
         Command::Schema => {
             let text = serde_json::to_string_pretty(&recipe::schema::schema())
                 .map_err(|e| Error::Numeric(format!("the schema does not serialise: {e}")))?;

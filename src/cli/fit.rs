@@ -1,0 +1,205 @@
+//! `glossmeter fit`: recipe parameters from readings (the inverse problem). Argument parsing and output
+//! only; the fit itself is `glossmeter::fit` (docs/inverse.md).
+use std::path::PathBuf;
+
+use serde_json::{json, Value};
+
+use crate::cli::compare::parse_delimiter;
+use crate::cli::output::{print, Target};
+use crate::cli::{check_rtol, Format};
+use crate::fit::{self, FitOptions, FitReport, FreeParameter, TargetReading};
+use crate::instrument::sheet::{self, SheetOptions};
+use crate::{recipe, Error, Result};
+
+#[derive(clap::Args, Debug)]
+pub struct FitArgs {
+    /// The recipe (JSON); the fit starts from its values.
+    pub recipe: PathBuf,
+    /// A free parameter: a JSON Pointer with bounds, PATH=LO..HI, or PATH=log:LO..HI to fit its logarithm
+    /// (e.g. /roughness=log:1e-3..0.5). Repeatable.
+    #[arg(long = "free", required = true)]
+    pub free: Vec<String>,
+    /// A target reading, GEOMETRY/READING=VALUE[±U] (or +-U), e.g. astm-d523-60/gloss=85±0.2. Repeatable.
+    #[arg(long = "target")]
+    pub targets: Vec<String>,
+    /// Targets from a glossmeter sheet (CSV, the layouts `compare` reads).
+    #[arg(long, conflicts_with = "targets")]
+    pub sheet: Option<PathBuf>,
+    /// The sample of the sheet to fit (needed when the sheet has several).
+    #[arg(long, requires = "sheet")]
+    pub sample: Option<String>,
+    /// The sheet's separator (`,`, `;` or `tab`); detected from the header line by default.
+    #[arg(long, requires = "sheet")]
+    pub delimiter: Option<String>,
+    /// A sheet column to skip (repeatable), as in `compare`.
+    #[arg(long = "ignore-column", value_name = "HEADER", requires = "sheet")]
+    pub ignore_columns: Vec<String>,
+    /// Uncertainty of a target given without one, in the reading's unit.
+    #[arg(long, default_value_t = fit::DEFAULT_UNCERTAINTY)]
+    pub uncertainty: f64,
+    /// Relative tolerance of every forward reading.
+    #[arg(long, default_value_t = 1e-8)]
+    pub rtol: f64,
+    #[arg(long, value_enum, default_value_t = Format::Table)]
+    pub format: Format,
+    /// Write the fitted recipe to this new file (never overwrites one).
+    #[arg(long, short = 'o')]
+    pub output: Option<PathBuf>,
+    /// Leave the wall time out of the report.
+    #[arg(long)]
+    pub no_timing: bool,
+}
+
+pub fn run(a: FitArgs) -> Result<()> {
+    check_rtol(a.rtol)?;
+    if !(a.uncertainty.is_finite() && a.uncertainty > 0.0) {
+        return Err(Error::Usage(format!("--uncertainty must be a finite number > 0, got {}", a.uncertainty)));
+    }
+    // Refused before any work if it exists (or its directory does not); written whole or not at all.
+    let output = Target::new(a.output.as_deref(), "-o")?;
+    let free: Vec<FreeParameter> = a.free.iter().map(|f| FreeParameter::parse(f)).collect::<Result<_>>()?;
+    let targets: Vec<TargetReading> = match &a.sheet {
+        Some(s) => {
+            let options = SheetOptions {
+                delimiter: a.delimiter.as_deref().map(parse_delimiter).transpose()?,
+                ignore_columns: a.ignore_columns.clone(),
+            };
+            let (targets, notes) = fit::targets_from_sheet(&sheet::load(s, &options)?, a.sample.as_deref())?;
+            for n in notes {
+                eprintln!("note: {n}");
+            }
+            targets
+        }
+        None => a.targets.iter().map(|t| TargetReading::parse(t)).collect::<Result<_>>()?,
+    };
+    let material = recipe::load_file(&a.recipe)?;
+    let options = FitOptions { rtol: a.rtol, default_uncertainty: a.uncertainty, ..FitOptions::default() };
+    let report = fit::fit(&material.json, &material.file, &free, &targets, &options)?;
+    let text = match a.format {
+        Format::Json => {
+            serde_json::to_string_pretty(&json_report(&report, !a.no_timing))
+                .map_err(|e| Error::Numeric(format!("the report does not serialise: {e}")))?
+                + "\n"
+        }
+        Format::Table | Format::Csv => table(&material.name, &report, !a.no_timing),
+    };
+    print(&text)?;
+    if output.path().is_some() {
+        let fitted = serde_json::to_string_pretty(&report.recipe)
+            .map_err(|e| Error::Numeric(format!("the recipe does not serialise: {e}")))?;
+        output.write(&(fitted + "\n"))?;
+    }
+    if !report.ok() {
+        let mut why = Vec::new();
+        if !report.converged {
+            why.push("it did not converge");
+        }
+        if report.parameters.iter().any(|p| p.at_bound) {
+            why.push("a parameter is at a bound");
+        }
+        if !report.identifiable {
+            why.push("the targets do not determine every parameter");
+        }
+        return Err(Error::Check(format!("the fit is not to be trusted: {}", why.join("; "))));
+    }
+    Ok(())
+}
+
+fn num(x: f64) -> Value {
+    if x.is_finite() {
+        json!(x)
+    } else {
+        Value::Null
+    }
+}
+
+/// The JSON contract of issue 11 (docs/inverse.md §Output), and `verdict`: the same words as the table's.
+pub fn json_report(r: &FitReport, timing: bool) -> Value {
+    json!({
+        "parameters": r.parameters.iter().map(|p| json!({
+            "path": p.pointer, "value": num(p.value), "std_error": p.std_error.map(num), "lower": p.lower,
+            "upper": p.upper, "at_bound": p.at_bound,
+        })).collect::<Vec<_>>(),
+        "targets": r.targets.iter().map(|t| json!({
+            "geometry": t.target.geometry, "name": t.target.name, "measured": t.target.value,
+            "uncertainty": t.uncertainty, "predicted": num(t.predicted), "residual": num(t.residual),
+        })).collect::<Vec<_>>(),
+        "converged": r.converged,
+        "identifiable": r.identifiable,
+        "singular_values": r.singular_values.iter().map(|s| num(*s)).collect::<Vec<_>>(),
+        "correlation": r.correlation.iter().map(|row| row.iter().map(|c| c.map(num)).collect::<Vec<_>>()).collect::<Vec<_>>(),
+        "verdict": r.verdict,
+        "evaluations": r.evaluations,
+        "seconds": if timing { num(r.seconds) } else { Value::Null },
+        "recipe": r.recipe,
+    })
+}
+
+fn sig(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() {
+        format!("{x}")
+    } else {
+        format!("{x:.6e}").parse::<f64>().map(|v| format!("{v}")).unwrap_or_default()
+    }
+}
+
+fn table(name: &str, r: &FitReport, timing: bool) -> String {
+    let mut s = format!("fit of {name}: {}; {} forward runs", r.termination, r.evaluations);
+    if timing {
+        s.push_str(&format!(", {:.2} s", r.seconds));
+    }
+    s.push_str("\n\nparameter                                  value      ± std error   bounds                 note\n");
+    for p in &r.parameters {
+        let se = p.std_error.map(|e| format!("{e:.3e}")).unwrap_or_else(|| "undetermined".into());
+        let bounds = format!("{}{}..{}", if p.log { "log:" } else { "" }, p.lower, p.upper);
+        let mut note = Vec::new();
+        if p.at_bound {
+            note.push("AT BOUND".to_string());
+        }
+        if let Some(i) = p.most_sensitive {
+            let t = &r.targets[i].target;
+            note.push(format!("set mostly by {}/{}", t.geometry, t.name));
+        }
+        s.push_str(&format!(
+            "{:<40} {:>12} {:>14}   {:<22} {}\n",
+            p.pointer,
+            sig(p.value),
+            se,
+            bounds,
+            note.join("; ")
+        ));
+    }
+    s.push_str("\ntarget                       measured        ± u     predicted    residual   weighted\n");
+    for t in &r.targets {
+        s.push_str(&format!(
+            "{:<26} {:>11.4} {:>10.3} {:>13.4} {:>11.3e} {:>10.3}\n",
+            format!("{}/{}", t.target.geometry, t.target.name),
+            t.target.value,
+            t.uncertainty,
+            t.predicted,
+            t.residual,
+            t.weighted_residual
+        ));
+    }
+    s.push_str(&format!("\nχ² = {:.4}\n", r.chi2));
+    s.push_str(&format!(
+        "singular values of the weighted Jacobian (columns × bound width): {}\n",
+        r.singular_values.iter().map(|v| format!("{v:.4e}")).collect::<Vec<_>>().join(", ")
+    ));
+    if r.parameters.len() > 1 {
+        s.push_str("correlation:\n");
+        for row in &r.correlation {
+            let cells: Vec<String> =
+                row.iter().map(|c| c.map(|c| format!("{c:>7.3}")).unwrap_or_else(|| "      —".into())).collect();
+            s.push_str(&format!("  {}\n", cells.join(" ")));
+        }
+    }
+    s.push_str(&format!(
+        "identifiable: {}\n",
+        if r.identifiable { "yes: the targets determine every parameter" } else { "NO" }
+    ));
+    for v in &r.verdict {
+        s.push_str(&format!("  - {v}\n"));
+    }
+    s
+}
