@@ -19,6 +19,7 @@ import argparse
 import json
 import math
 import os
+import random
 import subprocess
 import sys
 
@@ -161,11 +162,14 @@ def ciede2000(l1, a1, b1, l2, a2, b2):
     return math.sqrt((dl / sl) ** 2 + (dc / sc) ** 2 + (dH / sh) ** 2 + rt * (dc / sc) * (dH / sh))
 
 
-def targets(truth):
-    t = [f"astm-d523-60/gloss={value(truth, 'astm-d523-60', 'gloss'):.6f}±{U_GLOSS}"]
+def targets(truth, rng=None):
+    """The four values as --target arguments; with `rng`, each perturbed by a normal draw of its uncertainty
+    (a simulated measurement)."""
+    noise = (lambda u: rng.gauss(0.0, u)) if rng else (lambda u: 0.0)
+    t = [f"astm-d523-60/gloss={value(truth, 'astm-d523-60', 'gloss') + noise(U_GLOSS):.6f}±{U_GLOSS}"]
     for g in FOUR[1:]:
         for q in ["L*", "a*", "b*"]:
-            t.append(f"{g}/{q}={value(truth, g, q):.6f}±{U_LAB}")
+            t.append(f"{g}/{q}={value(truth, g, q) + noise(U_LAB):.6f}±{U_LAB}")
     return t
 
 
@@ -190,21 +194,27 @@ def main():
     ap.add_argument("--bin", default="target/release/glossmeter")
     ap.add_argument("--out", default="/tmp/four-values")
     ap.add_argument("--dry-run", action="store_true", help="no fit: compare the start recipe with the truth")
+    ap.add_argument("--noise", type=int, metavar="SEED", help="perturb the targets by N(0, u) (random.Random(SEED))")
+    ap.add_argument("--case", choices=sorted(CASES), action="append", help="only this case (repeatable)")
     a = ap.parse_args()
     os.makedirs(a.out, exist_ok=True)
     os.makedirs("fixtures/inverse", exist_ok=True)
+    rng = random.Random(a.noise) if a.noise is not None else None
     for case, c in CASES.items():
+        if a.case and case not in a.case:
+            continue
         truth_path = f"fixtures/inverse/{case}-truth.json"
         start_path = f"fixtures/inverse/{case}-start.json"
         write_recipe(truth_path, c["source"], c["truth"], "truth")
         write_recipe(start_path, c["source"], {**c["truth"], **c["start"]}, "start")
         truth = measure(a.bin, truth_path, FOUR + HELD_OUT)
-        tgt = targets(truth)
+        tgt = targets(truth, rng)
         print(f"## {case}\n\ntargets (from {truth_path}):\n")
         for t in tgt:
             print(f"    --target '{t}'")
-        fitted_path = os.path.join(a.out, f"{case}-fitted.json")
-        report_path = os.path.join(a.out, f"{case}-fit.json")
+        tag = f"-noise{a.noise}" if a.noise is not None else ""
+        fitted_path = os.path.join(a.out, f"{case}{tag}-fitted.json")
+        report_path = os.path.join(a.out, f"{case}{tag}-fit.json")
         if a.dry_run:
             fitted_path = start_path
         else:
