@@ -38,7 +38,7 @@ pub struct FitArgs {
     #[arg(long, default_value_t = fit::DEFAULT_UNCERTAINTY)]
     pub uncertainty: f64,
     /// Relative tolerance of every forward reading.
-    #[arg(long, default_value_t = 1e-8)]
+    #[arg(long, default_value_t = 1e-6)]
     pub rtol: f64,
     #[arg(long, value_enum, default_value_t = Format::Table)]
     pub format: Format,
