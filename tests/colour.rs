@@ -277,3 +277,25 @@ fn a_long_lived_planner_knows_the_colour_geometries() {
     }
     assert!(!p.geometry("astm-d523-60").unwrap().geometry.is_colour());
 }
+
+#[test]
+fn fit_takes_colour_targets() {
+    // A spectral Lambertian whose 550 nm albedo is 0.5 reads L* = 73.0519 at E2194 45° (D65, 10°); fitting that
+    // albedo from 0.3 to this one colour target recovers it.
+    let dir = std::env::temp_dir().join(format!("glossmeter-colour-fit-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let recipe = dir.join("start.json");
+    std::fs::write(&recipe, r#"{"model": "lambert", "wavelengths_nm": [400, 550, 700], "albedo": [0.2, 0.3, 0.4]}"#)
+        .unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_glossmeter"))
+        .args(["fit", recipe.to_str().unwrap(), "--free", "/albedo/1=0.05..0.95"])
+        .args(["--target", "astm-e2194-45/L*=73.05188932989438±0.01", "--format", "json", "--no-timing"])
+        .output()
+        .unwrap();
+    let _ = std::fs::remove_dir_all(&dir);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let p = &v["parameters"][0];
+    let (x, se) = (p["value"].as_f64().unwrap(), p["std_error"].as_f64().unwrap());
+    assert!((x - 0.5).abs() < 1e-6 && (x - 0.5).abs() <= 3.0 * se + 1e-9, "{p}");
+}
