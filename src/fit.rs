@@ -833,6 +833,54 @@ pub fn fit(
         (converged, termination)
     };
 
+    // The linear error analysis, checked: along every determined direction (singular value s ≥ 1) step one
+    // standard error each way, t ± δ with δ_k = width_k·v_k/s, integrate adaptively there, and compare the
+    // actual change of χ² with the change the linearised model predicts, ‖r + Jδ‖² − ‖r‖² (≈ 1 at the
+    // optimum). A ratio outside [1/2, 2] means the readings are not linear in the parameters over one
+    // standard error (a curved valley, a kink, a switch of model): the standard errors and correlations are
+    // then not to be trusted and the fit is not reported identifiable (Bates & Watts, *Nonlinear Regression
+    // Analysis and Its Applications*, 1988, ch. 7, on when linear approximation intervals fail).
+    let mut nonlinear: Vec<String> = Vec::new();
+    for &i in &order {
+        let s = svd.singular_values[i];
+        if s < 1.0 || null(s) {
+            continue;
+        }
+        let v = v_t.row(i);
+        for sign in [1.0, -1.0] {
+            let delta: Vec<f64> = (0..n).map(|k| sign * widths[k] * v[k] / s).collect();
+            let tt: Vec<f64> = (0..n).map(|k| t[k] + delta[k]).collect();
+            let inside = (0..n).all(|k| {
+                let (a, b) = free[k].t_bounds();
+                tt[k] >= a && tt[k] <= b
+            });
+            if !inside {
+                continue;
+            }
+            let step = DVector::from_column_slice(&delta);
+            let expected = (&r + &jt * &step).norm_squared() - chi2;
+            let actual = match fwd.run(&problem.x_of_t(&tt), Mode::Freeze) {
+                Ok(Some((pred, _))) => problem.weighted(&pred).norm_squared() - chi2,
+                _ => f64::NAN,
+            };
+            let ratio = actual / expected;
+            if !(ratio.is_finite() && (0.5..=2.0).contains(&ratio)) {
+                let combo: Vec<String> = (0..n)
+                    .filter(|&k| v[k].abs() >= 0.2)
+                    .map(|k| format!("{:+.2}·Δ{}", v[k], free[k].pointer))
+                    .collect();
+                nonlinear.push(format!(
+                    "the readings are not linear in the parameters over one standard error along {}: one standard \
+                     error that way changes χ² by {actual:.3}, where the linear error analysis says {expected:.3}; the \
+                     standard errors and correlations are not to be trusted here (a profile of χ² or a Monte Carlo \
+                     over the noise would be)",
+                    combo.join(" ")
+                ));
+                break;
+            }
+        }
+    }
+
     // Verdict: every direction whose full-range move changes the weighted residuals by less than one.
     let mut verdict = Vec::new();
     let mut identifiable = true;
@@ -865,6 +913,10 @@ pub fn fit(
             )
         };
         verdict.push(what);
+    }
+    if !nonlinear.is_empty() {
+        identifiable = false;
+        verdict.extend(nonlinear);
     }
     for a in 0..n {
         for b in a + 1..n {
