@@ -1,6 +1,6 @@
 //! JSON Schemas (draft 2020-12) of the JSON outputs of `measure` (one recipe or many), `compare` and the
 //! JSON lines of `sweep`: the contract that scripts and CI rely on, printed by
-//! `glossmeter schema --output-format measure|compare|sweep`. `tests/schemas.rs` validates real outputs
+//! `glossmeter schema --output-format measure|compare|sweep` (`fit`'s is added with the `fit` command). `tests/schemas.rs` validates real outputs
 //! against them, so a field added to an output without its schema fails the tests.
 use serde_json::{json, Value};
 
@@ -82,9 +82,11 @@ fn comparison() -> Value {
         "uncertainty": num_or_null(), "predicted": num_or_null(), "error_estimate": num_or_null(),
         "difference": {"type": ["number", "null"], "description": "predicted − measured mean"},
         "allowance": allowance(),
-        "verdict": {"type": "string", "enum": ["ok", "OUTSIDE", "no allowance", "no value", "not predicted"]},
+        "verdict": {"type": "string", "enum": ["ok", "OUTSIDE", "unchecked", "not predicted"],
+                    "description": "unchecked (no value, or no allowance) and OUTSIDE fail the check (exit 1)"},
         "inside": {"type": ["boolean", "null"]},
-        "reason": {"type": ["string", "null"]},
+        "reason": {"type": ["string", "null"], "description": "why not predicted, or why the prediction has no value"},
+        "unchecked": {"type": ["string", "null"], "description": "why the row could not be checked"},
     });
     let required: Vec<&str> = props.as_object().expect("object").keys().map(String::as_str).collect();
     json!({"type": "object", "additionalProperties": false, "required": required, "properties": props})

@@ -21,7 +21,7 @@ use serde_json::{json, Value};
 
 use crate::instrument::plan::{Plan, PlanOptions, Reading};
 use crate::instrument::standards::StandardGeometry;
-use crate::{recipe, Error, Result};
+use crate::{recipe, registry, Error, Result};
 
 /// One varied parameter: a JSON Pointer into the template, its range and (for a grid) its number of values.
 #[derive(Clone, Debug, PartialEq)]
@@ -143,20 +143,18 @@ impl Sweep {
         if axes.is_empty() {
             return Err(Error::Usage("give at least one --vary PATH=LO..HI:N".into()));
         }
-        for (i, a) in axes.iter().enumerate() {
-            match template.pointer(&a.path) {
-                Some(v) if v.is_number() => {}
-                Some(_) => {
-                    return Err(Error::input(file, &a.path, "--vary needs a number at this path in the template"))
-                }
-                None => {
-                    return Err(Error::input(
-                        file,
-                        &a.path,
-                        "--vary: no such path in the template (the path is a JSON Pointer, e.g. /coat/roughness)",
-                    ))
-                }
+        let model = match template.get("model") {
+            Some(Value::String(m)) => m.clone(),
+            _ => {
+                return Err(Error::input(
+                    file,
+                    "/model",
+                    "the template needs a \"model\" (a recipe, see glossmeter schema)",
+                ))
             }
+        };
+        for (i, a) in axes.iter().enumerate() {
+            check_path(&template, file, &model, &a.path)?;
             if axes[..i].iter().any(|b| b.path == a.path) {
                 return Err(Error::Usage(format!("--vary {}: the path is varied twice", a.path)));
             }
@@ -265,7 +263,7 @@ impl Sweep {
         let values = self.point(i);
         let mut recipe_json = self.template.clone();
         for (a, v) in self.axes.iter().zip(&values) {
-            *recipe_json.pointer_mut(&a.path).expect("checked in new") = json!(v);
+            set(&mut recipe_json, &a.path, json!(v));
         }
         let name = format!("{} [point {i}]", self.file);
         let outcome = recipe::parse_str(&recipe_json.to_string(), &name)
@@ -369,6 +367,8 @@ impl Sweep {
                         let x = readings.iter().find(|x| &x.geometry == g && &x.name == n)?;
                         if let Some(p) = &x.problem {
                             problems.push(format!("{g} {n}: {p}"));
+                        } else if !x.converged {
+                            problems.push(format!("{g} {n}: not converged within the evaluation budget"));
                         }
                         x.value.map(|v| (v, x.error_estimate))
                     })
@@ -376,6 +376,76 @@ impl Sweep {
                 (cells, problems.join("; "))
             }
         }
+    }
+}
+
+/// A varied path must be a numeric parameter of the template's model in the parameter registry
+/// (`crate::registry`), addressing one number: the template's value there is a number, or the key is absent
+/// from an object that exists (an optional parameter, set at each point), or the registry allows one number
+/// in place of the array the template has (a grey albedo for an RGB one).
+fn check_path(template: &Value, file: &str, model: &str, path: &str) -> Result<()> {
+    let Some(param) = registry::lookup(model, path) else {
+        let examples: Vec<String> = registry::of_model(model)
+            .filter(|p| p.ty.is_numeric() && !p.pointer.contains('*'))
+            .take(6)
+            .map(|p| p.pointer.to_string())
+            .collect();
+        return Err(Error::input(
+            file,
+            path,
+            format!(
+                "--vary: not a parameter of a `{model}` recipe (its numeric parameters include {}; the full list is \
+                 in docs/recipe-format.md)",
+                examples.join(", ")
+            ),
+        ));
+    };
+    if !param.ty.is_numeric() {
+        return Err(Error::input(
+            file,
+            path,
+            format!("--vary: the parameter is {}, not a number", param.ty.describe()),
+        ));
+    }
+    let one_number_allowed = matches!(
+        param.ty,
+        registry::Type::Number
+            | registry::Type::Colour
+            | registry::Type::NumberOrSpectral
+            | registry::Type::DielectricOrConductorIor
+    ) || param.pointer != path; // an element of an array entry
+    match template.pointer(path) {
+        Some(Value::Number(_)) => Ok(()),
+        Some(_) if one_number_allowed => Ok(()),
+        Some(_) => Err(Error::input(
+            file,
+            path,
+            format!("--vary needs one number: the parameter is {}; vary one element ({path}/0)", param.ty.describe()),
+        )),
+        None => {
+            let (parent, _) = path.rsplit_once('/').expect("a registered pointer has a /");
+            match template.pointer(parent) {
+                Some(Value::Object(_)) if one_number_allowed => Ok(()),
+                _ => Err(Error::input(
+                    file,
+                    path,
+                    "--vary: the template has no value here and no object to add it to (give the parameter in the \
+                     template)",
+                )),
+            }
+        }
+    }
+}
+
+/// Set the number at `path` (checked by [`check_path`]): replace the value, or add the key to its object.
+fn set(doc: &mut Value, path: &str, v: Value) {
+    if let Some(x) = doc.pointer_mut(path) {
+        *x = v;
+        return;
+    }
+    let (parent, key) = path.rsplit_once('/').expect("checked");
+    if let Some(Value::Object(o)) = doc.pointer_mut(parent) {
+        o.insert(registry::unescape(key), v);
     }
 }
 

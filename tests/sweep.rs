@@ -21,6 +21,13 @@ fn gm(args: &[&str]) -> (i32, String, String) {
     gm_env(args, None)
 }
 
+fn tmp_dir(name: &str) -> std::path::PathBuf {
+    let d = std::env::temp_dir().join(format!("glossmeter-sweep-test-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
 const T: &str = "fixtures/recipes/rgb-lambert.json";
 
 #[test]
@@ -77,6 +84,9 @@ fn bad_sweeps_exit_2() {
         (&["--vary", "/albedo/0=0..1:2", "--log", "/albedo/0"], "LO > 0"),
         (&["--vary", "/albedo/0=0..1"], ":N"),
         (&["--vary", "/model=0..1:2"], "number"),
+        (&["--vary", "/albedo/0=0..1:2", "--shard", "0/2"], "K/M"),
+        (&["--vary", "/albedo/0=0..1", "--lhs", "0"], "at least 1"),
+        (&["--vary", "/albedo/7=0..1:2"], "/albedo/7"),
     ] {
         let mut a = vec!["sweep", T];
         a.extend(args);
@@ -125,12 +135,14 @@ fn a_batch_reads_the_same_bits_as_one_recipe_at_a_time() {
 
 #[test]
 fn a_measure_baseline_fails_readings_that_moved() {
-    let b = "fixtures/baselines/glass-n1.5.json";
-    let (code, out, _) = gm(&["measure", "fixtures/recipes/glass-n1.5.json", "-g", "astm-d523-60", "--baseline", b]);
+    let dir = tmp_dir("baseline");
+    let base = dir.join("glass.json");
+    let b = base.to_str().unwrap();
+    let glass = "fixtures/recipes/glass-n1.5.json";
+    assert_eq!(gm(&["measure", glass, "-g", "astm-d523-60", "--format", "json", "-o", b]).0, 0);
+    let (code, out, _) = gm(&["measure", glass, "-g", "astm-d523-60", "--baseline", b]);
     assert_eq!(code, 0, "{out}");
     assert!(out.contains("baseline: 1 reading(s) checked, 0 moved"), "{out}");
-    let dir = std::env::temp_dir().join(format!("glossmeter-sweep-test-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
     let moved = dir.join("moved.json");
     let text = std::fs::read_to_string(b).unwrap();
     let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
@@ -147,4 +159,60 @@ fn a_measure_baseline_fails_readings_that_moved() {
     ]);
     assert_eq!(code, 1);
     assert!(out.contains("1 moved"), "{out}");
+}
+
+/// Issue 12 item 5: the batch's bytes do not depend on the thread count (integrals never split across threads).
+#[test]
+fn a_batch_is_bit_identical_on_one_and_two_threads() {
+    let args = [
+        "measure",
+        "fixtures/recipes",
+        "-g",
+        "astm-d523-20",
+        "-g",
+        "astm-e430-30",
+        "--format",
+        "json",
+        "--no-timing",
+        "--allow-unconverged",
+    ];
+    let (c1, one, e1) = gm_env(&args, Some("1"));
+    let (c2, two, _) = gm_env(&args, Some("2"));
+    assert_eq!((c1, c2), (0, 0), "{e1}");
+    assert!(one.len() > 10_000, "all shipped recipes: {}", one.len());
+    assert_eq!(one, two);
+}
+
+/// Paths go through the parameter registry: an unknown one is named as a JSON Pointer with examples; an
+/// optional parameter the template lacks is added at every point; `-o` streams into a file that appears whole.
+#[test]
+fn sweep_paths_come_from_the_registry() {
+    let dir = tmp_dir("registry");
+    let t = dir.join("phong-no-kd.json");
+    std::fs::write(&t, r#"{"model": "phong", "exponent": 200, "ks": 0.04}"#).unwrap();
+    let t = t.to_str().unwrap();
+    let (code, _, err) = gm(&["sweep", t, "--vary", "/exponentt=1..2:2"]);
+    assert_eq!(code, 2);
+    assert!(err.contains("/exponentt") && err.contains("not a parameter of a `phong` recipe"), "{err}");
+    assert!(err.contains("/exponent"), "examples listed: {err}");
+    let (code, _, err) = gm(&["sweep", t, "--vary", "/name=1..2:2"]);
+    assert_eq!(code, 2);
+    assert!(err.contains("not a number"), "{err}");
+    let out = dir.join("kd.csv");
+    let o = out.to_str().unwrap();
+    let args = ["sweep", t, "--vary", "/kd=0..0.5:3", "-g", "astm-d523-60", "--no-timing", "-o", o];
+    let (code, stdout, err) = gm(&args);
+    assert_eq!((code, stdout.as_str()), (0, ""), "{err}");
+    let text = std::fs::read_to_string(&out).unwrap();
+    let g: Vec<f64> = text.lines().skip(1).map(|l| l.split(',').nth(2).unwrap().parse().unwrap()).collect();
+    assert_eq!(g.len(), 3);
+    assert!(g[0] < g[1] && g[1] < g[2], "the diffuse term adds to the gloss reading: {g:?}");
+    // The file exists now: a second run is refused before any work, and the file is untouched.
+    let (code, _, err) = gm(&args);
+    assert_eq!(code, 2);
+    assert!(err.contains("already exists"), "{err}");
+    assert_eq!(std::fs::read_to_string(&out).unwrap(), text);
+    let names: Vec<String> =
+        std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    assert_eq!(names.len(), 2, "no temporary file left: {names:?}");
 }

@@ -2,14 +2,14 @@
 //! or JSON with a material column; and `--baseline PREVIOUS.json` for one or many recipes.
 use serde_json::{json, Value};
 
-use crate::cli::{format, pad_table, Format};
+use crate::cli::{format, pad_table};
 use crate::comparison::Drift;
 use crate::instrument::plan::Reading;
 use crate::recipe::Material;
 use crate::{Error, Result};
 
 pub fn table(materials: &[Material], readings: &[Vec<Reading>], timing: bool) -> String {
-    let mut head = vec!["material", "geometry", "reading", "value", "unit", "± error", "evaluations"];
+    let mut head = vec!["material", "geometry", "reading", "value", "unit", "numerical error", "evaluations"];
     if timing {
         head.push("time");
     }
@@ -28,7 +28,7 @@ pub fn table(materials: &[Material], readings: &[Vec<Reading>], timing: bool) ->
                     row.extend(["—".to_string(), r.unit.clone(), "—".to_string()]);
                 }
             }
-            row.push(r.evaluations.to_string());
+            row.push(if r.converged { r.evaluations.to_string() } else { format!("{} *", r.evaluations) });
             if timing {
                 row.push(format::secs(r.seconds));
             }
@@ -44,6 +44,13 @@ pub fn table(materials: &[Material], readings: &[Vec<Reading>], timing: bool) ->
     }
     s.push('\n');
     s.push_str(&pad_table(&rows, &[3, 5, 6, 7]));
+    let all = || readings.iter().flatten();
+    if all().any(|r| !r.converged) {
+        s.push_str("* not converged: the evaluation budget ran out before the tolerance was met\n");
+    }
+    if all().any(|r| r.value.is_some()) {
+        s.push_str("numerical error: the integration's error estimate, not the uncertainty of the prediction\n");
+    }
     for n in notes {
         s.push_str(&format!("note: {n}\n"));
     }
@@ -55,8 +62,8 @@ pub fn table(materials: &[Material], readings: &[Vec<Reading>], timing: bool) ->
 pub fn json_doc(materials: &[Material], readings: &[Vec<Reading>], timing: bool) -> Value {
     let mut all = vec![];
     for (m, rs) in materials.iter().zip(readings) {
-        let one: Value = serde_json::from_str(&format::json(m, rs, timing)).expect("our own JSON");
-        for mut r in one["readings"].as_array().cloned().unwrap_or_default() {
+        for r in rs {
+            let mut r = format::reading_json(r, timing);
             r["material"] = json!(m.name);
             r["file"] = json!(m.file);
             all.push(r);
@@ -93,15 +100,6 @@ pub fn csv(materials: &[Material], readings: &[Vec<Reading>], timing: bool) -> R
     let bytes =
         w.into_inner().map_err(|e| Error::Io { file: "<csv>".into(), source: std::io::Error::other(e.to_string()) })?;
     Ok(String::from_utf8(bytes).expect("utf-8"))
-}
-
-/// The text of a batch in a format.
-pub fn render(format: Format, materials: &[Material], readings: &[Vec<Reading>], timing: bool) -> Result<String> {
-    Ok(match format {
-        Format::Table => table(materials, readings, timing),
-        Format::Json => serde_json::to_string_pretty(&json_doc(materials, readings, timing)).expect("finite") + "\n",
-        Format::Csv => csv(materials, readings, timing)?,
-    })
 }
 
 /// The baseline lines of a table.

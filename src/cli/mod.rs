@@ -218,11 +218,11 @@ fn dispatch(cli: Cli) -> Result<()> {
                 .map(|b| crate::comparison::check_baseline(readings.iter().map(|r| (material.name.as_str(), r)), b));
             text.push_str(&match format {
                 Format::Table => format::table(&material, &readings, !no_timing),
-                Format::Json => with_baseline(
-                    format::json(&material, &readings, !no_timing),
+                Format::Json => format::pretty(&with_baseline(
+                    format::json_doc(&material, &readings, !no_timing),
                     drift.as_deref(),
                     baseline_file.clone(),
-                ),
+                )),
                 Format::Csv => format::csv(&readings, !no_timing)?,
             });
             if let (Format::Table, Some(d)) = (format, &drift) {
@@ -320,15 +320,19 @@ pub fn pad_table(rows: &[Vec<String>], right: &[usize]) -> String {
 }
 
 /// Add the baseline checks to a JSON document (when a baseline was given).
-fn with_baseline(text: String, drift: Option<&[crate::comparison::Drift]>, file: Option<String>) -> String {
-    let (Some(d), Some(file)) = (drift, file) else { return text };
-    let mut doc: serde_json::Value = serde_json::from_str(&text).expect("our own JSON");
-    doc["baseline"] = serde_json::json!({
-        "file": file,
-        "checks": d.iter().map(compare::drift_json).collect::<Vec<_>>(),
-        "moved": d.iter().filter(|x| x.moved).count(),
-    });
-    serde_json::to_string_pretty(&doc).expect("finite") + "\n"
+fn with_baseline(
+    mut doc: serde_json::Value,
+    drift: Option<&[crate::comparison::Drift]>,
+    file: Option<String>,
+) -> serde_json::Value {
+    if let (Some(d), Some(file)) = (drift, file) {
+        doc["baseline"] = serde_json::json!({
+            "file": file,
+            "checks": d.iter().map(compare::drift_json).collect::<Vec<_>>(),
+            "moved": d.iter().filter(|x| x.moved).count(),
+        });
+    }
+    doc
 }
 
 /// Exit status 1 when a baseline reading moved.
@@ -369,14 +373,21 @@ fn measure_batch(
             b,
         )
     });
-    let mut text = batch::render(how.format, &materials, &readings, how.timing)?;
-    match (how.format, &drift) {
-        (Format::Table, Some(d)) => text.push_str(&batch::drift_text(d)),
-        (Format::Json, Some(_)) => {
-            text = with_baseline(text, drift.as_deref(), how.baseline.as_ref().map(|(_, f)| f.clone()))
+    let text = match how.format {
+        Format::Table => {
+            let mut t = batch::table(&materials, &readings, how.timing);
+            if let Some(d) = &drift {
+                t.push_str(&batch::drift_text(d));
+            }
+            t
         }
-        _ => {}
-    }
+        Format::Json => format::pretty(&with_baseline(
+            batch::json_doc(&materials, &readings, how.timing),
+            drift.as_deref(),
+            how.baseline.as_ref().map(|(_, f)| f.clone()),
+        )),
+        Format::Csv => batch::csv(&materials, &readings, how.timing)?,
+    };
     target.write(&text)?;
     check_drift(drift.as_deref())?;
     let all: Vec<crate::Reading> = readings.into_iter().flatten().collect();

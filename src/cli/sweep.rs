@@ -1,10 +1,10 @@
 //! `glossmeter sweep`: a template recipe measured over a grid or a Latin hypercube of JSON Pointer paths,
 //! streamed as CSV or JSON lines. The points, shards and rows are the library's (`crate::sweep`); this module
 //! parses the arguments, draws the progress bar (only when stderr is a terminal) and writes.
-use std::io::{IsTerminal, Write};
+use std::io::IsTerminal;
 use std::path::PathBuf;
 
-use crate::cli::{check_rtol, STDOUT};
+use crate::cli::{check_rtol, Target};
 use crate::instrument::plan::PlanOptions;
 use crate::sweep::{self, Design, Sweep};
 use crate::{resolve_geometries, Error, Result};
@@ -45,7 +45,11 @@ pub struct SweepArgs {
     /// Leave the per-point wall time out (then the output is reproducible byte for byte).
     #[arg(long)]
     pub no_timing: bool,
-    /// Write to this file instead of stdout (never overwrites).
+    /// Evaluation budget of each aperture integral (a reading that runs out is marked not converged).
+    #[arg(long, default_value_t = PlanOptions::default().max_evals)]
+    pub max_evals: usize,
+    /// Write to this new file instead of stdout (refused before any work if it exists; the file appears
+    /// whole when the sweep ends, or not at all).
     #[arg(long, short = 'o')]
     pub output: Option<PathBuf>,
 }
@@ -64,33 +68,21 @@ pub fn run(a: SweepArgs) -> Result<()> {
         None => Design::Grid,
     };
     let (k, m) = a.shard.as_deref().map(sweep::parse_shard).transpose()?.unwrap_or((1, 1));
+    if a.max_evals == 0 {
+        return Err(Error::Usage("--max-evals must be at least 1".into()));
+    }
+    let target = Target::new(a.output.as_deref(), "--output")?;
     let file = a.template.display().to_string();
-    let text = std::fs::read_to_string(&a.template).map_err(|source| Error::Io { file: file.clone(), source })?;
-    let template: serde_json::Value =
-        serde_json::from_str(&text).map_err(|e| Error::input(&file, "", format!("not JSON: {e}")))?;
+    let text = crate::input::read_text(&a.template, "recipe")?;
+    let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
+    let template: serde_json::Value = serde_json::from_str(text).map_err(|e| {
+        Error::input(&file, "", format!("malformed JSON at line {}, column {}: {e}", e.line(), e.column()))
+    })?;
     let geos = resolve_geometries(&a.geometries, &[] as &[&str])?;
-    let options = PlanOptions { rtol: a.rtol, ..PlanOptions::default() };
+    let options = PlanOptions { rtol: a.rtol, max_evals: a.max_evals, ..PlanOptions::default() };
     let s = Sweep::new(template, &file, axes, design, geos, options)?;
     let range = s.shard(k, m);
     let timing = !a.no_timing;
-    let (name, sink): (String, Box<dyn Write>) = match &a.output {
-        None => (STDOUT.into(), Box::new(std::io::stdout().lock())),
-        Some(p) => {
-            let f = std::fs::OpenOptions::new().write(true).create_new(true).open(p).map_err(|e| {
-                if e.kind() == std::io::ErrorKind::AlreadyExists {
-                    Error::Usage(format!("{}: already exists; glossmeter never overwrites a file", p.display()))
-                } else {
-                    Error::Io { file: p.display().to_string(), source: e }
-                }
-            })?;
-            (p.display().to_string(), Box::new(f))
-        }
-    };
-    let mut out = std::io::BufWriter::new(sink);
-    let io = |source: std::io::Error| Error::Io { file: name.clone(), source };
-    if a.format == SweepFormat::Csv && k == 1 {
-        out.write_all(s.csv_header(timing).as_bytes()).map_err(io)?;
-    }
     let bar = if std::io::stderr().is_terminal() {
         let b = indicatif::ProgressBar::new(range.end - range.start);
         b.set_style(
@@ -101,15 +93,21 @@ pub fn run(a: SweepArgs) -> Result<()> {
     } else {
         indicatif::ProgressBar::hidden()
     };
-    s.run(range, |r| {
-        let line = match a.format {
-            SweepFormat::Csv => s.csv_row(&r, timing),
-            SweepFormat::Jsonl => s.jsonl_row(&r, timing),
-        };
-        bar.inc(1);
-        out.write_all(line.as_bytes()).map_err(io)
+    let name = target.name();
+    let io = |source: std::io::Error| Error::Io { file: name.clone(), source };
+    target.stream(|out| {
+        if a.format == SweepFormat::Csv && k == 1 {
+            out.write_all(s.csv_header(timing).as_bytes()).map_err(io)?;
+        }
+        s.run(range, |r| {
+            let line = match a.format {
+                SweepFormat::Csv => s.csv_row(&r, timing),
+                SweepFormat::Jsonl => s.jsonl_row(&r, timing),
+            };
+            bar.inc(1);
+            out.write_all(line.as_bytes()).map_err(io)
+        })
     })?;
     bar.finish_and_clear();
-    out.flush().map_err(io)?;
     Ok(())
 }
