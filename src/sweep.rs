@@ -211,6 +211,10 @@ impl Sweep {
     /// The parameter values of point i.
     pub fn point(&self, i: u64) -> Vec<f64> {
         let map = |a: &Axis, t: f64| -> f64 {
+            // The ends exactly (exp(ln LO) is not always LO).
+            if t <= 0.0 {
+                return a.lo;
+            }
             if t >= 1.0 {
                 return a.hi;
             }
