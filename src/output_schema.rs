@@ -102,17 +102,19 @@ fn allowance() -> Value {
 /// `compare --format json`.
 pub fn compare() -> Value {
     let count = json!({"type": "integer", "minimum": 0});
+    let lab = json!({"type": "array", "items": {"type": "number"}, "minItems": 3, "maxItems": 3,
+                     "description": "L*, a*, b*"});
     json!({
         "$schema": DRAFT,
         "title": "glossmeter compare --format json",
         "type": "object",
-        "required": ["sheet", "rule", "comparisons", "summary"],
+        "required": ["sheet", "rule", "comparisons", "summary", "colour_differences"],
         "additionalProperties": false,
         "properties": {
             "sheet": {"type": "object", "additionalProperties": false,
               "required": ["file", "encoding", "delimiter", "layout", "metadata", "ignored_columns"],
               "properties": {"file": {"type": "string"}, "encoding": {"type": "string"},
-                "delimiter": {"type": "string", "enum": [",", ";", "\t"]}, "layout": {"type": "string", "enum": ["long", "wide"]},
+                "delimiter": {"type": "string", "enum": [",", ";", "\t"]}, "layout": {"type": "string", "enum": ["long", "wide", "colour"]},
                 "metadata": {"type": "object", "additionalProperties": {"type": "string"},
                              "description": "the sheet's `# key: value` lines"},
                 "ignored_columns": {"type": "array", "items": {"type": "string"}}}},
@@ -123,6 +125,13 @@ pub fn compare() -> Value {
               "required": ["readings", "inside", "outside", "no_value", "no_allowance", "not_predicted"],
               "properties": {"readings": count, "inside": count, "outside": count, "no_value": count,
                              "no_allowance": count, "not_predicted": count}},
+            "colour_differences": {"type": "array", "description": "CIEDE2000 per (sample, geometry) with L*, a*, b*",
+              "items": {"type": "object", "additionalProperties": false,
+                "required": ["sample", "geometry", "line", "measured", "predicted", "de00", "inside"],
+                "properties": {"sample": {"type": "string"}, "geometry": {"type": "string"},
+                  "line": {"type": "integer", "minimum": 1},
+                  "measured": lab.clone(), "predicted": lab,
+                  "de00": {"type": "number", "minimum": 0}, "inside": {"type": ["boolean", "null"]}}}},
             "baseline": baseline(),
         },
     })

@@ -120,15 +120,24 @@ fn outputs_follow_their_schemas() {
     let (_, out) = gm(&["measure", "fixtures/recipes/phong.json", "--format", "json"]);
     assert_valid(&m, &serde_json::from_str(&out).unwrap(), "phong");
     let c = schema("compare");
-    for sheet in ["rhopoint-iq.csv", "byk-windows-1252.csv", "tab-separated.csv"] {
+    for (recipe, sheet) in [
+        ("glass-n1.5.json", "rhopoint-iq.csv"),
+        ("glass-n1.5.json", "byk-windows-1252.csv"),
+        ("glass-n1.5.json", "tab-separated.csv"),
+        ("blue-metallic-spectral.json", "colour-blue-metallic.csv"),
+    ] {
         let (_, out) = gm(&[
             "compare",
-            "fixtures/recipes/glass-n1.5.json",
+            &format!("fixtures/recipes/{recipe}"),
             &format!("fixtures/sheets/{sheet}"),
             "--format",
             "json",
         ]);
-        assert_valid(&c, &serde_json::from_str(&out).unwrap(), sheet);
+        let doc: Value = serde_json::from_str(&out).unwrap();
+        if sheet.starts_with("colour") {
+            assert!(!doc["colour_differences"].as_array().unwrap().is_empty(), "{out}");
+        }
+        assert_valid(&c, &doc, sheet);
     }
     let (_, out) = gm(&[
         "compare",
