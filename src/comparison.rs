@@ -20,7 +20,7 @@ use std::path::{Path, PathBuf};
 use rayon::prelude::*;
 
 use crate::instrument::plan::{Plan, PlanOptions, Reading};
-use crate::instrument::sheet::{Layout, Sheet, SheetRow};
+use crate::instrument::sheet::{self, Layout, Sheet, SheetOptions, SheetRow};
 use crate::instrument::standards::{self, StandardGeometry};
 use crate::recipe::{self, Material};
 use crate::{Error, Result};
@@ -99,6 +99,14 @@ pub fn group_rows(rows: &[SheetRow]) -> Vec<Group> {
         g.stats = statistics(&g.values);
     }
     groups
+}
+
+/// A sheet read as targets, for callers other than `compare` (`fit --sheet`): every (sample, geometry,
+/// reading) with its values, the largest stated uncertainty, the statistics and the lines they came from.
+pub fn read_targets(path: &Path, options: &SheetOptions) -> Result<(Sheet, Vec<Group>)> {
+    let sheet = sheet::load(path, options)?;
+    let groups = group_rows(&sheet.rows);
+    Ok((sheet, groups))
 }
 
 /// How verdicts are reached.

@@ -16,12 +16,15 @@
 //! * [`quadrature`]: the deterministic adaptive cubature with error estimates.
 //! * [`instrument`]: aperture geometry, the standards as data, the measurement plan and the readings.
 //! * [`api`]: the one-call API ([`measure`], the default panel, geometry resolution).
+//! * [`batch`], [`sweep`]: many recipes at once, and sweeps over a template's JSON Pointer paths (streamed, sharded).
+//! * [`output_schema`]: JSON Schemas of the `measure`, `compare` and `sweep` outputs.
 //! * [`comparison`]: predictions beside instrument sheets: statistics, verdicts, many samples, baselines.
 //! * `cli` (feature `cli`, on by default): the thin command-line layer. The library builds and works without
 //!   it and its dependencies (clap, plotters): `cargo build --lib --no-default-features`.
 #![forbid(unsafe_code)]
 
 pub mod api;
+pub mod batch;
 pub mod brdf;
 #[cfg(feature = "cli")]
 pub mod cli;
@@ -33,10 +36,12 @@ pub mod input;
 pub mod instrument;
 pub mod measured;
 pub mod optics;
+pub mod output_schema;
 pub mod quadrature;
 pub mod recipe;
 pub mod registry;
 pub mod spectrum;
+pub mod sweep;
 
 pub use api::{measure, measure_file, resolve_geometries, resolve_geometries_or, DEFAULT_PANEL};
 pub use error::{Error, Result};

@@ -103,39 +103,48 @@ pub fn table(material: &Material, readings: &[Reading], timing: bool) -> String 
     s
 }
 
-pub fn json(material: &Material, readings: &[Reading], timing: bool) -> String {
-    let rs: Vec<serde_json::Value> = readings
-        .iter()
-        .map(|r| {
-            let mut o = json!({
-                "geometry": r.geometry,
-                "name": r.name,
-                "quantity": r.quantity,
-                "value": r.value,
-                "unit": r.unit,
-                "error_estimate": if r.value.is_some() { Some(r.error_estimate) } else { None },
-                "evaluations": r.evaluations,
-                "converged": r.converged,
-            });
-            if timing {
-                o["seconds"] = json!(r.seconds);
-            }
-            if let Some(p) = &r.problem {
-                o["problem"] = json!(p);
-            }
-            if let Some(n) = &r.note {
-                o["note"] = json!(n);
-            }
-            o
-        })
-        .collect();
-    let doc = json!({
-        "material": {"name": material.name, "file": material.file, "model": material.brdf.describe()},
-        "readings": rs,
+/// One reading as `measure --format json` writes it (the schema is `output_schema::measure`).
+pub fn reading_json(r: &Reading, timing: bool) -> serde_json::Value {
+    let mut o = json!({
+        "geometry": r.geometry,
+        "name": r.name,
+        "quantity": r.quantity,
+        "value": r.value,
+        "unit": r.unit,
+        "error_estimate": if r.value.is_some() { Some(r.error_estimate) } else { None },
+        "evaluations": r.evaluations,
+        "converged": r.converged,
     });
-    let mut s = serde_json::to_string_pretty(&doc).expect("finite values serialise");
+    if timing {
+        o["seconds"] = json!(r.seconds);
+    }
+    if let Some(p) = &r.problem {
+        o["problem"] = json!(p);
+    }
+    if let Some(n) = &r.note {
+        o["note"] = json!(n);
+    }
+    o
+}
+
+/// The JSON document of one material's readings (built as a value, never re-parsed: serde_json's default
+/// float parser is not exact to the last bit).
+pub fn json_doc(material: &Material, readings: &[Reading], timing: bool) -> serde_json::Value {
+    json!({
+        "material": {"name": material.name, "file": material.file, "model": material.brdf.describe()},
+        "readings": readings.iter().map(|r| reading_json(r, timing)).collect::<Vec<_>>(),
+    })
+}
+
+/// A JSON value as the CLI prints it: pretty, with a final newline.
+pub fn pretty(doc: &serde_json::Value) -> String {
+    let mut s = serde_json::to_string_pretty(doc).expect("finite values serialise");
     s.push('\n');
     s
+}
+
+pub fn json(material: &Material, readings: &[Reading], timing: bool) -> String {
+    pretty(&json_doc(material, readings, timing))
 }
 
 pub fn csv(readings: &[Reading], timing: bool) -> Result<String> {

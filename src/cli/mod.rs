@@ -12,6 +12,7 @@ use crate::instrument::plan::{Plan, PlanOptions};
 use crate::instrument::standards;
 use crate::{recipe, resolve_geometries, Error, Result};
 
+pub mod batch;
 pub mod compare;
 pub mod convergence;
 pub mod fit;
@@ -19,6 +20,7 @@ pub mod format;
 pub mod junit;
 pub mod output;
 pub mod plot;
+pub mod sweep;
 
 pub use output::{print, Target, STDOUT};
 
@@ -57,12 +59,25 @@ impl ColourArgs {
     }
 }
 
+/// The outputs whose JSON Schema `glossmeter schema --output-format` prints.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum OutputSchema {
+    Measure,
+    Compare,
+    Sweep,
+}
+
 #[derive(Subcommand, Debug)]
 pub enum Command {
-    /// Read a material (recipe JSON) through instrument geometries.
+    /// Read materials (recipe JSON files, or directories of them) through instrument geometries.
     Measure {
-        /// The recipe (JSON; see `glossmeter schema` and docs/recipe-format.md).
-        recipe: PathBuf,
+        /// The recipe (JSON; see `glossmeter schema` and docs/recipe-format.md); several recipes or a directory
+        /// are measured together in parallel, in one table / CSV / JSON with a material column.
+        #[arg(required = true, num_args = 1..)]
+        recipes: Vec<PathBuf>,
+        /// A previous `measure` or `compare` JSON: exit 1 if a reading moved by more than both error estimates.
+        #[arg(long, value_name = "PREVIOUS.json")]
+        baseline: Option<PathBuf>,
         /// A shipped geometry id (repeatable); see `glossmeter standards`. Default: ASTM D523 20°/60°/85°,
         /// ASTM E430 30° (gloss, haze, DOI), ISO 13803 20° haze and the ASTM D4039 haze index.
         #[arg(long = "geometry", short = 'g')]
@@ -98,8 +113,13 @@ pub enum Command {
         /// A geometry id.
         id: Option<String>,
     },
-    /// Print the JSON Schema of the recipe format.
-    Schema,
+    /// Print the JSON Schema of the recipe format, or of an output (`--output-format measure|compare|sweep`).
+    Schema {
+        #[arg(long, value_enum)]
+        output_format: Option<OutputSchema>,
+    },
+    /// Measure a template recipe over a grid or a Latin hypercube of JSON Pointer paths (CSV or JSON lines).
+    Sweep(sweep::SweepArgs),
     /// Set predictions beside a glossmeter sheet (CSV); exits 1 if a reading falls outside its uncertainty.
     Compare(compare::CompareArgs),
     /// Error against run time over a sweep of tolerances (table, CSV, JSON, and a log–log plot).
@@ -146,7 +166,8 @@ pub fn exit_status(e: &Error) -> i32 {
 fn dispatch(cli: Cli) -> Result<()> {
     match cli.command {
         Command::Measure {
-            recipe,
+            recipes,
+            baseline,
             geometries,
             geometry_files,
             rtol,
@@ -164,13 +185,24 @@ fn dispatch(cli: Cli) -> Result<()> {
                 return Err(Error::Usage("--max-evals must be at least 1".into()));
             }
             let target = Target::new(output.as_deref(), "--output")?;
-            let material = recipe::load_file(&recipe)?;
+            let baseline_file = baseline.as_ref().map(|p| p.display().to_string());
+            let baseline = baseline.as_deref().map(crate::comparison::load_baseline).transpose()?;
+            let options = PlanOptions { rtol, max_evals, colour, ..PlanOptions::default() };
+            if recipes.len() > 1 || recipes[0].is_dir() {
+                if explain {
+                    return Err(Error::Usage("--explain takes one recipe".into()));
+                }
+                let batch = Batch {
+                    baseline: baseline.as_deref().map(|b| (b, baseline_file.clone().unwrap_or_default())),
+                    format,
+                    timing: !no_timing,
+                    allow_unconverged,
+                };
+                return measure_batch(&recipes, &geometries, &geometry_files, &options, &batch, &target);
+            }
+            let material = recipe::load_file(&recipes[0])?;
             let geos = resolve_geometries(&geometries, &geometry_files)?;
-            let plan = Plan::compile(
-                material.brdf.clone(),
-                geos,
-                PlanOptions { rtol, max_evals, colour, ..PlanOptions::default() },
-            )?;
+            let plan = Plan::compile(material.brdf.clone(), geos, options)?;
             let mut text = String::new();
             if explain {
                 let e = plan.explain();
@@ -181,12 +213,23 @@ fn dispatch(cli: Cli) -> Result<()> {
                 }
             }
             let readings = plan.execute();
+            let drift = baseline
+                .as_deref()
+                .map(|b| crate::comparison::check_baseline(readings.iter().map(|r| (material.name.as_str(), r)), b));
             text.push_str(&match format {
                 Format::Table => format::table(&material, &readings, !no_timing),
-                Format::Json => format::json(&material, &readings, !no_timing),
+                Format::Json => format::pretty(&with_baseline(
+                    format::json_doc(&material, &readings, !no_timing),
+                    drift.as_deref(),
+                    baseline_file.clone(),
+                )),
                 Format::Csv => format::csv(&readings, !no_timing)?,
             });
+            if let (Format::Table, Some(d)) = (format, &drift) {
+                text.push_str(&batch::drift_text(d));
+            }
             target.write(&text)?;
+            check_drift(drift.as_deref())?;
             readings_status(&readings, allow_unconverged)
         }
         Command::Standards { id } => {
@@ -199,8 +242,15 @@ fn dispatch(cli: Cli) -> Result<()> {
         Command::Convergence(args) => convergence::run(args),
         Command::Compare(args) => compare::run(args),
         Command::Fit(args) => fit::run(args),
-        Command::Schema => {
-            let text = serde_json::to_string_pretty(&recipe::schema::schema())
+        Command::Sweep(args) => sweep::run(args),
+        Command::Schema { output_format } => {
+            let schema = match output_format {
+                None => recipe::schema::schema(),
+                Some(OutputSchema::Measure) => crate::output_schema::measure(),
+                Some(OutputSchema::Compare) => crate::output_schema::compare(),
+                Some(OutputSchema::Sweep) => crate::output_schema::sweep(),
+            };
+            let text = serde_json::to_string_pretty(&schema)
                 .map_err(|e| Error::Numeric(format!("the schema does not serialise: {e}")))?;
             print(&(text + "\n"))
         }
@@ -267,4 +317,79 @@ pub fn pad_table(rows: &[Vec<String>], right: &[usize]) -> String {
         }
     }
     s
+}
+
+/// Add the baseline checks to a JSON document (when a baseline was given).
+fn with_baseline(
+    mut doc: serde_json::Value,
+    drift: Option<&[crate::comparison::Drift]>,
+    file: Option<String>,
+) -> serde_json::Value {
+    if let (Some(d), Some(file)) = (drift, file) {
+        doc["baseline"] = serde_json::json!({
+            "file": file,
+            "checks": d.iter().map(compare::drift_json).collect::<Vec<_>>(),
+            "moved": d.iter().filter(|x| x.moved).count(),
+        });
+    }
+    doc
+}
+
+/// Exit status 1 when a baseline reading moved.
+fn check_drift(drift: Option<&[crate::comparison::Drift]>) -> Result<()> {
+    let moved = drift.map(|d| d.iter().filter(|x| x.moved).count()).unwrap_or(0);
+    if moved > 0 {
+        return Err(Error::Check(format!(
+            "{moved} reading(s) moved from the baseline by more than both error estimates"
+        )));
+    }
+    Ok(())
+}
+
+/// How a batch `measure` reports.
+struct Batch<'a> {
+    baseline: Option<(&'a [crate::comparison::BaselineEntry], String)>,
+    format: Format,
+    timing: bool,
+    allow_unconverged: bool,
+}
+
+/// `measure` of several recipes or a directory.
+fn measure_batch(
+    paths: &[PathBuf],
+    geometries: &[String],
+    geometry_files: &[PathBuf],
+    options: &PlanOptions,
+    how: &Batch,
+    target: &Target,
+) -> Result<()> {
+    let files = crate::batch::recipe_files(paths)?;
+    let materials = crate::batch::load_all(&files)?;
+    let geos = resolve_geometries(geometries, geometry_files)?;
+    let readings = crate::batch::measure_many(&materials, &geos, options)?;
+    let drift = how.baseline.as_ref().map(|(b, _)| {
+        crate::comparison::check_baseline(
+            materials.iter().zip(&readings).flat_map(|(m, rs)| rs.iter().map(move |r| (m.name.as_str(), r))),
+            b,
+        )
+    });
+    let text = match how.format {
+        Format::Table => {
+            let mut t = batch::table(&materials, &readings, how.timing);
+            if let Some(d) = &drift {
+                t.push_str(&batch::drift_text(d));
+            }
+            t
+        }
+        Format::Json => format::pretty(&with_baseline(
+            batch::json_doc(&materials, &readings, how.timing),
+            drift.as_deref(),
+            how.baseline.as_ref().map(|(_, f)| f.clone()),
+        )),
+        Format::Csv => batch::csv(&materials, &readings, how.timing)?,
+    };
+    target.write(&text)?;
+    check_drift(drift.as_deref())?;
+    let all: Vec<crate::Reading> = readings.into_iter().flatten().collect();
+    readings_status(&all, how.allow_unconverged)
 }

@@ -42,6 +42,30 @@ impl Target {
             Some(p) => write_new_file(p, text.as_bytes()),
         }
     }
+
+    /// How the target is named in errors: the file, or `<stdout>`.
+    pub fn name(&self) -> String {
+        self.path.as_ref().map(|p| p.display().to_string()).unwrap_or_else(|| STDOUT.into())
+    }
+
+    /// Stream output through `body` (for output too large to hold, `sweep`): standard output as it comes, or
+    /// a file that still appears whole or not at all (the temporary file is linked to its name only when
+    /// `body` succeeded). `body`'s I/O errors should name [`Target::name`].
+    pub fn stream(&self, body: impl FnOnce(&mut dyn Write) -> Result<()>) -> Result<()> {
+        let io = |source| Error::Io { file: self.name(), source };
+        match &self.path {
+            None => {
+                let mut out = std::io::BufWriter::new(std::io::stdout().lock());
+                body(&mut out)?;
+                out.flush().map_err(io)
+            }
+            Some(p) => write_new_file_by(p, |f| {
+                let mut out = std::io::BufWriter::new(f);
+                body(&mut out)?;
+                out.flush().map_err(io)
+            }),
+        }
+    }
 }
 
 /// Refuse an existing path (never overwritten) and a path whose directory does not exist.
@@ -83,6 +107,13 @@ pub fn write_new_file_with(
     bytes: &[u8],
     write: impl FnOnce(&mut File, &[u8]) -> std::io::Result<()>,
 ) -> Result<()> {
+    let io = |source| Error::Io { file: path.display().to_string(), source };
+    write_new_file_by(path, |f| write(f, bytes).map_err(io))
+}
+
+/// Create the new file `path` atomically with the contents `body` writes (see the module documentation):
+/// on any error of `body`, of the flush or of the link, no file is left behind.
+pub fn write_new_file_by(path: &Path, body: impl FnOnce(&mut File) -> Result<()>) -> Result<()> {
     static COUNTER: AtomicUsize = AtomicUsize::new(0);
     let io = |source| Error::Io { file: path.display().to_string(), source };
     let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| "output".into());
@@ -95,9 +126,9 @@ pub fn write_new_file_with(
             Err(e) => return Err(io(e)),
         }
     };
-    let result = write(&mut file, bytes).and_then(|_| file.flush()).and_then(|_| file.sync_all());
+    let result = body(&mut file).and_then(|_| file.flush().and_then(|_| file.sync_all()).map_err(io));
     drop(file);
-    let result = result.map_err(io).and_then(|_| {
+    let result = result.and_then(|_| {
         std::fs::hard_link(&tmp, path).map_err(|e| {
             if e.kind() == std::io::ErrorKind::AlreadyExists {
                 Error::Usage(format!(

@@ -1,0 +1,56 @@
+//! Many recipes measured in one process: the recipe files of a list of files and directories, each read
+//! through the same geometries, in parallel over recipes (and, within each recipe, over its integrals). One
+//! integral always runs on one thread, so every reading is the same bits whatever the thread count or the
+//! number of recipes measured together (tests/sheets.rs compares a batch with one-by-one runs).
+use std::path::{Path, PathBuf};
+
+use rayon::prelude::*;
+
+use crate::instrument::plan::{Plan, PlanOptions, Reading};
+use crate::instrument::standards::StandardGeometry;
+use crate::recipe::{self, Material};
+use crate::{Error, Result};
+
+/// The recipe files named by `paths`: files as given, directories replaced by their `*.json` files (not
+/// recursive), sorted by name.
+pub fn recipe_files(paths: &[PathBuf]) -> Result<Vec<PathBuf>> {
+    let mut out = vec![];
+    for p in paths {
+        if p.is_dir() {
+            let rd = std::fs::read_dir(p).map_err(|source| Error::Io { file: p.display().to_string(), source })?;
+            let mut files: Vec<PathBuf> = vec![];
+            for e in rd {
+                let e = e.map_err(|source| Error::Io { file: p.display().to_string(), source })?;
+                let f = e.path();
+                if f.is_file() && f.extension().is_some_and(|x| x == "json") {
+                    files.push(f);
+                }
+            }
+            if files.is_empty() {
+                return Err(Error::input(p.display().to_string(), "", "the directory has no *.json recipes"));
+            }
+            files.sort();
+            out.extend(files);
+        } else {
+            out.push(p.clone());
+        }
+    }
+    Ok(out)
+}
+
+/// Load every recipe (the first bad one is the error, before any work is done).
+pub fn load_all(files: &[PathBuf]) -> Result<Vec<Material>> {
+    files.iter().map(|f| recipe::load_file(Path::new(f))).collect()
+}
+
+/// Read every material through the geometries; the readings of material i are element i.
+pub fn measure_many(
+    materials: &[Material],
+    geometries: &[StandardGeometry],
+    options: &PlanOptions,
+) -> Result<Vec<Vec<Reading>>> {
+    materials
+        .par_iter()
+        .map(|m| Ok(Plan::compile(m.brdf.clone(), geometries.to_vec(), options.clone())?.execute()))
+        .collect()
+}

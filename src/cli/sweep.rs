@@ -1,0 +1,113 @@
+//! `glossmeter sweep`: a template recipe measured over a grid or a Latin hypercube of JSON Pointer paths,
+//! streamed as CSV or JSON lines. The points, shards and rows are the library's (`crate::sweep`); this module
+//! parses the arguments, draws the progress bar (only when stderr is a terminal) and writes.
+use std::io::IsTerminal;
+use std::path::PathBuf;
+
+use crate::cli::{check_rtol, Target};
+use crate::instrument::plan::PlanOptions;
+use crate::sweep::{self, Design, Sweep};
+use crate::{resolve_geometries, Error, Result};
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum SweepFormat {
+    Csv,
+    Jsonl,
+}
+
+#[derive(clap::Args, Debug)]
+pub struct SweepArgs {
+    /// The template recipe (JSON).
+    pub template: PathBuf,
+    /// A varied number: PATH=LO..HI:N (grid) or PATH=LO..HI (with --lhs); PATH is a JSON Pointer (repeatable).
+    #[arg(long = "vary", value_name = "PATH=LO..HI[:N]", required = true)]
+    pub vary: Vec<String>,
+    /// Space this path's values logarithmically (repeatable).
+    #[arg(long = "log", value_name = "PATH")]
+    pub log: Vec<String>,
+    /// A Latin hypercube of N points instead of the grid.
+    #[arg(long, value_name = "N")]
+    pub lhs: Option<u64>,
+    /// The hypercube's seed.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// A shipped geometry id (repeatable; default: the default panel).
+    #[arg(long = "geometry", short = 'g')]
+    pub geometries: Vec<String>,
+    /// Compute only the K-th of M contiguous slices (concatenated in order they equal the whole run).
+    #[arg(long, value_name = "K/M")]
+    pub shard: Option<String>,
+    #[arg(long, value_enum, default_value_t = SweepFormat::Csv)]
+    pub format: SweepFormat,
+    /// Relative tolerance of every reading.
+    #[arg(long, default_value_t = 1e-6)]
+    pub rtol: f64,
+    /// Leave the per-point wall time out (then the output is reproducible byte for byte).
+    #[arg(long)]
+    pub no_timing: bool,
+    /// Evaluation budget of each aperture integral (a reading that runs out is marked not converged).
+    #[arg(long, default_value_t = PlanOptions::default().max_evals)]
+    pub max_evals: usize,
+    /// Write to this new file instead of stdout (refused before any work if it exists; the file appears
+    /// whole when the sweep ends, or not at all).
+    #[arg(long, short = 'o')]
+    pub output: Option<PathBuf>,
+}
+
+pub fn run(a: SweepArgs) -> Result<()> {
+    check_rtol(a.rtol)?;
+    let mut axes = a.vary.iter().map(|v| sweep::parse_vary(v)).collect::<Result<Vec<_>>>()?;
+    for l in &a.log {
+        match axes.iter_mut().find(|x| &x.path == l) {
+            Some(x) => x.log = true,
+            None => return Err(Error::Usage(format!("--log {l}: not a --vary path"))),
+        }
+    }
+    let design = match a.lhs {
+        Some(n) => Design::Lhs { n, seed: a.seed },
+        None => Design::Grid,
+    };
+    let (k, m) = a.shard.as_deref().map(sweep::parse_shard).transpose()?.unwrap_or((1, 1));
+    if a.max_evals == 0 {
+        return Err(Error::Usage("--max-evals must be at least 1".into()));
+    }
+    let target = Target::new(a.output.as_deref(), "--output")?;
+    let file = a.template.display().to_string();
+    let text = crate::input::read_text(&a.template, "recipe")?;
+    let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
+    let template: serde_json::Value = serde_json::from_str(text).map_err(|e| {
+        Error::input(&file, "", format!("malformed JSON at line {}, column {}: {e}", e.line(), e.column()))
+    })?;
+    let geos = resolve_geometries(&a.geometries, &[] as &[&str])?;
+    let options = PlanOptions { rtol: a.rtol, max_evals: a.max_evals, ..PlanOptions::default() };
+    let s = Sweep::new(template, &file, axes, design, geos, options)?;
+    let range = s.shard(k, m);
+    let timing = !a.no_timing;
+    let bar = if std::io::stderr().is_terminal() {
+        let b = indicatif::ProgressBar::new(range.end - range.start);
+        b.set_style(
+            indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} points, {per_sec}, eta {eta}")
+                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+        );
+        b
+    } else {
+        indicatif::ProgressBar::hidden()
+    };
+    let name = target.name();
+    let io = |source: std::io::Error| Error::Io { file: name.clone(), source };
+    target.stream(|out| {
+        if a.format == SweepFormat::Csv && k == 1 {
+            out.write_all(s.csv_header(timing).as_bytes()).map_err(io)?;
+        }
+        s.run(range, |r| {
+            let line = match a.format {
+                SweepFormat::Csv => s.csv_row(&r, timing),
+                SweepFormat::Jsonl => s.jsonl_row(&r, timing),
+            };
+            bar.inc(1);
+            out.write_all(line.as_bytes()).map_err(io)
+        })
+    })?;
+    bar.finish_and_clear();
+    Ok(())
+}

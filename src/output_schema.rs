@@ -1,0 +1,161 @@
+//! JSON Schemas (draft 2020-12) of the JSON outputs of `measure` (one recipe or many), `compare` and the
+//! JSON lines of `sweep`: the contract that scripts and CI rely on, printed by
+//! `glossmeter schema --output-format measure|compare|sweep` (`fit`'s is added with the `fit` command). `tests/schemas.rs` validates real outputs
+//! against them, so a field added to an output without its schema fails the tests.
+use serde_json::{json, Value};
+
+const DRAFT: &str = "https://json-schema.org/draft/2020-12/schema";
+
+fn num_or_null() -> Value {
+    json!({"type": ["number", "null"]})
+}
+
+/// One reading of `measure` (the fields of the one-recipe JSON; a batch adds `material` and `file`).
+fn reading(batch: bool) -> Value {
+    let mut props = json!({
+        "geometry": {"type": "string", "description": "the geometry id"},
+        "name": {"type": "string", "description": "the reading's name (e.g. haze-narrow)"},
+        "quantity": {"type": "string", "enum": ["gloss", "haze", "log-haze", "doi", "haze-index", "rspec"]},
+        "value": {"type": ["number", "null"], "description": "null when there is no finite value (see problem)"},
+        "unit": {"type": "string"},
+        "error_estimate": {"type": ["number", "null"], "minimum": 0, "description": "numerical error estimate"},
+        "evaluations": {"type": "integer", "minimum": 0},
+        "converged": {"type": "boolean"},
+        "seconds": {"type": "number", "minimum": 0, "description": "wall time; absent with --no-timing"},
+        "problem": {"type": "string"},
+        "note": {"type": "string"},
+    });
+    let mut required =
+        vec!["geometry", "name", "quantity", "value", "unit", "error_estimate", "evaluations", "converged"];
+    if batch {
+        props["material"] = json!({"type": "string"});
+        props["file"] = json!({"type": "string"});
+        required.extend(["material", "file"]);
+    }
+    json!({"type": "object", "properties": props, "required": required, "additionalProperties": false})
+}
+
+fn material() -> Value {
+    json!({"type": "object", "required": ["name", "file", "model"], "additionalProperties": false,
+           "properties": {"name": {"type": "string"}, "file": {"type": "string"}, "model": {"type": "string"}}})
+}
+
+fn baseline() -> Value {
+    json!({"type": "object", "required": ["file", "checks", "moved"], "additionalProperties": false,
+      "properties": {
+        "file": {"type": "string"},
+        "moved": {"type": "integer", "minimum": 0},
+        "checks": {"type": "array", "items": {"type": "object", "additionalProperties": false,
+          "required": ["material", "geometry", "reading", "now", "then", "allowed", "moved"],
+          "properties": {"material": {"type": "string"}, "geometry": {"type": "string"}, "reading": {"type": "string"},
+            "now": {"type": "number"}, "then": {"type": "number"}, "allowed": {"type": "number", "minimum": 0},
+            "moved": {"type": "boolean"}}}}}})
+}
+
+/// `measure --format json`: one recipe (`material`), or many (`materials`, and `material` on each reading).
+pub fn measure() -> Value {
+    json!({
+        "$schema": DRAFT,
+        "title": "glossmeter measure --format json",
+        "oneOf": [
+            {"type": "object", "required": ["material", "readings"], "additionalProperties": false,
+             "properties": {"material": material(), "readings": {"type": "array", "items": reading(false)},
+                            "baseline": baseline()}},
+            {"type": "object", "required": ["materials", "readings"], "additionalProperties": false,
+             "properties": {"materials": {"type": "array", "items": material()},
+                            "readings": {"type": "array", "items": reading(true)}, "baseline": baseline()}},
+        ],
+    })
+}
+
+/// One compared (sample, reading).
+fn comparison() -> Value {
+    let props = json!({
+        "sample": {"type": "string"}, "material": {"type": "string"}, "recipe": {"type": "string"},
+        "geometry": {"type": "string"}, "reading": {"type": "string"},
+        "predicted_reading": {"type": ["string", "null"]},
+        "lines": {"type": "array", "items": {"type": "integer", "minimum": 1}},
+        "columns": {"type": "array", "items": {"type": "string"}},
+        "values": {"type": "array", "items": {"type": "number"}},
+        "n": {"type": "integer", "minimum": 1}, "mean": {"type": "number"},
+        "std": {"type": "number", "minimum": 0}, "min": {"type": "number"}, "max": {"type": "number"},
+        "uncertainty": num_or_null(), "predicted": num_or_null(), "error_estimate": num_or_null(),
+        "difference": {"type": ["number", "null"], "description": "predicted − measured mean"},
+        "allowance": allowance(),
+        "verdict": {"type": "string", "enum": ["ok", "OUTSIDE", "unchecked", "not predicted"],
+                    "description": "unchecked (no value, or no allowance) and OUTSIDE fail the check (exit 1)"},
+        "inside": {"type": ["boolean", "null"]},
+        "reason": {"type": ["string", "null"], "description": "why not predicted, or why the prediction has no value"},
+        "unchecked": {"type": ["string", "null"], "description": "why the row could not be checked"},
+    });
+    let required: Vec<&str> = props.as_object().expect("object").keys().map(String::as_str).collect();
+    json!({"type": "object", "additionalProperties": false, "required": required, "properties": props})
+}
+
+fn allowance() -> Value {
+    let nonneg = json!({"type": "number", "minimum": 0});
+    json!({"oneOf": [{"type": "null"}, {"type": "object", "additionalProperties": false,
+        "required": ["statistical", "stated", "prediction", "total"],
+        "properties": {"statistical": nonneg, "stated": nonneg, "prediction": nonneg, "total": nonneg}}]})
+}
+
+/// `compare --format json`.
+pub fn compare() -> Value {
+    let count = json!({"type": "integer", "minimum": 0});
+    let lab = json!({"type": "array", "items": {"type": "number"}, "minItems": 3, "maxItems": 3,
+                     "description": "L*, a*, b*"});
+    json!({
+        "$schema": DRAFT,
+        "title": "glossmeter compare --format json",
+        "type": "object",
+        "required": ["sheet", "rule", "comparisons", "summary", "colour_differences"],
+        "additionalProperties": false,
+        "properties": {
+            "sheet": {"type": "object", "additionalProperties": false,
+              "required": ["file", "encoding", "delimiter", "layout", "metadata", "ignored_columns"],
+              "properties": {"file": {"type": "string"}, "encoding": {"type": "string"},
+                "delimiter": {"type": "string", "enum": [",", ";", "\t"]}, "layout": {"type": "string", "enum": ["long", "wide", "colour"]},
+                "metadata": {"type": "object", "additionalProperties": {"type": "string"},
+                             "description": "the sheet's `# key: value` lines"},
+                "ignored_columns": {"type": "array", "items": {"type": "string"}}}},
+            "rule": {"type": "object", "additionalProperties": false, "required": ["k", "tolerance"],
+              "properties": {"k": {"type": "number", "minimum": 0}, "tolerance": num_or_null()}},
+            "comparisons": {"type": "array", "items": comparison()},
+            "summary": {"type": "object", "additionalProperties": false,
+              "required": ["readings", "inside", "outside", "no_value", "no_allowance", "not_predicted"],
+              "properties": {"readings": count, "inside": count, "outside": count, "no_value": count,
+                             "no_allowance": count, "not_predicted": count}},
+            "colour_differences": {"type": "array", "description": "CIEDE2000 per (sample, geometry) with L*, a*, b*",
+              "items": {"type": "object", "additionalProperties": false,
+                "required": ["sample", "geometry", "line", "measured", "predicted", "de00", "inside"],
+                "properties": {"sample": {"type": "string"}, "geometry": {"type": "string"},
+                  "line": {"type": "integer", "minimum": 1},
+                  "measured": lab.clone(), "predicted": lab,
+                  "de00": {"type": "number", "minimum": 0}, "inside": {"type": ["boolean", "null"]}}}},
+            "baseline": baseline(),
+        },
+    })
+}
+
+/// One line of `sweep --format jsonl`.
+pub fn sweep() -> Value {
+    json!({
+        "$schema": DRAFT,
+        "title": "glossmeter sweep --format jsonl (one object per line)",
+        "type": "object",
+        "required": ["index", "parameters"],
+        "additionalProperties": false,
+        "properties": {
+            "index": {"type": "integer", "minimum": 0},
+            "parameters": {"type": "object", "additionalProperties": {"type": "number"},
+                           "description": "the varied values, by JSON Pointer"},
+            "readings": {"type": "array", "items": {"type": "object", "additionalProperties": false,
+              "required": ["geometry", "name", "unit", "value", "error_estimate", "converged"],
+              "properties": {"geometry": {"type": "string"}, "name": {"type": "string"}, "unit": {"type": "string"},
+                "value": num_or_null(), "error_estimate": num_or_null(), "converged": {"type": "boolean"},
+                "problem": {"type": "string"}}}},
+            "problem": {"type": "string", "description": "why the recipe at this point is invalid (then no readings)"},
+            "seconds": {"type": "number", "minimum": 0},
+        },
+    })
+}

@@ -1,0 +1,523 @@
+//! Sweeps over recipes: a template recipe whose numbers at given JSON Pointer paths vary over a Cartesian grid
+//! or a Latin hypercube, every point measured through the same geometries. Paint designers use it to see how
+//! readings move with the recipe (20° gloss and haze against coat roughness and flake spread); a sweep that
+//! outgrows one process splits into shards.
+//!
+//! Design decisions (docs/instrument.md §Sweeps):
+//! * **Points are a pure function of their index.** The grid decomposes the index in mixed radix (last axis
+//!   fastest); the Latin hypercube draws each axis' cell from a keyed pseudo-random permutation of 0..N (a
+//!   Feistel network with cycle walking) and the offset inside the cell from a keyed hash (SplitMix64), so no
+//!   point list is ever stored and any point can be computed alone.
+//! * **Shards are contiguous index ranges** `[⌊(K−1)·P/M⌋, ⌊K·P/M⌋)`, so the shards' outputs, concatenated in order,
+//!   are the unsharded output byte for byte (the CSV header is written by shard 1 only).
+//! * **Streaming**: points run in parallel in chunks and are written in index order as each chunk ends, so
+//!   memory does not grow with the number of points.
+//! * **An invalid point is a row**, with the recipe's error in its `problem` column, not a failure of the sweep.
+use std::ops::Range;
+use std::time::Instant;
+
+use rayon::prelude::*;
+use serde_json::{json, Value};
+
+use crate::instrument::plan::{Plan, PlanOptions, Reading};
+use crate::instrument::standards::StandardGeometry;
+use crate::{recipe, registry, Error, Result};
+
+/// One varied parameter: a JSON Pointer into the template, its range and (for a grid) its number of values.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Axis {
+    pub path: String,
+    pub lo: f64,
+    pub hi: f64,
+    /// Grid points on this axis (None for a Latin hypercube).
+    pub n: Option<u64>,
+    /// Logarithmic spacing (lo > 0).
+    pub log: bool,
+}
+
+/// `PATH=LO..HI:N` (grid) or `PATH=LO..HI` (Latin hypercube).
+pub fn parse_vary(s: &str) -> Result<Axis> {
+    let bad =
+        |m: &str| Error::Usage(format!("--vary `{s}`: {m} (expected PATH=LO..HI:N, e.g. /coat/roughness=0.01..0.3:8)"));
+    let (path, range) = s.rsplit_once('=').ok_or_else(|| bad("no `=`"))?;
+    if !(path.is_empty() || path.starts_with('/')) {
+        return Err(bad("the path must be a JSON Pointer starting with `/`"));
+    }
+    let (range, n) = match range.rsplit_once(':') {
+        Some((r, n)) => (r, Some(n.trim().parse::<u64>().map_err(|_| bad("N must be a whole number"))?)),
+        None => (range, None),
+    };
+    let (lo, hi) = range.split_once("..").ok_or_else(|| bad("no `..` between LO and HI"))?;
+    let num = |t: &str| t.trim().parse::<f64>().ok().filter(|v| v.is_finite());
+    let (Some(lo), Some(hi)) = (num(lo), num(hi)) else {
+        return Err(bad("LO and HI must be finite numbers"));
+    };
+    if !(lo < hi) {
+        return Err(bad(&format!("LO must be below HI, got {lo} ≥ {hi}")));
+    }
+    if n == Some(0) {
+        return Err(bad("N must be at least 1"));
+    }
+    Ok(Axis { path: path.to_string(), lo, hi, n, log: false })
+}
+
+/// `K/M` with 1 ≤ K ≤ M.
+pub fn parse_shard(s: &str) -> Result<(u64, u64)> {
+    let bad = |m: &str| Error::Usage(format!("--shard `{s}`: {m} (expected K/M with 1 ≤ K ≤ M)"));
+    let (k, m) = s.split_once('/').ok_or_else(|| bad("no `/`"))?;
+    let (Ok(k), Ok(m)) = (k.trim().parse::<u64>(), m.trim().parse::<u64>()) else {
+        return Err(bad("K and M must be whole numbers"));
+    };
+    if m == 0 || k == 0 || k > m {
+        return Err(bad(&format!("K = {k}, M = {m}")));
+    }
+    Ok((k, m))
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Design {
+    /// The Cartesian product of the axes' grids.
+    Grid,
+    /// A Latin hypercube of n points drawn with a seed.
+    Lhs { n: u64, seed: u64 },
+}
+
+/// SplitMix64's finaliser (Steele, Lea & Flood 2014, "Fast splittable pseudorandom number generators"): a
+/// bijective 64-bit mix, used as a keyed hash.
+pub fn splitmix64(mut z: u64) -> u64 {
+    z = z.wrapping_add(0x9e37_79b9_7f4a_7c15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    z ^ (z >> 31)
+}
+
+/// A uniform number in [0, 1) from 64 random bits (the top 53).
+fn unit(bits: u64) -> f64 {
+    (bits >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
+}
+
+/// A keyed pseudo-random permutation of 0..n, evaluated at i without storing it: a 4-round balanced Feistel
+/// network on the smallest even number of bits covering n, with cycle walking (re-encrypt until the result
+/// is below n; it terminates because the network is a bijection of a domain smaller than 4n).
+pub fn permute(i: u64, n: u64, key: u64) -> u64 {
+    assert!(i < n);
+    let bits = (64 - (n - 1).leading_zeros()).max(2);
+    let half = bits.div_ceil(2);
+    let mask = (1u64 << half) - 1;
+    let mut x = i;
+    loop {
+        let (mut l, mut r) = (x >> half, x & mask);
+        for round in 0..4u64 {
+            let f = splitmix64(r ^ key.wrapping_mul(0x2545_f491_4f6c_dd1d).wrapping_add(round)) & mask;
+            (l, r) = (r, l ^ f);
+        }
+        x = (l << half) | r;
+        if x < n {
+            return x;
+        }
+    }
+}
+
+/// A sweep, ready to run point by point.
+pub struct Sweep {
+    pub template: Value,
+    /// The template's file (for messages and the rows' provenance).
+    pub file: String,
+    pub axes: Vec<Axis>,
+    pub design: Design,
+    pub geometries: Vec<StandardGeometry>,
+    pub options: PlanOptions,
+}
+
+impl Sweep {
+    /// Check the axes against the template: every path must exist and hold a number; log axes need lo > 0;
+    /// a grid needs N on every axis, a hypercube none.
+    pub fn new(
+        template: Value,
+        file: &str,
+        axes: Vec<Axis>,
+        design: Design,
+        geometries: Vec<StandardGeometry>,
+        options: PlanOptions,
+    ) -> Result<Sweep> {
+        if axes.is_empty() {
+            return Err(Error::Usage("give at least one --vary PATH=LO..HI:N".into()));
+        }
+        let model = match template.get("model") {
+            Some(Value::String(m)) => m.clone(),
+            _ => {
+                return Err(Error::input(
+                    file,
+                    "/model",
+                    "the template needs a \"model\" (a recipe, see glossmeter schema)",
+                ))
+            }
+        };
+        for (i, a) in axes.iter().enumerate() {
+            check_path(&template, file, &model, &a.path)?;
+            if axes[..i].iter().any(|b| b.path == a.path) {
+                return Err(Error::Usage(format!("--vary {}: the path is varied twice", a.path)));
+            }
+            if a.log && !(a.lo > 0.0) {
+                return Err(Error::Usage(format!("--log {}: logarithmic spacing needs LO > 0, got {}", a.path, a.lo)));
+            }
+            match (design, a.n) {
+                (Design::Grid, None) => {
+                    return Err(Error::Usage(format!("--vary {}: a grid needs :N (or use --lhs N)", a.path)))
+                }
+                (Design::Lhs { .. }, Some(_)) => {
+                    return Err(Error::Usage(format!(
+                        "--vary {}: with --lhs the number of points is --lhs N; drop :N",
+                        a.path
+                    )))
+                }
+                _ => {}
+            }
+        }
+        if let Design::Lhs { n: 0, .. } = design {
+            return Err(Error::Usage("--lhs N must be at least 1".into()));
+        }
+        let s = Sweep { template, file: file.to_string(), axes, design, geometries, options };
+        s.checked_len()?;
+        Ok(s)
+    }
+
+    fn checked_len(&self) -> Result<u64> {
+        match self.design {
+            Design::Lhs { n, .. } => Ok(n),
+            Design::Grid => self.axes.iter().try_fold(1u64, |p, a| {
+                p.checked_mul(a.n.expect("grid axes have n"))
+                    .ok_or_else(|| Error::Usage("the grid has more than 2^64 points".into()))
+            }),
+        }
+    }
+
+    /// The number of points.
+    pub fn len(&self) -> u64 {
+        self.checked_len().expect("checked in new")
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The index range of shard K of M (1-based K).
+    pub fn shard(&self, k: u64, m: u64) -> Range<u64> {
+        let p = self.len() as u128;
+        let at = |j: u64| (p * j as u128 / m as u128) as u64;
+        at(k - 1)..at(k)
+    }
+
+    /// The parameter values of point i.
+    pub fn point(&self, i: u64) -> Vec<f64> {
+        let map = |a: &Axis, t: f64| -> f64 {
+            // The ends exactly (exp(ln LO) is not always LO).
+            if t <= 0.0 {
+                return a.lo;
+            }
+            if t >= 1.0 {
+                return a.hi;
+            }
+            if a.log {
+                (a.lo.ln() + (a.hi.ln() - a.lo.ln()) * t).exp()
+            } else {
+                a.lo + (a.hi - a.lo) * t
+            }
+        };
+        match self.design {
+            Design::Grid => {
+                let mut rest = i;
+                let mut out = vec![0.0; self.axes.len()];
+                for (d, a) in self.axes.iter().enumerate().rev() {
+                    let n = a.n.expect("grid");
+                    let j = rest % n;
+                    rest /= n;
+                    out[d] = if n == 1 { a.lo } else { map(a, j as f64 / (n - 1) as f64) };
+                }
+                out
+            }
+            Design::Lhs { n, seed } => self
+                .axes
+                .iter()
+                .enumerate()
+                .map(|(d, a)| {
+                    let key = splitmix64(seed ^ splitmix64(d as u64 + 1));
+                    let cell = permute(i, n, key);
+                    let r = unit(splitmix64(key ^ splitmix64(i.wrapping_add(0x5bd1_e995))));
+                    map(a, (cell as f64 + r) / n as f64)
+                })
+                .collect(),
+        }
+    }
+
+    /// The reported readings of every point: (geometry id, reading name, unit), in output order.
+    pub fn columns(&self) -> Vec<(String, String, String)> {
+        let mut out = vec![];
+        for g in &self.geometries {
+            for (name, spec) in g.reading_names.iter().zip(&g.geometry.readings) {
+                out.push((g.geometry.id.clone(), name.clone(), spec.unit().to_string()));
+            }
+        }
+        out
+    }
+
+    /// Measure point i: the template with the point's values, validated and read through the geometries.
+    pub fn run_point(&self, i: u64) -> PointResult {
+        let start = Instant::now();
+        let values = self.point(i);
+        let mut recipe_json = self.template.clone();
+        for (a, v) in self.axes.iter().zip(&values) {
+            set(&mut recipe_json, &a.path, json!(v));
+        }
+        let name = format!("{} [point {i}]", self.file);
+        let outcome = recipe::parse_str(&recipe_json.to_string(), &name)
+            .and_then(|m| Plan::compile(m.brdf, self.geometries.clone(), self.options.clone()))
+            .map(|plan| plan.execute())
+            .map_err(|e| e.to_string());
+        PointResult { index: i, values, outcome, seconds: start.elapsed().as_secs_f64() }
+    }
+
+    /// Run the points of `range` in parallel, in chunks, handing each result to `sink` in index order.
+    pub fn run(&self, range: Range<u64>, mut sink: impl FnMut(PointResult) -> Result<()>) -> Result<()> {
+        let chunk = 16 * rayon::current_num_threads().max(1) as u64;
+        let mut start = range.start;
+        while start < range.end {
+            let end = (start + chunk).min(range.end);
+            let results: Vec<PointResult> = (start..end).into_par_iter().map(|i| self.run_point(i)).collect();
+            for r in results {
+                sink(r)?;
+            }
+            start = end;
+        }
+        Ok(())
+    }
+
+    /// The CSV header: index, one column per parameter, value and error of every reading, problem (and
+    /// seconds when timed).
+    pub fn csv_header(&self, timing: bool) -> String {
+        let mut h: Vec<String> = vec!["index".into()];
+        h.extend(self.axes.iter().map(|a| a.path.clone()));
+        for (g, n, u) in self.columns() {
+            h.push(format!("{g} {n} ({u})"));
+            h.push(format!("{g} {n} error"));
+        }
+        h.push("problem".into());
+        if timing {
+            h.push("seconds".into());
+        }
+        csv_line(&h)
+    }
+
+    /// One CSV row (numbers as Rust's shortest round-trip decimals; empty where there is no value).
+    pub fn csv_row(&self, r: &PointResult, timing: bool) -> String {
+        let mut row: Vec<String> = vec![r.index.to_string()];
+        row.extend(r.values.iter().map(|v| v.to_string()));
+        let cols = self.columns();
+        let (cells, problem) = self.cells(r, &cols);
+        for c in cells {
+            match c {
+                Some((v, e)) => {
+                    row.push(v.to_string());
+                    row.push(e.to_string());
+                }
+                None => {
+                    row.push(String::new());
+                    row.push(String::new());
+                }
+            }
+        }
+        row.push(problem);
+        if timing {
+            row.push(format!("{:.6}", r.seconds));
+        }
+        csv_line(&row)
+    }
+
+    /// One JSON line.
+    pub fn jsonl_row(&self, r: &PointResult, timing: bool) -> String {
+        let params: serde_json::Map<String, Value> =
+            self.axes.iter().zip(&r.values).map(|(a, v)| (a.path.clone(), json!(v))).collect();
+        let mut o = json!({"index": r.index, "parameters": params});
+        match &r.outcome {
+            Ok(readings) => {
+                o["readings"] = readings
+                    .iter()
+                    .map(|x| {
+                        let mut j = json!({"geometry": x.geometry, "name": x.name, "unit": x.unit, "value": x.value,
+                                           "error_estimate": x.value.map(|_| x.error_estimate), "converged": x.converged});
+                        if let Some(p) = &x.problem {
+                            j["problem"] = json!(p);
+                        }
+                        j
+                    })
+                    .collect();
+            }
+            Err(e) => o["problem"] = json!(e),
+        }
+        if timing {
+            o["seconds"] = json!(r.seconds);
+        }
+        o.to_string() + "\n"
+    }
+
+    fn cells(&self, r: &PointResult, cols: &[(String, String, String)]) -> (Vec<Option<(f64, f64)>>, String) {
+        match &r.outcome {
+            Err(e) => (vec![None; cols.len()], e.clone()),
+            Ok(readings) => {
+                let mut problems = vec![];
+                let cells = cols
+                    .iter()
+                    .map(|(g, n, _)| {
+                        let x = readings.iter().find(|x| &x.geometry == g && &x.name == n)?;
+                        if let Some(p) = &x.problem {
+                            problems.push(format!("{g} {n}: {p}"));
+                        } else if !x.converged {
+                            problems.push(format!("{g} {n}: not converged within the evaluation budget"));
+                        }
+                        x.value.map(|v| (v, x.error_estimate))
+                    })
+                    .collect();
+                (cells, problems.join("; "))
+            }
+        }
+    }
+}
+
+/// A varied path must be a numeric parameter of the template's model in the parameter registry
+/// (`crate::registry`), addressing one number: the template's value there is a number, or the key is absent
+/// from an object that exists (an optional parameter, set at each point), or the registry allows one number
+/// in place of the array the template has (a grey albedo for an RGB one).
+fn check_path(template: &Value, file: &str, model: &str, path: &str) -> Result<()> {
+    let Some(param) = registry::lookup(model, path) else {
+        let examples: Vec<String> = registry::of_model(model)
+            .filter(|p| p.ty.is_numeric() && !p.pointer.contains('*'))
+            .take(6)
+            .map(|p| p.pointer.to_string())
+            .collect();
+        return Err(Error::input(
+            file,
+            path,
+            format!(
+                "--vary: not a parameter of a `{model}` recipe (its numeric parameters include {}; the full list is \
+                 in docs/recipe-format.md)",
+                examples.join(", ")
+            ),
+        ));
+    };
+    if !param.ty.is_numeric() {
+        return Err(Error::input(
+            file,
+            path,
+            format!("--vary: the parameter is {}, not a number", param.ty.describe()),
+        ));
+    }
+    let one_number_allowed = matches!(
+        param.ty,
+        registry::Type::Number
+            | registry::Type::Colour
+            | registry::Type::NumberOrSpectral
+            | registry::Type::DielectricOrConductorIor
+    ) || param.pointer != path; // an element of an array entry
+    match template.pointer(path) {
+        Some(Value::Number(_)) => Ok(()),
+        Some(_) if one_number_allowed => Ok(()),
+        Some(_) => Err(Error::input(
+            file,
+            path,
+            format!("--vary needs one number: the parameter is {}; vary one element ({path}/0)", param.ty.describe()),
+        )),
+        None => {
+            let (parent, _) = path.rsplit_once('/').expect("a registered pointer has a /");
+            match template.pointer(parent) {
+                Some(Value::Object(_)) if one_number_allowed => Ok(()),
+                _ => Err(Error::input(
+                    file,
+                    path,
+                    "--vary: the template has no value here and no object to add it to (give the parameter in the \
+                     template)",
+                )),
+            }
+        }
+    }
+}
+
+/// Set the number at `path` (checked by [`check_path`]): replace the value, or add the key to its object.
+fn set(doc: &mut Value, path: &str, v: Value) {
+    if let Some(x) = doc.pointer_mut(path) {
+        *x = v;
+        return;
+    }
+    let (parent, key) = path.rsplit_once('/').expect("checked");
+    if let Some(Value::Object(o)) = doc.pointer_mut(parent) {
+        o.insert(registry::unescape(key), v);
+    }
+}
+
+fn csv_line(fields: &[String]) -> String {
+    let mut w = csv::WriterBuilder::new().terminator(csv::Terminator::Any(b'\n')).from_writer(vec![]);
+    w.write_record(fields).expect("writing to memory");
+    String::from_utf8(w.into_inner().expect("writing to memory")).expect("utf-8")
+}
+
+/// One point's outcome: its readings, or why the recipe at that point is invalid.
+#[derive(Clone, Debug)]
+pub struct PointResult {
+    pub index: u64,
+    pub values: Vec<f64>,
+    pub outcome: std::result::Result<Vec<Reading>, String>,
+    pub seconds: f64,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn permutations_are_bijections() {
+        for n in [1u64, 2, 3, 7, 16, 100, 1000] {
+            let mut seen: Vec<u64> = (0..n).map(|i| permute(i, n, 42)).collect();
+            seen.sort();
+            assert_eq!(seen, (0..n).collect::<Vec<_>>(), "n = {n}");
+        }
+    }
+
+    fn sweep(axes: Vec<Axis>, design: Design) -> Result<Sweep> {
+        let t: Value = serde_json::from_str(r#"{"model": "lambert", "albedo": 0.5}"#).unwrap();
+        Sweep::new(t, "t.json", axes, design, vec![], PlanOptions::default())
+    }
+
+    #[test]
+    fn grid_and_hypercube_points() {
+        let a = parse_vary("/albedo=0.1..0.9:5").unwrap();
+        let s = sweep(vec![a.clone()], Design::Grid).unwrap();
+        let v: Vec<f64> = (0..5).map(|i| s.point(i)[0]).collect();
+        assert_eq!(v, [0.1, 0.30000000000000004, 0.5, 0.7000000000000001, 0.9]);
+        let mut l = a.clone();
+        l.log = true;
+        let s = sweep(vec![l], Design::Grid).unwrap();
+        assert!((s.point(2)[0] - 0.3).abs() < 1e-15 && s.point(4)[0] == 0.9);
+        // A Latin hypercube puts exactly one point in each of the n cells of every axis.
+        let b = Axis { n: None, ..a.clone() };
+        let s = sweep(vec![b], Design::Lhs { n: 8, seed: 7 }).unwrap();
+        let mut cells: Vec<usize> = (0..8).map(|i| ((s.point(i)[0] - 0.1) / 0.8 * 8.0) as usize).collect();
+        cells.sort();
+        assert_eq!(cells, (0..8).collect::<Vec<_>>());
+        // Shards tile the range.
+        let s = sweep(vec![parse_vary("/albedo=0..1:10").unwrap()], Design::Grid).unwrap();
+        let r: Vec<_> = (1..=3).map(|k| s.shard(k, 3)).collect();
+        assert_eq!(r, [0..3, 3..6, 6..10]);
+    }
+
+    #[test]
+    fn bad_sweeps() {
+        for bad in ["/albedo=0.5..0.5:3", "/albedo=0.9..0.1:3", "/albedo=0..1:0", "albedo=0..1:2", "/albedo=a..1:2"] {
+            assert!(parse_vary(bad).is_err(), "{bad}");
+        }
+        for bad in ["0/3", "4/3", "1/0", "x"] {
+            assert!(parse_shard(bad).is_err(), "{bad}");
+        }
+        assert!(sweep(vec![parse_vary("/nope=0..1:2").unwrap()], Design::Grid).is_err());
+        assert!(sweep(vec![parse_vary("/model=0..1:2").unwrap()], Design::Grid).is_err());
+        assert!(sweep(vec![parse_vary("/albedo=0..1").unwrap()], Design::Grid).is_err());
+    }
+}

@@ -1,0 +1,218 @@
+//! `glossmeter sweep` and batch `measure`: shards whose concatenation is the unsharded run byte for byte,
+//! invalid points reported in their row, bad sweeps refused (exit 2), and results that do not depend on the
+//! thread count or on how many recipes are measured together.
+use std::process::Command;
+
+fn gm_env(args: &[&str], threads: Option<&str>) -> (i32, String, String) {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_glossmeter"));
+    c.args(args);
+    if let Some(t) = threads {
+        c.env("RAYON_NUM_THREADS", t);
+    }
+    let out = c.output().expect("run glossmeter");
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+fn gm(args: &[&str]) -> (i32, String, String) {
+    gm_env(args, None)
+}
+
+fn tmp_dir(name: &str) -> std::path::PathBuf {
+    let d = std::env::temp_dir().join(format!("glossmeter-sweep-test-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+const T: &str = "fixtures/recipes/rgb-lambert.json";
+
+#[test]
+fn shards_concatenate_to_the_whole_run() {
+    for (design, shards) in [
+        (&["--vary", "/albedo/0=0.2..1.2:3", "--vary", "/albedo/1=0.1..0.5:2"][..], 4u32),
+        (&["--vary", "/albedo/0=0.05..0.9", "--log", "/albedo/0", "--lhs", "7", "--seed", "3"], 3),
+    ] {
+        for format in ["csv", "jsonl"] {
+            let mut base = vec!["sweep", T, "-g", "astm-d523-60", "--no-timing", "--format", format];
+            base.extend(design);
+            let (code, whole, err) = gm(&base);
+            assert_eq!(code, 0, "{err}");
+            assert!(err.is_empty(), "no progress bar when stderr is not a terminal: {err}");
+            let mut joined = String::new();
+            for k in 1..=shards {
+                let s = format!("{k}/{shards}");
+                let mut a = base.clone();
+                a.extend(["--shard", &s]);
+                let (code, part, _) = gm(&a);
+                assert_eq!(code, 0);
+                joined.push_str(&part);
+            }
+            assert_eq!(joined, whole, "{design:?} {format}");
+            // Same bytes on one thread.
+            assert_eq!(gm_env(&base, Some("1")).1, whole);
+        }
+    }
+}
+
+#[test]
+fn rows_carry_values_errors_and_invalid_points() {
+    let (code, out, _) =
+        gm(&["sweep", T, "--vary", "/albedo/0=0.2..1.2:3", "-g", "astm-d523-60", "--no-timing", "--format", "csv"]);
+    assert_eq!(code, 0);
+    let lines: Vec<&str> = out.lines().collect();
+    assert_eq!(lines[0], "index,/albedo/0,astm-d523-60 gloss (GU),astm-d523-60 gloss error,problem");
+    assert_eq!(lines.len(), 4);
+    assert!(lines[1].starts_with("0,0.2,"));
+    // Albedo 1.2 is out of range: the row says why, and the sweep goes on.
+    assert!(lines[3].starts_with("2,1.2,,,") && lines[3].contains("albedo"), "{}", lines[3]);
+    // The diffuse flux in the gloss receptor, and so the reading, grows with the albedo.
+    let g = |l: &str| l.split(',').nth(2).unwrap().parse::<f64>().unwrap();
+    assert!(g(lines[2]) > g(lines[1]));
+}
+
+#[test]
+fn bad_sweeps_exit_2() {
+    for (args, want) in [
+        (&["--vary", "/no/such=0..1:2"][..], "/no/such"),
+        (&["--vary", "/albedo/0=0.5..0.5:2"], "LO must be below HI"),
+        (&["--vary", "/albedo/0=0..1:0"], "N must be at least 1"),
+        (&["--vary", "/albedo/0=0..1:2", "--shard", "3/2"], "K/M"),
+        (&["--vary", "/albedo/0=0..1:2", "--log", "/albedo/0"], "LO > 0"),
+        (&["--vary", "/albedo/0=0..1"], ":N"),
+        (&["--vary", "/model=0..1:2"], "number"),
+        (&["--vary", "/albedo/0=0..1:2", "--shard", "0/2"], "K/M"),
+        (&["--vary", "/albedo/0=0..1", "--lhs", "0"], "at least 1"),
+        (&["--vary", "/albedo/7=0..1:2"], "/albedo/7"),
+    ] {
+        let mut a = vec!["sweep", T];
+        a.extend(args);
+        let (code, out, err) = gm(&a);
+        assert_eq!(code, 2, "{args:?}: {err}");
+        assert!(out.is_empty() && err.contains(want), "{args:?}: {err}");
+    }
+}
+
+#[test]
+fn a_batch_reads_the_same_bits_as_one_recipe_at_a_time() {
+    let files =
+        ["fixtures/recipes/glass-n1.5.json", "fixtures/recipes/phong.json", "fixtures/recipes/rgb-lambert.json"];
+    let mut args = vec!["measure", "--format", "json", "--no-timing"];
+    args.extend(files);
+    let (code, out, err) = gm(&args);
+    assert_eq!(code, 0, "{err}");
+    let batch: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(batch["materials"].as_array().unwrap().len(), 3);
+    let mut k = 0;
+    for f in files {
+        let (_, one, _) = gm_env(&["measure", f, "--format", "json", "--no-timing"], Some("1"));
+        let one: serde_json::Value = serde_json::from_str(&one).unwrap();
+        for r in one["readings"].as_array().unwrap() {
+            let b = &batch["readings"][k];
+            assert_eq!(b["file"], f);
+            for key in ["geometry", "name", "value", "error_estimate", "evaluations"] {
+                assert_eq!(b[key], r[key], "{f} {key}");
+            }
+            k += 1;
+        }
+    }
+    assert_eq!(k, batch["readings"].as_array().unwrap().len());
+    // A directory is its *.json files; the table and CSV have a material column.
+    let (code, table, _) = gm(&["measure", "fixtures/materials/guenther-2005", "-g", "astm-d523-60", "--no-timing"]);
+    assert_eq!(code, 0);
+    assert!(table.contains("8 recipe(s)") && table.starts_with("8 recipe(s)"), "{table}");
+    let (_, csv, _) = gm(&["measure", "fixtures/materials/guenther-2005", "-g", "astm-d523-60", "--format", "csv"]);
+    assert!(csv.starts_with("material,file,geometry"), "{csv}");
+    assert_eq!(csv.lines().count(), 9);
+    // One bad recipe fails the batch before any work, naming its file.
+    let (code, _, err) = gm(&["measure", "fixtures/recipes/glass-n1.5.json", "fixtures/bad/negative-albedo.json"]);
+    assert_eq!(code, 2);
+    assert!(err.contains("fixtures/bad/negative-albedo.json"), "{err}");
+}
+
+#[test]
+fn a_measure_baseline_fails_readings_that_moved() {
+    let dir = tmp_dir("baseline");
+    let base = dir.join("glass.json");
+    let b = base.to_str().unwrap();
+    let glass = "fixtures/recipes/glass-n1.5.json";
+    assert_eq!(gm(&["measure", glass, "-g", "astm-d523-60", "--format", "json", "-o", b]).0, 0);
+    let (code, out, _) = gm(&["measure", glass, "-g", "astm-d523-60", "--baseline", b]);
+    assert_eq!(code, 0, "{out}");
+    assert!(out.contains("baseline: 1 reading(s) checked, 0 moved"), "{out}");
+    let moved = dir.join("moved.json");
+    let text = std::fs::read_to_string(b).unwrap();
+    let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let x = v["readings"][0]["value"].as_f64().unwrap();
+    v["readings"][0]["value"] = serde_json::json!(x + 0.001);
+    std::fs::write(&moved, v.to_string()).unwrap();
+    let (code, out, _) = gm(&[
+        "measure",
+        "fixtures/recipes/glass-n1.5.json",
+        "-g",
+        "astm-d523-60",
+        "--baseline",
+        moved.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 1);
+    assert!(out.contains("1 moved"), "{out}");
+}
+
+/// Issue 12 item 5: the batch's bytes do not depend on the thread count (integrals never split across threads).
+#[test]
+fn a_batch_is_bit_identical_on_one_and_two_threads() {
+    let args = [
+        "measure",
+        "fixtures/recipes",
+        "-g",
+        "astm-d523-20",
+        "-g",
+        "astm-e430-30",
+        "--format",
+        "json",
+        "--no-timing",
+        "--allow-unconverged",
+    ];
+    let (c1, one, e1) = gm_env(&args, Some("1"));
+    let (c2, two, _) = gm_env(&args, Some("2"));
+    assert_eq!((c1, c2), (0, 0), "{e1}");
+    assert!(one.len() > 10_000, "all shipped recipes: {}", one.len());
+    assert_eq!(one, two);
+}
+
+/// Paths go through the parameter registry: an unknown one is named as a JSON Pointer with examples; an
+/// optional parameter the template lacks is added at every point; `-o` streams into a file that appears whole.
+#[test]
+fn sweep_paths_come_from_the_registry() {
+    let dir = tmp_dir("registry");
+    let t = dir.join("phong-no-kd.json");
+    std::fs::write(&t, r#"{"model": "phong", "exponent": 200, "ks": 0.04}"#).unwrap();
+    let t = t.to_str().unwrap();
+    let (code, _, err) = gm(&["sweep", t, "--vary", "/exponentt=1..2:2"]);
+    assert_eq!(code, 2);
+    assert!(err.contains("/exponentt") && err.contains("not a parameter of a `phong` recipe"), "{err}");
+    assert!(err.contains("/exponent"), "examples listed: {err}");
+    let (code, _, err) = gm(&["sweep", t, "--vary", "/name=1..2:2"]);
+    assert_eq!(code, 2);
+    assert!(err.contains("not a number"), "{err}");
+    let out = dir.join("kd.csv");
+    let o = out.to_str().unwrap();
+    let args = ["sweep", t, "--vary", "/kd=0..0.5:3", "-g", "astm-d523-60", "--no-timing", "-o", o];
+    let (code, stdout, err) = gm(&args);
+    assert_eq!((code, stdout.as_str()), (0, ""), "{err}");
+    let text = std::fs::read_to_string(&out).unwrap();
+    let g: Vec<f64> = text.lines().skip(1).map(|l| l.split(',').nth(2).unwrap().parse().unwrap()).collect();
+    assert_eq!(g.len(), 3);
+    assert!(g[0] < g[1] && g[1] < g[2], "the diffuse term adds to the gloss reading: {g:?}");
+    // The file exists now: a second run is refused before any work, and the file is untouched.
+    let (code, _, err) = gm(&args);
+    assert_eq!(code, 2);
+    assert!(err.contains("already exists"), "{err}");
+    assert_eq!(std::fs::read_to_string(&out).unwrap(), text);
+    let names: Vec<String> =
+        std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    assert_eq!(names.len(), 2, "no temporary file left: {names:?}");
+}
