@@ -346,6 +346,7 @@ impl Planner {
                 source: d.source,
                 receptor: d.receptor,
                 lobes: &[],
+                kinks: &[],
                 has_delta: true,
                 has_regular: false,
                 weighting: standard_weighting.clone(),
@@ -385,6 +386,7 @@ impl Planner {
         // Step 1b: the specimen's methods.
         let terms = material.terms();
         let lobes: Vec<Lobe> = material.lobes();
+        let kinks = material.kinks();
         let has_delta = material.has_delta();
         let has_regular = material.has_regular();
         let projection = if options.fold_spectral { Projection::Fold } else { Projection::Separate };
@@ -406,6 +408,7 @@ impl Planner {
                     source: d.source,
                     receptor: d.receptor,
                     lobes: &lobes,
+                    kinks: &kinks,
                     has_delta,
                     has_regular,
                     // Only the kinds of the readings that use this flux: a gloss flux stays one luminous
@@ -799,14 +802,24 @@ fn describe_method(m: &Method, terms: &[Term]) -> String {
     let material_has_delta = m.target == Target::Standard || terms.iter().any(|t| t.kind == TermKind::Delta);
     let frozen = |r: Refine| if r == Refine::Frozen { ", frozen" } else { "" };
     let delta = match (&m.delta, material_has_delta, m.mirror.is_some()) {
-        (Some(p), _, _) => format!("analytic delta ({} box{})", p.cells.len(), frozen(p.refine)),
+        (Some(p), _, _) => format!(
+            "analytic delta{} ({} box{})",
+            describe_kinks(&p.kinks, "p cut along cos θi = cos θc"),
+            p.cells.len(),
+            frozen(p.refine)
+        ),
         (None, true, false) => "no mirror image in this stop (delta skipped)".to_string(),
         _ => String::new(),
     };
     let regular = m.regular.as_ref().map(|p| {
         let chart = match p.chart {
             Chart::Plain => "plain variables (no lobe narrower than the stops)".to_string(),
-            Chart::Lobe => format!("lobe variables, {} × {} split points", p.splits[0].len(), p.splits[1].len()),
+            Chart::Lobe => format!(
+                "lobe variables, {} × {} split points{}",
+                p.splits[0].len(),
+                p.splits[1].len(),
+                describe_kinks(&p.kinks, "t_p cut along ωi·h = cos θc")
+            ),
         };
         format!("{chart}, Genz–Malik 7/5 on {} initial box(es){}", p.cells.len(), frozen(p.refine))
     });
@@ -817,6 +830,15 @@ fn describe_method(m: &Method, terms: &[Term]) -> String {
         (true, Some(r)) => r,
         (false, Some(r)) => format!("{delta} + {r}"),
     }
+}
+
+/// The kinks of a part in words: ", <how> at θc = 19.72°, …" (empty without kinks).
+fn describe_kinks(kinks: &[f64], how: &str) -> String {
+    if kinks.is_empty() {
+        return String::new();
+    }
+    let angles: Vec<String> = kinks.iter().map(|c| format!("{:.4}°", c.acos().to_degrees())).collect();
+    format!(", {how} (Fresnel critical angle{} θc = {})", if kinks.len() > 1 { "s" } else { "" }, angles.join(", "))
 }
 
 /// A reading with a value `(v, e)`, no problem and no note (callers override those with struct update).
