@@ -205,13 +205,13 @@ mod tests {
     fn the_critical_cosine_is_where_total_internal_reflection_starts() {
         for eta in [0.05, 0.3375, 0.5, 0.95] {
             let c = critical_cosine(eta).unwrap();
-            assert!((cos_transmitted(c, eta).unwrap()).abs() < 1e-7, "η = {eta}");
+            assert!(cos_transmitted(c * (1.0 + 1e-12), eta).unwrap() < 1e-4, "η = {eta}");
             assert_eq!(fr_dielectric(c * (1.0 - 1e-12), eta), 1.0);
-            let (d1, d2) = (1e-6, 4e-6);
+            let (d1, d2) = (1e-12, 4e-12);
             let (r1, r2) = (1.0 - fr_dielectric(c + d1, eta), 1.0 - fr_dielectric(c + d2, eta));
             assert!(r1 > 0.0 && (r2 / r1 - 2.0).abs() < 1e-2, "√ growth: {r1} {r2}");
             assert_eq!(critical_cosine_complex(c64(eta, 0.0)), Some(c));
-            assert_eq!(fr_conductor(c * (1.0 - 1e-12), c64(eta, 0.0)), 1.0);
+            assert!((1.0 - fr_conductor(c * (1.0 - 1e-12), c64(eta, 0.0))).abs() < 1e-15);
         }
         assert_eq!(critical_cosine(1.0), None);
         assert_eq!(critical_cosine(1.5), None);
