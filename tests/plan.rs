@@ -160,6 +160,28 @@ fn a_budget_ends_in_not_converged_with_the_best_estimate() {
     assert!(r.evaluations < PlanOptions::default().max_evals, "{r:?}");
 }
 
+/// The wall-clock budget is one deadline for the whole plan (issue 8: the default panel of the pearl ran
+/// minutes, each of its 12 integrals with a budget of its own): the default panel ends near the budget, not
+/// near 12 × the budget / threads, and every reading still has a finite best estimate.
+#[test]
+fn the_wall_clock_budget_is_shared_by_the_plan() {
+    let budget = 0.5;
+    let panel: Vec<_> = glossmeter::api::DEFAULT_PANEL.iter().map(|id| standards::find(id).unwrap()).collect();
+    let opts = PlanOptions { max_seconds: Some(budget), ..PlanOptions::default() };
+    let plan = Plan::compile(pearl(), panel, opts).unwrap();
+    let start = std::time::Instant::now();
+    let readings = plan.execute();
+    let wall = start.elapsed().as_secs_f64();
+    // The bound: the budget, plus the late starters' grace, plus generous slack for a loaded machine (a
+    // budget per integral would be ≥ 6 × 0.5 s here on 2 threads).
+    let late = glossmeter::instrument::method::LATE_START_SHARE;
+    assert!(wall < budget * (1.0 + 12.0 * late) + 1.5, "{wall} s");
+    assert!(readings.iter().any(|r| !r.converged), "the pearl does not converge in 0.5 s");
+    for r in &readings {
+        assert!(r.value.is_some_and(f64::is_finite) && r.error_estimate.is_finite(), "{r:?}");
+    }
+}
+
 #[test]
 fn the_tolerance_floor_is_stated_and_enforced() {
     let g = vec![standards::find("astm-d523-60").unwrap()];

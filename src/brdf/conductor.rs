@@ -2,7 +2,8 @@
 //! reflectance of a complex index n + ik (Born & Wolf, *Principles of Optics* §14.2; pbrt-v4 `FrConductor`).
 //! A rough conductor is [`super::dielectric::MicrofacetSurface`] with [`super::dielectric::Ior::Conductor`].
 use super::dielectric::Ior;
-use super::{Brdf, Term, TermKind};
+use super::{Brdf, Kink, Term, TermKind};
+use crate::optics::fresnel::critical_cosine_complex;
 use crate::spectrum::Sampling;
 use crate::Vec3;
 use num_complex::Complex64;
@@ -42,6 +43,11 @@ impl Brdf for SmoothConductor {
 
     fn terms(&self) -> Vec<Term> {
         vec![Term { label: "specular reflection (conductor Fresnel)".into(), kind: TermKind::Delta }]
+    }
+
+    /// A real index below 1 (k = 0) has a critical angle.
+    fn kinks(&self) -> Vec<Kink> {
+        super::fresnel_kinks(self.ior.iter().map(|e| critical_cosine_complex(*e)), true)
     }
 
     fn describe(&self) -> String {

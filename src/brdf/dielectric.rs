@@ -10,8 +10,8 @@
 //!   Smith height-correlated (Heitz 2014 Eq. 99, default) or the V-cavity G of Cook & Torrance (1982). Below
 //!   [`Microfacet::SMOOTH_THRESHOLD`] the lobe is replaced by its delta limit R(θi) = F(cos θi) (D → δ(h − n),
 //!   G → 1, ωi·h → cos θi), so the directional albedo is continuous across the switch.
-use super::{Brdf, Lobe, Term, TermKind};
-use crate::optics::fresnel::{fr_conductor, fr_dielectric};
+use super::{Brdf, Kink, Lobe, Term, TermKind};
+use crate::optics::fresnel::{critical_cosine, critical_cosine_complex, fr_conductor, fr_dielectric};
 use crate::optics::microfacet::{Distribution, Microfacet, Shadowing};
 use crate::spectrum::Sampling;
 use crate::Vec3;
@@ -34,6 +34,15 @@ impl Ior {
         match *self {
             Ior::Dielectric(n) => fr_dielectric(c, n),
             Ior::Conductor(eta) => fr_conductor(c, eta),
+        }
+    }
+
+    /// The cosine of the critical angle, if the index has one (a real index below 1, as a dielectric or as a
+    /// conductor with k = 0).
+    pub fn critical_cosine(&self) -> Option<f64> {
+        match *self {
+            Ior::Dielectric(n) => critical_cosine(n),
+            Ior::Conductor(eta) => critical_cosine_complex(eta),
         }
     }
 
@@ -100,6 +109,10 @@ impl Brdf for SmoothDielectric {
 
     fn terms(&self) -> Vec<Term> {
         vec![Term { label: "specular reflection (Fresnel)".into(), kind: TermKind::Delta }]
+    }
+
+    fn kinks(&self) -> Vec<Kink> {
+        super::fresnel_kinks([critical_cosine(self.ior)], true)
     }
 
     fn describe(&self) -> String {
@@ -213,6 +226,12 @@ impl Brdf for MicrofacetSurface {
             let label = format!("microfacet lobe ({})", describe_facets(&self.facets));
             vec![Term { label: label.clone(), kind: TermKind::Lobe(Lobe::of_facets(&self.facets, 1.0, label)) }]
         }
+    }
+
+    /// The Fresnel factor F(ωi·h) of every index below 1 kinks at its critical angle (in cos θi in the
+    /// smooth limit).
+    fn kinks(&self) -> Vec<Kink> {
+        super::fresnel_kinks(self.ior.iter().map(Ior::critical_cosine), self.facets.effectively_smooth())
     }
 
     fn describe(&self) -> String {

@@ -51,6 +51,38 @@ impl Lobe {
     }
 }
 
+/// A kink of a model: a surface in (ωi, ωo) across which its value is continuous but its derivative is not
+/// (a Fresnel critical angle: `optics::fresnel::critical_cosine`). Adaptive cubature converges only slowly
+/// on a kink that crosses its boxes (a √-shaped knee costs refinement down to rounding on every box it
+/// crosses), so the plan puts every reported kink on partition boundaries (`instrument::flux::kink_point`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Kink {
+    /// The delta term's weight R(cos θi) kinks at cos θi = `cos`.
+    Incidence { cos: f64 },
+    /// The regular part kinks where ωi·h = `cos`, h = normalize(ωi + ωo) (the Fresnel factor of a
+    /// microfacet lobe). As ωi·ωo = 2(ωi·h)² − 1, that is the surface ωi·ωo = 2·cos² − 1: a condition on the
+    /// angle between the two directions alone.
+    HalfAngle { cos: f64 },
+}
+
+impl Kink {
+    /// The cosine of the critical angle.
+    pub fn cos(&self) -> f64 {
+        match *self {
+            Kink::Incidence { cos } | Kink::HalfAngle { cos } => cos,
+        }
+    }
+}
+
+/// The kinks of a set of Fresnel indices, one per distinct critical angle, in increasing order of cos θc;
+/// `delta` selects the term (the delta limit kinks in cos θi, a lobe in ωi·h).
+pub(crate) fn fresnel_kinks(critical: impl IntoIterator<Item = Option<f64>>, delta: bool) -> Vec<Kink> {
+    let mut c: Vec<f64> = critical.into_iter().flatten().collect();
+    c.sort_by(f64::total_cmp);
+    c.dedup();
+    c.into_iter().map(|cos| if delta { Kink::Incidence { cos } } else { Kink::HalfAngle { cos } }).collect()
+}
+
 /// A term of a model, for the measurement plan's explanation: what is evaluated and how.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Term {
@@ -108,6 +140,13 @@ pub trait Brdf: Send + Sync + std::fmt::Debug {
     /// The terms of the model (delta, diffuse, lobes) in evaluation order. The integrator uses the lobes to
     /// place its splits and the delta flag to add the analytic part; `--explain` prints them.
     fn terms(&self) -> Vec<Term>;
+
+    /// The kinks of the model's terms (see [`Kink`]), in increasing order of their cosine within each kind:
+    /// none by default. A model whose value has a discontinuous derivative inside the upper hemisphere must
+    /// report it, or the integrator refines around it to its budget.
+    fn kinks(&self) -> Vec<Kink> {
+        Vec::new()
+    }
 
     /// Whether f_r(ωi, ωo) = f_r(ωo, ωi) holds for this model (Helmholtz reciprocity).
     fn is_reciprocal(&self) -> bool {

@@ -92,7 +92,7 @@ pub fn table(material: &Material, readings: &[Reading], timing: bool) -> String 
         }
     }
     if readings.iter().any(|r| !r.converged) {
-        s.push_str("* not converged: the evaluation budget ran out before the tolerance was met\n");
+        s.push_str("* not converged: a budget (evaluations or wall-clock time, see the notes) ran out before the tolerance was met\n");
     }
     if readings.iter().any(|r| r.value.is_some()) {
         s.push_str("numerical error: the integration's error estimate, not the uncertainty of the prediction\n");

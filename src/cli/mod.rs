@@ -107,6 +107,10 @@ pub enum Command {
         max_evals: usize,
         #[command(flatten)]
         colour: ColourArgs,
+        /// Wall-clock budget of the whole measurement, seconds (all its integrals share it); a reading whose
+        /// integral runs out is "not converged" and its value depends on the machine's speed. 0: none.
+        #[arg(long, default_value_t = crate::instrument::plan::DEFAULT_MAX_SECONDS)]
+        max_seconds: f64,
     },
     /// List the shipped geometries, or show one with the provenance of every number.
     Standards {
@@ -178,16 +182,23 @@ fn dispatch(cli: Cli) -> Result<()> {
             allow_unconverged,
             max_evals,
             colour,
+            max_seconds,
         } => {
             check_rtol(rtol)?;
             let colour = colour.conditions()?;
             if max_evals == 0 {
                 return Err(Error::Usage("--max-evals must be at least 1".into()));
             }
+            if !(max_seconds.is_finite() && max_seconds >= 0.0) {
+                return Err(Error::Usage(format!(
+                    "--max-seconds must be a finite number of seconds ≥ 0 (0: no wall-clock budget), got {max_seconds}"
+                )));
+            }
+            let max_seconds = (max_seconds > 0.0).then_some(max_seconds);
             let target = Target::new(output.as_deref(), "--output")?;
             let baseline_file = baseline.as_ref().map(|p| p.display().to_string());
             let baseline = baseline.as_deref().map(crate::comparison::load_baseline).transpose()?;
-            let options = PlanOptions { rtol, max_evals, colour, ..PlanOptions::default() };
+            let options = PlanOptions { rtol, max_evals, max_seconds, colour, ..PlanOptions::default() };
             if recipes.len() > 1 || recipes[0].is_dir() {
                 if explain {
                     return Err(Error::Usage("--explain takes one recipe".into()));
@@ -272,8 +283,8 @@ pub fn readings_status(readings: &[crate::Reading], allow_unconverged: bool) -> 
     let unconverged = readings.iter().filter(|r| !r.converged).count();
     if unconverged > 0 && !allow_unconverged {
         return Err(Error::Check(format!(
-            "{unconverged} of {} reading(s) did not converge to the tolerance within the evaluation budget \
-             (their values are best estimates; --allow-unconverged exits 0 anyway)",
+            "{unconverged} of {} reading(s) did not converge to the tolerance within the budgets (evaluations \
+             or wall-clock time; their values are best estimates; --allow-unconverged exits 0 anyway)",
             readings.len()
         )));
     }

@@ -15,8 +15,8 @@
 //! Gaussian tail and to the end of the range for a heavy one, so a lobe of any width is resolved by the
 //! initial partition. An ideal-mirror (delta) component is integrated analytically in u (it sits at
 //! u = v = 0) as a 2-D integral over the stops' mirror overlap.
-use crate::brdf::Lobe;
-use crate::instrument::geometry::Stop;
+use crate::brdf::{Kink, Lobe};
+use crate::instrument::geometry::{Axes, Stop};
 
 /// Fraction of a flux's tolerance given to its delta part. The delta part is a smooth 2-D integral that
 /// converges to near machine precision in a few hundred evaluations, so it is asked for much more than its
@@ -152,11 +152,17 @@ impl AxisMap {
         [self.s[0] + self.r[0], self.s[1] + self.r[1]]
     }
 
+    /// The overlap [lo, hi] of p_s at lobe coordinate u: the source points whose partner u − p_s lies in the
+    /// receptor (empty when hi ≤ lo).
+    #[inline]
+    pub fn overlap(&self, u: f64) -> (f64, f64) {
+        (self.s[0].max(u - self.r[1]), self.s[1].min(u - self.r[0]))
+    }
+
     /// (p_s, p_r, Jacobian) at lobe coordinate u and overlap position t.
     #[inline]
     pub fn at(&self, u: f64, t: f64) -> (f64, f64, f64) {
-        let lo = self.s[0].max(u - self.r[1]);
-        let hi = self.s[1].min(u - self.r[0]);
+        let (lo, hi) = self.overlap(u);
         let len = (hi - lo).max(0.0);
         let ps = lo + t * len;
         (ps, u - ps, len)
@@ -204,6 +210,161 @@ impl AxisMap {
         pts.dedup_by(|x, y| (*x - *y).abs() <= tiny);
         pts
     }
+}
+
+/// The largest angle between a stop's axis and a direction through the stop: atan of the farthest corner's
+/// tangent-plane distance.
+fn stop_radius(stop: Stop) -> f64 {
+    let p = stop.p[0].abs().max(stop.p[1].abs());
+    let q = stop.q[0].abs().max(stop.q[1].abs());
+    p.hypot(q).atan()
+}
+
+/// The kinks of the delta part that may cross the source box `src` (the mirror overlap) at geometry angle θ:
+/// the cosines of the critical angles θc within θ ± the box's angular radius (a bound: θi of a direction
+/// through the box differs from θ by at most the angle between it and the source axis), in increasing order.
+pub fn delta_kinks(kinks: &[Kink], theta: f64, src: Stop) -> Vec<f64> {
+    let a = stop_radius(src);
+    let mut c: Vec<f64> = kinks
+        .iter()
+        .filter_map(|k| match *k {
+            Kink::Incidence { cos } => Some(cos),
+            Kink::HalfAngle { .. } => None,
+        })
+        .filter(|c| (theta - a..=theta + a).contains(&c.acos()))
+        .collect();
+    c.sort_by(f64::total_cmp);
+    c.dedup();
+    c
+}
+
+/// The kinks of the regular part that may cross the product of the (clipped) stops: the cosines c of the
+/// half-angle kinks ωi·h = c whose angle between ωi and ωo, 2·acos c, lies within 2θ ± (the stops' angular
+/// radii) (the triangle inequality on the sphere: the angle between ωi and ωo differs from the axes' 2θ by
+/// at most the two directions' angles from their axes), in increasing order.
+pub fn regular_kinks(kinks: &[Kink], theta: f64, src: Stop, rec: Stop) -> Vec<f64> {
+    let a = stop_radius(src) + stop_radius(rec);
+    let mut c: Vec<f64> = kinks
+        .iter()
+        .filter_map(|k| match *k {
+            Kink::HalfAngle { cos } => Some(cos),
+            Kink::Incidence { .. } => None,
+        })
+        .filter(|c| (2.0 * theta - a..=2.0 * theta + a).contains(&(2.0 * c.acos())))
+        .collect();
+    c.sort_by(f64::total_cmp);
+    c.dedup();
+    c
+}
+
+/// The root in [lo, hi] of an increasing function g (value and derivative), by Newton's method kept inside
+/// a bracket (bisection when a step leaves it); lo when g(lo) ≥ 0, hi when g(hi) ≤ 0 (no crossing).
+/// Deterministic: the same arguments give the same bits.
+pub fn increasing_root(g: impl Fn(f64) -> (f64, f64), lo: f64, hi: f64) -> f64 {
+    let (g_lo, _) = g(lo);
+    if !(g_lo < 0.0) {
+        return lo;
+    }
+    let (g_hi, _) = g(hi);
+    if !(g_hi > 0.0) {
+        return hi;
+    }
+    let (mut a, mut b) = (lo, hi);
+    // Start from the secant through the ends.
+    let mut x = lo - g_lo * (hi - lo) / (g_hi - g_lo);
+    if !(x > a && x < b) {
+        x = 0.5 * (a + b);
+    }
+    for _ in 0..100 {
+        let (gx, dg) = g(x);
+        if gx == 0.0 {
+            return x;
+        }
+        if gx < 0.0 {
+            a = x;
+        } else {
+            b = x;
+        }
+        let mut next = x - gx / dg;
+        if !(next > a && next < b) {
+            next = 0.5 * (a + b);
+        }
+        let tol = 4.0 * f64::EPSILON * x.abs().max(hi - lo);
+        if (next - x).abs() <= tol || b - a <= tol {
+            return next;
+        }
+        x = next;
+    }
+    x
+}
+
+/// The kink-aligned position along one segmented axis: t ∈ [0, 1] is cut into m + 1 equal segments (m =
+/// `cuts`, the number of kinks); segment j runs from breakpoint b_j to b_{j+1}, where b_0 = lo, b_{m+1} = hi and
+/// b_k = `root(k − 1)` (the kink's position, clamped and kept in order). The kinks are critical angles, and
+/// position increases with the Fresnel cosine (towards the normal), so below its first kink every index is
+/// in total internal reflection (R = 1, smooth) and segment j ≥ 1 has the √-shaped knee of index j at its
+/// lower end (1 − R ∝ √(x − b_j)) and is smooth at its upper end (index j + 1 is still totally reflected
+/// there). Segment 0 is linear; segment j ≥ 1 is graded towards its lower end, x = b_j + (b_{j+1} − b_j)·s²,
+/// so that √(x − b_j) ∝ s and the integrand is smooth up to the boundary (a linear Jacobian, the least
+/// polynomial degree a grading costs the cubature). Returns (x, dx/dt), dx/dt = 0 for an empty segment.
+#[inline]
+pub fn kinked_position(t: f64, lo: f64, hi: f64, cuts: usize, root: impl Fn(usize) -> f64) -> (f64, f64) {
+    if !(hi > lo) {
+        return (lo, 0.0);
+    }
+    let pieces = (cuts + 1) as f64;
+    let j = ((t * pieces).floor().max(0.0) as usize).min(cuts);
+    let s = t * pieces - j as f64;
+    let mut a = lo;
+    let mut b = if cuts == 0 { hi } else { root(0).clamp(lo, hi) };
+    for k in 1..=j {
+        a = b;
+        b = if k == cuts { hi } else { root(k).clamp(a, hi) };
+    }
+    let len = b - a;
+    if j == 0 {
+        (a + len * s, pieces * len)
+    } else {
+        (a + len * s * s, pieces * len * 2.0 * s)
+    }
+}
+
+/// The position p_s of the source-stop point on the critical-angle kink ωi·ωo = `dot` (the regular part's
+/// kink, [`Kink::HalfAngle`]) at fixed u = p_s + p_r, q_s and q_r, within [lo, hi]. ωi·ωo is the
+/// normalised N/√(AB) with N = cos 2θ (1 + p_s p_r) + sin 2θ (p_s − p_r) + q_s q_r, A = 1 + p_s² + q_s²,
+/// B = 1 + p_r² + q_r² (the product of the two unnormalised directions, `geometry::Axes`); it increases with
+/// p_s along a constant u (the two directions close up), at the rate N′ = cos 2θ (p_r − p_s) + 2 sin 2θ.
+pub fn half_angle_kink_point(axes: &Axes, dot: f64, u: f64, qs: f64, qr: f64, lo: f64, hi: f64) -> f64 {
+    let (c2, s2) = ((2.0 * axes.theta).cos(), (2.0 * axes.theta).sin());
+    increasing_root(
+        |ps| {
+            let pr = u - ps;
+            let n = c2 * (1.0 + ps * pr) + s2 * (ps - pr) + qs * qr;
+            let dn = c2 * (pr - ps) + 2.0 * s2;
+            let (a, b) = (1.0 + ps * ps + qs * qs, 1.0 + pr * pr + qr * qr);
+            let ab = a * b;
+            let r = ab.sqrt();
+            (n / r - dot, dn / r - 0.5 * n * (2.0 * ps * b - 2.0 * pr * a) / (ab * r))
+        },
+        lo,
+        hi,
+    )
+}
+
+/// The position p of the source-stop point on the critical-angle kink cos θi = `cos` (the delta part's kink,
+/// [`Kink::Incidence`]) at fixed q, within [lo, hi]: cos θi = (cos θ + p sin θ)/√(1 + p² + q²), increasing in
+/// p (towards the normal) at the rate (sin θ (1 + q²) − p cos θ)/(1 + p² + q²)^{3/2}.
+pub fn incidence_kink_point(axes: &Axes, cos: f64, q: f64, lo: f64, hi: f64) -> f64 {
+    let (c, s) = (axes.theta.cos(), axes.theta.sin());
+    increasing_root(
+        |p| {
+            let a = 1.0 + p * p + q * q;
+            let r = a.sqrt();
+            ((c + p * s) / r - cos, (s * (1.0 + q * q) - p * c) / (a * r))
+        },
+        lo,
+        hi,
+    )
 }
 
 /// Clip a stop to the upper hemisphere. For the source, z ∝ cos θ + p sin θ; for the receptor,
@@ -334,6 +495,61 @@ mod tests {
         // The boxes tile the product of the split intervals.
         let boxes = lobe_boxes(&[u.clone(), v.clone()]);
         assert_eq!(boxes.len(), (u.len() - 1) * (v.len() - 1));
+    }
+
+    /// The kink points lie on their kinks to rounding: ωi·ωo = 2c² − 1 (so ωi·h = c) for the half-angle
+    /// kink, cos θi = c for the incidence kink; the ends when the kink does not cross.
+    #[test]
+    fn kink_points_lie_on_their_kinks() {
+        let c = (1.0f64 - 0.3375 * 0.3375).sqrt();
+        for theta in [0.349, 0.35, 0.5] {
+            let axes = Axes::new(theta);
+            for (u, qs, qr) in [(0.0, 0.0, 0.0), (1e-3, 0.02, -0.01), (-0.02, -0.03, 0.03), (0.01, 0.0, 0.0)] {
+                let (lo, hi) = (-0.3, 0.3);
+                let ps = half_angle_kink_point(&axes, 2.0 * c * c - 1.0, u, qs, qr, lo, hi);
+                let (wi, wo) = (axes.source_dir(ps, qs), axes.receptor_dir(u - ps, qr));
+                let h = (wi + wo).normalize();
+                assert!((wi.dot(h) - c).abs() < 1e-15, "θ={theta} u={u}: ωi·h = {} at p_s = {ps}", wi.dot(h));
+                let p = incidence_kink_point(&axes, c, qs, lo, hi);
+                assert!((axes.source_dir(p, qs).z - c).abs() < 1e-15, "θ={theta}: cos θi at p = {p}");
+            }
+            // No crossing: the end on the kink's side.
+            let (lo, hi) = (0.2, 0.3);
+            let p = incidence_kink_point(&axes, c, 0.0, lo, hi);
+            assert!(p == lo || p == hi);
+        }
+        // The analytic derivative of the half-angle residual (Newton's step) against a central difference.
+        let axes = Axes::new(0.35);
+        let dot = |ps: f64| axes.source_dir(ps, 0.01).dot(axes.receptor_dir(0.003 - ps, -0.02));
+        let h = 1e-6;
+        let numeric = (dot(0.004 + h) - dot(0.004 - h)) / (2.0 * h);
+        let k = 0.7;
+        let root = half_angle_kink_point(&axes, k, 0.003, 0.01, -0.02, 0.0, 0.0);
+        assert_eq!(root, 0.0, "an empty bracket returns its end");
+        assert!(numeric > 0.0, "ωi·ωo increases with p_s at constant u");
+    }
+
+    /// The kinked position tiles [lo, hi]: each piece runs from one breakpoint to the next, ∫ dx/dt dt = hi − lo,
+    /// and the breakpoints sit at t = j/(m + 1).
+    #[test]
+    fn the_kinked_position_tiles_the_interval_with_a_kink_at_each_cut() {
+        let (lo, hi) = (-0.01, 0.02);
+        let roots = [0.004, -0.02, 0.011]; // the second is outside: clamped (and kept in order)
+        let m = roots.len();
+        let pos = |t: f64| kinked_position(t, lo, hi, m, |k| roots[k]);
+        assert_eq!(pos(0.0).0, lo);
+        assert!((pos(0.25 - 1e-15).0 - 0.004).abs() < 1e-12 && (pos(0.25 + 1e-15).0 - 0.004).abs() < 1e-12);
+        assert!((pos(0.5 + 1e-15).0 - 0.004).abs() < 1e-12, "the clamped root is an empty piece");
+        assert!((pos(0.75 + 1e-15).0 - 0.011).abs() < 1e-12);
+        assert!((pos(1.0 - 1e-15).0 - hi).abs() < 1e-12);
+        // Midpoint rule on a fine grid: ∫ dx/dt dt = hi − lo.
+        let n = 100_000;
+        let total: f64 = (0..n).map(|i| pos((i as f64 + 0.5) / n as f64).1).sum::<f64>() / n as f64;
+        assert!((total - (hi - lo)).abs() < 1e-9, "{total}");
+        // Monotone.
+        assert!((1..n).all(|i| pos(i as f64 / n as f64).0 >= pos((i - 1) as f64 / n as f64).0));
+        // An empty overlap.
+        assert_eq!(kinked_position(0.3, 0.1, 0.1, 1, |_| 0.1), (0.1, 0.0));
     }
 
     #[test]

@@ -16,15 +16,23 @@
 //! |Φ_r|) (+ the floor) as both parts are ≥ 0. The r·|Φ_δ| term needs the delta part's value, so it is the
 //! one quantity formed at run time (the smallest |Φ_δ| component, which keeps every component within its
 //! tolerance).
-use crate::brdf::{Brdf, Lobe};
+use crate::brdf::{Brdf, Kink, Lobe};
 use crate::instrument::flux::{
-    choose_chart, clip, lobe_boxes, lobe_splits, mirror_overlap, AxisMap, Chart, Flux, DELTA_SHARE,
+    choose_chart, clip, delta_kinks, half_angle_kink_point, incidence_kink_point, kinked_position, lobe_boxes,
+    lobe_splits, mirror_overlap, regular_kinks, AxisMap, Chart, Flux, DELTA_SHARE,
 };
 use crate::instrument::geometry::{solid_angle_density, Axes, Integral, Stop};
 use crate::instrument::sphere;
 use crate::quadrature::{integrate_partition, Cell, Estimate, Options, Refine};
 use crate::spectrum::Weighting;
 use crate::Vec3;
+use std::time::Instant;
+
+/// The share of its wall-clock budget an integral gets when it starts at or after the deadline it shares
+/// with the other integrals of a plan ([`Method::execute_until`]). A plan of J integrals on T threads then
+/// ends within about max_seconds·(1 + ⌈J/T⌉·LATE_START_SHARE) of wall time: the default panel's 12
+/// specimen integrals on 2 threads, 1.3 × the budget.
+pub const LATE_START_SHARE: f64 = 0.05;
 
 /// Which material a flux is taken on.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -56,6 +64,11 @@ pub enum Projection {
 #[derive(Clone, Debug, PartialEq)]
 pub struct DeltaPart {
     pub rule: Rule,
+    /// The cosines of the critical angles (`Kink::Incidence`) whose curve cos θi = c may cross the overlap, in
+    /// increasing order. Empty: the variables are (p, q). Otherwise (t, q): for each q, p runs over the
+    /// overlap in m + 1 pieces cut at the kinks' positions p*(q) (`flux::kinked_position`), t ∈ [0, 1] with
+    /// one piece per 1/(m + 1), so every kink lies on a boundary of the initial boxes.
+    pub kinks: Vec<f64>,
     /// The partition: the overlap box at design time, the final partition of a frozen method.
     pub cells: Vec<Cell<2>>,
     pub refine: Refine,
@@ -70,6 +83,11 @@ pub struct RegularPart {
     pub rule: Rule,
     /// The split points of the lobe chart on u and v (empty for the plain chart).
     pub splits: [Vec<f64>; 2],
+    /// The cosines c of the half-angle kinks (`Kink::HalfAngle`, ωi·h = c) whose surface may cross the
+    /// domain, in increasing order; non-empty only in the lobe chart (a kink forces it). For each (u, q_s,
+    /// q_r) the overlap position t_p runs over p_s in m + 1 pieces cut where ωi·ωo = 2c² − 1
+    /// (`flux::half_angle_kink_point`), so every kink lies on a boundary of the initial boxes.
+    pub kinks: Vec<f64>,
     /// The partition: the initial boxes at design time, the final partition of a frozen method.
     pub cells: Vec<Cell<4>>,
     pub refine: Refine,
@@ -126,6 +144,8 @@ pub struct Design<'a> {
     pub receptor: Stop,
     /// The material's lobes (for the chart and the split points).
     pub lobes: &'a [Lobe],
+    /// The material's kinks (`Brdf::kinks`): put on partition boundaries.
+    pub kinks: &'a [Kink],
     /// Whether the material has a delta term and a regular (diffuse or lobe) term.
     pub has_delta: bool,
     pub has_regular: bool,
@@ -151,23 +171,41 @@ impl Method {
         let mirror = clipped.filter(|_| on_mirror_axis).and_then(|(s, r)| mirror_overlap(s, r));
         let delta_share = if d.has_regular { DELTA_SHARE } else { 1.0 };
         let delta = match (d.has_delta, mirror) {
-            (true, Some((lo, hi))) => Some(DeltaPart {
-                rule: Rule::GenzMalik75,
-                cells: Cell::from_boxes(&[(lo, hi)]),
-                refine: Refine::Adaptive,
-                rtol: delta_share * d.rtol,
-                atol: delta_share * d.atol,
-            }),
+            (true, Some((lo, hi))) => {
+                let kinks = delta_kinks(d.kinks, d.theta, Stop { p: [lo[0], hi[0]], q: [lo[1], hi[1]] });
+                let boxes = if kinks.is_empty() {
+                    vec![(lo, hi)]
+                } else {
+                    let m = (kinks.len() + 1) as f64;
+                    (0..=kinks.len()).map(|j| ([j as f64 / m, lo[1]], [(j + 1) as f64 / m, hi[1]])).collect()
+                };
+                Some(DeltaPart {
+                    rule: Rule::GenzMalik75,
+                    kinks,
+                    cells: Cell::from_boxes(&boxes),
+                    refine: Refine::Adaptive,
+                    rtol: delta_share * d.rtol,
+                    atol: delta_share * d.atol,
+                })
+            }
             _ => None,
         };
         let regular = match (d.has_regular, clipped) {
             (true, Some((src, rec))) => {
-                // Off the mirror axis no lobe is centred in the stops: the plain variables.
-                let chart = if on_mirror_axis { choose_chart(d.lobes, d.theta, src, rec) } else { Chart::Plain };
+                // Off the mirror axis no lobe is centred in the stops: the plain variables (and no kink cuts:
+                // the cut's chart is the lobe chart, whose variables assume the mirror axis).
+                let kinks = if on_mirror_axis { regular_kinks(d.kinks, d.theta, src, rec) } else { Vec::new() };
+                let chart = if !on_mirror_axis {
+                    Chart::Plain
+                } else if kinks.is_empty() {
+                    choose_chart(d.lobes, d.theta, src, rec)
+                } else {
+                    Chart::Lobe
+                };
                 let (splits, boxes) = match chart {
                     Chart::Lobe => {
                         let splits = lobe_splits(d.lobes, d.theta, src, rec);
-                        let boxes = lobe_boxes(&splits);
+                        let boxes = kinked_boxes(lobe_boxes(&splits), kinks.len());
                         (splits, boxes)
                     }
                     Chart::Plain => (
@@ -180,6 +218,7 @@ impl Method {
                     chart,
                     rule: Rule::GenzMalik75,
                     splits,
+                    kinks,
                     cells: Cell::from_boxes(&boxes),
                     refine: Refine::Adaptive,
                     rtol: share * d.rtol,
@@ -225,6 +264,7 @@ impl Method {
             source,
             receptor,
             lobes: &brdf.lobes(),
+            kinks: &brdf.kinks(),
             has_delta: brdf.has_delta(),
             has_regular: brdf.has_regular(),
             weighting: Weighting::luminous(brdf.sampling())?,
@@ -243,20 +283,38 @@ impl Method {
 
     /// Execute the method on `brdf` (whose sampling has as many samples as the weighting has columns).
     pub fn execute(&self, brdf: &dyn Brdf) -> Flux {
-        self.run(brdf, false).0
+        self.run(brdf, false, None).0
+    }
+
+    /// [`Method::execute`] under a deadline shared with other integrals (`Plan::execute`): the integral stops
+    /// refining at that deadline, or [`LATE_START_SHARE`] of its own budget after it starts if that is
+    /// later (so an integral queued behind slow ones still gets a moment to converge), and never later than
+    /// its own budget.
+    pub fn execute_until(&self, brdf: &dyn Brdf, deadline: Option<Instant>) -> Flux {
+        self.run(brdf, false, deadline).0
     }
 
     /// Execute the method and return, with the flux, the frozen method: the same method with each part's
     /// final partition and `Refine::Frozen`. Executing the frozen method on the same material gives the same
     /// value and error bits; on a nearby material it gives a smooth function of the change.
     pub fn execute_and_freeze(&self, brdf: &dyn Brdf) -> (Flux, Method) {
-        let (flux, frozen) = self.run(brdf, true);
+        self.execute_and_freeze_until(brdf, None)
+    }
+
+    /// [`Method::execute_and_freeze`] with a shared deadline as in [`Method::execute_until`].
+    pub fn execute_and_freeze_until(&self, brdf: &dyn Brdf, deadline: Option<Instant>) -> (Flux, Method) {
+        let (flux, frozen) = self.run(brdf, true, deadline);
         (flux, frozen.expect("kept"))
     }
 
-    fn run(&self, brdf: &dyn Brdf, keep: bool) -> (Flux, Option<Method>) {
-        let start = std::time::Instant::now();
-        let deadline = self.max_seconds.map(|s| start + std::time::Duration::from_secs_f64(s));
+    fn run(&self, brdf: &dyn Brdf, keep: bool, shared: Option<Instant>) -> (Flux, Option<Method>) {
+        let start = Instant::now();
+        let after = |s: f64| start + std::time::Duration::from_secs_f64(s);
+        let deadline = match (self.max_seconds, shared) {
+            (Some(s), Some(d)) => Some(after(s).min(d.max(after(LATE_START_SHARE * s)))),
+            (Some(s), None) => Some(after(s)),
+            (None, d) => d,
+        };
         let k = self.weighting.len();
         let n = brdf.sampling().len();
         let mut frozen = keep.then(|| self.clone());
@@ -305,14 +363,27 @@ impl Method {
         // 1. The delta part: source points whose mirror (−p, −q) lies in the receptor.
         if let Some(part) = &self.delta {
             let mut scratch = vec![0.0; n];
+            let (lo, hi) = self.mirror.expect("a delta part has a mirror overlap");
+            let (p_lo, p_hi) = (lo[0], hi[0]);
             let (est, cells) = integrate_partition::<2, _>(
                 |pts, out| {
                     for (x, o) in pts.iter().zip(out.chunks_exact_mut(ncomp)) {
-                        let wi = axes.source_dir(x[0], x[1]);
+                        let (p, q, jac) = if part.kinks.is_empty() {
+                            (x[0], x[1], 1.0)
+                        } else {
+                            let (p, jac) = kinked_position(x[0], p_lo, p_hi, part.kinks.len(), |k| {
+                                incidence_kink_point(&axes, part.kinks[k], x[1], p_lo, p_hi)
+                            });
+                            (p, x[1], jac)
+                        };
+                        if jac <= 0.0 {
+                            continue;
+                        }
+                        let wi = axes.source_dir(p, q);
                         if wi.z <= 0.0 || !brdf.delta_reflectance(wi, &mut scratch) {
                             continue;
                         }
-                        store(o, &scratch, weighting, wi.z * solid_angle_density(x[0], x[1]), projection);
+                        store(o, &scratch, weighting, wi.z * solid_angle_density(p, q) * jac, projection);
                     }
                 },
                 ncomp,
@@ -347,10 +418,19 @@ impl Method {
                     for (i, x) in pts.iter().enumerate() {
                         let (ps, qs, pr, qr, jac) = if plain {
                             (x[0], x[1], x[2], x[3], 1.0)
-                        } else {
+                        } else if part.kinks.is_empty() {
                             let (ps, pr, jp) = ap.at(x[0], x[1]);
                             let (qs, qr, jq) = aq.at(x[2], x[3]);
                             (ps, qs, pr, qr, jp * jq)
+                        } else {
+                            let (qs, qr, jq) = aq.at(x[2], x[3]);
+                            let u = x[0];
+                            let (lo, hi) = ap.overlap(u);
+                            let (ps, jp) = kinked_position(x[1], lo, hi, part.kinks.len(), |k| {
+                                let c = part.kinks[k];
+                                half_angle_kink_point(&axes, 2.0 * c * c - 1.0, u, qs, qr, lo, hi)
+                            });
+                            (ps, qs, u - ps, qr, jp * jq)
                         };
                         if jac <= 0.0 {
                             continue;
@@ -394,6 +474,25 @@ impl Method {
         flux.seconds = start.elapsed().as_secs_f64();
         (flux, frozen)
     }
+}
+
+/// The initial boxes of a lobe chart with `kinks` kinks: every box cut on t_p into kinks + 1 equal pieces
+/// (the pieces of `flux::kinked_position`); the boxes unchanged without kinks.
+fn kinked_boxes(boxes: Vec<([f64; 4], [f64; 4])>, kinks: usize) -> Vec<([f64; 4], [f64; 4])> {
+    if kinks == 0 {
+        return boxes;
+    }
+    let m = (kinks + 1) as f64;
+    let mut out = Vec::with_capacity(boxes.len() * (kinks + 1));
+    for (lo, hi) in boxes {
+        for j in 0..=kinks {
+            let (mut a, mut b) = (lo, hi);
+            a[1] = j as f64 / m;
+            b[1] = (j + 1) as f64 / m;
+            out.push((a, b));
+        }
+    }
+    out
 }
 
 /// The direction pairs of one batch above the horizon, with the point index and geometric factor of each.

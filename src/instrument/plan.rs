@@ -51,10 +51,12 @@ pub const STANDARD_SHARE: f64 = 0.05;
 /// reference runs at this tolerance (`instrument::convergence`).
 pub const MIN_RTOL: f64 = 1e-12;
 
-/// The default wall-clock budget of one aperture integral, seconds: far above what any shipped fixture needs
-/// (the golden suite of 396 readings runs in about a second), so that no valid input hangs; an integral that
-/// hits it reports its best estimate, not converged.
-pub const DEFAULT_MAX_SECONDS: f64 = 60.0;
+/// The default wall-clock budget of one execution of a plan (all its aperture integrals together, run in
+/// parallel), seconds: far above what any shipped fixture needs (the golden suite of 396 readings runs in
+/// about a second), and short enough that the default panel of any valid input ends within 10 s of wall
+/// time (issue 8; with `method::LATE_START_SHARE`, ≤ 1.3 × 6 s on 2 threads, ≤ 1.6 × on one). An integral
+/// that hits it reports its best estimate, not converged.
+pub const DEFAULT_MAX_SECONDS: f64 = 6.0;
 
 /// Knobs of the planner. The defaults are what `measure` uses; the others exist to measure what each
 /// optimisation saves (`docs/performance.md`).
@@ -70,8 +72,10 @@ pub struct PlanOptions {
     /// Evaluation budget per flux integral (deterministic: a reading that hits it is the same bits on every
     /// machine).
     pub max_evals: usize,
-    /// Wall-clock budget per flux integral, seconds (None: none). A reading whose integral hits it has the
-    /// best estimate as its value, is marked not converged, and depends on the machine's speed.
+    /// Wall-clock budget of one execution of the plan, seconds (None: none): every integral of the plan stops
+    /// refining at the same deadline, [`Plan::execute`]'s start + this (an integral run on its own,
+    /// `Method::execute`, has it as its own budget). A reading whose integral hits it has the best estimate
+    /// as its value, is marked not converged, and depends on the machine's speed.
     pub max_seconds: Option<f64>,
     /// Illuminant and observer of colour readings (default D65 and the CIE 1964 10° observer, as colour QC
     /// uses; gloss readings are luminous whatever this says).
@@ -346,6 +350,7 @@ impl Planner {
                 source: d.source,
                 receptor: d.receptor,
                 lobes: &[],
+                kinks: &[],
                 has_delta: true,
                 has_regular: false,
                 weighting: standard_weighting.clone(),
@@ -385,6 +390,7 @@ impl Planner {
         // Step 1b: the specimen's methods.
         let terms = material.terms();
         let lobes: Vec<Lobe> = material.lobes();
+        let kinks = material.kinks();
         let has_delta = material.has_delta();
         let has_regular = material.has_regular();
         let projection = if options.fold_spectral { Projection::Fold } else { Projection::Separate };
@@ -406,6 +412,7 @@ impl Planner {
                     source: d.source,
                     receptor: d.receptor,
                     lobes: &lobes,
+                    kinks: &kinks,
                     has_delta,
                     has_regular,
                     // Only the kinds of the readings that use this flux: a gloss flux stays one luminous
@@ -595,9 +602,12 @@ impl Plan {
     /// error estimates are those of its fixed partition: check `converged` before trusting one far from
     /// the material it was frozen on.
     pub fn freeze(&self) -> (Vec<Reading>, Plan) {
+        let deadline = self.deadline();
         let todo = self.specimen_jobs();
-        let results: Vec<(Flux, Method)> =
-            todo.par_iter().map(|&j| self.jobs[j].method.execute_and_freeze(self.material.as_ref())).collect();
+        let results: Vec<(Flux, Method)> = todo
+            .par_iter()
+            .map(|&j| self.jobs[j].method.execute_and_freeze_until(self.material.as_ref(), deadline))
+            .collect();
         let mut frozen = self.clone();
         let mut flux = self.known_fluxes();
         for (&j, (f, m)) in todo.iter().zip(results) {
@@ -608,12 +618,18 @@ impl Plan {
         (self.readings_from(&flux), frozen)
     }
 
+    /// The shared deadline of one execution: now + the wall-clock budget.
+    fn deadline(&self) -> Option<std::time::Instant> {
+        self.options.max_seconds.map(|s| std::time::Instant::now() + std::time::Duration::from_secs_f64(s))
+    }
+
     /// Execute the plan: every specimen method on the material (the standards' fluxes were computed when the
-    /// plan was compiled), then the readings.
+    /// plan was compiled), then the readings. The specimen integrals share one wall-clock deadline.
     pub fn execute(&self) -> Vec<Reading> {
+        let deadline = self.deadline();
         let todo = self.specimen_jobs();
         let computed: Vec<Flux> =
-            todo.par_iter().map(|&j| self.jobs[j].method.execute(self.material.as_ref())).collect();
+            todo.par_iter().map(|&j| self.jobs[j].method.execute_until(self.material.as_ref(), deadline)).collect();
         let mut flux = self.known_fluxes();
         for (&j, f) in todo.iter().zip(computed) {
             flux[j] = Some(f);
@@ -799,14 +815,24 @@ fn describe_method(m: &Method, terms: &[Term]) -> String {
     let material_has_delta = m.target == Target::Standard || terms.iter().any(|t| t.kind == TermKind::Delta);
     let frozen = |r: Refine| if r == Refine::Frozen { ", frozen" } else { "" };
     let delta = match (&m.delta, material_has_delta, m.mirror.is_some()) {
-        (Some(p), _, _) => format!("analytic delta ({} box{})", p.cells.len(), frozen(p.refine)),
+        (Some(p), _, _) => format!(
+            "analytic delta{} ({} box{})",
+            describe_kinks(&p.kinks, "p cut along cos θi = cos θc"),
+            p.cells.len(),
+            frozen(p.refine)
+        ),
         (None, true, false) => "no mirror image in this stop (delta skipped)".to_string(),
         _ => String::new(),
     };
     let regular = m.regular.as_ref().map(|p| {
         let chart = match p.chart {
             Chart::Plain => "plain variables (no lobe narrower than the stops)".to_string(),
-            Chart::Lobe => format!("lobe variables, {} × {} split points", p.splits[0].len(), p.splits[1].len()),
+            Chart::Lobe => format!(
+                "lobe variables, {} × {} split points{}",
+                p.splits[0].len(),
+                p.splits[1].len(),
+                describe_kinks(&p.kinks, "t_p cut along ωi·h = cos θc")
+            ),
         };
         format!("{chart}, Genz–Malik 7/5 on {} initial box(es){}", p.cells.len(), frozen(p.refine))
     });
@@ -817,6 +843,15 @@ fn describe_method(m: &Method, terms: &[Term]) -> String {
         (true, Some(r)) => r,
         (false, Some(r)) => format!("{delta} + {r}"),
     }
+}
+
+/// The kinks of a part in words: ", <how> at θc = 19.72°, …" (empty without kinks).
+fn describe_kinks(kinks: &[f64], how: &str) -> String {
+    if kinks.is_empty() {
+        return String::new();
+    }
+    let angles: Vec<String> = kinks.iter().map(|c| format!("{:.4}°", c.acos().to_degrees())).collect();
+    format!(", {how} (Fresnel critical angle{} θc = {})", if kinks.len() > 1 { "s" } else { "" }, angles.join(", "))
 }
 
 /// A reading with a value `(v, e)`, no problem and no note (callers override those with struct update).

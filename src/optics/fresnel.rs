@@ -57,6 +57,26 @@ pub fn cos_transmitted(cos_i: f64, eta: f64) -> Option<f64> {
     }
 }
 
+/// The cosine of the critical angle of an interface into a medium of relative index `eta` < 1, the cosine
+/// below which total internal reflection sets in (sin θc = η, Born & Wolf §1.5.4); `None` for η ≥ 1 (no
+/// critical angle). The reflectance is continuous there but its derivative is not: just above cos θc,
+/// 1 − R ∝ √(cos θi − cos θc)·…, since cos θt = √(1 − sin²θi/η²) vanishes like a square root. A quadrature
+/// needs this point on a boundary of its partition (`brdf::Kink`).
+pub fn critical_cosine(eta: f64) -> Option<f64> {
+    (eta > 0.0 && eta < 1.0).then(|| ((1.0 - eta) * (1.0 + eta)).sqrt())
+}
+
+/// The critical cosine of a conductor index n + ik: the same as [`critical_cosine`] when k = 0 (the index is
+/// then a real index below 1 and the Fresnel reflectance has the same kink); `None` when k > 0 (n̂ cos θt
+/// never vanishes and the reflectance is smooth, however sharp its knee is for a small k).
+pub fn critical_cosine_complex(eta: Complex64) -> Option<f64> {
+    if eta.im == 0.0 {
+        critical_cosine(eta.re)
+    } else {
+        None
+    }
+}
+
 /// s/p power coefficients of a dielectric interface, relative index `eta` = n2/n1 > 0, cos θi ∈ [0, 1].
 /// Beyond the critical angle Rs = Rp = 1, Ts = Tp = 0.
 ///
@@ -176,6 +196,29 @@ mod tests {
     use super::*;
 
     fn c(re: f64, im: f64) -> Complex64 {
+        Complex64::new(re, im)
+    }
+
+    /// At the critical cosine the transmitted cosine is 0 (Snell's law at sin θi = η) and R = 1; just above it
+    /// R < 1 with 1 − R growing like a square root (the kink), and just below it R = 1.
+    #[test]
+    fn the_critical_cosine_is_where_total_internal_reflection_starts() {
+        for eta in [0.05, 0.3375, 0.5, 0.95] {
+            let c = critical_cosine(eta).unwrap();
+            assert!(cos_transmitted(c * (1.0 + 1e-12), eta).unwrap() < 1e-4, "η = {eta}");
+            assert_eq!(fr_dielectric(c * (1.0 - 1e-12), eta), 1.0);
+            let (d1, d2) = (1e-12, 4e-12);
+            let (r1, r2) = (1.0 - fr_dielectric(c + d1, eta), 1.0 - fr_dielectric(c + d2, eta));
+            assert!(r1 > 0.0 && (r2 / r1 - 2.0).abs() < 1e-2, "√ growth: {r1} {r2}");
+            assert_eq!(critical_cosine_complex(c64(eta, 0.0)), Some(c));
+            assert!((1.0 - fr_conductor(c * (1.0 - 1e-12), c64(eta, 0.0))).abs() < 1e-15);
+        }
+        assert_eq!(critical_cosine(1.0), None);
+        assert_eq!(critical_cosine(1.5), None);
+        assert_eq!(critical_cosine_complex(c64(0.3, 1e-3)), None);
+    }
+
+    fn c64(re: f64, im: f64) -> Complex64 {
         Complex64::new(re, im)
     }
 
