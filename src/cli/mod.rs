@@ -18,6 +18,7 @@ pub mod fit;
 pub mod format;
 pub mod junit;
 pub mod output;
+pub mod pictures;
 pub mod plot;
 
 pub use output::{print, Target, STDOUT};
@@ -92,6 +93,10 @@ pub enum Command {
         max_evals: usize,
         #[command(flatten)]
         colour: ColourArgs,
+        /// Also read every reading at the corners of the tolerances the standard data allow (and across the
+        /// plausible range of assumed numbers); reports the minimum and maximum (table and JSON).
+        #[arg(long)]
+        envelope: bool,
     },
     /// List the shipped geometries, or show one with the provenance of every number.
     Standards {
@@ -107,6 +112,8 @@ pub enum Command {
     /// Fit recipe parameters (JSON Pointers) to readings, with standard errors and an identifiability
     /// verdict; exits 1 if the fit did not converge, hit a bound or is not identifiable (docs/inverse.md).
     Fit(fit::FitArgs),
+    /// Draw a picture (PNG or SVG): the in-plane BRDF section with the apertures, or readings against a parameter.
+    Plot(pictures::PlotArgs),
 }
 
 /// Run the CLI; returns the process exit status.
@@ -157,20 +164,23 @@ fn dispatch(cli: Cli) -> Result<()> {
             allow_unconverged,
             max_evals,
             colour,
+            envelope,
         } => {
             check_rtol(rtol)?;
             let colour = colour.conditions()?;
             if max_evals == 0 {
                 return Err(Error::Usage("--max-evals must be at least 1".into()));
             }
+            if envelope && format == Format::Csv {
+                return Err(Error::Usage(
+                    "--envelope is reported in the table and JSON formats; use --format table or json".into(),
+                ));
+            }
             let target = Target::new(output.as_deref(), "--output")?;
             let material = recipe::load_file(&recipe)?;
             let geos = resolve_geometries(&geometries, &geometry_files)?;
-            let plan = Plan::compile(
-                material.brdf.clone(),
-                geos,
-                PlanOptions { rtol, max_evals, colour, ..PlanOptions::default() },
-            )?;
+            let options = PlanOptions { rtol, max_evals, colour, ..PlanOptions::default() };
+            let plan = Plan::compile(material.brdf.clone(), geos.clone(), options.clone())?;
             let mut text = String::new();
             if explain {
                 let e = plan.explain();
@@ -181,10 +191,21 @@ fn dispatch(cli: Cli) -> Result<()> {
                 }
             }
             let readings = plan.execute();
-            text.push_str(&match format {
-                Format::Table => format::table(&material, &readings, !no_timing),
-                Format::Json => format::json(&material, &readings, !no_timing),
-                Format::Csv => format::csv(&readings, !no_timing)?,
+            let envelopes = if envelope {
+                Some(crate::instrument::envelope::read(material.brdf.clone(), &geos, &readings, options)?)
+            } else {
+                None
+            };
+            text.push_str(&match (format, &envelopes) {
+                (Format::Table, None) => format::table(&material, &readings, !no_timing),
+                (Format::Table, Some(e)) => {
+                    format::table(&material, &readings, !no_timing) + &format::envelope_table(&readings, e)
+                }
+                (Format::Json, None) => format::json(&material, &readings, !no_timing),
+                (Format::Json, Some(e)) => {
+                    format::json_with_envelope(&format::json(&material, &readings, !no_timing), e)
+                }
+                (Format::Csv, _) => format::csv(&readings, !no_timing)?,
             });
             target.write(&text)?;
             readings_status(&readings, allow_unconverged)
@@ -199,6 +220,7 @@ fn dispatch(cli: Cli) -> Result<()> {
         Command::Convergence(args) => convergence::run(args),
         Command::Compare(args) => compare::run(args),
         Command::Fit(args) => fit::run(args),
+        Command::Plot(args) => pictures::run(args),
         Command::Schema => {
             let text = serde_json::to_string_pretty(&recipe::schema::schema())
                 .map_err(|e| Error::Numeric(format!("the schema does not serialise: {e}")))?;
