@@ -35,6 +35,9 @@ pub const MODELS: &[&str] = &[
     "cook-torrance-lobes",
     "paint",
     "merl",
+    "rgl",
+    "inplane-csv",
+    "e1392",
 ];
 
 /// An interval of allowed values; either end open or closed. An infinite end is always open.
@@ -821,6 +824,43 @@ pub const MERL_INTERPOLATION: Param = p(
     "nearest: the bin's value (MERL's lookup); trilinear: linear between the bins' sample points",
 );
 
+pub const RGL_FILE: Param = p(
+    "/file",
+    &["rgl"],
+    Type::Text,
+    "",
+    NONE,
+    Req,
+    "path of the RGL .bsdf tensor file, relative to the recipe's directory",
+);
+pub const INPLANE_FILE: Param = p(
+    "/file",
+    &["inplane-csv"],
+    Type::Text,
+    "",
+    NONE,
+    Req,
+    "path of the in-plane CSV table (theta_i, theta_o, brdf or brdf_cos), relative to the recipe's directory",
+);
+pub const E1392_FILE: Param = p(
+    "/file",
+    &["e1392"],
+    Type::Text,
+    "",
+    NONE,
+    Req,
+    "path of the ASTM E1392-style text table, relative to the recipe's directory",
+);
+pub const INPLANE_OFF_PLANE: Param = p(
+    "/off_plane",
+    &["inplane-csv", "e1392"],
+    Type::Choice(&["f", "f-cos-cos"]),
+    "",
+    NONE,
+    Opt("\"f\""),
+    "the isotropy assumption off the plane: f: f_r depends on (θh, θd) only (exact for a Lambertian); f-cos-cos: f_r·cos θi·cos θo does (exact for a microfacet lobe up to masking)",
+);
+
 /// Every entry, in the order of the docs table (descriptive fields first, then model by model).
 pub static PARAMS: &[&Param] = &[
     &MODEL,
@@ -909,6 +949,11 @@ pub static PARAMS: &[&Param] = &[
     // merl
     &MERL_FILE,
     &MERL_INTERPOLATION,
+    // rgl, inplane-csv, e1392
+    &RGL_FILE,
+    &INPLANE_FILE,
+    &E1392_FILE,
+    &INPLANE_OFF_PLANE,
 ];
 
 // ---------------------------------------------------------------------------------------------------------

@@ -67,6 +67,9 @@ pub struct CompareArgs {
     pub max_de00: Option<f64>,
     #[command(flatten)]
     pub colour: ColourArgs,
+    /// Also draw measured against predicted with error bars (FILE.png or FILE.svg, never overwritten).
+    #[arg(long)]
+    pub plot: Option<PathBuf>,
 }
 
 /// `,`, `;`, `tab` (or a literal tab).
@@ -83,6 +86,9 @@ pub fn run(a: CompareArgs) -> Result<()> {
     let rule = Rule { k: a.k, tolerance: a.tolerance };
     rule.check()?;
     check_rtol(a.rtol)?;
+    if let Some(p) = &a.plot {
+        crate::cli::plot::check_plot_path(p, "--plot")?;
+    }
     if let Some(m) = a.max_de00 {
         if !(m.is_finite() && m >= 0.0) {
             return Err(Error::Usage(format!("--max-de00 must be a finite number ≥ 0, got {m}")));
@@ -136,6 +142,9 @@ pub fn run(a: CompareArgs) -> Result<()> {
         CompareFormat::Junit => junit::compare(&sheet, &cmp, &drift)?,
     };
     target.write(&text)?;
+    if let Some(p) = &a.plot {
+        crate::cli::pictures::write_comparison(p, &cmp)?;
+    }
     let outside = cmp.iter().filter(|c| c.verdict == Verdict::Outside).count();
     let unchecked = cmp.iter().filter(|c| c.verdict.why_unchecked().is_some()).count();
     let moved = drift.iter().filter(|d| d.moved).count();

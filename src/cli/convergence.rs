@@ -60,7 +60,7 @@ pub fn run(args: ConvergenceArgs) -> Result<()> {
     }
     let target = Target::new(args.output.as_deref(), "--output")?;
     if let Some(p) = &args.plot {
-        plot::check_plot_path(p)?;
+        plot::check_plot_path(p, "--plot")?;
         if args.output.as_deref() == Some(p.as_path()) {
             return Err(Error::Usage(format!("--plot and --output name the same file {}", p.display())));
         }
@@ -81,7 +81,7 @@ pub fn run(args: ConvergenceArgs) -> Result<()> {
     };
     if let Some(p) = &args.plot {
         let title = format!("{}: error vs time", material.name);
-        let s = plot::write_svg(&sweep, &title, p)?;
+        let s = plot::write_plot(&sweep, &title, p)?;
         eprintln!(
             "plot: {} ({} series; errors below {:.1e} drawn at that floor: {} actual, {} estimated)",
             p.display(),

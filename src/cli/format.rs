@@ -1,6 +1,7 @@
 //! Output formats of `measure`. The JSON form is a contract for scripts and CI (docs/instrument.md
 //! §Output); the table is for people. A reading without a finite value is printed as "—" in the table,
 //! null in JSON, empty in CSV, with the reason: never as NaN or inf.
+use crate::instrument::envelope::Envelope;
 use crate::instrument::plan::Reading;
 use crate::recipe::Material;
 use crate::{Error, Result};
@@ -145,6 +146,61 @@ pub fn pretty(doc: &serde_json::Value) -> String {
 
 pub fn json(material: &Material, readings: &[Reading], timing: bool) -> String {
     pretty(&json_doc(material, readings, timing))
+}
+
+/// Add `"envelope_min"`, `"envelope_max"` and the variations to each reading of a `json` document (null where
+/// the standard data give no tolerance), and the envelope's method at the top.
+pub fn json_with_envelope(mut doc: serde_json::Value, envelopes: &[Option<Envelope>]) -> serde_json::Value {
+    if let Some(rs) = doc["readings"].as_array_mut() {
+        for (r, e) in rs.iter_mut().zip(envelopes) {
+            r["envelope_min"] = json!(e.as_ref().map(|e| e.min));
+            r["envelope_max"] = json!(e.as_ref().map(|e| e.max));
+            if let Some(e) = e {
+                r["envelope"] = json!({
+                    "variants": e.variants,
+                    "method": if e.corners { "all corners" } else { "one number at a time" },
+                    "varied": e.variations.iter().map(|v| json!({
+                        "pointer": v.pointer, "kind": v.kind, "nominal": v.nominal, "low": v.low, "high": v.high, "status": v.status
+                    })).collect::<Vec<_>>(),
+                });
+            }
+        }
+    }
+    doc
+}
+
+/// The envelope as a table after the readings.
+pub fn envelope_table(readings: &[Reading], envelopes: &[Option<Envelope>]) -> String {
+    let mut out = String::from("\ntolerance envelope (the standard's tolerances and the plausible ranges of assumed numbers; docs/instrument.md §Tolerance envelope)\n");
+    out += &format!(
+        "{:<13} {:<11} {:>12} {:>12} {:>12}  {}\n",
+        "geometry", "reading", "min", "nominal", "max", "variants"
+    );
+    for (r, e) in readings.iter().zip(envelopes) {
+        let nominal = r.value.map(|v| format!("{v:.6}")).unwrap_or_else(|| "—".into());
+        match e {
+            Some(e) => {
+                let how = if e.corners { "corners" } else { "one at a time" };
+                out += &format!(
+                    "{:<13} {:<11} {:>12.6} {:>12} {:>12.6}  {} ({how}, {} numbers varied)\n",
+                    r.geometry,
+                    r.name,
+                    e.min,
+                    nominal,
+                    e.max,
+                    e.variants,
+                    e.variations.len()
+                )
+            }
+            None => {
+                out += &format!(
+                    "{:<13} {:<11} {:>12} {:>12} {:>12}  no tolerances in the standard data\n",
+                    r.geometry, r.name, "—", nominal, "—"
+                )
+            }
+        }
+    }
+    out
 }
 
 pub fn csv(readings: &[Reading], timing: bool) -> Result<String> {

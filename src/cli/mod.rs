@@ -19,6 +19,7 @@ pub mod fit;
 pub mod format;
 pub mod junit;
 pub mod output;
+pub mod pictures;
 pub mod plot;
 pub mod sweep;
 
@@ -111,6 +112,10 @@ pub enum Command {
         /// integral runs out is "not converged" and its value depends on the machine's speed. 0: none.
         #[arg(long, default_value_t = crate::instrument::plan::DEFAULT_MAX_SECONDS)]
         max_seconds: f64,
+        /// Also read every reading at the corners of the tolerances the standard data allow (and across the
+        /// plausible range of assumed numbers); reports the minimum and maximum (table and JSON).
+        #[arg(long)]
+        envelope: bool,
     },
     /// List the shipped geometries, or show one with the provenance of every number.
     Standards {
@@ -131,6 +136,8 @@ pub enum Command {
     /// Fit recipe parameters (JSON Pointers) to readings, with standard errors and an identifiability
     /// verdict; exits 1 if the fit did not converge, hit a bound or is not identifiable (docs/inverse.md).
     Fit(fit::FitArgs),
+    /// Draw a picture (PNG or SVG): the in-plane BRDF section with the apertures, or readings against a parameter.
+    Plot(pictures::PlotArgs),
 }
 
 /// Run the CLI; returns the process exit status.
@@ -183,6 +190,7 @@ fn dispatch(cli: Cli) -> Result<()> {
             max_evals,
             colour,
             max_seconds,
+            envelope,
         } => {
             check_rtol(rtol)?;
             let colour = colour.conditions()?;
@@ -195,6 +203,11 @@ fn dispatch(cli: Cli) -> Result<()> {
                 )));
             }
             let max_seconds = (max_seconds > 0.0).then_some(max_seconds);
+            if envelope && format == Format::Csv {
+                return Err(Error::Usage(
+                    "--envelope is reported in the table and JSON formats; use --format table or json".into(),
+                ));
+            }
             let target = Target::new(output.as_deref(), "--output")?;
             let baseline_file = baseline.as_ref().map(|p| p.display().to_string());
             let baseline = baseline.as_deref().map(crate::comparison::load_baseline).transpose()?;
@@ -213,7 +226,7 @@ fn dispatch(cli: Cli) -> Result<()> {
             }
             let material = recipe::load_file(&recipes[0])?;
             let geos = resolve_geometries(&geometries, &geometry_files)?;
-            let plan = Plan::compile(material.brdf.clone(), geos, options)?;
+            let plan = Plan::compile(material.brdf.clone(), geos.clone(), options.clone())?;
             let mut text = String::new();
             if explain {
                 let e = plan.explain();
@@ -224,17 +237,31 @@ fn dispatch(cli: Cli) -> Result<()> {
                 }
             }
             let readings = plan.execute();
+            let envelopes = if envelope {
+                Some(crate::instrument::envelope::read(material.brdf.clone(), &geos, &readings, options)?)
+            } else {
+                None
+            };
             let drift = baseline
                 .as_deref()
                 .map(|b| crate::comparison::check_baseline(readings.iter().map(|r| (material.name.as_str(), r)), b));
-            text.push_str(&match format {
-                Format::Table => format::table(&material, &readings, !no_timing),
-                Format::Json => format::pretty(&with_baseline(
-                    format::json_doc(&material, &readings, !no_timing),
-                    drift.as_deref(),
-                    baseline_file.clone(),
-                )),
-                Format::Csv => format::csv(&readings, !no_timing)?,
+            text.push_str(&match (format, &envelopes) {
+                (Format::Table, None) => format::table(&material, &readings, !no_timing),
+                (Format::Table, Some(e)) => {
+                    format::table(&material, &readings, !no_timing) + &format::envelope_table(&readings, e)
+                }
+                (Format::Json, e) => {
+                    let doc = with_baseline(
+                        format::json_doc(&material, &readings, !no_timing),
+                        drift.as_deref(),
+                        baseline_file.clone(),
+                    );
+                    format::pretty(&match e {
+                        None => doc,
+                        Some(e) => format::json_with_envelope(doc, e),
+                    })
+                }
+                (Format::Csv, _) => format::csv(&readings, !no_timing)?,
             });
             if let (Format::Table, Some(d)) = (format, &drift) {
                 text.push_str(&batch::drift_text(d));
@@ -253,6 +280,7 @@ fn dispatch(cli: Cli) -> Result<()> {
         Command::Convergence(args) => convergence::run(args),
         Command::Compare(args) => compare::run(args),
         Command::Fit(args) => fit::run(args),
+        Command::Plot(args) => pictures::run(args),
         Command::Sweep(args) => sweep::run(args),
         Command::Schema { output_format } => {
             let schema = match output_format {

@@ -1,11 +1,17 @@
-//! Plots of `glossmeter convergence`: a log–log chart of the actual error (solid line, filled points) and
-//! the estimated error (dashed line) against the time per reading, one colour per reading. SVG only (the
-//! crate builds plotters with its SVG backend alone; a PNG needs the bitmap backend and a font).
+//! The pictures: the convergence chart of `glossmeter convergence --plot` (a log–log chart of the actual
+//! error, solid line and filled points, and the estimated error, dashed, against the time per reading), and
+//! the charts of `glossmeter plot` and `compare --plot` (`pictures.rs`). PNG or SVG, chosen by the file
+//! name; a file is never overwritten.
+//!
+//! Fonts: a clean CI machine may have no system fonts, so the text is drawn with DejaVu Sans embedded in the
+//! binary (`assets/fonts/`, Bitstream Vera licence with public-domain DejaVu changes: `assets/fonts/LICENSE`)
+//! through plotters' `ab_glyph` renderer, which reads no system font at all; the same metrics lay out the SVG.
 //!
 //! An error of exactly 0, or below the floor of the chart, cannot be drawn on a log axis: it is drawn at
 //! the floor as a hollow point, and the caption under the chart says so and gives the floor.
 use std::path::Path;
 
+use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use crate::instrument::convergence::Sweep;
@@ -24,23 +30,95 @@ pub struct PlotSummary {
     pub skipped: usize,
 }
 
-/// Refuse anything but an `.svg` file name; say why for `.png`.
-pub fn check_plot_path(path: &Path) -> Result<()> {
+/// The picture formats, from the file name.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PlotFormat {
+    Svg,
+    Png,
+}
+
+/// The format of a plot file from its extension; anything but `.svg` / `.png` is a usage error. An existing
+/// file, or a missing directory, is refused before any work (glossmeter never overwrites a file); `option`
+/// names the flag in the message.
+pub fn check_plot_path(path: &Path, option: &str) -> Result<PlotFormat> {
     let ext = path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase());
-    match ext.as_deref() {
-        Some("svg") => {}
-        Some("png") => {
+    let format = match ext.as_deref() {
+        Some("svg") => PlotFormat::Svg,
+        Some("png") => PlotFormat::Png,
+        _ => {
             return Err(Error::Usage(format!(
-                "--plot {}: PNG output is not available (glossmeter builds plotters with its SVG backend only); use a .svg file name",
+                "{option} {}: the plot file name must end in .svg or .png (the format is taken from it)",
                 path.display()
             )))
         }
-        _ => return Err(Error::Usage(format!("--plot {}: the plot file name must end in .svg", path.display()))),
-    }
-    super::output::check_new_file(path, "--plot")
+    };
+    super::output::check_new_file(path, option)?;
+    Ok(format)
 }
 
-fn plot_err(e: impl std::fmt::Display) -> Error {
+/// Register the embedded font once (plotters' `ab_glyph` text renderer has no font until one is registered).
+pub fn register_font() {
+    static ONCE: std::sync::Once = std::sync::Once::new();
+    ONCE.call_once(|| {
+        // The font is embedded and known to be valid; an error here would only lose the text.
+        let _ = plotters::style::register_font(
+            "sans-serif",
+            FontStyle::Normal,
+            include_bytes!("../../assets/fonts/DejaVuSans.ttf"),
+        );
+    });
+}
+
+/// Encode an 8-bit RGB raster as PNG bytes.
+pub fn encode_png(rgb: &[u8], (w, h): (u32, u32)) -> Result<Vec<u8>> {
+    use image::ImageEncoder;
+    let mut png = Vec::new();
+    image::codecs::png::PngEncoder::new(&mut png)
+        .write_image(rgb, w, h, image::ColorType::Rgb8)
+        .map_err(|e| Error::Numeric(format!("PNG encoding failed: {e}")))?;
+    Ok(png)
+}
+
+/// Draw with `$draw` (a closure taking a `DrawingArea`, written once and expanded for each backend) into a new
+/// file at `$path`, PNG or SVG by its name, of `$size` pixels; evaluates to the closure's `Result`. The picture
+/// is drawn in memory and written with `output::write_new_file`, so the file appears whole or not at all and
+/// an existing file is never overwritten (`$option` names the flag in the messages).
+#[macro_export]
+#[doc(hidden)]
+macro_rules! render_plot {
+    ($path:expr, $option:expr, $size:expr, $draw:expr) => {{
+        let path: &std::path::Path = $path;
+        let size: (u32, u32) = $size;
+        match $crate::cli::plot::check_plot_path(path, $option) {
+            Err(e) => Err(e),
+            Ok(format) => {
+                $crate::cli::plot::register_font();
+                let drawn = match format {
+                    $crate::cli::plot::PlotFormat::Svg => {
+                        let mut svg = String::new();
+                        let out = {
+                            let root = plotters::prelude::SVGBackend::with_string(&mut svg, size).into_drawing_area();
+                            ($draw)(root)
+                        };
+                        out.map(|v| (v, svg.into_bytes()))
+                    }
+                    $crate::cli::plot::PlotFormat::Png => {
+                        let mut rgb = vec![0u8; size.0 as usize * size.1 as usize * 3];
+                        let out = {
+                            let root =
+                                plotters::prelude::BitMapBackend::with_buffer(&mut rgb, size).into_drawing_area();
+                            ($draw)(root)
+                        };
+                        out.and_then(|v| $crate::cli::plot::encode_png(&rgb, size).map(|png| (v, png)))
+                    }
+                };
+                drawn.and_then(|(v, bytes)| $crate::cli::output::write_new_file(path, &bytes).map(|_| v))
+            }
+        }
+    }};
+}
+
+pub fn plot_err(e: impl std::fmt::Display) -> Error {
     Error::Numeric(format!("plotting failed: {e}"))
 }
 
@@ -50,8 +128,11 @@ struct Series {
     points: Vec<(f64, f64, f64)>,
 }
 
-/// Render the sweep as SVG text. `title` goes on top of the chart.
-pub fn render_svg(sweep: &Sweep, title: &str) -> Result<(String, PlotSummary)> {
+/// Draw the sweep on `root` (1000 × 720). `title` goes on top of the chart.
+pub fn draw_sweep<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, sweep: &Sweep, title: &str) -> Result<PlotSummary>
+where
+    DB::ErrorType: 'static,
+{
     let mut series: Vec<Series> = Vec::new();
     let mut skipped = 0;
     let mut scale: f64 = 0.0;
@@ -98,9 +179,7 @@ pub fn render_svg(sweep: &Sweep, title: &str) -> Result<(String, PlotSummary)> {
     let x_range = (tmin / 2.0)..(tmax * 2.0);
     let y_range = (emin / 3.0)..(emax * 3.0);
 
-    let mut svg = String::new();
     {
-        let root = SVGBackend::with_string(&mut svg, (1000, 720)).into_drawing_area();
         root.fill(&WHITE).map_err(plot_err)?;
         let (chart_area, caption_area) = root.split_vertically(660);
         let mut chart = ChartBuilder::on(&chart_area)
@@ -183,7 +262,7 @@ pub fn render_svg(sweep: &Sweep, title: &str) -> Result<(String, PlotSummary)> {
         }
         root.present().map_err(plot_err)?;
     }
-    Ok((svg, PlotSummary { series: series.len(), floor, clamped_actual, clamped_estimated, skipped }))
+    Ok(PlotSummary { series: series.len(), floor, clamped_actual, clamped_estimated, skipped })
 }
 
 fn tolerance_span(t: &[f64]) -> String {
@@ -194,10 +273,7 @@ fn tolerance_span(t: &[f64]) -> String {
     }
 }
 
-/// Render and write to a new file (refusing to overwrite one).
-pub fn write_svg(sweep: &Sweep, title: &str, path: &Path) -> Result<PlotSummary> {
-    check_plot_path(path)?;
-    let (svg, summary) = render_svg(sweep, title)?;
-    super::output::write_new_file(path, svg.as_bytes())?;
-    Ok(summary)
+/// Render the sweep to a new PNG or SVG file (by its name; refusing to overwrite one).
+pub fn write_plot(sweep: &Sweep, title: &str, path: &Path) -> Result<PlotSummary> {
+    crate::render_plot!(path, "--plot", (1000, 720), |root| draw_sweep(root, sweep, title))
 }

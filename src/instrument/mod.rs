@@ -9,6 +9,7 @@
 //! written out in `docs/instrument.md`.
 pub mod colour;
 pub mod convergence;
+pub mod envelope;
 pub mod flux;
 pub mod geometry;
 pub mod method;

@@ -365,7 +365,8 @@ pub(crate) enum Range {
 /// The value of a `{"value", "source", "status"}` object at `o.key`, with its provenance checked.
 pub(crate) fn sourced(o: &Obj, key: &str, range: Range, what: &str) -> Result<f64> {
     let s = o.obj(key)?;
-    s.deny_unknown(&["value", "source", "status"])?;
+    s.deny_unknown(&["value", "source", "status", "tolerance", "plausible"])?;
+    check_variation(&s)?;
     let (lo, hi) = match range {
         Range::Open(lo, hi) | Range::Closed(lo, hi) => (lo, hi),
     };
@@ -384,6 +385,39 @@ pub(crate) fn sourced(o: &Obj, key: &str, range: Range, what: &str) -> Result<f6
         return Err(s.err("status", format!("\"{status}\" is not a status; allowed: {}", STATUSES.join(", "))));
     }
     Ok(value)
+}
+
+/// The optional variations of a sourced number, for the tolerance envelope (`instrument::envelope`):
+/// `"tolerance": {"value": t ≥ 0, "source", "status"}` (the standard allows value ± t) and, for a number
+/// whose value is itself uncertain, `"plausible": {"low", "high", "source", "status"}` (low ≤ value ≤ high).
+fn check_variation(s: &Obj) -> Result<()> {
+    let provenance = |t: &Obj| -> Result<()> {
+        t.deny_unknown(&["value", "low", "high", "source", "status"])?;
+        if t.str("source")?.trim().is_empty() {
+            return Err(t.err("source", "must not be empty: cite where the tolerance comes from, or why it was chosen"));
+        }
+        let status = t.str("status")?;
+        if !STATUSES.contains(&status) {
+            return Err(t.err("status", format!("\"{status}\" is not a status; allowed: {}", STATUSES.join(", "))));
+        }
+        Ok(())
+    };
+    if let Some(t) = s.opt_obj("tolerance")? {
+        t.deny_unknown(&["value", "source", "status"])?;
+        t.num("value", 0.0, 10.0, "a tolerance in the number's unit")?;
+        provenance(&t)?;
+    }
+    if let Some(t) = s.opt_obj("plausible")? {
+        t.deny_unknown(&["low", "high", "source", "status"])?;
+        let lo = t.num("low", f64::MIN, f64::MAX, "the low end of the plausible range")?;
+        let hi = t.num("high", f64::MIN, f64::MAX, "the high end of the plausible range")?;
+        let v = s.num("value", f64::MIN, f64::MAX, "the value")?;
+        if !(lo <= v && v <= hi) {
+            return Err(t.err("low", format!("the plausible range [{lo}, {hi}] must contain the value {v}")));
+        }
+        provenance(&t)?;
+    }
+    Ok(())
 }
 
 /// The shape and size of a stop: (in-plane, perpendicular) full angles in degrees. The shape is checked

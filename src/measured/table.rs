@@ -187,8 +187,8 @@ impl Table {
             let w = w.unwrap_or(1.0);
             if w != 0.0 {
                 let v = &self.data[offset..offset + self.channels];
-                for c in 0..self.channels {
-                    out[c] += w * v[c];
+                for (o, x) in out.iter_mut().zip(v) {
+                    *o += w * x;
                 }
             }
             return;

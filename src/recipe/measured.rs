@@ -1,10 +1,13 @@
-//! `"model": "merl"`: a measured BRDF table in the MERL `.binary` format (`brdf::measured`), referenced by
-//! path from the recipe. A relative path is resolved against the recipe file's directory, so that a recipe
+//! `"model": "merl"` and `"model": "rgl"`: measured BRDF tables (`crate::measured`), referenced by path from
+//! the recipe. A relative path is resolved against the recipe file's directory, so that a recipe
 //! and its table can be moved together; for a label that is not a path (`<stdin>`, `<builtin:…>`) against
 //! the current directory.
 use super::Obj;
-use crate::brdf::measured::{Interpolation, MerlBrdf};
 use crate::brdf::Brdf;
+use crate::measured::merl::{Interpolation, MerlBrdf};
+use crate::measured::rgl::RglBrdf;
+use crate::measured::{e1392, inplane};
+use crate::registry;
 use crate::{Error, Result};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -24,11 +27,11 @@ pub fn resolve(recipe_file: &str, file: &str) -> PathBuf {
 /// `{"model": "merl", "file": "…", "interpolation": "nearest" | "trilinear"}`.
 pub fn parse_merl(obj: &Obj) -> Result<Arc<dyn Brdf>> {
     obj.deny_unknown_in("merl")?;
-    let file = obj.str(&obj.param_key(&crate::registry::MERL_FILE))?;
+    let file = obj.str(&obj.param_key(&registry::MERL_FILE))?;
     if file.is_empty() {
         return Err(obj.err("file", "empty path; expected the path of a MERL .binary table"));
     }
-    let interpolation = match obj.opt_str(&obj.param_key(&crate::registry::MERL_INTERPOLATION))? {
+    let interpolation = match obj.opt_str(&obj.param_key(&registry::MERL_INTERPOLATION))? {
         None | Some("nearest") => Interpolation::Nearest,
         Some("trilinear") => Interpolation::Trilinear,
         Some(other) => {
@@ -40,6 +43,49 @@ pub fn parse_merl(obj: &Obj) -> Result<Arc<dyn Brdf>> {
     let brdf = MerlBrdf::load(&path, interpolation).map_err(|e| match e {
         Error::Io { file: f, source } => obj.err("file", format!("cannot read the MERL table {f}: {source}")),
         other => obj.err("file", format!("not a valid MERL table: {other}")),
+    })?;
+    Ok(Arc::new(brdf))
+}
+
+/// `{"model": "rgl", "file": "…"}`: an RGL material database `.bsdf` tensor file.
+pub fn parse_rgl(obj: &Obj) -> Result<Arc<dyn Brdf>> {
+    obj.deny_unknown_in("rgl")?;
+    let file = obj.str(&obj.param_key(&registry::RGL_FILE))?;
+    if file.is_empty() {
+        return Err(obj.err("file", "empty path; expected the path of an RGL .bsdf file"));
+    }
+    let path = resolve(obj.file, file);
+    let brdf = RglBrdf::load(&path).map_err(|e| match e {
+        Error::Io { file: f, source } => obj.err("file", format!("cannot read the RGL file {f}: {source}")),
+        other => obj.err("file", format!("not a valid RGL .bsdf file: {other}")),
+    })?;
+    Ok(Arc::new(brdf))
+}
+
+/// `{"model": "inplane-csv", "file": "…"}` and `{"model": "e1392", "file": "…"}`: in-plane goniometer tables
+/// with the isotropic (θh, θd) extension (`measured::inplane`).
+pub fn parse_inplane(obj: &Obj, model: &str) -> Result<Arc<dyn Brdf>> {
+    obj.deny_unknown_in(model)?;
+    let what = if model == "e1392" { "an ASTM E1392 text table" } else { "an in-plane CSV table" };
+    let entry = if model == "e1392" { &registry::E1392_FILE } else { &registry::INPLANE_FILE };
+    let file = obj.str(&obj.param_key(entry))?;
+    if file.is_empty() {
+        return Err(obj.err("file", format!("empty path; expected the path of {what}")));
+    }
+    let path = resolve(obj.file, file);
+    let off_plane = match obj.opt_str(&obj.param_key(&registry::INPLANE_OFF_PLANE))? {
+        None | Some("f") => inplane::OffPlane::Brdf,
+        Some("f-cos-cos") => inplane::OffPlane::BrdfCosCos,
+        Some(other) => {
+            let allowed =
+                "allowed: \"f\" (f_r depends on (θh, θd) only, the default), \"f-cos-cos\" (f_r·cos θi·cos θo does)";
+            return Err(obj.err("off_plane", format!("unknown off-plane assumption \"{other}\"; {allowed}")));
+        }
+    };
+    let loaded = if model == "e1392" { e1392::load(&path) } else { inplane::load_csv(&path) };
+    let brdf = loaded.map(|b| b.with_off_plane(off_plane)).map_err(|e| match e {
+        Error::Io { file: f, source } => obj.err("file", format!("cannot read {what} {f}: {source}")),
+        other => obj.err("file", format!("not a valid table: {other}")),
     })?;
     Ok(Arc::new(brdf))
 }

@@ -152,6 +152,8 @@ pub fn parse_brdf(obj: &Obj) -> Result<Arc<dyn Brdf>> {
         }
         "cook-torrance-lobes" => parse_lobes(obj)?,
         "merl" => measured::parse_merl(obj)?,
+        "rgl" => measured::parse_rgl(obj)?,
+        "inplane-csv" | "e1392" => measured::parse_inplane(obj, model)?,
         other => return Err(obj.err("model", format!("unknown model \"{other}\"; {}", allowed()))),
     };
     Ok(brdf)

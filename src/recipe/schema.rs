@@ -24,6 +24,18 @@ const SUMMARIES: &[(&str, &str)] = &[
         "Layered automotive paint after Ďurikovič & Ágošton (2007); fields documented in docs/recipe-format.md §Paint",
     ),
     ("merl", "A measured BRDF table in the MERL .binary format (Matusik et al. 2003); see docs/recipe-format.md §merl"),
+    (
+        "rgl",
+        "A measured BRDF from the RGL material database (.bsdf tensor file, Dupuy & Jakob 2018), evaluated as pbrt-v4's MeasuredBxDF; see docs/recipe-format.md §rgl",
+    ),
+    (
+        "inplane-csv",
+        "An in-plane goniometer table (CSV: theta_i, theta_o and brdf or brdf_cos), isotropic (θh, θd) extension; see docs/recipe-format.md §inplane-csv",
+    ),
+    (
+        "e1392",
+        "An ASTM E1392-style text table (theta_i phi_i theta_s phi_s BRDF|CCBRDF); in-plane rows, isotropic extension; see docs/recipe-format.md §e1392",
+    ),
 ];
 
 /// `{"type": "number", ...bounds}` of a range.

@@ -1,0 +1,74 @@
+//! `measure --envelope`: every reading read at the corners of the tolerances in the standards files (and the
+//! plausible ranges of assumed numbers) brackets the nominal reading; geometries whose data give no tolerance
+//! say so (null), and the extremes are those of independent single-geometry runs at the corners.
+#![cfg(feature = "cli")]
+use glossmeter::cli::run;
+use glossmeter::instrument::envelope;
+use glossmeter::instrument::plan::{Plan, PlanOptions};
+use glossmeter::instrument::standards;
+use glossmeter::recipe;
+
+fn tmp(name: &str) -> std::path::PathBuf {
+    let d = std::env::temp_dir().join(format!("glossmeter-envelope-test-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d.join(name)
+}
+
+#[test]
+fn envelope_brackets_the_nominal_reading_in_json() {
+    let out = tmp("env.json");
+    let _ = std::fs::remove_file(&out);
+    let args = [
+        "glossmeter",
+        "measure",
+        "fixtures/recipes/rough-dielectric-beckmann.json",
+        "-g",
+        "astm-d523-60",
+        "-g",
+        "astm-e430-30",
+        "--rtol",
+        "1e-5",
+        "--envelope",
+        "--format",
+        "json",
+        "--no-timing",
+        "-o",
+        out.to_str().unwrap(),
+    ];
+    assert_eq!(run(args), 0);
+    let doc: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
+    let rs = doc["readings"].as_array().unwrap();
+    let g60 = &rs[0];
+    assert_eq!(g60["geometry"], "astm-d523-60");
+    let (lo, v, hi) =
+        (g60["envelope_min"].as_f64().unwrap(), g60["value"].as_f64().unwrap(), g60["envelope_max"].as_f64().unwrap());
+    assert!(lo < v && v < hi, "{lo} {v} {hi}");
+    assert_eq!(g60["envelope"]["variants"], 32);
+    // E430 has no tolerances in the shipped data: null, not a made-up spread.
+    let e430 = rs.iter().find(|r| r["geometry"] == "astm-e430-30").unwrap();
+    assert!(e430["envelope_min"].is_null() && e430["envelope_max"].is_null());
+    // CSV does not carry the envelope: refused rather than silently dropped.
+    assert_eq!(run(["glossmeter", "measure", "fixtures/recipes/glass-n1.5.json", "--envelope", "--format", "csv"]), 2);
+}
+
+#[test]
+fn envelope_extremes_are_those_of_the_corner_geometries() {
+    let m = recipe::load_file(std::path::Path::new("fixtures/recipes/rough-dielectric-beckmann.json")).unwrap();
+    let g = standards::find("astm-d523-20").unwrap();
+    let options = PlanOptions { rtol: 1e-5, ..Default::default() };
+    let nominal = Plan::compile(m.brdf.clone(), vec![g.clone()], options.clone()).unwrap().execute();
+    let env = envelope::read(m.brdf.clone(), std::slice::from_ref(&g), &nominal, options.clone()).unwrap();
+    let e = env[0].clone().unwrap();
+    // The same 2^k corner geometries read one by one, each in its own plan: the envelope is their extremes
+    // together with the nominal reading, and a lobe wider than the receptor makes them differ.
+    let (vars, corners) = envelope::variants(&g).unwrap();
+    assert_eq!(corners.len(), 1 << vars.len());
+    let mut values = vec![];
+    for c in corners {
+        values.push(Plan::compile(m.brdf.clone(), vec![c], options.clone()).unwrap().execute()[0].value.unwrap());
+    }
+    let lo = values.iter().copied().fold(f64::INFINITY, f64::min).min(nominal[0].value.unwrap());
+    let hi = values.iter().copied().fold(f64::NEG_INFINITY, f64::max).max(nominal[0].value.unwrap());
+    assert_eq!((e.min, e.max), (lo, hi));
+    assert!(e.max > e.min);
+}

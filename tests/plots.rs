@@ -1,0 +1,181 @@
+//! The pictures: every kind in PNG and SVG exists, has a plausible size and is not blank (a PNG has several
+//! colours and a share of non-white pixels; an SVG has lines and text, drawn with the embedded font), and an
+//! existing file is never overwritten.
+#![cfg(feature = "cli")]
+use glossmeter::cli::run;
+use std::path::PathBuf;
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("glossmeter-plots-test-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    let p = d.join(name);
+    let _ = std::fs::remove_file(&p);
+    p
+}
+
+fn check_png(p: &PathBuf) {
+    let bytes = std::fs::read(p).unwrap();
+    assert!(bytes.len() > 10_000, "{}: {} bytes", p.display(), bytes.len());
+    let img = image::load_from_memory(&bytes).unwrap().to_rgb8();
+    let (w, h) = img.dimensions();
+    assert!(w >= 800 && h >= 400, "{w} × {h}");
+    let mut colours = std::collections::HashSet::new();
+    let mut ink = 0usize;
+    for px in img.pixels() {
+        colours.insert(px.0);
+        if px.0 != [255, 255, 255] {
+            ink += 1;
+        }
+    }
+    let share = ink as f64 / (w * h) as f64;
+    assert!(colours.len() >= 5 && share > 0.01, "{}: {} colours, {share:.4} ink", p.display(), colours.len());
+}
+
+fn check_svg(p: &PathBuf) {
+    let s = std::fs::read_to_string(p).unwrap();
+    assert!(s.len() > 5_000, "{}: {} bytes", p.display(), s.len());
+    assert!(
+        s.starts_with("<svg") && s.contains("<text") && (s.contains("<polyline") || s.contains("<path")),
+        "{}",
+        p.display()
+    );
+}
+
+#[test]
+fn section_plots_in_both_formats() {
+    for ext in ["png", "svg"] {
+        let p = tmp(&format!("section.{ext}"));
+        let args = [
+            "glossmeter",
+            "plot",
+            "fixtures/recipes/rough-dielectric-beckmann.json",
+            "--kind",
+            "section",
+            "-g",
+            "astm-d523-20",
+            "-g",
+            "astm-d523-60",
+            "-o",
+            p.to_str().unwrap(),
+        ];
+        assert_eq!(run(args), 0);
+        if ext == "png" {
+            check_png(&p)
+        } else {
+            check_svg(&p)
+        }
+        // Never overwritten: the second run refuses and leaves the file as it was.
+        let before = std::fs::read(&p).unwrap();
+        assert_eq!(run(args), 2);
+        assert_eq!(std::fs::read(&p).unwrap(), before);
+    }
+    let bad = tmp("section.jpg");
+    assert_eq!(
+        run([
+            "glossmeter",
+            "plot",
+            "fixtures/recipes/grey-lambert.json",
+            "--kind",
+            "section",
+            "-o",
+            bad.to_str().unwrap()
+        ]),
+        2
+    );
+    assert!(!bad.exists());
+}
+
+#[test]
+fn gloss_vs_parameter_plots() {
+    for ext in ["png", "svg"] {
+        let p = tmp(&format!("vary.{ext}"));
+        let args = [
+            "glossmeter",
+            "plot",
+            "fixtures/recipes/rough-dielectric-beckmann.json",
+            "--kind",
+            "gloss-vs-parameter",
+            "--vary",
+            "/roughness=0.05..0.3",
+            "--points",
+            "4",
+            "-g",
+            "astm-d523-60",
+            "-g",
+            "astm-d523-85",
+            "-o",
+            p.to_str().unwrap(),
+        ];
+        assert_eq!(run(args), 0);
+        if ext == "png" {
+            check_png(&p)
+        } else {
+            check_svg(&p)
+        }
+    }
+    // A pointer that names no number is bad input.
+    let p = tmp("vary-bad.svg");
+    let args = [
+        "glossmeter",
+        "plot",
+        "fixtures/recipes/rough-dielectric-beckmann.json",
+        "--kind",
+        "gloss-vs-parameter",
+        "--vary",
+        "/nothing=0..1",
+        "-o",
+        p.to_str().unwrap(),
+    ];
+    assert_eq!(run(args), 2);
+    assert!(!p.exists());
+}
+
+#[test]
+fn compare_and_convergence_plots() {
+    let p = tmp("compare.png");
+    assert_eq!(
+        run([
+            "glossmeter",
+            "compare",
+            "fixtures/recipes/black-glass.json",
+            "fixtures/sheets/black-glass-check.csv",
+            "--plot",
+            p.to_str().unwrap()
+        ]),
+        0
+    );
+    check_png(&p);
+    let p = tmp("compare.svg");
+    assert_eq!(
+        run([
+            "glossmeter",
+            "compare",
+            "fixtures/recipes/black-glass.json",
+            "fixtures/sheets/black-glass-check.csv",
+            "--plot",
+            p.to_str().unwrap()
+        ]),
+        0
+    );
+    check_svg(&p);
+    let p = tmp("convergence.png");
+    assert_eq!(
+        run([
+            "glossmeter",
+            "convergence",
+            "fixtures/recipes/grey-lambert.json",
+            "-g",
+            "astm-d523-60",
+            "--tolerances",
+            "1e-3,1e-5",
+            "--min-time-ms",
+            "0",
+            "--max-repetitions",
+            "1",
+            "--plot",
+            p.to_str().unwrap(),
+        ]),
+        0
+    );
+    check_png(&p);
+}
