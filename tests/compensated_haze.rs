@@ -23,8 +23,11 @@ fn fixture(name: &str) -> String {
     std::fs::read_to_string(format!("{}/fixtures/recipes/{name}.json", env!("CARGO_MANIFEST_DIR"))).unwrap()
 }
 
+/// A reading's name, its raw haze (value, error) and its compensated haze (value, error).
+type Pair = (String, (f64, f64), (f64, f64));
+
 /// (raw, compensated) value and error pairs of every compensated reading, matched by name.
-fn pairs(rs: &[Reading]) -> Vec<(String, (f64, f64), (f64, f64))> {
+fn pairs(rs: &[Reading]) -> Vec<Pair> {
     rs.iter()
         .filter(|r| r.quantity == "haze-compensated")
         .map(|c| {
