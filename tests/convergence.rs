@@ -85,7 +85,18 @@ fn lambertian_sweep_actual_error_is_within_the_estimate_and_decreases() {
         }
         // Errors relative to the scale of the reading: its value, except for DOI = 100·(1 − Φ_off/Φ_spec),
         // a small difference (0.003 for a Lambertian) whose rounding level is set by the 100, not by itself.
-        let scale = if r.quantity == "doi" { 100.0 } else { reference.abs() };
+        // A compensated haze is a difference too (exactly 0 for a Lambertian): its scale is the raw haze it
+        // is subtracted from (docs/instrument.md §1.7).
+        let raw = |name: &str| {
+            sweep.rows.iter().find(|x| x.geometry == r.geometry && x.reading == name && x.rtol == r.rtol).unwrap()
+        };
+        let scale = match r.quantity.as_str() {
+            "doi" => 100.0,
+            "haze-compensated" | "log-haze-compensated" => {
+                raw(r.reading.trim_end_matches("-compensated")).reference.unwrap().abs()
+            }
+            _ => reference.abs(),
+        };
         series.entry((r.geometry.clone(), r.reading.clone())).or_default().push((r.rtol, actual / scale));
     }
     for ((g, name), pts) in &series {

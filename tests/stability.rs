@@ -260,6 +260,13 @@ fn reference_reading(
         ReadingSpec::LogHaze { receptors, specular, k } => {
             k * ((100.0 * mean(receptors) / standard(stop(specular))) / 20.0 + 1.0).log10()
         }
+        ReadingSpec::HazeCompensated { receptors, specular, compensation, factor } => {
+            100.0 * (mean(receptors) - factor * specimen(stop(compensation))) / standard(stop(specular))
+        }
+        ReadingSpec::LogHazeCompensated { receptors, specular, compensation, factor, k } => {
+            let h = 100.0 * (mean(receptors) - factor * specimen(stop(compensation))) / standard(stop(specular));
+            k * (h / 20.0 + 1.0).log10()
+        }
         ReadingSpec::Doi { specular, offset } => 100.0 * (1.0 - mean(offset) / specimen(stop(specular))),
         ReadingSpec::HazeIndex { .. } => unreachable!("composites are combined by the caller"),
         ReadingSpec::Colour { .. } => unreachable!("colour geometries are not in this test's panels"),

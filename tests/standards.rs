@@ -127,7 +127,10 @@ fn stop_solid_angle_matches_rectangular_pyramid() {
 #[test]
 fn e430_offsets_and_named_readings() {
     let g = standards::find("astm-e430-30").unwrap();
-    assert_eq!(g.reading_names, vec!["gloss", "haze-narrow", "haze-wide", "doi"]);
+    assert_eq!(
+        g.reading_names,
+        vec!["gloss", "haze-narrow", "haze-wide", "doi", "haze-narrow-compensated", "haze-wide-compensated"]
+    );
     let geo = &g.geometry;
     let centre = |n: &str| {
         let s = geo.receptor(n).unwrap();

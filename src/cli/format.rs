@@ -46,7 +46,14 @@ pub fn table(material: &Material, readings: &[Reading], timing: bool) -> String 
         let mut row = vec![r.geometry.clone(), r.name.clone()];
         match r.value {
             Some(v) => {
-                row.push(format!("{:.*}", decimals(r.error_estimate), v));
+                // A value that rounds to zero is shown as 0.0, never "-0.0" (a compensated haze of −1e-15).
+                let shown = format!("{:.*}", decimals(r.error_estimate), v);
+                let shown = if shown.trim_start_matches('-').chars().all(|c| c == '0' || c == '.') {
+                    shown.trim_start_matches('-').to_string()
+                } else {
+                    shown
+                };
+                row.push(shown);
                 row.push(r.unit.clone());
                 row.push(format!("{:.1e}", r.error_estimate));
             }

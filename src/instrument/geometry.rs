@@ -36,6 +36,29 @@ impl Stop {
         let f = |p: f64, q: f64| (p * q / (1.0 + p * p + q * q).sqrt()).atan();
         f(self.p[1], self.q[1]) - f(self.p[0], self.q[1]) - f(self.p[1], self.q[0]) + f(self.p[0], self.q[0])
     }
+
+    /// Projected solid angle Ω⊥ = ∫ cos θo dω of this stop on the receptor lens of a geometry of angle θ
+    /// (radians), in closed form. With cos θo = (cos θ − p sin θ)/√(1+p²+q²) and dω = dp dq/(1+p²+q²)^{3/2},
+    /// Ω⊥ = cos θ·∬(1+p²+q²)⁻² dp dq − sin θ·∬ p(1+p²+q²)⁻² dp dq, each a corner sum of the antiderivatives
+    /// G(P,Q) = ½[P/√(1+P²)·atan(Q/√(1+P²)) + Q/√(1+Q²)·atan(P/√(1+Q²))] (the differential-area-to-rectangle
+    /// view factor × π; Howell, *A Catalog of Radiation Heat Transfer Configuration Factors*, B-3) and
+    /// H(P,Q) = ½[atan Q − atan(Q/√(1+P²))/√(1+P²)] (∫ p/(a²+p²)² dp = −1/(2(a²+p²)), then ∫ dq/(b²+q²)).
+    /// A Lambertian surface of albedo ρ sends (ρ/π)·Ω⊥(R)·∫_S cos θi dωi into stop R, so the ratio of two
+    /// stops' Lambertian fluxes is the ratio of their Ω⊥, whatever the source.
+    pub fn projected_solid_angle(&self, theta: f64) -> f64 {
+        let g = |p: f64, q: f64| {
+            let (a, b) = ((1.0 + p * p).sqrt(), (1.0 + q * q).sqrt());
+            0.5 * (p / a * (q / a).atan() + q / b * (p / b).atan())
+        };
+        let h = |p: f64, q: f64| {
+            let a = (1.0 + p * p).sqrt();
+            0.5 * (q.atan() - (q / a).atan() / a)
+        };
+        let corners = |f: &dyn Fn(f64, f64) -> f64| {
+            f(self.p[1], self.q[1]) - f(self.p[0], self.q[1]) - f(self.p[1], self.q[0]) + f(self.p[0], self.q[0])
+        };
+        theta.cos() * corners(&g) - theta.sin() * corners(&h)
+    }
 }
 
 /// The two lens axes of a geometry of angle θ (radians from the normal).
@@ -84,6 +107,13 @@ pub enum ReadingSpec {
     Haze { receptors: Vec<String>, specular: String },
     /// Logarithmic haze: k·log10(H/20 + 1) of the linear haze above (BYK micro-haze plus, k = 1285.1).
     LogHaze { receptors: Vec<String>, specular: String, k: f64 },
+    /// Brightness-compensated haze, HU: 100·(mean_r Φ(specimen, r) − factor·Φ(specimen, compensation)) /
+    /// Φ(standard, `specular`). `factor` = mean_r Ω⊥(r) / Ω⊥(compensation), the ratio of the receptors'
+    /// projected solid angles ([`Stop::projected_solid_angle`]), is what makes a Lambertian body read 0
+    /// (`docs/instrument.md` §1.7).
+    HazeCompensated { receptors: Vec<String>, specular: String, compensation: String, factor: f64 },
+    /// Logarithmic compensated haze: k·log10(H_c/20 + 1) of the compensated linear haze H_c above.
+    LogHazeCompensated { receptors: Vec<String>, specular: String, compensation: String, factor: f64, k: f64 },
     /// Distinctness of image: 100·(Φ(specular) − mean_r Φ(r)) / Φ(specular), all on the specimen.
     Doi { specular: String, offset: Vec<String> },
     /// Haze index (ASTM D4039): gloss of one geometry minus the gloss of another.
@@ -155,6 +185,8 @@ impl ReadingSpec {
             ReadingSpec::Gloss { .. } => "gloss",
             ReadingSpec::Haze { .. } => "haze",
             ReadingSpec::LogHaze { .. } => "log-haze",
+            ReadingSpec::HazeCompensated { .. } => "haze-compensated",
+            ReadingSpec::LogHazeCompensated { .. } => "log-haze-compensated",
             ReadingSpec::Doi { .. } => "doi",
             ReadingSpec::HazeIndex { .. } => "haze-index",
             ReadingSpec::Colour { quantity, .. } => quantity.name(),
@@ -174,8 +206,8 @@ impl ReadingSpec {
     pub fn unit(&self) -> &'static str {
         match self {
             ReadingSpec::Gloss { .. } | ReadingSpec::HazeIndex { .. } => "GU",
-            ReadingSpec::Haze { .. } => "HU",
-            ReadingSpec::LogHaze { .. } => "HU(log)",
+            ReadingSpec::Haze { .. } | ReadingSpec::HazeCompensated { .. } => "HU",
+            ReadingSpec::LogHaze { .. } | ReadingSpec::LogHazeCompensated { .. } => "HU(log)",
             ReadingSpec::Doi { .. } => "DOI",
             ReadingSpec::Colour { quantity: ColourQuantity::H, .. } => "°",
             ReadingSpec::Colour { .. } => "",

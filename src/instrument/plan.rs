@@ -485,6 +485,10 @@ fn add_geometry(
             ReadingSpec::Haze { receptors, specular } | ReadingSpec::LogHaze { receptors, specular, .. } => {
                 (receptors.iter().collect(), vec![specular])
             }
+            ReadingSpec::HazeCompensated { receptors, specular, compensation, .. }
+            | ReadingSpec::LogHazeCompensated { receptors, specular, compensation, .. } => {
+                (receptors.iter().chain(std::iter::once(compensation)).collect(), vec![specular])
+            }
             ReadingSpec::Doi { specular, offset } => (std::iter::once(specular).chain(offset.iter()).collect(), vec![]),
             ReadingSpec::HazeIndex { .. } => (vec![], vec![]),
             ReadingSpec::Colour { terms, .. } => (terms.iter().map(|(n, _)| n).collect(), vec![]),
@@ -783,6 +787,25 @@ impl Plan {
                 j.used_by.join(", ")
             ));
         }
+        s.push_str("Readings, from the integrals above:\n");
+        for r in self.readings.iter().filter(|r| r.reported) {
+            let jobs = |m: &BTreeMap<String, usize>| m.iter().map(|(n, j)| format!("{n} #{j}")).collect::<Vec<_>>();
+            let extra = match &r.spec {
+                ReadingSpec::HazeCompensated { compensation, factor, .. }
+                | ReadingSpec::LogHazeCompensated { compensation, factor, .. } => {
+                    format!("; minus {factor:.6} × {compensation} (ratio of projected solid angles)")
+                }
+                _ => String::new(),
+            };
+            s.push_str(&format!(
+                "  {}/{} ({}): specimen {}; standard {}{extra}\n",
+                r.geometry,
+                r.name,
+                r.spec.quantity(),
+                if r.specimen_jobs.is_empty() { "—".to_string() } else { jobs(&r.specimen_jobs).join(", ") },
+                if r.standard_jobs.is_empty() { "—".to_string() } else { jobs(&r.standard_jobs).join(", ") },
+            ));
+        }
         s.push_str(&format!(
             "Tolerance: relative {:e} on every reading; {} of it to each specimen flux ({} of that to its analytic \
              part), {} to the gloss standard.\n",
@@ -923,6 +946,20 @@ pub fn reading_value(
                 (k * (h / 20.0 + 1.0).log10(), k * he / (std::f64::consts::LN_10 * (h + 20.0)))
             })
         }
+        ReadingSpec::HazeCompensated { receptors, specular, compensation, factor } => {
+            compensated_haze(mean(receptors), specimen(compensation), *factor, standard(specular))
+        }
+        ReadingSpec::LogHazeCompensated { receptors, specular, compensation, factor, k } => {
+            let (h, he) = compensated_haze(mean(receptors), specimen(compensation), *factor, standard(specular))?;
+            if !(h > -20.0) {
+                return Err(format!(
+                    "the compensated linear haze {h} is at or below −20, where K·log10(H/20 + 1) has no value (the \
+                     compensation receptor sees more diffuse light than the haze receptors, relative to a \
+                     Lambertian body)"
+                ));
+            }
+            Ok((k * (h / 20.0 + 1.0).log10(), k * he / (std::f64::consts::LN_10 * (h + 20.0))))
+        }
         ReadingSpec::Doi { specular, offset } => {
             let (s, se) = specimen(specular);
             let (o, oe) = mean(offset);
@@ -931,6 +968,18 @@ pub fn reading_value(
         ReadingSpec::HazeIndex { .. } => Err("a composite reading has no fluxes of its own".into()),
         ReadingSpec::Colour { .. } => Err("a colour reading needs X, Y, Z (plan::colour_xyz)".into()),
     }
+}
+
+/// Compensated linear haze H_c = 100·(Φ_h − c·Φ_c)/Φ_std from the mean haze flux Φ_h, the compensation
+/// receptor's flux Φ_c, the factor c and the standard's specular flux, each (value, error); the errors add
+/// (first order, the numerator's error is e_h + c·e_c).
+fn compensated_haze(
+    (h, he): (f64, f64),
+    (c, ce): (f64, f64),
+    factor: f64,
+    (d, de): (f64, f64),
+) -> std::result::Result<(f64, f64), String> {
+    ratio(h - factor * c, he + factor * ce, d, de, Denominator::Standard).map(|(v, e)| (100.0 * v, 100.0 * e))
 }
 
 /// The value and error of a haze index (ASTM D4039) from its two gloss readings' (value, error).

@@ -327,7 +327,7 @@ pub fn parse(text: &str, origin: &str) -> Result<StandardGeometry> {
     let mut reading_names: Vec<String> = Vec::with_capacity(readings_v.len());
     for (i, v) in readings_v.iter().enumerate() {
         let r = Obj::new(origin, format!("/readings/{i}"), v)?;
-        let (spec, name) = reading(&r, &names, id)?;
+        let (spec, name) = reading(&r, &names, id, (theta, &receptors))?;
         let display = name.unwrap_or_else(|| spec.quantity().to_string());
         if reading_names.contains(&display) {
             return Err(r.err(
@@ -490,20 +490,68 @@ fn check_receptor(o: &Obj, path: &str, name: &str, names: &[&str]) -> Result<()>
     }
 }
 
-/// One entry of `readings`: the compiled spec and its optional display name.
-fn reading(r: &Obj, names: &[&str], own_id: &str) -> Result<(ReadingSpec, Option<String>)> {
+/// The allowed `quantity` values of a reading.
+pub const QUANTITIES: &[&str] =
+    &["gloss", "haze", "log-haze", "haze-compensated", "log-haze-compensated", "doi", "haze-index"];
+
+/// The subtraction factor of a compensated haze reading: mean_r Ω⊥(r) / Ω⊥(compensation), the ratio of the
+/// haze receptors' and the compensation receptor's projected solid angles (`docs/instrument.md` §1.7), so that
+/// a Lambertian body reads exactly 0. The compensation receptor must see the body's diffuse light away from
+/// the specular region: a stop that overlaps the specular receptor or a haze receptor is refused (it would
+/// subtract specular or haze light, not the body's).
+fn compensation_factor(
+    r: &Obj,
+    receptors: &[String],
+    specular: &str,
+    compensation: &str,
+    geometry: (f64, &[(String, Stop)]),
+) -> Result<f64> {
+    let (theta, stops) = geometry;
+    let stop = |name: &str| stops.iter().find(|(n, _)| n == name).map(|(_, s)| *s).expect("receptor checked");
+    let c = stop(compensation);
+    let deg = |s: &Stop| format!("{:.4}° to {:.4}°", s.p[0].atan().to_degrees(), s.p[1].atan().to_degrees());
+    let overlaps = |a: &Stop, b: &Stop| a.p[0] < b.p[1] && b.p[0] < a.p[1] && a.q[0] < b.q[1] && b.q[0] < a.q[1];
+    for (role, name) in std::iter::once(("specular", specular)).chain(receptors.iter().map(|n| ("haze", n.as_str()))) {
+        let s = stop(name);
+        if name == compensation || overlaps(&c, &s) {
+            return Err(r.err(
+                "compensation",
+                format!(
+                    "the compensation receptor \"{compensation}\" (in plane {} from specular) overlaps the {role} \
+                     receptor \"{name}\" ({}); it must see the body's diffuse light away from the specular and haze \
+                     receptors",
+                    deg(&c),
+                    deg(&s)
+                ),
+            ));
+        }
+    }
+    let omega = c.projected_solid_angle(theta);
+    if !(omega > 0.0) {
+        return Err(r.err("compensation", "the compensation receptor has no projected solid angle"));
+    }
+    let mean = receptors.iter().map(|n| stop(n).projected_solid_angle(theta)).sum::<f64>() / receptors.len() as f64;
+    Ok(mean / omega)
+}
+
+/// One entry of `readings`: the compiled spec and its optional display name. `geometry` is (θ, receptors).
+fn reading(
+    r: &Obj,
+    names: &[&str],
+    own_id: &str,
+    geometry: (f64, &[(String, Stop)]),
+) -> Result<(ReadingSpec, Option<String>)> {
     let q = r.str("quantity")?;
     let allowed: &[&str] = match q {
         "gloss" => &["quantity", "name", "receptor"],
         "haze" => &["quantity", "name", "receptors", "specular"],
         "log-haze" => &["quantity", "name", "receptors", "specular", "k"],
+        "haze-compensated" => &["quantity", "name", "receptors", "specular", "compensation"],
+        "log-haze-compensated" => &["quantity", "name", "receptors", "specular", "compensation", "k"],
         "doi" => &["quantity", "name", "specular", "offset"],
         "haze-index" => &["quantity", "name", "minuend", "subtrahend"],
         other => {
-            return Err(r.err(
-                "quantity",
-                format!("unknown quantity \"{other}\"; allowed: gloss, haze, log-haze, doi, haze-index"),
-            ))
+            return Err(r.err("quantity", format!("unknown quantity \"{other}\"; allowed: {}", QUANTITIES.join(", "))))
         }
     };
     r.deny_unknown(allowed)?;
@@ -522,6 +570,18 @@ fn reading(r: &Obj, names: &[&str], own_id: &str) -> Result<(ReadingSpec, Option
             specular: receptor_ref(r, "specular", names)?,
             k: sourced(r, "k", Range::Open(0.0, 1e6), "the log-haze scale factor K")?,
         },
+        "haze-compensated" | "log-haze-compensated" => {
+            let receptors = receptor_list(r, "receptors", names)?;
+            let specular = receptor_ref(r, "specular", names)?;
+            let compensation = receptor_ref(r, "compensation", names)?;
+            let factor = compensation_factor(r, &receptors, &specular, &compensation, geometry)?;
+            if q == "haze-compensated" {
+                ReadingSpec::HazeCompensated { receptors, specular, compensation, factor }
+            } else {
+                let k = sourced(r, "k", Range::Open(0.0, 1e6), "the log-haze scale factor K")?;
+                ReadingSpec::LogHazeCompensated { receptors, specular, compensation, factor, k }
+            }
+        }
         "doi" => ReadingSpec::Doi {
             specular: receptor_ref(r, "specular", names)?,
             offset: receptor_list(r, "offset", names)?,
@@ -609,7 +669,7 @@ pub fn describe(g: &StandardGeometry) -> String {
     let rv = s.get("readings").and_then(Value::as_array).cloned().unwrap_or_default();
     for ((spec, name), raw) in geo.readings.iter().zip(&g.reading_names).zip(&rv) {
         out += &format!("    {name} ({}): {}\n", spec.unit(), reading_summary(spec));
-        if let ReadingSpec::LogHaze { .. } = spec {
+        if let ReadingSpec::LogHaze { .. } | ReadingSpec::LogHazeCompensated { .. } = spec {
             out += &format!("      K: {}\n", sourced_text(raw.get("k"), ""));
         }
     }
@@ -628,6 +688,15 @@ fn reading_summary(r: &ReadingSpec) -> String {
         ReadingSpec::LogHaze { receptors, specular, k } => {
             format!("{k}·log10(H/20 + 1), H = 100·mean Φ({}) / Φ_standard({specular})", receptors.join(", "))
         }
+        ReadingSpec::HazeCompensated { receptors, specular, compensation, factor } => format!(
+            "100·(mean Φ({}) − {factor:.6}·Φ({compensation})) / Φ_standard({specular}) (factor = mean Ω⊥ of the haze \
+             receptors / Ω⊥({compensation}): a Lambertian body reads 0)",
+            receptors.join(", ")
+        ),
+        ReadingSpec::LogHazeCompensated { receptors, specular, compensation, factor, k } => format!(
+            "{k}·log10(H_c/20 + 1), H_c = 100·(mean Φ({}) − {factor:.6}·Φ({compensation})) / Φ_standard({specular})",
+            receptors.join(", ")
+        ),
         ReadingSpec::Doi { specular, offset } => {
             format!("100·(Φ({specular}) − mean Φ({})) / Φ({specular})", offset.join(", "))
         }
