@@ -15,7 +15,8 @@ fn reading(batch: bool) -> Value {
     let mut props = json!({
         "geometry": {"type": "string", "description": "the geometry id"},
         "name": {"type": "string", "description": "the reading's name (e.g. haze-narrow)"},
-        "quantity": {"type": "string", "enum": ["gloss", "haze", "log-haze", "doi", "haze-index", "rspec"]},
+        "quantity": {"type": "string", "enum": ["gloss", "haze", "log-haze", "haze-compensated",
+            "log-haze-compensated", "doi", "haze-index", "X", "Y", "Z", "L*", "a*", "b*", "C*", "h"]},
         "value": {"type": ["number", "null"], "description": "null when there is no finite value (see problem)"},
         "unit": {"type": "string"},
         "error_estimate": {"type": ["number", "null"], "minimum": 0, "description": "numerical error estimate"},
@@ -24,6 +25,9 @@ fn reading(batch: bool) -> Value {
         "seconds": {"type": "number", "minimum": 0, "description": "wall time; absent with --no-timing"},
         "problem": {"type": "string"},
         "note": {"type": "string"},
+        "envelope_min": {"type": ["number", "null"], "description": "with --envelope: the least reading within the tolerances"},
+        "envelope_max": {"type": ["number", "null"], "description": "with --envelope: the greatest reading within the tolerances"},
+        "envelope": {"type": "object", "description": "with --envelope: how the envelope was read (variants, method, numbers varied)"},
     });
     let mut required =
         vec!["geometry", "name", "quantity", "value", "unit", "error_estimate", "evaluations", "converged"];
