@@ -201,3 +201,22 @@ fn the_tolerance_floor_is_stated_and_enforced() {
     assert!(glossmeter::instrument::convergence::validate_tolerances(&[1e-6, 1e-11]).is_err());
     assert!(glossmeter::instrument::convergence::validate_tolerances(&[1e-6, 1e-10]).is_ok());
 }
+
+/// Issue 10: a narrow Gaussian lobe far from the overlap kinks is read by the Gauss–Hermite lobe rule, which
+/// `--explain` names with its fallback; a lobe over a diffuse body keeps Genz–Malik; a frozen re-run of the
+/// shaped rule gives the same bits.
+#[test]
+fn the_planner_names_the_shaped_rule_it_chooses_and_freezes_it() {
+    let g = vec![standards::find("astm-d523-20").unwrap()];
+    let b3 = Plan::compile(fixture("bench-b3-beckmann-1e-4.json"), g.clone(), PlanOptions::default()).unwrap();
+    let text = b3.explain();
+    assert!(text.contains("Gauss–Hermite in (u, v) scaled to the lobe"), "{text}");
+    assert!(text.contains("fallback: Genz–Malik 7/5"), "{text}");
+    let readings = b3.execute();
+    assert!(readings[0].converged && readings[0].evaluations <= 500, "{:?}", readings[0]);
+    let (first, frozen) = b3.freeze();
+    assert_eq!(bits(&first[0]), bits(&readings[0]));
+    assert_eq!(bits(&frozen.execute()[0]), bits(&readings[0]));
+    let paint = Plan::compile(fixture("cerulean-blue-c-literal.json"), g, PlanOptions::default()).unwrap();
+    assert!(!paint.explain().contains("Gauss–Hermite"), "a lobe over a diffuse body keeps the adaptive rule");
+}

@@ -16,14 +16,14 @@
 //! |Φ_r|) (+ the floor) as both parts are ≥ 0. The r·|Φ_δ| term needs the delta part's value, so it is the
 //! one quantity formed at run time (the smallest |Φ_δ| component, which keeps every component within its
 //! tolerance).
-use crate::brdf::{Brdf, Kink, Lobe};
+use crate::brdf::{Brdf, Kink, Lobe, TermKind};
 use crate::instrument::flux::{
     choose_chart, clip, delta_kinks, half_angle_kink_point, incidence_kink_point, kinked_position, lobe_boxes,
-    lobe_splits, mirror_overlap, regular_kinks, AxisMap, Chart, Flux, DELTA_SHARE,
+    lobe_splits, lobe_widths_uv, mirror_overlap, regular_kinks, AxisMap, Chart, Flux, DELTA_SHARE,
 };
 use crate::instrument::geometry::{solid_angle_density, Axes, Integral, Stop};
 use crate::instrument::sphere;
-use crate::quadrature::{integrate_partition, Cell, Estimate, Options, Refine};
+use crate::quadrature::{gauss_hermite, gauss_legendre, integrate_partition, Cell, Estimate, Options, Refine};
 use crate::spectrum::Weighting;
 use crate::Vec3;
 use std::time::Instant;
@@ -41,14 +41,29 @@ pub enum Target {
     Standard,
 }
 
-/// The cubature rule of a part. One today; the enum is where Gauss–Hermite (narrow Gaussian lobes) and
-/// tensor-product rules go when the plan learns to choose them.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// The cubature rule of a part, chosen by the planner ([`Method::design`]) from the material's lobes and the
+/// geometry; deterministic (the same method for the same input).
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Rule {
-    /// Genz & Malik's degree-7 rule with its embedded degree-5 rule for the error estimate
-    /// (`quadrature::Rule`), globally adaptive.
+    /// Genz & Malik's degree-7 rule with its embedded null rules for the error estimate
+    /// (`quadrature::Rule`), globally adaptive on the part's partition. The fallback of every other rule.
     GenzMalik75,
+    /// A narrow Gaussian-tailed lobe far from every kink of the overlap (issue 10): a tensor product of
+    /// Gauss–Hermite rules in u and v scaled to the lobe's widths (u = width[0]·x, v = width[1]·y, weight
+    /// e^{−x²−y²}) and Gauss–Legendre rules in t_p and t_q, the orders raised through [`LOBE_LEVELS`]
+    /// `levels.0..=levels.1` until two successive levels agree to the part's tolerance (their difference is
+    /// the error estimate). If none do, the part's Genz–Malik partition is integrated instead (the fallback).
+    LobeGaussHermite { width: [f64; 2], levels: (usize, usize) },
 }
+
+/// The (Gauss–Hermite, Gauss–Legendre) orders per axis of [`Rule::LobeGaussHermite`], level by level:
+/// 4²·2² = 64 points, then 324, 1 024, 3 600, 9 216.
+pub const LOBE_LEVELS: [(usize, usize); 5] = [(4, 2), (6, 3), (8, 4), (12, 5), (16, 6)];
+
+/// How far (in lobe widths) the nearest overlap kink or range end must be from the lobe centre, on both
+/// axes, for [`Rule::LobeGaussHermite`]: the largest node of the 16-point rule is at 4.69 widths, and the
+/// Gaussian is below e⁻⁶⁴ of its peak at 8.
+pub const LOBE_REACH: f64 = 8.0;
 
 /// When the spectral weighting is applied.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -146,9 +161,10 @@ pub struct Design<'a> {
     pub lobes: &'a [Lobe],
     /// The material's kinks (`Brdf::kinks`): put on partition boundaries.
     pub kinks: &'a [Kink],
-    /// Whether the material has a delta term and a regular (diffuse or lobe) term.
+    /// Whether the material has a delta term and a regular (diffuse or lobe) term, and a diffuse one.
     pub has_delta: bool,
     pub has_regular: bool,
+    pub has_diffuse: bool,
     pub weighting: Weighting,
     pub projection: Projection,
     /// Relative tolerance of the flux and its absolute floor.
@@ -214,9 +230,15 @@ impl Method {
                     ),
                 };
                 let share = 1.0 - DELTA_SHARE;
+                let rule = match chart {
+                    Chart::Lobe if kinks.is_empty() && on_mirror_axis => {
+                        lobe_rule(d.lobes, d.has_diffuse, d.theta, src, rec).unwrap_or(Rule::GenzMalik75)
+                    }
+                    _ => Rule::GenzMalik75,
+                };
                 Some(RegularPart {
                     chart,
-                    rule: Rule::GenzMalik75,
+                    rule,
                     splits,
                     kinks,
                     cells: Cell::from_boxes(&boxes),
@@ -267,6 +289,7 @@ impl Method {
             kinks: &brdf.kinks(),
             has_delta: brdf.has_delta(),
             has_regular: brdf.has_regular(),
+            has_diffuse: brdf.terms().iter().any(|t| t.kind == TermKind::Diffuse),
             weighting: Weighting::luminous(brdf.sampling())?,
             projection: Projection::Fold,
             rtol: tolerance.0,
@@ -412,50 +435,66 @@ impl Method {
             let delta_min = flux.delta.iter().map(|d| d.abs()).fold(f64::INFINITY, f64::min);
             let atol = part.atol.max(part.rtol * delta_min);
             let mut batch = PairBatch::default();
-            let (est, cells) = integrate_partition::<4, _>(
-                |pts, out| {
-                    batch.clear(pts.len());
-                    for (i, x) in pts.iter().enumerate() {
-                        let (ps, qs, pr, qr, jac) = if plain {
-                            (x[0], x[1], x[2], x[3], 1.0)
-                        } else if part.kinks.is_empty() {
-                            let (ps, pr, jp) = ap.at(x[0], x[1]);
-                            let (qs, qr, jq) = aq.at(x[2], x[3]);
-                            (ps, qs, pr, qr, jp * jq)
-                        } else {
-                            let (qs, qr, jq) = aq.at(x[2], x[3]);
-                            let u = x[0];
-                            let (lo, hi) = ap.overlap(u);
-                            let (ps, jp) = kinked_position(x[1], lo, hi, part.kinks.len(), |k| {
-                                let c = part.kinks[k];
-                                half_angle_kink_point(&axes, 2.0 * c * c - 1.0, u, qs, qr, lo, hi)
-                            });
-                            (ps, qs, u - ps, qr, jp * jq)
-                        };
-                        if jac <= 0.0 {
-                            continue;
-                        }
-                        let wi = axes.source_dir(ps, qs);
-                        let wo = rec_axes.receptor_dir(pr, qr);
-                        if wi.z <= 0.0 || wo.z <= 0.0 {
-                            continue;
-                        }
-                        let g = wi.z * wo.z * solid_angle_density(ps, qs) * solid_angle_density(pr, qr) * jac;
-                        batch.push(i, wi, wo, g);
+            let mut integrand = |pts: &[[f64; 4]], out: &mut [f64]| {
+                batch.clear(pts.len());
+                for (i, x) in pts.iter().enumerate() {
+                    let (ps, qs, pr, qr, jac) = if plain {
+                        (x[0], x[1], x[2], x[3], 1.0)
+                    } else if part.kinks.is_empty() {
+                        let (ps, pr, jp) = ap.at(x[0], x[1]);
+                        let (qs, qr, jq) = aq.at(x[2], x[3]);
+                        (ps, qs, pr, qr, jp * jq)
+                    } else {
+                        let (qs, qr, jq) = aq.at(x[2], x[3]);
+                        let u = x[0];
+                        let (lo, hi) = ap.overlap(u);
+                        let (ps, jp) = kinked_position(x[1], lo, hi, part.kinks.len(), |k| {
+                            let c = part.kinks[k];
+                            half_angle_kink_point(&axes, 2.0 * c * c - 1.0, u, qs, qr, lo, hi)
+                        });
+                        (ps, qs, u - ps, qr, jp * jq)
+                    };
+                    if jac <= 0.0 {
+                        continue;
                     }
-                    batch.values.clear();
-                    batch.values.resize(batch.wi.len() * n, 0.0);
-                    brdf.eval_batch(&batch.wi, &batch.wo, &mut batch.values);
-                    for ((&i, &g), v) in batch.index.iter().zip(&batch.g).zip(batch.values.chunks_exact(n)) {
-                        store(&mut out[i * ncomp..(i + 1) * ncomp], v, weighting, g, projection);
+                    let wi = axes.source_dir(ps, qs);
+                    let wo = rec_axes.receptor_dir(pr, qr);
+                    if wi.z <= 0.0 || wo.z <= 0.0 {
+                        continue;
                     }
-                },
-                ncomp,
-                &part.cells,
-                &Options { rtol: part.rtol, atol, max_evals: self.max_evals, deadline },
-                part.refine,
-                keep,
-            );
+                    let g = wi.z * wo.z * solid_angle_density(ps, qs) * solid_angle_density(pr, qr) * jac;
+                    batch.push(i, wi, wo, g);
+                }
+                batch.values.clear();
+                batch.values.resize(batch.wi.len() * n, 0.0);
+                brdf.eval_batch(&batch.wi, &batch.wo, &mut batch.values);
+                for ((&i, &g), v) in batch.index.iter().zip(&batch.g).zip(batch.values.chunks_exact(n)) {
+                    store(&mut out[i * ncomp..(i + 1) * ncomp], v, weighting, g, projection);
+                }
+            };
+            let opts = Options { rtol: part.rtol, atol, max_evals: self.max_evals, deadline };
+            // A shaped rule first (when the planner chose one), the Genz–Malik partition if it does not agree.
+            let mut spent = 0;
+            let shaped = match part.rule {
+                Rule::LobeGaussHermite { width, levels } => {
+                    let r = lobe_gauss_hermite(&mut integrand, ncomp, width, levels, &opts, part.refine);
+                    spent = r.1;
+                    r.0
+                }
+                Rule::GenzMalik75 => None,
+            };
+            let (mut est, cells, rule) = match shaped {
+                Some((est, level)) => {
+                    let Rule::LobeGaussHermite { width, .. } = part.rule else { unreachable!("shaped") };
+                    (est, part.cells.clone(), Rule::LobeGaussHermite { width, levels: (level - 1, level) })
+                }
+                None => {
+                    let (est, cells) =
+                        integrate_partition::<4, _>(&mut integrand, ncomp, &part.cells, &opts, part.refine, keep);
+                    (est, cells, Rule::GenzMalik75)
+                }
+            };
+            est.evaluations += spent;
             let (regular, regular_err) = weighted(&est);
             flux.regular = regular;
             flux.error = flux.error.iter().zip(&regular_err).map(|(a, b)| a + b).collect();
@@ -467,6 +506,7 @@ impl Method {
             if let Some(m) = frozen.as_mut() {
                 let p = m.regular.as_mut().expect("the same parts");
                 p.cells = cells;
+                p.rule = rule;
                 p.refine = Refine::Frozen;
             }
         }
@@ -474,6 +514,99 @@ impl Method {
         flux.seconds = start.elapsed().as_secs_f64();
         (flux, frozen)
     }
+}
+
+/// The shaped rule of a lobe-chart part, if one fits: [`Rule::LobeGaussHermite`] for a material whose regular
+/// part is one Gaussian-tailed lobe (no diffuse term, no heavy tail) whose centre u = v = 0 is inside the
+/// range of the lobe variables and at least
+/// [`LOBE_REACH`] widths from every kink of the overlap length and every end of the range, on both axes.
+pub fn lobe_rule(lobes: &[Lobe], has_diffuse: bool, theta: f64, src: Stop, rec: Stop) -> Option<Rule> {
+    let [lobe] = lobes else { return None };
+    if has_diffuse || lobe.heavy_tail {
+        return None;
+    }
+    let width = lobe_widths_uv(lobe, theta);
+    let clear = |a: AxisMap, w: f64| {
+        let [lo, hi] = a.range();
+        let kinks = [lo, hi, a.s[1] + a.r[0], a.s[0] + a.r[1]];
+        w > 0.0 && w.is_finite() && lo < 0.0 && hi > 0.0 && kinks.iter().all(|k| k.abs() >= LOBE_REACH * w)
+    };
+    let fits = clear(AxisMap { s: src.p, r: rec.p }, width[0]) && clear(AxisMap { s: src.q, r: rec.q }, width[1]);
+    fits.then_some(Rule::LobeGaussHermite { width, levels: (0, LOBE_LEVELS.len() - 1) })
+}
+
+/// One level of [`Rule::LobeGaussHermite`]: the tensor rule's sum per component, in a fixed point order.
+fn lobe_tensor_sum(
+    f: &mut impl FnMut(&[[f64; 4]], &mut [f64]),
+    ncomp: usize,
+    width: [f64; 2],
+    (nh, nt): (usize, usize),
+) -> Vec<f64> {
+    let (xh, wh) = gauss_hermite(nh);
+    // ∫ g(u) du = w ∫ g(w x) e^{x²} e^{−x²} dx: the weights for g itself.
+    let wh: Vec<f64> = xh.iter().zip(&wh).map(|(x, w)| w * (x * x).exp()).collect();
+    let (xl, wl) = gauss_legendre(nt);
+    let tl: Vec<f64> = xl.iter().map(|x| 0.5 * (x + 1.0)).collect();
+    let wl: Vec<f64> = wl.iter().map(|w| 0.5 * w).collect();
+    let mut pts = Vec::with_capacity(nh * nt * nt);
+    let mut wts = Vec::with_capacity(nh * nt * nt);
+    let mut vals = vec![0.0; nh * nt * nt * ncomp];
+    let mut sum = vec![0.0; ncomp];
+    for (x, wx) in xh.iter().zip(&wh) {
+        pts.clear();
+        wts.clear();
+        for (y, wy) in xh.iter().zip(&wh) {
+            for (tp, wp) in tl.iter().zip(&wl) {
+                for (tq, wq) in tl.iter().zip(&wl) {
+                    pts.push([width[0] * x, *tp, width[1] * y, *tq]);
+                    wts.push(wx * wy * wp * wq);
+                }
+            }
+        }
+        vals.iter_mut().for_each(|v| *v = 0.0);
+        f(&pts, &mut vals);
+        for (w, v) in wts.iter().zip(vals.chunks_exact(ncomp)) {
+            for c in 0..ncomp {
+                let v = if v[c].is_finite() { v[c] } else { 0.0 };
+                sum[c] += w * v;
+            }
+        }
+    }
+    sum.iter().map(|s| s * width[0] * width[1]).collect()
+}
+
+/// Run [`Rule::LobeGaussHermite`]: levels `levels.0..=levels.1` of [`LOBE_LEVELS`] until two successive ones
+/// agree to max(atol, rtol·|I|) in every component (adaptive), or just those levels (frozen). Returns the
+/// estimate and its last level when they agree, else None, and the evaluations spent either way.
+fn lobe_gauss_hermite(
+    f: &mut impl FnMut(&[[f64; 4]], &mut [f64]),
+    ncomp: usize,
+    width: [f64; 2],
+    levels: (usize, usize),
+    opts: &Options,
+    refine: Refine,
+) -> (Option<(Estimate, usize)>, usize) {
+    let cost = |(nh, nt): (usize, usize)| nh * nh * nt * nt;
+    let mut evals = 0;
+    let mut previous: Option<Vec<f64>> = None;
+    let last = levels.1.min(LOBE_LEVELS.len() - 1);
+    for (level, &orders) in LOBE_LEVELS.iter().enumerate().take(last + 1).skip(levels.0) {
+        if evals + cost(orders) > opts.max_evals {
+            break;
+        }
+        let now = lobe_tensor_sum(f, ncomp, width, orders);
+        evals += cost(orders);
+        if let Some(prev) = previous {
+            let error: Vec<f64> = now.iter().zip(&prev).map(|(a, b)| (a - b).abs()).collect();
+            let converged = now.iter().zip(&error).all(|(v, e)| *e <= opts.atol.max(opts.rtol * v.abs()));
+            if converged || refine == Refine::Frozen {
+                let est = Estimate { value: now, error, evaluations: 0, regions: 1, converged, out_of_time: false };
+                return (Some((est, level)), evals);
+            }
+        }
+        previous = Some(now);
+    }
+    (None, evals)
 }
 
 /// The initial boxes of a lobe chart with `kinks` kinks: every box cut on t_p into kinks + 1 equal pieces

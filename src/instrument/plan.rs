@@ -30,7 +30,7 @@ use crate::colorimetry::{cielab, Conditions};
 use crate::instrument::flux::{lobe_widths_uv, Chart, Flux, DELTA_SHARE};
 use crate::instrument::geometry::{ColourQuantity, Integral, ReadingSpec, Scale, Stop};
 pub use crate::instrument::method::Target;
-use crate::instrument::method::{Design, Method, Projection};
+use crate::instrument::method::{Design, Method, Projection, Rule, LOBE_LEVELS, LOBE_REACH};
 use crate::instrument::standards::{self, StandardGeometry};
 use crate::quadrature::Refine;
 use crate::spectrum::{Sampling, Weighting, WeightingKind};
@@ -353,6 +353,7 @@ impl Planner {
                 kinks: &[],
                 has_delta: true,
                 has_regular: false,
+                has_diffuse: false,
                 weighting: standard_weighting.clone(),
                 projection: Projection::Fold,
                 rtol: STANDARD_SHARE * options.rtol,
@@ -393,6 +394,7 @@ impl Planner {
         let kinks = material.kinks();
         let has_delta = material.has_delta();
         let has_regular = material.has_regular();
+        let has_diffuse = terms.iter().any(|t| t.kind == TermKind::Diffuse);
         let projection = if options.fold_spectral { Projection::Fold } else { Projection::Separate };
         let mut jobs = Vec::with_capacity(drafts.len());
         let mut standard_flux = vec![None; drafts.len()];
@@ -415,6 +417,7 @@ impl Planner {
                     kinks: &kinks,
                     has_delta,
                     has_regular,
+                    has_diffuse,
                     // Only the kinds of the readings that use this flux: a gloss flux stays one luminous
                     // component (and the same bits) whatever colour readings share the plan.
                     weighting: Weighting::stack(&d.kinds, material.sampling())?,
@@ -857,7 +860,24 @@ fn describe_method(m: &Method, terms: &[Term]) -> String {
                 describe_kinks(&p.kinks, "t_p cut along ωi·h = cos θc")
             ),
         };
-        format!("{chart}, Genz–Malik 7/5 on {} initial box(es){}", p.cells.len(), frozen(p.refine))
+        let rule = match p.rule {
+            Rule::GenzMalik75 => format!("Genz–Malik 7/5 on {} initial box(es)", p.cells.len()),
+            Rule::LobeGaussHermite { width, levels } => format!(
+                "Gauss–Hermite in (u, v) scaled to the lobe ({:.3e} × {:.3e}) × Gauss–Legendre in (t_p, t_q), \
+                 orders {} raised until two successive agree (the lobe is ≥ {} widths from every overlap kink; \
+                 fallback: Genz–Malik 7/5 on {} initial box(es))",
+                width[0],
+                width[1],
+                LOBE_LEVELS[levels.0..=levels.1]
+                    .iter()
+                    .map(|(h, l)| format!("{h}²×{l}²"))
+                    .collect::<Vec<_>>()
+                    .join(" → "),
+                LOBE_REACH,
+                p.cells.len()
+            ),
+        };
+        format!("{chart}, {rule}{}", frozen(p.refine))
     });
     match (delta.is_empty(), regular) {
         (true, None) => "nothing to integrate: zero".to_string(),
