@@ -256,6 +256,7 @@ fn reference_reading(
     let mean = |names: &[String]| names.iter().map(|n| specimen(stop(n))).sum::<f64>() / names.len() as f64;
     match spec {
         ReadingSpec::Gloss { receptor } => 100.0 * specimen(stop(receptor)) / standard(stop(receptor)),
+        ReadingSpec::Profile { receptor, reference } => 100.0 * specimen(stop(receptor)) / standard(stop(reference)),
         ReadingSpec::Haze { receptors, specular } => 100.0 * mean(receptors) / standard(stop(specular)),
         ReadingSpec::LogHaze { receptors, specular, k } => {
             k * ((100.0 * mean(receptors) / standard(stop(specular))) / 20.0 + 1.0).log10()

@@ -19,6 +19,7 @@ const IDS: &[&str] = &[
     "astm-d4039",
     "astm-d2457-45",
     "tappi-t480-75",
+    "rspec-20",
 ];
 
 fn root() -> PathBuf {

@@ -21,6 +21,7 @@ pub mod junit;
 pub mod output;
 pub mod pictures;
 pub mod plot;
+pub mod profile;
 pub mod sweep;
 
 pub use output::{print, Target, STDOUT};
@@ -138,6 +139,9 @@ pub enum Command {
     Fit(fit::FitArgs),
     /// Draw a picture (PNG or SVG): the in-plane BRDF section with the apertures, or readings against a parameter.
     Plot(pictures::PlotArgs),
+    /// The goniophotometric profile about the 20° specular direction (Rhopoint IQ-class 512-pixel array):
+    /// one row per pixel, angle and normalised reading with their error estimates (CSV or JSON).
+    Profile(profile::ProfileArgs),
 }
 
 /// Run the CLI; returns the process exit status.
@@ -281,6 +285,7 @@ fn dispatch(cli: Cli) -> Result<()> {
         Command::Compare(args) => compare::run(args),
         Command::Fit(args) => fit::run(args),
         Command::Plot(args) => pictures::run(args),
+        Command::Profile(args) => profile::run(args),
         Command::Sweep(args) => sweep::run(args),
         Command::Schema { output_format } => {
             let schema = match output_format {

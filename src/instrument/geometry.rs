@@ -116,6 +116,10 @@ pub enum ReadingSpec {
     LogHazeCompensated { receptors: Vec<String>, specular: String, compensation: String, factor: f64, k: f64 },
     /// Distinctness of image: 100·(Φ(specular) − mean_r Φ(r)) / Φ(specular), all on the specimen.
     Doi { specular: String, offset: Vec<String> },
+    /// One pixel of a goniophotometric profile (`instrument::profile`), GU: 100·Φ(specimen, `receptor`) /
+    /// Φ(standard, `reference`), the reference being a pixel-sized window centred on the specular direction.
+    /// Built by the profile module, not written in geometry files.
+    Profile { receptor: String, reference: String },
     /// Haze index (ASTM D4039): gloss of one geometry minus the gloss of another.
     HazeIndex { minuend: String, subtrahend: String },
     /// A colour reading (`docs/colour.md`): from X, Y, Z = Σ sign·Φ_XYZ(integral) / `white` over the named
@@ -188,6 +192,7 @@ impl ReadingSpec {
             ReadingSpec::HazeCompensated { .. } => "haze-compensated",
             ReadingSpec::LogHazeCompensated { .. } => "log-haze-compensated",
             ReadingSpec::Doi { .. } => "doi",
+            ReadingSpec::Profile { .. } => "profile",
             ReadingSpec::HazeIndex { .. } => "haze-index",
             ReadingSpec::Colour { quantity, .. } => quantity.name(),
         }
@@ -205,7 +210,7 @@ impl ReadingSpec {
 
     pub fn unit(&self) -> &'static str {
         match self {
-            ReadingSpec::Gloss { .. } | ReadingSpec::HazeIndex { .. } => "GU",
+            ReadingSpec::Gloss { .. } | ReadingSpec::HazeIndex { .. } | ReadingSpec::Profile { .. } => "GU",
             ReadingSpec::Haze { .. } | ReadingSpec::HazeCompensated { .. } => "HU",
             ReadingSpec::LogHaze { .. } | ReadingSpec::LogHazeCompensated { .. } => "HU(log)",
             ReadingSpec::Doi { .. } => "DOI",

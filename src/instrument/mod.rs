@@ -14,6 +14,7 @@ pub mod flux;
 pub mod geometry;
 pub mod method;
 pub mod plan;
+pub mod profile;
 pub mod reference;
 pub mod sheet;
 pub mod sphere;

@@ -485,6 +485,7 @@ fn add_geometry(
         let name = sg.reading_names.get(ri).cloned().unwrap_or_else(|| spec.quantity().to_string());
         let (spec_rx, std_rx): (Vec<&String>, Vec<&String>) = match spec {
             ReadingSpec::Gloss { receptor } => (vec![receptor], vec![receptor]),
+            ReadingSpec::Profile { receptor, reference } => (vec![receptor], vec![reference]),
             ReadingSpec::Haze { receptors, specular } | ReadingSpec::LogHaze { receptors, specular, .. } => {
                 (receptors.iter().collect(), vec![specular])
             }
@@ -951,6 +952,10 @@ pub fn reading_value(
     match spec {
         ReadingSpec::Gloss { receptor } => {
             let ((s, se), (d, de)) = (specimen(receptor), standard(receptor));
+            ratio(s, se, d, de, Denominator::Standard).map(|(v, e)| (100.0 * v, 100.0 * e))
+        }
+        ReadingSpec::Profile { receptor, reference } => {
+            let ((s, se), (d, de)) = (specimen(receptor), standard(reference));
             ratio(s, se, d, de, Denominator::Standard).map(|(v, e)| (100.0 * v, 100.0 * e))
         }
         ReadingSpec::Haze { receptors, specular } => {

@@ -88,7 +88,7 @@ pub const READING_COLUMNS: &[ReadingColumn] = &[
         geometry: "rspec-20",
         reading: "rspec",
         not_predicted: None,
-        source: "Rhopoint IQ peak specular reflectance at 20° (predicted where the `rspec-20` geometry is shipped)",
+        source: "Rhopoint IQ peak specular reflectance at 20° (the `rspec-20` geometry, docs/instrument.md §1.8)",
     },
     ReadingColumn {
         names: &["riq", "reflectedimagequality"],

@@ -26,6 +26,7 @@ pub const BUILTIN: &[(&str, &str)] = &[
     ("astm-d4039.json", include_str!("../../standards/astm-d4039.json")),
     ("astm-d2457-45.json", include_str!("../../standards/astm-d2457-45.json")),
     ("tappi-t480-75.json", include_str!("../../standards/tappi-t480-75.json")),
+    ("rspec-20.json", include_str!("../../standards/rspec-20.json")),
 ];
 
 /// The allowed provenance words of a sourced number.
@@ -43,9 +44,20 @@ pub struct StandardGeometry {
     pub origin: String,
 }
 
-const TOP_FIELDS: &[&str] =
-    &["id", "title", "standards", "angle_deg", "scale", "reference_index", "source", "receptors", "readings", "notes"];
-const GEOMETRY_ONLY: &[&str] = &["angle_deg", "scale", "reference_index", "source", "receptors"];
+const TOP_FIELDS: &[&str] = &[
+    "id",
+    "title",
+    "standards",
+    "angle_deg",
+    "scale",
+    "reference_index",
+    "source",
+    "receptors",
+    "readings",
+    "notes",
+    "profile",
+];
+const GEOMETRY_ONLY: &[&str] = &["angle_deg", "scale", "reference_index", "source", "receptors", "profile"];
 
 /// The allowed `scale.kind` values.
 pub const SCALE_KINDS: &[&str] = &["black-glass", "mirror"];
@@ -289,6 +301,9 @@ pub fn parse(text: &str, origin: &str) -> Result<StandardGeometry> {
             ));
         }
         let source = Stop::from_angles(s_in.to_radians(), s_perp.to_radians(), 0.0);
+        if let Some(p) = o.opt_obj("profile")? {
+            crate::instrument::profile::parse_spec(&p, angle)?;
+        }
         let rec_v = o.array("receptors")?;
         if rec_v.is_empty() {
             return Err(o.err("receptors", "at least one receptor is required"));
@@ -665,6 +680,15 @@ pub fn describe(g: &StandardGeometry) -> String {
             out += &format!("    offset from specular: {}\n", sourced_text(r.get("offset_deg"), "°"));
         }
     }
+    if let Some(p) = s.get("profile") {
+        out += "  profile array (glossmeter profile):\n";
+        out += &format!("    pixels: {}\n", sourced_text(p.get("pixels"), ""));
+        out += &format!("    pixel size in plane: {}\n", sourced_text(p.get("pixel_deg"), "°"));
+        out += &format!("    pixel height: {}\n", sourced_text(p.get("perpendicular_deg"), "°"));
+        if let Some(n) = p.get("notes").and_then(Value::as_str) {
+            out += &format!("    {n}\n");
+        }
+    }
     out += "  readings:\n";
     let rv = s.get("readings").and_then(Value::as_array).cloned().unwrap_or_default();
     for ((spec, name), raw) in geo.readings.iter().zip(&g.reading_names).zip(&rv) {
@@ -701,6 +725,7 @@ fn reading_summary(r: &ReadingSpec) -> String {
             format!("100·(Φ({specular}) − mean Φ({})) / Φ({specular})", offset.join(", "))
         }
         ReadingSpec::HazeIndex { minuend, subtrahend } => format!("gloss({minuend}) − gloss({subtrahend})"),
+        ReadingSpec::Profile { receptor, reference } => format!("100·Φ({receptor}) / Φ_standard({reference})"),
         ReadingSpec::Colour { quantity, terms, .. } => {
             let t: Vec<String> =
                 terms.iter().map(|(n, s)| format!("{}Φ_XYZ({n})", if *s < 0.0 { "− " } else { "" })).collect();

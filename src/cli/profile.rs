@@ -1,0 +1,180 @@
+//! `glossmeter profile`: the goniophotometric profile of a recipe on a geometry with a profile array
+//! (default `rspec-20`, the 512-pixel array of a Rhopoint IQ-class meter), one row per pixel with its angle,
+//! its normalised reading and their error estimates, as CSV or JSON, and optionally a picture. The
+//! computation is `instrument::profile::measure`; this module parses, formats and writes.
+use std::path::PathBuf;
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use serde_json::json;
+
+use super::format::plain;
+use super::plot::plot_err;
+use super::Target;
+use crate::instrument::plan::PlanOptions;
+use crate::instrument::profile::{self, Profile};
+use crate::recipe::{self, Material};
+use crate::{Error, Result};
+
+/// The geometry profiled when none is given.
+pub const DEFAULT_GEOMETRY: &str = "rspec-20";
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum ProfileFormat {
+    Csv,
+    Json,
+}
+
+/// Arguments of `glossmeter profile`.
+#[derive(clap::Args, Debug)]
+pub struct ProfileArgs {
+    /// The recipe (JSON).
+    pub recipe: PathBuf,
+    /// A shipped geometry id with a profile array (default rspec-20).
+    #[arg(long = "geometry", short = 'g')]
+    pub geometry: Option<String>,
+    /// A user geometry file with a `profile` block (instead of --geometry).
+    #[arg(long = "geometry-file", conflicts_with = "geometry")]
+    pub geometry_file: Option<PathBuf>,
+    #[arg(long, value_enum, default_value_t = ProfileFormat::Csv)]
+    pub format: ProfileFormat,
+    /// Also draw the profile (reading against angle) to this new .svg or .png file.
+    #[arg(long, value_name = "FILE.svg")]
+    pub plot: Option<PathBuf>,
+    /// Write the CSV/JSON to this new file instead of stdout (refuses to overwrite).
+    #[arg(long, short = 'o')]
+    pub output: Option<PathBuf>,
+    /// Relative tolerance of every pixel's reading.
+    #[arg(long, default_value_t = 1e-6)]
+    pub rtol: f64,
+    /// Exit 0 even if a pixel did not converge within its budget (it is still marked in the output).
+    #[arg(long)]
+    pub allow_unconverged: bool,
+}
+
+pub fn run(args: ProfileArgs) -> Result<()> {
+    super::check_rtol(args.rtol)?;
+    let target = Target::new(args.output.as_deref(), "--output")?;
+    if let Some(p) = &args.plot {
+        super::plot::check_plot_path(p, "--plot")?;
+        if args.output.as_deref() == Some(p.as_path()) {
+            return Err(Error::Usage(format!("--plot and --output name the same file {}", p.display())));
+        }
+    }
+    let material = recipe::load_file(&args.recipe)?;
+    let g = match &args.geometry_file {
+        Some(f) => crate::instrument::standards::load_file(f)?,
+        None => crate::instrument::standards::find(args.geometry.as_deref().unwrap_or(DEFAULT_GEOMETRY))?,
+    };
+    // Checked before any work: the geometry must have a profile array.
+    profile::of(&g)?;
+    let options = PlanOptions { rtol: args.rtol, ..PlanOptions::default() };
+    let prof = profile::measure(material.brdf.clone(), &g, options)?;
+    let text = match args.format {
+        ProfileFormat::Csv => csv(&prof)?,
+        ProfileFormat::Json => json(&material, &prof),
+    };
+    if let Some(p) = &args.plot {
+        let title = format!("{}: {} profile", material.name, prof.geometry);
+        crate::render_plot!(p, "--plot", (1000, 640), |root| draw(root, &prof, &title))?;
+        eprintln!("plot: {} ({} pixels)", p.display(), prof.rows.len());
+    }
+    target.write(&text)?;
+    let readings: Vec<crate::Reading> = prof.rows.iter().map(|r| r.reading.clone()).collect();
+    super::readings_status(&readings, args.allow_unconverged)
+}
+
+/// The columns of the CSV, in order (also the keys of a JSON row).
+pub const COLUMNS: &[&str] =
+    &["pixel", "angle_deg", "angle_half_width_deg", "value", "error_estimate", "unit", "converged", "evaluations"];
+
+/// CSV: one line per pixel, every number in full precision; an empty value where there is none.
+pub fn csv(p: &Profile) -> Result<String> {
+    let mut w = csv::Writer::from_writer(vec![]);
+    let err = |e: csv::Error| Error::Io { file: "<csv>".into(), source: std::io::Error::other(e) };
+    w.write_record(COLUMNS).map_err(err)?;
+    for r in &p.rows {
+        w.write_record([
+            r.pixel.to_string(),
+            plain(r.angle_deg),
+            plain(r.half_width_deg),
+            r.reading.value.map(plain).unwrap_or_default(),
+            if r.reading.value.is_some() { plain(r.reading.error_estimate) } else { String::new() },
+            r.reading.unit.clone(),
+            r.reading.converged.to_string(),
+            r.reading.evaluations.to_string(),
+        ])
+        .map_err(err)?;
+    }
+    let bytes =
+        w.into_inner().map_err(|e| Error::Io { file: "<csv>".into(), source: std::io::Error::other(e.to_string()) })?;
+    Ok(String::from_utf8(bytes).expect("csv is utf-8"))
+}
+
+/// JSON: the material, the array and one object per pixel (null where there is no value).
+pub fn json(material: &Material, p: &Profile) -> String {
+    let rows: Vec<serde_json::Value> = p
+        .rows
+        .iter()
+        .map(|r| {
+            let value = r.reading.value;
+            json!({
+                "pixel": r.pixel,
+                "angle_deg": r.angle_deg,
+                "angle_half_width_deg": r.half_width_deg,
+                "value": value,
+                "error_estimate": value.map(|_| r.reading.error_estimate),
+                "unit": r.reading.unit,
+                "converged": r.reading.converged,
+                "evaluations": r.reading.evaluations,
+                "problem": r.reading.problem,
+            })
+        })
+        .collect();
+    let doc = json!({
+        "material": {"name": material.name, "file": material.file, "model": material.brdf.describe()},
+        "geometry": p.geometry,
+        "pixels": p.spec.pixels,
+        "pixel_deg": p.spec.pixel_deg,
+        "perpendicular_deg": p.spec.perpendicular.to_degrees(),
+        "normalisation": "100·Φ(specimen, pixel) / Φ(gloss standard, a pixel-sized window centred on the specular \
+                          direction): the standard reads 100 inside its source image (docs/instrument.md §1.8)",
+        "evaluations": p.rows.iter().map(|r| r.reading.evaluations).sum::<usize>(),
+        "rows": rows,
+    });
+    let mut s = serde_json::to_string_pretty(&doc).expect("finite values serialise");
+    s.push('\n');
+    s
+}
+
+/// Draw the profile: reading (GU) against the angle from the specular direction, one point per pixel joined
+/// by a line; pixels without a value are left out (the caption says how many).
+fn draw<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, p: &Profile, title: &str) -> Result<()> {
+    root.fill(&WHITE).map_err(plot_err)?;
+    let pts: Vec<(f64, f64)> = p.rows.iter().filter_map(|r| r.reading.value.map(|v| (r.angle_deg, v))).collect();
+    let missing = p.rows.len() - pts.len();
+    let (x0, x1) =
+        p.rows.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), r| (a.min(r.angle_deg), b.max(r.angle_deg)));
+    let (x0, x1) = if x0 < x1 { (x0, x1) } else { (x0 - 1.0, x0 + 1.0) };
+    let ymax = pts.iter().map(|(_, v)| *v).fold(0.0, f64::max);
+    let ymin = pts.iter().map(|(_, v)| *v).fold(0.0, f64::min);
+    let ymax = if ymax > ymin { ymax * 1.05 } else { ymin + 1.0 };
+    let caption = if missing > 0 { format!(" ({missing} pixels without a value left out)") } else { String::new() };
+    let mut chart = ChartBuilder::on(&root)
+        .caption(format!("{title}{caption}"), ("sans-serif", 22))
+        .margin(16)
+        .x_label_area_size(44)
+        .y_label_area_size(64)
+        .build_cartesian_2d(x0..x1, ymin..ymax)
+        .map_err(plot_err)?;
+    chart
+        .configure_mesh()
+        .x_desc("angle from the specular direction (°)")
+        .y_desc("reading (GU, standard = 100)")
+        .label_style(("sans-serif", 15))
+        .draw()
+        .map_err(plot_err)?;
+    chart.draw_series(LineSeries::new(pts.iter().copied(), BLUE.stroke_width(2))).map_err(plot_err)?;
+    root.present().map_err(plot_err)?;
+    Ok(())
+}
