@@ -143,6 +143,25 @@ pub struct Reading {
     pub note: Option<String>,
 }
 
+/// One execution of a plan ([`Plan::run`]): the readings, and the flux of every integral of the plan.
+#[derive(Clone, Debug)]
+pub struct Execution {
+    pub readings: Vec<Reading>,
+    /// One flux per job of the plan, in plan order (`Plan::jobs`): the specimen integrals computed by this
+    /// execution and the gloss standards' fluxes computed when the plan was compiled.
+    pub fluxes: Vec<Flux>,
+}
+
+impl Execution {
+    /// The BRDF evaluations of the whole plan: every distinct integral (job) counted once, the gloss
+    /// standards' integrals included (as in each reading's own count). A reading's `evaluations` counts
+    /// every integral it uses, so an integral shared by several readings is in each of their counts but
+    /// only once here. A frozen plan's integrals count what its fixed partitions cost.
+    pub fn evaluations(&self) -> usize {
+        self.fluxes.iter().map(|f| f.evaluations).sum()
+    }
+}
+
 /// The shape of a material, which a plan's methods depend on: its sampling and the kinds of its terms.
 #[derive(Clone, Debug, PartialEq)]
 struct Shape {
@@ -633,6 +652,12 @@ impl Plan {
     /// Execute the plan: every specimen method on the material (the standards' fluxes were computed when the
     /// plan was compiled), then the readings. The specimen integrals share one wall-clock deadline.
     pub fn execute(&self) -> Vec<Reading> {
+        self.run().readings
+    }
+
+    /// [`Plan::execute`], keeping the flux of every integral with the readings: what the whole plan cost
+    /// ([`Execution::evaluations`], each distinct integral counted once).
+    pub fn run(&self) -> Execution {
         let deadline = self.deadline();
         let todo = self.specimen_jobs();
         let computed: Vec<Flux> =
@@ -641,8 +666,8 @@ impl Plan {
         for (&j, f) in todo.iter().zip(computed) {
             flux[j] = Some(f);
         }
-        let flux: Vec<Flux> = flux.into_iter().map(|f| f.expect("every job ran")).collect();
-        self.readings_from(&flux)
+        let fluxes: Vec<Flux> = flux.into_iter().map(|f| f.expect("every job ran")).collect();
+        Execution { readings: self.readings_from(&fluxes), fluxes }
     }
 
     /// The jobs to run on the material, in plan order. Only these go to the thread pool: a plan with one
