@@ -54,6 +54,13 @@ pub fn measure_many(
 
 /// [`measure_many`] keeping each material's execution (its readings and the fluxes of its plan, for the
 /// plan's evaluation count).
-pub fn run_many(materials: &[Material], geometries: &[StandardGeometry], options: &PlanOptions) -> Result<Vec<Execution>> {
-    materials.par_iter().map(|m| Ok(Plan::compile(m.brdf.clone(), geometries.to_vec(), options.clone())?.run())).collect()
+pub fn run_many(
+    materials: &[Material],
+    geometries: &[StandardGeometry],
+    options: &PlanOptions,
+) -> Result<Vec<Execution>> {
+    materials
+        .par_iter()
+        .map(|m| Ok(Plan::compile(m.brdf.clone(), geometries.to_vec(), options.clone())?.run()))
+        .collect()
 }

@@ -42,7 +42,8 @@ fn a_shared_integral_is_counted_once() {
         // Every integral of the plan is used by a reading, and the shared ones make the plan's count smaller
         // than the readings' sum.
         assert_eq!(used.len(), plan.jobs.len(), "{name}");
-        let shared: Vec<&glossmeter::instrument::plan::Job> = plan.jobs.iter().filter(|j| j.used_by.len() > 1).collect();
+        let shared: Vec<&glossmeter::instrument::plan::Job> =
+            plan.jobs.iter().filter(|j| j.used_by.len() > 1).collect();
         assert!(!shared.is_empty(), "{name}: the two geometries share the 20° gloss receptor");
         let readings_sum: usize = exec.readings.iter().map(|r| r.evaluations).sum();
         assert!(exec.evaluations() < readings_sum, "{name}: {} vs {readings_sum}", exec.evaluations());
@@ -74,8 +75,13 @@ fn measure_json_reports_the_plan_cost() {
     let doc = gm(&args);
     let (_, exec) = run("cerulean-blue-c.json", &ids);
     assert_eq!(doc["evaluations"].as_u64(), Some(exec.evaluations() as u64));
-    let per_reading: Vec<u64> = doc["readings"].as_array().unwrap().iter().map(|r| r["evaluations"].as_u64().unwrap()).collect();
-    assert_eq!(per_reading, exec.readings.iter().map(|r| r.evaluations as u64).collect::<Vec<_>>(), "per-reading counts stay");
+    let per_reading: Vec<u64> =
+        doc["readings"].as_array().unwrap().iter().map(|r| r["evaluations"].as_u64().unwrap()).collect();
+    assert_eq!(
+        per_reading,
+        exec.readings.iter().map(|r| r.evaluations as u64).collect::<Vec<_>>(),
+        "per-reading counts stay"
+    );
     assert!(doc["evaluations"].as_u64().unwrap() < per_reading.iter().sum::<u64>());
 
     let batch = gm(&[

@@ -255,11 +255,7 @@ fn dispatch(cli: Cli) -> Result<()> {
                 (Format::Json, e) => {
                     let mut doc = format::json_doc(&material, &readings, !no_timing);
                     doc["evaluations"] = serde_json::json!(evaluations);
-                    let doc = with_baseline(
-                        doc,
-                        drift.as_deref(),
-                        baseline_file.clone(),
-                    );
+                    let doc = with_baseline(doc, drift.as_deref(), baseline_file.clone());
                     format::pretty(&match e {
                         None => doc,
                         Some(e) => format::json_with_envelope(doc, e),

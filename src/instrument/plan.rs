@@ -67,6 +67,10 @@ pub struct PlanOptions {
     /// Apply the spectral weighting in the integrand (k components) rather than after integrating every
     /// sample (n components).
     pub fold_spectral: bool,
+    /// With `fold_spectral`, let a material that can sum a luminous-only flux's samples itself do so
+    /// (`Brdf::eval_batch_folded`: the paint's folded flake tables); off, the integrand weights the n
+    /// samples the material returns (kept to measure what it saves, `docs/performance.md`).
+    pub fold_in_material: bool,
     /// Compute each distinct flux once.
     pub share_fluxes: bool,
     /// Evaluation budget per flux integral (deterministic: a reading that hits it is the same bits on every
@@ -87,6 +91,7 @@ impl Default for PlanOptions {
         PlanOptions {
             rtol: 1e-6,
             fold_spectral: true,
+            fold_in_material: true,
             share_fluxes: true,
             max_evals: 50_000_000,
             max_seconds: Some(DEFAULT_MAX_SECONDS),
@@ -414,7 +419,11 @@ impl Planner {
         let has_delta = material.has_delta();
         let has_regular = material.has_regular();
         let has_diffuse = terms.iter().any(|t| t.kind == TermKind::Diffuse);
-        let projection = if options.fold_spectral { Projection::Fold } else { Projection::Separate };
+        let projection = match (options.fold_spectral, options.fold_in_material) {
+            (false, _) => Projection::Separate,
+            (true, false) => Projection::Fold,
+            (true, true) => Projection::FoldInMaterial,
+        };
         let mut jobs = Vec::with_capacity(drafts.len());
         let mut standard_flux = vec![None; drafts.len()];
         let mut std_results = std_methods.into_iter().zip(std_flux.iter().cloned());
@@ -719,6 +728,15 @@ impl Plan {
             match projection {
                 Some(Projection::Fold) | None =>
                     "applied in the integrand, so each aperture integral has one component per weighted quantity",
+                Some(Projection::FoldInMaterial) => {
+                    let row = Weighting::luminous(m.sampling()).ok().and_then(|w| w.rows.into_iter().next());
+                    if row.is_some_and(|r| m.folds(&r)) {
+                        "applied in the integrand, so each aperture integral has one component per weighted \
+                         quantity; a luminous-only integral has the material sum its samples itself (folded tables)"
+                    } else {
+                        "applied in the integrand, so each aperture integral has one component per weighted quantity"
+                    }
+                }
                 Some(Projection::Separate) => "folding off: each sample is integrated separately, then weighted",
             }
         ));
