@@ -256,26 +256,29 @@ struct Draft {
 /// `Sync`: plans can be compiled from several threads. The cache is keyed by every input of the standard's
 /// method (θ, index, stops, tolerance, budget), so a cached flux is the same bits as a recomputed one.
 pub struct Planner {
-    builtin: Vec<StandardGeometry>,
+    /// Every builtin geometry (gloss, then colour), copied on first use only: a planner that only compiles
+    /// plans never needs them (the geometries come resolved), and `geometry` borrows the per-process parse.
+    builtin: std::sync::OnceLock<Vec<StandardGeometry>>,
     standards: Mutex<HashMap<JobKey, Flux>>,
 }
 
 impl Planner {
+    /// A planner; the builtin gloss geometries are parsed (once per process) and checked here.
     pub fn new() -> Result<Planner> {
-        Ok(Planner { builtin: standards::builtin_all()?, standards: Mutex::new(HashMap::new()) })
+        standards::builtin_static()?;
+        Ok(Planner { builtin: std::sync::OnceLock::new(), standards: Mutex::new(HashMap::new()) })
     }
 
-    /// The builtin geometries: gloss, then colour (`standards::builtin_all`).
+    /// The builtin geometries: gloss, then colour (`standards::builtin_all`; empty if the colour ones do not
+    /// parse, which `tests/colour.rs` rules out for the shipped files).
     pub fn builtin(&self) -> &[StandardGeometry] {
-        &self.builtin
+        self.builtin.get_or_init(|| standards::builtin_all().unwrap_or_default())
     }
 
-    /// The builtin geometry with this id; an unknown id is a usage error listing the known ids.
+    /// The builtin geometry with this id (`standards::find`); an unknown id is a usage error listing the known
+    /// ids.
     pub fn geometry(&self, id: &str) -> Result<StandardGeometry> {
-        self.builtin.iter().find(|g| g.geometry.id == id).cloned().ok_or_else(|| {
-            let ids: Vec<&str> = self.builtin.iter().map(|g| g.geometry.id.as_str()).collect();
-            Error::Usage(format!("unknown geometry id \"{id}\"; known ids: {}", ids.join(", ")))
-        })
+        standards::find(id)
     }
 
     /// Number of gloss-standard fluxes cached.
