@@ -162,11 +162,9 @@ pub fn find(id: &str) -> Result<StandardGeometry> {
     let colour = crate::instrument::colour::builtin_static()?;
     match colour.iter().find(|g| g.geometry.id == id) {
         Some(g) => Ok(g.clone()),
-        None => Err(Error::Usage(format!(
-            "unknown geometry id \"{id}\"; known ids: {}; colour: {}",
-            ids(&all),
-            ids(&colour)
-        ))),
+        None => {
+            Err(Error::Usage(format!("unknown geometry id \"{id}\"; known ids: {}; colour: {}", ids(all), ids(colour))))
+        }
     }
 }
 
