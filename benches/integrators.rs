@@ -868,6 +868,17 @@ fn b5(md: &mut String, quick: bool) {
     let default = PlanOptions { rtol: 1e-6, ..Default::default() };
     let variants: Vec<(&str, &str, PlanOptions)> = vec![
         ("cerulean-blue-c.json", "default (fold + share)", default.clone()),
+        (
+            "cerulean-blue-c.json",
+            "fold_in_material: false (per-sample paint, weighted in the integrand)",
+            PlanOptions { fold_in_material: false, ..default.clone() },
+        ),
+        ("cerulean-blue-c-literal.json", "default (narrow flake lobes)", default.clone()),
+        (
+            "cerulean-blue-c-literal.json",
+            "fold_in_material: false (narrow flake lobes)",
+            PlanOptions { fold_in_material: false, ..default.clone() },
+        ),
         ("cerulean-blue-c.json", "default, 2-thread pool", default.clone()),
         ("cerulean-blue-c.json", "fold_spectral: false", PlanOptions { fold_spectral: false, ..default.clone() }),
         ("cerulean-blue-c.json", "share_fluxes: false", PlanOptions { share_fluxes: false, ..default.clone() }),

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use rayon::prelude::*;
 
-use crate::instrument::plan::{Plan, PlanOptions, Reading};
+use crate::instrument::plan::{Execution, Plan, PlanOptions, Reading};
 use crate::instrument::standards::StandardGeometry;
 use crate::recipe::{self, Material};
 use crate::{Error, Result};
@@ -49,8 +49,18 @@ pub fn measure_many(
     geometries: &[StandardGeometry],
     options: &PlanOptions,
 ) -> Result<Vec<Vec<Reading>>> {
+    Ok(run_many(materials, geometries, options)?.into_iter().map(|e| e.readings).collect())
+}
+
+/// [`measure_many`] keeping each material's execution (its readings and the fluxes of its plan, for the
+/// plan's evaluation count).
+pub fn run_many(
+    materials: &[Material],
+    geometries: &[StandardGeometry],
+    options: &PlanOptions,
+) -> Result<Vec<Execution>> {
     materials
         .par_iter()
-        .map(|m| Ok(Plan::compile(m.brdf.clone(), geometries.to_vec(), options.clone())?.execute()))
+        .map(|m| Ok(Plan::compile(m.brdf.clone(), geometries.to_vec(), options.clone())?.run()))
         .collect()
 }

@@ -39,9 +39,21 @@ fn reading(batch: bool) -> Value {
     json!({"type": "object", "properties": props, "required": required, "additionalProperties": false})
 }
 
-fn material() -> Value {
-    json!({"type": "object", "required": ["name", "file", "model"], "additionalProperties": false,
-           "properties": {"name": {"type": "string"}, "file": {"type": "string"}, "model": {"type": "string"}}})
+fn material(batch: bool) -> Value {
+    let mut m = json!({"type": "object", "required": ["name", "file", "model"], "additionalProperties": false,
+           "properties": {"name": {"type": "string"}, "file": {"type": "string"}, "model": {"type": "string"}}});
+    if batch {
+        m["properties"]["evaluations"] = plan_evaluations("of this material's plan");
+        m["required"] = json!(["name", "file", "model", "evaluations"]);
+    }
+    m
+}
+
+/// The `"evaluations"` of a plan (`plan::Execution::evaluations`).
+fn plan_evaluations(whose: &str) -> Value {
+    json!({"type": "integer", "minimum": 0, "description": format!(
+        "BRDF evaluations {whose}: every distinct aperture integral (the gloss standards' included) counted once; \
+         a reading's own evaluations count every integral it uses, so shared integrals appear in several readings")})
 }
 
 fn baseline() -> Value {
@@ -62,12 +74,14 @@ pub fn measure() -> Value {
         "$schema": DRAFT,
         "title": "glossmeter measure --format json",
         "oneOf": [
-            {"type": "object", "required": ["material", "readings"], "additionalProperties": false,
-             "properties": {"material": material(), "readings": {"type": "array", "items": reading(false)},
+            {"type": "object", "required": ["material", "readings", "evaluations"], "additionalProperties": false,
+             "properties": {"material": material(false), "readings": {"type": "array", "items": reading(false)},
+                            "evaluations": plan_evaluations("of the whole plan"), "baseline": baseline()}},
+            {"type": "object", "required": ["materials", "readings", "evaluations"], "additionalProperties": false,
+             "properties": {"materials": {"type": "array", "items": material(true)},
+                            "readings": {"type": "array", "items": reading(true)},
+                            "evaluations": plan_evaluations("of all the materials' plans together"),
                             "baseline": baseline()}},
-            {"type": "object", "required": ["materials", "readings"], "additionalProperties": false,
-             "properties": {"materials": {"type": "array", "items": material()},
-                            "readings": {"type": "array", "items": reading(true)}, "baseline": baseline()}},
         ],
     })
 }

@@ -131,6 +131,22 @@ pub trait Brdf: Send + Sync + std::fmt::Debug {
         }
     }
 
+    /// Whether [`Brdf::eval_batch_folded`] evaluates the weighted sum with the row `w` (n weights) itself.
+    /// False by default. The plan asks once per integral whose weighting is that one row (a luminous-only
+    /// flux) and then calls `eval_batch_folded` for its batches; otherwise it weights the n samples.
+    fn folds(&self, _w: &[f64]) -> bool {
+        false
+    }
+
+    /// The weighted sum of the samples, Σ_j w_j f_j(ωi, ωo), at many pairs, when the model has prepared that
+    /// row ([`Brdf::folds`]): `out` has m values, every one written (zeros below the horizon). It must equal
+    /// Σ_j w_j·(the samples of [`Brdf::eval_batch`]) to rounding (a model sums in its own order, e.g. one
+    /// folded reflectance table instead of n, so the last bits may differ) and not depend on the batching.
+    /// Returns false, leaving `out` alone, for a row the model has not prepared (the default).
+    fn eval_batch_folded(&self, _w: &[f64], _wi: &[Vec3], _wo: &[Vec3], _out: &mut [f64]) -> bool {
+        false
+    }
+
     /// The ideal-mirror component: f_δ = R(ωi)·δ(ωo − mirror(ωi)) / cos θo. Writes R per sample and returns
     /// true if the model has one; returns false (and leaves `out` alone) otherwise.
     fn delta_reflectance(&self, _wi: Vec3, _out: &mut [f64]) -> bool {

@@ -24,11 +24,11 @@ use super::{Brdf, Lobe, Term, TermKind};
 use crate::optics::fresnel::{fr_conductor, fr_dielectric, fresnel_dielectric, refract_into};
 use crate::optics::kubelka_munk::{self, Layer};
 use crate::optics::microfacet::{Distribution, Microfacet, Shadowing};
-use crate::optics::tabulated::ChebTable;
+use crate::optics::tabulated::{basis, dot, ChebTable};
 use crate::optics::thin_film::{stack, FilmLayer};
 use crate::quadrature::gauss_legendre;
 use crate::registry::{self as reg, Param, Range};
-use crate::spectrum::Sampling;
+use crate::spectrum::{Sampling, Weighting};
 use crate::{Error, Result, Vec3};
 use num_complex::Complex64;
 use std::f64::consts::PI;
@@ -214,6 +214,90 @@ struct FlakeTerm {
 /// reflectance ≤ 1): far below any tolerance a reading is asked for.
 pub const TABLE_TOLERANCE: f64 = 1e-12;
 
+/// The paint prepared for one weighted sum of its samples, Σ_j w_j f_j (the luminous row of its sampling:
+/// what gloss, haze and DOI read; `Brdf::eval_batch_folded`). Everything that does not depend on direction is
+/// summed over the samples once, here, so an evaluation does one sample's work where the per-sample path
+/// does n (`docs/model.md` §Folded evaluation).
+#[derive(Clone, Debug, PartialEq)]
+struct Folded {
+    /// The row w it was prepared for.
+    weights: Vec<f64>,
+    /// Σ_j w_j: the weight of the rough coat's grey lobe.
+    coat: f64,
+    /// Σ_j w_j·body_j.
+    body: f64,
+    /// One per flake term, in the order of `Paint::flakes`.
+    flakes: Vec<FoldedFlake>,
+    /// The second flake term's cover has the same optical depths as the first's (the same pigment at the same
+    /// depth): the transmissions computed for the first serve the second.
+    shared_depth: bool,
+}
+
+/// A flake term prepared for a weighted sum.
+#[derive(Clone, Debug, PartialEq)]
+struct FoldedFlake {
+    /// Split light: w_j·(the diffuse weight of sample j).
+    diffuse: Vec<f64>,
+    /// The lobe's reflectance folded into one table, Σ_j w_j·T_j, when the per-sample factors in front of the
+    /// tables do not depend on direction (light not split, or a grey cover: one τ for every sample).
+    table: Option<ChebTable>,
+    /// Otherwise the samples' tables on one grid: an evaluation sums their coefficients with the weights
+    /// w_j·τ_j(θi')·τ_j(θo') and runs one Clenshaw recurrence (the interpolant is linear in its coefficients).
+    grid: Option<Vec<ChebTable>>,
+    /// Split light with a grey cover: every sample's τ is sample 0's.
+    grey_cover: bool,
+}
+
+impl Folded {
+    /// Prepare `paint` for the row `w` (n weights).
+    fn new(paint: &Paint, w: &[f64]) -> Folded {
+        let lambdas = &paint.spec.sampling.wavelengths_nm;
+        let flakes = paint
+            .flakes()
+            .map(|fl| {
+                let grey_cover = fl.depth.iter().all(|d| d.to_bits() == fl.depth[0].to_bits());
+                let grid = fl.table.as_ref().and_then(|t| {
+                    let pieces = t.iter().map(ChebTable::pieces).max().expect("one table per sample");
+                    t.iter()
+                        .enumerate()
+                        .map(|(k, tk)| match tk.pieces() == pieces {
+                            true => Some(tk.clone()),
+                            false => ChebTable::fit_with_pieces(
+                                |c| fl.reflectance_direct(k, c, lambdas[k]),
+                                0.0,
+                                1.0,
+                                pieces,
+                                TABLE_TOLERANCE,
+                            ),
+                        })
+                        .collect::<Option<Vec<_>>>()
+                });
+                let constant = !fl.split || grey_cover;
+                let table = grid.as_ref().filter(|_| constant).and_then(|g| ChebTable::combine(g, w));
+                FoldedFlake {
+                    diffuse: fl.diffuse.iter().zip(w).map(|(d, w)| w * d).collect(),
+                    grid: if table.is_some() { None } else { grid },
+                    table,
+                    grey_cover,
+                }
+            })
+            .collect();
+        let shared_depth = match (&paint.metallic, &paint.pearlescent) {
+            (Some(a), Some(b)) => {
+                a.split && b.split && a.depth.iter().zip(&b.depth).all(|(x, y)| x.to_bits() == y.to_bits())
+            }
+            _ => false,
+        };
+        Folded {
+            weights: w.to_vec(),
+            coat: w.iter().sum(),
+            body: paint.body.iter().zip(w).map(|(b, w)| w * b).sum(),
+            flakes,
+            shared_depth,
+        }
+    }
+}
+
 impl FlakeTerm {
     /// Flake reflectance ρ at the local cosine `cos_local` for sample `k` (before the pigment above it).
     #[inline]
@@ -255,6 +339,16 @@ impl FlakeTerm {
             0.0
         } else {
             (-self.depth[k] / mu).exp()
+        }
+    }
+
+    /// e = τ − 1 = expm1(−ε X'/μ) (−1 where μ ≤ 0, τ = 0 there): τ = 1 + e and 1 − τ = −e from one call.
+    #[inline]
+    fn expm1_tau(&self, k: usize, mu: f64) -> f64 {
+        if mu <= 0.0 {
+            -1.0
+        } else {
+            (-self.depth[k] / mu).exp_m1()
         }
     }
 
@@ -314,6 +408,8 @@ pub struct Paint {
     rough_coat: Option<Microfacet>,
     metallic: Option<FlakeTerm>,
     pearlescent: Option<FlakeTerm>,
+    /// Prepared for the luminous row of the sampling (None if the sampling has none).
+    folded: Option<Folded>,
 }
 
 /// Diffuse (hemispherical) reflectance of the air → coat interface for light incident from air,
@@ -471,7 +567,11 @@ impl Paint {
             let optics = FlakeOptics::Pearl { layers: [tio2, mica, tio2], medium: eta };
             flake("pearlescent flakes", p.spread, p.area_ratio, p.depth_mm, optics)
         });
-        Ok(Paint { spec, body_weight, r_l, body, r_e, r_i, rough_coat, metallic, pearlescent })
+        let mut paint =
+            Paint { spec, body_weight, r_l, body, r_e, r_i, rough_coat, metallic, pearlescent, folded: None };
+        let luminous = Weighting::luminous(&paint.spec.sampling).ok().and_then(|w| w.rows.into_iter().next());
+        paint.folded = luminous.map(|w| Folded::new(&paint, &w));
+        Ok(paint)
     }
 
     pub fn spec(&self) -> &PaintSpec {
@@ -495,6 +595,165 @@ impl Paint {
 
     fn flakes(&self) -> impl Iterator<Item = &FlakeTerm> {
         self.metallic.iter().chain(self.pearlescent.iter())
+    }
+
+    /// Σ_j w_j f_j(ωi, ωo) for the prepared row: the terms of [`Brdf::eval`] with the same formulas, summed
+    /// over the samples once where they do not depend on direction (`docs/model.md` §Folded evaluation). It
+    /// equals Σ_j w_j·eval_j to rounding (the summation order differs; `tests/paint.rs` bounds the difference).
+    fn eval_folded(&self, fo: &Folded, wi: Vec3, wo: Vec3) -> f64 {
+        if wi.z.is_nan() || wo.z.is_nan() || wi.z <= 0.0 || wo.z <= 0.0 {
+            return 0.0;
+        }
+        let eta = self.spec.coat.index;
+        let mut coat = 0.0;
+        if let Some(mf) = &self.rough_coat {
+            let h = (wi + wo).normalize();
+            let v = fr_dielectric(wi.dot(h).clamp(0.0, 1.0), eta)
+                * mf.d(h)
+                * mf.g(wi, wo, h, Shadowing::SmithHeightCorrelated)
+                / (4.0 * wi.z * wo.z);
+            if v.is_finite() && v > 0.0 {
+                coat = v * fo.coat;
+            }
+        }
+        let t_i = fresnel_dielectric(wi.z.min(1.0), eta).t();
+        let flakes = [self.metallic.as_ref(), self.pearlescent.as_ref()];
+        let mut folded = fo.flakes.iter();
+        let terms: [Option<(&FlakeTerm, &FoldedFlake)>; 2] =
+            flakes.map(|f| f.map(|f| (f, folded.next().expect("one folded term per flake term"))));
+        match self.spec.form {
+            Form::Physical => {
+                let (Some(wi_in), Some(wo_in)) = (refract_into(wi, eta), refract_into(wo, eta)) else {
+                    return coat;
+                };
+                let t_o = fresnel_dielectric(wo.z.min(1.0), eta).t();
+                let factor = t_i * t_o / (eta * eta);
+                let h = (wi_in + wo_in).normalize();
+                let cos_local = wi_in.dot(h).clamp(0.0, 1.0);
+                let (mu_i, mu_o) = (wi_in.z, wo_in.z);
+                let geo = |fl: &FlakeTerm| -> f64 {
+                    if fl.smooth {
+                        return 0.0;
+                    }
+                    let g = fl.facets.d(h) * fl.facets.g(wi_in, wo_in, h, Shadowing::SmithHeightCorrelated)
+                        / (4.0 * wi_in.z * wo_in.z);
+                    if g.is_finite() && g > 0.0 {
+                        g
+                    } else {
+                        0.0
+                    }
+                };
+                let mut sum = fo.body;
+                // Per-sample sums of the flake terms whose factors depend on direction and sample (split light
+                // under a coloured cover): the diffuse part Σ w_j d_j (1 − τ_i)(1 − τ_o) and the lobe's
+                // Σ w_j τ_i τ_o R_j. With τ = 1 + e and e = expm1(−ε_j X'/μ), 1 − τ = −e: two expm1 per
+                // sample and cover, shared by the two flake terms when their covers have the same depths. Each
+                // R_j is one dot product of its piece's coefficients with the Chebyshev basis at cos_local,
+                // computed once for both terms when their tables share a grid.
+                let mut diffuse = [0.0; 2];
+                let mut lobe_sum = [0.0; 2];
+                let mut lobe = [0.0; 2];
+                let mut located = [(0usize, 0.0); 2];
+                let mut bases = [[0.0; crate::optics::tabulated::N]; 2];
+                let mut have_basis = false;
+                for (f, t) in terms.iter().enumerate() {
+                    if let Some((fl, ff)) = t {
+                        lobe[f] = geo(fl);
+                        if let Some(g) = ff.grid.as_deref().or(ff.table.as_ref().map(std::slice::from_ref)) {
+                            located[f] = g[0].locate(cos_local);
+                            // The basis depends on t alone: the second term reuses the first's at the same t.
+                            bases[f] = if f == 1 && have_basis && located[1].1.to_bits() == located[0].1.to_bits() {
+                                bases[0]
+                            } else {
+                                basis(located[f].1)
+                            };
+                            have_basis = true;
+                        }
+                    }
+                }
+                let joint = fo.shared_depth && terms[0].is_some_and(|(_, ff)| !ff.grey_cover);
+                const TERMS: [usize; 2] = [0, 1];
+                for f in 0..2 {
+                    let Some((fl, ff)) = terms[f] else { continue };
+                    if !fl.split || (joint && f == 1) {
+                        continue; // not split (no per-sample factor), or summed with term 0
+                    }
+                    if ff.grey_cover {
+                        let (ei, eo) = (fl.expm1_tau(0, mu_i), fl.expm1_tau(0, mu_o));
+                        diffuse[f] = ei * eo * ff.diffuse.iter().sum::<f64>();
+                        if lobe[f] > 0.0 {
+                            lobe_sum[f] = (1.0 + ei) * (1.0 + eo) * self.unattenuated(fl, ff, fo, cos_local, &bases[f]);
+                        }
+                        continue;
+                    }
+                    let members: &[usize] = if joint { &TERMS } else { std::slice::from_ref(&TERMS[f]) };
+                    for (j, &w) in fo.weights.iter().enumerate() {
+                        let (ei, eo) = (fl.expm1_tau(j, mu_i), fl.expm1_tau(j, mu_o));
+                        let att = w * (1.0 + ei) * (1.0 + eo);
+                        for &m in members {
+                            let Some((mfl, mff)) = terms[m] else { continue };
+                            diffuse[m] += mff.diffuse[j] * (ei * eo);
+                            if lobe[m] > 0.0 {
+                                let r = match &mff.grid {
+                                    Some(g) => dot(g[j].piece(located[m].0), &bases[m]),
+                                    None => mfl.reflectance_direct(j, cos_local, self.lambda(j)),
+                                };
+                                lobe_sum[m] += att * r;
+                            }
+                        }
+                    }
+                }
+                for (f, t) in terms.iter().enumerate() {
+                    let Some((fl, ff)) = t else { continue };
+                    sum += fl.area * diffuse[f];
+                    if lobe[f] <= 0.0 {
+                        continue;
+                    }
+                    let r = if fl.split { lobe_sum[f] } else { self.unattenuated(fl, ff, fo, cos_local, &bases[f]) };
+                    sum += fl.area * lobe[f] * r;
+                }
+                coat + factor * sum
+            }
+            Form::PaperEq1 => {
+                let h = (wi + wo).normalize();
+                let cos_local = wi.dot(h).clamp(0.0, 1.0);
+                let mut sum = fo.body;
+                for (fl, ff) in terms.iter().flatten() {
+                    if fl.smooth {
+                        continue;
+                    }
+                    let d_ct = PI * fl.facets.d(h);
+                    let geo = d_ct * fl.facets.g(wi, wo, h, Shadowing::VCavity) / (PI * wi.z * wo.z);
+                    if !geo.is_finite() || geo <= 0.0 {
+                        continue;
+                    }
+                    let b = ff.table.as_ref().map(|t| basis(t.locate(cos_local).1)).unwrap_or_default();
+                    sum += fl.area * geo * self.unattenuated(fl, ff, fo, cos_local, &b);
+                }
+                coat + t_i * sum
+            }
+        }
+    }
+
+    /// Σ_j w_j R_j(cos_local) of a flake whose lobe has no per-sample factor in front of its tables (`b`: the
+    /// Chebyshev basis at cos_local's position in the folded table's piece).
+    fn unattenuated(
+        &self,
+        fl: &FlakeTerm,
+        ff: &FoldedFlake,
+        fo: &Folded,
+        cos_local: f64,
+        b: &[f64; crate::optics::tabulated::N],
+    ) -> f64 {
+        match &ff.table {
+            Some(t) => dot(t.piece(t.locate(cos_local).0), b),
+            None => fo.weights.iter().enumerate().map(|(j, w)| w * fl.reflectance(j, cos_local, self.lambda(j))).sum(),
+        }
+    }
+
+    #[inline]
+    fn lambda(&self, j: usize) -> f64 {
+        self.spec.sampling.wavelengths_nm[j]
     }
 }
 
@@ -581,6 +840,20 @@ impl Brdf for Paint {
                 }
             }
         }
+    }
+
+    fn folds(&self, w: &[f64]) -> bool {
+        self.folded.as_ref().is_some_and(|f| f.weights == w)
+    }
+
+    fn eval_batch_folded(&self, w: &[f64], wi: &[Vec3], wo: &[Vec3], out: &mut [f64]) -> bool {
+        let Some(fo) = self.folded.as_ref().filter(|f| f.weights == w) else {
+            return false;
+        };
+        for ((a, b), o) in wi.iter().zip(wo).zip(out.iter_mut()) {
+            *o = self.eval_folded(fo, *a, *b);
+        }
+        true
     }
 
     fn delta_reflectance(&self, wi: Vec3, out: &mut [f64]) -> bool {

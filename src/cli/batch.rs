@@ -75,6 +75,18 @@ pub fn json_doc(materials: &[Material], readings: &[Vec<Reading>], timing: bool)
     })
 }
 
+/// Add each material's plan cost (`"evaluations"` in its `materials` entry: the BRDF evaluations of its
+/// plan, each distinct integral counted once) and their sum at the top of a [`json_doc`] document.
+pub fn with_evaluations(mut doc: Value, evaluations: &[usize]) -> Value {
+    if let Some(ms) = doc["materials"].as_array_mut() {
+        for (m, e) in ms.iter_mut().zip(evaluations) {
+            m["evaluations"] = json!(e);
+        }
+    }
+    doc["evaluations"] = json!(evaluations.iter().sum::<usize>());
+    doc
+}
+
 /// The CSV of `measure` with `material` and `file` columns in front.
 pub fn csv(materials: &[Material], readings: &[Vec<Reading>], timing: bool) -> Result<String> {
     let err = |e: csv::Error| Error::Io { file: "<csv>".into(), source: std::io::Error::other(e) };

@@ -240,7 +240,9 @@ fn dispatch(cli: Cli) -> Result<()> {
                     _ => eprint!("{e}"),
                 }
             }
-            let readings = plan.execute();
+            let run = plan.run();
+            let evaluations = run.evaluations();
+            let readings = run.readings;
             let envelopes = if envelope {
                 Some(crate::instrument::envelope::read(material.brdf.clone(), &geos, &readings, options)?)
             } else {
@@ -255,11 +257,9 @@ fn dispatch(cli: Cli) -> Result<()> {
                     format::table(&material, &readings, !no_timing) + &format::envelope_table(&readings, e)
                 }
                 (Format::Json, e) => {
-                    let doc = with_baseline(
-                        format::json_doc(&material, &readings, !no_timing),
-                        drift.as_deref(),
-                        baseline_file.clone(),
-                    );
+                    let mut doc = format::json_doc(&material, &readings, !no_timing);
+                    doc["evaluations"] = serde_json::json!(evaluations);
+                    let doc = with_baseline(doc, drift.as_deref(), baseline_file.clone());
                     format::pretty(&match e {
                         None => doc,
                         Some(e) => format::json_with_envelope(doc, e),
@@ -410,7 +410,9 @@ fn measure_batch(
     let files = crate::batch::recipe_files(paths)?;
     let materials = crate::batch::load_all(&files)?;
     let geos = resolve_geometries(geometries, geometry_files)?;
-    let readings = crate::batch::measure_many(&materials, &geos, options)?;
+    let runs = crate::batch::run_many(&materials, &geos, options)?;
+    let evaluations: Vec<usize> = runs.iter().map(|e| e.evaluations()).collect();
+    let readings: Vec<Vec<crate::Reading>> = runs.into_iter().map(|e| e.readings).collect();
     let drift = how.baseline.as_ref().map(|(b, _)| {
         crate::comparison::check_baseline(
             materials.iter().zip(&readings).flat_map(|(m, rs)| rs.iter().map(move |r| (m.name.as_str(), r))),
@@ -426,7 +428,7 @@ fn measure_batch(
             t
         }
         Format::Json => format::pretty(&with_baseline(
-            batch::json_doc(&materials, &readings, how.timing),
+            batch::with_evaluations(batch::json_doc(&materials, &readings, how.timing), &evaluations),
             drift.as_deref(),
             how.baseline.as_ref().map(|(_, f)| f.clone()),
         )),

@@ -226,9 +226,14 @@ const NO_SCALE: Scale = Scale::Mirror { value: 100.0 };
 
 /// Every builtin colour geometry (each file's id equals its name), parsed once per process.
 pub fn builtin() -> Result<Vec<StandardGeometry>> {
+    builtin_static().map(<[StandardGeometry]>::to_vec)
+}
+
+/// [`builtin`] without the copy: parsed once per process, borrowed for the rest of it.
+pub fn builtin_static() -> Result<&'static [StandardGeometry]> {
     static PARSED: std::sync::OnceLock<Vec<StandardGeometry>> = std::sync::OnceLock::new();
     if let Some(all) = PARSED.get() {
-        return Ok(all.clone());
+        return Ok(all);
     }
     let mut out: Vec<StandardGeometry> = Vec::with_capacity(BUILTIN.len());
     for (file, text) in BUILTIN {
@@ -243,7 +248,7 @@ pub fn builtin() -> Result<Vec<StandardGeometry>> {
         g.origin = "builtin".into();
         out.push(g);
     }
-    Ok(PARSED.get_or_init(|| out).clone())
+    Ok(PARSED.get_or_init(|| out))
 }
 
 /// Ids of the builtin colour geometries, in table order (without parsing them).

@@ -70,6 +70,10 @@ pub const LOBE_REACH: f64 = 8.0;
 pub enum Projection {
     /// In the integrand: the cubature integrates the k weighted components (cheapest when k < n).
     Fold,
+    /// As `Fold`, and a one-row weighting that the material has prepared (`Brdf::folds`: the paint's
+    /// luminous row) is summed by the material itself (`Brdf::eval_batch_folded`: one folded reflectance
+    /// table per flake term instead of n); the default. Otherwise the same as `Fold`.
+    FoldInMaterial,
     /// After: the cubature integrates the n samples and the weighting is applied to the results
     /// (kept to measure what folding saves; `PlanOptions::fold_spectral`).
     Separate,
@@ -291,7 +295,7 @@ impl Method {
             has_regular: brdf.has_regular(),
             has_diffuse: brdf.terms().iter().any(|t| t.kind == TermKind::Diffuse),
             weighting: Weighting::luminous(brdf.sampling())?,
-            projection: Projection::Fold,
+            projection: Projection::FoldInMaterial,
             rtol: tolerance.0,
             atol: tolerance.1,
             max_evals,
@@ -366,15 +370,18 @@ impl Method {
         let axes = Axes::new(self.theta);
         let rec_axes = Axes::new(self.viewing);
         let ncomp = match self.projection {
-            Projection::Fold => k,
+            Projection::Fold | Projection::FoldInMaterial => k,
             Projection::Separate => n,
         };
+        // The material sums the one weighted component itself.
+        let in_material =
+            self.projection == Projection::FoldInMaterial && k == 1 && brdf.folds(&self.weighting.rows[0]);
         let weighting = &self.weighting;
         let projection = self.projection;
         // The k weighted components of an estimate, and their error bounds.
         let weighted = |e: &Estimate| -> (Vec<f64>, Vec<f64>) {
             match projection {
-                Projection::Fold => (e.value.clone(), e.error.clone()),
+                Projection::Fold | Projection::FoldInMaterial => (e.value.clone(), e.error.clone()),
                 Projection::Separate => (
                     (0..k).map(|c| weighting.component(c, &e.value)).collect(),
                     (0..k).map(|c| weighting.component_error(c, &e.error)).collect(),
@@ -466,6 +473,14 @@ impl Method {
                     batch.push(i, wi, wo, g);
                 }
                 batch.values.clear();
+                if in_material {
+                    batch.values.resize(batch.wi.len(), 0.0);
+                    brdf.eval_batch_folded(&weighting.rows[0], &batch.wi, &batch.wo, &mut batch.values);
+                    for ((&i, &g), v) in batch.index.iter().zip(&batch.g).zip(&batch.values) {
+                        out[i] = v * g;
+                    }
+                    return;
+                }
                 batch.values.resize(batch.wi.len() * n, 0.0);
                 brdf.eval_batch(&batch.wi, &batch.wo, &mut batch.values);
                 for ((&i, &g), v) in batch.index.iter().zip(&batch.g).zip(batch.values.chunks_exact(n)) {
@@ -669,7 +684,7 @@ fn store(out: &mut [f64], values: &[f64], weighting: &Weighting, g: f64, project
                 *o = v * g;
             }
         }
-        Projection::Fold => {
+        Projection::Fold | Projection::FoldInMaterial => {
             for (c, o) in out.iter_mut().enumerate() {
                 *o = weighting.component(c, values) * g;
             }

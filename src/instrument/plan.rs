@@ -67,6 +67,10 @@ pub struct PlanOptions {
     /// Apply the spectral weighting in the integrand (k components) rather than after integrating every
     /// sample (n components).
     pub fold_spectral: bool,
+    /// With `fold_spectral`, let a material that can sum a luminous-only flux's samples itself do so
+    /// (`Brdf::eval_batch_folded`: the paint's folded flake tables); off, the integrand weights the n
+    /// samples the material returns (kept to measure what it saves, `docs/performance.md`).
+    pub fold_in_material: bool,
     /// Compute each distinct flux once.
     pub share_fluxes: bool,
     /// Evaluation budget per flux integral (deterministic: a reading that hits it is the same bits on every
@@ -87,6 +91,7 @@ impl Default for PlanOptions {
         PlanOptions {
             rtol: 1e-6,
             fold_spectral: true,
+            fold_in_material: true,
             share_fluxes: true,
             max_evals: 50_000_000,
             max_seconds: Some(DEFAULT_MAX_SECONDS),
@@ -141,6 +146,25 @@ pub struct Reading {
     pub problem: Option<String>,
     /// A caveat on a valid value (e.g. a specimen outside the scope of the standard's formula).
     pub note: Option<String>,
+}
+
+/// One execution of a plan ([`Plan::run`]): the readings, and the flux of every integral of the plan.
+#[derive(Clone, Debug)]
+pub struct Execution {
+    pub readings: Vec<Reading>,
+    /// One flux per job of the plan, in plan order (`Plan::jobs`): the specimen integrals computed by this
+    /// execution and the gloss standards' fluxes computed when the plan was compiled.
+    pub fluxes: Vec<Flux>,
+}
+
+impl Execution {
+    /// The BRDF evaluations of the whole plan: every distinct integral (job) counted once, the gloss
+    /// standards' integrals included (as in each reading's own count). A reading's `evaluations` counts
+    /// every integral it uses, so an integral shared by several readings is in each of their counts but
+    /// only once here. A frozen plan's integrals count what its fixed partitions cost.
+    pub fn evaluations(&self) -> usize {
+        self.fluxes.iter().map(|f| f.evaluations).sum()
+    }
 }
 
 /// The shape of a material, which a plan's methods depend on: its sampling and the kinds of its terms.
@@ -232,26 +256,29 @@ struct Draft {
 /// `Sync`: plans can be compiled from several threads. The cache is keyed by every input of the standard's
 /// method (θ, index, stops, tolerance, budget), so a cached flux is the same bits as a recomputed one.
 pub struct Planner {
-    builtin: Vec<StandardGeometry>,
+    /// Every builtin geometry (gloss, then colour), copied on first use only: a planner that only compiles
+    /// plans never needs them (the geometries come resolved), and `geometry` borrows the per-process parse.
+    builtin: std::sync::OnceLock<Vec<StandardGeometry>>,
     standards: Mutex<HashMap<JobKey, Flux>>,
 }
 
 impl Planner {
+    /// A planner; the builtin gloss geometries are parsed (once per process) and checked here.
     pub fn new() -> Result<Planner> {
-        Ok(Planner { builtin: standards::builtin_all()?, standards: Mutex::new(HashMap::new()) })
+        standards::builtin_static()?;
+        Ok(Planner { builtin: std::sync::OnceLock::new(), standards: Mutex::new(HashMap::new()) })
     }
 
-    /// The builtin geometries: gloss, then colour (`standards::builtin_all`).
+    /// The builtin geometries: gloss, then colour (`standards::builtin_all`; empty if the colour ones do not
+    /// parse, which `tests/colour.rs` rules out for the shipped files).
     pub fn builtin(&self) -> &[StandardGeometry] {
-        &self.builtin
+        self.builtin.get_or_init(|| standards::builtin_all().unwrap_or_default())
     }
 
-    /// The builtin geometry with this id; an unknown id is a usage error listing the known ids.
+    /// The builtin geometry with this id (`standards::find`); an unknown id is a usage error listing the known
+    /// ids.
     pub fn geometry(&self, id: &str) -> Result<StandardGeometry> {
-        self.builtin.iter().find(|g| g.geometry.id == id).cloned().ok_or_else(|| {
-            let ids: Vec<&str> = self.builtin.iter().map(|g| g.geometry.id.as_str()).collect();
-            Error::Usage(format!("unknown geometry id \"{id}\"; known ids: {}", ids.join(", ")))
-        })
+        standards::find(id)
     }
 
     /// Number of gloss-standard fluxes cached.
@@ -395,7 +422,11 @@ impl Planner {
         let has_delta = material.has_delta();
         let has_regular = material.has_regular();
         let has_diffuse = terms.iter().any(|t| t.kind == TermKind::Diffuse);
-        let projection = if options.fold_spectral { Projection::Fold } else { Projection::Separate };
+        let projection = match (options.fold_spectral, options.fold_in_material) {
+            (false, _) => Projection::Separate,
+            (true, false) => Projection::Fold,
+            (true, true) => Projection::FoldInMaterial,
+        };
         let mut jobs = Vec::with_capacity(drafts.len());
         let mut standard_flux = vec![None; drafts.len()];
         let mut std_results = std_methods.into_iter().zip(std_flux.iter().cloned());
@@ -634,6 +665,12 @@ impl Plan {
     /// Execute the plan: every specimen method on the material (the standards' fluxes were computed when the
     /// plan was compiled), then the readings. The specimen integrals share one wall-clock deadline.
     pub fn execute(&self) -> Vec<Reading> {
+        self.run().readings
+    }
+
+    /// [`Plan::execute`], keeping the flux of every integral with the readings: what the whole plan cost
+    /// ([`Execution::evaluations`], each distinct integral counted once).
+    pub fn run(&self) -> Execution {
         let deadline = self.deadline();
         let todo = self.specimen_jobs();
         let computed: Vec<Flux> =
@@ -642,8 +679,8 @@ impl Plan {
         for (&j, f) in todo.iter().zip(computed) {
             flux[j] = Some(f);
         }
-        let flux: Vec<Flux> = flux.into_iter().map(|f| f.expect("every job ran")).collect();
-        self.readings_from(&flux)
+        let fluxes: Vec<Flux> = flux.into_iter().map(|f| f.expect("every job ran")).collect();
+        Execution { readings: self.readings_from(&fluxes), fluxes }
     }
 
     /// The jobs to run on the material, in plan order. Only these go to the thread pool: a plan with one
@@ -695,6 +732,15 @@ impl Plan {
             match projection {
                 Some(Projection::Fold) | None =>
                     "applied in the integrand, so each aperture integral has one component per weighted quantity",
+                Some(Projection::FoldInMaterial) => {
+                    let row = Weighting::luminous(m.sampling()).ok().and_then(|w| w.rows.into_iter().next());
+                    if row.is_some_and(|r| m.folds(&r)) {
+                        "applied in the integrand, so each aperture integral has one component per weighted \
+                         quantity; a luminous-only integral has the material sum its samples itself (folded tables)"
+                    } else {
+                        "applied in the integrand, so each aperture integral has one component per weighted quantity"
+                    }
+                }
                 Some(Projection::Separate) => "folding off: each sample is integrated separately, then weighted",
             }
         ));

@@ -108,12 +108,18 @@ fn scale(o: &Obj) -> Result<Scale> {
 /// Parsed once per process (the files are embedded, so the result cannot change); an error is returned
 /// again on every call.
 pub fn builtin() -> Result<Vec<StandardGeometry>> {
+    builtin_static().map(<[StandardGeometry]>::to_vec)
+}
+
+/// [`builtin`] without the copy: the geometries parsed once per process, borrowed for the rest of it
+/// (`find` copies only the one it returns).
+pub fn builtin_static() -> Result<&'static [StandardGeometry]> {
     static PARSED: std::sync::OnceLock<Vec<StandardGeometry>> = std::sync::OnceLock::new();
     if let Some(all) = PARSED.get() {
-        return Ok(all.clone());
+        return Ok(all);
     }
     let all = parse_builtin()?;
-    Ok(PARSED.get_or_init(|| all).clone())
+    Ok(PARSED.get_or_init(|| all))
 }
 
 fn parse_builtin() -> Result<Vec<StandardGeometry>> {
@@ -161,18 +167,16 @@ fn ids(gs: &[StandardGeometry]) -> String {
 /// The builtin geometry (gloss, or colour: `instrument::colour`) with this id; an unknown id is a usage error
 /// listing the known ids.
 pub fn find(id: &str) -> Result<StandardGeometry> {
-    let all = builtin()?;
+    let all = builtin_static()?;
     if let Some(g) = all.iter().find(|g| g.geometry.id == id) {
         return Ok(g.clone());
     }
-    let colour = crate::instrument::colour::builtin()?;
+    let colour = crate::instrument::colour::builtin_static()?;
     match colour.iter().find(|g| g.geometry.id == id) {
         Some(g) => Ok(g.clone()),
-        None => Err(Error::Usage(format!(
-            "unknown geometry id \"{id}\"; known ids: {}; colour: {}",
-            ids(&all),
-            ids(&colour)
-        ))),
+        None => {
+            Err(Error::Usage(format!("unknown geometry id \"{id}\"; known ids: {}; colour: {}", ids(all), ids(colour))))
+        }
     }
 }
 

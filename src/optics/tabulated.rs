@@ -15,7 +15,7 @@
 //! ch. 3–4; Press et al., *Numerical Recipes* §5.8).
 
 /// Interpolation nodes per piece (degree N − 1).
-const N: usize = 16;
+pub const N: usize = 16;
 /// Largest number of pieces tried before giving up.
 const MAX_PIECES: usize = 1024;
 
@@ -38,66 +38,161 @@ impl ChebTable {
     pub fn fit(f: impl Fn(f64) -> f64, a: f64, b: f64, tol: f64) -> Option<ChebTable> {
         let mut pieces = 8;
         while pieces <= MAX_PIECES {
-            let width = (b - a) / pieces as f64;
-            let mut coeffs = Vec::with_capacity(pieces * N);
-            let mut vals = [0.0; N];
-            for p in 0..pieces {
-                let (lo, hi) = (a + p as f64 * width, a + (p + 1) as f64 * width);
-                for (j, v) in vals.iter_mut().enumerate() {
-                    let x = (std::f64::consts::PI * (j as f64 + 0.5) / N as f64).cos();
-                    *v = f(0.5 * (lo + hi) + 0.5 * (hi - lo) * x);
-                    if !v.is_finite() {
-                        return None;
-                    }
-                }
-                for k in 0..N {
-                    let mut c = 0.0;
-                    for (j, v) in vals.iter().enumerate() {
-                        c += v * (std::f64::consts::PI * k as f64 * (j as f64 + 0.5) / N as f64).cos();
-                    }
-                    coeffs.push(if k == 0 { c / N as f64 } else { 2.0 * c / N as f64 });
-                }
+            match ChebTable::fit_pieces(&f, a, b, pieces, tol) {
+                Fit::Met(t) => return Some(t),
+                Fit::NotFinite => return None,
+                Fit::Missed => pieces *= 2,
             }
-            let mut table = ChebTable { a, b, pieces, coeffs, max_error: 0.0 };
-            let mut worst: f64 = 0.0;
-            for p in 0..pieces {
-                let (lo, hi) = (a + p as f64 * width, a + (p + 1) as f64 * width);
-                for j in 0..=N {
-                    let x = 0.5 * (lo + hi) + 0.5 * (hi - lo) * (std::f64::consts::PI * j as f64 / N as f64).cos();
-                    worst = worst.max((table.eval(x) - f(x)).abs());
-                }
-            }
-            if worst <= tol {
-                table.max_error = worst;
-                return Some(table);
-            }
-            pieces *= 2;
         }
         None
+    }
+
+    /// The table of `pieces` pieces, if its deviation at the check points is ≤ `tol` (`fit` at one piece
+    /// count: what [`ChebTable::on_grid_of`] needs to put tables on a common grid).
+    pub fn fit_with_pieces(f: impl Fn(f64) -> f64, a: f64, b: f64, pieces: usize, tol: f64) -> Option<ChebTable> {
+        match ChebTable::fit_pieces(&f, a, b, pieces, tol) {
+            Fit::Met(t) => Some(t),
+            _ => None,
+        }
+    }
+
+    fn fit_pieces(f: &impl Fn(f64) -> f64, a: f64, b: f64, pieces: usize, tol: f64) -> Fit {
+        // cos(πk(j + ½)/N) and the nodes cos(π(j + ½)/N), once per fit rather than per piece.
+        let nodes: [f64; N] = std::array::from_fn(|j| (std::f64::consts::PI * (j as f64 + 0.5) / N as f64).cos());
+        let basis: [[f64; N]; N] = std::array::from_fn(|k| {
+            std::array::from_fn(|j| (std::f64::consts::PI * k as f64 * (j as f64 + 0.5) / N as f64).cos())
+        });
+        let width = (b - a) / pieces as f64;
+        let mut coeffs = Vec::with_capacity(pieces * N);
+        let mut vals = [0.0; N];
+        for p in 0..pieces {
+            let (lo, hi) = (a + p as f64 * width, a + (p + 1) as f64 * width);
+            for (v, x) in vals.iter_mut().zip(&nodes) {
+                *v = f(0.5 * (lo + hi) + 0.5 * (hi - lo) * x);
+                if !v.is_finite() {
+                    return Fit::NotFinite;
+                }
+            }
+            for (k, row) in basis.iter().enumerate() {
+                let mut c = 0.0;
+                for (v, b) in vals.iter().zip(row) {
+                    c += v * b;
+                }
+                coeffs.push(if k == 0 { c / N as f64 } else { 2.0 * c / N as f64 });
+            }
+        }
+        let mut table = ChebTable { a, b, pieces, coeffs, max_error: 0.0 };
+        let mut worst: f64 = 0.0;
+        for p in 0..pieces {
+            let (lo, hi) = (a + p as f64 * width, a + (p + 1) as f64 * width);
+            for j in 0..=N {
+                let x = 0.5 * (lo + hi) + 0.5 * (hi - lo) * (std::f64::consts::PI * j as f64 / N as f64).cos();
+                worst = worst.max((table.eval(x) - f(x)).abs());
+            }
+        }
+        if worst <= tol {
+            table.max_error = worst;
+            Fit::Met(table)
+        } else {
+            Fit::Missed
+        }
     }
 
     pub fn pieces(&self) -> usize {
         self.pieces
     }
 
-    /// The interpolant at x (clamped into [a, b]).
+    /// Whether `other` has the same interval and pieces (so one [`ChebTable::locate`] serves both).
+    pub fn same_grid(&self, other: &ChebTable) -> bool {
+        self.a == other.a && self.b == other.b && self.pieces == other.pieces
+    }
+
+    /// The piece of x (clamped into [a, b]) and x's position t ∈ [−1, 1] in it.
     #[inline]
-    pub fn eval(&self, x: f64) -> f64 {
+    pub fn locate(&self, x: f64) -> (usize, f64) {
         let x = x.clamp(self.a, self.b);
         let width = (self.b - self.a) / self.pieces as f64;
         let p = (((x - self.a) / width) as usize).min(self.pieces - 1);
         let lo = self.a + p as f64 * width;
-        let t = 2.0 * (x - lo) / width - 1.0;
-        let c = &self.coeffs[p * N..(p + 1) * N];
-        // Clenshaw: b_k = c_k + 2t b_{k+1} − b_{k+2}; f = c_0 + t b_1 − b_2.
-        let (mut b1, mut b2) = (0.0, 0.0);
-        for &ck in c[1..].iter().rev() {
-            let b0 = ck + 2.0 * t * b1 - b2;
-            b2 = b1;
-            b1 = b0;
-        }
-        c[0] + t * b1 - b2
+        (p, 2.0 * (x - lo) / width - 1.0)
     }
+
+    /// The N Chebyshev coefficients of piece `p`.
+    #[inline]
+    pub fn piece(&self, p: usize) -> &[f64; N] {
+        self.coeffs[p * N..(p + 1) * N].try_into().expect("N coefficients per piece")
+    }
+
+    /// The interpolant at x (clamped into [a, b]).
+    #[inline]
+    pub fn eval(&self, x: f64) -> f64 {
+        let (p, t) = self.locate(x);
+        clenshaw(self.piece(p), t)
+    }
+
+    /// The table Σ_j w_j T_j of tables on one grid: its coefficients are the weighted sums of theirs (the
+    /// interpolant is linear in the coefficients), so it interpolates Σ_j w_j f_j with a deviation of at most
+    /// Σ_j |w_j|·(T_j's deviation) plus rounding, which `max_error` states. None if the grids differ.
+    pub fn combine(tables: &[ChebTable], weights: &[f64]) -> Option<ChebTable> {
+        let first = tables.first()?;
+        if tables.len() != weights.len() || tables.iter().any(|t| !t.same_grid(first)) {
+            return None;
+        }
+        let mut coeffs = vec![0.0; first.coeffs.len()];
+        for (t, w) in tables.iter().zip(weights) {
+            for (c, x) in coeffs.iter_mut().zip(&t.coeffs) {
+                *c += w * x;
+            }
+        }
+        let max_error = tables.iter().zip(weights).map(|(t, w)| w.abs() * t.max_error).sum::<f64>();
+        Some(ChebTable { a: first.a, b: first.b, pieces: first.pieces, coeffs, max_error })
+    }
+}
+
+/// The outcome of one piece count.
+enum Fit {
+    Met(ChebTable),
+    Missed,
+    NotFinite,
+}
+
+/// The Chebyshev polynomials T_0(t) … T_{N−1}(t) by their recurrence T_{k+1} = 2t T_k − T_{k−1} (stable on
+/// [−1, 1], |T_k| ≤ 1): with them, Σ_k c_k T_k(t) of several coefficient sets at one t is one dot product
+/// each ([`dot`]), where Clenshaw's recurrence would be run once per set.
+#[inline]
+pub fn basis(t: f64) -> [f64; N] {
+    let mut b = [0.0; N];
+    b[0] = 1.0;
+    b[1] = t;
+    for k in 2..N {
+        b[k] = 2.0 * t * b[k - 1] - b[k - 2];
+    }
+    b
+}
+
+/// Σ_k c_k T_k(t) from the [`basis`] at t.
+#[inline]
+pub fn dot(c: &[f64; N], basis: &[f64; N]) -> f64 {
+    // Four partial sums (independent chains) added pairwise.
+    let mut s = [0.0; 4];
+    for (cc, bb) in c.chunks_exact(4).zip(basis.chunks_exact(4)) {
+        for i in 0..4 {
+            s[i] += cc[i] * bb[i];
+        }
+    }
+    (s[0] + s[1]) + (s[2] + s[3])
+}
+
+/// Σ_k c_k T_k(t) by Clenshaw's recurrence: b_k = c_k + 2t b_{k+1} − b_{k+2}; f = c_0 + t b_1 − b_2.
+#[inline]
+pub fn clenshaw(c: &[f64; N], t: f64) -> f64 {
+    let (mut b1, mut b2) = (0.0, 0.0);
+    for &ck in c[1..].iter().rev() {
+        let b0 = ck + 2.0 * t * b1 - b2;
+        b2 = b1;
+        b1 = b0;
+    }
+    c[0] + t * b1 - b2
 }
 
 #[cfg(test)]

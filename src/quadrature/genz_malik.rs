@@ -172,10 +172,49 @@ pub enum Refine {
     Frozen,
 }
 
+/// Components stored inline up to this many (a luminous flux has 1, a colour flux 3, a flux both use 4).
+const INLINE: usize = 4;
+
+/// A region's ncomp sums: inline for ncomp ≤ [`INLINE`], so that refining a region allocates nothing (issue
+/// 10: nothing in the hot path allocates); on the heap beyond.
+struct Comps {
+    len: usize,
+    inline: [f64; INLINE],
+    heap: Vec<f64>,
+}
+
+impl Comps {
+    fn zeros(len: usize) -> Comps {
+        let heap = if len > INLINE { vec![0.0; len] } else { Vec::new() };
+        Comps { len, inline: [0.0; INLINE], heap }
+    }
+}
+
+impl std::ops::Deref for Comps {
+    type Target = [f64];
+    fn deref(&self) -> &[f64] {
+        if self.len <= INLINE {
+            &self.inline[..self.len]
+        } else {
+            &self.heap
+        }
+    }
+}
+
+impl std::ops::DerefMut for Comps {
+    fn deref_mut(&mut self) -> &mut [f64] {
+        if self.len <= INLINE {
+            &mut self.inline[..self.len]
+        } else {
+            &mut self.heap
+        }
+    }
+}
+
 struct Region<const D: usize> {
     cell: Cell<D>,
-    value: Vec<f64>,
-    error: Vec<f64>,
+    value: Comps,
+    error: Comps,
     /// Largest component error: the priority.
     worst: f64,
     split_axis: usize,
@@ -217,7 +256,8 @@ fn apply<const D: usize, F: FnMut(&[[f64; D]], &mut [f64])>(
     ncomp: usize,
     batch: &mut Batch<D>,
     first_id: usize,
-) -> Vec<Region<D>> {
+    out: &mut Vec<Region<D>>,
+) {
     let npts = rule.len();
     batch.points.clear();
     for cell in cells {
@@ -232,13 +272,10 @@ fn apply<const D: usize, F: FnMut(&[[f64; D]], &mut [f64])>(
     batch.values.clear();
     batch.values.resize(batch.points.len() * ncomp, 0.0);
     f(&batch.points, &mut batch.values);
-    cells
-        .iter()
-        .enumerate()
-        .map(|(i, cell)| {
-            summarise(rule, *cell, &batch.values[i * npts * ncomp..(i + 1) * npts * ncomp], ncomp, first_id + i)
-        })
-        .collect()
+    out.clear();
+    out.extend(cells.iter().enumerate().map(|(i, cell)| {
+        summarise(rule, *cell, &batch.values[i * npts * ncomp..(i + 1) * npts * ncomp], ncomp, first_id + i)
+    }));
 }
 
 /// Components up to this many get the calibrated estimate ([`calibrated`]); more (an unfolded spectrum, n
@@ -275,8 +312,8 @@ pub fn calibrated(n1: f64, n2: f64, n3: f64, abs7: f64) -> f64 {
 fn summarise<const D: usize>(rule: &Rule<D>, cell: Cell<D>, values: &[f64], ncomp: usize, id: usize) -> Region<D> {
     let half = cell.half;
     let vol: f64 = half.iter().map(|h| 2.0 * h).product();
-    let mut s7 = vec![0.0; ncomp];
-    let mut s5 = vec![0.0; ncomp];
+    let mut s7 = Comps::zeros(ncomp);
+    let mut s5 = Comps::zeros(ncomp);
     let mut s3 = [0.0f64; MAX_SMALL];
     let mut abs7 = [0.0f64; MAX_SMALL];
     let small = ncomp <= MAX_SMALL;
@@ -379,8 +416,11 @@ pub fn integrate_partition<const D: usize, F: FnMut(&[[f64; D]], &mut [f64])>(
         Refine::Adaptive => 1,
         Refine::Frozen => 64,
     };
+    // The regions of one rule application (reused: no allocation per step once it has grown).
+    let mut fresh: Vec<Region<D>> = Vec::with_capacity(chunk.max(2));
     for group in cells.chunks(chunk) {
-        for r in apply(&rule, &mut f, group, ncomp, &mut batch, next_id) {
+        apply(&rule, &mut f, group, ncomp, &mut batch, next_id, &mut fresh);
+        for r in fresh.drain(..) {
             next_id += 1;
             evals += npts;
             for k in 0..ncomp {
@@ -408,10 +448,10 @@ pub fn integrate_partition<const D: usize, F: FnMut(&[[f64; D]], &mut [f64])>(
         c1[ax] -= half[ax];
         c2[ax] += half[ax];
         let children = [Cell { center: c1, half }, Cell { center: c2, half }];
-        let mut ab = apply(&rule, &mut f, &children, ncomp, &mut batch, next_id);
+        apply(&rule, &mut f, &children, ncomp, &mut batch, next_id, &mut fresh);
         next_id += 2;
         evals += 2 * npts;
-        let (b, a) = (ab.pop().expect("two children"), ab.pop().expect("two children"));
+        let (b, a) = (fresh.pop().expect("two children"), fresh.pop().expect("two children"));
         for k in 0..ncomp {
             total[k] += a.value[k] + b.value[k] - r.value[k];
             err[k] += a.error[k] + b.error[k] - r.error[k];
