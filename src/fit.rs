@@ -235,12 +235,44 @@ pub struct FitOptions {
     pub default_uncertainty: f64,
     /// Most forward-model runs (each a full set of readings) the solver may spend, Jacobians excluded.
     pub max_iterations: usize,
+    /// For an exactly determined fit (as many targets as free parameters), how many further solver runs
+    /// from deterministic starts check that the solution is the only one ([`restart_fractions`]); 0 says
+    /// in the verdict that uniqueness is not checked. Ignored when there are more targets than parameters.
+    pub restarts: usize,
 }
+
+/// Restarts of an exactly determined fit by default.
+pub const DEFAULT_RESTARTS: usize = 2;
 
 impl Default for FitOptions {
     fn default() -> Self {
-        FitOptions { rtol: 1e-6, default_uncertainty: DEFAULT_UNCERTAINTY, max_iterations: 200 }
+        FitOptions {
+            rtol: 1e-6,
+            default_uncertainty: DEFAULT_UNCERTAINTY,
+            max_iterations: 200,
+            restarts: DEFAULT_RESTARTS,
+        }
     }
+}
+
+/// The k-th deterministic restart (k = 1, 2, …) as fractions of each parameter's bound width (in the fitted
+/// variable, so in the logarithm for `log:` bounds): the k-th point of the Halton sequence in bases 2, 3, 5,
+/// 7, … (Halton 1960), k = 1 giving 1/2, 1/3, 1/5, …; well spread over the box and the same on every run.
+pub fn restart_fractions(k: usize, n: usize) -> Vec<f64> {
+    const PRIMES: [usize; 12] = [2, 3, 5, 7, 11, 13, 17, 19, 23, 29, 31, 37];
+    (0..n)
+        .map(|j| {
+            let base = PRIMES[j % PRIMES.len()];
+            // A further shift for more than 12 parameters keeps the columns apart.
+            let (mut i, mut f, mut r) = (k + j / PRIMES.len(), 1.0, 0.0);
+            while i > 0 {
+                f /= base as f64;
+                r += f * (i % base) as f64;
+                i /= base;
+            }
+            r
+        })
+        .collect()
 }
 
 /// One fitted parameter.
@@ -294,8 +326,14 @@ pub struct FitReport {
     pub verdict: Vec<String>,
     /// χ² = Σ weighted residual².
     pub chi2: f64,
-    /// Forward-model runs (each a full set of readings).
+    /// Forward-model runs (each a full set of readings): the solver's points, the Jacobians' displaced
+    /// points, the final Jacobian, the linearity check's and the restarts' (all of them).
     pub evaluations: usize,
+    /// Of `evaluations`, the runs of the linearity check (one standard error each way along every
+    /// determined direction).
+    pub linearity_evaluations: usize,
+    /// Of `evaluations`, the runs of the restarts of an exactly determined fit.
+    pub restart_evaluations: usize,
     pub seconds: f64,
     /// The recipe with the fitted values.
     pub recipe: Value,
@@ -705,12 +743,14 @@ pub fn fit(
     if let Err(e) = &problem.current {
         return Err(Error::Numeric(format!("the start does not evaluate: {e}")));
     }
-    let lm = LevenbergMarquardt::new()
-        .with_ftol(1e-12)
-        .with_xtol(1e-10)
-        .with_gtol(1e-12)
-        .with_patience(options.max_iterations.div_ceil(free.len() + 1).max(1));
-    let (problem, report) = lm.minimize(problem);
+    let solver = || {
+        LevenbergMarquardt::new()
+            .with_ftol(1e-12)
+            .with_xtol(1e-10)
+            .with_gtol(1e-12)
+            .with_patience(options.max_iterations.div_ceil(free.len() + 1).max(1))
+    };
+    let (problem, report) = solver().minimize(problem);
     let (converged, termination) = match &report.termination {
         TerminationReason::Converged { .. } => (true, "converged (ftol/xtol)".to_string()),
         TerminationReason::Orthogonal => (true, "converged (the residuals are orthogonal to the Jacobian)".into()),
@@ -841,6 +881,7 @@ pub fn fit(
     // then not to be trusted and the fit is not reported identifiable (Bates & Watts, *Nonlinear Regression
     // Analysis and Its Applications*, 1988, ch. 7, on when linear approximation intervals fail).
     let mut nonlinear: Vec<String> = Vec::new();
+    let runs_before_linearity = fwd.runs.get();
     for &i in &order {
         let s = svd.singular_values[i];
         if s < 1.0 || null(s) {
@@ -881,6 +922,90 @@ pub fn fit(
         }
     }
 
+    // An exactly determined fit (m = n) has zero residuals at any exact solution, and the readings may have
+    // more than one (a gloss that rises and falls with a parameter; two parameters that trade off): the
+    // covariance at one solution says nothing of another. Restart the solver from deterministic starts
+    // spread over the bounds and compare where each lands: at this solution (every parameter within three
+    // standard errors), at another one that fits the targets as well (χ² within 1 of this one: a second
+    // solution the targets cannot tell from this one), or at a worse local minimum.
+    let linearity_evaluations = fwd.runs.get() - runs_before_linearity;
+    let mut uniqueness: Vec<String> = Vec::new();
+    let mut second_solution = false;
+    let runs_before_restarts = fwd.runs.get();
+    if m == n {
+        if options.restarts == 0 {
+            uniqueness.push(format!(
+                "the fit is exactly determined ({m} target(s) for {n} free parameter(s)): the residuals vanish at any \
+                 exact solution, and whether another one exists is not checked (restarts 0)"
+            ));
+        } else {
+            let (mut same, mut worse, mut failed) = (0usize, 0usize, 0usize);
+            let mut others: Vec<String> = Vec::new();
+            for k in 1..=options.restarts {
+                let fr = restart_fractions(k, n);
+                let u_k = DVector::from_iterator(n, fr.iter().map(|f| (2.0 * f - 1.0).clamp(-1.0, 1.0).asin()));
+                let mut p_k = Problem {
+                    fwd: &fwd,
+                    targets,
+                    u_sigma: u_sigma.clone(),
+                    u: u_k.clone(),
+                    current: Err(String::new()),
+                    last_error: std::cell::RefCell::new(None),
+                };
+                p_k.set_params(&u_k);
+                if p_k.current.is_err() {
+                    failed += 1;
+                    continue;
+                }
+                let (p_k, _) = solver().minimize(p_k);
+                let Ok(c_k) = &p_k.current else {
+                    failed += 1;
+                    continue;
+                };
+                let t_k = p_k.t_of_u(&p_k.u);
+                let chi2_k = p_k.weighted(&c_k.predictions).norm_squared();
+                let apart = (0..n).any(|j| match std_t[j] {
+                    Some(sd) if sd > 0.0 => (t_k[j] - t[j]).abs() > 3.0 * sd,
+                    // An undetermined parameter: apart if it moved by more than 1e-3 of its bound width.
+                    _ => (t_k[j] - t[j]).abs() > 1e-3 * widths[j],
+                });
+                if !apart {
+                    same += 1;
+                } else if chi2_k <= chi2 + 1.0 {
+                    let x_k = p_k.x_of_t(&t_k);
+                    others.push(format!("{} (χ² = {chi2_k:.3})", describe_point(free, &x_k)));
+                } else {
+                    worse += 1;
+                }
+            }
+            let restarts = options.restarts;
+            let mut line = format!(
+                "the fit is exactly determined ({m} target(s) for {n} free parameter(s)); {restarts} restart(s) from \
+                 deterministic starts spread over the bounds (Halton points): {same} returned to this solution"
+            );
+            if worse > 0 {
+                line.push_str(&format!(", {worse} stopped at a worse local minimum"));
+            }
+            if failed > 0 {
+                line.push_str(&format!(", {failed} could not be evaluated"));
+            }
+            if !others.is_empty() {
+                line.push_str(&format!(
+                    ", {} found another solution that fits the targets as well: {}; the targets do not single out \
+                     one recipe",
+                    others.len(),
+                    others.join("; ")
+                ));
+                second_solution = true;
+            } else {
+                line.push_str("; no second solution was found from these starts (which does not prove there is none)");
+            }
+            uniqueness.push(line);
+        }
+    }
+
+    let restart_evaluations = fwd.runs.get() - runs_before_restarts;
+
     // Verdict: every direction whose full-range move changes the weighted residuals by less than one.
     let mut verdict = Vec::new();
     let mut identifiable = true;
@@ -918,6 +1043,10 @@ pub fn fit(
         identifiable = false;
         verdict.extend(nonlinear);
     }
+    if second_solution {
+        identifiable = false;
+    }
+    verdict.extend(uniqueness);
     for a in 0..n {
         for b in a + 1..n {
             if let Some(c) = correlation[a][b] {
@@ -985,6 +1114,8 @@ pub fn fit(
         verdict,
         chi2,
         evaluations: fwd.runs.get(),
+        linearity_evaluations,
+        restart_evaluations,
         seconds: clock.elapsed().as_secs_f64(),
         recipe,
     })

@@ -1,6 +1,6 @@
-//! JSON Schemas (draft 2020-12) of the JSON outputs of `measure` (one recipe or many), `compare` and the
-//! JSON lines of `sweep`: the contract that scripts and CI rely on, printed by
-//! `glossmeter schema --output-format measure|compare|sweep` (`fit`'s is added with the `fit` command). `tests/schemas.rs` validates real outputs
+//! JSON Schemas (draft 2020-12) of the JSON outputs of `measure` (one recipe or many), `compare`, `fit` and
+//! the JSON lines of `sweep`: the contract that scripts and CI rely on, printed by
+//! `glossmeter schema --output-format measure|compare|sweep|fit`. `tests/schemas.rs` validates real outputs
 //! against them, so a field added to an output without its schema fails the tests.
 use serde_json::{json, Value};
 
@@ -174,6 +174,43 @@ pub fn sweep() -> Value {
                 "problem": {"type": "string"}}}},
             "problem": {"type": "string", "description": "why the recipe at this point is invalid (then no readings)"},
             "seconds": {"type": "number", "minimum": 0},
+        },
+    })
+}
+
+/// `fit --format json` (docs/inverse.md §Output): the contract of issue 11, and `verdict` (the table's words).
+pub fn fit() -> Value {
+    let num = json!({"type": "number"});
+    let stderr = json!({"type": ["number", "null"], "minimum": 0,
+                        "description": "null when the targets do not determine the parameter"});
+    json!({
+        "$schema": DRAFT,
+        "title": "glossmeter fit --format json",
+        "type": "object",
+        "required": ["parameters", "targets", "converged", "identifiable", "singular_values", "correlation",
+                     "verdict", "evaluations", "seconds", "recipe"],
+        "additionalProperties": false,
+        "properties": {
+            "parameters": {"type": "array", "minItems": 1, "items": {"type": "object", "additionalProperties": false,
+              "required": ["path", "value", "std_error", "lower", "upper", "at_bound"],
+              "properties": {"path": {"type": "string", "description": "JSON Pointer into the recipe"},
+                "value": num_or_null(), "std_error": stderr, "lower": num, "upper": num,
+                "at_bound": {"type": "boolean"}}}},
+            "targets": {"type": "array", "minItems": 1, "items": {"type": "object", "additionalProperties": false,
+              "required": ["geometry", "name", "measured", "uncertainty", "predicted", "residual"],
+              "properties": {"geometry": {"type": "string"}, "name": {"type": "string"}, "measured": num,
+                "uncertainty": {"type": "number", "minimum": 0}, "predicted": num_or_null(),
+                "residual": {"type": ["number", "null"], "description": "predicted − measured"}}}},
+            "converged": {"type": "boolean"},
+            "identifiable": {"type": "boolean"},
+            "singular_values": {"type": "array", "items": {"type": ["number", "null"], "minimum": 0},
+              "description": "of the weighted Jacobian, columns scaled by the bound widths, largest first"},
+            "correlation": {"type": "array", "items": {"type": "array", "items": num_or_null()}},
+            "verdict": {"type": "array", "items": {"type": "string"}},
+            "evaluations": {"type": "integer", "minimum": 0,
+              "description": "forward runs (each a full set of readings): the solver's, the Jacobians', the linearity check's and any restarts'"},
+            "seconds": {"type": ["number", "null"], "minimum": 0, "description": "null with --no-timing"},
+            "recipe": {"type": "object", "description": "the recipe with the fitted values"},
         },
     })
 }

@@ -854,11 +854,11 @@ pub const E1392_FILE: Param = p(
 pub const INPLANE_OFF_PLANE: Param = p(
     "/off_plane",
     &["inplane-csv", "e1392"],
-    Type::Choice(&["f", "f-cos-cos"]),
+    Type::Choice(&["f", "f-cos-cos", "microfacet"]),
     "",
     NONE,
     Opt("\"f\""),
-    "the isotropy assumption off the plane: f: f_r depends on (θh, θd) only (exact for a Lambertian); f-cos-cos: f_r·cos θi·cos θo does (exact for a microfacet lobe up to masking)",
+    "the isotropy assumption off the plane: f: f_r depends on (θh, θd) only (exact for a Lambertian); f-cos-cos: f_r·cos θi·cos θo does (exact for a microfacet lobe up to masking); microfacet: f_r·cos θi·cos θo/G2 does, G2 the Smith term of the table's own distribution (exact for an isotropic microfacet lobe with Smith masking)",
 );
 
 /// Every entry, in the order of the docs table (descriptive fields first, then model by model).

@@ -67,7 +67,38 @@ fn one_roughness_from_one_gloss() {
     assert!((r.parameters[0].value - 0.05).abs() < 1e-4, "{}", r.parameters[0].value);
     assert!(r.targets[0].weighted_residual.abs() < 1e-3);
     assert_eq!(r.recipe["roughness"].as_f64(), Some(r.parameters[0].value));
-    assert!(r.evaluations < 80, "{} forward runs", r.evaluations);
+    // The solver's runs; then the linearity check's (one standard error each way along the one direction) and
+    // the restarts' of this exactly determined fit, all counted in `evaluations`.
+    assert!(r.evaluations - r.linearity_evaluations - r.restart_evaluations < 80, "{} forward runs", r.evaluations);
+    assert_eq!(r.linearity_evaluations, 2, "{r:#?}");
+    assert!(r.restart_evaluations > 0, "{r:#?}");
+    // One target for one parameter: the verdict says so, and the restarts (gloss falls monotonically with the
+    // roughness, so there is one solution) all return to it.
+    let line = r.verdict.iter().find(|v| v.contains("exactly determined")).expect("an m = n verdict line");
+    assert!(line.contains("2 restart(s)") && line.contains("2 returned to this solution"), "{line}");
+    // Without restarts the verdict says uniqueness is not checked, and nothing else changes.
+    let r0 = fit(
+        &glass("beckmann", 0.12, 1.5),
+        "start.json",
+        &[free("/roughness=log:1e-3..0.5")],
+        &targets(G60, &v, 0.2),
+        &FitOptions { rtol: 1e-8, restarts: 0, ..FitOptions::default() },
+    )
+    .unwrap();
+    assert_eq!(r0.restart_evaluations, 0);
+    assert!(r0.verdict.iter().any(|v| v.contains("exactly determined") && v.contains("not checked")), "{r0:#?}");
+    assert_eq!(r0.parameters[0].value.to_bits(), r.parameters[0].value.to_bits());
+    assert_eq!(r0.evaluations, r.evaluations - r.restart_evaluations);
+}
+
+/// Restart points are deterministic Halton points inside the bounds.
+#[test]
+fn restart_points_are_halton() {
+    assert_eq!(glossmeter::fit::restart_fractions(1, 3), vec![0.5, 1.0 / 3.0, 0.2]);
+    assert_eq!(glossmeter::fit::restart_fractions(2, 2), vec![0.25, 2.0 / 3.0]);
+    for k in 1..20 {
+        assert!(glossmeter::fit::restart_fractions(k, 5).iter().all(|f| *f > 0.0 && *f < 1.0));
+    }
 }
 
 /// A small deterministic normal generator (xorshift64* + Box–Muller), so the test needs no extra crate.

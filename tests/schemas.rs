@@ -165,6 +165,55 @@ fn outputs_follow_their_schemas() {
     for line in out.lines() {
         assert_valid(&s, &serde_json::from_str(line).unwrap(), line);
     }
+    // fit: one roughness to one gloss (exactly determined), with and without timing; two parameters of which
+    // the targets see one (an undetermined standard error, a null); a fit that hits a bound.
+    let f = schema("fit");
+    let rough = "fixtures/recipes/rough-dielectric-beckmann.json";
+    for args in [
+        &[
+            "fit",
+            rough,
+            "--free",
+            "/roughness=log:1e-3..0.5",
+            "--target",
+            "astm-d523-60/gloss=40±0.2",
+            "--format",
+            "json",
+        ][..],
+        &[
+            "fit",
+            rough,
+            "--free",
+            "/roughness=log:1e-3..0.5",
+            "--target",
+            "astm-d523-60/gloss=40±0.2",
+            "--format",
+            "json",
+            "--no-timing",
+        ],
+        &[
+            "fit",
+            rough,
+            "--free",
+            "/roughness=log:1e-3..0.5",
+            "--free",
+            "/ior=1.3..1.8",
+            "--target",
+            "astm-d523-60/gloss=40±0.2",
+            "--target",
+            "astm-d523-20/gloss=12±0.2",
+            "--target",
+            "astm-d523-85/gloss=80±0.2",
+            "--format",
+            "json",
+        ],
+        &["fit", rough, "--free", "/roughness=0.05..0.5", "--target", "astm-d523-60/gloss=99±0.2", "--format", "json"],
+    ] {
+        let (code, out) = gm(args);
+        assert!(code == 0 || code == 1, "{args:?}: exit {code}");
+        let doc: Value = serde_json::from_str(&out).unwrap_or_else(|e| panic!("{args:?}: {e}: {out}"));
+        assert_valid(&f, &doc, &format!("{args:?}"));
+    }
     // The validator itself rejects what it should.
     let mut e = vec![];
     validate(&m, &serde_json::json!({"material": {"name": "x"}, "readings": [], "extra": 1}), "", &mut e);

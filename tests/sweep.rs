@@ -216,3 +216,34 @@ fn sweep_paths_come_from_the_registry() {
         std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
     assert_eq!(names.len(), 2, "no temporary file left: {names:?}");
 }
+
+/// The progress bar's terminal path: under a pseudo-terminal (util-linux `script`, which runs the command with
+/// stdin, stdout and stderr on a pty) the bar is drawn on the terminal, and the file written with `-o` holds
+/// the same bytes as a run without a terminal (the bar never reaches the output).
+#[test]
+fn the_progress_bar_is_drawn_on_a_terminal_only() {
+    if Command::new("script").arg("--version").output().is_err() {
+        panic!("util-linux `script` is needed to give the sweep a terminal (apt-get install util-linux)");
+    }
+    let d = tmp_dir("pty");
+    let (plain, on_tty) = (d.join("plain.csv"), d.join("tty.csv"));
+    let exe = env!("CARGO_BIN_EXE_glossmeter");
+    let args = ["sweep", T, "-g", "astm-d523-60", "--no-timing", "--vary", "/albedo/0=0.2..1.2:40"];
+    let (code, _, err) = gm(&[&args[..], &["-o", plain.to_str().unwrap()]].concat());
+    assert_eq!(code, 0, "{err}");
+    assert!(err.is_empty(), "no bar without a terminal: {err}");
+    // One shell word per argument (no argument here holds a quote).
+    let cmd = [&[exe][..], &args[..], &["-o", on_tty.to_str().unwrap()]]
+        .concat()
+        .iter()
+        .map(|a| format!("'{a}'"))
+        .collect::<Vec<_>>()
+        .join(" ");
+    let out = Command::new("script").args(["-q", "-e", "-c", &cmd, "/dev/null"]).output().expect("run script");
+    let terminal = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{terminal}");
+    // The bar's template is "{bar:40} {pos}/{len} points, …": the terminal saw it (with its escape codes).
+    assert!(terminal.contains("/40 points"), "no progress bar on the terminal: {terminal:?}");
+    assert_eq!(std::fs::read(&on_tty).unwrap(), std::fs::read(&plain).unwrap());
+    let _ = std::fs::remove_dir_all(&d);
+}

@@ -37,6 +37,11 @@ pub struct FitArgs {
     /// Uncertainty of a target given without one, in the reading's unit.
     #[arg(long, default_value_t = fit::DEFAULT_UNCERTAINTY)]
     pub uncertainty: f64,
+    /// For an exactly determined fit (as many targets as free parameters): solver restarts from
+    /// deterministic starts that check whether another solution fits the targets as well (0: not checked,
+    /// said in the verdict).
+    #[arg(long, default_value_t = fit::DEFAULT_RESTARTS)]
+    pub restarts: usize,
     /// Relative tolerance of every forward reading.
     #[arg(long, default_value_t = 1e-6)]
     pub rtol: f64,
@@ -73,7 +78,8 @@ pub fn run(a: FitArgs) -> Result<()> {
         None => a.targets.iter().map(|t| TargetReading::parse(t)).collect::<Result<_>>()?,
     };
     let material = recipe::load_file(&a.recipe)?;
-    let options = FitOptions { rtol: a.rtol, default_uncertainty: a.uncertainty, ..FitOptions::default() };
+    let options =
+        FitOptions { rtol: a.rtol, default_uncertainty: a.uncertainty, restarts: a.restarts, ..FitOptions::default() };
     let report = fit::fit(&material.json, &material.file, &free, &targets, &options)?;
     let text = match a.format {
         Format::Json => {
@@ -145,6 +151,16 @@ fn sig(x: f64) -> String {
 
 fn table(name: &str, r: &FitReport, timing: bool) -> String {
     let mut s = format!("fit of {name}: {}; {} forward runs", r.termination, r.evaluations);
+    let mut parts = Vec::new();
+    if r.linearity_evaluations > 0 {
+        parts.push(format!("{} for the linearity check", r.linearity_evaluations));
+    }
+    if r.restart_evaluations > 0 {
+        parts.push(format!("{} for the restarts", r.restart_evaluations));
+    }
+    if !parts.is_empty() {
+        s.push_str(&format!(" (of which {})", parts.join(", ")));
+    }
     if timing {
         s.push_str(&format!(", {:.2} s", r.seconds));
     }

@@ -67,6 +67,7 @@ pub enum OutputSchema {
     Measure,
     Compare,
     Sweep,
+    Fit,
 }
 
 #[derive(Subcommand, Debug)]
@@ -123,7 +124,7 @@ pub enum Command {
         /// A geometry id.
         id: Option<String>,
     },
-    /// Print the JSON Schema of the recipe format, or of an output (`--output-format measure|compare|sweep`).
+    /// Print the JSON Schema of the recipe format, or of an output (`--output-format measure|compare|sweep|fit`).
     Schema {
         #[arg(long, value_enum)]
         output_format: Option<OutputSchema>,
@@ -293,6 +294,7 @@ fn dispatch(cli: Cli) -> Result<()> {
                 Some(OutputSchema::Measure) => crate::output_schema::measure(),
                 Some(OutputSchema::Compare) => crate::output_schema::compare(),
                 Some(OutputSchema::Sweep) => crate::output_schema::sweep(),
+                Some(OutputSchema::Fit) => crate::output_schema::fit(),
             };
             let text = serde_json::to_string_pretty(&schema)
                 .map_err(|e| Error::Numeric(format!("the schema does not serialise: {e}")))?;

@@ -10,21 +10,35 @@
 //! angle at load time.
 //!
 //! **Isotropy assumption** (explicit; an in-plane scan says nothing about the other azimuths). The material is
-//! taken to be isotropic and its BRDF to depend on the pair of directions only through the Rusinkiewicz
-//! half and difference angles (θh, θd) — the "bivariate" approximation of Romeiro, Vasilyev & Zickler
-//! (ECCV 2008, "Passive reflectometry"), which drops the φd dependence. An in-plane pair (θi, θo) has
-//! θh = |θo − θi|/2 and θd = (θi + θo)/2, so a pair of directions anywhere maps back to the in-plane pairs
-//! (θd − θh, θd + θh) and (θd + θh, θd − θh), one the reciprocal of the other; the one whose θi is nearer
-//! to the actual polar angle of ωi is used (for a pair in the plane of incidence that is the pair itself, so
-//! the table is exact in the plane and the assumption enters only through the apertures' perpendicular
-//! extent).
+//! taken to be isotropic, and a quantity Q of the pair of directions to depend on it only through the
+//! Rusinkiewicz half and difference angles (θh, θd), dropping the φd dependence (the "bivariate"
+//! approximation of Romeiro, Vasilyev & Zickler, ECCV 2008, "Passive reflectometry"). An in-plane pair
+//! (θi, θo) has θh = |θo − θi|/2 and θd = (θi + θo)/2, so a pair of directions anywhere maps back to the
+//! in-plane pairs (θd − θh, θd + θh) and (θd + θh, θd − θh), one the reciprocal of the other; of those that
+//! lie inside the measured domain, the one whose θi is nearer the actual polar angle of ωi is used (for a
+//! pair in the plane of incidence that is the pair itself, so the table is exact in the plane).
 //!
-//! Which quantity is taken to depend on (θh, θd) alone is the recipe's choice (`"off_plane"`, [`OffPlane`]):
-//! f_r itself (exact for a Lambertian), or f_r·cos θi·cos θo, which is F(θd)·D(θh)·G/4 for a microfacet lobe
-//! (Walter et al. 2007, Eq. 20), so exact for the lobe up to its masking term G. Off the plane the two differ
-//! by the factor (cos θi′ cos θo′)/(cos θi cos θo) = 1 − tan²θh tan²θd at φd = 90° (the primes: the in-plane
-//! pair), which is why a glossy lobe read at 60° and 85° needs the second.
-use super::table::{half_diff, Axis, Table};
+//! Which quantity Q is is the recipe's choice (`"off_plane"`, [`OffPlane`]):
+//! * `f`: f_r itself, exact for a constant (Lambertian) BRDF;
+//! * `f-cos-cos`: f_r·cos θi·cos θo, which for a microfacet lobe is F(θd)·D(θh)·G/4 (Walter et al. 2007,
+//!   Eq. 20), exact for the lobe up to its masking term G;
+//! * `microfacet`: f_r·cos θi·cos θo / G2(θi, θo) = F(θd)·D(θh)/4, with G2 the Smith height-correlated
+//!   masking-shadowing term (Heitz 2014, "Understanding the masking-shadowing function", Eq. 99) of the
+//!   table's own microfacet distribution: exact for any isotropic microfacet lobe with Smith masking, whatever
+//!   its D and F. D is read from the table along the cut of constant θd at the table's smallest θi (F is
+//!   constant along it; at θi = 0 this is the retro-reflection cut of Dupuy et al. 2015, "Extracting
+//!   microfacet-based BRDF parameters from arbitrary materials with power iterations"), normalised by
+//!   ∫ D cos θm dω = 1, and Λ follows from D by the projected-area identity
+//!   cos θ·(1 + Λ(θ)) = ∫ ⟨ω·m⟩ D(m) dm (Heitz 2014, Eq. 43 with Smith's G1 = 1/(1 + Λ)); G2 enters D's
+//!   cut itself, so the two are iterated (three fixed-point passes from Λ = 0).
+//!
+//! **Beyond the measured domain.** Near grazing an off-plane pair can have θd + θh above the largest measured
+//! θo (at 85° the perpendicular receptor tilts the half vector by up to ≈ 26°, so θd + θh exceeds 90°):
+//! no in-plane pair holds its (θh, θd). There Q is continued by separability, Q(θh, θd) =
+//! Q(θh, θd*)·Q(0, θd)/Q(0, θd*), θd* the largest difference angle at which (θh, θd*) is measured — exact
+//! when Q is a product of a function of θh and one of θd (a constant; F(θd)·D(θh)), and the specular row
+//! Q(0, ·) carrying the θd dependence.
+use super::table::{file_name, reflection_half_diff, Axis, Nodes, Table};
 use crate::brdf::{Brdf, Lobe, Term, TermKind};
 use crate::spectrum::Sampling;
 use crate::{Error, Result, Vec3};
@@ -47,6 +61,9 @@ pub enum OffPlane {
     Brdf,
     /// f_r·cos θi·cos θo as a function of (θh, θd): exact for a microfacet lobe up to its masking term.
     BrdfCosCos,
+    /// f_r·cos θi·cos θo / G2(θi, θo) as a function of (θh, θd), G2 the Smith height-correlated term of the
+    /// table's own distribution: exact for an isotropic microfacet lobe with Smith masking.
+    Microfacet,
 }
 
 impl OffPlane {
@@ -55,6 +72,7 @@ impl OffPlane {
         match self {
             OffPlane::Brdf => "f",
             OffPlane::BrdfCosCos => "f-cos-cos",
+            OffPlane::Microfacet => "microfacet",
         }
     }
 }
@@ -66,6 +84,171 @@ pub struct Point {
     pub theta_o_deg: f64,
     pub value: f64,
     pub line: usize,
+}
+
+/// The measured domain (radians): the rows' θi and the θo range of each row. A pair (θi, θo) is measured when
+/// θi lies between the first and last row and every row its value is interpolated from (the two around θi,
+/// at the same offset θo − θi from the specular direction) holds that offset within its θo range — so that
+/// no lookup reads a row's clamped end value for a θo beyond it.
+#[derive(Clone, Debug)]
+struct Domain {
+    rows: Vec<f64>,
+    ranges: Vec<(f64, f64)>,
+}
+
+impl Domain {
+    fn theta_i(&self) -> (f64, f64) {
+        (self.rows[0], self.rows[self.rows.len() - 1])
+    }
+
+    fn row_holds(&self, i: usize, ti: f64, to: f64) -> bool {
+        let shifted = to - ti + self.rows[i];
+        shifted >= self.ranges[i].0 && shifted <= self.ranges[i].1
+    }
+
+    fn contains(&self, (ti, to): (f64, f64)) -> bool {
+        let (lo, hi) = self.theta_i();
+        if !(ti >= lo && ti <= hi) {
+            return false;
+        }
+        // The bracketing rows as `Axis::linear` gives them: rows[i] ≤ θi ≤ rows[i + 1].
+        let i = self.rows[..self.rows.len() - 1].partition_point(|&x| x <= ti).saturating_sub(1);
+        if self.rows[i] == ti || self.rows.len() == 1 {
+            return self.row_holds(i, ti, to);
+        }
+        self.row_holds(i, ti, to) && self.row_holds(i + 1, ti, to)
+    }
+
+    /// The largest difference angle θd* ≤ θd at which a pair with half angle θh is measured, if any: the
+    /// specular-side ordering (θd* − θh, θd* + θh) sits at the last row θr with θr + 2θh inside that row (the
+    /// pair on a row is read from it alone); the reciprocal one (θd* + θh, θd* − θh) at θd* = last θi − θh.
+    /// Returned with the measured pair there (computed once, so that rounding cannot move it off a row).
+    fn largest_theta_d(&self, th: f64, td: f64) -> Option<(f64, (f64, f64))> {
+        for pair in [(td - th, td + th), (td + th, td - th)] {
+            if self.contains(pair) {
+                return Some((td, pair));
+            }
+        }
+        let mut best: Option<(f64, (f64, f64))> = None;
+        let mut consider = |cand: f64, pair: (f64, f64)| {
+            if cand <= td && self.contains(pair) && best.is_none_or(|b| cand > b.0) {
+                best = Some((cand, pair));
+            }
+        };
+        for (i, &r) in self.rows.iter().enumerate().rev() {
+            if r + th <= td && r + 2.0 * th <= self.ranges[i].1 {
+                consider(r + th, (r, r + 2.0 * th));
+                break;
+            }
+        }
+        let (_, hi) = self.theta_i();
+        let b = (hi - th).min(td);
+        consider(b, (b + th, b - th));
+        best
+    }
+}
+
+/// Smith's Λ of the table's distribution (`OffPlane::Microfacet`), held as the projected area
+/// A(θ) = cos θ·(1 + Λ(θ)) = ∫ ⟨ω·m⟩ D(m) dm on a uniform grid of θ over [0, π/2]: A is smooth up to grazing
+/// (where Λ grows like tan θ and would not interpolate), and Λ = A/cos θ − 1 at the exact cos θ.
+#[derive(Clone, Debug)]
+struct SmithLambda {
+    step: f64,
+    area: Vec<f64>,
+}
+
+/// Grid of the projected-area table: 0.1° (A is smooth; the fixtures' Λ is read to ≤ 1e-5 relative).
+const LAMBDA_STEP_DEG: f64 = 0.1;
+/// Fixed-point passes between D's cut and Λ (the cut's own G2 depends on Λ; Λ changes by < 1e-6 relative on
+/// the fixtures after the third).
+const LAMBDA_PASSES: usize = 3;
+
+impl SmithLambda {
+    /// Λ ≡ 0 (A = cos θ).
+    fn zero() -> Self {
+        let step = LAMBDA_STEP_DEG.to_radians();
+        let n = (FRAC_PI_2 / step).round() as usize;
+        SmithLambda { step, area: (0..=n).map(|j| (j as f64 * step).min(FRAC_PI_2).cos()).collect() }
+    }
+
+    /// Λ at polar angle θ: A linear in θ between the nodes, divided by cos θ.
+    fn at(&self, theta: f64) -> f64 {
+        let theta = theta.abs().min(FRAC_PI_2);
+        let u = (theta / self.step).min((self.area.len() - 1) as f64);
+        let i = (u as usize).min(self.area.len() - 2);
+        let t = u - i as f64;
+        let a = (1.0 - t) * self.area[i] + t * self.area[i + 1];
+        let l = a / theta.cos() - 1.0;
+        if l.is_finite() {
+            l.max(0.0)
+        } else {
+            f64::INFINITY
+        }
+    }
+
+    /// Smith height-correlated masking-shadowing G2 = 1/(1 + Λ(θi) + Λ(θo)) (Heitz 2014, Eq. 99).
+    fn g2(&self, theta_i: f64, theta_o: f64) -> f64 {
+        1.0 / (1.0 + self.at(theta_i) + self.at(theta_o))
+    }
+
+    /// The projected area of an isotropic distribution D(θm) given at θm = k·dθ (k = 0..): D normalised by
+    /// 2π ∫ D cos θm sin θm dθm = 1, then A(θ) = ∫ D(θm) sin θm Φ(θ, θm) dθm with Φ the azimuthal integral of
+    /// ⟨ω·m⟩ in closed form (`projected_cosine_azimuthal`). Trapezoidal rule in θm.
+    fn from_distribution(d: &[f64], d_theta: f64) -> Self {
+        let step = LAMBDA_STEP_DEG.to_radians();
+        let n = (FRAC_PI_2 / step).round() as usize;
+        let last = d.len() - 1;
+        let trap = |k: usize| if k == 0 || k == last { 0.5 } else { 1.0 };
+        let norm: f64 = d
+            .iter()
+            .enumerate()
+            .map(|(k, &dk)| {
+                let tm = k as f64 * d_theta;
+                trap(k) * dk * tm.cos() * tm.sin()
+            })
+            .sum::<f64>()
+            * 2.0
+            * std::f64::consts::PI
+            * d_theta;
+        if !(norm > 0.0 && norm.is_finite()) {
+            return Self::zero();
+        }
+        let area = (0..=n)
+            .map(|j| {
+                let (st, ct) = (j as f64 * step).min(FRAC_PI_2).sin_cos();
+                let sum: f64 = d
+                    .iter()
+                    .enumerate()
+                    .map(|(k, &dk)| {
+                        let (sm, cm) = (k as f64 * d_theta).sin_cos();
+                        trap(k) * dk * sm * projected_cosine_azimuthal(st * sm, ct.max(0.0) * cm)
+                    })
+                    .sum();
+                // Never below the flat surface's cos θ (Λ ≥ 0).
+                (sum * d_theta / norm).max(ct.max(0.0))
+            })
+            .collect();
+        SmithLambda { step, area }
+    }
+}
+
+/// ∫₀^{2π} max(0, a·cos φ + b) dφ for a, b ≥ 0: 2πb if b ≥ a, else 2(√(a² − b²) + b·(π − acos(b/a))) — the
+/// azimuthal part of ∫ ⟨ω·m⟩ dm with a = sin θ sin θm, b = cos θ cos θm.
+fn projected_cosine_azimuthal(a: f64, b: f64) -> f64 {
+    use std::f64::consts::PI;
+    if b >= a {
+        2.0 * PI * b
+    } else {
+        2.0 * ((a * a - b * b).sqrt() + b * (PI - (b / a).acos()))
+    }
+}
+
+/// The quantity interpolated between rows (linearly in θi at a fixed offset from the specular direction).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Row {
+    F,
+    CosCos,
+    CosCosOverG2,
 }
 
 /// An in-plane table with the isotropic extension.
@@ -82,7 +265,10 @@ pub struct InPlaneBrdf {
     /// Points of the file not used (e.g. out of the plane), said in `describe`.
     unused: usize,
     theta_o_range: (f64, f64),
+    domain: Domain,
     off_plane: OffPlane,
+    /// Smith's Λ of the table's distribution (`OffPlane::Microfacet`; zero otherwise).
+    lambda: SmithLambda,
     sampling: Sampling,
 }
 
@@ -115,6 +301,7 @@ impl InPlaneBrdf {
         let mut rows = Vec::new();
         let mut min_step = f64::INFINITY;
         let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+        let mut row_ranges = Vec::new();
         let mut k = 0;
         while k < points.len() {
             let ti = points[k].theta_i_deg;
@@ -140,8 +327,10 @@ impl InPlaneBrdf {
                     Quantity::BrdfCos => p.value / t.cos(),
                 })
                 .collect();
-            lo = lo.min(tos[0]);
-            hi = hi.max(tos[tos.len() - 1]);
+            let (first, last) = (tos[0], tos[tos.len() - 1]);
+            lo = lo.min(first);
+            hi = hi.max(last);
+            row_ranges.push((first, last));
             let axis = Axis::values(tos);
             min_step = min_step.min(axis.min_spacing());
             thetas.push(ti.to_radians());
@@ -150,6 +339,7 @@ impl InPlaneBrdf {
         if rows.is_empty() {
             return Err(Error::input(file, "", "no data points"));
         }
+        let domain = Domain { rows: thetas.clone(), ranges: row_ranges };
         Ok(InPlaneBrdf {
             file: file.to_string(),
             format,
@@ -159,14 +349,24 @@ impl InPlaneBrdf {
             points: points.len(),
             unused,
             theta_o_range: (lo, hi),
+            domain,
             off_plane: OffPlane::Brdf,
+            lambda: SmithLambda::zero(),
             sampling: Sampling::grey(),
         })
     }
 
-    /// The same table with the given off-plane extension.
+    /// The same table with the given off-plane extension (for `Microfacet`, Λ of the table's distribution is
+    /// computed here, once).
     pub fn with_off_plane(mut self, off_plane: OffPlane) -> Self {
         self.off_plane = off_plane;
+        self.lambda = SmithLambda::zero();
+        if off_plane == OffPlane::Microfacet {
+            for _ in 0..LAMBDA_PASSES {
+                let (d, d_theta) = self.distribution_cut();
+                self.lambda = SmithLambda::from_distribution(&d, d_theta);
+            }
+        }
         self
     }
 
@@ -174,33 +374,39 @@ impl InPlaneBrdf {
         self.off_plane
     }
 
+    /// Smith's Λ(θ) of the table's distribution (0 unless the extension is `microfacet`).
+    pub fn smith_lambda(&self, theta: f64) -> f64 {
+        self.lambda.at(theta)
+    }
+
     /// f_r at an in-plane pair (θi ≥ 0, signed θo), radians: linear in θo within rows; between rows linear in
     /// θi at a fixed offset θo − θi from the specular direction (so that the specular peak, which moves with
     /// θi, is interpolated onto itself).
     pub fn in_plane(&self, theta_i: f64, theta_o: f64) -> f64 {
-        self.interpolate(theta_i, theta_o, false)
+        self.interpolate(theta_i, theta_o, Row::F)
     }
 
     /// f_r·cos θi·cos θo at an in-plane pair, interpolated as that product between rows (the quantity the
-    /// `f-cos-cos` extension takes to be smooth).
+    /// `f-cos-cos` and `microfacet` extensions take to be smooth).
     pub fn in_plane_cos_cos(&self, theta_i: f64, theta_o: f64) -> f64 {
-        self.interpolate(theta_i, theta_o, true)
+        self.interpolate(theta_i, theta_o, Row::CosCos)
     }
 
-    fn interpolate(&self, theta_i: f64, theta_o: f64, cos_cos: bool) -> f64 {
+    fn interpolate(&self, theta_i: f64, theta_o: f64, row: Row) -> f64 {
         let (i0, i1, t) = self.theta_i.linear(theta_i);
         let row_theta = |i: usize| match &self.theta_i.nodes {
-            super::table::Nodes::Values(v) => v[i],
-            super::table::Nodes::Index(_) => i as f64,
+            Nodes::Values(v) => v[i],
+            Nodes::Index(_) => i as f64,
         };
         let at = |i: usize| {
             let (ti, to) = (row_theta(i), theta_o - theta_i + row_theta(i));
             let mut v = [0.0];
             self.rows[i].linear(&[to], &mut v);
-            if cos_cos {
-                v[0] * ti.cos() * to.clamp(-FRAC_PI_2, FRAC_PI_2).cos()
-            } else {
-                v[0]
+            let to = to.clamp(-FRAC_PI_2, FRAC_PI_2);
+            match row {
+                Row::F => v[0],
+                Row::CosCos => v[0] * ti.cos() * to.cos(),
+                Row::CosCosOverG2 => v[0] * ti.cos() * to.cos() / self.lambda.g2(ti, to),
             }
         };
         let a = at(i0);
@@ -208,6 +414,75 @@ impl InPlaneBrdf {
             return a;
         }
         (1.0 - t) * a + t * at(i1)
+    }
+
+    /// The quantity Q that the extension takes to depend on (θh, θd) only, at a measured in-plane pair.
+    fn q_in_plane(&self, (ti, to): (f64, f64)) -> f64 {
+        match self.off_plane {
+            OffPlane::Brdf => self.in_plane(ti, to),
+            OffPlane::BrdfCosCos => self.in_plane_cos_cos(ti, to),
+            // Interpolated between rows as F(θd)·D(θh)/4 itself (smooth in θd at the rows' fixed offset).
+            OffPlane::Microfacet => self.interpolate(ti, to, Row::CosCosOverG2),
+        }
+    }
+
+    /// The measured in-plane pair with half/difference angles (θh, θd): of the two reciprocal ones inside the
+    /// domain, the one whose θi is nearer `near`; None if neither is measured.
+    fn measured_pair(&self, th: f64, td: f64, near: f64) -> Option<(f64, f64)> {
+        let a = (td - th, td + th);
+        let b = (td + th, td - th);
+        match (self.domain.contains(a), self.domain.contains(b)) {
+            (true, true) => Some(if (a.0 - near).abs() <= (b.0 - near).abs() { a } else { b }),
+            (true, false) => Some(a),
+            (false, true) => Some(b),
+            (false, false) => None,
+        }
+    }
+
+    /// Q(θh, θd): at the measured pair when there is one, else continued by separability from the largest
+    /// measured θd* and the specular row (module documentation); a pair no continuation reaches (θh beyond
+    /// the domain's half-width) reads the nearest in-plane value, clamped.
+    fn q(&self, th: f64, td: f64, near: f64) -> f64 {
+        if let Some(p) = self.measured_pair(th, td, near) {
+            return self.q_in_plane(p);
+        }
+        // Q(θh, θd) = Q(θh, θd*)·Q(0, θd)/Q(0, θd*), the specular row read at θd or its last measured θd.
+        if let (Some((td_star, p)), Some((_, s))) =
+            (self.domain.largest_theta_d(th, td), self.domain.largest_theta_d(0.0, td))
+        {
+            if let Some((_, s_star)) = self.domain.largest_theta_d(0.0, td_star) {
+                let den = self.q_in_plane(s_star);
+                if den > 0.0 {
+                    return self.q_in_plane(p) * self.q_in_plane(s) / den;
+                }
+            }
+        }
+        // No continuation reaches the pair (θh beyond the domain's half-width): the nearest in-plane value,
+        // clamped into the measured angles (not to grazing, where G2 vanishes).
+        let (ti, to) = if td - th >= 0.0 { (td - th, td + th) } else { (td + th, td - th) };
+        let (lo, hi) = self.theta_o_range;
+        self.q_in_plane((ti.min(self.domain.theta_i().1), to.clamp(lo, hi)))
+    }
+
+    /// D(θm) up to a constant along the cut θd = the table's smallest θi, for θm = k·dθ as far as the cut is
+    /// measured: Q there is F(θd)·D(θm)/4 with F fixed (module documentation), with the current Λ.
+    fn distribution_cut(&self) -> (Vec<f64>, f64) {
+        let d_theta = (0.5 * self.min_step).clamp(0.01f64.to_radians(), 0.1f64.to_radians());
+        let td = self.domain.theta_i().0;
+        let mut d = Vec::new();
+        let mut k = 0usize;
+        while let Some(p) = self.measured_pair(k as f64 * d_theta, td, td) {
+            let tm = k as f64 * d_theta;
+            if tm >= FRAC_PI_2 {
+                break;
+            }
+            d.push(self.q_in_plane(p).max(0.0));
+            k += 1;
+        }
+        if d.len() < 2 {
+            d = vec![0.0, 0.0];
+        }
+        (d, d_theta)
     }
 
     /// Slope width reported to the integrator: tan of half the smallest θo step (a step of the receptor by
@@ -223,38 +498,24 @@ impl Brdf for InPlaneBrdf {
     }
 
     fn eval(&self, wi: Vec3, wo: Vec3, out: &mut [f64]) {
-        if !(wi.z > 0.0 && wo.z > 0.0) {
-            out.fill(0.0);
-            return;
-        }
-        let hd = half_diff(wi, wo);
+        let Some(hd) = reflection_half_diff(wi, wo, out) else { return };
         let (th, td) = (hd.theta_h, hd.theta_d);
-        let actual = (wi.x * wi.x + wi.y * wi.y).sqrt().atan2(wi.z);
-        // The in-plane pair with (θh, θd) whose θi is nearer the actual one (the other is its reciprocal).
-        let pair = |td: f64| {
-            let a = (td - th, td + th);
-            let b = (td + th, td - th);
-            if a.0 >= 0.0 && (a.0 - actual).abs() <= (b.0 - actual).abs() {
-                a
-            } else {
-                b
-            }
-        };
+        let theta_i = (wi.x * wi.x + wi.y * wi.y).sqrt().atan2(wi.z);
         out[0] = match self.off_plane {
-            // A pair off the plane near grazing can map beyond the in-plane domain (θd + θh > 90°); the
-            // table's own clamping then gives its nearest in-plane value (exact for a constant BRDF, an
-            // overestimate for a lobe: docs/recipe-format.md §inplane-csv states the error at 85°).
+            // f itself is not a product of a θh and a θd function for a lobe, so it is not continued by
+            // separability: the nearer reciprocal pair, clamped into the in-plane domain (exact for a constant).
             OffPlane::Brdf => {
-                let (ti, to) = pair(td);
+                let a = (td - th, td + th);
+                let b = (td + th, td - th);
+                let (ti, to) = if a.0 >= 0.0 && (a.0 - theta_i).abs() <= (b.0 - theta_i).abs() { a } else { b };
                 self.in_plane(ti.min(FRAC_PI_2), to.clamp(-FRAC_PI_2, FRAC_PI_2))
             }
-            // g = f·cos θi′·cos θo′ at the in-plane pair, divided by the actual cosines (exact in the plane).
-            // Beyond the measured domain the clamped pair's cosines make g small: an underestimate near
-            // grazing, where the masking term (not in the assumption) matters as well (docs: 85°).
-            OffPlane::BrdfCosCos => {
-                let (ti, to) = pair(td);
-                let g = self.in_plane_cos_cos(ti.min(FRAC_PI_2), to.clamp(-FRAC_PI_2, FRAC_PI_2));
-                let f = g / (wi.z * wo.z);
+            // f = Q/(cos θi cos θo) at the actual cosines (exact in the plane), times G2 for `microfacet`.
+            OffPlane::BrdfCosCos | OffPlane::Microfacet => {
+                let q = self.q(th, td, theta_i);
+                let theta_o = (wo.x * wo.x + wo.y * wo.y).sqrt().atan2(wo.z);
+                let g2 = if self.off_plane == OffPlane::Microfacet { self.lambda.g2(theta_i, theta_o) } else { 1.0 };
+                let f = q * g2 / (wi.z * wo.z);
                 if f.is_finite() {
                     f.max(0.0)
                 } else {
@@ -277,7 +538,7 @@ impl Brdf for InPlaneBrdf {
     }
 
     fn describe(&self) -> String {
-        let name = Path::new(&self.file).file_name().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+        let name = file_name(&self.file);
         let unused =
             if self.unused > 0 { format!(", {} out-of-plane points not used", self.unused) } else { String::new() };
         format!(
@@ -290,6 +551,7 @@ impl Brdf for InPlaneBrdf {
             match self.off_plane {
                 OffPlane::Brdf => "f = f(θh, θd)",
                 OffPlane::BrdfCosCos => "f·cos θi·cos θo = g(θh, θd)",
+                OffPlane::Microfacet => "f·cos θi·cos θo/G2 = g(θh, θd), Smith G2 of the table's own D",
             }
         )
     }

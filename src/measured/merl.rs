@@ -19,7 +19,7 @@
 //! This file only decodes the bytes and chooses those coordinates; the table and its interpolation are the
 //! shared layer in `table.rs`. `docs/model.md` §Measured tables (MERL) gives the details and the known limits
 //! of the data.
-use super::table::{floor_index, Axis, Edge, Table};
+use super::table::{file_name, floor_index, reflection_half_diff, Axis, Edge, Table};
 pub use super::table::{fold_phi_d, half_diff, HalfDiff};
 use crate::brdf::{Brdf, Lobe, Term, TermKind};
 use crate::spectrum::Sampling;
@@ -233,11 +233,7 @@ impl Brdf for MerlBrdf {
     }
 
     fn eval(&self, wi: Vec3, wo: Vec3, out: &mut [f64]) {
-        if !(wi.z > 0.0 && wo.z > 0.0) {
-            out.fill(0.0);
-            return;
-        }
-        let hd = half_diff(wi, wo);
+        let Some(hd) = reflection_half_diff(wi, wo, out) else { return };
         let v = match self.interpolation {
             Interpolation::Nearest => self.nearest(&hd),
             Interpolation::Trilinear => self.trilinear(&hd),
@@ -259,7 +255,7 @@ impl Brdf for MerlBrdf {
     }
 
     fn describe(&self) -> String {
-        let name = Path::new(&self.file).file_name().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+        let name = file_name(&self.file);
         let [nh, nd, np] = self.dims;
         format!(
             "measured MERL table {name} ({nh} × {nd} × {np} θh × θd × φd, {} lookup, {} invalid entries read as 0)",

@@ -623,7 +623,7 @@ impl Brdf for RglBrdf {
     }
 
     fn describe(&self) -> String {
-        let name = Path::new(&self.file).file_name().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+        let name = super::table::file_name(&self.file);
         let [np, nt, n, ny, nx] = self.shape;
         let dropped = if self.dropped > 0 {
             format!(", {} wavelengths outside 360–830 nm not used", self.dropped)

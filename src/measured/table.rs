@@ -238,6 +238,22 @@ pub fn half_diff(wi: Vec3, wo: Vec3) -> HalfDiff {
     HalfDiff { theta_h, phi_h, theta_d, phi_d }
 }
 
+/// The preamble every tabulated BRDF's `eval` shares (MERL, in-plane tables): a table holds reflection only,
+/// so below either horizon the BRDF is 0 (`out` zeroed, `None`); above both, the half/difference angles of
+/// the pair, the coordinates the lookup starts from.
+pub fn reflection_half_diff(wi: Vec3, wo: Vec3, out: &mut [f64]) -> Option<HalfDiff> {
+    if !(wi.z > 0.0 && wo.z > 0.0) {
+        out.fill(0.0);
+        return None;
+    }
+    Some(half_diff(wi, wo))
+}
+
+/// The file name of a table's path, for `describe` (the path as given is in the error messages).
+pub fn file_name(file: &str) -> String {
+    std::path::Path::new(file).file_name().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default()
+}
+
 /// Fold φd into [0, π) by reciprocity (f(φd) = f(φd + π) for an isotropic reciprocal BRDF). MERL's loaders
 /// add π when φd < 0; here φd = π (which `atan2` returns for in-plane pairs, the sign of a zero deciding
 /// between ±π) also maps to 0, so that the in-plane geometry does not depend on the sign of a rounding.

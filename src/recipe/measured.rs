@@ -76,9 +76,11 @@ pub fn parse_inplane(obj: &Obj, model: &str) -> Result<Arc<dyn Brdf>> {
     let off_plane = match obj.opt_str(&obj.param_key(&registry::INPLANE_OFF_PLANE))? {
         None | Some("f") => inplane::OffPlane::Brdf,
         Some("f-cos-cos") => inplane::OffPlane::BrdfCosCos,
+        Some("microfacet") => inplane::OffPlane::Microfacet,
         Some(other) => {
             let allowed =
-                "allowed: \"f\" (f_r depends on (θh, θd) only, the default), \"f-cos-cos\" (f_r·cos θi·cos θo does)";
+                "allowed: \"f\" (f_r depends on (θh, θd) only, the default), \"f-cos-cos\" (f_r·cos θi·cos θo \
+                           does), \"microfacet\" (f_r·cos θi·cos θo/G2 does, G2 the table's own Smith term)";
             return Err(obj.err("off_plane", format!("unknown off-plane assumption \"{other}\"; {allowed}")));
         }
     };
