@@ -182,3 +182,17 @@ fn a_recipe_string_with_quotes_is_echoed_escaped() {
         assert!(!fuzz_cases::prints_non_finite(&e), "{e}");
     }
 }
+
+/// The 10⁶-case run's 9 failures (docs/reliability.md): `fixtures/bad/nan-string.json`, the user's own file
+/// name, echoed unquoted at the head of an error, was taken for a NaN printed by glossmeter.
+#[test]
+fn the_cli_check_ignores_the_arguments_echoed_back() {
+    fuzz_cases::BINARY.get_or_init(|| env!("CARGO_BIN_EXE_glossmeter").into());
+    let case = r#"["measure", "fixtures/bad/nan-string.json", "--max-seconds", "1"]"#;
+    assert!(matches!(fuzz_cases::run_cli(case), Ok(Outcome::Refused)), "{:?}", fuzz_cases::run_cli(case));
+    let args = ["measure".to_string(), "fixtures/bad/nan-string.json".to_string()];
+    let shown = "error: fixtures/bad/nan-string.json: field `/albedo`: got string \"NaN\"";
+    assert!(!fuzz_cases::prints_non_finite(&fuzz_cases::without_args(shown, &args)));
+    // glossmeter's own text still counts.
+    assert!(fuzz_cases::prints_non_finite(&fuzz_cases::without_args("fixtures/x.json: value NaN", &args)));
+}

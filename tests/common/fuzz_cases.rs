@@ -828,6 +828,18 @@ pub fn generate_cli(rng: &mut Rng, cheap: bool) -> String {
     serde_json::to_string(&a).unwrap()
 }
 
+/// `out` with the command line's own arguments (file names such as `fixtures/bad/nan-string.json`, echoed
+/// unquoted at the head of an error) replaced by a space, so that only glossmeter's own text is checked.
+pub fn without_args(out: &str, args: &[String]) -> String {
+    let mut s = out.to_string();
+    let mut args: Vec<&String> = args.iter().filter(|a| a.chars().count() > 2).collect();
+    args.sort_by_key(|a| std::cmp::Reverse(a.len()));
+    for a in args {
+        s = s.replace(a.as_str(), " ");
+    }
+    s
+}
+
 /// The binary that CLI cases run (set by the test or the driver before the first case).
 pub static BINARY: std::sync::OnceLock<PathBuf> = std::sync::OnceLock::new();
 
@@ -888,7 +900,7 @@ pub fn run_cli(text: &str) -> Result<Outcome, String> {
         fail("a panic message")
     } else if code == Some(2) && !stderr.contains("error") {
         fail("exit 2 without an error message")
-    } else if prints_non_finite(&stdout) || prints_non_finite(&stderr) {
+    } else if prints_non_finite(&without_args(&stdout, &args)) || prints_non_finite(&without_args(&stderr, &args)) {
         fail("a non-finite number printed")
     } else {
         let mut v = Ok(if code == Some(2) { Outcome::Refused } else { Outcome::Accepted(None) });
