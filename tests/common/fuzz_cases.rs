@@ -852,12 +852,15 @@ pub const CLI_TIMEOUT_S: f64 = 120.0;
 /// not exist at all after exit 2.
 pub fn run_cli(text: &str) -> Result<Outcome, String> {
     let args: Vec<String> = serde_json::from_str(text).map_err(|e| format!("bad case {text}: {e}"))?;
+    // Names of their own: tests run command lines from several threads of one process.
+    static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let n = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
     let mut new_files = Vec::new();
     let args: Vec<String> = args
         .into_iter()
         .map(|a| {
             if a == "@NEW" {
-                let p = scratch(&format!("cli-{}.out", new_files.len()));
+                let p = scratch(&format!("cli-{n}-{}.out", new_files.len()));
                 let _ = std::fs::remove_file(&p);
                 new_files.push(p.clone());
                 p.to_string_lossy().into_owned()
@@ -868,7 +871,7 @@ pub fn run_cli(text: &str) -> Result<Outcome, String> {
         .collect();
     let bin = BINARY.get().ok_or("BINARY not set")?;
     // Output to files (no pipe to drain while waiting), the process polled against a timeout.
-    let (out_path, err_path) = (scratch("cli-stdout"), scratch("cli-stderr"));
+    let (out_path, err_path) = (scratch(&format!("cli-stdout-{n}")), scratch(&format!("cli-stderr-{n}")));
     let mut child = std::process::Command::new(bin)
         .args(&args)
         .current_dir(root())
@@ -920,7 +923,7 @@ pub fn run_cli(text: &str) -> Result<Outcome, String> {
         }
         v
     };
-    for f in &new_files {
+    for f in new_files.iter().chain([&out_path, &err_path]) {
         let _ = std::fs::remove_file(f);
     }
     verdict
