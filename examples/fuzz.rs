@@ -1,23 +1,37 @@
-//! The fuzz driver (issue 8), run by hand:
+//! The fuzz driver (issue 8), run by hand in release mode (the command-line category runs the binary, so
+//! build it first):
 //!
 //! ```text
-//! nice cargo run --release --example fuzz -- CASES [SEED] [MEASURE_EVERY]
+//! cargo build --release --bin glossmeter --example fuzz
+//! nice -n 19 target/release/examples/fuzz CASES [SEED] [LIGHT_EVERY] [FULL_EVERY] [CLI_EVERY] [FIRST]
 //! ```
 //!
-//! It runs CASES cases, round-robin over the four categories of `tests/common/fuzz_cases.rs` (generated
-//! recipes, mutated recipes, mutated geometry files, generated and mutated sheets), each replayable from its
-//! number and SEED. Every case must be accepted, or refused with an error naming the file and a field or line;
-//! a panic or a malformed error is a failure. Every MEASURE_EVERY-th accepted recipe (default 50) is measured
-//! on the default panel at rtol 1e-3 with 200 000 evaluations per integral, and every reading must be finite
-//! or absent with a reason. It prints a Markdown summary (cases, accepted, refused, failures per category; the
-//! slowest measured inputs) for docs/reliability.md.
+//! Cases FIRST .. FIRST + CASES are run (FIRST defaults to 0), so a range of a long run can be replayed
+//! alone. Each failure is printed on stderr as it happens, and the summary so far every 100 000 cases on
+//! stdout, so that a run stopped early still says what it found.
+//!
+//! It runs CASES cases over the six categories of `tests/common/fuzz_cases.rs`: every CLI_EVERY-th case
+//! (default 200) is a command line run as a process (with a small budget: `--max-seconds 1` for `measure`,
+//! `--rtol 1e-3` for `compare`); the others go round-robin over recipes generated from the parameter registry
+//! or from random fields, mutated recipes, mutated geometry files, generated and mutated sheets and generated
+//! MERL tables, checked in the library. Each case is replayable from its number and SEED. Every case must be
+//! accepted, or refused with an error naming the file and a field or line (a command line: exit 0, 1 or 2,
+//! no panic, no NaN/inf printed outside the quoted input, no file lost or left behind, ended within
+//! `CLI_TIMEOUT_S`); anything else is a failure.
+//!
+//! Accepted recipes and tables are measured on the default panel: every LIGHT_EVERY-th (default 50) with a
+//! small budget (rtol 1e-3, 200 000 evaluations per integral, 1 s per plan), every FULL_EVERY-th (default
+//! 1000) with the default options of `glossmeter measure` (rtol 1e-6, 5·10⁷ evaluations, the 6 s budget),
+//! timed. Every reading must be finite or absent with a reason; a measurement still running after 60 s would
+//! be a hang (it is timed, not interrupted: the library has no way to stop it from outside). It prints a
+//! Markdown summary for docs/reliability.md.
 #[path = "../tests/common/fuzz_cases.rs"]
 mod fuzz_cases;
 
 use std::collections::BTreeMap;
 use std::time::Instant;
 
-use fuzz_cases::{case_text, check_readings, run_case, Category, Outcome, Rng, Seeds};
+use fuzz_cases::{case_text, check_readings, run_case, Category, Outcome, Rng, Seeds, BINARY};
 use glossmeter::{measure, resolve_geometries, PlanOptions, DEFAULT_PANEL};
 
 #[derive(Default)]
@@ -26,26 +40,57 @@ struct Tally {
     accepted: usize,
     refused: usize,
     failures: usize,
-    measured: usize,
+    light: usize,
+    full: usize,
+    unconverged_full: usize,
+    seconds: f64,
+    slowest_case: f64,
 }
+
+/// A measurement slower than this is reported as a hang.
+const HANG_S: f64 = 60.0;
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
-    let cases: usize = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(10_000);
-    let seed: u64 = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(1);
-    let every: usize = args.get(3).and_then(|s| s.parse().ok()).unwrap_or(50);
+    let arg = |i: usize, d: u64| args.get(i).and_then(|s| s.parse().ok()).unwrap_or(d);
+    let cases = arg(1, 10_000) as usize;
+    let seed = arg(2, 1);
+    let light_every = arg(3, 50) as usize;
+    let full_every = arg(4, 1000) as usize;
+    let cli_every = arg(5, 200) as usize;
+    let first = arg(6, 0) as usize;
+    // target/release/examples/fuzz → target/release/glossmeter
+    let exe = std::env::current_exe().unwrap();
+    let bin = exe.parent().and_then(|d| d.parent()).unwrap().join("glossmeter");
+    assert!(bin.exists(), "{} not built: cargo build --release --bin glossmeter first", bin.display());
+    BINARY.set(bin).unwrap();
     std::panic::set_hook(Box::new(|_| {}));
     let seeds = Seeds::load();
     let panel = resolve_geometries(DEFAULT_PANEL, &[] as &[&str]).unwrap();
-    let opts = PlanOptions { rtol: 1e-3, max_evals: 200_000, ..PlanOptions::default() };
+    let light = PlanOptions { rtol: 1e-3, max_evals: 200_000, max_seconds: Some(1.0), ..PlanOptions::default() };
+    let full = PlanOptions::default();
     let mut tally: BTreeMap<Category, Tally> = BTreeMap::new();
     let mut failures: Vec<String> = Vec::new();
     let mut slowest: Vec<(f64, String)> = Vec::new();
+    let mut slowest_light = 0f64;
+    let mut over_10s = 0usize;
     let mut accepted_recipes = 0usize;
     let start = Instant::now();
-    for k in 0..cases {
-        let cat = Category::ALL[k % 4];
+    let in_library = [
+        Category::GeneratedRecipe,
+        Category::MutatedRecipe,
+        Category::MutatedGeometry,
+        Category::Sheet,
+        Category::MerlTable,
+    ];
+    for k in first..first + cases {
+        let cat = if k % cli_every == cli_every - 1 {
+            Category::CommandLine
+        } else {
+            in_library[(k - k / cli_every) % in_library.len()]
+        };
         let mut rng = Rng::new(seed.wrapping_mul(1_000_003).wrapping_add(k as u64));
+        let t0 = Instant::now();
         let text = case_text(cat, &seeds, &mut rng);
         let t = tally.entry(cat).or_default();
         t.cases += 1;
@@ -53,54 +98,145 @@ fn main() {
             Err(_) => {
                 t.failures += 1;
                 failures.push(format!("case {k} ({}): panic on {text:?}", cat.name()));
+                eprintln!("FAILURE {}", failures.last().unwrap());
             }
             Ok(Err(e)) => {
                 t.failures += 1;
                 failures.push(format!("case {k} ({}): {e}", cat.name()));
+                eprintln!("FAILURE {}", failures.last().unwrap());
             }
             Ok(Ok(Outcome::Refused)) => t.refused += 1,
             Ok(Ok(Outcome::Accepted(m))) => {
                 t.accepted += 1;
                 if let Some(m) = m {
                     accepted_recipes += 1;
-                    if accepted_recipes % every == 0 {
-                        t.measured += 1;
-                        let t0 = Instant::now();
-                        let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| measure(&m, &panel, &opts)));
-                        let secs = t0.elapsed().as_secs_f64();
+                    let which = if accepted_recipes % full_every == 0 {
+                        Some(&full)
+                    } else if accepted_recipes % light_every == 0 {
+                        Some(&light)
+                    } else {
+                        None
+                    };
+                    if let Some(opts) = which {
+                        let is_full = std::ptr::eq(opts, &full);
+                        let t1 = Instant::now();
+                        let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| measure(&m, &panel, opts)));
+                        let secs = t1.elapsed().as_secs_f64();
                         let verdict = match r {
                             Err(_) => Err("panic while measuring".to_string()),
                             Ok(Err(e)) => Err(format!("measure failed: {e}")),
-                            Ok(Ok(readings)) => check_readings(&readings),
+                            Ok(Ok(readings)) => {
+                                if is_full && readings.iter().any(|r| !r.converged) {
+                                    t.unconverged_full += 1;
+                                }
+                                check_readings(&readings)
+                            }
                         };
+                        let verdict =
+                            verdict.and_then(
+                                |()| {
+                                    if secs > HANG_S {
+                                        Err(format!("a hang: {secs:.0} s"))
+                                    } else {
+                                        Ok(())
+                                    }
+                                },
+                            );
                         if let Err(e) = verdict {
                             t.failures += 1;
                             failures.push(format!("case {k} ({}): {e} on {text:?}", cat.name()));
+                            eprintln!("FAILURE {}", failures.last().unwrap());
                         }
-                        slowest.push((secs, format!("case {k}: {}", text.replace('\n', " "))));
-                        slowest.sort_by(|a, b| b.0.total_cmp(&a.0));
-                        slowest.truncate(5);
+                        if is_full {
+                            t.full += 1;
+                            if secs > 10.0 {
+                                over_10s += 1;
+                            }
+                            slowest.push((secs, format!("case {k} ({}): {}", cat.name(), text.replace('\n', " "))));
+                            slowest.sort_by(|a, b| b.0.total_cmp(&a.0));
+                            slowest.truncate(8);
+                        } else {
+                            t.light += 1;
+                            slowest_light = slowest_light.max(secs);
+                        }
                     }
                 }
             }
         }
-        if (k + 1) % 100_000 == 0 {
-            eprintln!("{} cases, {:.0} s", k + 1, start.elapsed().as_secs_f64());
+        let dt = t0.elapsed().as_secs_f64();
+        t.seconds += dt;
+        t.slowest_case = t.slowest_case.max(dt);
+        if (k + 1) % 10_000 == 0 {
+            eprintln!("{} cases, {:.0} s, {} failures", k + 1, start.elapsed().as_secs_f64(), failures.len());
+        }
+        if (k + 1 - first) % 100_000 == 0 {
+            println!("\n## After {} cases\n", k + 1 - first);
+            let wall = start.elapsed().as_secs_f64();
+            let so_far = Summary { cases: k + 1 - first, seed, first, light_every, full_every, cli_every, wall };
+            so_far.print(&tally, slowest_light, over_10s, &slowest, &failures);
         }
     }
-    println!("Fuzz run: {cases} cases, seed {seed}, {:.0} s wall\n", start.elapsed().as_secs_f64());
-    println!("| category | cases | accepted | refused | measured (default panel) | failures |");
-    println!("|---|---|---|---|---|---|");
-    for (cat, t) in &tally {
-        println!("| {} | {} | {} | {} | {} | {} |", cat.name(), t.cases, t.accepted, t.refused, t.measured, t.failures);
-    }
-    println!("\nSlowest measured inputs (default panel, rtol 1e-3, 200 000 evaluations per integral):\n");
-    for (s, t) in &slowest {
-        let t: String = t.chars().take(160).collect();
-        println!("- {s:.2} s: `{t}`");
-    }
-    println!("\nFailures: {}", failures.len());
-    for f in failures.iter().take(20) {
-        println!("- {f}");
+    let _ = std::fs::remove_dir_all(fuzz_cases::scratch("x").parent().unwrap());
+    println!("\n## Final\n");
+    let summary =
+        Summary { cases, seed, first, light_every, full_every, cli_every, wall: start.elapsed().as_secs_f64() };
+    summary.print(&tally, slowest_light, over_10s, &slowest, &failures);
+}
+
+struct Summary {
+    cases: usize,
+    seed: u64,
+    first: usize,
+    light_every: usize,
+    full_every: usize,
+    cli_every: usize,
+    wall: f64,
+}
+
+impl Summary {
+    fn print(
+        &self,
+        tally: &BTreeMap<Category, Tally>,
+        slowest_light: f64,
+        over_10s: usize,
+        slowest: &[(f64, String)],
+        failures: &[String],
+    ) {
+        let Summary { cases, seed, first, light_every, full_every, cli_every, wall } = self;
+        println!(
+            "Fuzz run: {cases} cases from case {first}, seed {seed}, light every {light_every}, full every \
+         {full_every}, command line every {cli_every}; {wall:.0} s wall\n"
+        );
+        println!(
+            "| category | cases | accepted | refused | measured (small budget) | measured (default options) | of \
+         them not converged | failures | seconds | slowest case (s) |"
+        );
+        println!("|---|---|---|---|---|---|---|---|---|---|");
+        for (cat, t) in tally {
+            println!(
+                "| {} | {} | {} | {} | {} | {} | {} | {} | {:.0} | {:.2} |",
+                cat.name(),
+                t.cases,
+                t.accepted,
+                t.refused,
+                t.light,
+                t.full,
+                t.unconverged_full,
+                t.failures,
+                t.seconds,
+                t.slowest_case
+            );
+        }
+        println!("\nSlowest small-budget measurement: {slowest_light:.2} s");
+        println!("Default-option measurements over 10 s: {over_10s}");
+        println!("\nSlowest measured inputs (default panel, default options):\n");
+        for (s, t) in slowest {
+            let t: String = t.chars().take(300).collect();
+            println!("- {s:.2} s: `{t}`");
+        }
+        println!("\nFailures: {}", failures.len());
+        for f in failures.iter().take(40) {
+            println!("- {f}");
+        }
     }
 }

@@ -127,11 +127,14 @@ impl Default for Rule {
 impl Rule {
     pub fn check(&self) -> Result<()> {
         if !(self.k.is_finite() && self.k >= 0.0) {
-            return Err(Error::Usage(format!("-k must be a finite number ≥ 0, got {}", self.k)));
+            return Err(Error::Usage(format!("-k must be a finite number ≥ 0, got {}", crate::error::given(self.k))));
         }
         if let Some(t) = self.tolerance {
             if !(t.is_finite() && t >= 0.0) {
-                return Err(Error::Usage(format!("--tolerance must be a finite number ≥ 0, got {t}")));
+                return Err(Error::Usage(format!(
+                    "--tolerance must be a finite number ≥ 0, got {}",
+                    crate::error::given(t)
+                )));
             }
         }
         Ok(())

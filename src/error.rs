@@ -27,6 +27,13 @@ pub enum Error {
 
 pub type Result<T> = std::result::Result<T, Error>;
 
+/// A number the user gave, shown in an error message in backquotes as the user's own value (`` `NaN` ``,
+/// `` `inf` ``, `` `0` ``): glossmeter's own text never shows a non-finite number, so a reader (or the fuzz
+/// checker, tests/common/fuzz_cases.rs) can tell an echoed input from a computed NaN (issue 8).
+pub fn given(x: f64) -> String {
+    format!("`{x}`")
+}
+
 impl Error {
     pub fn input(file: impl Into<String>, field: impl Into<String>, message: impl Into<String>) -> Self {
         Error::Input { file: file.into(), field: field.into(), message: message.into() }

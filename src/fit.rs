@@ -60,19 +60,19 @@ impl FreeParameter {
             .split_once('=')
             .ok_or_else(|| bad("expected PATH=LO..HI (or PATH=log:LO..HI), e.g. /roughness=log:1e-3..0.5".into()))?;
         if !pointer.starts_with('/') {
-            return Err(bad(format!("\"{pointer}\" is not a JSON Pointer (RFC 6901); it starts with '/'")));
+            return Err(bad(format!("{pointer:?} is not a JSON Pointer (RFC 6901); it starts with '/'")));
         }
         let (log, range) = match bounds.strip_prefix("log:") {
             Some(r) => (true, r),
             None => (false, bounds),
         };
-        let (lo, hi) = range.split_once("..").ok_or_else(|| bad(format!("bounds \"{bounds}\" are not LO..HI")))?;
+        let (lo, hi) = range.split_once("..").ok_or_else(|| bad(format!("bounds {bounds:?} are not LO..HI")))?;
         let num = |s: &str, what: &str| -> Result<f64> {
             s.trim()
                 .parse::<f64>()
                 .ok()
                 .filter(|x| x.is_finite())
-                .ok_or_else(|| bad(format!("{what} bound \"{s}\" is not a finite number")))
+                .ok_or_else(|| bad(format!("{what} bound {s:?} is not a finite number")))
         };
         let (lower, upper) = (num(lo, "lower")?, num(hi, "upper")?);
         if lower >= upper {
@@ -126,7 +126,7 @@ impl TargetReading {
             .ok_or_else(|| bad("expected GEOMETRY/READING=VALUE[±U], e.g. astm-d523-60/gloss=85±0.5".into()))?;
         let (geometry, name) = left
             .split_once('/')
-            .ok_or_else(|| bad(format!("\"{left}\" is not GEOMETRY/READING (e.g. astm-d523-20/gloss)")))?;
+            .ok_or_else(|| bad(format!("{left:?} is not GEOMETRY/READING (e.g. astm-d523-20/gloss)")))?;
         if geometry.is_empty() || name.is_empty() {
             return Err(bad("the geometry and the reading must both be given".into()));
         }
@@ -139,7 +139,7 @@ impl TargetReading {
             .parse::<f64>()
             .ok()
             .filter(|x| x.is_finite())
-            .ok_or_else(|| bad(format!("value \"{v}\" is not a finite number")))?;
+            .ok_or_else(|| bad(format!("value {v:?} is not a finite number")))?;
         let uncertainty = match u {
             None => None,
             Some(u) => Some(
@@ -147,7 +147,7 @@ impl TargetReading {
                     .parse::<f64>()
                     .ok()
                     .filter(|x| x.is_finite() && *x > 0.0)
-                    .ok_or_else(|| bad(format!("uncertainty \"{u}\" is not a finite number > 0")))?,
+                    .ok_or_else(|| bad(format!("uncertainty {u:?} is not a finite number > 0")))?,
             ),
         };
         Ok(TargetReading { geometry: geometry.to_string(), name: name.to_string(), value, uncertainty })
@@ -176,7 +176,7 @@ pub fn targets_from_sheet(
         Some(s) if samples.contains(&s) => s,
         Some(s) => {
             return Err(Error::Usage(format!(
-                "--sample {s}: {} has no sample \"{s}\"; it has {}",
+                "--sample {s}: {} has no sample {s:?}; it has {}",
                 sheet.file,
                 samples.join(", ")
             )))
@@ -217,7 +217,7 @@ pub fn targets_from_sheet(
     }
     if targets.is_empty() {
         return Err(Error::Usage(format!(
-            "--sheet {}: sample \"{chosen}\" has no reading glossmeter predicts, so no targets",
+            "--sheet {}: sample {chosen:?} has no reading glossmeter predicts, so no targets",
             sheet.file
         )));
     }
@@ -586,7 +586,7 @@ fn check_free(recipe: &Value, free: &[FreeParameter]) -> Result<Vec<f64>> {
             let numeric: Vec<&str> =
                 registry::of_model(model).filter(|e| e.ty.is_numeric()).map(|e| e.pointer).collect();
             Error::Usage(format!(
-                "{arg}: not a parameter of a \"{model}\" recipe; its numeric parameters are {}",
+                "{arg}: not a parameter of a {model:?} recipe; its numeric parameters are {}",
                 numeric.join(", ")
             ))
         })?;

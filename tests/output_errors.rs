@@ -27,6 +27,19 @@ const CASES: &[&[&str]] = &[
     &["measure", "fixtures/recipes/glass-n1.5.json", "-g", "astm-d523-60"],
     &["measure", "fixtures/recipes/glass-n1.5.json", "-g", "astm-d523-60", "--format", "json"],
     &["compare", "fixtures/recipes/black-glass.json", "fixtures/sheets/black-glass-check.csv"],
+    CONVERGENCE,
+];
+
+/// A quick `convergence` (issue 8 item 3: it was not among the closed-pipe cases).
+const CONVERGENCE: &[&str] = &[
+    "convergence",
+    "fixtures/recipes/grey-lambert.json",
+    "-g",
+    "astm-d523-60",
+    "--tolerances",
+    "1e-3",
+    "--max-repetitions",
+    "1",
 ];
 
 #[test]
@@ -51,5 +64,102 @@ fn a_full_disk_on_stdout_is_an_error_not_a_panic() {
         assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
         assert!(stderr.contains("<stdout>") && stderr.contains("No space left"), "{args:?}: {stderr}");
         assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+    }
+}
+
+/// A small tmpfs filled to the last byte, unmounted when dropped (even when the test fails). None when it
+/// cannot be mounted (not root, no tmpfs): the test then says so on stderr and checks nothing (the
+/// library-level test `cli::output::tests::a_failed_write_leaves_no_file_and_an_error` still covers it).
+struct FullDisk(std::path::PathBuf);
+
+impl FullDisk {
+    fn mount(name: &str) -> Option<FullDisk> {
+        let dir = std::env::temp_dir().join(format!("glossmeter-full-{name}-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).ok()?;
+        let ok = Command::new("mount")
+            .args(["-t", "tmpfs", "-o", "size=64k", "tmpfs"])
+            .arg(&dir)
+            .stderr(Stdio::null())
+            .status()
+            .is_ok_and(|s| s.success());
+        if !ok {
+            eprintln!("{name}: cannot mount a tmpfs here (not root?): the full-disk check is skipped");
+            let _ = std::fs::remove_dir(&dir);
+            return None;
+        }
+        let disk = FullDisk(dir);
+        // Fill it: write until the disk refuses.
+        let mut filler = std::fs::File::create(disk.0.join("filler")).unwrap();
+        let block = vec![b'x'; 4096];
+        while std::io::Write::write_all(&mut filler, &block).is_ok() {}
+        let _ = std::io::Write::write_all(&mut filler, b"x");
+        Some(disk)
+    }
+
+    fn entries(&self) -> Vec<String> {
+        let mut v: Vec<String> = std::fs::read_dir(&self.0)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        v.sort();
+        v
+    }
+}
+
+impl Drop for FullDisk {
+    fn drop(&mut self) {
+        let _ = Command::new("umount").arg(&self.0).status();
+        let _ = std::fs::remove_dir(&self.0);
+    }
+}
+
+/// Issue 8 item 2: `-o` and `--plot` on a full filesystem left a 0-byte file (and exited 0 for `-o`). Now:
+/// status 2, the file named with the system's reason, and no file (not even an empty one, nor the
+/// temporary) left behind, so a rerun under the same name is not blocked.
+#[test]
+fn a_full_disk_leaves_no_file_and_exits_2() {
+    let Some(disk) = FullDisk::mount("files") else { return };
+    let target = |name: &str| disk.0.join(name).to_string_lossy().into_owned();
+    let cases: Vec<(Vec<String>, String)> = vec![
+        (
+            ["measure", "fixtures/recipes/glass-n1.5.json", "-g", "astm-d523-60", "-o"]
+                .iter()
+                .map(|s| s.to_string())
+                .chain([target("readings.txt")])
+                .collect(),
+            target("readings.txt"),
+        ),
+        (
+            ["compare", "fixtures/recipes/black-glass.json", "fixtures/sheets/black-glass-check.csv", "-o"]
+                .iter()
+                .map(|s| s.to_string())
+                .chain([target("compare.txt")])
+                .collect(),
+            target("compare.txt"),
+        ),
+        (
+            CONVERGENCE.iter().map(|s| s.to_string()).chain(["-o".into(), target("sweep.txt")]).collect(),
+            target("sweep.txt"),
+        ),
+        (
+            CONVERGENCE.iter().map(|s| s.to_string()).chain(["--plot".into(), target("plot.svg")]).collect(),
+            target("plot.svg"),
+        ),
+        (
+            ["compare", "fixtures/recipes/black-glass.json", "fixtures/sheets/black-glass-check.csv", "--plot"]
+                .iter()
+                .map(|s| s.to_string())
+                .chain([target("compare.svg")])
+                .collect(),
+            target("compare.svg"),
+        ),
+    ];
+    for (args, file) in &cases {
+        let out = glossmeter().args(args).stdout(Stdio::null()).stderr(Stdio::piped()).output().unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
+        assert!(stderr.contains(file.as_str()) && stderr.contains("No space left"), "{args:?}: {stderr}");
+        assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+        assert_eq!(disk.entries(), ["filler"], "{args:?}: a file was left behind");
     }
 }

@@ -91,7 +91,10 @@ pub fn run(a: CompareArgs) -> Result<()> {
     }
     if let Some(m) = a.max_de00 {
         if !(m.is_finite() && m >= 0.0) {
-            return Err(Error::Usage(format!("--max-de00 must be a finite number ≥ 0, got {m}")));
+            return Err(Error::Usage(format!(
+                "--max-de00 must be a finite number ≥ 0, got {}",
+                crate::error::given(m)
+            )));
         }
     }
     let colour = a.colour.conditions()?;

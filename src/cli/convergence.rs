@@ -53,7 +53,10 @@ pub fn run(args: ConvergenceArgs) -> Result<()> {
     let tolerances = if args.tolerances.is_empty() { DEFAULT_TOLERANCES.to_vec() } else { args.tolerances.clone() };
     convergence::validate_tolerances(&tolerances).map_err(|e| Error::Usage(format!("--tolerances: {e}")))?;
     if !(args.min_time_ms.is_finite() && args.min_time_ms >= 0.0) {
-        return Err(Error::Usage(format!("--min-time-ms must be a number ≥ 0, got {}", args.min_time_ms)));
+        return Err(Error::Usage(format!(
+            "--min-time-ms must be a number ≥ 0, got {}",
+            crate::error::given(args.min_time_ms)
+        )));
     }
     if args.max_repetitions == 0 {
         return Err(Error::Usage("--max-repetitions must be at least 1".into()));

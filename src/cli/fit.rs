@@ -58,7 +58,10 @@ pub struct FitArgs {
 pub fn run(a: FitArgs) -> Result<()> {
     check_rtol(a.rtol)?;
     if !(a.uncertainty.is_finite() && a.uncertainty > 0.0) {
-        return Err(Error::Usage(format!("--uncertainty must be a finite number > 0, got {}", a.uncertainty)));
+        return Err(Error::Usage(format!(
+            "--uncertainty must be a finite number > 0, got {}",
+            crate::error::given(a.uncertainty)
+        )));
     }
     // Refused before any work if it exists (or its directory does not); written whole or not at all.
     let output = Target::new(a.output.as_deref(), "-o")?;

@@ -204,7 +204,8 @@ fn dispatch(cli: Cli) -> Result<()> {
             }
             if !(max_seconds.is_finite() && max_seconds >= 0.0) {
                 return Err(Error::Usage(format!(
-                    "--max-seconds must be a finite number of seconds ≥ 0 (0: no wall-clock budget), got {max_seconds}"
+                    "--max-seconds must be a finite number of seconds ≥ 0 (0: no wall-clock budget), got {}",
+                    crate::error::given(max_seconds)
                 )));
             }
             let max_seconds = (max_seconds > 0.0).then_some(max_seconds);
@@ -332,7 +333,7 @@ pub const NEUTRAL_HUE: &str = "neutral colour";
 /// `--rtol` in (0, 1), checked before any work.
 pub fn check_rtol(rtol: f64) -> Result<()> {
     if !(rtol.is_finite() && rtol > 0.0 && rtol < 1.0) {
-        return Err(Error::Usage(format!("--rtol must be a number in (0, 1), got {rtol}")));
+        return Err(Error::Usage(format!("--rtol must be a number in (0, 1), got {}", crate::error::given(rtol))));
     }
     Ok(())
 }

@@ -75,7 +75,7 @@ impl Observer {
         match s.trim().to_ascii_lowercase().trim_end_matches('°').trim_end_matches("deg") {
             "2" | "1931" => Ok(Observer::Cie1931),
             "10" | "1964" => Ok(Observer::Cie1964),
-            _ => Err(Error::Usage(format!("unknown observer \"{s}\"; allowed: 2 (CIE 1931 2°), 10 (CIE 1964 10°)"))),
+            _ => Err(Error::Usage(format!("unknown observer {s:?}; allowed: 2 (CIE 1931 2°), 10 (CIE 1964 10°)"))),
         }
     }
 
@@ -114,7 +114,7 @@ impl Illuminant {
             "D50" => Ok(Illuminant::D50),
             "A" => Ok(Illuminant::A),
             "C" => Ok(Illuminant::C),
-            _ => Err(Error::Usage(format!("unknown illuminant \"{s}\"; allowed: D65, D50, A, C"))),
+            _ => Err(Error::Usage(format!("unknown illuminant {s:?}; allowed: D65, D50, A, C"))),
         }
     }
 

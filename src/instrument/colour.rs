@@ -91,7 +91,7 @@ pub fn parse(text: &str, origin: &str) -> Result<StandardGeometry> {
     let o = Obj::new(origin, "", &spec)?;
     let id = o.str("id")?;
     if id.is_empty() || !id.chars().all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '-' || c == '.') {
-        return Err(o.err("id", format!("\"{id}\" is not a valid id: use lower-case letters, digits, '-' and '.'")));
+        return Err(o.err("id", format!("{id:?} is not a valid id: use lower-case letters, digits, '-' and '.'")));
     }
     let title = nonempty_str(&o, "title")?;
     string_list(&o, "standards")?;
@@ -189,7 +189,7 @@ pub fn parse(text: &str, origin: &str) -> Result<StandardGeometry> {
                 }
                 other => {
                     return Err(
-                        o.err("specular", format!("unknown value \"{other}\"; allowed: \"included\", \"excluded\""))
+                        o.err("specular", format!("unknown value {other:?}; allowed: \"included\", \"excluded\""))
                     )
                 }
             };
@@ -215,7 +215,7 @@ pub fn parse(text: &str, origin: &str) -> Result<StandardGeometry> {
             };
             (geometry, names)
         }
-        other => return Err(o.err("kind", format!("unknown kind \"{other}\"; allowed: \"directional\", \"sphere\""))),
+        other => return Err(o.err("kind", format!("unknown kind {other:?}; allowed: \"directional\", \"sphere\""))),
     };
     Ok(StandardGeometry { geometry, reading_names, spec: spec.clone(), origin: origin.to_string() })
 }
@@ -240,10 +240,10 @@ pub fn builtin_static() -> Result<&'static [StandardGeometry]> {
         let label = format!("<builtin:colour/{file}>");
         let mut g = parse(text, &label)?;
         if g.geometry.id != file.trim_end_matches(".json") {
-            return Err(Error::input(label, "/id", format!("id \"{}\" must equal the file name", g.geometry.id)));
+            return Err(Error::input(label, "/id", format!("id {:?} must equal the file name", g.geometry.id)));
         }
         if out.iter().any(|o| o.geometry.id == g.geometry.id) {
-            return Err(Error::input(label, "/id", format!("duplicate id \"{}\"", g.geometry.id)));
+            return Err(Error::input(label, "/id", format!("duplicate id {:?}", g.geometry.id)));
         }
         g.origin = "builtin".into();
         out.push(g);

@@ -155,8 +155,9 @@ pub fn validate_tolerances(tolerances: &[f64]) -> Result<()> {
     for (i, t) in tolerances.iter().enumerate() {
         if !(t.is_finite() && *t > 0.0 && *t < 1.0) {
             return Err(Error::Usage(format!(
-                "tolerance {} is {t}; every tolerance must be a number in (0, 1), e.g. 1e-2, 1e-4, 1e-6",
-                i + 1
+                "tolerance {} is {}; every tolerance must be a number in (0, 1), e.g. 1e-2, 1e-4, 1e-6",
+                i + 1,
+                crate::error::given(*t)
             )));
         }
         if *t < MIN_RTOL * REFERENCE_FACTOR {

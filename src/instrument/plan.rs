@@ -296,14 +296,14 @@ impl Planner {
         if !(options.rtol.is_finite() && options.rtol > 0.0 && options.rtol < 1.0) {
             return Err(Error::Usage(format!(
                 "the relative tolerance (rtol) must be a number in (0, 1), got {}",
-                options.rtol
+                crate::error::given(options.rtol)
             )));
         }
         if options.rtol < MIN_RTOL {
             return Err(Error::Usage(format!(
                 "the relative tolerance (rtol) {} is below {MIN_RTOL:e}, the tightest that double precision can \
                  reach here (below it the error estimates are rounding noise and the work never ends)",
-                options.rtol
+                crate::error::given(options.rtol)
             )));
         }
         if options.max_seconds.is_some_and(|s| !(s.is_finite() && s > 0.0)) || options.max_evals == 0 {

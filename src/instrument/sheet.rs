@@ -433,7 +433,7 @@ pub fn parse_number(s: &str) -> std::result::Result<f64, String> {
     let t = s.trim();
     let t = if t.contains(',') {
         if t.contains('.') || t.matches(',').count() > 1 {
-            return Err(format!("\"{s}\" mixes `.` and `,` (thousands separators are not read)"));
+            return Err(format!("{s:?} mixes `.` and `,` (thousands separators are not read)"));
         }
         t.replace(',', ".")
     } else {
@@ -441,13 +441,13 @@ pub fn parse_number(s: &str) -> std::result::Result<f64, String> {
     };
     // Rust's parser reads "inf" and "NaN": they are not readings.
     if !t.bytes().all(|c| c.is_ascii_digit() || matches!(c, b'.' | b'-' | b'+' | b'e' | b'E')) {
-        return Err(format!("expected a number, got \"{s}\""));
+        return Err(format!("expected a number, got {s:?}"));
     }
-    t.parse::<f64>().map_err(|_| format!("expected a number, got \"{s}\"")).and_then(|v| {
+    t.parse::<f64>().map_err(|_| format!("expected a number, got {s:?}")).and_then(|v| {
         if v.is_finite() {
             Ok(v)
         } else {
-            Err(format!("\"{s}\" is not a finite number"))
+            Err(format!("{s:?} is not a finite number"))
         }
     })
 }

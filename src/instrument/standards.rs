@@ -96,7 +96,7 @@ fn scale(o: &Obj) -> Result<Scale> {
                     Ok(Scale::Mirror { value })
                 }
                 other => {
-                    Err(s.err("kind", format!("unknown scale kind \"{other}\"; allowed: {}", SCALE_KINDS.join(", "))))
+                    Err(s.err("kind", format!("unknown scale kind {other:?}; allowed: {}", SCALE_KINDS.join(", "))))
                 }
             }
         }
@@ -129,14 +129,10 @@ fn parse_builtin() -> Result<Vec<StandardGeometry>> {
         let mut g = parse(text, &label)?;
         let stem = file.trim_end_matches(".json");
         if g.geometry.id != stem {
-            return Err(Error::input(
-                label,
-                "id",
-                format!("id \"{}\" must equal the file name \"{stem}\"", g.geometry.id),
-            ));
+            return Err(Error::input(label, "id", format!("id {:?} must equal the file name {stem:?}", g.geometry.id)));
         }
         if out.iter().any(|o: &StandardGeometry| o.geometry.id == g.geometry.id) {
-            return Err(Error::input(label, "/id", format!("duplicate id \"{}\"", g.geometry.id)));
+            return Err(Error::input(label, "/id", format!("duplicate id {:?}", g.geometry.id)));
         }
         g.origin = "builtin".to_string();
         out.push(g);
@@ -150,7 +146,7 @@ fn parse_builtin() -> Result<Vec<StandardGeometry>> {
                         return Err(Error::input(
                             format!("<builtin:{}.json>", g.geometry.id),
                             format!("/readings/{i}/{key}"),
-                            format!("\"{id}\" is not a builtin non-composite geometry id; known: {}", ids(&out)),
+                            format!("{id:?} is not a builtin non-composite geometry id; known: {}", ids(&out)),
                         ));
                     }
                 }
@@ -175,7 +171,7 @@ pub fn find(id: &str) -> Result<StandardGeometry> {
     match colour.iter().find(|g| g.geometry.id == id) {
         Some(g) => Ok(g.clone()),
         None => {
-            Err(Error::Usage(format!("unknown geometry id \"{id}\"; known ids: {}; colour: {}", ids(all), ids(colour))))
+            Err(Error::Usage(format!("unknown geometry id {id:?}; known ids: {}; colour: {}", ids(all), ids(colour))))
         }
     }
 }
@@ -225,7 +221,7 @@ pub fn check_user(g: &StandardGeometry, shipped: &[StandardGeometry]) -> Result<
         return Err(Error::input(
             &g.origin,
             "/id",
-            format!("\"{id}\" is the id of a shipped geometry; give a user geometry an id of its own"),
+            format!("{id:?} is the id of a shipped geometry; give a user geometry an id of its own"),
         ));
     }
     for (i, r) in g.geometry.readings.iter().enumerate() {
@@ -235,7 +231,7 @@ pub fn check_user(g: &StandardGeometry, shipped: &[StandardGeometry]) -> Result<
                     return Err(Error::input(
                         &g.origin,
                         format!("/readings/{i}/{key}"),
-                        format!("\"{part}\" is not a shipped non-composite geometry id; known: {}", ids(shipped)),
+                        format!("{part:?} is not a shipped non-composite geometry id; known: {}", ids(shipped)),
                     ));
                 }
             }
@@ -251,7 +247,7 @@ pub fn parse(text: &str, origin: &str) -> Result<StandardGeometry> {
     o.deny_unknown(TOP_FIELDS)?;
     let id = o.str("id")?;
     if id.is_empty() || !id.chars().all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '-' || c == '.') {
-        return Err(o.err("id", format!("\"{id}\" is not a valid id: use lower-case letters, digits, '-' and '.'")));
+        return Err(o.err("id", format!("{id:?} is not a valid id: use lower-case letters, digits, '-' and '.'")));
     }
     let title = nonempty_str(&o, "title")?;
     string_list(&o, "standards")?;
@@ -317,7 +313,7 @@ pub fn parse(text: &str, origin: &str) -> Result<StandardGeometry> {
             let r = Obj::new(origin, format!("/receptors/{i}"), v)?;
             let name = nonempty_str(&r, "name")?;
             if receptors.iter().any(|(n, _)| *n == name) {
-                return Err(r.err("name", format!("duplicate receptor name \"{name}\"")));
+                return Err(r.err("name", format!("duplicate receptor name {name:?}")));
             }
             let (r_in, r_perp) = aperture(&r, &["name", "shape", "in_plane_deg", "perpendicular_deg", "offset_deg"])?;
             let off = sourced(
@@ -351,7 +347,7 @@ pub fn parse(text: &str, origin: &str) -> Result<StandardGeometry> {
         if reading_names.contains(&display) {
             return Err(r.err(
                 "name",
-                format!("two readings would both be displayed as \"{display}\"; give them distinct \"name\" fields"),
+                format!("two readings would both be displayed as {display:?}; give them distinct \"name\" fields"),
             ));
         }
         reading_names.push(display);
@@ -401,7 +397,7 @@ pub(crate) fn sourced(o: &Obj, key: &str, range: Range, what: &str) -> Result<f6
     }
     let status = s.str("status")?;
     if !STATUSES.contains(&status) {
-        return Err(s.err("status", format!("\"{status}\" is not a status; allowed: {}", STATUSES.join(", "))));
+        return Err(s.err("status", format!("{status:?} is not a status; allowed: {}", STATUSES.join(", "))));
     }
     Ok(value)
 }
@@ -417,7 +413,7 @@ fn check_variation(s: &Obj) -> Result<()> {
         }
         let status = t.str("status")?;
         if !STATUSES.contains(&status) {
-            return Err(t.err("status", format!("\"{status}\" is not a status; allowed: {}", STATUSES.join(", "))));
+            return Err(t.err("status", format!("{status:?} is not a status; allowed: {}", STATUSES.join(", "))));
         }
         Ok(())
     };
@@ -451,7 +447,7 @@ pub(crate) fn aperture(o: &Obj, allowed: &[&str]) -> Result<(f64, f64)> {
                  the inscribed one (side = diameter/√2) or the square of equal solid angle (side ≈ 0.886 × diameter), \
                  and say which in the numbers' \"source\"",
         )),
-        other => return Err(o.err("shape", format!("unknown shape \"{other}\"; allowed: rectangle"))),
+        other => return Err(o.err("shape", format!("unknown shape {other:?}; allowed: rectangle"))),
     }
     o.deny_unknown(allowed)?;
     let what = "a full aperture angle in degrees";
@@ -504,7 +500,7 @@ fn check_receptor(o: &Obj, path: &str, name: &str, names: &[&str]) -> Result<()>
         Err(Error::input(
             o.file,
             path,
-            format!("unknown receptor \"{name}\"; receptors defined in this geometry: {}", names.join(", ")),
+            format!("unknown receptor {name:?}; receptors defined in this geometry: {}", names.join(", ")),
         ))
     }
 }
@@ -536,8 +532,8 @@ fn compensation_factor(
             return Err(r.err(
                 "compensation",
                 format!(
-                    "the compensation receptor \"{compensation}\" (in plane {} from specular) overlaps the {role} \
-                     receptor \"{name}\" ({}); it must see the body's diffuse light away from the specular and haze \
+                    "the compensation receptor {compensation:?} (in plane {} from specular) overlaps the {role} \
+                     receptor {name:?} ({}); it must see the body's diffuse light away from the specular and haze \
                      receptors",
                     deg(&c),
                     deg(&s)
@@ -570,7 +566,7 @@ fn reading(
         "doi" => &["quantity", "name", "specular", "offset"],
         "haze-index" => &["quantity", "name", "minuend", "subtrahend"],
         other => {
-            return Err(r.err("quantity", format!("unknown quantity \"{other}\"; allowed: {}", QUANTITIES.join(", "))))
+            return Err(r.err("quantity", format!("unknown quantity {other:?}; allowed: {}", QUANTITIES.join(", "))))
         }
     };
     r.deny_unknown(allowed)?;
@@ -675,7 +671,7 @@ pub fn describe(g: &StandardGeometry) -> String {
         let recs = s.get("receptors").and_then(Value::as_array).cloned().unwrap_or_default();
         for (r, (name, stop)) in recs.iter().zip(&geo.receptors) {
             out += &format!(
-                "  receptor \"{name}\": {} (solid angle {:.4e} sr)\n",
+                "  receptor {name:?}: {} (solid angle {:.4e} sr)\n",
                 r.get("shape").and_then(Value::as_str).unwrap_or("?"),
                 stop.solid_angle()
             );

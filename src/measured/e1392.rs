@@ -98,7 +98,7 @@ pub fn parse(text: &str, file: &str) -> Result<InPlaneBrdf> {
                 Error::input(
                     file,
                     format!("line {n}, column {}", header[c]),
-                    format!("\"{}\" is not a finite number", cells[c]),
+                    format!("{:?} is not a finite number", cells[c]),
                 )
             })
         };

@@ -601,7 +601,7 @@ pub fn parse_csv(text: &str, file: &str) -> Result<InPlaneBrdf> {
                 Error::input(
                     file,
                     format!("line {}, column {}", i + 1, cols[c]),
-                    format!("\"{}\" is not a finite number", cells[c]),
+                    format!("{:?} is not a finite number", cells[c]),
                 )
             })
         };

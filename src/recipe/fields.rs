@@ -220,7 +220,7 @@ pub fn kind(v: &Value) -> String {
         Value::Null => "null".into(),
         Value::Bool(b) => format!("boolean {b}"),
         Value::Number(n) => format!("number {n}"),
-        Value::String(s) if s.len() <= 24 => format!("string \"{s}\""),
+        Value::String(s) if s.len() <= 24 => format!("string {s:?}"),
         Value::String(_) => "a string".into(),
         Value::Array(a) => format!("an array of {}", a.len()),
         Value::Object(_) => "an object".into(),

@@ -36,7 +36,7 @@ pub fn parse_merl(obj: &Obj) -> Result<Arc<dyn Brdf>> {
         Some("trilinear") => Interpolation::Trilinear,
         Some(other) => {
             let allowed = "allowed: \"nearest\" (the default, MERL's lookup), \"trilinear\"";
-            return Err(obj.err("interpolation", format!("unknown interpolation \"{other}\"; {allowed}")));
+            return Err(obj.err("interpolation", format!("unknown interpolation {other:?}; {allowed}")));
         }
     };
     let path = resolve(obj.file, file);
@@ -81,7 +81,7 @@ pub fn parse_inplane(obj: &Obj, model: &str) -> Result<Arc<dyn Brdf>> {
             let allowed =
                 "allowed: \"f\" (f_r depends on (θh, θd) only, the default), \"f-cos-cos\" (f_r·cos θi·cos θo \
                            does), \"microfacet\" (f_r·cos θi·cos θo/G2 does, G2 the table's own Smith term)";
-            return Err(obj.err("off_plane", format!("unknown off-plane assumption \"{other}\"; {allowed}")));
+            return Err(obj.err("off_plane", format!("unknown off-plane assumption {other:?}; {allowed}")));
         }
     };
     let loaded = if model == "e1392" { e1392::load(&path) } else { inplane::load_csv(&path) };

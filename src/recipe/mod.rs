@@ -82,7 +82,7 @@ pub fn parse_brdf(obj: &Obj) -> Result<Arc<dyn Brdf>> {
         Some(v) => return Err(obj.err("model", format!("expected a string, got {}; {}", kind(v), allowed()))),
     };
     if !MODELS.contains(&model) {
-        return Err(obj.err("model", format!("unknown model \"{model}\"; {}", allowed())));
+        return Err(obj.err("model", format!("unknown model {model:?}; {}", allowed())));
     }
     if model == "paint" {
         return paint::parse_paint(obj);
@@ -154,7 +154,7 @@ pub fn parse_brdf(obj: &Obj) -> Result<Arc<dyn Brdf>> {
         "merl" => measured::parse_merl(obj)?,
         "rgl" => measured::parse_rgl(obj)?,
         "inplane-csv" | "e1392" => measured::parse_inplane(obj, model)?,
-        other => return Err(obj.err("model", format!("unknown model \"{other}\"; {}", allowed()))),
+        other => return Err(obj.err("model", format!("unknown model {other:?}; {}", allowed()))),
     };
     Ok(brdf)
 }
@@ -293,7 +293,7 @@ fn distribution(obj: &Obj, p: &Param) -> Result<Distribution> {
     match s {
         None | Some("beckmann") => Ok(Distribution::Beckmann),
         Some("ggx") => Ok(Distribution::Ggx),
-        Some(other) => Err(obj.err(&key, format!("unknown distribution \"{other}\"; allowed: \"beckmann\", \"ggx\""))),
+        Some(other) => Err(obj.err(&key, format!("unknown distribution {other:?}; allowed: \"beckmann\", \"ggx\""))),
     }
 }
 
@@ -304,7 +304,7 @@ fn shadowing(obj: &Obj) -> Result<Shadowing> {
         Some("v-cavity") => Ok(Shadowing::VCavity),
         Some(other) => Err(obj.err(
             "shadowing",
-            format!("unknown shadowing \"{other}\"; allowed: \"smith\" (height-correlated, the default), \"smith-separable\" (G1·G1, as Mitsuba 3), \"v-cavity\""),
+            format!("unknown shadowing {other:?}; allowed: \"smith\" (height-correlated, the default), \"smith-separable\" (G1·G1, as Mitsuba 3), \"v-cavity\""),
         )),
     }
 }

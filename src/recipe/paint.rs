@@ -36,7 +36,7 @@ pub fn parse_paint_spec(obj: &Obj) -> Result<PaintSpec> {
     obj.deny_unknown_in(PAINT)?;
     if let Some(m) = obj.opt_str("model")? {
         if m != "paint" {
-            return Err(obj.err("model", format!("expected \"paint\", got \"{m}\"")));
+            return Err(obj.err("model", format!("expected \"paint\", got {m:?}")));
         }
     }
     opt_string(obj, "name")?;
@@ -48,7 +48,7 @@ pub fn parse_paint_spec(obj: &Obj) -> Result<PaintSpec> {
         Some("paper-eq1") => Form::PaperEq1,
         Some(other) => {
             return Err(
-                obj.err("form", format!("unknown form \"{other}\"; allowed: \"physical\" (default), \"paper-eq1\""))
+                obj.err("form", format!("unknown form {other:?}; allowed: \"physical\" (default), \"paper-eq1\""))
             )
         }
     };
@@ -59,7 +59,7 @@ pub fn parse_paint_spec(obj: &Obj) -> Result<PaintSpec> {
             return Err(obj.err(
                 "flake_light",
                 format!(
-                    "unknown flake_light \"{other}\"; allowed: \"split\" (default), \"paper\" (Eq. 5 as in the paper)"
+                    "unknown flake_light {other:?}; allowed: \"split\" (default), \"paper\" (Eq. 5 as in the paper)"
                 ),
             ))
         }
@@ -109,7 +109,7 @@ fn parse_coat(o: &Obj) -> Result<ClearCoat> {
         Some(other) => {
             return Err(o.err(
                 "distribution",
-                format!("unknown distribution \"{other}\"; allowed: \"beckmann\" (default), \"ggx\""),
+                format!("unknown distribution {other:?}; allowed: \"beckmann\" (default), \"ggx\""),
             ))
         }
     };

@@ -42,17 +42,27 @@ pub enum Category {
     MutatedRecipe,
     MutatedGeometry,
     Sheet,
+    MerlTable,
+    CommandLine,
 }
 
 impl Category {
-    pub const ALL: [Category; 4] =
-        [Category::GeneratedRecipe, Category::MutatedRecipe, Category::MutatedGeometry, Category::Sheet];
+    pub const ALL: [Category; 6] = [
+        Category::GeneratedRecipe,
+        Category::MutatedRecipe,
+        Category::MutatedGeometry,
+        Category::Sheet,
+        Category::MerlTable,
+        Category::CommandLine,
+    ];
     pub fn name(self) -> &'static str {
         match self {
             Category::GeneratedRecipe => "generated recipes",
             Category::MutatedRecipe => "mutated recipes",
             Category::MutatedGeometry => "mutated geometry files",
             Category::Sheet => "generated and mutated sheets",
+            Category::MerlTable => "generated MERL tables",
+            Category::CommandLine => "command lines",
         }
     }
 }
@@ -331,8 +341,8 @@ pub enum Outcome {
 /// an unknown geometry id) naming what is unknown. Anything else is a violation, returned as Err.
 pub fn check_error(e: &Error, file: &str) -> Result<(), String> {
     let shown = e.to_string();
-    if shown.contains("NaN") && !shown.contains("\"NaN\"") {
-        return Err(format!("an error prints NaN: {shown}"));
+    if prints_non_finite(&shown) {
+        return Err(format!("an error prints a non-finite number (outside the quoted input): {shown}"));
     }
     match e {
         Error::Input { file: f, field, message } => {
@@ -358,6 +368,20 @@ pub fn run_case(cat: Category, text: &str) -> Result<Outcome, String> {
             Ok(m) => Ok(Outcome::Accepted(Some(m))),
             Err(e) => check_error(&e, "fuzz.json").map(|_| Outcome::Refused),
         },
+        Category::MerlTable => {
+            let r = match recipe::parse_str(text, "fuzz.json") {
+                Ok(m) => Ok(Outcome::Accepted(Some(m))),
+                Err(e) => check_error(&e, "fuzz.json").map(|_| Outcome::Refused),
+            };
+            // The table is in memory once parsed: the scratch file can go.
+            if let Some(f) =
+                serde_json::from_str::<serde_json::Value>(text).ok().and_then(|v| v["file"].as_str().map(String::from))
+            {
+                let _ = std::fs::remove_file(f);
+            }
+            r
+        }
+        Category::CommandLine => run_cli(text),
         Category::MutatedGeometry => {
             let r = standards::parse(text, "fuzz-geometry.json")
                 .and_then(|g| standards::builtin().and_then(|b| standards::check_user(&g, &b)));
@@ -382,7 +406,11 @@ pub fn run_case(cat: Category, text: &str) -> Result<Outcome, String> {
 /// The text of case `k` of a category (deterministic in `seed`).
 pub fn case_text(cat: Category, seeds: &Seeds, rng: &mut Rng) -> String {
     match cat {
+        // Three in four from the parameter registry (mostly valid), one in four from random fields.
+        Category::GeneratedRecipe if rng.chance(0.75) => generate_registry_recipe(rng),
         Category::GeneratedRecipe => generate_recipe(rng),
+        Category::MerlTable => generate_merl(rng),
+        Category::CommandLine => generate_cli(rng, true),
         Category::MutatedRecipe => {
             let base: &String = rng.pick(&seeds.recipes);
             mutate(base, rng)
@@ -418,4 +446,485 @@ pub fn scratch(name: &str) -> PathBuf {
 
 pub fn exists(p: &Path) -> bool {
     p.exists()
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// What glossmeter printed: a non-finite number of its own, outside the user's quoted text.
+// ---------------------------------------------------------------------------------------------------------
+
+/// `s` with every quoted part removed ("…" with \" escapes, `…`, and clap's '…'): what remains is
+/// glossmeter's own text. Error messages quote the user's input (`got string "NaN-"`, `expected a number,
+/// got "NaN,1"`, `` `inf` `` for a number given on the command line), which may spell anything. A quote that
+/// is never closed quotes nothing (the rest is kept), so an unbalanced quote cannot hide glossmeter's text.
+pub fn unquoted(s: &str) -> String {
+    let chars: Vec<char> = s.chars().collect();
+    let mut out = String::with_capacity(s.len());
+    let mut i = 0;
+    while i < chars.len() {
+        let c = chars[i];
+        // clap quotes a value as 'NaN'; an apostrophe inside a word ("doesn't") opens nothing.
+        let word = |k: usize| chars.get(k).is_some_and(|d| d.is_alphanumeric());
+        let opens = c == '"' || c == '`' || (c == '\'' && (i == 0 || !word(i - 1)));
+        if opens {
+            // The matching close: the next unescaped `"` (escapes only inside "…"), the next backquote, or the
+            // next ' that ends a word.
+            let mut j = i + 1;
+            let mut close = None;
+            while j < chars.len() {
+                if c == '"' && chars[j] == '\\' {
+                    j += 2;
+                    continue;
+                }
+                if chars[j] == c && (c != '\'' || !word(j + 1)) {
+                    close = Some(j);
+                    break;
+                }
+                j += 1;
+            }
+            if let Some(j) = close {
+                out.push(c);
+                out.push(c);
+                i = j + 1;
+                continue;
+            }
+        }
+        out.push(c);
+        i += 1;
+    }
+    out
+}
+
+/// Whether glossmeter's own text (outside quotes) shows a non-finite number: NaN, inf or infinity as a word.
+pub fn prints_non_finite(s: &str) -> bool {
+    unquoted(s)
+        .split(|c: char| !c.is_ascii_alphanumeric())
+        .any(|w| matches!(w.to_ascii_lowercase().as_str(), "nan" | "inf" | "infinity"))
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// Recipes from the parameter registry: every field of a model, in its range.
+// ---------------------------------------------------------------------------------------------------------
+
+/// A number in `range`: an end (if closed), just inside an end, or a random interior point (log-uniform
+/// above the lower end when the range is unbounded).
+fn number_in(range: glossmeter::registry::Range, rng: &mut Rng) -> f64 {
+    let u = (rng.next() >> 11) as f64 / (1u64 << 53) as f64;
+    let (lo, hi) = (range.lo, range.hi);
+    let x = match rng.below(6) {
+        0 if range.lo_closed => lo,
+        1 if range.hi_closed && hi.is_finite() => hi,
+        2 => {
+            if hi.is_finite() {
+                lo + (hi - lo) * 1e-9
+            } else {
+                lo + 1e-9 * lo.abs().max(1.0)
+            }
+        }
+        _ if hi.is_finite() => lo + (hi - lo) * u,
+        _ => lo + 10f64.powf(-3.0 + 5.0 * u),
+    };
+    if range.contains(x) {
+        x
+    } else {
+        // An open end that was hit: the middle of the range, or just above an open lower end.
+        if hi.is_finite() {
+            0.5 * (lo + hi)
+        } else {
+            lo + 1.0
+        }
+    }
+}
+
+fn conductor_ior(rng: &mut Rng) -> serde_json::Value {
+    use glossmeter::registry::{CONDUCTOR_K_RANGE, CONDUCTOR_N_RANGE};
+    let pair =
+        |rng: &mut Rng| serde_json::json!([number_in(CONDUCTOR_N_RANGE, rng), number_in(CONDUCTOR_K_RANGE, rng)]);
+    if rng.chance(0.7) {
+        pair(rng)
+    } else {
+        serde_json::Value::Array((0..3).map(|_| pair(rng)).collect())
+    }
+}
+
+/// The value of one registry entry (and, for objects, of the entries below it).
+fn registry_value(model: &str, e: &glossmeter::registry::Param, samples: usize, rng: &mut Rng) -> serde_json::Value {
+    use glossmeter::registry::Type;
+    use serde_json::{json, Value};
+    let num = |rng: &mut Rng| json!(number_in(e.range.expect("numeric entries have a range"), rng));
+    match e.ty {
+        Type::Number => num(rng),
+        Type::Colour | Type::NumberOrSpectral if rng.chance(0.5) => num(rng),
+        Type::Colour => Value::Array((0..3).map(|_| num(rng)).collect()),
+        Type::Spectral | Type::NumberOrSpectral => Value::Array((0..samples).map(|_| num(rng)).collect()),
+        Type::Numbers => {
+            let mut w: Vec<f64> = (0..samples).map(|_| number_in(e.range.unwrap(), rng).round()).collect();
+            w.sort_by(f64::total_cmp);
+            w.dedup();
+            json!(w)
+        }
+        Type::Choice(c) => json!(rng.pick(c)),
+        Type::Bool => json!(rng.chance(0.5)),
+        Type::Text => json!("fuzz"),
+        Type::Notes => json!("a note"),
+        Type::Object => Value::Object(registry_object(model, e.pointer, samples, rng)),
+        Type::Objects => Value::Array(
+            (0..1 + rng.below(3))
+                .map(|_| Value::Object(registry_object(model, &format!("{}/*", e.pointer), samples, rng)))
+                .collect(),
+        ),
+        Type::ConductorIor => conductor_ior(rng),
+        Type::DielectricOrConductorIor if rng.chance(0.5) => num(rng),
+        Type::DielectricOrConductorIor => conductor_ior(rng),
+    }
+}
+
+/// The object at pattern `prefix` of a `model` recipe: its required fields, and each optional one with
+/// probability 1/2.
+fn registry_object(
+    model: &str,
+    prefix: &str,
+    samples: usize,
+    rng: &mut Rng,
+) -> serde_json::Map<String, serde_json::Value> {
+    use glossmeter::registry::{self, Presence};
+    let depth = registry::tokens(prefix).map_or(0, |t| t.len());
+    let mut obj = serde_json::Map::new();
+    for e in registry::of_model(model) {
+        let Some(t) = registry::tokens(e.pointer) else { continue };
+        if t.len() != depth + 1 || !e.pointer.starts_with(&format!("{prefix}/")) {
+            continue;
+        }
+        if e.pointer == "/model" || e.pointer == "/wavelengths_nm" || e.pointer == "/file" {
+            continue;
+        }
+        // An array element's fields (…/ior/0) belong to its array's value.
+        if registry::is_index(t[depth]) {
+            continue;
+        }
+        if e.presence == Presence::Required || rng.chance(0.5) {
+            obj.insert(e.key(), registry_value(model, e, samples, rng));
+        }
+    }
+    obj
+}
+
+/// A recipe built from the registry: a random model and its fields in their ranges (cross-field rules such
+/// as kd + ks ≤ 1 or one pigment description of two are left to chance, so some are refused).
+pub fn generate_registry_recipe(rng: &mut Rng) -> String {
+    use serde_json::{json, Value};
+    let model = *rng.pick(glossmeter::registry::MODELS);
+    let spectral = model == "paint" && rng.chance(0.3);
+    let samples = if spectral { 1 + rng.below(5) } else { 3 };
+    let mut obj = registry_object(model, "", samples, rng);
+    obj.insert("model".into(), json!(model));
+    if spectral {
+        let w: Vec<f64> = (0..samples).map(|i| 400.0 + 80.0 * i as f64).collect();
+        obj.insert("wavelengths_nm".into(), json!(w));
+    }
+    if model == "merl" {
+        let f = root().join("fixtures/materials/merl/lambert-tiny.binary");
+        obj.insert("file".into(), json!(f.to_string_lossy()));
+    }
+    Value::Object(obj).to_string()
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// MERL tables: random headers, sizes and values, written to a scratch file.
+// ---------------------------------------------------------------------------------------------------------
+
+/// A random MERL `.binary` (small or nonsense dimensions; exact, short or long bodies; values finite,
+/// negative, NaN or infinite) written to a scratch file, and a recipe that reads it.
+pub fn generate_merl(rng: &mut Rng) -> String {
+    let dim = |rng: &mut Rng| -> i32 {
+        match rng.below(20) {
+            0 => 0,
+            1 => -3,
+            2 => 100_000,
+            _ => 1 + rng.below(8) as i32,
+        }
+    };
+    let dims = [dim(rng), dim(rng), dim(rng)];
+    let n = if dims.iter().all(|d| (1..=8).contains(d)) { dims.iter().map(|d| *d as usize).product() } else { 8 };
+    let count = match rng.below(10) {
+        0 => rng.below(3 * n),
+        1 => 3 * n + 1 + rng.below(4),
+        _ => 3 * n,
+    };
+    let mut bytes: Vec<u8> = dims.iter().flat_map(|d| d.to_le_bytes()).collect();
+    for _ in 0..count {
+        let u = (rng.next() >> 11) as f64 / (1u64 << 53) as f64;
+        let v = match rng.below(40) {
+            0 => f64::NAN,
+            1 => f64::INFINITY,
+            2 | 3 => -1.0,
+            4 => 1e300,
+            _ => 3000.0 * u,
+        };
+        bytes.extend_from_slice(&v.to_le_bytes());
+    }
+    if rng.chance(0.05) {
+        bytes.truncate(rng.below(12));
+    }
+    let path = scratch(&format!("merl-{:016x}.binary", rng.next()));
+    std::fs::write(&path, &bytes).unwrap();
+    let interpolation = rng.pick(&["nearest", "trilinear", "nearest", "cubic"]);
+    serde_json::json!({"model": "merl", "file": path.to_string_lossy(), "interpolation": interpolation}).to_string()
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// Command lines: random subcommands, options and values, run as a process.
+// ---------------------------------------------------------------------------------------------------------
+
+const CLI_NUMBERS: &[&str] =
+    &["1e-3", "1e-2", "1e-12", "1e-13", "0", "-1", "1", "2", "NaN", "inf", "-inf", "1e999", "x", "1e-300", ""];
+const CLI_IDS: &[&str] =
+    &["astm-d523-20", "astm-d523-60", "astm-d523-85", "astm-e430-30", "iso-13803-20", "astm-d4039", "nope", ""];
+
+fn files(dir: &str, ext: &str) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(root().join(dir))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == ext))
+        .map(|p| p.strip_prefix(root()).unwrap().to_string_lossy().into_owned())
+        .collect();
+    v.sort();
+    v
+}
+
+/// The value of option `opt` in a generated command line.
+fn cli_value(opt: &str, rng: &mut Rng) -> String {
+    let paths = ["@NEW", "@NEW", "@NEW", "Cargo.toml", "fixtures", "/dev/full", "/nonexistent/dir/x.txt", ""];
+    match opt {
+        "-g" => rng.pick(CLI_IDS).to_string(),
+        "--rtol" | "--max-seconds" | "-k" | "--tolerance" | "--max-de00" | "--min-time-ms" => {
+            rng.pick(CLI_NUMBERS).to_string()
+        }
+        "--tolerances" => {
+            rng.pick(&["1e-2,1e-3", "1e-2", "0.5,1e-3", "NaN", "x", "", "1e-2,,1e-3", "1e-20"]).to_string()
+        }
+        "--max-evals" | "--max-repetitions" => {
+            rng.pick(&["0", "1", "100", "20000", "-1", "x", "NaN", "99999999999999999999"]).to_string()
+        }
+        "--format" => rng.pick(&["table", "json", "csv", "junit", "xml", ""]).to_string(),
+        "--illuminant" => rng.pick(&["D65", "D50", "A", "C", "F2", ""]).to_string(),
+        "--observer" => rng.pick(&["10", "2", "5", ""]).to_string(),
+        "--delimiter" => rng.pick(&[",", ";", "\\t", "ab", ""]).to_string(),
+        "-o" | "--plot" => rng.pick(&paths).to_string(),
+        "--geometry-file" => {
+            let mut g = files("fixtures/geometry", "json");
+            g.push("nope.json".into());
+            rng.pick(&g).clone()
+        }
+        _ => String::new(),
+    }
+}
+
+/// One random argument vector (without the program name), as a JSON array of strings. Paths are relative to
+/// the crate root (the process runs there); `@NEW` stands for a fresh scratch path. `cheap`: the readings
+/// get a small budget first (`--max-seconds 1` for `measure`, `--rtol 1e-3` for `compare`; a second
+/// budget given at random is then a usage error, exit 2), so that 10⁴ command lines fit in minutes.
+pub fn generate_cli(rng: &mut Rng, cheap: bool) -> String {
+    let mut recipes = files("fixtures/recipes", "json");
+    recipes.retain(|r| !r.contains("bench-b3")); // keep the run fast; the panel is fuzzed in the library
+    recipes.extend(files("fixtures/bad", "json"));
+    recipes.extend(["nope.json", "fixtures", "/dev/null", "", "-"].map(String::from));
+    let mut sheets = files("fixtures/sheets", "csv");
+    sheets.extend(files("fixtures/sheets/bad", "csv"));
+    let mut a: Vec<String> = Vec::new();
+    let sub = *rng.pick(&[
+        "measure",
+        "measure",
+        "measure",
+        "compare",
+        "compare",
+        "convergence",
+        "standards",
+        "schema",
+        "help",
+        "bogus",
+        "--version",
+        "-h",
+    ]);
+    a.push(sub.into());
+    let options: &[&str] = match sub {
+        "measure" => &[
+            "-g",
+            "-g",
+            "--rtol",
+            "--format",
+            "--explain",
+            "--no-timing",
+            "--allow-unconverged",
+            "--max-evals",
+            "--max-seconds",
+            "-o",
+            "--geometry-file",
+            "--illuminant",
+            "--observer",
+            "--envelope",
+            "--bogus",
+        ],
+        "compare" => &[
+            "--rtol",
+            "--format",
+            "-k",
+            "--tolerance",
+            "-o",
+            "--plot",
+            "--allow-unconverged",
+            "--max-de00",
+            "--delimiter",
+            "--illuminant",
+            "--bogus",
+        ],
+        "convergence" => &["-g", "--format", "--plot", "-o", "--min-time-ms", "--max-repetitions", "--bogus"],
+        _ => &[],
+    };
+    match sub {
+        "measure" | "compare" | "convergence" => {
+            a.push(rng.pick(&recipes).clone());
+            if sub == "compare" {
+                a.push(if rng.chance(0.9) { rng.pick(&sheets).clone() } else { "nope.csv".into() });
+            }
+            if cheap && sub == "measure" {
+                a.extend(["--max-seconds".into(), "1".into()]);
+            }
+            if cheap && sub == "compare" {
+                a.extend(["--rtol".into(), "1e-3".into()]);
+            }
+            if sub == "convergence" {
+                let t = cli_value("--tolerances", rng);
+                a.extend(["--tolerances".into(), t, "--max-repetitions".into(), "1".into()]);
+                a.extend(["--min-time-ms".into(), "0".into(), "-g".into(), "astm-d523-60".into()]);
+            }
+            for _ in 0..rng.below(5) {
+                let opt = *rng.pick(options);
+                a.push(opt.into());
+                if rng.chance(0.05) {
+                    break; // an option without its value, at the end
+                }
+                let v = cli_value(opt, rng);
+                if !v.is_empty() || rng.chance(0.3) {
+                    a.push(v);
+                }
+            }
+        }
+        "standards" => {
+            if rng.chance(0.7) {
+                a.push(rng.pick(CLI_IDS).to_string());
+            }
+        }
+        "schema" => {
+            if rng.chance(0.5) {
+                a.extend(["--output-format".into(), rng.pick(&["measure", "compare", "sweep", "fit", ""]).to_string()]);
+            }
+        }
+        _ => {
+            if rng.chance(0.3) {
+                a.push("--bogus".into());
+            }
+        }
+    }
+    serde_json::to_string(&a).unwrap()
+}
+
+/// `out` with the command line's own arguments (file names such as `fixtures/bad/nan-string.json`, echoed
+/// unquoted at the head of an error) replaced by a space, so that only glossmeter's own text is checked.
+pub fn without_args(out: &str, args: &[String]) -> String {
+    let mut s = out.to_string();
+    let mut args: Vec<&String> = args.iter().filter(|a| a.chars().count() > 2).collect();
+    args.sort_by_key(|a| std::cmp::Reverse(a.len()));
+    for a in args {
+        s = s.replace(a.as_str(), " ");
+    }
+    s
+}
+
+/// The binary that CLI cases run (set by the test or the driver before the first case).
+pub static BINARY: std::sync::OnceLock<PathBuf> = std::sync::OnceLock::new();
+
+/// A command line that has not ended after this long is a hang (its readings have a 6 s budget at most).
+pub const CLI_TIMEOUT_S: f64 = 120.0;
+
+/// Run one command line; the contract: exit 0, 1 or 2 (never a panic's 101 or a signal), within
+/// [`CLI_TIMEOUT_S`]; "error: …" on stderr for 2, no panic message, no non-finite number printed outside
+/// quotes, and no silent loss: a new `-o`/`--plot` file exists (and is not empty) after exit 0 or 1, and does
+/// not exist at all after exit 2.
+pub fn run_cli(text: &str) -> Result<Outcome, String> {
+    let args: Vec<String> = serde_json::from_str(text).map_err(|e| format!("bad case {text}: {e}"))?;
+    // Names of their own: tests run command lines from several threads of one process.
+    static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let n = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let mut new_files = Vec::new();
+    let args: Vec<String> = args
+        .into_iter()
+        .map(|a| {
+            if a == "@NEW" {
+                let p = scratch(&format!("cli-{n}-{}.out", new_files.len()));
+                let _ = std::fs::remove_file(&p);
+                new_files.push(p.clone());
+                p.to_string_lossy().into_owned()
+            } else {
+                a
+            }
+        })
+        .collect();
+    let bin = BINARY.get().ok_or("BINARY not set")?;
+    // Output to files (no pipe to drain while waiting), the process polled against a timeout.
+    let (out_path, err_path) = (scratch(&format!("cli-stdout-{n}")), scratch(&format!("cli-stderr-{n}")));
+    let mut child = std::process::Command::new(bin)
+        .args(&args)
+        .current_dir(root())
+        .stdin(std::process::Stdio::null())
+        .stdout(std::fs::File::create(&out_path).unwrap())
+        .stderr(std::fs::File::create(&err_path).unwrap())
+        .spawn()
+        .map_err(|e| format!("cannot run {}: {e}", bin.display()))?;
+    let t0 = std::time::Instant::now();
+    let status = loop {
+        match child.try_wait() {
+            Ok(Some(s)) => break s,
+            Ok(None) if t0.elapsed().as_secs_f64() > CLI_TIMEOUT_S => {
+                let _ = child.kill();
+                let _ = child.wait();
+                return Err(format!("a hang: {args:?} still running after {CLI_TIMEOUT_S} s"));
+            }
+            Ok(None) => std::thread::sleep(std::time::Duration::from_millis(1)),
+            Err(e) => return Err(format!("wait: {e}")),
+        }
+    };
+    let stdout = String::from_utf8_lossy(&std::fs::read(&out_path).unwrap_or_default()).into_owned();
+    let stderr = String::from_utf8_lossy(&std::fs::read(&err_path).unwrap_or_default()).into_owned();
+    let code = status.code();
+    let fail = |why: &str| Err(format!("{why}: {args:?} → {code:?}\nstderr: {stderr}"));
+    let verdict = if !matches!(code, Some(0..=2)) {
+        fail("exit status outside 0–2")
+    } else if stderr.contains("panicked") {
+        fail("a panic message")
+    } else if code == Some(2) && !stderr.contains("error") {
+        fail("exit 2 without an error message")
+    } else if prints_non_finite(&without_args(&stdout, &args)) || prints_non_finite(&without_args(&stderr, &args)) {
+        fail("a non-finite number printed")
+    } else {
+        let mut v = Ok(if code == Some(2) { Outcome::Refused } else { Outcome::Accepted(None) });
+        for f in &new_files {
+            // Only the files that the command line names as -o or --plot targets.
+            let named = args.windows(2).any(|w| (w[0] == "-o" || w[0] == "--plot") && w[1] == f.to_string_lossy());
+            if !named {
+                continue;
+            }
+            let len = std::fs::metadata(f).map(|m| m.len());
+            match (code, len) {
+                (Some(2), Ok(_)) => v = fail("a file left behind by a refused run"),
+                (Some(0 | 1), Ok(0)) => v = fail("an empty output file"),
+                (Some(0 | 1), Err(_)) => v = fail("an output file missing after success"),
+                _ => {}
+            }
+        }
+        v
+    };
+    for f in new_files.iter().chain([&out_path, &err_path]) {
+        let _ = std::fs::remove_file(f);
+    }
+    verdict
 }
