@@ -10,45 +10,24 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use glossmeter::instrument::plan::{Plan, PlanOptions};
-use glossmeter::instrument::{colour, standards};
-use glossmeter::spectrum::SamplingKind;
+use glossmeter::instrument::plan::PlanOptions;
+
+mod common;
 
 const GOLDEN: &str = "fixtures/golden/readings.json";
 
-fn recipes() -> Vec<std::path::PathBuf> {
-    let mut v: Vec<_> = std::fs::read_dir("fixtures/recipes")
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "json"))
-        .collect();
-    v.sort();
-    v
-}
-
 /// One line per reading: "recipe|geometry|name" → "value-bits error-bits evaluations converged".
 fn current() -> BTreeMap<String, String> {
-    let gloss = standards::builtin().unwrap();
-    let mut all = gloss.clone();
-    all.extend(colour::builtin().unwrap());
-    let mut out = BTreeMap::new();
-    for path in recipes() {
-        let m = glossmeter::recipe::load_file(&path).unwrap();
-        let stem = path.file_stem().unwrap().to_string_lossy().into_owned();
-        let geos = if m.brdf.sampling().kind == SamplingKind::Rgb { &gloss } else { &all };
-        let plan = Plan::compile(m.brdf.clone(), geos.clone(), PlanOptions::default()).unwrap();
-        for r in plan.execute() {
+    common::every_fixture_reading(&PlanOptions::default())
+        .into_iter()
+        .map(|(key, r)| {
             let v = match r.value {
                 Some(x) => format!("{:016x}", x.to_bits()),
                 None => "none".to_string(),
             };
-            out.insert(
-                format!("{stem}|{}|{}", r.geometry, r.name),
-                format!("{v} {:016x} {} {}", r.error_estimate.to_bits(), r.evaluations, r.converged),
-            );
-        }
-    }
-    out
+            (key, format!("{v} {:016x} {} {}", r.error_estimate.to_bits(), r.evaluations, r.converged))
+        })
+        .collect()
 }
 
 #[test]

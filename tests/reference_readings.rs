@@ -14,10 +14,10 @@
 //! profile, opt-level 2; 102 s at 0f642ca) at a commit whose engine is trusted (the file records which).
 use std::collections::BTreeMap;
 
-use glossmeter::instrument::plan::{Plan, PlanOptions};
-use glossmeter::instrument::{colour, standards};
-use glossmeter::spectrum::SamplingKind;
+use glossmeter::instrument::plan::PlanOptions;
 use serde_json::{json, Value};
+
+mod common;
 
 const REFERENCE: &str = "fixtures/reference/readings-rtol1e-10.json";
 const REFERENCE_RTOL: f64 = 1e-10;
@@ -42,35 +42,12 @@ fn hue_undefined(
     c_ref <= (c_err + ROUNDING).max(1e-9)
 }
 
-fn recipes() -> Vec<std::path::PathBuf> {
-    let mut v: Vec<_> = std::fs::read_dir("fixtures/recipes")
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "json"))
-        .collect();
-    v.sort();
-    v
-}
-
 /// "recipe|geometry|name" → (value, estimate, evaluations, converged), at `options`.
 fn readings(options: &PlanOptions) -> BTreeMap<String, (Option<f64>, f64, usize, bool)> {
-    let gloss = standards::builtin().unwrap();
-    let mut all = gloss.clone();
-    all.extend(colour::builtin().unwrap());
-    let mut out = BTreeMap::new();
-    for path in recipes() {
-        let m = glossmeter::recipe::load_file(&path).unwrap();
-        let stem = path.file_stem().unwrap().to_string_lossy().into_owned();
-        let geos = if m.brdf.sampling().kind == SamplingKind::Rgb { &gloss } else { &all };
-        let plan = Plan::compile(m.brdf.clone(), geos.clone(), options.clone()).unwrap();
-        for r in plan.execute() {
-            out.insert(
-                format!("{stem}|{}|{}", r.geometry, r.name),
-                (r.value, r.error_estimate, r.evaluations, r.converged),
-            );
-        }
-    }
-    out
+    common::every_fixture_reading(options)
+        .into_iter()
+        .map(|(key, r)| (key, (r.value, r.error_estimate, r.evaluations, r.converged)))
+        .collect()
 }
 
 fn git_head() -> String {

@@ -51,3 +51,34 @@ impl Brdf for TestBeckmann {
         format!("test beckmann m = {}", self.m)
     }
 }
+
+/// Every reading of every shipped fixture recipe (`fixtures/recipes/*.json`, sorted) on every builtin geometry,
+/// keyed "recipe|geometry|name": one plan per recipe, the colour geometries joining it unless the recipe is RGB.
+/// The reading set of `tests/golden.rs` and `tests/reference_readings.rs`.
+pub fn every_fixture_reading(
+    options: &glossmeter::instrument::plan::PlanOptions,
+) -> Vec<(String, glossmeter::instrument::plan::Reading)> {
+    use glossmeter::instrument::plan::Plan;
+    use glossmeter::instrument::{colour, standards};
+    use glossmeter::spectrum::SamplingKind;
+    let gloss = standards::builtin().unwrap();
+    let mut all = gloss.clone();
+    all.extend(colour::builtin().unwrap());
+    let mut recipes: Vec<_> = std::fs::read_dir("fixtures/recipes")
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "json"))
+        .collect();
+    recipes.sort();
+    let mut out = Vec::new();
+    for path in recipes {
+        let m = glossmeter::recipe::load_file(&path).unwrap();
+        let stem = path.file_stem().unwrap().to_string_lossy().into_owned();
+        let geos = if m.brdf.sampling().kind == SamplingKind::Rgb { &gloss } else { &all };
+        let plan = Plan::compile(m.brdf.clone(), geos.clone(), options.clone()).unwrap();
+        for r in plan.execute() {
+            out.push((format!("{stem}|{}|{}", r.geometry, r.name), r));
+        }
+    }
+    out
+}
