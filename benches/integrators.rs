@@ -23,7 +23,7 @@ use std::path::Path;
 use std::sync::Arc;
 use std::time::Instant;
 
-use glossmeter::brdf::{Brdf, Lobe, Term, TermKind};
+use glossmeter::brdf::{Brdf, Lobe, Tail, Term, TermKind};
 use glossmeter::instrument::flux::Flux;
 use glossmeter::instrument::geometry::{solid_angle_density, Axes, Stop};
 use glossmeter::instrument::method::Method;
@@ -172,7 +172,7 @@ impl Brdf for BenchMicrofacet {
                 slope_width: self.alpha,
                 medium_eta: 1.0,
                 label,
-                heavy_tail: self.dist == Dist::Ggx,
+                tail: if self.dist == Dist::Ggx { Tail::InverseQuartic } else { Tail::Gaussian },
             }),
         }]
     }
@@ -705,6 +705,10 @@ fn main() {
     }
 
     where_the_evaluations_go(&mut md, &cases);
+    // BENCH_CASES=NARROW (or no filter) runs the narrow-GGX rows.
+    if std::env::var("BENCH_CASES").map_or(true, |l| l.split(',').any(|id| id.trim() == "NARROW")) {
+        narrow_ggx(&mut md);
+    }
     b5(&mut md, quick);
 
     print!("{md}");
@@ -716,6 +720,63 @@ fn main() {
         Ok(()) => eprintln!("[bench] wrote {}", out.display()),
         Err(e) => eprintln!("[bench] could not write {}: {e}", out.display()),
     }
+}
+
+/// Narrow GGX (issue 10): the polar rule the planner chooses (`Rule::LobePolar`) beside the Genz–Malik 7/5
+/// partition forced on the same method (same lobe chart, same initial boxes: the engine before the polar
+/// rule), in one run, at α = 1e-3, 1e-5, 1e-7 on astm-d523-20 (n = 1.5). Reference: the forced partition at
+/// rtol 1e-11, cross-checked against the polar rule at 1e-11.
+fn narrow_ggx(md: &mut String) {
+    use glossmeter::instrument::method::Rule;
+    let _ = writeln!(md, "\n## Narrow GGX: the polar rule beside the forced Genz–Malik partition (same chart)\n");
+    let _ = writeln!(
+        md,
+        "Specimen flux, astm-d523-20, n = 1.5; load average at the start of this section {}.\n",
+        loadavg()
+    );
+    let _ = writeln!(md, "| α | method | value | claimed | rel. err | evaluations | time | runs |");
+    let _ = writeln!(md, "|---|---|---|---|---|---|---|---|");
+    for alpha in [1e-3, 1e-5, 1e-7] {
+        let c = case("NARROW", "GGX", Arc::new(BenchMicrofacet::new(Dist::Ggx, alpha, 1.5)), "astm-d523-20");
+        let forced = |rtol: f64| {
+            let mut p = problem(&c, rtol);
+            p.method.regular.as_mut().expect("a regular part").rule = Rule::GenzMalik75;
+            p
+        };
+        let reference = forced(1e-11).solve();
+        let polar_fine = problem(&c, 1e-11).solve();
+        let r = reference.value[0];
+        eprintln!(
+            "[bench] narrow GGX α = {alpha:e}: reference {r:.15e} ({} evaluations), polar at 1e-11 {:.15e} ({}), rel. diff {:.1e}",
+            reference.evaluations,
+            polar_fine.value[0],
+            polar_fine.evaluations,
+            (polar_fine.value[0] - r).abs() / r
+        );
+        for rtol in [1e-6, 1e-9] {
+            for (name, p) in [("polar (planner's choice)", problem(&c, rtol)), ("Genz–Malik 7/5 forced", forced(rtol))]
+            {
+                let (f, secs, runs): (Flux, f64, usize) = timed(|| p.solve());
+                let _ = writeln!(
+                    md,
+                    "| {alpha:.0e} | {name}, rtol {rtol:.0e} | {:.10e} | {} | {} | {} | {} | {runs} |",
+                    f.value[0],
+                    fmt_e(f.error[0] / f.value[0]),
+                    fmt_e((f.value[0] - r).abs() / r),
+                    f.evaluations,
+                    fmt_time(secs),
+                );
+            }
+        }
+        let _ = writeln!(
+            md,
+            "| {alpha:.0e} | reference: forced partition, rtol 1e-11 | {r:.15e} | {} | polar at 1e-11: {} | {} | | |",
+            fmt_e(reference.error[0] / r),
+            fmt_e((polar_fine.value[0] - r).abs() / r),
+            reference.evaluations
+        );
+    }
+    let _ = writeln!(md, "\nLoad average at the end of this section {}.", loadavg());
 }
 
 /// Records, for every regular evaluation, the lobe coordinates (u, v) = (p_s + p_r, q_s + q_r) in units of

@@ -345,7 +345,7 @@ impl Brdf for WardDur2006 {
             slope_width: self.alpha,
             medium_eta: 1.0,
             label: "Ward–Dür 2006".into(),
-            heavy_tail: false,
+            tail: glossmeter::brdf::Tail::Gaussian,
         };
         vec![glossmeter::brdf::Term { label: "Ward–Dür 2006".into(), kind: TermKind::Lobe(lobe) }]
     }

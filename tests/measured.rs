@@ -486,7 +486,12 @@ impl Brdf for LobeFn {
         out.fill(Self::f(hd.theta_h, hd.theta_d));
     }
     fn terms(&self) -> Vec<glossmeter::brdf::Term> {
-        let l = glossmeter::brdf::Lobe { slope_width: 0.1, medium_eta: 1.0, label: "lobe".into(), heavy_tail: true };
+        let l = glossmeter::brdf::Lobe {
+            slope_width: 0.1,
+            medium_eta: 1.0,
+            label: "lobe".into(),
+            tail: glossmeter::brdf::Tail::Unknown,
+        };
         vec![glossmeter::brdf::Term { label: "lobe".into(), kind: TermKind::Lobe(l) }]
     }
     fn describe(&self) -> String {

@@ -432,7 +432,11 @@ fn rough_coat_energy_and_reciprocity() {
                 slope_width: alpha,
                 medium_eta: 1.0,
                 label: "clear coat".into(),
-                heavy_tail: dist == Distribution::Ggx
+                tail: if dist == Distribution::Ggx {
+                    glossmeter::brdf::Tail::InverseQuartic
+                } else {
+                    glossmeter::brdf::Tail::Gaussian
+                }
             })
         );
         for ti in [0.0, 20.0, 40.0, 60.0, 70.0, 80.0, 89.0] {

@@ -9,7 +9,7 @@
 //! `wi` points from the surface towards the source, `wo` towards the receptor; both are unit vectors with
 //! z > 0. `eval` returns the *regular* part of f_r in sr⁻¹ (no cosine factor); a delta component is reported
 //! separately by [`Brdf::delta_reflectance`].
-use crate::optics::microfacet::Microfacet;
+use crate::optics::microfacet::{Distribution, Microfacet};
 use crate::spectrum::Sampling;
 use crate::{Error, Result, Vec3};
 
@@ -36,18 +36,42 @@ pub struct Lobe {
     pub medium_eta: f64,
     /// Short label for `--explain`, e.g. "metallic flakes".
     pub label: String,
-    /// True if the lobe falls off slower than a Gaussian (GGX: ∝ u⁻⁴; a measured table: unknown). A
-    /// Gaussian-tailed lobe (Beckmann, Phong, Ward) is below e⁻¹⁰⁰ of its peak beyond 10 widths, so the
-    /// integrator stops splitting there; a heavy tail is split geometrically out to the ends of the range.
-    pub heavy_tail: bool,
+    /// How the lobe falls off far from its centre ([`Tail`]).
+    pub tail: Tail,
+}
+
+/// The tail of a lobe: how its value falls off with the distance u from the specular direction, in widths.
+/// The integrator places its split points and chooses its rule by it (`instrument::method`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Tail {
+    /// Gaussian (Beckmann, Phong, Ward, flakes): below e⁻¹⁰⁰ of its peak beyond 10 widths, so the integrator
+    /// stops splitting there.
+    Gaussian,
+    /// The GGX (Trowbridge–Reitz) tail, D ∝ α²/(α² + tan²θh)² (Walter et al. 2007, Eq. 33): ∝ u⁻⁴, and exactly
+    /// 1/(1 + ρ²)² in the scaled polar radius ρ, which the polar rule (`Rule::LobePolar`) maps to a polynomial.
+    InverseQuartic,
+    /// Heavier than a Gaussian in a way the model does not state (a measured table): split geometrically
+    /// out to the ends of the range, integrated by the adaptive partition.
+    Unknown,
+}
+
+impl Tail {
+    /// Whether the tail falls off slower than a Gaussian (split out to the ends of the range).
+    pub fn is_heavy(self) -> bool {
+        self != Tail::Gaussian
+    }
 }
 
 impl Lobe {
     /// The lobe of a microfacet distribution formed in a medium of index `medium_eta`: its width is the
-    /// roughness, its tail the distribution's own (`Microfacet::heavy_tail`). (It lives here rather than on
+    /// roughness, its tail the distribution's own (GGX: `Tail::InverseQuartic`, Beckmann: `Tail::Gaussian`). (It lives here rather than on
     /// `Microfacet` because `optics` sits below `brdf` and knows nothing of lobes.)
     pub fn of_facets(facets: &Microfacet, medium_eta: f64, label: String) -> Lobe {
-        Lobe { slope_width: facets.alpha, medium_eta, label, heavy_tail: facets.heavy_tail() }
+        let tail = match facets.distribution {
+            Distribution::Ggx => Tail::InverseQuartic,
+            Distribution::Beckmann => Tail::Gaussian,
+        };
+        Lobe { slope_width: facets.alpha, medium_eta, label, tail }
     }
 }
 

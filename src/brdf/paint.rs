@@ -925,7 +925,7 @@ impl Brdf for Paint {
                     slope_width: fl.facets.alpha,
                     medium_eta: medium,
                     label: fl.label.into(),
-                    heavy_tail: false,
+                    tail: super::Tail::Gaussian,
                 })
             };
             t.push(Term { label: fl.label.into(), kind });

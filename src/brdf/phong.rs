@@ -118,7 +118,7 @@ impl Brdf for Phong {
                 slope_width: self.equivalent_slope_width(),
                 medium_eta: 1.0,
                 label,
-                heavy_tail: false,
+                tail: super::Tail::Gaussian,
             }),
         });
         t

@@ -79,7 +79,7 @@ impl Brdf for Ward {
         let label = format!("Ward lobe (α = {})", self.alpha);
         t.push(Term {
             label: label.clone(),
-            kind: TermKind::Lobe(Lobe { slope_width: self.alpha, medium_eta: 1.0, label, heavy_tail: false }),
+            kind: TermKind::Lobe(Lobe { slope_width: self.alpha, medium_eta: 1.0, label, tail: super::Tail::Gaussian }),
         });
         t
     }

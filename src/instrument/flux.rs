@@ -122,8 +122,8 @@ pub fn lobe_splits(lobes: &[Lobe], theta: f64, source: Stop, receptor: Stop) -> 
     let ap = AxisMap { s: source.p, r: receptor.p };
     let aq = AxisMap { s: source.q, r: receptor.q };
     let widths: Vec<[f64; 2]> = lobes.iter().map(|l| lobe_widths_uv(l, theta)).collect();
-    let up = ap.splits(&widths.iter().zip(lobes).map(|(w, l)| (w[0], l.heavy_tail)).collect::<Vec<_>>());
-    let uq = aq.splits(&widths.iter().zip(lobes).map(|(w, l)| (w[1], l.heavy_tail)).collect::<Vec<_>>());
+    let up = ap.splits(&widths.iter().zip(lobes).map(|(w, l)| (w[0], l.tail.is_heavy())).collect::<Vec<_>>());
+    let uq = aq.splits(&widths.iter().zip(lobes).map(|(w, l)| (w[1], l.tail.is_heavy())).collect::<Vec<_>>());
     [up, uq]
 }
 
@@ -413,7 +413,12 @@ mod tests {
     }
 
     fn lobe(m: f64, eta: f64, heavy: bool) -> Lobe {
-        Lobe { slope_width: m, medium_eta: eta, label: "test".into(), heavy_tail: heavy }
+        Lobe {
+            slope_width: m,
+            medium_eta: eta,
+            label: "test".into(),
+            tail: if heavy { crate::brdf::Tail::InverseQuartic } else { crate::brdf::Tail::Gaussian },
+        }
     }
 
     /// The widths against a direct construction: tilt a flake by δ inside the medium (in the plane, then

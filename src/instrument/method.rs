@@ -16,14 +16,17 @@
 //! |Φ_r|) (+ the floor) as both parts are ≥ 0. The r·|Φ_δ| term needs the delta part's value, so it is the
 //! one quantity formed at run time (the smallest |Φ_δ| component, which keeps every component within its
 //! tolerance).
-use crate::brdf::{Brdf, Kink, Lobe, TermKind};
+use crate::brdf::{Brdf, Kink, Lobe, Tail, TermKind};
 use crate::instrument::flux::{
     choose_chart, clip, delta_kinks, half_angle_kink_point, incidence_kink_point, kinked_position, lobe_boxes,
     lobe_splits, lobe_widths_uv, mirror_overlap, regular_kinks, AxisMap, Chart, Flux, DELTA_SHARE,
 };
 use crate::instrument::geometry::{solid_angle_density, Axes, Integral, Stop};
 use crate::instrument::sphere;
-use crate::quadrature::{gauss_hermite, gauss_legendre, integrate_partition, Cell, Estimate, Options, Refine};
+use crate::quadrature::{
+    gauss_hermite, gauss_legendre, integrate_partition, legendre_on, mapped_legendre, polar_rectangle, Cell, Estimate,
+    Map, Options, Refine,
+};
 use crate::spectrum::Weighting;
 use crate::Vec3;
 use std::time::Instant;
@@ -54,7 +57,32 @@ pub enum Rule {
     /// `levels.0..=levels.1` until two successive levels agree to the part's tolerance (their difference is
     /// the error estimate). If none do, the part's Genz–Malik partition is integrated instead (the fallback).
     LobeGaussHermite { width: [f64; 2], levels: (usize, usize) },
+    /// A narrow lobe with GGX's heavy u⁻⁴ tail (`Tail::InverseQuartic`) whose centre lies inside the kink square (issue 10; [`polar_rule`]): the
+    /// (u, v) range is cut at the overlap kinks `u`, `v` (each axis: the range ends and the two kinks, in
+    /// increasing order) into up to 3 × 3 pieces. The piece that holds u = v = 0 is integrated in the polar
+    /// variables of `quadrature::polar_rectangle` scaled to the lobe's `width` (x = u/w_u = ρ cos φ,
+    /// y = v/w_v = ρ sin φ, ρ = tan β), every other piece by Gauss–Legendre in σ = 1/x along its tail
+    /// coordinate times Gauss–Legendre in y = c·tan γ across it (c = √(1 + x²), the kernel's width there;
+    /// `quadrature::Map`), all times Gauss–Legendre in t_p, t_q. Piece k reports its value at level `levels[k]` of [`POLAR_LEVELS`] /
+    /// [`TAIL_LEVELS`] and the difference from the level below as its error; the piece with the largest error
+    /// is raised until the sum meets the part's tolerance. If a piece runs out of levels, the part's
+    /// Genz–Malik partition is integrated instead (the fallback).
+    LobePolar { width: [f64; 2], u: [f64; 4], v: [f64; 4], levels: [u8; 9] },
 }
+
+/// The (φ nodes per sector, β nodes, t nodes per axis) of the polar piece of [`Rule::LobePolar`], level by
+/// level: 4·3·6·2² = 288 points, then 512, 1 152, 4 608, 18 432, 51 200.
+pub const POLAR_LEVELS: [(usize, usize, usize); 6] =
+    [(3, 6, 2), (4, 8, 2), (6, 12, 2), (8, 16, 3), (12, 24, 4), (16, 32, 5)];
+
+/// The (tail-axis nodes, cross-axis nodes, t nodes per axis) of a tail piece of [`Rule::LobePolar`], level by
+/// level: 3·3·2² = 36 points, then 64, 144, 576, 2 304, 6 400.
+pub const TAIL_LEVELS: [(usize, usize, usize); 6] =
+    [(3, 3, 2), (4, 4, 2), (6, 6, 2), (8, 8, 3), (12, 12, 4), (16, 16, 5)];
+
+/// How far (in lobe widths, on both axes and both sides) the overlap kinks must be from the lobe centre for
+/// [`Rule::LobePolar`]: the polar piece then holds the peak and the tail pieces only the tail.
+pub const POLAR_REACH: f64 = 2.0;
 
 /// The (Gauss–Hermite, Gauss–Legendre) orders per axis of [`Rule::LobeGaussHermite`], level by level:
 /// 4²·2² = 64 points, then 324, 1 024, 3 600, 9 216.
@@ -236,7 +264,9 @@ impl Method {
                 let share = 1.0 - DELTA_SHARE;
                 let rule = match chart {
                     Chart::Lobe if kinks.is_empty() && on_mirror_axis => {
-                        lobe_rule(d.lobes, d.has_diffuse, d.theta, src, rec).unwrap_or(Rule::GenzMalik75)
+                        lobe_rule(d.lobes, d.has_diffuse, d.theta, src, rec)
+                            .or_else(|| polar_rule(d.lobes, d.has_diffuse, d.theta, src, rec))
+                            .unwrap_or(Rule::GenzMalik75)
                     }
                     _ => Rule::GenzMalik75,
                 };
@@ -494,15 +524,17 @@ impl Method {
                 Rule::LobeGaussHermite { width, levels } => {
                     let r = lobe_gauss_hermite(&mut integrand, ncomp, width, levels, &opts, part.refine);
                     spent = r.1;
-                    r.0
+                    r.0.map(|(est, level)| (est, Rule::LobeGaussHermite { width, levels: (level - 1, level) }))
+                }
+                Rule::LobePolar { width, u, v, levels } => {
+                    let r = lobe_polar(&mut integrand, ncomp, width, [u, v], levels, &opts, part.refine);
+                    spent = r.1;
+                    r.0.map(|(est, levels)| (est, Rule::LobePolar { width, u, v, levels }))
                 }
                 Rule::GenzMalik75 => None,
             };
             let (mut est, cells, rule) = match shaped {
-                Some((est, level)) => {
-                    let Rule::LobeGaussHermite { width, .. } = part.rule else { unreachable!("shaped") };
-                    (est, part.cells.clone(), Rule::LobeGaussHermite { width, levels: (level - 1, level) })
-                }
+                Some((est, rule)) => (est, part.cells.clone(), rule),
                 None => {
                     let (est, cells) =
                         integrate_partition::<4, _>(&mut integrand, ncomp, &part.cells, &opts, part.refine, keep);
@@ -537,7 +569,7 @@ impl Method {
 /// [`LOBE_REACH`] widths from every kink of the overlap length and every end of the range, on both axes.
 pub fn lobe_rule(lobes: &[Lobe], has_diffuse: bool, theta: f64, src: Stop, rec: Stop) -> Option<Rule> {
     let [lobe] = lobes else { return None };
-    if has_diffuse || lobe.heavy_tail {
+    if has_diffuse || lobe.tail.is_heavy() {
         return None;
     }
     let width = lobe_widths_uv(lobe, theta);
@@ -622,6 +654,187 @@ fn lobe_gauss_hermite(
         previous = Some(now);
     }
     (None, evals)
+}
+
+/// The polar rule of a lobe-chart part, if one fits ([`Rule::LobePolar`]): a material whose regular part is
+/// one lobe with GGX's tail (`Tail::InverseQuartic`: not a measured table's unknown one, nor a lobe over a
+/// diffuse body; a Gaussian tail gets [`Rule::LobeGaussHermite`] or the partition, see
+/// `docs/instrument.md` §Quadrature) whose centre u = v = 0 is inside the range of the lobe variables and at least
+/// [`POLAR_REACH`] widths from every kink of the overlap length and every end of the range, on both axes.
+pub fn polar_rule(lobes: &[Lobe], has_diffuse: bool, theta: f64, src: Stop, rec: Stop) -> Option<Rule> {
+    let [lobe] = lobes else { return None };
+    if has_diffuse || lobe.tail != Tail::InverseQuartic {
+        return None;
+    }
+    let width = lobe_widths_uv(lobe, theta);
+    let breaks = |a: AxisMap, w: f64| {
+        let [lo, hi] = a.range();
+        let mut b = [lo, a.s[1] + a.r[0], a.s[0] + a.r[1], hi];
+        b.sort_by(f64::total_cmp);
+        let clear = w > 0.0 && w.is_finite() && lo < 0.0 && hi > 0.0 && b.iter().all(|k| k.abs() >= POLAR_REACH * w);
+        clear.then_some(b)
+    };
+    let u = breaks(AxisMap { s: src.p, r: rec.p }, width[0])?;
+    let v = breaks(AxisMap { s: src.q, r: rec.q }, width[1])?;
+    Some(Rule::LobePolar { width, u, v, levels: [1; 9] })
+}
+
+/// One piece of [`Rule::LobePolar`]: its u and v intervals, whether it holds the lobe centre (the polar
+/// piece), its level and its sums at that level and the one below.
+struct PolarPiece {
+    index: usize,
+    interval: [[f64; 2]; 2],
+    central: bool,
+    level: usize,
+    below: Vec<f64>,
+    at: Vec<f64>,
+}
+
+/// The points of a piece of [`Rule::LobePolar`] at one level, in the lobe chart's variables (u, t_p, v, t_q),
+/// with their weights, in a fixed order.
+fn polar_piece_points(width: [f64; 2], interval: [[f64; 2]; 2], central: bool, level: usize) -> Vec<([f64; 4], f64)> {
+    let [w0, w1] = width;
+    let scaled = [[interval[0][0] / w0, interval[0][1] / w0], [interval[1][0] / w1, interval[1][1] / w1]];
+    // (x, y, weight) in the scaled lobe variables x = u/w_u, y = v/w_v.
+    let (plane, nt) = if central {
+        let (nphi, nr, nt) = POLAR_LEVELS[level];
+        let lo = [scaled[0][0], scaled[1][0]];
+        let hi = [scaled[0][1], scaled[1][1]];
+        let nodes = polar_rectangle(lo, hi, nphi, nr, Map::Tan { scale: 1.0 });
+        (nodes.into_iter().map(|([x, y], w)| (x, y, w)).collect::<Vec<_>>(), nt)
+    } else {
+        // The tail coordinate is the axis whose interval does not hold 0 (the first when neither does): σ = 1/x
+        // along it; across it the kernel 1/(c² + y²)² (c² = 1 + x²) in y = c·tan γ.
+        let (no, ni, nt) = TAIL_LEVELS[level];
+        let outer = if scaled[0][0] < 0.0 && scaled[0][1] > 0.0 { 1 } else { 0 };
+        let inner = 1 - outer;
+        let (xo, wo) = mapped_legendre(no, scaled[outer][0], scaled[outer][1], Map::Reciprocal);
+        let mut plane = Vec::with_capacity(no * ni);
+        for (x, wx) in xo.iter().zip(&wo) {
+            let map = Map::Tan { scale: (1.0 + x * x).sqrt() };
+            let (y, wy) = mapped_legendre(ni, scaled[inner][0], scaled[inner][1], map);
+            for (y, wy) in y.iter().zip(&wy) {
+                plane.push(if outer == 0 { (*x, *y, wx * wy) } else { (*y, *x, wx * wy) });
+            }
+        }
+        (plane, nt)
+    };
+    let (tl, wl) = legendre_on(nt, 0.0, 1.0);
+    let mut out = Vec::with_capacity(plane.len() * nt * nt);
+    for (x, y, w) in plane {
+        for (tp, wp) in tl.iter().zip(&wl) {
+            for (tq, wq) in tl.iter().zip(&wl) {
+                out.push(([w0 * x, *tp, w1 * y, *tq], w * w0 * w1 * wp * wq));
+            }
+        }
+    }
+    out
+}
+
+/// The sum of a piece of [`Rule::LobePolar`] at one level, per component (non-finite values count as 0, as
+/// in [`lobe_tensor_sum`]).
+fn polar_piece_sum(f: &mut impl FnMut(&[[f64; 4]], &mut [f64]), ncomp: usize, points: &[([f64; 4], f64)]) -> Vec<f64> {
+    let pts: Vec<[f64; 4]> = points.iter().map(|(p, _)| *p).collect();
+    let mut vals = vec![0.0; pts.len() * ncomp];
+    f(&pts, &mut vals);
+    let mut sum = vec![0.0; ncomp];
+    for ((_, w), v) in points.iter().zip(vals.chunks_exact(ncomp)) {
+        for c in 0..ncomp {
+            if v[c].is_finite() {
+                sum[c] += w * v[c];
+            }
+        }
+    }
+    sum
+}
+
+/// Run [`Rule::LobePolar`]: every piece at its level and the one below; while the summed differences exceed
+/// max(atol, rtol·|I|) in some component, the piece with the largest difference (relative to that tolerance;
+/// the first on ties) goes one level up (adaptive; a frozen rule keeps its levels). Returns the estimate and
+/// the pieces' levels when the sum meets the tolerance, None when the piece to raise has no level left or the
+/// budget would be exceeded, and the evaluations spent either way.
+fn lobe_polar(
+    f: &mut impl FnMut(&[[f64; 4]], &mut [f64]),
+    ncomp: usize,
+    width: [f64; 2],
+    breaks: [[f64; 4]; 2],
+    levels: [u8; 9],
+    opts: &Options,
+    refine: Refine,
+) -> (Option<(Estimate, [u8; 9])>, usize) {
+    let mut evals = 0;
+    let mut pieces = Vec::new();
+    for i in 0..3 {
+        for j in 0..3 {
+            let interval = [[breaks[0][i], breaks[0][i + 1]], [breaks[1][j], breaks[1][j + 1]]];
+            if !(interval[0][1] > interval[0][0] && interval[1][1] > interval[1][0]) {
+                continue;
+            }
+            let holds = |a: [f64; 2]| a[0] < 0.0 && a[1] > 0.0;
+            let central = holds(interval[0]) && holds(interval[1]);
+            let top = if central { POLAR_LEVELS.len() } else { TAIL_LEVELS.len() } - 1;
+            let level = (levels[3 * i + j] as usize).clamp(1, top);
+            pieces.push(PolarPiece { index: 3 * i + j, interval, central, level, below: vec![], at: vec![] });
+        }
+    }
+    let mut run = |p: &PolarPiece, level: usize, evals: &mut usize| -> Option<Vec<f64>> {
+        let points = polar_piece_points(width, p.interval, p.central, level);
+        if *evals + points.len() > opts.max_evals {
+            return None;
+        }
+        *evals += points.len();
+        Some(polar_piece_sum(f, ncomp, &points))
+    };
+    for p in &mut pieces {
+        let Some(below) = run(p, p.level - 1, &mut evals) else { return (None, evals) };
+        let Some(at) = run(p, p.level, &mut evals) else { return (None, evals) };
+        p.below = below;
+        p.at = at;
+    }
+    loop {
+        let value: Vec<f64> = (0..ncomp).map(|c| pieces.iter().map(|p| p.at[c]).sum()).collect();
+        let error: Vec<f64> = (0..ncomp).map(|c| pieces.iter().map(|p| (p.at[c] - p.below[c]).abs()).sum()).collect();
+        let tol: Vec<f64> = value.iter().map(|v| opts.atol.max(opts.rtol * v.abs())).collect();
+        let converged = error.iter().zip(&tol).all(|(e, t)| e <= t);
+        if converged || refine == Refine::Frozen {
+            let mut reached = [1u8; 9];
+            for p in &pieces {
+                reached[p.index] = p.level as u8;
+            }
+            let regions = pieces.len();
+            let est = Estimate { value, error, evaluations: 0, regions, converged, out_of_time: false };
+            return (Some((est, reached)), evals);
+        }
+        let excess = |p: &PolarPiece| {
+            (0..ncomp)
+                .map(|c| {
+                    let e = (p.at[c] - p.below[c]).abs();
+                    if tol[c] > 0.0 {
+                        e / tol[c]
+                    } else if e > 0.0 {
+                        f64::INFINITY
+                    } else {
+                        0.0
+                    }
+                })
+                .fold(0.0, f64::max)
+        };
+        let mut worst = 0;
+        for k in 1..pieces.len() {
+            if excess(&pieces[k]) > excess(&pieces[worst]) {
+                worst = k;
+            }
+        }
+        let top = if pieces[worst].central { POLAR_LEVELS.len() } else { TAIL_LEVELS.len() } - 1;
+        if pieces[worst].level >= top {
+            return (None, evals);
+        }
+        let level = pieces[worst].level + 1;
+        let Some(at) = run(&pieces[worst], level, &mut evals) else { return (None, evals) };
+        let p = &mut pieces[worst];
+        p.below = std::mem::replace(&mut p.at, at);
+        p.level = level;
+    }
 }
 
 /// The initial boxes of a lobe chart with `kinks` kinks: every box cut on t_p into kinks + 1 equal pieces

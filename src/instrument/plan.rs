@@ -30,7 +30,7 @@ use crate::colorimetry::{cielab, Conditions};
 use crate::instrument::flux::{lobe_widths_uv, Chart, Flux, DELTA_SHARE};
 use crate::instrument::geometry::{ColourQuantity, Integral, ReadingSpec, Scale, Stop};
 pub use crate::instrument::method::Target;
-use crate::instrument::method::{Design, Method, Projection, Rule, LOBE_LEVELS, LOBE_REACH};
+use crate::instrument::method::{Design, Method, Projection, Rule, LOBE_LEVELS, LOBE_REACH, POLAR_LEVELS, POLAR_REACH};
 use crate::instrument::standards::{self, StandardGeometry};
 use crate::quadrature::Refine;
 use crate::spectrum::{Sampling, Weighting, WeightingKind};
@@ -757,8 +757,8 @@ impl Plan {
                      {}",
                     l.slope_width,
                     if l.medium_eta != 1.0 { format!(" inside a medium of index {}", l.medium_eta) } else { String::new() },
-                    if l.heavy_tail { ", heavy tail" } else { "" },
-                    if l.heavy_tail { "out to the ends of the range" } else { "out to 10× its width (Gaussian tail)" }
+                    if l.tail.is_heavy() { ", heavy tail" } else { "" },
+                    if l.tail.is_heavy() { "out to the ends of the range" } else { "out to 10× its width (Gaussian tail)" }
                 ),
             };
             s.push_str(&format!("  - {}: {how}\n", t.label));
@@ -923,6 +923,7 @@ fn describe_method(m: &Method, terms: &[Term]) -> String {
                 LOBE_REACH,
                 p.cells.len()
             ),
+            Rule::LobePolar { width, u, v, levels } => describe_polar(width, u, v, levels, p.cells.len()),
         };
         format!("{chart}, {rule}{}", frozen(p.refine))
     });
@@ -933,6 +934,39 @@ fn describe_method(m: &Method, terms: &[Term]) -> String {
         (true, Some(r)) => r,
         (false, Some(r)) => format!("{delta} + {r}"),
     }
+}
+
+/// [`Rule::LobePolar`] in words: the pieces, their rules, the levels (the designed ones, or a frozen method's).
+fn describe_polar(width: [f64; 2], u: [f64; 4], v: [f64; 4], levels: [u8; 9], boxes: usize) -> String {
+    let holds = |b: &[f64; 4], i: usize| b[i] < 0.0 && b[i + 1] > 0.0;
+    let mut tails = 0;
+    let mut central = 1;
+    let mut tail_levels = Vec::new();
+    for i in 0..3 {
+        for j in 0..3 {
+            if !(u[i + 1] > u[i] && v[j + 1] > v[j]) {
+                continue;
+            }
+            if holds(&u, i) && holds(&v, j) {
+                central = levels[3 * i + j];
+            } else {
+                tails += 1;
+                tail_levels.push(levels[3 * i + j].to_string());
+            }
+        }
+    }
+    format!(
+        "polar variables about the specular point in the kink square (x = u/{:.3e} = ρ cos φ, y = v/{:.3e} = \
+         ρ sin φ, ρ = tan β for GGX's tail; Gauss–Legendre in φ per sector and in ρ, level {central} of {}) + Gauss–Legendre on \
+         {tails} tail box(es) (in σ = 1/x along its tail coordinate × y = c·tan γ across it; levels {}) × Gauss–Legendre in (t_p, t_q); each piece raised until \
+         the summed differences of successive levels meet the tolerance (the lobe is ≥ {} widths from every \
+         overlap kink; fallback: Genz–Malik 7/5 on {boxes} initial box(es))",
+        width[0],
+        width[1],
+        POLAR_LEVELS.len() - 1,
+        if tail_levels.is_empty() { "none".to_string() } else { tail_levels.join(", ") },
+        POLAR_REACH,
+    )
 }
 
 /// The kinks of a part in words: ", <how> at θc = 19.72°, …" (empty without kinks).

@@ -532,7 +532,7 @@ impl Brdf for InPlaneBrdf {
                 slope_width: self.resolution_slope(),
                 medium_eta: 1.0,
                 label: format!("measured ({})", self.format),
-                heavy_tail: true,
+                tail: crate::brdf::Tail::Unknown,
             }),
         }]
     }

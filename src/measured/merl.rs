@@ -249,7 +249,7 @@ impl Brdf for MerlBrdf {
                 slope_width: self.resolution_slope(),
                 medium_eta: 1.0,
                 label,
-                heavy_tail: true,
+                tail: crate::brdf::Tail::Unknown,
             }),
         }]
     }

@@ -612,7 +612,7 @@ impl Brdf for RglBrdf {
                 slope_width: self.resolution_slope(),
                 medium_eta: 1.0,
                 label: "measured (RGL)".into(),
-                heavy_tail: true,
+                tail: crate::brdf::Tail::Unknown,
             }),
         }]
     }

@@ -10,7 +10,8 @@
 //! (d) a fixed, single-threaded order of work. The Rust crates looked at (bilby 0.3: scalar only, no initial
 //! split; scirs2-integrate: very heavy) offer none of (a)–(c) together, so the rule is implemented here
 //! (`genz_malik.rs`, tested against closed forms in its own test module). `gauss.rs` holds the crate's
-//! one-dimensional Gauss–Legendre and Gauss–Kronrod rules, `hermite.rs` the Gauss–Hermite rules of narrow lobes.
+//! one-dimensional Gauss–Legendre and Gauss–Kronrod rules, `hermite.rs` the Gauss–Hermite rules of narrow lobes, `polar.rs` the polar (ρ = tan β) and
+//! box product rules of narrow heavy-tailed lobes.
 //!
 //! The rule is Genz & Malik's degree-7 rule with an embedded degree-5 rule (A. C. Genz, A. A. Malik,
 //! "An adaptive algorithm for numerical integration over an n-dimensional rectangular region",
@@ -22,8 +23,10 @@
 mod gauss;
 mod genz_malik;
 mod hermite;
+mod polar;
 
 pub use gauss::{adaptive as gauss_kronrod_adaptive, gauss_legendre};
 pub use hermite::gauss_hermite;
+pub use polar::{legendre_on, mapped_legendre, polar_rectangle, Map};
 
 pub use genz_malik::{integrate, integrate_partition, pointwise, Cell, Estimate, Options, Refine, Rule};

@@ -43,7 +43,7 @@ impl Brdf for TestBeckmann {
                 slope_width: self.m,
                 medium_eta: 1.0,
                 label: "beckmann".into(),
-                heavy_tail: false,
+                tail: glossmeter::brdf::Tail::Gaussian,
             }),
         }]
     }

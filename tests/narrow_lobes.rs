@@ -1,0 +1,128 @@
+//! Issue 10, narrow lobes: the cost of a GGX or Beckmann lobe of roughness 1e-3 … 1e-8 at ASTM D523 20°
+//! (n = 1.5, the default rtol 1e-6) stops growing as the lobe narrows, the readings agree with the engine's
+//! own rtol-1e-10 values from before the polar rule (`fixtures/reference/narrow-lobes-d523-20.json`, with
+//! its provenance) within their estimates, and the plan names the rule it chose. Evaluation counts are exact
+//! and reproducible, so the cost targets are tests here; times are measured in `benches/integrators.rs`.
+use std::sync::Arc;
+
+use glossmeter::brdf::Brdf;
+use glossmeter::instrument::method::{Method, Rule};
+use glossmeter::instrument::plan::{Plan, PlanOptions, Reading};
+use glossmeter::instrument::standards;
+use serde_json::Value;
+
+const GEOMETRY: &str = "astm-d523-20";
+
+fn material(distribution: &str, roughness: f64) -> Arc<dyn Brdf> {
+    let text =
+        format!(r#"{{"model":"microfacet","distribution":"{distribution}","roughness":{roughness:e},"ior":1.5}}"#);
+    glossmeter::recipe::parse_str(&text, "<narrow>").unwrap().brdf
+}
+
+fn plan(distribution: &str, roughness: f64, rtol: f64) -> Plan {
+    let options = PlanOptions { rtol, max_seconds: None, ..PlanOptions::default() };
+    Plan::compile(material(distribution, roughness), vec![standards::find(GEOMETRY).unwrap()], options).unwrap()
+}
+
+fn gloss(distribution: &str, roughness: f64, rtol: f64) -> Reading {
+    plan(distribution, roughness, rtol).execute().into_iter().find(|r| r.quantity == "gloss").unwrap()
+}
+
+fn reference() -> Vec<(String, f64, f64, f64)> {
+    let text = std::fs::read_to_string("fixtures/reference/narrow-lobes-d523-20.json").unwrap();
+    let doc: Value = serde_json::from_str(&text).unwrap();
+    doc["readings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| {
+            let d = r["distribution"].as_str().unwrap().to_string();
+            (d, r["roughness"].as_f64().unwrap(), r["gloss"].as_f64().unwrap(), r["error_estimate"].as_f64().unwrap())
+        })
+        .collect()
+}
+
+const ROUGHNESS: [f64; 6] = [1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8];
+
+/// Every reading at the default rtol 1e-6, and GGX's at 1e-9 too, within its estimate (plus the reference's)
+/// of the reference; the estimate itself within the reading's tolerance.
+#[test]
+fn narrow_lobe_readings_agree_with_the_rtol_1e_10_reference_within_their_estimates() {
+    let stored = reference();
+    assert_eq!(stored.len(), 2 * ROUGHNESS.len());
+    for (d, m, value, estimate) in &stored {
+        for rtol in [1e-6, 1e-9] {
+            if rtol < 1e-6 && d != "ggx" {
+                continue;
+            }
+            let r = gloss(d, *m, rtol);
+            let v = r.value.unwrap();
+            assert!(r.converged, "{d} {m:e} at {rtol:e}");
+            let actual = (v - value).abs();
+            assert!(
+                actual <= r.error_estimate + estimate,
+                "{d} {m:e} at {rtol:e}: {v} vs {value}, estimate {}",
+                r.error_estimate
+            );
+            assert!(r.error_estimate <= rtol * v, "{d} {m:e} at {rtol:e}: estimate {}", r.error_estimate);
+        }
+    }
+}
+
+/// The issue's target: Beckmann and GGX cost at roughness 1e-8 within 1.5× of 1e-3. Below
+/// `Microfacet::SMOOTH_THRESHOLD` = 1e-7 the model itself is its delta limit (a 2-D integral), so the
+/// narrowest lobe actually integrated is 1e-7: it is held to the same target, and the counts from 1e-5 to
+/// 1e-7 are equal (nothing grows with 1/α any more).
+#[test]
+fn the_cost_stops_growing_as_the_lobe_narrows() {
+    for d in ["ggx", "beckmann"] {
+        let counts: Vec<usize> = ROUGHNESS.iter().map(|m| gloss(d, *m, 1e-6).evaluations).collect();
+        let at = |m: f64| counts[ROUGHNESS.iter().position(|x| *x == m).unwrap()];
+        assert!(at(1e-8) as f64 <= 1.5 * at(1e-3) as f64, "{d}: {counts:?}");
+        assert!(at(1e-7) as f64 <= 1.5 * at(1e-3) as f64, "{d}: {counts:?}");
+        assert!(at(1e-5) == at(1e-6) && at(1e-6) == at(1e-7), "{d}: {counts:?}");
+        // GGX far below the partition's 28 k – 85 k before the polar rule (Beckmann 1e-3 is still the
+        // partition's: its lobe is too close to the kinks for Gauss–Hermite, and the polar rule is GGX's).
+        if d == "ggx" {
+            assert!(counts.iter().all(|c| *c <= 5_000), "{d}: {counts:?}");
+        }
+    }
+}
+
+/// `--explain` names the rule of each integral: polar for narrow GGX; Gauss–Hermite for a narrow Beckmann
+/// lobe; the partition for a wide lobe and for a Beckmann lobe too close to the overlap kinks.
+#[test]
+fn the_plan_names_the_polar_rule() {
+    let polar = "polar variables about the specular point";
+    for (d, m, named) in [("ggx", 1e-5, true), ("ggx", 1e-3, true), ("beckmann", 1e-3, false), ("ggx", 1e-2, false)] {
+        let text = plan(d, m, 1e-6).explain();
+        assert_eq!(text.contains(polar), named, "{d} {m:e}:\n{text}");
+        if named && d == "ggx" {
+            assert!(text.contains("ρ = tan β") && text.contains("σ = 1/x"), "{text}");
+        }
+    }
+    let text = plan("beckmann", 1e-5, 1e-6).explain();
+    assert!(text.contains("Gauss–Hermite") && !text.contains(polar), "{text}");
+}
+
+/// A frozen polar method keeps the levels its pieces reached and repeats the adaptive run's bits; on a nearby
+/// material it runs the same points (the same evaluations).
+#[test]
+fn a_frozen_polar_method_repeats_its_bits() {
+    let g = standards::find(GEOMETRY).unwrap().geometry;
+    let rec = g.receptor("gloss").copied().unwrap();
+    let brdf = material("ggx", 1e-3);
+    let method = Method::for_material(brdf.as_ref(), g.theta, g.source, rec, (1e-6, 0.0), 50_000_000).unwrap();
+    let rule = method.regular.as_ref().unwrap().rule;
+    assert!(matches!(rule, Rule::LobePolar { levels, .. } if levels == [1; 9]), "{rule:?}");
+    let (flux, frozen) = method.execute_and_freeze(brdf.as_ref());
+    assert!(flux.converged);
+    let Rule::LobePolar { levels, .. } = frozen.regular.as_ref().unwrap().rule else { panic!("kept") };
+    assert!(levels.iter().any(|l| *l > 1), "{levels:?}");
+    let again = frozen.execute(brdf.as_ref());
+    assert_eq!(again.value, flux.value);
+    assert_eq!(again.error, flux.error);
+    let near = frozen.execute(material("ggx", 1.01e-3).as_ref());
+    assert_eq!(near.evaluations, again.evaluations);
+    assert!(near.value != again.value && (near.value[0] / flux.value[0] - 1.0).abs() < 1e-3);
+}
