@@ -1,12 +1,13 @@
 //! Many recipes measured in one process: the recipe files of a list of files and directories, each read
-//! through the same geometries, in parallel over recipes (and, within each recipe, over its integrals). One
-//! integral always runs on one thread, so every reading is the same bits whatever the thread count or the
+//! through the same geometries, in parallel: the plans are compiled in parallel by one [`Planner`], then the
+//! integrals of all of them run as one flat parallel loop ([`Plan::run_all`]). One integral always runs on
+//! one thread, so every reading is the same bits whatever the thread count or the
 //! number of recipes measured together (tests/sheets.rs compares a batch with one-by-one runs).
 use std::path::{Path, PathBuf};
 
 use rayon::prelude::*;
 
-use crate::instrument::plan::{Execution, Plan, PlanOptions, Reading};
+use crate::instrument::plan::{Execution, Plan, PlanOptions, Planner, Reading};
 use crate::instrument::standards::StandardGeometry;
 use crate::recipe::{self, Material};
 use crate::{Error, Result};
@@ -59,8 +60,12 @@ pub fn run_many(
     geometries: &[StandardGeometry],
     options: &PlanOptions,
 ) -> Result<Vec<Execution>> {
-    materials
+    // One planner for the batch: the gloss standards' fluxes, which do not depend on the material, are
+    // computed once rather than once per recipe (a cached flux is the same bits as a recomputed one).
+    let planner = Planner::new()?;
+    let plans: Vec<Plan> = materials
         .par_iter()
-        .map(|m| Ok(Plan::compile(m.brdf.clone(), geometries.to_vec(), options.clone())?.run()))
-        .collect()
+        .map(|m| planner.compile(m.brdf.clone(), geometries.to_vec(), options.clone()))
+        .collect::<Result<_>>()?;
+    Ok(Plan::run_all(&plans))
 }

@@ -10,8 +10,9 @@
 //!   point list is ever stored and any point can be computed alone.
 //! * **Shards are contiguous index ranges** `[⌊(K−1)·P/M⌋, ⌊K·P/M⌋)`, so the shards' outputs, concatenated in order,
 //!   are the unsharded output byte for byte (the CSV header is written by shard 1 only).
-//! * **Streaming**: points run in parallel in chunks and are written in index order as each chunk ends, so
-//!   memory does not grow with the number of points.
+//! * **Streaming**: points run in parallel in chunks (their plans compiled in parallel, then all their
+//!   integrals in one flat parallel loop) and are written in index order as each chunk ends, so memory does
+//!   not grow with the number of points.
 //! * **An invalid point is a row**, with the recipe's error in its `problem` column, not a failure of the sweep.
 use std::ops::Range;
 use std::time::Instant;
@@ -19,9 +20,14 @@ use std::time::Instant;
 use rayon::prelude::*;
 use serde_json::{json, Value};
 
-use crate::instrument::plan::{Plan, PlanOptions, Reading};
+use crate::instrument::method::Target;
+use crate::instrument::plan::{Execution, Plan, PlanOptions, Planner, Reading};
 use crate::instrument::standards::StandardGeometry;
 use crate::{recipe, registry, Error, Result};
+
+/// Points per thread in one chunk of [`Sweep::run`]: the rows of a chunk are kept until it ends (constant
+/// memory: a few hundred rows), and each chunk ends with at most one integral running alone per thread.
+const CHUNK_PER_THREAD: u64 = 64;
 
 /// One varied parameter: a JSON Pointer into the template, its range and (for a grid) its number of values.
 #[derive(Clone, Debug, PartialEq)]
@@ -264,28 +270,74 @@ impl Sweep {
     /// Measure point i: the template with the point's values, validated and read through the geometries.
     pub fn run_point(&self, i: u64) -> PointResult {
         let start = Instant::now();
+        let (values, plan) = self.plan_point(i, &Planner::new().expect("the builtin geometries parse"));
+        let outcome = plan.map(|p| p.execute());
+        PointResult { index: i, values, outcome, seconds: start.elapsed().as_secs_f64() }
+    }
+
+    /// The values of point i and its plan (or the recipe's error, as text for the row).
+    fn plan_point(&self, i: u64, planner: &Planner) -> (Vec<f64>, std::result::Result<Plan, String>) {
         let values = self.point(i);
         let mut recipe_json = self.template.clone();
         for (a, v) in self.axes.iter().zip(&values) {
             set(&mut recipe_json, &a.path, json!(v));
         }
         let name = format!("{} [point {i}]", self.file);
-        let outcome = recipe::parse_str(&recipe_json.to_string(), &name)
-            .and_then(|m| Plan::compile(m.brdf, self.geometries.clone(), self.options.clone()))
-            .map(|plan| plan.execute())
+        let plan = recipe::parse_str(&recipe_json.to_string(), &name)
+            .and_then(|m| planner.compile(m.brdf, self.geometries.clone(), self.options.clone()))
             .map_err(|e| e.to_string());
-        PointResult { index: i, values, outcome, seconds: start.elapsed().as_secs_f64() }
+        (values, plan)
     }
 
-    /// Run the points of `range` in parallel, in chunks, handing each result to `sink` in index order.
+    /// Run the points of `range` in parallel, in chunks, handing each result to `sink` in index order. In
+    /// each chunk the points' plans are compiled in parallel (one [`Planner`] for the whole run, so the gloss
+    /// standards' fluxes are computed once), then every integral of every plan runs in one flat parallel
+    /// loop ([`Plan::run_all`]): the threads balance integrals, not points, and a chunk ends within one
+    /// integral on every thread. A point's `seconds` is its parsing and planning time plus the wall time of
+    /// its integrals.
     pub fn run(&self, range: Range<u64>, mut sink: impl FnMut(PointResult) -> Result<()>) -> Result<()> {
-        let chunk = 16 * rayon::current_num_threads().max(1) as u64;
+        let planner = Planner::new()?;
+        let chunk = CHUNK_PER_THREAD * rayon::current_num_threads().max(1) as u64;
         let mut start = range.start;
         while start < range.end {
             let end = (start + chunk).min(range.end);
-            let results: Vec<PointResult> = (start..end).into_par_iter().map(|i| self.run_point(i)).collect();
-            for r in results {
-                sink(r)?;
+            let planned: Vec<(Vec<f64>, std::result::Result<Plan, String>, f64)> = (start..end)
+                .into_par_iter()
+                .map(|i| {
+                    let t = Instant::now();
+                    let (values, plan) = self.plan_point(i, &planner);
+                    (values, plan, t.elapsed().as_secs_f64())
+                })
+                .collect();
+            let mut rows = Vec::with_capacity(planned.len());
+            let mut plans = Vec::new();
+            for (values, plan, planning) in planned {
+                let planned_ok = match plan {
+                    Ok(p) => {
+                        plans.push(p);
+                        Ok(plans.len() - 1)
+                    }
+                    Err(m) => Err(m),
+                };
+                rows.push((values, planned_ok, planning));
+            }
+            let mut runs: Vec<Option<Execution>> = Plan::run_all(&plans).into_iter().map(Some).collect();
+            for ((values, planned_ok, planning), i) in rows.into_iter().zip(start..end) {
+                let (outcome, seconds) = match planned_ok {
+                    Ok(k) => {
+                        let e = runs[k].take().expect("one execution per plan");
+                        let integrals: f64 = plans[k]
+                            .jobs
+                            .iter()
+                            .zip(&e.fluxes)
+                            .filter(|(j, _)| j.method.target == Target::Specimen)
+                            .map(|(_, f)| f.seconds)
+                            .sum();
+                        (Ok(e.readings), planning + integrals)
+                    }
+                    Err(m) => (Err(m), planning),
+                };
+                sink(PointResult { index: i, values, outcome, seconds })?;
             }
             start = end;
         }

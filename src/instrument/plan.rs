@@ -683,6 +683,48 @@ impl Plan {
         Execution { readings: self.readings_from(&fluxes), fluxes }
     }
 
+    /// Execute several plans as one pool of integrals: every specimen integral of every plan is one task of a
+    /// single flat parallel loop, so the thread pool balances integrals, not plans. A batch of plans whose
+    /// costs differ a hundredfold, each with one or two integrals that dominate it, then ends within one
+    /// integral on every thread; running plan after plan, each with its own parallel loop over its integrals
+    /// ([`Plan::run`] inside a parallel loop over plans), nests two loops whose inner one (14 integrals of
+    /// 6–20 µs for most recipes) costs more in hand-overs than it spreads, and ends when the last plan's
+    /// dominant integral does (docs/performance.md §Batch and sweep throughput). Each execution is the same
+    /// bits as [`Plan::run`] of that plan alone (each integral is the same method on the same material, on
+    /// one thread); each plan's wall-clock budget starts when its first integral does.
+    pub fn run_all(plans: &[Plan]) -> Vec<Execution> {
+        let tasks: Vec<(usize, usize)> = plans
+            .iter()
+            .enumerate()
+            .flat_map(|(p, plan)| plan.specimen_jobs().into_iter().map(move |j| (p, j)))
+            .collect();
+        let deadlines: Vec<std::sync::OnceLock<Option<std::time::Instant>>> =
+            plans.iter().map(|_| std::sync::OnceLock::new()).collect();
+        // One task per leaf (`with_max_len(1)`): an idle thread can always take the next integral, however
+        // the range was split.
+        let computed: Vec<Flux> = tasks
+            .par_iter()
+            .with_max_len(1)
+            .map(|&(p, j)| {
+                let plan = &plans[p];
+                let deadline = *deadlines[p].get_or_init(|| plan.deadline());
+                plan.jobs[j].method.execute_until(plan.material.as_ref(), deadline)
+            })
+            .collect();
+        let mut flux: Vec<Vec<Option<Flux>>> = plans.iter().map(Plan::known_fluxes).collect();
+        for (&(p, j), f) in tasks.iter().zip(computed) {
+            flux[p][j] = Some(f);
+        }
+        plans
+            .iter()
+            .zip(flux)
+            .map(|(plan, fl)| {
+                let fluxes: Vec<Flux> = fl.into_iter().map(|f| f.expect("every job ran")).collect();
+                Execution { readings: plan.readings_from(&fluxes), fluxes }
+            })
+            .collect()
+    }
+
     /// The jobs to run on the material, in plan order. Only these go to the thread pool: a plan with one
     /// specimen integral runs it on the calling thread (rayon runs a one-item parallel iterator in place),
     /// which spares a one-off small plan the hand-over to the pool and back (tens of µs).
