@@ -100,3 +100,57 @@ fn cerulean_blue_a_is_bitwise_reproducible_across_thread_counts() {
 fn cerulean_blue_c_is_bitwise_reproducible_across_thread_counts() {
     check(recipe("cerulean-blue-c.json"), "cerulean-blue-c");
 }
+
+/// Issue 12 item 5: running many plans as one flat loop of integrals (`Plan::run_all`, behind the batch
+/// `measure` and `sweep`) gives every plan the bits of its own `Plan::run`, fluxes included, on 1, 2 and 4
+/// threads; and a batch through one shared planner (`batch::measure_many`) the bits of one-by-one plans.
+#[test]
+fn many_plans_in_one_flat_loop_give_each_plans_own_bits() {
+    let brdfs: Vec<Arc<dyn Brdf>> = vec![
+        recipe("cerulean-blue-a.json"),
+        Arc::new(TestBeckmann { m: 1e-3, n: 1.5, s: Sampling::rgb() }),
+        Arc::new(TestBeckmann { m: 0.1, n: 1.5, s: Sampling::rgb() }),
+        recipe("cerulean-blue-c.json"),
+    ];
+    let opts = PlanOptions { rtol: 1e-6, ..Default::default() };
+    let plans: Vec<Plan> = brdfs.iter().map(|b| Plan::compile(b.clone(), panel(), opts.clone()).unwrap()).collect();
+    let flux_bits = |e: &glossmeter::instrument::plan::Execution| -> Vec<(Vec<u64>, Vec<u64>, usize, bool)> {
+        e.fluxes
+            .iter()
+            .map(|f| {
+                (
+                    f.value.iter().map(|v| v.to_bits()).collect(),
+                    f.error.iter().map(|v| v.to_bits()).collect(),
+                    f.evaluations,
+                    f.converged,
+                )
+            })
+            .collect()
+    };
+    let alone: Vec<_> = plans.iter().map(|p| p.run()).collect();
+    for k in [1, 2, 4] {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(k).build().unwrap();
+        let all = pool.install(|| Plan::run_all(&plans));
+        assert_eq!(all.len(), plans.len());
+        for (i, (a, b)) in alone.iter().zip(&all).enumerate() {
+            assert_eq!(bits(&a.readings), bits(&b.readings), "plan {i} on {k} thread(s): readings differ");
+            assert_eq!(flux_bits(a), flux_bits(b), "plan {i} on {k} thread(s): fluxes differ");
+        }
+        let materials: Vec<glossmeter::recipe::Material> =
+            ["cerulean-blue-a.json", "rgb-lambert.json", "cerulean-blue-c.json"]
+                .iter()
+                .map(|n| {
+                    glossmeter::recipe::load_file(
+                        &Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/recipes").join(n),
+                    )
+                    .unwrap()
+                })
+                .collect();
+        let batch = pool.install(|| glossmeter::batch::measure_many(&materials, &panel(), &opts)).unwrap();
+        for (m, rs) in materials.iter().zip(&batch) {
+            let one = Plan::compile(m.brdf.clone(), panel(), opts.clone()).unwrap().execute();
+            assert_eq!(bits(&one), bits(rs), "{} in a batch on {k} thread(s)", m.name);
+        }
+    }
+    assert_eq!(Plan::run_all(&[]).len(), 0);
+}

@@ -247,3 +247,32 @@ fn the_progress_bar_is_drawn_on_a_terminal_only() {
     assert_eq!(std::fs::read(&on_tty).unwrap(), std::fs::read(&plain).unwrap());
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// A sweep's rows (plans compiled in parallel by one planner, integrals in one flat loop per chunk) are
+/// those of its points measured one by one, an invalid point included, on 1 and 2 threads.
+#[test]
+fn sweep_rows_are_those_of_points_run_alone() {
+    use glossmeter::instrument::plan::PlanOptions;
+    use glossmeter::sweep::{parse_vary, Design, Sweep};
+    let template: serde_json::Value =
+        serde_json::from_str(r#"{"model": "microfacet", "distribution": "ggx", "roughness": 0.1, "ior": 1.5}"#)
+            .unwrap();
+    let geos = glossmeter::resolve_geometries(&["astm-d523-20", "astm-e430-30"], &[] as &[&str]).unwrap();
+    let axes = vec![parse_vary("/roughness=-0.05..0.5:12").unwrap()];
+    let opts = PlanOptions { rtol: 1e-5, ..Default::default() };
+    let s = Sweep::new(template, "t.json", axes, Design::Grid, geos, opts).unwrap();
+    let alone: String = (0..s.len()).map(|i| s.csv_row(&s.run_point(i), false)).collect();
+    assert!(alone.contains("out of range"), "point 0 is invalid: {alone}");
+    for k in [1, 2] {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(k).build().unwrap();
+        let mut rows = String::new();
+        pool.install(|| {
+            s.run(0..s.len(), |r| {
+                rows.push_str(&s.csv_row(&r, false));
+                Ok(())
+            })
+        })
+        .unwrap();
+        assert_eq!(rows, alone, "{k} thread(s)");
+    }
+}
