@@ -24,8 +24,8 @@ use crate::instrument::flux::{
 use crate::instrument::geometry::{solid_angle_density, Axes, Integral, Stop};
 use crate::instrument::sphere;
 use crate::quadrature::{
-    gauss_hermite, gauss_legendre, integrate_partition, legendre_on, mapped_legendre, polar_rectangle, Cell, Estimate,
-    Map, Options, Refine,
+    gauss_hermite, gauss_legendre, integrate_partition, legendre_on, mapped_legendre, polar_rectangle, tensor, Cell,
+    Estimate, Map, Options, Refine,
 };
 use crate::spectrum::Weighting;
 use crate::Vec3;
@@ -68,6 +68,15 @@ pub enum Rule {
     /// is raised until the sum meets the part's tolerance. If a piece runs out of levels, the part's
     /// Genz–Malik partition is integrated instead (the fallback).
     LobePolar { width: [f64; 2], u: [f64; 4], v: [f64; 4], levels: [u8; 9] },
+    /// A smooth integrand (issue 10: no lobe much narrower than the stops, no Fresnel kink): the anisotropic
+    /// tensor Gauss–Legendre rule of `quadrature::tensor` with the same per-axis orders on every box of
+    /// `chart`'s kink partition ([`tensor_boxes`]: the one box of the stops' product in the plain chart, the
+    /// boxes between the overlap kinks of u and v in the lobe chart), the orders `tensor::ORDERS[levels[k]]`
+    /// raised one axis at a time (up to [`TENSOR_MAX_LEVEL`]) until the sum of the per-axis differences of
+    /// successive orders (the error estimate) meets the part's tolerance. If they do not, the part's
+    /// Genz–Malik partition is integrated instead (the fallback). `path` is empty when designed; a frozen
+    /// method keeps the raises of its run and replays them (the same points, the same bits).
+    TensorGauss { chart: TensorChart, levels: [usize; 4], path: tensor::Path },
 }
 
 /// The (φ nodes per sector, β nodes, t nodes per axis) of the polar piece of [`Rule::LobePolar`], level by
@@ -83,6 +92,37 @@ pub const TAIL_LEVELS: [(usize, usize, usize); 6] =
 /// How far (in lobe widths, on both axes and both sides) the overlap kinks must be from the lobe centre for
 /// [`Rule::LobePolar`]: the polar piece then holds the peak and the tail pieces only the tail.
 pub const POLAR_REACH: f64 = 2.0;
+
+/// The variables of [`Rule::TensorGauss`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TensorChart {
+    /// (p_s, q_s, p_r, q_r) on the one box of the stops' product.
+    Plain,
+    /// (u, t_p, v, t_q) on the boxes between the overlap kinks of u and v.
+    Lobe,
+    /// (p_s, p_r, v, t_q): plain in the plane of incidence, lobe variables across it, on the boxes between
+    /// the overlap kinks of v (a lobe wider than the stops in u but not in v: the ridge v = q_s + q_r
+    /// becomes an axis).
+    PlainPLobeQ,
+}
+
+/// The highest level of [`Rule::TensorGauss`] an axis may reach (`tensor::ORDERS[TENSOR_MAX_LEVEL]` = 24
+/// points): beyond it the integrand is not smooth at the scale of the box and the fallback does better.
+pub const TENSOR_MAX_LEVEL: usize = 9;
+
+/// [`Rule::TensorGauss`] is chosen ([`smooth_rule`]) when every lobe is at least [`TENSOR_MIN_WIDTH_U`]
+/// times the u-range wide (smooth in the plane of incidence) and between [`TENSOR_MIN_WIDTH`] and
+/// [`TENSOR_MAX_WIDTH_V`] of the v-range (a lobe the v axis must resolve, but not so narrow that its order
+/// passes [`TENSOR_MAX_LEVEL`]). The bounds are where the rule was measured to cost fewer evaluations than the
+/// calibrated Genz–Malik partition on the shipped fixtures (`docs/instrument.md` §Quadrature): B4's GGX
+/// α = 0.3 at 85° (7.2 × the u-range, 0.35 of the v-range) 2 159 against 2 639; it cost more at every
+/// other wide-lobe integral tried (B4 at 75°: 2.9 and 0.63, 2 204 against 986; GGX α = 0.3 conductor at
+/// 60°: 4.5 and 0.81, 3 023 against 872; Blinn–Phong at 20°: 2.0 and 0.79, 1 574 against 530).
+pub const TENSOR_MIN_WIDTH: f64 = 0.25;
+/// See [`TENSOR_MIN_WIDTH`].
+pub const TENSOR_MAX_WIDTH_V: f64 = 0.5;
+/// See [`TENSOR_MIN_WIDTH`].
+pub const TENSOR_MIN_WIDTH_U: f64 = 4.0;
 
 /// The (Gauss–Hermite, Gauss–Legendre) orders per axis of [`Rule::LobeGaussHermite`], level by level:
 /// 4²·2² = 64 points, then 324, 1 024, 3 600, 9 216.
@@ -266,6 +306,7 @@ impl Method {
                     Chart::Lobe if kinks.is_empty() && on_mirror_axis => {
                         lobe_rule(d.lobes, d.has_diffuse, d.theta, src, rec)
                             .or_else(|| polar_rule(d.lobes, d.has_diffuse, d.theta, src, rec))
+                            .or_else(|| smooth_rule(d.lobes, d.theta, src, rec))
                             .unwrap_or(Rule::GenzMalik75)
                     }
                     _ => Rule::GenzMalik75,
@@ -468,15 +509,20 @@ impl Method {
         if let Some(part) = &self.regular {
             let ap = AxisMap { s: src.p, r: rec.p };
             let aq = AxisMap { s: src.q, r: rec.q };
-            let plain = part.chart == Chart::Plain;
+            // The chart the integrand is evaluated in: the part's, or the shaped rule's while it runs.
+            let part_vars = if part.chart == Chart::Plain { TensorChart::Plain } else { TensorChart::Lobe };
+            let vars = std::cell::Cell::new(part_vars);
             let delta_min = flux.delta.iter().map(|d| d.abs()).fold(f64::INFINITY, f64::min);
             let atol = part.atol.max(part.rtol * delta_min);
             let mut batch = PairBatch::default();
             let mut integrand = |pts: &[[f64; 4]], out: &mut [f64]| {
                 batch.clear(pts.len());
                 for (i, x) in pts.iter().enumerate() {
-                    let (ps, qs, pr, qr, jac) = if plain {
+                    let (ps, qs, pr, qr, jac) = if vars.get() == TensorChart::Plain {
                         (x[0], x[1], x[2], x[3], 1.0)
+                    } else if vars.get() == TensorChart::PlainPLobeQ {
+                        let (qs, qr, jq) = aq.at(x[2], x[3]);
+                        (x[0], qs, x[1], qr, jq)
                     } else if part.kinks.is_empty() {
                         let (ps, pr, jp) = ap.at(x[0], x[1]);
                         let (qs, qr, jq) = aq.at(x[2], x[3]);
@@ -531,6 +577,15 @@ impl Method {
                     spent = r.1;
                     r.0.map(|(est, levels)| (est, Rule::LobePolar { width, u, v, levels }))
                 }
+                Rule::TensorGauss { chart, levels, path } => {
+                    vars.set(chart);
+                    let replay = (part.refine == Refine::Frozen).then_some(path);
+                    let boxes = tensor_boxes(chart, src, rec);
+                    let r = tensor_gauss(&mut integrand, ncomp, chart, boxes, levels, &opts, replay);
+                    vars.set(part_vars);
+                    spent = r.1;
+                    r.0
+                }
                 Rule::GenzMalik75 => None,
             };
             let (mut est, cells, rule) = match shaped {
@@ -549,7 +604,11 @@ impl Method {
             flux.regions += est.regions;
             flux.converged &= est.converged;
             flux.out_of_time |= est.out_of_time;
-            flux.chart = Some(part.chart);
+            flux.chart = Some(match rule {
+                Rule::TensorGauss { chart: TensorChart::Plain, .. } => Chart::Plain,
+                Rule::TensorGauss { .. } => Chart::Lobe,
+                _ => part.chart,
+            });
             if let Some(m) = frozen.as_mut() {
                 let p = m.regular.as_mut().expect("the same parts");
                 p.cells = cells;
@@ -580,6 +639,85 @@ pub fn lobe_rule(lobes: &[Lobe], has_diffuse: bool, theta: f64, src: Stop, rec: 
     };
     let fits = clear(AxisMap { s: src.p, r: rec.p }, width[0]) && clear(AxisMap { s: src.q, r: rec.q }, width[1]);
     fits.then_some(Rule::LobeGaussHermite { width, levels: (0, LOBE_LEVELS.len() - 1) })
+}
+
+/// The smooth-integrand rule of a lobe-chart part without kinks, if it fits: [`Rule::TensorGauss`] in the
+/// variables (p_s, p_r, v, t_q) ([`TensorChart::PlainPLobeQ`]: plain in the plane of incidence, where the
+/// lobe is far wider than the stops, the lobe variable across it, where the ridge v = q_s + q_r becomes an
+/// axis) within the bounds of [`TENSOR_MIN_WIDTH`] (B4's GGX α = 0.3 at 85°: 0.6 wide in u against a u-range
+/// of 0.083, 0.052 in v against 0.15). The levels start at 1 (2 points) on every axis.
+pub fn smooth_rule(lobes: &[Lobe], theta: f64, src: Stop, rec: Stop) -> Option<Rule> {
+    let range = [(src.p[1] - src.p[0]) + (rec.p[1] - rec.p[0]), (src.q[1] - src.q[0]) + (rec.q[1] - rec.q[0])];
+    let fits = |l: &Lobe| {
+        let w = lobe_widths_uv(l, theta);
+        w.iter().all(|w| w.is_finite())
+            && w[0] >= TENSOR_MIN_WIDTH_U * range[0]
+            && (TENSOR_MIN_WIDTH * range[1]..=TENSOR_MAX_WIDTH_V * range[1]).contains(&w[1])
+    };
+    if lobes.is_empty() || !lobes.iter().all(fits) {
+        return None;
+    }
+    Some(Rule::TensorGauss { chart: TensorChart::PlainPLobeQ, levels: [1; 4], path: tensor::Path::default() })
+}
+
+/// The boxes of [`Rule::TensorGauss`] in its chart's variables: the stops' product (p_s, q_s, p_r, q_r) in the
+/// plain chart; in the lobe chart (u, t_p, v, t_q) the products of the intervals between the range ends and
+/// the overlap kinks s₁ + r₀, s₀ + r₁ of u and of v (where the overlap length is linear), t ∈ [0, 1].
+pub fn tensor_boxes(chart: TensorChart, src: Stop, rec: Stop) -> Vec<([f64; 4], [f64; 4])> {
+    let kinks = |a: AxisMap| {
+        let [lo, hi] = a.range();
+        let mut x = vec![lo, hi, a.s[1] + a.r[0], a.s[0] + a.r[1]];
+        x.retain(|x| *x >= lo && *x <= hi);
+        x.sort_by(f64::total_cmp);
+        x.dedup_by(|a, b| (*a - *b).abs() <= 1e-14 * (hi - lo));
+        x
+    };
+    match chart {
+        TensorChart::Plain => {
+            vec![([src.p[0], src.q[0], rec.p[0], rec.q[0]], [src.p[1], src.q[1], rec.p[1], rec.q[1]])]
+        }
+        TensorChart::Lobe => {
+            lobe_boxes(&[kinks(AxisMap { s: src.p, r: rec.p }), kinks(AxisMap { s: src.q, r: rec.q })])
+        }
+        TensorChart::PlainPLobeQ => kinks(AxisMap { s: src.q, r: rec.q })
+            .windows(2)
+            .map(|v| ([src.p[0], rec.p[0], v[0], 0.0], [src.p[1], rec.p[1], v[1], 1.0]))
+            .collect(),
+    }
+}
+
+/// Run [`Rule::TensorGauss`]: the estimate and the rule with its path of raises when the orders converged (or
+/// the path was replayed), else None; and the evaluations spent either way.
+fn tensor_gauss(
+    f: &mut impl FnMut(&[[f64; 4]], &mut [f64]),
+    ncomp: usize,
+    chart: TensorChart,
+    boxes: Vec<([f64; 4], [f64; 4])>,
+    levels: [usize; 4],
+    opts: &Options,
+    replay: Option<tensor::Path>,
+) -> (Option<(Estimate, Rule)>, usize) {
+    let (r, spent) = tensor::integrate(
+        f,
+        ncomp,
+        &boxes,
+        levels,
+        tensor::Adapt { max_level: TENSOR_MAX_LEVEL, shared: true },
+        opts,
+        replay,
+    );
+    let r = r.map(|(t, path)| {
+        let est = Estimate {
+            value: t.value,
+            error: t.error,
+            evaluations: 0,
+            regions: boxes.len(),
+            converged: t.converged,
+            out_of_time: false,
+        };
+        (est, Rule::TensorGauss { chart, levels, path })
+    });
+    (r, spent)
 }
 
 /// One level of [`Rule::LobeGaussHermite`]: the tensor rule's sum per component, in a fixed point order.

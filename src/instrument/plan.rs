@@ -30,9 +30,11 @@ use crate::colorimetry::{cielab, Conditions};
 use crate::instrument::flux::{lobe_widths_uv, Chart, Flux, DELTA_SHARE};
 use crate::instrument::geometry::{ColourQuantity, Integral, ReadingSpec, Scale, Stop};
 pub use crate::instrument::method::Target;
-use crate::instrument::method::{Design, Method, Projection, Rule, LOBE_LEVELS, LOBE_REACH, POLAR_LEVELS, POLAR_REACH};
+use crate::instrument::method::{
+    Design, Method, Projection, Rule, TensorChart, LOBE_LEVELS, LOBE_REACH, POLAR_LEVELS, POLAR_REACH, TENSOR_MAX_LEVEL,
+};
 use crate::instrument::standards::{self, StandardGeometry};
-use crate::quadrature::Refine;
+use crate::quadrature::{tensor, Refine};
 use crate::spectrum::{Sampling, Weighting, WeightingKind};
 use crate::{Error, Result};
 
@@ -966,6 +968,7 @@ fn describe_method(m: &Method, terms: &[Term]) -> String {
                 p.cells.len()
             ),
             Rule::LobePolar { width, u, v, levels } => describe_polar(width, u, v, levels, p.cells.len()),
+            Rule::TensorGauss { chart, levels, path } => describe_tensor(chart, levels, path, p.cells.len()),
         };
         format!("{chart}, {rule}{}", frozen(p.refine))
     });
@@ -1008,6 +1011,25 @@ fn describe_polar(width: [f64; 2], u: [f64; 4], v: [f64; 4], levels: [u8; 9], bo
         POLAR_LEVELS.len() - 1,
         if tail_levels.is_empty() { "none".to_string() } else { tail_levels.join(", ") },
         POLAR_REACH,
+    )
+}
+
+/// [`Rule::TensorGauss`] in words: its boxes, its orders (the starting ones, or the final ones of a frozen
+/// method's path) and its fallback.
+fn describe_tensor(chart: TensorChart, levels: [usize; 4], path: tensor::Path, fallback_boxes: usize) -> String {
+    let orders = path.replayed(levels, tensor::MAX_BOXES).map(|l| tensor::ORDERS[l]);
+    let (vars, boxes) = match chart {
+        TensorChart::Plain => ("(p_s, q_s, p_r, q_r)", "on the one box of the stops' product"),
+        TensorChart::Lobe => ("(u, t_p, v, t_q)", "on the boxes between the overlap kinks of u and v"),
+        TensorChart::PlainPLobeQ => ("(p_s, p_r, v, t_q)", "on the boxes between the overlap kinks of v"),
+    };
+    format!(
+        "smooth integrand: tensor Gauss–Legendre in {vars} {boxes}, orders {} {}, per-axis orders raised \
+         (up to {}) until the sum of the per-axis differences of successive orders (calibrated) meets the \
+         tolerance (fallback: Genz–Malik 7/5 on {fallback_boxes} initial box(es) of the lobe variables)",
+        orders.map(|o| o.to_string()).join("×"),
+        if path.len > 0 { "(the highest final orders over the boxes)" } else { "to start on every box" },
+        tensor::ORDERS[TENSOR_MAX_LEVEL],
     )
 }
 

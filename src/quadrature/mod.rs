@@ -11,7 +11,8 @@
 //! split; scirs2-integrate: very heavy) offer none of (a)–(c) together, so the rule is implemented here
 //! (`genz_malik.rs`, tested against closed forms in its own test module). `gauss.rs` holds the crate's
 //! one-dimensional Gauss–Legendre and Gauss–Kronrod rules, `hermite.rs` the Gauss–Hermite rules of narrow lobes, `polar.rs` the polar (ρ = tan β) and
-//! box product rules of narrow heavy-tailed lobes.
+//! box product rules of narrow heavy-tailed lobes, `tensor.rs` the anisotropic tensor Gauss–Legendre rules with
+//! per-axis p-refinement of smooth integrands.
 //!
 //! The rule is Genz & Malik's degree-7 rule with an embedded degree-5 rule (A. C. Genz, A. A. Malik,
 //! "An adaptive algorithm for numerical integration over an n-dimensional rectangular region",
@@ -24,6 +25,7 @@ mod gauss;
 mod genz_malik;
 mod hermite;
 mod polar;
+pub mod tensor;
 
 pub use gauss::{adaptive as gauss_kronrod_adaptive, gauss_legendre};
 pub use hermite::gauss_hermite;
