@@ -532,6 +532,39 @@ fn main() {
                 note: format!("{} regions{}", f.regions, if f.converged { "" } else { ", NOT converged" }),
             });
         }
+        // The two rules forced on the same integral at rtol 1e-6 (issue 10): the tensor rule (in (p_s, p_r, v,
+        // t_q), whatever the planner chooses) and the Genz–Malik 7/5 engine on the planner's lobe-variable
+        // partition (the fallback; hcubature's algorithm with our variables and splits).
+        for (label, rule) in [
+            (
+                "tensor Gauss–Legendre forced (p_s, p_r, v, t_q), rtol 1e-6",
+                glossmeter::instrument::method::Rule::TensorGauss {
+                    chart: glossmeter::instrument::method::TensorChart::PlainPLobeQ,
+                    levels: [1; 4],
+                    path: Default::default(),
+                },
+            ),
+            (
+                "Genz–Malik 7/5 forced (planner's partition), rtol 1e-6",
+                glossmeter::instrument::method::Rule::GenzMalik75,
+            ),
+        ] {
+            let mut p = problem(c, 1e-6);
+            let Some(part) = p.method.regular.as_mut() else { continue };
+            part.rule = rule;
+            let (f, secs, runs): (Flux, f64, usize) = timed(|| p.solve());
+            rows.push(Row {
+                case: c.id,
+                method: label.into(),
+                value: f.value[0],
+                claimed: f.error[0] / f.value[0].abs(),
+                rel_err: (f.value[0] - reference).abs() / reference,
+                evals: f.evaluations,
+                seconds: secs,
+                runs,
+                note: format!("{:?} chart{}", f.chart, if f.converged { "" } else { ", NOT converged" }),
+            });
+        }
         // The same case with the material from its recipe (the engine's own model): checks that the bench
         // BRDF and the crate's model agree, and what the recipe model costs.
         if let Some(file) = recipe_of(c.id) {
