@@ -21,6 +21,7 @@
 //! the Smith height-correlated masking-shadowing function. The alternative `Form::PaperEq1` evaluates Eq. (1)
 //! as printed, for comparison only.
 use super::{Brdf, Lobe, Term, TermKind};
+use crate::optics::coat_albedo::CoatAlbedo;
 use crate::optics::fresnel::{fr_conductor, fr_dielectric, fresnel_dielectric, refract_into};
 use crate::optics::kubelka_munk::{self, Layer};
 use crate::optics::microfacet::{Distribution, Microfacet, Shadowing};
@@ -406,6 +407,8 @@ pub struct Paint {
     r_e: f64,
     r_i: f64,
     rough_coat: Option<Microfacet>,
+    /// E(μ) and Ē of the rough coat's lobe (energy-exact coupling, `optics::coat_albedo`).
+    coat_albedo: Option<CoatAlbedo>,
     metallic: Option<FlakeTerm>,
     pearlescent: Option<FlakeTerm>,
     /// Prepared for the luminous row of the sampling (None if the sampling has none).
@@ -519,7 +522,17 @@ impl Paint {
         let r_l: Vec<f64> = (0..n)
             .map(|j| kubelka_munk::layer(k_mix[j], s_mix[j], l.thickness_mm).over(l.primer_reflectance[j]))
             .collect();
-        let r_e = diffuse_fresnel_reflectance(eta);
+        let rough_coat =
+            (c.roughness >= Microfacet::SMOOTH_THRESHOLD).then(|| Microfacet::new(c.distribution, c.roughness));
+        // A rough coat lets in 1 − E(θ) and reflects back inside r_i = 1 − (1 − Ē)/η² (Kelemen &
+        // Szirmay-Kalos 2001); a smooth one T(θ) = 1 − F(θ) and r_i = 1 − (1 − r_e)/η², its limit.
+        let coat_albedo = match &rough_coat {
+            Some(mf) => Some(CoatAlbedo::build(mf, eta).ok_or_else(|| {
+                usage(format!("clear coat roughness {}: its albedo rule gave a non-finite value", c.roughness))
+            })?),
+            None => None,
+        };
+        let r_e = coat_albedo.as_ref().map_or_else(|| diffuse_fresnel_reflectance(eta), |a| a.mean);
         let r_i = 1.0 - (1.0 - r_e) / (eta * eta);
         let body_weight = (1.0 - am - ap).max(0.0);
         let use_saunderson = spec.internal_reflection && spec.form == Form::Physical;
@@ -530,8 +543,6 @@ impl Paint {
                 body_weight * r / PI * s
             })
             .collect();
-        let rough_coat =
-            (c.roughness >= Microfacet::SMOOTH_THRESHOLD).then(|| Microfacet::new(c.distribution, c.roughness));
         let cover =
             |depth: f64| -> Vec<Layer> { (0..n).map(|j| kubelka_munk::layer(k_mix[j], s_mix[j], depth)).collect() };
         let split = spec.form == Form::Physical && spec.flake_light == FlakeLight::Split;
@@ -567,8 +578,19 @@ impl Paint {
             let optics = FlakeOptics::Pearl { layers: [tio2, mica, tio2], medium: eta };
             flake("pearlescent flakes", p.spread, p.area_ratio, p.depth_mm, optics)
         });
-        let mut paint =
-            Paint { spec, body_weight, r_l, body, r_e, r_i, rough_coat, metallic, pearlescent, folded: None };
+        let mut paint = Paint {
+            spec,
+            body_weight,
+            r_l,
+            body,
+            r_e,
+            r_i,
+            rough_coat,
+            coat_albedo,
+            metallic,
+            pearlescent,
+            folded: None,
+        };
         let luminous = Weighting::luminous(&paint.spec.sampling).ok().and_then(|w| w.rows.into_iter().next());
         paint.folded = luminous.map(|w| Folded::new(&paint, &w));
         Ok(paint)
@@ -591,6 +613,15 @@ impl Paint {
     /// r_i, the diffuse reflectance of the coat–air interface from inside.
     pub fn internal_diffuse_reflectance(&self) -> f64 {
         self.r_i
+    }
+
+    /// Power that crosses the coat at exterior cosine μ (either way): 1 − E(μ) for a rough coat, the
+    /// Fresnel transmittance T(μ) for a smooth one.
+    fn coat_transmittance(&self, mu: f64) -> f64 {
+        match &self.coat_albedo {
+            Some(a) => 1.0 - a.at(mu),
+            None => fresnel_dielectric(mu.min(1.0), self.spec.coat.index).t(),
+        }
     }
 
     fn flakes(&self) -> impl Iterator<Item = &FlakeTerm> {
@@ -626,7 +657,7 @@ impl Paint {
                 let (Some(wi_in), Some(wo_in)) = (refract_into(wi, eta), refract_into(wo, eta)) else {
                     return coat;
                 };
-                let t_o = fresnel_dielectric(wo.z.min(1.0), eta).t();
+                let (t_i, t_o) = (self.coat_transmittance(wi.z), self.coat_transmittance(wo.z));
                 let factor = t_i * t_o / (eta * eta);
                 let h = (wi_in + wo_in).normalize();
                 let cos_local = wi_in.dot(h).clamp(0.0, 1.0);
@@ -788,7 +819,7 @@ impl Brdf for Paint {
                 let (Some(wi_in), Some(wo_in)) = (refract_into(wi, eta), refract_into(wo, eta)) else {
                     return;
                 };
-                let t_o = fresnel_dielectric(wo.z.min(1.0), eta).t();
+                let (t_i, t_o) = (self.coat_transmittance(wi.z), self.coat_transmittance(wo.z));
                 let factor = t_i * t_o / (eta * eta);
                 for (o, b) in out.iter_mut().zip(&self.body) {
                     *o += factor * b;
@@ -874,7 +905,10 @@ impl Brdf for Paint {
             out.iter_mut().for_each(|o| *o = rho);
         }
         let lambdas = &self.spec.sampling.wavelengths_nm;
-        let t_i = fresnel_dielectric(cos_i, eta).t();
+        let t_i = match self.spec.form {
+            Form::Physical => self.coat_transmittance(cos_i),
+            Form::PaperEq1 => fresnel_dielectric(cos_i, eta).t(),
+        };
         for fl in self.flakes().filter(|f| f.smooth) {
             // Mirror geometry: h = n, θo = θi. Physical: interior delta A·R·δ(ωo' − mirror ωi')/cos θo' maps
             // to the exterior delta with weight T(θi)·T(θo)·A·R (docs/model.md §Delta limit of the flakes).
@@ -950,7 +984,13 @@ impl Brdf for Paint {
         };
         let coat = match &self.rough_coat {
             None => format!("smooth coat η = {}", s.coat.index),
-            Some(mf) => format!("rough coat η = {} ({:?} {})", s.coat.index, mf.distribution, mf.alpha),
+            Some(mf) => format!(
+                "rough coat η = {} ({:?} {}; energy-exact coupling, albedo table within {:.0e} of its rule)",
+                s.coat.index,
+                mf.distribution,
+                mf.alpha,
+                self.coat_albedo.as_ref().map_or(0.0, |a| a.max_error)
+            ),
         };
         let mut d = format!(
             "paint (Ďurikovič & Ágošton 2007, {form}): {coat}, KM layer X = {} mm with {} pigment(s)",

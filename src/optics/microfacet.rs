@@ -153,7 +153,7 @@ impl Microfacet {
     /// same bits. For a = 1/(α tan θ) > 6.5, Λ < e^{−a²}/(2a√π) < 3·10⁻²⁰. This skips an `erfc` and two
     /// `exp` in the common case of narrow lobes (flakes, α ~ 10⁻³) away from grazing.
     #[inline]
-    fn lambda_in_g(&self, w: Vec3) -> f64 {
+    pub(crate) fn lambda_in_g(&self, w: Vec3) -> f64 {
         if self.distribution == Distribution::Beckmann && w.z > 0.0 {
             let t2 = (w.x * w.x + w.y * w.y) / (w.z * w.z);
             // a² = 1/(α² tan²θ) > 6.5² ⇔ α² tan²θ·42.25 < 1
