@@ -666,7 +666,7 @@ pub fn fit(
     }
     let geometries: Vec<StandardGeometry> = ids
         .iter()
-        .map(|id| planner.geometry(id).map_err(|e| Error::Usage(format!("--target {id}/…: {e}"))))
+        .map(|id| planner.geometry(id).map_err(|e| Error::Usage(format!("--target {id:?}: {e}"))))
         .collect::<Result<_>>()?;
     let plan_options = PlanOptions { rtol: options.rtol, ..PlanOptions::default() };
     // Match every target to a reading of the plan.
@@ -691,9 +691,8 @@ pub fn fit(
                 let has: Vec<&str> =
                     names.iter().filter(|(g, _, _)| *g == t.geometry).map(|(_, n, _)| n.as_str()).collect();
                 Error::Usage(format!(
-                    "--target {}/{}: geometry {} has no reading \"{}\"; its readings are {}",
-                    t.geometry,
-                    t.name,
+                    "--target {:?}: geometry {:?} has no reading {:?}; its readings are {}",
+                    format!("{}/{}", t.geometry, t.name),
                     t.geometry,
                     t.name,
                     has.join(", ")
@@ -705,9 +704,8 @@ pub fn fit(
     for (k, i) in index.iter().enumerate() {
         if let Some(prev) = seen.insert(*i, k) {
             return Err(Error::Usage(format!(
-                "--target {}/{}: the same reading is targeted twice (also target {})",
-                targets[k].geometry,
-                targets[k].name,
+                "--target {:?}: the same reading is targeted twice (also target {})",
+                format!("{}/{}", targets[k].geometry, targets[k].name),
                 prev + 1
             )));
         }

@@ -28,7 +28,12 @@ pub fn table(materials: &[Material], readings: &[Vec<Reading>], timing: bool) ->
                     row.extend(["—".to_string(), r.unit.clone(), "—".to_string()]);
                 }
             }
-            row.push(if r.converged { r.evaluations.to_string() } else { format!("{} *", r.evaluations) });
+            // The mark (and its footnote) only on a printed value: a reading without one says why in its note.
+            row.push(if r.converged || r.value.is_none() {
+                r.evaluations.to_string()
+            } else {
+                format!("{} *", r.evaluations)
+            });
             if timing {
                 row.push(format::secs(r.seconds));
             }
@@ -45,7 +50,7 @@ pub fn table(materials: &[Material], readings: &[Vec<Reading>], timing: bool) ->
     s.push('\n');
     s.push_str(&pad_table(&rows, &[3, 5, 6, 7]));
     let all = || readings.iter().flatten();
-    if all().any(|r| !r.converged) {
+    if all().any(|r| !r.converged && r.value.is_some()) {
         s.push_str("* not converged: the evaluation budget ran out before the tolerance was met\n");
     }
     if all().any(|r| r.value.is_some()) {

@@ -63,7 +63,12 @@ pub fn table(material: &Material, readings: &[Reading], timing: bool) -> String 
                 row.push("—".into());
             }
         }
-        row.push(if r.converged { r.evaluations.to_string() } else { format!("{} *", r.evaluations) });
+        // The mark (and its footnote) only on a printed value: a reading without one says why in its note.
+        row.push(if r.converged || r.value.is_none() {
+            r.evaluations.to_string()
+        } else {
+            format!("{} *", r.evaluations)
+        });
         if timing {
             row.push(secs(r.seconds));
         }
@@ -99,7 +104,7 @@ pub fn table(material: &Material, readings: &[Reading], timing: bool) -> String 
             s.push('\n');
         }
     }
-    if readings.iter().any(|r| !r.converged) {
+    if readings.iter().any(|r| !r.converged && r.value.is_some()) {
         s.push_str("* not converged: a budget (evaluations or wall-clock time, see the notes) ran out before the tolerance was met\n");
     }
     if readings.iter().any(|r| r.value.is_some()) {
@@ -241,4 +246,29 @@ pub fn csv(readings: &[Reading], timing: bool) -> Result<String> {
     let bytes =
         w.into_inner().map_err(|e| Error::Io { file: "<csv>".into(), source: std::io::Error::other(e.to_string()) })?;
     Ok(String::from_utf8(bytes).expect("csv is utf-8"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::instrument::plan::{Plan, PlanOptions};
+
+    /// The "not converged" mark and footnote belong to printed values: a reading without a value (and not
+    /// converged) gets neither, a value that did not converge gets both.
+    #[test]
+    fn the_not_converged_footnote_only_for_printed_values() {
+        let m = crate::recipe::parse_str(r#"{"model": "lambert", "albedo": 0.5}"#, "l.json").unwrap();
+        let geos = vec![crate::instrument::standards::find("astm-d523-60").unwrap()];
+        let r = Plan::compile(m.brdf.clone(), geos, PlanOptions::default()).unwrap().execute();
+        let mut no_value = r[0].clone();
+        no_value.value = None;
+        no_value.converged = false;
+        no_value.problem = Some("no value here".into());
+        let t = table(&m, &[no_value], false);
+        assert!(!t.contains("not converged") && !t.contains(" *"), "{t}");
+        let mut unconverged = r[0].clone();
+        unconverged.converged = false;
+        let t = table(&m, &[unconverged], false);
+        assert!(t.contains("* not converged") && t.contains(" *\n"), "{t}");
+    }
 }

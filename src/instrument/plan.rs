@@ -265,16 +265,22 @@ pub struct Planner {
 }
 
 impl Planner {
-    /// A planner; the builtin gloss geometries are parsed (once per process) and checked here.
+    /// A planner; the builtin gloss and colour geometries are parsed (once per process) and checked here, so
+    /// a builtin file that does not parse is this error rather than a missing geometry later.
     pub fn new() -> Result<Planner> {
         standards::builtin_static()?;
+        crate::instrument::colour::builtin_static()?;
         Ok(Planner { builtin: std::sync::OnceLock::new(), standards: Mutex::new(HashMap::new()) })
     }
 
-    /// The builtin geometries: gloss, then colour (`standards::builtin_all`; empty if the colour ones do not
-    /// parse, which `tests/colour.rs` rules out for the shipped files).
-    pub fn builtin(&self) -> &[StandardGeometry] {
-        self.builtin.get_or_init(|| standards::builtin_all().unwrap_or_default())
+    /// The builtin geometries: gloss, then colour (`standards::builtin_all`); a parse error is returned, never
+    /// swallowed into an empty list (`Planner::new` has already checked both sets).
+    pub fn builtin(&self) -> Result<&[StandardGeometry]> {
+        if let Some(all) = self.builtin.get() {
+            return Ok(all);
+        }
+        let all = standards::builtin_all()?;
+        Ok(self.builtin.get_or_init(|| all))
     }
 
     /// The builtin geometry with this id (`standards::find`); an unknown id is a usage error listing the known
@@ -1325,6 +1331,20 @@ mod tests {
 
     fn grey() -> Arc<dyn Brdf> {
         Arc::new(Lambert::new(vec![0.5], Sampling::grey()).unwrap())
+    }
+
+    /// `Planner::builtin` is every builtin geometry, gloss then colour, through the error path (a parse error
+    /// is an `Err`, no longer an empty list): the colour ones are there, not swallowed.
+    #[test]
+    fn the_planners_builtin_geometries_are_gloss_then_colour() {
+        let p = Planner::new().unwrap();
+        let ids: Vec<String> = p.builtin().unwrap().iter().map(|g| g.geometry.id.clone()).collect();
+        let gloss: Vec<String> = standards::builtin().unwrap().into_iter().map(|g| g.geometry.id).collect();
+        let colour: Vec<String> =
+            crate::instrument::colour::builtin().unwrap().into_iter().map(|g| g.geometry.id).collect();
+        assert!(!colour.is_empty() && !gloss.is_empty());
+        assert_eq!(ids, [gloss, colour].concat());
+        assert_eq!(p.builtin().unwrap().len(), ids.len(), "the second call borrows the same list");
     }
 
     #[test]

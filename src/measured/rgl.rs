@@ -203,12 +203,12 @@ impl TensorFile {
             let name_bytes = c.take(len, &format!("the name of field {k}"))?;
             let name = String::from_utf8_lossy(name_bytes).into_owned();
             let at = c.pos;
-            let rank = c.u16(&format!("the rank of field `{name}`"))?;
+            let rank = c.u16(&format!("the rank of field {name:?}"))?;
             if rank > MAX_RANK {
                 return Err(Error::input(file, name, format!("rank {rank} at byte offset {at}; at most {MAX_RANK}")));
             }
             let at = c.pos;
-            let code = c.u8(&format!("the type of field `{name}`"))?;
+            let code = c.u8(&format!("the type of field {name:?}"))?;
             let dtype = Dtype::from_code(code).ok_or_else(|| {
                 Error::input(
                     file,
@@ -216,11 +216,11 @@ impl TensorFile {
                     format!("unknown element type {code} at byte offset {at}; allowed 1–11"),
                 )
             })?;
-            let offset = c.u64(&format!("the data offset of field `{name}`"))?;
+            let offset = c.u64(&format!("the data offset of field {name:?}"))?;
             let mut shape = Vec::with_capacity(rank as usize);
             let mut count: u128 = 1;
             for j in 0..rank {
-                let d = c.u64(&format!("dimension {j} of field `{name}`"))?;
+                let d = c.u64(&format!("dimension {j} of field {name:?}"))?;
                 count = count.saturating_mul(d as u128);
                 shape.push(d as usize);
             }
@@ -631,7 +631,7 @@ impl Brdf for RglBrdf {
             String::new()
         };
         format!(
-            "measured RGL table {name} \"{}\" ({}, {np} × {nt} incident directions, {n} × {n} spectral grid, NDF {ny} × {nx}, {}{dropped})",
+            "measured RGL table {name} {:?} ({}, {np} × {nt} incident directions, {n} × {n} spectral grid, NDF {ny} × {nx}, {}{dropped})",
             self.description,
             if self.isotropic { "isotropic" } else { "anisotropic" },
             self.sampling.describe()
