@@ -13,7 +13,7 @@
 //! last ladder step still within 5 %. A lobe that falls faster than a Gaussian near its peak (GGX: 5 % at
 //! 0.161·α) is reported narrower than it is, which only adds splits; the tail is always taken as heavy (the
 //! splits go on geometrically to the ends of the range), since nothing is known of it.
-use glossmeter::brdf::Lobe;
+use glossmeter::brdf::{Lobe, Tail};
 use glossmeter::instrument::geometry::Axes;
 use glossmeter::Vec3;
 
@@ -136,7 +136,8 @@ pub fn conclude(found: &[(f64, Found)]) -> (Vec<Lobe>, String) {
                      has a mirror component, pass it as delta=",
                 );
             }
-            let lobe = Lobe { slope_width: m, medium_eta: 1.0, label: "lobe of f (probed)".into(), heavy_tail: true };
+            let lobe =
+                Lobe { slope_width: m, medium_eta: 1.0, label: "lobe of f (probed)".into(), tail: Tail::Unknown };
             (vec![lobe], note)
         }
     }

@@ -10,7 +10,7 @@
 //! exception is raised, as itself, when the measurement returns.
 use std::sync::Mutex;
 
-use glossmeter::brdf::{Brdf, Lobe, Term, TermKind};
+use glossmeter::brdf::{Brdf, Lobe, Tail, Term, TermKind};
 use glossmeter::instrument::plan::{Plan, PlanOptions, Target};
 use glossmeter::recipe::Material;
 use glossmeter::spectrum::{Sampling, Weighting};
@@ -305,7 +305,9 @@ fn parse_lobes(lobes: &Bound<'_, PyAny>) -> PyResult<Vec<Lobe>> {
         if !(eta.is_finite() && (1.0..=4.0).contains(&eta)) {
             return Err(bad(i, format!("eta {eta} is outside [1, 4]")));
         }
-        out.push(Lobe { slope_width: slope, medium_eta: eta, label, heavy_tail: heavy });
+        // A heavy tail of a user's function has no stated shape: `Tail::Unknown` (split out to the range ends).
+        let tail = if heavy { Tail::Unknown } else { Tail::Gaussian };
+        out.push(Lobe { slope_width: slope, medium_eta: eta, label, tail });
     }
     Ok(out)
 }
