@@ -105,6 +105,30 @@ impl Row {
     }
 }
 
+/// The table rows of one section: per strategy and thread count, the median wall time, the throughput over
+/// `items`, the speed-up over the same strategy on 1 thread, CPU and wait, and `(size, identical)` from `tail`
+/// (evaluations or bytes, and whether the output equals the library path's on 1 thread).
+fn print_rows(names: &[&str; 2], rows: &[Vec<Row>], items: f64, tail: impl Fn(usize, usize) -> (usize, bool)) {
+    for (s, (name, row)) in names.iter().zip(rows).enumerate() {
+        let t1 = median(row[0].walls.clone());
+        for (k, r) in row.iter().enumerate() {
+            let t = median(r.walls.clone());
+            let (size, identical) = tail(s, k);
+            println!(
+                "| {} | {} | {:.1} ms | {:.0} | {:.2}× | {} | {} | {} |",
+                name,
+                k + 1,
+                t * 1e3,
+                items / t,
+                t1 / t,
+                r.cpu(),
+                size,
+                identical
+            );
+        }
+    }
+}
+
 fn main() {
     let reps: usize = std::env::var("REPS").ok().and_then(|r| r.parse().ok()).unwrap_or(11);
     let n = 100;
@@ -153,23 +177,7 @@ fn main() {
     println!("### Batch `measure`: {n} microfacet recipes (Beckmann/GGX, roughness 0.02–0.5, n = 1.5), default panel, rtol 1e-6, median of {reps}\n");
     println!("| strategy | threads | median time | recipes / s | speed-up (same strategy) | CPU time / run | run-queue wait / run | evaluations | bit-identical to `measure_many` on 1 thread |");
     println!("|---|---|---|---|---|---|---|---|---|");
-    for s in 0..2 {
-        let t1 = median(rows[s][0].walls.clone());
-        for k in 0..2 {
-            let t = median(rows[s][k].walls.clone());
-            println!(
-                "| {} | {} | {:.1} ms | {:.0} | {:.2}× | {} | {} | {} |",
-                names[s],
-                k + 1,
-                t * 1e3,
-                n as f64 / t,
-                t1 / t,
-                rows[s][k].cpu(),
-                evals[s][k],
-                out[s][k] == out[0][0]
-            );
-        }
-    }
+    print_rows(&names, &rows, n as f64, |s, k| (evals[s][k], out[s][k] == out[0][0]));
 
     let template: serde_json::Value = serde_json::from_str(&texts[1]).expect("json");
     let axes = vec![parse_vary("/roughness=0.02..0.5:100").expect("axis")];
@@ -206,22 +214,6 @@ fn main() {
     println!("\n### `sweep`: GGX roughness 0.02..0.5, 100 grid points, default panel, rtol 1e-6, CSV rows without timing, median of {reps}\n");
     println!("| strategy | threads | median time | points / s | speed-up (same strategy) | CPU time / run | run-queue wait / run | bytes | byte-identical to `Sweep::run` on 1 thread |");
     println!("|---|---|---|---|---|---|---|---|---|");
-    for s in 0..2 {
-        let t1 = median(rows[s][0].walls.clone());
-        for k in 0..2 {
-            let t = median(rows[s][k].walls.clone());
-            println!(
-                "| {} | {} | {:.1} ms | {:.0} | {:.2}× | {} | {} | {} |",
-                names[s],
-                k + 1,
-                t * 1e3,
-                sw.len() as f64 / t,
-                t1 / t,
-                rows[s][k].cpu(),
-                out[s][k].len(),
-                out[s][k] == out[0][0]
-            );
-        }
-    }
+    print_rows(&names, &rows, sw.len() as f64, |s, k| (out[s][k].len(), out[s][k] == out[0][0]));
     println!("\nload average after: {}", load());
 }
