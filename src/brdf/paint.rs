@@ -647,7 +647,6 @@ impl Paint {
                 coat = v * fo.coat;
             }
         }
-        let t_i = fresnel_dielectric(wi.z.min(1.0), eta).t();
         let flakes = [self.metallic.as_ref(), self.pearlescent.as_ref()];
         let mut folded = fo.flakes.iter();
         let terms: [Option<(&FlakeTerm, &FoldedFlake)>; 2] =
@@ -746,6 +745,8 @@ impl Paint {
                 coat + factor * sum
             }
             Form::PaperEq1 => {
+                // Eq. (1) as printed: the smooth-interface transmittance on the way in only.
+                let t_i = fresnel_dielectric(wi.z.min(1.0), eta).t();
                 let h = (wi + wo).normalize();
                 let cos_local = wi.dot(h).clamp(0.0, 1.0);
                 let mut sum = fo.body;
@@ -813,7 +814,6 @@ impl Brdf for Paint {
                 out.iter_mut().for_each(|o| *o += v);
             }
         }
-        let t_i = fresnel_dielectric(wi.z.min(1.0), eta).t();
         match self.spec.form {
             Form::Physical => {
                 let (Some(wi_in), Some(wo_in)) = (refract_into(wi, eta), refract_into(wo, eta)) else {
@@ -851,6 +851,8 @@ impl Brdf for Paint {
                 }
             }
             Form::PaperEq1 => {
+                // Eq. (1) as printed: the smooth-interface transmittance on the way in only.
+                let t_i = fresnel_dielectric(wi.z.min(1.0), eta).t();
                 let tau = t_i;
                 for (o, b) in out.iter_mut().zip(&self.body) {
                     *o += tau * b;
