@@ -95,28 +95,28 @@ pub fn with_evaluations(mut doc: Value, evaluations: &[usize]) -> Value {
 /// The CSV of `measure` with `material` and `file` columns in front.
 pub fn csv(materials: &[Material], readings: &[Vec<Reading>], timing: bool) -> Result<String> {
     let err = |e: csv::Error| Error::Io { file: "<csv>".into(), source: std::io::Error::other(e) };
-    let mut w = csv::Writer::from_writer(vec![]);
-    for (i, (m, rs)) in materials.iter().zip(readings).enumerate() {
+    let mut head: Option<Vec<String>> = None;
+    let mut rows = vec![];
+    for (m, rs) in materials.iter().zip(readings) {
         let one = format::csv(rs, timing)?;
         let mut rdr = csv::ReaderBuilder::new().has_headers(false).from_reader(one.as_bytes());
         for (j, rec) in rdr.records().enumerate() {
             let rec = rec.map_err(err)?;
             if j == 0 {
-                if i == 0 {
-                    let mut h = vec!["material", "file"];
-                    h.extend(rec.iter());
-                    w.write_record(&h).map_err(err)?;
-                }
+                head.get_or_insert_with(|| {
+                    ["material", "file"].into_iter().chain(rec.iter()).map(String::from).collect()
+                });
                 continue;
             }
-            let mut row = vec![m.name.as_str(), m.file.as_str()];
-            row.extend(rec.iter());
-            w.write_record(&row).map_err(err)?;
+            rows.push(
+                [m.name.as_str(), m.file.as_str()].into_iter().chain(rec.iter()).map(String::from).collect::<Vec<_>>(),
+            );
         }
     }
-    let bytes =
-        w.into_inner().map_err(|e| Error::Io { file: "<csv>".into(), source: std::io::Error::other(e.to_string()) })?;
-    Ok(String::from_utf8(bytes).expect("utf-8"))
+    match head {
+        Some(h) => format::csv_text(&h.iter().map(String::as_str).collect::<Vec<_>>(), rows),
+        None => Ok(String::new()),
+    }
 }
 
 /// The baseline lines of a table.

@@ -373,9 +373,7 @@ fn json_text(
 }
 
 fn csv_text(cmp: &[Comparison]) -> Result<String> {
-    let mut w = csv::Writer::from_writer(vec![]);
-    let err = |e: csv::Error| Error::Io { file: "<csv>".into(), source: std::io::Error::other(e) };
-    w.write_record([
+    let head = [
         "line",
         "sample",
         "material",
@@ -392,13 +390,12 @@ fn csv_text(cmp: &[Comparison]) -> Result<String> {
         "allowance",
         "verdict",
         "note",
-    ])
-    .map_err(err)?;
+    ];
     let e = |v: Option<f64>| v.map(plain).unwrap_or_default();
-    for c in cmp {
+    let rows = cmp.iter().map(|c| {
         let p = c.predicted.as_ref();
         let s = c.group.stats;
-        w.write_record([
+        [
             c.group.lines[0].to_string(),
             c.group.sample.clone(),
             c.material.clone(),
@@ -418,10 +415,7 @@ fn csv_text(cmp: &[Comparison]) -> Result<String> {
                 Verdict::NotPredicted(why) => format!("not predicted: {why}"),
                 v => v.why_unchecked().map(|w| format!("not checked: {w}")).unwrap_or_default(),
             },
-        ])
-        .map_err(err)?;
-    }
-    let bytes =
-        w.into_inner().map_err(|e| Error::Io { file: "<csv>".into(), source: std::io::Error::other(e.to_string()) })?;
-    Ok(String::from_utf8(bytes).expect("utf-8"))
+        ]
+    });
+    crate::cli::format::csv_text(&head, rows)
 }

@@ -156,8 +156,6 @@ pub fn table(material: &Material, sweep: &Sweep) -> String {
             notes.push(format!("rtol {:e} {} {}: {p}", r.rtol, r.geometry, r.reading));
         }
     }
-    let ncol = head.len();
-    let widths: Vec<usize> = (0..ncol).map(|c| rows.iter().map(|r| r[c].chars().count()).max().unwrap_or(0)).collect();
     let mut s =
         format!("{} ({})\n{}\n{}\n", material.name, material.file, material.brdf.describe(), reference_note(sweep));
     s.push_str(&format!(
@@ -165,26 +163,7 @@ pub fn table(material: &Material, sweep: &Sweep) -> String {
         sweep.options.min_seconds * 1e3,
         sweep.options.max_repetitions
     ));
-    for (i, r) in rows.iter().enumerate() {
-        let cells: Vec<String> = r
-            .iter()
-            .enumerate()
-            .map(|(c, v)| {
-                let pad = " ".repeat(widths[c] - v.chars().count());
-                if matches!(c, 0 | 3 | 4 | 5 | 6 | 7) {
-                    format!("{pad}{v}")
-                } else {
-                    format!("{v}{pad}")
-                }
-            })
-            .collect();
-        s.push_str(cells.join("  ").trim_end());
-        s.push('\n');
-        if i == 0 {
-            s.push_str(&widths.iter().map(|w| "-".repeat(*w)).collect::<Vec<_>>().join("  "));
-            s.push('\n');
-        }
-    }
+    s.push_str(&super::pad_table(&rows, &[0, 3, 4, 5, 6, 7]));
     if sweep.rows.iter().any(|r| !r.converged) {
         s.push_str("* evaluation budget exhausted before the tolerance was met\n");
     }
@@ -196,9 +175,7 @@ pub fn table(material: &Material, sweep: &Sweep) -> String {
 
 /// CSV: one line per row, every number in full precision; empty cells where there is no value.
 pub fn csv(sweep: &Sweep) -> Result<String> {
-    let mut w = csv::Writer::from_writer(vec![]);
-    let err = |e: csv::Error| Error::Io { file: "<csv>".into(), source: std::io::Error::other(e) };
-    w.write_record([
+    let head = [
         "rtol",
         "geometry",
         "reading",
@@ -216,11 +193,10 @@ pub fn csv(sweep: &Sweep) -> Result<String> {
         "repetitions",
         "converged",
         "problem",
-    ])
-    .map_err(err)?;
+    ];
     let opt = |x: Option<f64>| x.map(plain).unwrap_or_default();
-    for r in &sweep.rows {
-        w.write_record([
+    let rows = sweep.rows.iter().map(|r| {
+        [
             plain(r.rtol),
             r.geometry.clone(),
             r.reading.clone(),
@@ -238,12 +214,9 @@ pub fn csv(sweep: &Sweep) -> Result<String> {
             r.repetitions.to_string(),
             r.converged.to_string(),
             r.problem.clone().unwrap_or_default(),
-        ])
-        .map_err(err)?;
-    }
-    let bytes =
-        w.into_inner().map_err(|e| Error::Io { file: "<csv>".into(), source: std::io::Error::other(e.to_string()) })?;
-    Ok(String::from_utf8(bytes).expect("csv is utf-8"))
+        ]
+    });
+    super::format::csv_text(&head, rows)
 }
 
 /// JSON: the sweep's settings and one object per row (null where there is no value).

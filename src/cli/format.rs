@@ -80,30 +80,9 @@ pub fn table(material: &Material, readings: &[Reading], timing: bool) -> String 
         }
         rows.push(row);
     }
-    let ncol = rows[0].len();
-    let widths: Vec<usize> = (0..ncol).map(|c| rows.iter().map(|r| r[c].chars().count()).max().unwrap_or(0)).collect();
     let mut s = format!("{} ({})\n{}\n\n", material.name, material.file, material.brdf.describe());
-    for (i, r) in rows.iter().enumerate() {
-        let cells: Vec<String> = r
-            .iter()
-            .enumerate()
-            .map(|(c, v)| {
-                let pad = widths[c] - v.chars().count();
-                // numbers right-aligned, words left-aligned
-                if matches!(c, 2 | 4 | 5 | 6) {
-                    format!("{}{v}", " ".repeat(pad))
-                } else {
-                    format!("{v}{}", " ".repeat(pad))
-                }
-            })
-            .collect();
-        s.push_str(cells.join("  ").trim_end());
-        s.push('\n');
-        if i == 0 {
-            s.push_str(&widths.iter().map(|w| "-".repeat(*w)).collect::<Vec<_>>().join("  "));
-            s.push('\n');
-        }
-    }
+    // numbers right-aligned, words left-aligned
+    s.push_str(&super::pad_table(&rows, &[2, 4, 5, 6]));
     if readings.iter().any(|r| !r.converged && r.value.is_some()) {
         s.push_str("* not converged: a budget (evaluations or wall-clock time, see the notes) ran out before the tolerance was met\n");
     }
@@ -216,16 +195,13 @@ pub fn envelope_table(readings: &[Reading], envelopes: &[Option<Envelope>]) -> S
 }
 
 pub fn csv(readings: &[Reading], timing: bool) -> Result<String> {
-    let mut w = csv::Writer::from_writer(vec![]);
     let mut head = vec!["geometry", "name", "quantity", "value", "unit", "error_estimate", "evaluations", "converged"];
     if timing {
         head.push("seconds");
     }
     head.push("problem");
     head.push("note");
-    let err = |e: csv::Error| Error::Io { file: "<csv>".into(), source: std::io::Error::other(e) };
-    w.write_record(&head).map_err(err)?;
-    for r in readings {
+    let rows = readings.iter().map(|r| {
         let mut rec = vec![
             r.geometry.clone(),
             r.name.clone(),
@@ -241,7 +217,19 @@ pub fn csv(readings: &[Reading], timing: bool) -> Result<String> {
         }
         rec.push(r.problem.clone().unwrap_or_default());
         rec.push(r.note.clone().unwrap_or_default());
-        w.write_record(&rec).map_err(err)?;
+        rec
+    });
+    csv_text(&head, rows)
+}
+
+/// CSV text in memory: the header, then one record per row (quoted where the csv crate must). Every CSV that
+/// the command line writes (measure, many recipes, compare, convergence, profile) goes through here.
+pub fn csv_text<R: IntoIterator<Item = String>>(header: &[&str], rows: impl IntoIterator<Item = R>) -> Result<String> {
+    let err = |e: csv::Error| Error::Io { file: "<csv>".into(), source: std::io::Error::other(e) };
+    let mut w = csv::Writer::from_writer(vec![]);
+    w.write_record(header).map_err(err)?;
+    for row in rows {
+        w.write_record(row).map_err(err)?;
     }
     let bytes =
         w.into_inner().map_err(|e| Error::Io { file: "<csv>".into(), source: std::io::Error::other(e.to_string()) })?;

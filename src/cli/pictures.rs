@@ -257,14 +257,7 @@ fn draw_sections<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, name: &str, p
                 .label(format!("mirror (delta) component, R = {r:.4}"))
                 .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], BLACK.stroke_width(2)));
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font(("sans-serif", 12))
-            .draw()
-            .map_err(plot_err)?;
+        super::plot::draw_legend(&mut chart, SeriesLabelPosition::UpperRight, 12)?;
     }
     root.present().map_err(plot_err)?;
     Ok(())
@@ -299,14 +292,7 @@ fn draw_vs_parameter<DB: DrawingBackend>(
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], c.stroke_width(2)));
         chart.draw_series(pts.iter().map(|&p| Circle::new(p, 3, c.filled()))).map_err(plot_err)?;
     }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .label_font(("sans-serif", 13))
-        .draw()
-        .map_err(plot_err)?;
+    super::plot::draw_legend(&mut chart, SeriesLabelPosition::UpperRight, 13)?;
     root.present().map_err(plot_err)?;
     Ok(())
 }
@@ -391,14 +377,7 @@ fn draw_comparison<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, name: &str,
             .label(label.clone())
             .legend(move |(x, y)| Circle::new((x + 8, y), 4, c.filled()));
     }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperLeft)
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .label_font(("sans-serif", 13))
-        .draw()
-        .map_err(plot_err)?;
+    super::plot::draw_legend(&mut chart, SeriesLabelPosition::UpperLeft, 13)?;
     root.present().map_err(plot_err)?;
     Ok(())
 }

@@ -122,6 +122,23 @@ pub fn plot_err(e: impl std::fmt::Display) -> Error {
     Error::Numeric(format!("plotting failed: {e}"))
 }
 
+/// The legend of every chart the command line draws: the series labels in a framed, slightly transparent box
+/// in a corner, in a sans-serif font of `size` px.
+pub fn draw_legend<'a, DB: DrawingBackend + 'a, CT: plotters::coord::CoordTranslate>(
+    chart: &mut ChartContext<'a, DB, CT>,
+    position: SeriesLabelPosition,
+    size: u32,
+) -> Result<()> {
+    chart
+        .configure_series_labels()
+        .position(position)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font(("sans-serif", size))
+        .draw()
+        .map_err(plot_err)
+}
+
 /// One series: (time, actual error, estimated error) per tolerance, loose to tight.
 struct Series {
     label: String,
@@ -236,14 +253,7 @@ where
                 .label(format!("largest error estimate of the reference run ({ref_err:.1e}): actual errors below it are not resolved"))
                 .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], grey.stroke_width(1)));
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font(("sans-serif", 12))
-            .draw()
-            .map_err(plot_err)?;
+        draw_legend(&mut chart, SeriesLabelPosition::UpperRight, 12)?;
         let mut lines = vec![format!(
             "Reference: {}. Points from loose to tight tolerance ({}); solid = actual error |value − reference|, dashed = the engine's estimate.",
             sweep.reference.label(),

@@ -90,11 +90,8 @@ pub const COLUMNS: &[&str] =
 
 /// CSV: one line per pixel, every number in full precision; an empty value where there is none.
 pub fn csv(p: &Profile) -> Result<String> {
-    let mut w = csv::Writer::from_writer(vec![]);
-    let err = |e: csv::Error| Error::Io { file: "<csv>".into(), source: std::io::Error::other(e) };
-    w.write_record(COLUMNS).map_err(err)?;
-    for r in &p.rows {
-        w.write_record([
+    let rows = p.rows.iter().map(|r| {
+        [
             r.pixel.to_string(),
             plain(r.angle_deg),
             plain(r.half_width_deg),
@@ -103,12 +100,9 @@ pub fn csv(p: &Profile) -> Result<String> {
             r.reading.unit.clone(),
             r.reading.converged.to_string(),
             r.reading.evaluations.to_string(),
-        ])
-        .map_err(err)?;
-    }
-    let bytes =
-        w.into_inner().map_err(|e| Error::Io { file: "<csv>".into(), source: std::io::Error::other(e.to_string()) })?;
-    Ok(String::from_utf8(bytes).expect("csv is utf-8"))
+        ]
+    });
+    super::format::csv_text(COLUMNS, rows)
 }
 
 /// JSON: the material, the array and one object per pixel (null where there is no value).
