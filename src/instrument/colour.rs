@@ -20,8 +20,8 @@ use std::f64::consts::PI;
 
 use crate::instrument::geometry::{ColourQuantity, Geometry, Integral, ReadingSpec, Scale, Stop};
 use crate::instrument::reference::projected_solid_angle;
-use crate::instrument::standards::{aperture, nonempty_str, sourced, string_list, Range, StandardGeometry};
-use crate::recipe::fields::{kind, parse_json, Obj};
+use crate::instrument::standards::{aperture, header, sourced, Range, StandardGeometry};
+use crate::recipe::fields::{parse_json, Obj};
 use crate::{Error, Result, Vec3};
 
 /// Every shipped colour geometry: (file name, text).
@@ -89,17 +89,7 @@ pub fn colour_kind(g: &Geometry) -> Option<ColourKind> {
 pub fn parse(text: &str, origin: &str) -> Result<StandardGeometry> {
     let spec = parse_json(text, origin)?;
     let o = Obj::new(origin, "", &spec)?;
-    let id = o.str("id")?;
-    if id.is_empty() || !id.chars().all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '-' || c == '.') {
-        return Err(o.err("id", format!("{id:?} is not a valid id: use lower-case letters, digits, '-' and '.'")));
-    }
-    let title = nonempty_str(&o, "title")?;
-    string_list(&o, "standards")?;
-    if let Some(v) = o.get("notes") {
-        if !v.is_string() {
-            return Err(o.err("notes", format!("expected a string, got {}", kind(v))));
-        }
-    }
+    let (id, title) = header(&o)?;
     let allowed = |extra: &[&'static str]| -> Vec<&'static str> { COMMON.iter().chain(extra).copied().collect() };
     let (geometry, reading_names) = match o.str("kind")? {
         "directional" => {

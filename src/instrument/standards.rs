@@ -245,17 +245,7 @@ pub fn parse(text: &str, origin: &str) -> Result<StandardGeometry> {
     let spec = parse_json(text, origin)?;
     let o = Obj::new(origin, "", &spec)?;
     o.deny_unknown(TOP_FIELDS)?;
-    let id = o.str("id")?;
-    if id.is_empty() || !id.chars().all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '-' || c == '.') {
-        return Err(o.err("id", format!("{id:?} is not a valid id: use lower-case letters, digits, '-' and '.'")));
-    }
-    let title = nonempty_str(&o, "title")?;
-    string_list(&o, "standards")?;
-    if let Some(v) = o.get("notes") {
-        if !v.is_string() {
-            return Err(o.err("notes", format!("expected a string, got {}", kind(v))));
-        }
-    }
+    let (id, title) = header(&o)?;
 
     // Readings are read first: a geometry whose readings are haze-index is a composite and has no optics.
     let readings_v = o.array("readings")?;
@@ -454,6 +444,23 @@ pub(crate) fn aperture(o: &Obj, allowed: &[&str]) -> Result<(f64, f64)> {
     let a = sourced(o, "in_plane_deg", Range::Open(0.0, 20.0), what)?;
     let b = sourced(o, "perpendicular_deg", Range::Open(0.0, 20.0), what)?;
     Ok((a, b))
+}
+
+/// The fields every geometry file opens with, gloss and colour alike: `id` (lower-case letters, digits, '-' and
+/// '.'), a non-empty `title`, the `standards` it follows (strings) and optional `notes` (a string).
+pub(crate) fn header<'a>(o: &Obj<'a>) -> Result<(&'a str, String)> {
+    let id = o.str("id")?;
+    if id.is_empty() || !id.chars().all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '-' || c == '.') {
+        return Err(o.err("id", format!("{id:?} is not a valid id: use lower-case letters, digits, '-' and '.'")));
+    }
+    let title = nonempty_str(o, "title")?;
+    string_list(o, "standards")?;
+    if let Some(v) = o.get("notes") {
+        if !v.is_string() {
+            return Err(o.err("notes", format!("expected a string, got {}", kind(v))));
+        }
+    }
+    Ok((id, title))
 }
 
 pub(crate) fn nonempty_str(o: &Obj, key: &str) -> Result<String> {
