@@ -41,6 +41,15 @@ fn check_svg(p: &PathBuf) {
     );
 }
 
+/// A PNG or an SVG, by the file's extension.
+fn check_picture(p: &PathBuf) {
+    match p.extension().and_then(|e| e.to_str()) {
+        Some("png") => check_png(p),
+        Some("svg") => check_svg(p),
+        other => panic!("{}: not a picture ({other:?})", p.display()),
+    }
+}
+
 #[test]
 fn section_plots_in_both_formats() {
     for ext in ["png", "svg"] {
@@ -59,11 +68,7 @@ fn section_plots_in_both_formats() {
             p.to_str().unwrap(),
         ];
         assert_eq!(run(args), 0);
-        if ext == "png" {
-            check_png(&p)
-        } else {
-            check_svg(&p)
-        }
+        check_picture(&p);
         // Never overwritten: the second run refuses and leaves the file as it was.
         let before = std::fs::read(&p).unwrap();
         assert_eq!(run(args), 2);
@@ -107,11 +112,7 @@ fn gloss_vs_parameter_plots() {
             p.to_str().unwrap(),
         ];
         assert_eq!(run(args), 0);
-        if ext == "png" {
-            check_png(&p)
-        } else {
-            check_svg(&p)
-        }
+        check_picture(&p);
     }
     // A pointer that names no number is bad input.
     let p = tmp("vary-bad.svg");
@@ -132,32 +133,19 @@ fn gloss_vs_parameter_plots() {
 
 #[test]
 fn compare_and_convergence_plots() {
-    let p = tmp("compare.png");
-    assert_eq!(
-        run([
+    for ext in ["png", "svg"] {
+        let p = tmp(&format!("compare.{ext}"));
+        let args = [
             "glossmeter",
             "compare",
             "fixtures/recipes/black-glass.json",
             "fixtures/sheets/black-glass-check.csv",
             "--plot",
-            p.to_str().unwrap()
-        ]),
-        0
-    );
-    check_png(&p);
-    let p = tmp("compare.svg");
-    assert_eq!(
-        run([
-            "glossmeter",
-            "compare",
-            "fixtures/recipes/black-glass.json",
-            "fixtures/sheets/black-glass-check.csv",
-            "--plot",
-            p.to_str().unwrap()
-        ]),
-        0
-    );
-    check_svg(&p);
+            p.to_str().unwrap(),
+        ];
+        assert_eq!(run(args), 0);
+        check_picture(&p);
+    }
     let p = tmp("convergence.png");
     assert_eq!(
         run([
