@@ -24,8 +24,8 @@ use crate::instrument::flux::{
 use crate::instrument::geometry::{solid_angle_density, Axes, Integral, Stop};
 use crate::instrument::sphere;
 use crate::quadrature::{
-    gauss_hermite, gauss_legendre, integrate_partition, legendre_on, mapped_legendre, polar_rectangle, tensor, Cell,
-    Estimate, Map, Options, Refine,
+    gauss_hermite_table, gauss_legendre_table, integrate_partition, legendre_on_into, mapped_legendre_into,
+    polar_rectangle_into, tensor, Cell, Estimate, Map, Options, PolarBuffers, Refine,
 };
 use crate::spectrum::Weighting;
 use crate::Vec3;
@@ -720,44 +720,61 @@ fn tensor_gauss(
     (r, spent)
 }
 
-/// One level of [`Rule::LobeGaussHermite`]: the tensor rule's sum per component, in a fixed point order.
+/// The buffers of [`Rule::LobeGaussHermite`], made once per execution and reused level after level (issue 10
+/// item 4: nothing in the hot path allocates).
+#[derive(Default)]
+struct HermiteScratch {
+    wh: Vec<f64>,
+    t: (Vec<f64>, Vec<f64>),
+    pts: Vec<[f64; 4]>,
+    wts: Vec<f64>,
+    vals: Vec<f64>,
+}
+
+/// One level of [`Rule::LobeGaussHermite`]: the tensor rule's sum per component into `sum`, in a fixed point
+/// order.
 fn lobe_tensor_sum(
     f: &mut impl FnMut(&[[f64; 4]], &mut [f64]),
     ncomp: usize,
     width: [f64; 2],
     (nh, nt): (usize, usize),
-) -> Vec<f64> {
-    let (xh, wh) = gauss_hermite(nh);
+    s: &mut HermiteScratch,
+    sum: &mut [f64],
+) {
+    let (xh, wh0) = gauss_hermite_table(nh);
     // ∫ g(u) du = w ∫ g(w x) e^{x²} e^{−x²} dx: the weights for g itself.
-    let wh: Vec<f64> = xh.iter().zip(&wh).map(|(x, w)| w * (x * x).exp()).collect();
-    let (xl, wl) = gauss_legendre(nt);
-    let tl: Vec<f64> = xl.iter().map(|x| 0.5 * (x + 1.0)).collect();
-    let wl: Vec<f64> = wl.iter().map(|w| 0.5 * w).collect();
-    let mut pts = Vec::with_capacity(nh * nt * nt);
-    let mut wts = Vec::with_capacity(nh * nt * nt);
-    let mut vals = vec![0.0; nh * nt * nt * ncomp];
-    let mut sum = vec![0.0; ncomp];
-    for (x, wx) in xh.iter().zip(&wh) {
-        pts.clear();
-        wts.clear();
-        for (y, wy) in xh.iter().zip(&wh) {
-            for (tp, wp) in tl.iter().zip(&wl) {
-                for (tq, wq) in tl.iter().zip(&wl) {
-                    pts.push([width[0] * x, *tp, width[1] * y, *tq]);
-                    wts.push(wx * wy * wp * wq);
+    s.wh.clear();
+    s.wh.extend(xh.iter().zip(wh0).map(|(x, w)| w * (x * x).exp()));
+    let (tl, wl) = &mut s.t;
+    tl.clear();
+    wl.clear();
+    let (xl, wl0) = gauss_legendre_table(nt);
+    tl.extend(xl.iter().map(|x| 0.5 * (x + 1.0)));
+    wl.extend(wl0.iter().map(|w| 0.5 * w));
+    s.vals.clear();
+    s.vals.resize(nh * nt * nt * ncomp, 0.0);
+    sum.iter_mut().for_each(|x| *x = 0.0);
+    for (x, wx) in xh.iter().zip(&s.wh) {
+        s.pts.clear();
+        s.wts.clear();
+        for (y, wy) in xh.iter().zip(&s.wh) {
+            for (tp, wp) in tl.iter().zip(wl.iter()) {
+                for (tq, wq) in tl.iter().zip(wl.iter()) {
+                    s.pts.push([width[0] * x, *tp, width[1] * y, *tq]);
+                    s.wts.push(wx * wy * wp * wq);
                 }
             }
         }
-        vals.iter_mut().for_each(|v| *v = 0.0);
-        f(&pts, &mut vals);
-        for (w, v) in wts.iter().zip(vals.chunks_exact(ncomp)) {
+        s.vals.iter_mut().for_each(|v| *v = 0.0);
+        f(&s.pts, &mut s.vals);
+        for (w, v) in s.wts.iter().zip(s.vals.chunks_exact(ncomp)) {
             for c in 0..ncomp {
                 let v = if v[c].is_finite() { v[c] } else { 0.0 };
                 sum[c] += w * v;
             }
         }
     }
-    sum.iter().map(|s| s * width[0] * width[1]).collect()
+    sum.iter_mut().for_each(|x| *x = *x * width[0] * width[1]);
 }
 
 /// Run [`Rule::LobeGaussHermite`]: levels `levels.0..=levels.1` of [`LOBE_LEVELS`] until two successive ones
@@ -773,23 +790,26 @@ fn lobe_gauss_hermite(
 ) -> (Option<(Estimate, usize)>, usize) {
     let cost = |(nh, nt): (usize, usize)| nh * nh * nt * nt;
     let mut evals = 0;
-    let mut previous: Option<Vec<f64>> = None;
+    let mut scratch = HermiteScratch::default();
+    let (mut now, mut prev) = (vec![0.0; ncomp], vec![0.0; ncomp]);
+    let mut have_previous = false;
     let last = levels.1.min(LOBE_LEVELS.len() - 1);
     for (level, &orders) in LOBE_LEVELS.iter().enumerate().take(last + 1).skip(levels.0) {
         if evals + cost(orders) > opts.max_evals {
             break;
         }
-        let now = lobe_tensor_sum(f, ncomp, width, orders);
+        lobe_tensor_sum(f, ncomp, width, orders, &mut scratch, &mut now);
         evals += cost(orders);
-        if let Some(prev) = previous {
-            let error: Vec<f64> = now.iter().zip(&prev).map(|(a, b)| (a - b).abs()).collect();
-            let converged = now.iter().zip(&error).all(|(v, e)| *e <= opts.atol.max(opts.rtol * v.abs()));
+        if have_previous {
+            let converged = now.iter().zip(&prev).all(|(v, p)| (v - p).abs() <= opts.atol.max(opts.rtol * v.abs()));
             if converged || refine == Refine::Frozen {
+                let error: Vec<f64> = now.iter().zip(&prev).map(|(a, b)| (a - b).abs()).collect();
                 let est = Estimate { value: now, error, evaluations: 0, regions: 1, converged, out_of_time: false };
                 return (Some((est, level)), evals);
             }
         }
-        previous = Some(now);
+        std::mem::swap(&mut now, &mut prev);
+        have_previous = true;
     }
     (None, evals)
 }
@@ -828,69 +848,90 @@ struct PolarPiece {
     at: Vec<f64>,
 }
 
+/// The buffers [`Rule::LobePolar`] works in, made once per execution and reused level after level (issue 10
+/// item 4: nothing in the hot path allocates; they only grow, to the largest level reached).
+#[derive(Default)]
+struct PolarScratch {
+    /// (x, y, weight) in the scaled lobe variables.
+    plane: Vec<(f64, f64, f64)>,
+    rect: Vec<([f64; 2], f64)>,
+    buffers: PolarBuffers,
+    outer: (Vec<f64>, Vec<f64>),
+    inner: (Vec<f64>, Vec<f64>),
+    t: (Vec<f64>, Vec<f64>),
+    pts: Vec<[f64; 4]>,
+    wts: Vec<f64>,
+    vals: Vec<f64>,
+}
+
 /// The points of a piece of [`Rule::LobePolar`] at one level, in the lobe chart's variables (u, t_p, v, t_q),
-/// with their weights, in a fixed order.
-fn polar_piece_points(width: [f64; 2], interval: [[f64; 2]; 2], central: bool, level: usize) -> Vec<([f64; 4], f64)> {
+/// with their weights, in a fixed order, into `s.pts` and `s.wts`.
+fn polar_piece_points(width: [f64; 2], interval: [[f64; 2]; 2], central: bool, level: usize, s: &mut PolarScratch) {
     let [w0, w1] = width;
     let scaled = [[interval[0][0] / w0, interval[0][1] / w0], [interval[1][0] / w1, interval[1][1] / w1]];
     // (x, y, weight) in the scaled lobe variables x = u/w_u, y = v/w_v.
-    let (plane, nt) = if central {
+    s.plane.clear();
+    let nt = if central {
         let (nphi, nr, nt) = POLAR_LEVELS[level];
         let lo = [scaled[0][0], scaled[1][0]];
         let hi = [scaled[0][1], scaled[1][1]];
-        let nodes = polar_rectangle(lo, hi, nphi, nr, Map::Tan { scale: 1.0 });
-        (nodes.into_iter().map(|([x, y], w)| (x, y, w)).collect::<Vec<_>>(), nt)
+        polar_rectangle_into(lo, hi, nphi, nr, Map::Tan { scale: 1.0 }, &mut s.buffers, &mut s.rect);
+        s.plane.extend(s.rect.iter().map(|&([x, y], w)| (x, y, w)));
+        nt
     } else {
         // The tail coordinate is the axis whose interval does not hold 0 (the first when neither does): σ = 1/x
         // along it; across it the kernel 1/(c² + y²)² (c² = 1 + x²) in y = c·tan γ.
         let (no, ni, nt) = TAIL_LEVELS[level];
         let outer = if scaled[0][0] < 0.0 && scaled[0][1] > 0.0 { 1 } else { 0 };
         let inner = 1 - outer;
-        let (xo, wo) = mapped_legendre(no, scaled[outer][0], scaled[outer][1], Map::Reciprocal);
-        let mut plane = Vec::with_capacity(no * ni);
-        for (x, wx) in xo.iter().zip(&wo) {
+        let (xo, wo) = &mut s.outer;
+        mapped_legendre_into(no, scaled[outer][0], scaled[outer][1], Map::Reciprocal, xo, wo);
+        let (y, wy) = &mut s.inner;
+        for (x, wx) in xo.iter().zip(wo.iter()) {
             let map = Map::Tan { scale: (1.0 + x * x).sqrt() };
-            let (y, wy) = mapped_legendre(ni, scaled[inner][0], scaled[inner][1], map);
-            for (y, wy) in y.iter().zip(&wy) {
-                plane.push(if outer == 0 { (*x, *y, wx * wy) } else { (*y, *x, wx * wy) });
+            mapped_legendre_into(ni, scaled[inner][0], scaled[inner][1], map, y, wy);
+            for (y, wy) in y.iter().zip(wy.iter()) {
+                s.plane.push(if outer == 0 { (*x, *y, wx * wy) } else { (*y, *x, wx * wy) });
             }
         }
-        (plane, nt)
+        nt
     };
-    let (tl, wl) = legendre_on(nt, 0.0, 1.0);
-    let mut out = Vec::with_capacity(plane.len() * nt * nt);
-    for (x, y, w) in plane {
-        for (tp, wp) in tl.iter().zip(&wl) {
-            for (tq, wq) in tl.iter().zip(&wl) {
-                out.push(([w0 * x, *tp, w1 * y, *tq], w * w0 * w1 * wp * wq));
+    let (tl, wl) = &mut s.t;
+    legendre_on_into(nt, 0.0, 1.0, tl, wl);
+    s.pts.clear();
+    s.wts.clear();
+    for &(x, y, w) in &s.plane {
+        for (tp, wp) in tl.iter().zip(wl.iter()) {
+            for (tq, wq) in tl.iter().zip(wl.iter()) {
+                s.pts.push([w0 * x, *tp, w1 * y, *tq]);
+                s.wts.push(w * w0 * w1 * wp * wq);
             }
         }
     }
-    out
 }
 
-/// The sum of a piece of [`Rule::LobePolar`] at one level, per component (non-finite values count as 0, as
-/// in [`lobe_tensor_sum`]).
-fn polar_piece_sum(f: &mut impl FnMut(&[[f64; 4]], &mut [f64]), ncomp: usize, points: &[([f64; 4], f64)]) -> Vec<f64> {
-    let pts: Vec<[f64; 4]> = points.iter().map(|(p, _)| *p).collect();
-    let mut vals = vec![0.0; pts.len() * ncomp];
-    f(&pts, &mut vals);
-    let mut sum = vec![0.0; ncomp];
-    for ((_, w), v) in points.iter().zip(vals.chunks_exact(ncomp)) {
+/// The sum of the points in `s` per component into `sum` (non-finite values count as 0, as in
+/// [`lobe_tensor_sum`]).
+fn polar_piece_sum(f: &mut impl FnMut(&[[f64; 4]], &mut [f64]), ncomp: usize, s: &mut PolarScratch, sum: &mut [f64]) {
+    s.vals.clear();
+    s.vals.resize(s.pts.len() * ncomp, 0.0);
+    f(&s.pts, &mut s.vals);
+    sum.iter_mut().for_each(|x| *x = 0.0);
+    for (w, v) in s.wts.iter().zip(s.vals.chunks_exact(ncomp)) {
         for c in 0..ncomp {
             if v[c].is_finite() {
                 sum[c] += w * v[c];
             }
         }
     }
-    sum
 }
 
 /// Run [`Rule::LobePolar`]: every piece at its level and the one below; while the summed differences exceed
 /// max(atol, rtol·|I|) in some component, the piece with the largest difference (relative to that tolerance;
 /// the first on ties) goes one level up (adaptive; a frozen rule keeps its levels). Returns the estimate and
 /// the pieces' levels when the sum meets the tolerance, None when the piece to raise has no level left or the
-/// budget would be exceeded, and the evaluations spent either way.
+/// budget would be exceeded, and the evaluations spent either way. Its buffers are made once here (per
+/// piece and per execution, not per level).
 fn lobe_polar(
     f: &mut impl FnMut(&[[f64; 4]], &mut [f64]),
     ncomp: usize,
@@ -901,7 +942,7 @@ fn lobe_polar(
     refine: Refine,
 ) -> (Option<(Estimate, [u8; 9])>, usize) {
     let mut evals = 0;
-    let mut pieces = Vec::new();
+    let mut pieces = Vec::with_capacity(9);
     for i in 0..3 {
         for j in 0..3 {
             let interval = [[breaks[0][i], breaks[0][i + 1]], [breaks[1][j], breaks[1][j + 1]]];
@@ -912,27 +953,37 @@ fn lobe_polar(
             let central = holds(interval[0]) && holds(interval[1]);
             let top = if central { POLAR_LEVELS.len() } else { TAIL_LEVELS.len() } - 1;
             let level = (levels[3 * i + j] as usize).clamp(1, top);
-            pieces.push(PolarPiece { index: 3 * i + j, interval, central, level, below: vec![], at: vec![] });
+            let (below, at) = (vec![0.0; ncomp], vec![0.0; ncomp]);
+            pieces.push(PolarPiece { index: 3 * i + j, interval, central, level, below, at });
         }
     }
-    let mut run = |p: &PolarPiece, level: usize, evals: &mut usize| -> Option<Vec<f64>> {
-        let points = polar_piece_points(width, p.interval, p.central, level);
-        if *evals + points.len() > opts.max_evals {
-            return None;
+    let mut scratch = PolarScratch::default();
+    // The sums of one piece at one level into `sum`; false when the budget would be exceeded.
+    let mut run = |p: &PolarPiece, level: usize, evals: &mut usize, sum: &mut [f64]| -> bool {
+        polar_piece_points(width, p.interval, p.central, level, &mut scratch);
+        if *evals + scratch.pts.len() > opts.max_evals {
+            return false;
         }
-        *evals += points.len();
-        Some(polar_piece_sum(f, ncomp, &points))
+        *evals += scratch.pts.len();
+        polar_piece_sum(f, ncomp, &mut scratch, sum);
+        true
     };
     for p in &mut pieces {
-        let Some(below) = run(p, p.level - 1, &mut evals) else { return (None, evals) };
-        let Some(at) = run(p, p.level, &mut evals) else { return (None, evals) };
+        let mut below = std::mem::take(&mut p.below);
+        let mut at = std::mem::take(&mut p.at);
+        if !run(p, p.level - 1, &mut evals, &mut below) || !run(p, p.level, &mut evals, &mut at) {
+            return (None, evals);
+        }
         p.below = below;
         p.at = at;
     }
+    let (mut value, mut error, mut tol) = (vec![0.0; ncomp], vec![0.0; ncomp], vec![0.0; ncomp]);
     loop {
-        let value: Vec<f64> = (0..ncomp).map(|c| pieces.iter().map(|p| p.at[c]).sum()).collect();
-        let error: Vec<f64> = (0..ncomp).map(|c| pieces.iter().map(|p| (p.at[c] - p.below[c]).abs()).sum()).collect();
-        let tol: Vec<f64> = value.iter().map(|v| opts.atol.max(opts.rtol * v.abs())).collect();
+        for c in 0..ncomp {
+            value[c] = pieces.iter().map(|p| p.at[c]).sum();
+            error[c] = pieces.iter().map(|p| (p.at[c] - p.below[c]).abs()).sum();
+            tol[c] = opts.atol.max(opts.rtol * value[c].abs());
+        }
         let converged = error.iter().zip(&tol).all(|(e, t)| e <= t);
         if converged || refine == Refine::Frozen {
             let mut reached = [1u8; 9];
@@ -968,9 +1019,15 @@ fn lobe_polar(
             return (None, evals);
         }
         let level = pieces[worst].level + 1;
-        let Some(at) = run(&pieces[worst], level, &mut evals) else { return (None, evals) };
+        // The level below becomes the old level: its buffer is reused for the new sums.
         let p = &mut pieces[worst];
-        p.below = std::mem::replace(&mut p.at, at);
+        std::mem::swap(&mut p.below, &mut p.at);
+        let mut at = std::mem::take(&mut p.at);
+        if !run(&pieces[worst], level, &mut evals, &mut at) {
+            return (None, evals);
+        }
+        let p = &mut pieces[worst];
+        p.at = at;
         p.level = level;
     }
 }

@@ -38,6 +38,20 @@ pub fn gauss_legendre(n: usize) -> (Vec<f64>, Vec<f64>) {
     (x, w)
 }
 
+/// The largest order [`gauss_legendre_table`] holds.
+pub const TABLE_MAX_ORDER: usize = 64;
+
+/// The n-point Gauss–Legendre rule on [−1, 1] (1 ≤ n ≤ [`TABLE_MAX_ORDER`]) from a table computed once per
+/// process by [`gauss_legendre`] (the same bits), so that a rule raised level by level in a hot loop
+/// (`instrument::method`'s polar and Gauss–Hermite rules) neither recomputes nor allocates its nodes.
+pub fn gauss_legendre_table(n: usize) -> (&'static [f64], &'static [f64]) {
+    static TABLE: std::sync::OnceLock<Vec<(Vec<f64>, Vec<f64>)>> = std::sync::OnceLock::new();
+    assert!((1..=TABLE_MAX_ORDER).contains(&n), "Gauss–Legendre order {n} outside the table");
+    let t = TABLE.get_or_init(|| (1..=TABLE_MAX_ORDER).map(gauss_legendre).collect());
+    let (x, w) = &t[n - 1];
+    (x, w)
+}
+
 /// Kronrod 15-point nodes (non-negative half) and weights, and the embedded Gauss 7-point weights
 /// (QUADPACK `qk15`).
 const XGK: [f64; 8] = [

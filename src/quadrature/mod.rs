@@ -27,8 +27,11 @@ mod hermite;
 mod polar;
 pub mod tensor;
 
-pub use gauss::{adaptive as gauss_kronrod_adaptive, gauss_legendre};
-pub use hermite::gauss_hermite;
-pub use polar::{legendre_on, mapped_legendre, polar_rectangle, Map};
+pub use gauss::{adaptive as gauss_kronrod_adaptive, gauss_legendre, gauss_legendre_table, TABLE_MAX_ORDER};
+pub use hermite::{gauss_hermite, gauss_hermite_table, HERMITE_TABLE_MAX_ORDER};
+pub use polar::{
+    legendre_on, legendre_on_into, mapped_legendre, mapped_legendre_into, polar_rectangle, polar_rectangle_into, Map,
+    PolarBuffers,
+};
 
 pub use genz_malik::{integrate, integrate_partition, pointwise, Cell, Estimate, Options, Refine, Rule};

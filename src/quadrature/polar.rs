@@ -11,14 +11,24 @@
 //! α → 0. The rectangle [x0, x1] × [y0, y1] (containing 0) is cut into four sectors at its corners' angles;
 //! in each, the radius runs to the side it meets, ρ_max(φ) = x1/cos φ (right side) etc., and β = s·atan ρ_max
 //! with s ∈ [0, 1]. Both rules are exact products of one-dimensional Gauss–Legendre rules (`gauss.rs`).
-use super::gauss::gauss_legendre;
+use super::gauss::gauss_legendre_table;
 use std::f64::consts::PI;
 
 /// The n-point Gauss–Legendre rule on [a, b]: (nodes, weights).
 pub fn legendre_on(n: usize, a: f64, b: f64) -> (Vec<f64>, Vec<f64>) {
-    let (x, w) = gauss_legendre(n);
+    let (mut x, mut w) = (Vec::with_capacity(n), Vec::with_capacity(n));
+    legendre_on_into(n, a, b, &mut x, &mut w);
+    (x, w)
+}
+
+/// [`legendre_on`] into the caller's buffers (cleared first): no allocation once they have room for n.
+pub fn legendre_on_into(n: usize, a: f64, b: f64, x: &mut Vec<f64>, w: &mut Vec<f64>) {
+    let (gx, gw) = gauss_legendre_table(n);
     let (c, h) = (0.5 * (a + b), 0.5 * (b - a));
-    (x.iter().map(|x| c + h * x).collect(), w.iter().map(|w| h * w).collect())
+    x.clear();
+    w.clear();
+    x.extend(gx.iter().map(|x| c + h * x));
+    w.extend(gw.iter().map(|w| h * w));
 }
 
 /// The radius ρ_max(φ) of the rectangle [x0, x1] × [y0, y1] (x0, y0 < 0 < x1, y1) along the direction φ: the
@@ -58,17 +68,29 @@ pub enum Map {
 /// The n-point Gauss–Legendre rule for ∫_a^b g(x) dx taken in the variable `map`: nodes and weights in x
 /// (Σ w g(x) ≈ ∫ g dx), in increasing order of the mapped variable.
 pub fn mapped_legendre(n: usize, a: f64, b: f64, map: Map) -> (Vec<f64>, Vec<f64>) {
+    let (mut x, mut w) = (Vec::with_capacity(n), Vec::with_capacity(n));
+    mapped_legendre_into(n, a, b, map, &mut x, &mut w);
+    (x, w)
+}
+
+/// [`mapped_legendre`] into the caller's buffers (cleared first; the same bits): no allocation once they
+/// have room for n.
+pub fn mapped_legendre_into(n: usize, a: f64, b: f64, map: Map, x: &mut Vec<f64>, w: &mut Vec<f64>) {
     match map {
-        Map::Linear => legendre_on(n, a, b),
+        Map::Linear => legendre_on_into(n, a, b, x, w),
         Map::Reciprocal => {
-            let (s, w) = legendre_on(n, 1.0 / b, 1.0 / a);
-            (s.iter().map(|s| 1.0 / s).collect(), s.iter().zip(&w).map(|(s, w)| w / (s * s)).collect())
+            legendre_on_into(n, 1.0 / b, 1.0 / a, x, w);
+            for (s, w) in x.iter_mut().zip(w.iter_mut()) {
+                *w /= *s * *s;
+                *s = 1.0 / *s;
+            }
         }
         Map::Tan { scale } => {
-            let (g, w) = legendre_on(n, (a / scale).atan(), (b / scale).atan());
-            let x = g.iter().map(|g| scale * g.tan()).collect();
-            let w = g.iter().zip(&w).map(|(g, w)| w * scale / (g.cos() * g.cos())).collect();
-            (x, w)
+            legendre_on_into(n, (a / scale).atan(), (b / scale).atan(), x, w);
+            for (g, w) in x.iter_mut().zip(w.iter_mut()) {
+                *w = *w * scale / (g.cos() * g.cos());
+                *g = scale * g.tan();
+            }
         }
     }
 }
@@ -81,23 +103,47 @@ pub fn mapped_legendre(n: usize, a: f64, b: f64, map: Map) -> (Vec<f64>, Vec<f64
 /// integrates sin β cos β. Deterministic node order (sectors anticlockwise from the lower right corner, then
 /// φ, then ρ).
 pub fn polar_rectangle(lo: [f64; 2], hi: [f64; 2], n_phi: usize, n_r: usize, radial: Map) -> Vec<([f64; 2], f64)> {
+    let mut out = Vec::with_capacity(4 * n_phi * n_r);
+    polar_rectangle_into(lo, hi, n_phi, n_r, radial, &mut PolarBuffers::default(), &mut out);
+    out
+}
+
+/// The one-dimensional node buffers [`polar_rectangle_into`] works in (kept by a caller that calls it level
+/// after level, so that nothing is allocated once they have grown).
+#[derive(Debug, Default)]
+pub struct PolarBuffers {
+    phi: (Vec<f64>, Vec<f64>),
+    rho: (Vec<f64>, Vec<f64>),
+}
+
+/// [`polar_rectangle`] into `out` (cleared first; the same nodes, weights and order), working in `buffers`:
+/// no allocation once the buffers and `out` have room.
+pub fn polar_rectangle_into(
+    lo: [f64; 2],
+    hi: [f64; 2],
+    n_phi: usize,
+    n_r: usize,
+    radial: Map,
+    buffers: &mut PolarBuffers,
+    out: &mut Vec<([f64; 2], f64)>,
+) {
     let c1 = lo[1].atan2(hi[0]);
     let c2 = hi[1].atan2(hi[0]);
     let c3 = hi[1].atan2(lo[0]);
     let c4 = lo[1].atan2(lo[0]) + 2.0 * PI;
     let corners = [c1, c2, c3, c4, c1 + 2.0 * PI];
-    let mut out = Vec::with_capacity(4 * n_phi * n_r);
+    out.clear();
+    let PolarBuffers { phi: (px, pw), rho: (r, wr) } = buffers;
     for k in 0..4 {
-        let (px, pw) = legendre_on(n_phi, corners[k], corners[k + 1]);
-        for (phi, wphi) in px.iter().zip(&pw) {
+        legendre_on_into(n_phi, corners[k], corners[k + 1], px, pw);
+        for (phi, wphi) in px.iter().zip(pw.iter()) {
             let (sphi, cphi) = phi.sin_cos();
-            let (r, wr) = mapped_legendre(n_r, 0.0, radius_to_sides(*phi, lo, hi), radial);
-            for (rho, w) in r.iter().zip(&wr) {
+            mapped_legendre_into(n_r, 0.0, radius_to_sides(*phi, lo, hi), radial, r, wr);
+            for (rho, w) in r.iter().zip(wr.iter()) {
                 out.push(([rho * cphi, rho * sphi], wphi * w * rho));
             }
         }
     }
-    out
 }
 
 #[cfg(test)]
