@@ -3,7 +3,8 @@
 //! taken ≥ 100 ms in total and reported as the median time per run.
 //!
 //! Run: `cargo bench --bench integrators` (release). `BENCH_QUICK=1` shrinks the baselines for a smoke
-//! test. The Markdown tables go to stdout and to `bench/results/latest.md`; see `bench/README.md` and
+//! test. `BENCH_CASES=B1,B3,NARROW,B5,BATCH` runs only the sections named (the cases B1–B4, the narrow-GGX
+//! rows, the B5 panel with its side-by-side rule table, the batch throughput); unset, all of them. The Markdown tables go to stdout and to `bench/results/latest.md`; see `bench/README.md` and
 //! `docs/performance.md`.
 //!
 //! Cases (the specimen flux Φ = ∫_source ∫_receptor f cos θi cos θo dωi dωo through the gloss receptor):
@@ -16,7 +17,12 @@
 //!   converge. The baselines integrate the *same* BRDF object over the plain variables (p_s, q_s, p_r, q_r)
 //!   of the stops, with the same cosines and solid-angle densities.
 //! * B5 the Cerulean Blue paints (fixtures/recipes/cerulean-blue-{a,b,c}.json) over the default panel, via
-//!   the measurement plan, with the plan's ablations; and batch throughput over rayon pools of 1 and 2.
+//!   the measurement plan, with the plan's ablations; the narrow-flake `-literal` panel with the planner's
+//!   methods beside Genz–Malik and the tensor rule forced on every specimen integral (whole panel and per
+//!   integral, with where Genz–Malik's refinement goes); and batch throughput over rayon pools of 1 and 2.
+//!
+//! Every "forced rule" row of every section goes through one helper (`rule_rows`), and says what actually
+//! ran (`rule_label`: the final rule and chart of the frozen method, so a fallback shows).
 use std::fmt::Write as _;
 use std::panic::AssertUnwindSafe;
 use std::path::Path;
@@ -26,7 +32,7 @@ use std::time::Instant;
 use glossmeter::brdf::{Brdf, Lobe, Tail, Term, TermKind};
 use glossmeter::instrument::flux::Flux;
 use glossmeter::instrument::geometry::{solid_angle_density, Axes, Stop};
-use glossmeter::instrument::method::Method;
+use glossmeter::instrument::method::{Method, Rule, Target, TensorChart};
 use glossmeter::instrument::plan::{Plan, PlanOptions, Reading};
 use glossmeter::instrument::standards::{self, StandardGeometry};
 use glossmeter::optics::fresnel::fr_dielectric;
@@ -229,6 +235,92 @@ fn problem(c: &Case, rtol: f64) -> Problem<'_> {
     let method =
         Method::for_material(b, c.theta, c.source, c.receptor, (rtol, 0.0), 200_000_000).expect("luminous weighting");
     Problem { brdf: b, method }
+}
+
+/// The specimen flux of a case with the regular part's rule replaced by `rule` (None: the planner's own).
+fn forced(c: &Case, rtol: f64, rule: Option<Rule>) -> Problem<'_> {
+    let mut p = problem(c, rtol);
+    if let (Some(part), Some(rule)) = (p.method.regular.as_mut(), rule) {
+        part.rule = rule;
+    }
+    p
+}
+
+/// What a run of `m` actually integrated, from its frozen method (an untimed run): the final rule and its
+/// variables, so a forced shaped rule that fell back says so, and the tensor rule's mixed chart is not called
+/// the lobe chart.
+fn rule_label(m: &Method, brdf: &dyn Brdf) -> String {
+    use glossmeter::instrument::method::TensorChart;
+    let (_, frozen) = m.execute_and_freeze(brdf);
+    let Some(part) = frozen.regular.as_ref() else { return "no regular part".into() };
+    let chart = match part.chart {
+        glossmeter::instrument::flux::Chart::Plain => "plain (p_s, q_s, p_r, q_r)",
+        glossmeter::instrument::flux::Chart::Lobe => "lobe (u, t_p, v, t_q)",
+    };
+    match part.rule {
+        Rule::GenzMalik75 => {
+            // Where the refinement went: the bisections per axis, summed over the final regions (each
+            // region's log₂ of its initial box's half-width over its own).
+            let initial = &m.regular.as_ref().expect("the same parts").cells;
+            let mut cuts = [0.0f64; 4];
+            for c in &part.cells {
+                let inside = |b: &&glossmeter::quadrature::Cell<4>| {
+                    (0..4).all(|k| (c.center[k] - b.center[k]).abs() <= b.half[k] * (1.0 + 1e-12))
+                };
+                if let Some(b) = initial.iter().find(inside) {
+                    for k in 0..4 {
+                        cuts[k] += (b.half[k] / c.half[k]).log2().round();
+                    }
+                }
+            }
+            format!(
+                "Genz–Malik 7/5, {chart} chart, {} initial → {} final regions, bisections per axis {:?}",
+                initial.len(),
+                part.cells.len(),
+                cuts.map(|x| x as usize)
+            )
+        }
+        Rule::LobeGaussHermite { .. } => "Gauss–Hermite × Gauss–Legendre, lobe chart".into(),
+        Rule::LobePolar { .. } => "polar + tail boxes, lobe chart".into(),
+        Rule::TensorGauss { chart, .. } => format!(
+            "tensor Gauss–Legendre, {} chart",
+            match chart {
+                TensorChart::Plain => "plain (p_s, q_s, p_r, q_r)",
+                TensorChart::Lobe => "lobe (u, t_p, v, t_q) kink-partition",
+                TensorChart::PlainPLobeQ => "mixed (p_s, p_r, v, t_q)",
+            }
+        ),
+    }
+}
+
+/// The rows of one case with each rule of `rules` forced on its regular part (None: the planner's choice),
+/// side by side in one run (issue 10; review D2: one helper for every case and section).
+fn rule_rows(c: &Case, rtol: f64, rules: &[(&str, Option<Rule>)], reference: f64) -> Vec<Row> {
+    let mut rows = Vec::new();
+    for (label, rule) in rules {
+        let p = forced(c, rtol, *rule);
+        if rule.is_some() && p.method.regular.is_none() {
+            continue;
+        }
+        let (f, secs, runs): (Flux, f64, usize) = timed(|| p.solve());
+        rows.push(Row {
+            case: c.id,
+            method: format!("{label}, rtol {rtol:.0e}"),
+            value: f.value[0],
+            claimed: f.error[0] / f.value[0].abs(),
+            rel_err: (f.value[0] - reference).abs() / reference,
+            evals: f.evaluations,
+            seconds: secs,
+            runs,
+            note: format!("{}{}", rule_label(&p.method, p.brdf), if f.converged { "" } else { ", NOT converged" }),
+        });
+    }
+    rows
+}
+
+/// Whether `BENCH_CASES` (a comma-separated list; unset: everything) asks for the section `id`.
+fn wants(id: &str) -> bool {
+    std::env::var("BENCH_CASES").map_or(true, |l| l.split(',').any(|x| x.trim() == id))
 }
 
 /// The plain 4-D integrand in (p_s, q_s, p_r, q_r): luminous f · cos θi cos θo · both solid-angle densities.
@@ -471,10 +563,8 @@ fn main() {
         ),
     ];
     // BENCH_CASES=B1,B2 runs only those cases (for side-by-side runs of two commits on a busy machine).
-    let cases: Vec<_> = match std::env::var("BENCH_CASES") {
-        Ok(list) => cases.into_iter().filter(|c| list.split(',').any(|id| id.trim() == c.id)).collect(),
-        Err(_) => cases,
-    };
+    // BENCH_CASES=B5,BATCH,NARROW likewise names the other sections.
+    let cases: Vec<_> = cases.into_iter().filter(|c| wants(c.id)).collect();
     let mc_sizes: Vec<usize> =
         if quick { vec![1_000, 10_000, 100_000] } else { vec![1_000, 10_000, 100_000, 1_000_000, 10_000_000] };
     let grid_sizes: Vec<usize> = if quick { vec![4, 8, 16] } else { vec![4, 8, 16, 32, 48] };
@@ -535,36 +625,22 @@ fn main() {
         // The two rules forced on the same integral at rtol 1e-6 (issue 10): the tensor rule (in (p_s, p_r, v,
         // t_q), whatever the planner chooses) and the Genz–Malik 7/5 engine on the planner's lobe-variable
         // partition (the fallback; hcubature's algorithm with our variables and splits).
-        for (label, rule) in [
-            (
-                "tensor Gauss–Legendre forced (p_s, p_r, v, t_q), rtol 1e-6",
-                glossmeter::instrument::method::Rule::TensorGauss {
-                    chart: glossmeter::instrument::method::TensorChart::PlainPLobeQ,
-                    levels: [1; 4],
-                    path: Default::default(),
-                },
-            ),
-            (
-                "Genz–Malik 7/5 forced (planner's partition), rtol 1e-6",
-                glossmeter::instrument::method::Rule::GenzMalik75,
-            ),
-        ] {
-            let mut p = problem(c, 1e-6);
-            let Some(part) = p.method.regular.as_mut() else { continue };
-            part.rule = rule;
-            let (f, secs, runs): (Flux, f64, usize) = timed(|| p.solve());
-            rows.push(Row {
-                case: c.id,
-                method: label.into(),
-                value: f.value[0],
-                claimed: f.error[0] / f.value[0].abs(),
-                rel_err: (f.value[0] - reference).abs() / reference,
-                evals: f.evaluations,
-                seconds: secs,
-                runs,
-                note: format!("{:?} chart{}", f.chart, if f.converged { "" } else { ", NOT converged" }),
-            });
-        }
+        rows.extend(rule_rows(
+            c,
+            1e-6,
+            &[
+                (
+                    "ours, tensor Gauss–Legendre forced (p_s, p_r, v, t_q)",
+                    Some(Rule::TensorGauss {
+                        chart: TensorChart::PlainPLobeQ,
+                        levels: [1; 4],
+                        path: Default::default(),
+                    }),
+                ),
+                ("ours, Genz–Malik 7/5 forced (planner's partition)", Some(Rule::GenzMalik75)),
+            ],
+            reference,
+        ));
         // The same case with the material from its recipe (the engine's own model): checks that the bench
         // BRDF and the crate's model agree, and what the recipe model costs.
         if let Some(file) = recipe_of(c.id) {
@@ -738,11 +814,16 @@ fn main() {
     }
 
     where_the_evaluations_go(&mut md, &cases);
-    // BENCH_CASES=NARROW (or no filter) runs the narrow-GGX rows.
-    if std::env::var("BENCH_CASES").map_or(true, |l| l.split(',').any(|id| id.trim() == "NARROW")) {
+    if wants("NARROW") {
         narrow_ggx(&mut md);
     }
-    b5(&mut md, quick);
+    if wants("B5") {
+        b5(&mut md);
+        b5_rules(&mut md);
+    }
+    if wants("BATCH") {
+        batch(&mut md, quick);
+    }
 
     print!("{md}");
     let out = Path::new(env!("CARGO_MANIFEST_DIR")).join("bench/results/latest.md");
@@ -760,7 +841,6 @@ fn main() {
 /// rule), in one run, at α = 1e-3, 1e-5, 1e-7 on astm-d523-20 (n = 1.5). Reference: the forced partition at
 /// rtol 1e-11, cross-checked against the polar rule at 1e-11.
 fn narrow_ggx(md: &mut String) {
-    use glossmeter::instrument::method::Rule;
     let _ = writeln!(md, "\n## Narrow GGX: the polar rule beside the forced Genz–Malik partition (same chart)\n");
     let _ = writeln!(
         md,
@@ -771,12 +851,7 @@ fn narrow_ggx(md: &mut String) {
     let _ = writeln!(md, "|---|---|---|---|---|---|---|---|");
     for alpha in [1e-3, 1e-5, 1e-7] {
         let c = case("NARROW", "GGX", Arc::new(BenchMicrofacet::new(Dist::Ggx, alpha, 1.5)), "astm-d523-20");
-        let forced = |rtol: f64| {
-            let mut p = problem(&c, rtol);
-            p.method.regular.as_mut().expect("a regular part").rule = Rule::GenzMalik75;
-            p
-        };
-        let reference = forced(1e-11).solve();
+        let reference = forced(&c, 1e-11, Some(Rule::GenzMalik75)).solve();
         let polar_fine = problem(&c, 1e-11).solve();
         let r = reference.value[0];
         eprintln!(
@@ -787,17 +862,18 @@ fn narrow_ggx(md: &mut String) {
             (polar_fine.value[0] - r).abs() / r
         );
         for rtol in [1e-6, 1e-9] {
-            for (name, p) in [("polar (planner's choice)", problem(&c, rtol)), ("Genz–Malik 7/5 forced", forced(rtol))]
-            {
-                let (f, secs, runs): (Flux, f64, usize) = timed(|| p.solve());
+            let rules = [("polar (planner's choice)", None), ("Genz–Malik 7/5 forced", Some(Rule::GenzMalik75))];
+            for x in rule_rows(&c, rtol, &rules, r) {
                 let _ = writeln!(
                     md,
-                    "| {alpha:.0e} | {name}, rtol {rtol:.0e} | {:.10e} | {} | {} | {} | {} | {runs} |",
-                    f.value[0],
-                    fmt_e(f.error[0] / f.value[0]),
-                    fmt_e((f.value[0] - r).abs() / r),
-                    f.evaluations,
-                    fmt_time(secs),
+                    "| {alpha:.0e} | {} | {:.10e} | {} | {} | {} | {} | {} |",
+                    x.method,
+                    x.value,
+                    fmt_e(x.claimed),
+                    fmt_e(x.rel_err),
+                    x.evals,
+                    fmt_time(x.seconds),
+                    x.runs
                 );
             }
         }
@@ -954,7 +1030,7 @@ fn run_panel(brdf: Arc<dyn Brdf>, opts: PlanOptions, threads: usize) -> PanelRun
     PanelRun { readings, seconds, runs, jobs }
 }
 
-fn b5(md: &mut String, quick: bool) {
+fn b5(md: &mut String) {
     let _ = writeln!(md, "\n## B5: Cerulean Blue over the default panel ({})\n", PANEL.join(", "));
     let _ = writeln!(md, "Plan at rtol 1e-6, executed in a 1-thread rayon pool (single-core time); integrals = distinct aperture integrals of the plan (specimen and standard).\n");
     let _ = writeln!(md, "| recipe | plan options | integrals | specimen BRDF evaluations | time | runs | readings |");
@@ -1046,7 +1122,86 @@ fn b5(md: &mut String, quick: bool) {
         }
         let _ = writeln!(md);
     }
-    batch(md, quick);
+}
+
+/// Replace the regular rule of every specimen integral of `plan` that has one (None: keep the planner's).
+fn force_plan_rule(plan: &mut Plan, rule: Option<Rule>) {
+    let Some(rule) = rule else { return };
+    for job in plan.jobs.iter_mut().filter(|j| j.method.target == Target::Specimen) {
+        if let Some(part) = job.method.regular.as_mut() {
+            part.rule = rule;
+        }
+    }
+}
+
+/// B5 with the narrow flake lobes (cerulean-blue-c-literal) over the default panel, side by side in one run
+/// (issue 10): the planner's methods, Genz–Malik 7/5 forced on every specimen integral (the engine before
+/// issue 10's rules), and the tensor Gauss–Legendre rule with p-refinement forced on the overlap-kink partition
+/// (`TensorChart::Lobe`, orders shared by its boxes; its fallback is the Genz–Malik partition). Whole-panel
+/// evaluations (exact, counted by a wrapper) and single-core times; then, per specimen integral, where the
+/// evaluations go and each rule's actual error against a Genz–Malik run at 10⁻⁴ of the integral's tolerance.
+fn b5_rules(md: &mut String) {
+    let file = "cerulean-blue-c-literal.json";
+    let Some(brdf) = recipe(file) else { return };
+    let opts = PlanOptions { rtol: 1e-6, ..Default::default() };
+    let tensor = Rule::TensorGauss { chart: TensorChart::Lobe, levels: [1; 4], path: Default::default() };
+    let rules: [(&str, Option<Rule>); 3] = [
+        ("planner's choice", None),
+        ("Genz–Malik 7/5 forced", Some(Rule::GenzMalik75)),
+        ("tensor Gauss–Legendre forced (kink partition)", Some(tensor)),
+    ];
+    let _ = writeln!(
+        md,
+        "\n## B5 {file}: the planner beside forced rules (one run; load average at the start {})\n",
+        loadavg()
+    );
+    let _ = writeln!(md, "| rules of the specimen integrals | specimen BRDF evaluations | time (1 thread) | runs |");
+    let _ = writeln!(md, "|---|---|---|---|");
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build().expect("pool");
+    for (label, rule) in rules {
+        let mut plan = Plan::compile(brdf.clone(), panel(), opts.clone()).expect("plan compiles");
+        force_plan_rule(&mut plan, rule);
+        let (_, secs, runs) = pool.install(|| timed(|| plan.execute()));
+        let counting = Arc::new(Counting { inner: brdf.clone(), n: Default::default() });
+        let mut counted = Plan::compile(counting.clone(), panel(), opts.clone()).expect("plan compiles");
+        force_plan_rule(&mut counted, rule);
+        pool.install(|| counted.execute());
+        let evals = counting.n.load(std::sync::atomic::Ordering::Relaxed);
+        let _ = writeln!(md, "| {label} | {evals} | {} | {runs} |", fmt_time(secs));
+    }
+    let _ = writeln!(md, "\nPer specimen integral (evaluations of the integral; actual error relative to Genz–Malik at 10⁻⁴ × the integral's tolerances; est. = the integral's own estimate, relative):\n");
+    let _ = writeln!(md, "| # | used by | rule | evaluations | est. | actual | actual / est. | what ran |");
+    let _ = writeln!(md, "|---|---|---|---|---|---|---|---|");
+    let plan = Plan::compile(brdf.clone(), panel(), opts).expect("plan compiles");
+    for (j, job) in plan.jobs.iter().enumerate().filter(|(_, j)| j.method.target == Target::Specimen) {
+        let mut tight = job.method.clone();
+        if let Some(p) = tight.regular.as_mut() {
+            (p.rule, p.rtol, p.atol) = (Rule::GenzMalik75, 1e-4 * p.rtol, 1e-4 * p.atol);
+        }
+        if let Some(p) = tight.delta.as_mut() {
+            (p.rtol, p.atol) = (1e-4 * p.rtol, 1e-4 * p.atol);
+        }
+        let r = tight.execute(brdf.as_ref()).value[0];
+        for (label, rule) in rules {
+            let mut m = job.method.clone();
+            if let (Some(p), Some(rule)) = (m.regular.as_mut(), rule) {
+                p.rule = rule;
+            }
+            let f = m.execute(brdf.as_ref());
+            let actual = (f.value[0] - r).abs();
+            let _ = writeln!(
+                md,
+                "| {j} | {} | {label} | {} | {} | {} | {:.3} | {} |",
+                job.used_by.join(", "),
+                f.evaluations,
+                fmt_e(f.error[0] / f.value[0].abs()),
+                fmt_e(actual / r.abs()),
+                actual / f.error[0],
+                rule_label(&m, brdf.as_ref())
+            );
+        }
+    }
+    let _ = writeln!(md, "\nLoad average at the end of this section {}.", loadavg());
 }
 
 /// cerulean-c over the panel at several rtol against an rtol-1e-9 run: how pessimistic the estimate is, and
