@@ -268,8 +268,8 @@ fn rule_label(m: &Method, brdf: &dyn Brdf) -> String {
                     (0..4).all(|k| (c.center[k] - b.center[k]).abs() <= b.half[k] * (1.0 + 1e-12))
                 };
                 if let Some(b) = initial.iter().find(inside) {
-                    for k in 0..4 {
-                        cuts[k] += (b.half[k] / c.half[k]).log2().round();
+                    for (k, cut) in cuts.iter_mut().enumerate() {
+                        *cut += (b.half[k] / c.half[k]).log2().round();
                     }
                 }
             }
