@@ -14,7 +14,9 @@ F the unpolarised Fresnel reflectance of the interface air -> eta.
 The chart is NOT the engine's: here the integral runs over the outgoing direction (u = cos theta_o in [0, 1],
 phi_o in [0, pi], doubled by symmetry), where the horizon is the coordinate line u = 0, by nested adaptive
 Gauss-Kronrod (scipy.integrate.quad, QUADPACK) at epsabs 1e-14 with break points graded about the specular
-direction. The engine integrates in scaled half-vector slopes by a fixed rule.
+direction. The engine integrates in scaled half-vector slopes by a fixed rule (its reference rule), from which
+the shipped table assets/coat-albedo-table.bin that paints read was generated (examples/make_coat_albedo_table.rs);
+tests/paint.rs compares both the rule and the table with these values.
 """
 import datetime
 import json

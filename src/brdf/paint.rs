@@ -21,7 +21,7 @@
 //! the Smith height-correlated masking-shadowing function. The alternative `Form::PaperEq1` evaluates Eq. (1)
 //! as printed, for comparison only.
 use super::{Brdf, Lobe, Term, TermKind};
-use crate::optics::coat_albedo::CoatAlbedo;
+use crate::optics::coat_albedo::{CoatAlbedo, OutOfTable, ALPHA_BREAKS, ETA_MAX, ETA_MIN};
 use crate::optics::fresnel::{fr_conductor, fr_dielectric, fresnel_dielectric, refract_into};
 use crate::optics::kubelka_munk::{self, Layer};
 use crate::optics::microfacet::{Distribution, Microfacet, Shadowing};
@@ -526,9 +526,27 @@ impl Paint {
             (c.roughness >= Microfacet::SMOOTH_THRESHOLD).then(|| Microfacet::new(c.distribution, c.roughness));
         // A rough coat lets in 1 − E(θ) and reflects back inside r_i = 1 − (1 − Ē)/η² (Kelemen &
         // Szirmay-Kalos 2001); a smooth one T(θ) = 1 − F(θ) and r_i = 1 − (1 − r_e)/η², its limit.
+        // E comes from the shipped table (`optics::coat_albedo`), which covers roughness [10⁻³, 1] and the
+        // whole index range; a rough coat outside it is refused, naming the field.
         let coat_albedo = match &rough_coat {
-            Some(mf) => Some(CoatAlbedo::build(mf, eta).ok_or_else(|| {
-                usage(format!("clear coat roughness {}: its albedo rule gave a non-finite value", c.roughness))
+            Some(mf) => Some(CoatAlbedo::new(mf, eta).map_err(|why| {
+                let (lo, hi) = (ALPHA_BREAKS[0], ALPHA_BREAKS[ALPHA_BREAKS.len() - 1]);
+                match why {
+                    OutOfTable::Roughness => usage(format!(
+                        "{} = {}: a rough clear coat's roughness must lie in [{lo}, {hi}], the range of its \
+                         directional-albedo table (docs/model.md §Energy-exact rough clear coat); below {} \
+                         the coat is smooth",
+                        reg::COAT_ROUGHNESS.pointer,
+                        c.roughness,
+                        Microfacet::SMOOTH_THRESHOLD
+                    )),
+                    OutOfTable::Index => usage(format!(
+                        "{} = {}: a rough clear coat's index must lie in [{ETA_MIN}, {ETA_MAX}], the range of its \
+                         directional-albedo table",
+                        reg::COAT_INDEX.pointer,
+                        c.index
+                    )),
+                }
             })?),
             None => None,
         };
@@ -987,11 +1005,8 @@ impl Brdf for Paint {
         let coat = match &self.rough_coat {
             None => format!("smooth coat η = {}", s.coat.index),
             Some(mf) => format!(
-                "rough coat η = {} ({:?} {}; energy-exact coupling, albedo table within {:.0e} of its rule)",
-                s.coat.index,
-                mf.distribution,
-                mf.alpha,
-                self.coat_albedo.as_ref().map_or(0.0, |a| a.max_error)
+                "rough coat η = {} ({:?} {}; energy-exact coupling, directional albedo from the shipped table)",
+                s.coat.index, mf.distribution, mf.alpha
             ),
         };
         let mut d = format!(

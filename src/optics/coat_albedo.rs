@@ -29,13 +29,26 @@
 //! Against scipy's adaptive integral over the outgoing direction (`tools/ref_coat_albedo.py`) the rule is
 //! within 6.3·10⁻¹¹ for Beckmann 0.01–1, GGX 0.02–0.5, θ 0–89° (`tests/paint.rs`).
 //!
-//! The table: E on μ ∈ [μ₀, 1], μ₀ = 1/64 (θ = 89.1°), in Chebyshev pieces ([`NODES`] Chebyshev–Gauss nodes
-//! each) graded towards grazing (where E varies on the scale of α) and towards the normal (where Λ(ωi) ∝
-//! exp(−μ²/(α² sin²θ)) is not analytic at μ = 1, felt for α ~ 1), checked against the rule at every piece's
-//! middle and ends when built (the largest deviation is kept: `max_error`). Below μ₀ the table holds E(μ₀) (no
-//! instrument reaches 89°). Ē is the exact cosine-weighted mean of the tabulated function (so the coupled coat
-//! conserves energy to the table's own error); it is integrated piecewise by Gauss–Legendre, exact for the
-//! polynomial pieces. Cost: 0.3–1.1·10⁶ lobe evaluations per table (`benches/paint_build.rs`).
+//! The reference rule's node counts ([`PHI_NODES`], [`CORE_NODES`], [`TAIL_NODES`]: 12, 48, 24) agree with
+//! 16, 64 and 32 nodes to 1.4·10⁻¹² (Beckmann α = 1), ≤ 1.3·10⁻¹⁴ elsewhere, for
+//! α 10⁻⁴–1 (both distributions, η = 1.5, 40 μ in [μ₀, 1]); it costs 6–40·10³ lobe evaluations per E, so a paint
+//! does not run it: it reads the shipped table (below).
+//!
+//! The per-paint function: E on μ ∈ [μ₀, 1], μ₀ = 1/64 (θ = 89.1°), in Chebyshev pieces ([`NODES`]
+//! coefficients each) graded towards grazing (where E varies on the scale of α) and towards the normal (where
+//! Λ(ωi) ∝ exp(−μ²/(α² sin²θ)) is not analytic at μ = 1, felt for α ~ 1). Below μ₀ it holds E(μ₀) (no
+//! instrument reaches 89°). Ē is the exact cosine-weighted mean of that function (so the coupled coat
+//! conserves energy to the function's own error); it is integrated piecewise by Gauss–Legendre, exact for the
+//! polynomial pieces.
+//!
+//! The shipped table (`assets/coat-albedo-table.bin`, provenance `assets/coat-albedo-table.json`, written by
+//! `cargo run --release --example make_coat_albedo_table` from the reference rule): for each distribution, the
+//! per-paint function's μ-Chebyshev coefficients as a tensor Chebyshev series in ln α (pieces [`ALPHA_BREAKS`],
+//! [`ALPHA_NODES`] terms each) and η ∈ [[`ETA_MIN`], [`ETA_MAX`]] ([`ETA_NODES`] terms), trailing coefficients
+//! dropped while their absolute sum stays within [`TRUNCATION_BUDGET`] per block. A paint's build sums the
+//! series at its (α, η): no lobe evaluation. Supported: α ∈ [`ALPHA_BREAKS`] ends = [10⁻⁷, 1] (every rough coat: below 10⁻⁷ a coat is smooth), η ∈ [1.3, 1.8]
+//! (the recipe's whole index range); outside, [`CoatAlbedo::new`] refuses. The table's error against the rule at
+//! off-grid (α, η, μ) is tested (`tests/paint.rs`).
 use super::fresnel::fr_dielectric;
 use super::microfacet::{Distribution, Microfacet};
 use crate::quadrature::gauss_legendre;
@@ -43,27 +56,77 @@ use crate::Vec3;
 use std::f64::consts::PI;
 
 /// Gauss–Legendre nodes of each azimuthal panel.
-pub const PHI_NODES: usize = 8;
+pub const PHI_NODES: usize = 12;
 /// Gauss–Legendre nodes of the core radial panel (Beckmann t ∈ [0, 2.5], GGX t ∈ [0, 1]).
-pub const CORE_NODES: usize = 32;
+pub const CORE_NODES: usize = 48;
 /// Gauss–Legendre nodes of the Beckmann tail panel t ∈ [2.5, 6.5] and of each graded GGX tail panel.
-pub const TAIL_NODES: usize = 16;
+pub const TAIL_NODES: usize = 24;
 /// Where the Beckmann core panel ends (scaled slope).
 const BECKMANN_SPLIT: f64 = 2.5;
 /// Beckmann's scaled-slope cut: e^{−T²} = 5·10⁻¹⁹.
 const BECKMANN_CUT: f64 = 6.5;
 /// Smallest μ tabulated (θ = 89.105°).
 pub const MU_MIN: f64 = 1.0 / 64.0;
-/// Break points of the table's pieces: [μ₀2^k, μ₀2^{k+1}] up to 1/2 (graded towards grazing, where E varies
-/// on the scale of α), then [1 − 2^{−k}, 1 − 2^{−k−1}] up to 15/16 and [15/16, 1] (graded towards the normal,
-/// where Λ(ωi) ∝ exp(−μ²/(α² sin²θ)) makes E non-analytic at μ = 1: negligible for small α, not for α ~ 1).
-const BREAKS: [f64; 10] = [MU_MIN, 1.0 / 32.0, 1.0 / 16.0, 0.125, 0.25, 0.5, 0.75, 0.875, 0.9375, 1.0];
-/// Pieces of the table.
-const PIECES: usize = BREAKS.len() - 1;
-/// Chebyshev nodes per piece.
+/// Break points of the per-paint function's pieces in μ: [μ₀2^k, μ₀2^{k+1}] up to 1/2 (graded towards
+/// grazing, where E varies on the scale of α), then [1 − 2^{−k}, 1 − 2^{−k−1}] up to 15/16 and [15/16, 1]
+/// (graded towards the normal, where Λ(ωi) ∝ exp(−μ²/(α² sin²θ)) makes E non-analytic at μ = 1: negligible
+/// for small α, not for α ~ 1).
+pub const BREAKS: [f64; 10] = [MU_MIN, 1.0 / 32.0, 1.0 / 16.0, 0.125, 0.25, 0.5, 0.75, 0.875, 0.9375, 1.0];
+/// Pieces of the per-paint function.
+pub const PIECES: usize = BREAKS.len() - 1;
+/// Chebyshev coefficients (and nodes) per μ piece.
 pub const NODES: usize = 14;
-/// Largest deviation of the table from the rule accepted at the check points.
-pub const TABLE_TOLERANCE: f64 = 1e-10;
+/// Break points of the shipped table's pieces in α (each piece a Chebyshev series in ln α); its ends are the
+/// supported roughness range.
+pub const ALPHA_BREAKS: [f64; 14] = [1e-7, 1e-5, 1e-4, 1e-3, 2e-3, 4e-3, 0.01, 0.02, 0.04, 0.09, 0.18, 0.3, 0.55, 1.0];
+/// Chebyshev terms per α piece.
+pub const ALPHA_NODES: usize = 16;
+/// The shipped table's index range (the recipe's: `/clear_coat/index`).
+pub const ETA_MIN: f64 = 1.3;
+pub const ETA_MAX: f64 = 1.8;
+/// Chebyshev terms in η.
+pub const ETA_NODES: usize = 16;
+/// Bound on the absolute sum of the coefficients the generator dropped per (distribution, α piece, μ piece)
+/// block, so on the truncation's contribution to |E_table − E_series| anywhere.
+pub const TRUNCATION_BUDGET: f64 = 1e-11;
+/// The distributions in the table's order.
+pub const DISTRIBUTIONS: [Distribution; 2] = [Distribution::Beckmann, Distribution::Ggx];
+
+/// The k-th of n Chebyshev–Gauss nodes on [lo, hi] (descending in k, as the coefficient transforms use them).
+pub fn cheb_node(k: usize, n: usize, lo: f64, hi: f64) -> f64 {
+    0.5 * (lo + hi) + 0.5 * (hi - lo) * (PI * (k as f64 + 0.5) / n as f64).cos()
+}
+
+/// Chebyshev coefficients c_k (Σ c_k T_k on [−1, 1]) of the interpolant through values at the n
+/// Chebyshev–Gauss nodes.
+pub fn cheb_coefficients(vals: &[f64]) -> Vec<f64> {
+    let n = vals.len();
+    (0..n)
+        .map(|k| {
+            let c: f64 =
+                vals.iter().enumerate().map(|(j, v)| v * (PI * k as f64 * (j as f64 + 0.5) / n as f64).cos()).sum();
+            if k == 0 {
+                c / n as f64
+            } else {
+                2.0 * c / n as f64
+            }
+        })
+        .collect()
+}
+
+/// T_0(x) … T_{n−1}(x).
+fn cheb_t(x: f64, out: &mut [f64]) {
+    let n = out.len();
+    if n > 0 {
+        out[0] = 1.0;
+    }
+    if n > 1 {
+        out[1] = x;
+    }
+    for k in 2..n {
+        out[k] = 2.0 * x * out[k - 1] - out[k - 2];
+    }
+}
 
 /// The rule's fixed nodes.
 struct Rule {
@@ -186,17 +249,17 @@ fn lobe_albedo_with(rule: &Rule, mf: &Microfacet, eta: f64, mu: f64) -> (f64, us
     (total / PI, evals)
 }
 
-/// E(μ) tabulated, with its hemispherical average Ē = ∫₀¹ E(μ) 2μ dμ.
+/// E(μ) as the per-paint piecewise Chebyshev function, with its hemispherical average Ē = ∫₀¹ E(μ) 2μ dμ.
 #[derive(Clone, Debug, PartialEq)]
 pub struct CoatAlbedo {
     /// PIECES × NODES Chebyshev coefficients.
     coeffs: Vec<f64>,
-    /// Ē of the tabulated function.
+    /// Ē of the function.
     pub mean: f64,
-    /// Largest |table − rule| at the check points.
-    pub max_error: f64,
-    /// Lobe evaluations the rule spent building and checking the table.
+    /// Lobe evaluations spent building it: 0 from the shipped table.
     pub evaluations: usize,
+    /// Table coefficients summed building it: 0 from the rule.
+    pub table_terms: usize,
 }
 
 fn piece_bounds(p: usize) -> (f64, f64) {
@@ -207,75 +270,172 @@ fn piece_of(mu: f64) -> usize {
     BREAKS[1..PIECES].iter().take_while(|&&b| mu >= b).count()
 }
 
-impl CoatAlbedo {
-    /// Build the table for a rough interface (its lobe `mf`) of index `eta`; `None` if the table deviates
-    /// from the rule by more than [`TABLE_TOLERANCE`] at a check point (never observed: `tests/paint.rs`).
-    pub fn new(mf: &Microfacet, eta: f64) -> Option<CoatAlbedo> {
-        Self::build(mf, eta).filter(|t| t.max_error <= TABLE_TOLERANCE)
-    }
+/// Why the shipped table cannot give a coat's E.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum OutOfTable {
+    /// α outside [`ALPHA_BREAKS`]' ends.
+    Roughness,
+    /// η outside [[`ETA_MIN`], [`ETA_MAX`]].
+    Index,
+}
 
-    /// The table and its check, whatever the deviation found (`max_error`); `None` only if the rule gave a
-    /// non-finite value.
-    pub fn build(mf: &Microfacet, eta: f64) -> Option<CoatAlbedo> {
-        let rule = Rule::new();
-        let evaluations = std::cell::Cell::new(0usize);
-        let e = |mu: f64| {
-            let (v, n) = lobe_albedo_with(&rule, mf, eta, mu);
-            evaluations.set(evaluations.get() + n);
-            v
-        };
-        let mut coeffs = Vec::with_capacity(PIECES * NODES);
-        let mut vals = [0.0; NODES];
-        for p in 0..PIECES {
-            let (lo, hi) = piece_bounds(p);
-            for (j, v) in vals.iter_mut().enumerate() {
-                let x = (PI * (j as f64 + 0.5) / NODES as f64).cos();
-                *v = e(0.5 * (lo + hi) + 0.5 * (hi - lo) * x);
-                if !v.is_finite() {
-                    return None;
+/// The shipped table, parsed once: rows of μ-Chebyshev coefficients, one row per (distribution, α piece,
+/// μ piece, α term, η term), each of its stored length.
+struct Table {
+    data: Vec<f64>,
+    /// (offset into `data`, length) per row.
+    rows: Vec<(u32, u8)>,
+}
+
+/// The bytes of `assets/coat-albedo-table.bin` (format: [`parse_table`]).
+pub const TABLE_BYTES: &[u8] = include_bytes!("../../assets/coat-albedo-table.bin");
+/// Its first eight bytes.
+pub const TABLE_MAGIC: &[u8; 8] = b"GMCOAT01";
+
+/// Rows of the table, in its order.
+pub const TABLE_ROWS: usize = DISTRIBUTIONS.len() * (ALPHA_BREAKS.len() - 1) * PIECES * ALPHA_NODES * ETA_NODES;
+
+fn row_index(dist: usize, ap: usize, mp: usize, ka: usize, ke: usize) -> usize {
+    (((dist * (ALPHA_BREAKS.len() - 1) + ap) * PIECES + mp) * ALPHA_NODES + ka) * ETA_NODES + ke
+}
+
+/// Parse the table: the magic, then as little-endian u32 the counts (distributions, α pieces, ALPHA_NODES,
+/// ETA_NODES, PIECES, NODES), as f64 the α breaks, η range and μ breaks (all checked against this module's
+/// constants), then [`TABLE_ROWS`] rows in [`row_index`] order, each a u8 length L ≤ NODES and L f64.
+fn parse_table(b: &[u8]) -> std::result::Result<Table, String> {
+    let mut at = 0usize;
+    let mut take = |n: usize| -> std::result::Result<&[u8], String> {
+        let s = b.get(at..at + n).ok_or_else(|| format!("coat-albedo table truncated at byte {at}"))?;
+        at += n;
+        Ok(s)
+    };
+    if take(8)? != TABLE_MAGIC {
+        return Err("coat-albedo table: bad magic".into());
+    }
+    let counts = [DISTRIBUTIONS.len(), ALPHA_BREAKS.len() - 1, ALPHA_NODES, ETA_NODES, PIECES, NODES];
+    for c in counts {
+        let v = u32::from_le_bytes(take(4)?.try_into().expect("4 bytes"));
+        if v as usize != c {
+            return Err(format!("coat-albedo table: layout count {v}, the code expects {c}"));
+        }
+    }
+    let expect: Vec<f64> = ALPHA_BREAKS.iter().chain(&[ETA_MIN, ETA_MAX]).chain(&BREAKS).copied().collect();
+    for e in expect {
+        let v = f64::from_le_bytes(take(8)?.try_into().expect("8 bytes"));
+        if v != e {
+            return Err(format!("coat-albedo table: break point {v}, the code expects {e}"));
+        }
+    }
+    let mut data = Vec::new();
+    let mut rows = Vec::with_capacity(TABLE_ROWS);
+    for _ in 0..TABLE_ROWS {
+        let len = take(1)?[0];
+        if len as usize > NODES {
+            return Err(format!("coat-albedo table: row of {len} > {NODES} coefficients"));
+        }
+        rows.push((data.len() as u32, len));
+        for _ in 0..len {
+            data.push(f64::from_le_bytes(take(8)?.try_into().expect("8 bytes")));
+        }
+    }
+    if at != b.len() {
+        return Err(format!("coat-albedo table: {} trailing bytes", b.len() - at));
+    }
+    Ok(Table { data, rows })
+}
+
+fn table() -> &'static Table {
+    static T: std::sync::OnceLock<Table> = std::sync::OnceLock::new();
+    // The bytes are compiled in and checked by the unit test below: a failure here is a build defect.
+    T.get_or_init(|| parse_table(TABLE_BYTES).expect("the shipped coat-albedo table parses"))
+}
+
+/// Coefficients stored in the shipped table (after truncation) and its rows.
+pub fn table_size() -> (usize, usize) {
+    let t = table();
+    (t.data.len(), t.rows.len())
+}
+
+impl CoatAlbedo {
+    /// E for a rough interface (its lobe `mf`) of index `eta`, from the shipped table (module docs): sums
+    /// the table's series at (ln α, η); refused outside the table's range.
+    pub fn new(mf: &Microfacet, eta: f64) -> std::result::Result<CoatAlbedo, OutOfTable> {
+        let (a_lo, a_hi) = (ALPHA_BREAKS[0], ALPHA_BREAKS[ALPHA_BREAKS.len() - 1]);
+        if !(a_lo..=a_hi).contains(&mf.alpha) {
+            return Err(OutOfTable::Roughness);
+        }
+        if !(ETA_MIN..=ETA_MAX).contains(&eta) {
+            return Err(OutOfTable::Index);
+        }
+        let dist = DISTRIBUTIONS.iter().position(|&d| d == mf.distribution).expect("both distributions tabulated");
+        let ap = ALPHA_BREAKS[1..ALPHA_BREAKS.len() - 1].iter().take_while(|&&b| mf.alpha >= b).count();
+        let (l0, l1) = (ALPHA_BREAKS[ap].ln(), ALPHA_BREAKS[ap + 1].ln());
+        let xa = ((2.0 * mf.alpha.ln() - l0 - l1) / (l1 - l0)).clamp(-1.0, 1.0);
+        let xe = ((2.0 * eta - ETA_MIN - ETA_MAX) / (ETA_MAX - ETA_MIN)).clamp(-1.0, 1.0);
+        let (mut ta, mut te) = ([0.0; ALPHA_NODES], [0.0; ETA_NODES]);
+        cheb_t(xa, &mut ta);
+        cheb_t(xe, &mut te);
+        let t = table();
+        let mut coeffs = vec![0.0; PIECES * NODES];
+        let mut terms = 0usize;
+        for mp in 0..PIECES {
+            let c = &mut coeffs[mp * NODES..(mp + 1) * NODES];
+            for (ka, &wa) in ta.iter().enumerate() {
+                for (ke, &we) in te.iter().enumerate() {
+                    let (off, len) = t.rows[row_index(dist, ap, mp, ka, ke)];
+                    let w = wa * we;
+                    for (ck, &v) in c.iter_mut().zip(&t.data[off as usize..off as usize + len as usize]) {
+                        *ck += w * v;
+                    }
+                    terms += len as usize;
                 }
             }
-            for k in 0..NODES {
-                let c: f64 = vals
-                    .iter()
-                    .enumerate()
-                    .map(|(j, v)| v * (PI * k as f64 * (j as f64 + 0.5) / NODES as f64).cos())
-                    .sum();
-                coeffs.push(if k == 0 { c / NODES as f64 } else { 2.0 * c / NODES as f64 });
-            }
         }
-        let mut table = CoatAlbedo { coeffs, mean: 0.0, max_error: 0.0, evaluations: 0 };
-        // Check between the nodes: the ends and the middle of every piece (where an interpolant errs most;
-        // a shared end is checked once, from the piece above it, which `at` uses there).
-        let mut max_error: f64 = 0.0;
+        Ok(Self::finish(coeffs, 0, terms))
+    }
+
+    /// E from the reference rule at the μ nodes (`PIECES × NODES` runs of [`lobe_albedo`]: 10⁵–10⁶ lobe
+    /// evaluations, so for tests and the table's generator, never a paint); `None` if the rule gave a
+    /// non-finite value.
+    pub fn from_rule(mf: &Microfacet, eta: f64) -> Option<CoatAlbedo> {
+        let rule = Rule::new();
+        let mut evaluations = 0usize;
+        let mut coeffs = Vec::with_capacity(PIECES * NODES);
         for p in 0..PIECES {
             let (lo, hi) = piece_bounds(p);
-            let mut points = vec![lo, 0.5 * (lo + hi)];
-            if p + 1 == PIECES {
-                points.push(hi);
+            let mut vals = [0.0; NODES];
+            for (j, v) in vals.iter_mut().enumerate() {
+                let (e, n) = lobe_albedo_with(&rule, mf, eta, cheb_node(j, NODES, lo, hi));
+                evaluations += n;
+                if !e.is_finite() {
+                    return None;
+                }
+                *v = e;
             }
-            for x in points {
-                max_error = max_error.max((table.at(x) - e(x)).abs());
-            }
+            coeffs.extend(cheb_coefficients(&vals));
         }
-        if !max_error.is_finite() {
-            return None;
-        }
-        table.max_error = max_error;
+        Some(Self::finish(coeffs, evaluations, 0))
+    }
+
+    /// The μ-Chebyshev coefficients, piece after piece.
+    pub fn coefficients(&self) -> &[f64] {
+        &self.coeffs
+    }
+
+    fn finish(coeffs: Vec<f64>, evaluations: usize, table_terms: usize) -> CoatAlbedo {
+        let mut a = CoatAlbedo { coeffs, mean: 0.0, evaluations, table_terms };
         // Ē of the function `at` evaluates: E(μ₀)·μ₀² on [0, μ₀], then each piece by Gauss–Legendre
         // (exact: the integrand is a polynomial of degree NODES on each piece).
         let (gx, gw) = gauss_legendre(NODES / 2 + 2);
-        let mut mean = table.at(MU_MIN) * MU_MIN * MU_MIN;
+        let mut mean = a.at(MU_MIN) * MU_MIN * MU_MIN;
         for p in 0..PIECES {
             let (lo, hi) = piece_bounds(p);
             let (m, h) = (0.5 * (lo + hi), 0.5 * (hi - lo));
             mean +=
-                gx.iter().zip(&gw).map(|(&x, &w)| w * table.piece_eval(p, m + h * x) * 2.0 * (m + h * x)).sum::<f64>()
-                    * h;
+                gx.iter().zip(&gw).map(|(&x, &w)| w * a.piece_eval(p, m + h * x) * 2.0 * (m + h * x)).sum::<f64>() * h;
         }
-        table.mean = mean;
-        table.evaluations = evaluations.get();
-        Some(table)
+        a.mean = mean;
+        a
     }
 
     fn piece_eval(&self, p: usize, mu: f64) -> f64 {
@@ -292,10 +452,39 @@ impl CoatAlbedo {
         x * b1 - b2 + c[0]
     }
 
-    /// E(μ) from the table (E(μ₀) below μ₀; μ is clamped to 1).
+    /// E(μ) (E(μ₀) below μ₀; μ is clamped to 1).
     #[inline]
     pub fn at(&self, mu: f64) -> f64 {
         let mu = mu.clamp(MU_MIN, 1.0);
         self.piece_eval(piece_of(mu), mu)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn shipped_table_parses_with_this_layout() {
+        let t = parse_table(TABLE_BYTES).expect("parses");
+        assert_eq!(t.rows.len(), TABLE_ROWS);
+        assert!(t.data.iter().all(|v| v.is_finite()));
+        // A corrupted copy is refused, not misread.
+        let mut bad = TABLE_BYTES.to_vec();
+        bad[8] ^= 1;
+        assert!(parse_table(&bad).unwrap_err().contains("layout count"));
+        assert!(parse_table(&TABLE_BYTES[..TABLE_BYTES.len() - 1]).unwrap_err().contains("truncated"));
+    }
+
+    #[test]
+    fn chebyshev_transform_reproduces_its_nodes() {
+        let vals: Vec<f64> = (0..NODES).map(|j| cheb_node(j, NODES, 0.2, 0.7).exp()).collect();
+        let c = cheb_coefficients(&vals);
+        let mut t = [0.0; NODES];
+        for (j, v) in vals.iter().enumerate() {
+            cheb_t((PI * (j as f64 + 0.5) / NODES as f64).cos(), &mut t);
+            let s: f64 = c.iter().zip(&t).map(|(a, b)| a * b).sum();
+            assert!((s - v).abs() < 1e-14, "{s} vs {v}");
+        }
     }
 }
