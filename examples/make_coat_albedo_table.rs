@@ -11,6 +11,8 @@
 //! row (distribution, α piece, μ piece, α term, η term) keeps its leading μ coefficients; the trailing ones
 //! below a threshold τ are dropped, τ the largest for which the dropped coefficients of the
 //! (distribution, α piece, μ piece) block sum to at most TRUNCATION_BUDGET.
+// The transforms index a (α term, η term, μ term) tensor by all three indices at once.
+#![allow(clippy::needless_range_loop)]
 use glossmeter::optics::coat_albedo::*;
 use glossmeter::optics::microfacet::Microfacet;
 use rayon::prelude::*;

@@ -1202,4 +1202,10 @@ fn realistic_paints_read_in_the_real_meter_ranges() {
         let (g20, _) = read(name);
         assert!(g20 > 500.0, "{name}: the literal flake spread reads {g20} at 20°");
     }
+    // The rough-coat semi-gloss: 60° inside the semi-gloss class of all three sources (MPI Gloss Level 5
+    // 35–70, ISO 2813 41–70, Firwood 41–69: docs/model.md §Paints that read like paints), and 20° below 60°
+    // (no sourced 20° range; a lobe wider than the 20° receptor loses more there).
+    let (g20, g60) = read("semigloss-white");
+    assert!((41.0..=69.0).contains(&g60), "semigloss-white: 60° reads {g60}");
+    assert!(g20 < g60, "semigloss-white: 20° {g20} vs 60° {g60}");
 }

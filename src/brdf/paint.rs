@@ -526,7 +526,7 @@ impl Paint {
             (c.roughness >= Microfacet::SMOOTH_THRESHOLD).then(|| Microfacet::new(c.distribution, c.roughness));
         // A rough coat lets in 1 − E(θ) and reflects back inside r_i = 1 − (1 − Ē)/η² (Kelemen &
         // Szirmay-Kalos 2001); a smooth one T(θ) = 1 − F(θ) and r_i = 1 − (1 − r_e)/η², its limit.
-        // E comes from the shipped table (`optics::coat_albedo`), which covers roughness [10⁻³, 1] and the
+        // E comes from the shipped table (`optics::coat_albedo`), which covers roughness [10⁻⁷, 1] and the
         // whole index range; a rough coat outside it is refused, naming the field.
         let coat_albedo = match &rough_coat {
             Some(mf) => Some(CoatAlbedo::new(mf, eta).map_err(|why| {
