@@ -303,17 +303,15 @@ fn rule_rows(c: &Case, rtol: f64, rules: &[(&str, Option<Rule>)], reference: f64
             continue;
         }
         let (f, secs, runs): (Flux, f64, usize) = timed(|| p.solve());
-        rows.push(Row {
-            case: c.id,
-            method: format!("{label}, rtol {rtol:.0e}"),
-            value: f.value[0],
-            claimed: f.error[0] / f.value[0].abs(),
-            rel_err: (f.value[0] - reference).abs() / reference,
-            evals: f.evaluations,
-            seconds: secs,
+        rows.push(Row::of_flux(
+            c.id,
+            format!("{label}, rtol {rtol:.0e}"),
+            &f,
+            reference,
+            secs,
             runs,
-            note: format!("{}{}", rule_label(&p.method, p.brdf), if f.converged { "" } else { ", NOT converged" }),
-        });
+            format!("{}{}", rule_label(&p.method, p.brdf), if f.converged { "" } else { ", NOT converged" }),
+        ));
     }
     rows
 }
@@ -435,6 +433,31 @@ struct Row {
     seconds: f64,
     runs: usize,
     note: String,
+}
+
+impl Row {
+    /// A row of our engine: its flux on `case` against `reference`, timed `secs` over `runs` runs.
+    fn of_flux(
+        case: &'static str,
+        method: String,
+        f: &Flux,
+        reference: f64,
+        secs: f64,
+        runs: usize,
+        note: String,
+    ) -> Row {
+        Row {
+            case,
+            method,
+            value: f.value[0],
+            claimed: f.error[0] / f.value[0].abs(),
+            rel_err: (f.value[0] - reference).abs() / reference,
+            evals: f.evaluations,
+            seconds: secs,
+            runs,
+            note,
+        }
+    }
 }
 
 fn fmt_time(s: f64) -> String {
@@ -610,17 +633,15 @@ fn main() {
         for rtol in [1e-3, 1e-6, 1e-9] {
             let p = problem(c, rtol);
             let (f, secs, runs): (Flux, f64, usize) = timed(|| p.solve());
-            rows.push(Row {
-                case: c.id,
-                method: format!("ours, rtol {rtol:.0e}"),
-                value: f.value[0],
-                claimed: f.error[0] / f.value[0].abs(),
-                rel_err: (f.value[0] - reference).abs() / reference,
-                evals: f.evaluations,
-                seconds: secs,
+            rows.push(Row::of_flux(
+                c.id,
+                format!("ours, rtol {rtol:.0e}"),
+                &f,
+                reference,
+                secs,
                 runs,
-                note: format!("{} regions{}", f.regions, if f.converged { "" } else { ", NOT converged" }),
-            });
+                format!("{} regions{}", f.regions, if f.converged { "" } else { ", NOT converged" }),
+            ));
         }
         // The two rules forced on the same integral at rtol 1e-6 (issue 10): the tensor rule (in (p_s, p_r, v,
         // t_q), whatever the planner chooses) and the Genz–Malik 7/5 engine on the planner's lobe-variable
@@ -648,17 +669,15 @@ fn main() {
                 let rc = Case { brdf, geometry: c.geometry.clone(), title: c.title.clone(), ..*c };
                 let p = problem(&rc, 1e-6);
                 if let Some((f, secs, runs)) = try_run(file, || timed(|| p.solve())) {
-                    rows.push(Row {
-                        case: c.id,
-                        method: "ours, recipe BRDF, rtol 1e-6".into(),
-                        value: f.value[0],
-                        claimed: f.error[0] / f.value[0].abs(),
-                        rel_err: (f.value[0] - reference).abs() / reference,
-                        evals: f.evaluations,
-                        seconds: secs,
+                    rows.push(Row::of_flux(
+                        c.id,
+                        "ours, recipe BRDF, rtol 1e-6".into(),
+                        &f,
+                        reference,
+                        secs,
                         runs,
-                        note: format!("fixtures/recipes/{file}"),
-                    });
+                        format!("fixtures/recipes/{file}"),
+                    ));
                 }
             }
         }

@@ -45,10 +45,24 @@ pub const TABLE_MAX_ORDER: usize = 64;
 /// process by [`gauss_legendre`] (the same bits), so that a rule raised level by level in a hot loop
 /// (`instrument::method`'s polar and Gauss–Hermite rules) neither recomputes nor allocates its nodes.
 pub fn gauss_legendre_table(n: usize) -> (&'static [f64], &'static [f64]) {
-    static TABLE: std::sync::OnceLock<Vec<(Vec<f64>, Vec<f64>)>> = std::sync::OnceLock::new();
-    assert!((1..=TABLE_MAX_ORDER).contains(&n), "Gauss–Legendre order {n} outside the table");
-    let t = TABLE.get_or_init(|| (1..=TABLE_MAX_ORDER).map(gauss_legendre).collect());
-    let (x, w) = &t[n - 1];
+    static TABLE: RuleTable = RuleTable::new();
+    from_table(&TABLE, n, TABLE_MAX_ORDER, gauss_legendre, "Gauss–Legendre")
+}
+
+/// Rules of orders 1..=max, built once per process.
+pub(crate) type RuleTable = std::sync::OnceLock<Vec<(Vec<f64>, Vec<f64>)>>;
+
+/// The n-point rule of `table`, which `build` fills with the orders 1..=`max` on first use (the same bits as
+/// `build(n)`); `name` is the rule's, for the message if n is outside the table.
+pub(crate) fn from_table(
+    table: &'static RuleTable,
+    n: usize,
+    max: usize,
+    build: fn(usize) -> (Vec<f64>, Vec<f64>),
+    name: &str,
+) -> (&'static [f64], &'static [f64]) {
+    assert!((1..=max).contains(&n), "{name} order {n} outside the table");
+    let (x, w) = &table.get_or_init(|| (1..=max).map(build).collect())[n - 1];
     (x, w)
 }
 

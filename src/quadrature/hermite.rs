@@ -53,11 +53,8 @@ pub const HERMITE_TABLE_MAX_ORDER: usize = 32;
 /// The n-point Gauss–Hermite rule (1 ≤ n ≤ [`HERMITE_TABLE_MAX_ORDER`]) from a table computed once per process by
 /// [`gauss_hermite`] (the same bits): a rule raised level by level neither recomputes nor allocates its nodes.
 pub fn gauss_hermite_table(n: usize) -> (&'static [f64], &'static [f64]) {
-    static TABLE: std::sync::OnceLock<Vec<(Vec<f64>, Vec<f64>)>> = std::sync::OnceLock::new();
-    assert!((1..=HERMITE_TABLE_MAX_ORDER).contains(&n), "Gauss–Hermite order {n} outside the table");
-    let t = TABLE.get_or_init(|| (1..=HERMITE_TABLE_MAX_ORDER).map(gauss_hermite).collect());
-    let (x, w) = &t[n - 1];
-    (x, w)
+    static TABLE: super::gauss::RuleTable = super::gauss::RuleTable::new();
+    super::gauss::from_table(&TABLE, n, HERMITE_TABLE_MAX_ORDER, gauss_hermite, "Gauss–Hermite")
 }
 
 #[cfg(test)]
