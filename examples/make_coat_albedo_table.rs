@@ -15,6 +15,7 @@
 #![allow(clippy::needless_range_loop)]
 use glossmeter::optics::coat_albedo::*;
 use glossmeter::optics::microfacet::Microfacet;
+use glossmeter::optics::tabulated::{coefficients, node_on};
 use rayon::prelude::*;
 use std::io::Write;
 
@@ -31,8 +32,8 @@ fn main() {
     let results: Vec<(Vec<f64>, usize)> = tasks
         .par_iter()
         .map(|&(d, ap, i, j)| {
-            let la = cheb_node(i, ALPHA_NODES, ALPHA_BREAKS[ap].ln(), ALPHA_BREAKS[ap + 1].ln());
-            let eta = cheb_node(j, ETA_NODES, ETA_MIN, ETA_MAX);
+            let la = node_on(i, ALPHA_NODES, ALPHA_BREAKS[ap].ln(), ALPHA_BREAKS[ap + 1].ln());
+            let eta = node_on(j, ETA_NODES, ETA_MIN, ETA_MAX);
             let a = CoatAlbedo::from_rule(&Microfacet::new(DISTRIBUTIONS[d], la.exp()), eta)
                 .unwrap_or_else(|| panic!("non-finite E at {:?} α {} η {eta}", DISTRIBUTIONS[d], la.exp()));
             (a.coefficients().to_vec(), a.evaluations)
@@ -59,13 +60,11 @@ fn main() {
                     // Transform in η for each α node, then in α.
                     let by_eta: Vec<Vec<f64>> = (0..ALPHA_NODES)
                         .map(|i| {
-                            cheb_coefficients(
-                                &(0..ETA_NODES).map(|j| at(d, ap, i, j)[mp * NODES + km]).collect::<Vec<_>>(),
-                            )
+                            coefficients(&(0..ETA_NODES).map(|j| at(d, ap, i, j)[mp * NODES + km]).collect::<Vec<_>>())
                         })
                         .collect();
                     for ke in 0..ETA_NODES {
-                        let c = cheb_coefficients(&(0..ALPHA_NODES).map(|i| by_eta[i][ke]).collect::<Vec<_>>());
+                        let c = coefficients(&(0..ALPHA_NODES).map(|i| by_eta[i][ke]).collect::<Vec<_>>());
                         for ka in 0..ALPHA_NODES {
                             coef[ka][ke][km] = c[ka];
                         }

@@ -51,6 +51,7 @@
 //! off-grid (α, η, μ) is tested (`tests/paint.rs`).
 use super::fresnel::fr_dielectric;
 use super::microfacet::{Distribution, Microfacet};
+use super::tabulated::{basis_into, coefficients, node_on};
 use crate::quadrature::gauss_legendre;
 use crate::Vec3;
 use std::f64::consts::PI;
@@ -91,42 +92,6 @@ pub const ETA_NODES: usize = 16;
 pub const TRUNCATION_BUDGET: f64 = 1e-11;
 /// The distributions in the table's order.
 pub const DISTRIBUTIONS: [Distribution; 2] = [Distribution::Beckmann, Distribution::Ggx];
-
-/// The k-th of n Chebyshev–Gauss nodes on [lo, hi] (descending in k, as the coefficient transforms use them).
-pub fn cheb_node(k: usize, n: usize, lo: f64, hi: f64) -> f64 {
-    0.5 * (lo + hi) + 0.5 * (hi - lo) * (PI * (k as f64 + 0.5) / n as f64).cos()
-}
-
-/// Chebyshev coefficients c_k (Σ c_k T_k on [−1, 1]) of the interpolant through values at the n
-/// Chebyshev–Gauss nodes.
-pub fn cheb_coefficients(vals: &[f64]) -> Vec<f64> {
-    let n = vals.len();
-    (0..n)
-        .map(|k| {
-            let c: f64 =
-                vals.iter().enumerate().map(|(j, v)| v * (PI * k as f64 * (j as f64 + 0.5) / n as f64).cos()).sum();
-            if k == 0 {
-                c / n as f64
-            } else {
-                2.0 * c / n as f64
-            }
-        })
-        .collect()
-}
-
-/// T_0(x) … T_{n−1}(x).
-fn cheb_t(x: f64, out: &mut [f64]) {
-    let n = out.len();
-    if n > 0 {
-        out[0] = 1.0;
-    }
-    if n > 1 {
-        out[1] = x;
-    }
-    for k in 2..n {
-        out[k] = 2.0 * x * out[k - 1] - out[k - 2];
-    }
-}
 
 /// The rule's fixed nodes.
 struct Rule {
@@ -374,8 +339,8 @@ impl CoatAlbedo {
         let xa = ((2.0 * mf.alpha.ln() - l0 - l1) / (l1 - l0)).clamp(-1.0, 1.0);
         let xe = ((2.0 * eta - ETA_MIN - ETA_MAX) / (ETA_MAX - ETA_MIN)).clamp(-1.0, 1.0);
         let (mut ta, mut te) = ([0.0; ALPHA_NODES], [0.0; ETA_NODES]);
-        cheb_t(xa, &mut ta);
-        cheb_t(xe, &mut te);
+        basis_into(xa, &mut ta);
+        basis_into(xe, &mut te);
         let t = table();
         let mut coeffs = vec![0.0; PIECES * NODES];
         let mut terms = 0usize;
@@ -406,14 +371,14 @@ impl CoatAlbedo {
             let (lo, hi) = piece_bounds(p);
             let mut vals = [0.0; NODES];
             for (j, v) in vals.iter_mut().enumerate() {
-                let (e, n) = lobe_albedo_with(&rule, mf, eta, cheb_node(j, NODES, lo, hi));
+                let (e, n) = lobe_albedo_with(&rule, mf, eta, node_on(j, NODES, lo, hi));
                 evaluations += n;
                 if !e.is_finite() {
                     return None;
                 }
                 *v = e;
             }
-            coeffs.extend(cheb_coefficients(&vals));
+            coeffs.extend(coefficients(&vals));
         }
         Some(Self::finish(coeffs, evaluations, 0))
     }
@@ -479,11 +444,11 @@ mod tests {
 
     #[test]
     fn chebyshev_transform_reproduces_its_nodes() {
-        let vals: Vec<f64> = (0..NODES).map(|j| cheb_node(j, NODES, 0.2, 0.7).exp()).collect();
-        let c = cheb_coefficients(&vals);
+        let vals: Vec<f64> = (0..NODES).map(|j| node_on(j, NODES, 0.2, 0.7).exp()).collect();
+        let c = coefficients(&vals);
         let mut t = [0.0; NODES];
         for (j, v) in vals.iter().enumerate() {
-            cheb_t((PI * (j as f64 + 0.5) / NODES as f64).cos(), &mut t);
+            basis_into((PI * (j as f64 + 0.5) / NODES as f64).cos(), &mut t);
             let s: f64 = c.iter().zip(&t).map(|(a, b)| a * b).sum();
             assert!((s - v).abs() < 1e-14, "{s} vs {v}");
         }

@@ -162,12 +162,49 @@ enum Fit {
 #[inline]
 pub fn basis(t: f64) -> [f64; N] {
     let mut b = [0.0; N];
-    b[0] = 1.0;
-    b[1] = t;
-    for k in 2..N {
-        b[k] = 2.0 * t * b[k - 1] - b[k - 2];
-    }
+    basis_into(t, &mut b);
     b
+}
+
+/// T_0(t) … T_{n−1}(t) into `out` (n = its length), by the recurrence T_k = 2t T_{k−1} − T_{k−2}.
+#[inline]
+pub fn basis_into(t: f64, out: &mut [f64]) {
+    let n = out.len();
+    if n > 0 {
+        out[0] = 1.0;
+    }
+    if n > 1 {
+        out[1] = t;
+    }
+    for k in 2..n {
+        out[k] = 2.0 * t * out[k - 1] - out[k - 2];
+    }
+}
+
+/// The k-th of n Chebyshev–Gauss nodes on [lo, hi], (lo + hi)/2 + (hi − lo)/2 · cos(π(k + ½)/n) (descending
+/// in k, the order [`coefficients`] takes its values in).
+pub fn node_on(k: usize, n: usize, lo: f64, hi: f64) -> f64 {
+    0.5 * (lo + hi) + 0.5 * (hi - lo) * (std::f64::consts::PI * (k as f64 + 0.5) / n as f64).cos()
+}
+
+/// Chebyshev coefficients c_k = (2/n) Σ_j f(x_j) cos(πk(j + ½)/n) (c₀ halved) of the interpolant through the
+/// values at the n Chebyshev–Gauss nodes ([`node_on`]), for any n (the tables above use n = [`N`]).
+pub fn coefficients(vals: &[f64]) -> Vec<f64> {
+    let n = vals.len();
+    (0..n)
+        .map(|k| {
+            let c: f64 = vals
+                .iter()
+                .enumerate()
+                .map(|(j, v)| v * (std::f64::consts::PI * k as f64 * (j as f64 + 0.5) / n as f64).cos())
+                .sum();
+            if k == 0 {
+                c / n as f64
+            } else {
+                2.0 * c / n as f64
+            }
+        })
+        .collect()
 }
 
 /// Σ_k c_k T_k(t) from the [`basis`] at t.
