@@ -24,8 +24,14 @@ pub const ALBEDO_TOLERANCE: f64 = 1e-9;
 
 /// Directional albedo of `brdf` for the incident direction `wi` (unit, z > 0), per spectral sample, with an
 /// error estimate (absolute, max over samples). Includes the delta reflectance. Returns zeros for wi at or
-/// below the horizon.
+/// below the horizon. The absolute tolerance is [`ALBEDO_TOLERANCE`].
 pub fn directional_albedo(brdf: &dyn Brdf, wi: Vec3) -> (Vec<f64>, f64) {
+    directional_albedo_to(brdf, wi, ALBEDO_TOLERANCE)
+}
+
+/// [`directional_albedo`] to the absolute tolerance `tolerance` (> 0; 1e-12 is about the floor of the
+/// Gauss–Kronrod panels in double precision): a white-furnace check tighter than the integrator's default.
+pub fn directional_albedo_to(brdf: &dyn Brdf, wi: Vec3, tolerance: f64) -> (Vec<f64>, f64) {
     let n = brdf.sampling().len();
     let mut total = vec![0.0; n];
     if wi.z.is_nan() || wi.z <= 0.0 {
@@ -53,7 +59,7 @@ pub fn directional_albedo(brdf: &dyn Brdf, wi: Vec3) -> (Vec<f64>, f64) {
     let c = wi.z;
     let phi_i = wi.y.atan2(wi.x);
 
-    let inner_tol = ALBEDO_TOLERANCE / (4.0 * PI);
+    let inner_tol = tolerance / (4.0 * PI);
     let mut fval = vec![0.0; n];
     // The outer integrand carries the inner error estimate as an extra component, so that its integral over
     // φ is the inner contribution to the total error.
@@ -91,7 +97,7 @@ pub fn directional_albedo(brdf: &dyn Brdf, wi: Vec3) -> (Vec<f64>, f64) {
         out[n] = e;
     };
     let breaks: Vec<f64> = (0..=16).map(|k| phi_i + k as f64 * PI / 8.0).collect();
-    let (regular, outer_err) = adaptive(&mut outer, &breaks, n + 1, n, ALBEDO_TOLERANCE, 2000);
+    let (regular, outer_err) = adaptive(&mut outer, &breaks, n + 1, n, tolerance, 2000);
     for (t, r) in total.iter_mut().zip(&regular[..n]) {
         *t += r;
     }
