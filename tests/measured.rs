@@ -197,16 +197,37 @@ fn lambertian_table_reads_rho_over_pi_with_both_lookups() {
         let desc = m.brdf.describe();
         assert!(desc.contains("lambert.binary") && desc.contains("90 × 90 × 180") && desc.contains(interp), "{desc}");
         assert!(desc.contains("0 invalid"), "{desc}");
+        // Every cell the same per channel: a constant BRDF, stated as a diffuse term (issue 10: the plain
+        // chart, 57 evaluations at D523 20°/60°/85°, instead of splits at the resolution).
         let terms = m.brdf.terms();
         assert_eq!(terms.len(), 1);
-        match &terms[0].kind {
-            TermKind::Lobe(l) => {
-                assert!(close(l.slope_width, (FRAC_PI_2 / 8100.0).tan(), 1e-15), "{}", l.slope_width);
-                assert!((l.slope_width - 1.939e-4).abs() < 1e-7);
-                assert_eq!((l.medium_eta, l.label.as_str()), (1.0, "measured (MERL)"));
-            }
-            k => panic!("expected a lobe, got {k:?}"),
+        assert_eq!(terms[0].kind, TermKind::Diffuse, "{terms:?}");
+        assert!(terms[0].label.contains("every cell the same value per channel"), "{}", terms[0].label);
+        let table = MerlBrdf::load(&d.join("lambert.binary"), Interpolation::Nearest).unwrap();
+        assert!(table.is_flat() && table.half_width().is_infinite());
+        assert!(close(table.resolution_slope(), (FRAC_PI_2 / 8100.0).tan(), 1e-15));
+        assert!((table.resolution_slope() - 1.939e-4).abs() < 1e-7);
+    }
+    // One cell different: no longer flat, a lobe whose tail is the table's, with the resolution as its width.
+    let bumped = d.join("bumped.binary");
+    write_merl(&bumped, MERL_DIMS, |ih, id, ip, c| {
+        let v = RHO[c] / PI / MERL_SCALE[c];
+        if (ih, id, ip) == (40, 10, 3) {
+            1.01 * v
+        } else {
+            v
         }
+    });
+    let m = MerlBrdf::load(&bumped, Interpolation::Trilinear).unwrap();
+    assert!(!m.is_flat());
+    match &m.terms()[0].kind {
+        TermKind::Lobe(l) => {
+            assert!(close(l.slope_width, (FRAC_PI_2 / 8100.0).tan(), 1e-15), "{}", l.slope_width);
+            assert_eq!((l.medium_eta, l.label.as_str()), (1.0, "measured (MERL)"));
+            // The bump is far from the specular scan: the lobe never falls to half, its half width is infinite.
+            assert_eq!(l.tail, glossmeter::brdf::Tail::Table { half_width: f64::INFINITY });
+        }
+        k => panic!("expected a lobe, got {k:?}"),
     }
     std::fs::remove_dir_all(&d).ok();
 }

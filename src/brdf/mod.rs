@@ -42,7 +42,7 @@ pub struct Lobe {
 
 /// The tail of a lobe: how its value falls off with the distance u from the specular direction, in widths.
 /// The integrator places its split points and chooses its rule by it (`instrument::method`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Tail {
     /// Gaussian (Beckmann, Phong, Ward, flakes): below e⁻¹⁰⁰ of its peak beyond 10 widths, so the integrator
     /// stops splitting there.
@@ -50,9 +50,18 @@ pub enum Tail {
     /// The GGX (Trowbridge–Reitz) tail, D ∝ α²/(α² + tan²θh)² (Walter et al. 2007, Eq. 33): ∝ u⁻⁴, and exactly
     /// 1/(1 + ρ²)² in the scaled polar radius ρ, which the polar rule (`Rule::LobePolar`) maps to a polynomial.
     InverseQuartic,
-    /// Heavier than a Gaussian in a way the model does not state (a measured table): split geometrically
-    /// out to the ends of the range, integrated by the adaptive partition.
+    /// Heavier than a Gaussian in a way the model does not state (a user's function probed from Python):
+    /// split geometrically out to the ends of the range, integrated by the adaptive partition.
     Unknown,
+    /// A measured table's lobe: it falls off however the table's values do, and the table's interpolation
+    /// kinks at every cell boundary (rings of θh around the specular direction, steps of θd, θi and φd), so
+    /// no shaped rule for an analytic tail applies; split like `Unknown`, integrated by the partition
+    /// (`docs/instrument.md` §Quadrature, *Measured tables*). `half_width` is the lobe's own half width at half
+    /// maximum as a slope (tan of the half-vector tilt), measured from the table when it is loaded
+    /// ([`crate::measured::table::specular_half_width`]); infinite when the table does not fall to half its
+    /// specular value within 40° of tilt. The lobe's `slope_width` stays the table's resolution (where the
+    /// partition must split).
+    Table { half_width: f64 },
 }
 
 impl Tail {

@@ -815,9 +815,11 @@ fn lobe_gauss_hermite(
 }
 
 /// The polar rule of a lobe-chart part, if one fits ([`Rule::LobePolar`]): a material whose regular part is
-/// one lobe with GGX's tail (`Tail::InverseQuartic`: not a measured table's unknown one, nor a lobe over a
-/// diffuse body; a Gaussian tail gets [`Rule::LobeGaussHermite`] or the partition, see
-/// `docs/instrument.md` §Quadrature) whose centre u = v = 0 is inside the range of the lobe variables and at least
+/// one lobe with GGX's tail (`Tail::InverseQuartic`: not a lobe over a diffuse body; a Gaussian tail gets
+/// [`Rule::LobeGaussHermite`] or the partition; a measured table's lobe, `Tail::Table`, keeps the partition:
+/// the rule was measured on every shipped table and on MERL-format GGX tables and lost or fell back on each,
+/// because the table's interpolation kinks at its cells, not its tail, set the cost, see
+/// `docs/instrument.md` §Quadrature, *Measured tables*) whose centre u = v = 0 is inside the range of the lobe variables and at least
 /// [`POLAR_REACH`] widths from every kink of the overlap length and every end of the range, on both axes.
 pub fn polar_rule(lobes: &[Lobe], has_diffuse: bool, theta: f64, src: Stop, rec: Stop) -> Option<Rule> {
     let [lobe] = lobes else { return None };

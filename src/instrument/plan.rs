@@ -25,7 +25,7 @@ use std::sync::{Arc, Mutex};
 
 use rayon::prelude::*;
 
-use crate::brdf::{Brdf, Lobe, Term, TermKind};
+use crate::brdf::{Brdf, Lobe, Tail, Term, TermKind};
 use crate::colorimetry::{cielab, Conditions};
 use crate::instrument::flux::{lobe_widths_uv, Chart, Flux, DELTA_SHARE};
 use crate::instrument::geometry::{ColourQuantity, Integral, ReadingSpec, Scale, Stop};
@@ -807,7 +807,17 @@ impl Plan {
                      {}",
                     l.slope_width,
                     if l.medium_eta != 1.0 { format!(" inside a medium of index {}", l.medium_eta) } else { String::new() },
-                    if l.tail.is_heavy() { ", heavy tail" } else { "" },
+                    match l.tail {
+                        Tail::Table { half_width } if half_width.is_finite() => format!(
+                            ", a measured table's tail (its own half width at half maximum {half_width:.3e}, kinks at \
+                             its cells; the partition)"
+                        ),
+                        Tail::Table { .. } => ", a measured table's tail (it does not fall to half within 40° of \
+                                                tilt; kinks at its cells; the partition)"
+                            .to_string(),
+                        t if t.is_heavy() => ", heavy tail".to_string(),
+                        _ => String::new(),
+                    },
                     if l.tail.is_heavy() { "out to the ends of the range" } else { "out to 10× its width (Gaussian tail)" }
                 ),
             };

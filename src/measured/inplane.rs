@@ -270,6 +270,12 @@ pub struct InPlaneBrdf {
     /// Smith's Λ of the table's distribution (`OffPlane::Microfacet`; zero otherwise).
     lambda: SmithLambda,
     sampling: Sampling,
+    /// Every value of the file the same (to `table::FLAT_RTOL`): with the `f` extension a constant BRDF, stated as a diffuse term
+    /// (issue 10).
+    flat: bool,
+    /// The lobe's half width at half maximum as a slope, measured from the table (with its extension) when
+    /// it is built ([`super::table::specular_half_width`]).
+    half_width: f64,
 }
 
 impl InPlaneBrdf {
@@ -340,7 +346,8 @@ impl InPlaneBrdf {
             return Err(Error::input(file, "", "no data points"));
         }
         let domain = Domain { rows: thetas.clone(), ranges: row_ranges };
-        Ok(InPlaneBrdf {
+        let flat = super::table::is_flat(rows.iter().flat_map(|r| (0..r.axes()[0].len()).map(|i| r.cell(&[i])[0])));
+        let mut brdf = InPlaneBrdf {
             file: file.to_string(),
             format,
             theta_i: Axis::values(thetas),
@@ -353,7 +360,28 @@ impl InPlaneBrdf {
             off_plane: OffPlane::Brdf,
             lambda: SmithLambda::zero(),
             sampling: Sampling::grey(),
-        })
+            flat,
+            half_width: f64::INFINITY,
+        };
+        brdf.half_width = brdf.measure_half_width();
+        Ok(brdf)
+    }
+
+    fn measure_half_width(&self) -> f64 {
+        super::table::specular_half_width(|wi, wo, out| self.eval(wi, wo, out), 1)
+    }
+
+    /// The lobe's half width at half maximum about the specular direction, as a slope, measured from the
+    /// table with its off-plane extension (`Tail::Table`).
+    pub fn half_width(&self) -> f64 {
+        self.half_width
+    }
+
+    /// Whether the table is a constant BRDF as evaluated: every value the same (to `table::FLAT_RTOL`, the
+    /// rounding of a file of f·cos θo) and the `f` extension
+    /// ([`Brdf::terms`] then states a diffuse term, integrated in the plain chart).
+    pub fn is_flat(&self) -> bool {
+        self.flat && self.off_plane == OffPlane::Brdf
     }
 
     /// The same table with the given off-plane extension (for `Microfacet`, Λ of the table's distribution is
@@ -367,6 +395,7 @@ impl InPlaneBrdf {
                 self.lambda = SmithLambda::from_distribution(&d, d_theta);
             }
         }
+        self.half_width = self.measure_half_width();
         self
     }
 
@@ -526,13 +555,22 @@ impl Brdf for InPlaneBrdf {
     }
 
     fn terms(&self) -> Vec<Term> {
+        if self.is_flat() {
+            return vec![Term {
+                label: format!(
+                    "measured in-plane table ({}): every value the same (to 1e-9), a constant BRDF",
+                    self.format
+                ),
+                kind: TermKind::Diffuse,
+            }];
+        }
         vec![Term {
             label: format!("measured in-plane table ({}, isotropic (θh, θd) extension)", self.format),
             kind: TermKind::Lobe(Lobe {
                 slope_width: self.resolution_slope(),
                 medium_eta: 1.0,
                 label: format!("measured ({})", self.format),
-                tail: crate::brdf::Tail::Unknown,
+                tail: crate::brdf::Tail::Table { half_width: self.half_width },
             }),
         }]
     }

@@ -69,6 +69,11 @@ pub struct MerlBrdf {
     invalid: usize,
     interpolation: Interpolation,
     sampling: Sampling,
+    /// Every cell valid and equal per channel (to `table::FLAT_RTOL`): a constant BRDF, stated as a diffuse term (issue 10).
+    flat: bool,
+    /// The lobe's half width at half maximum as a slope, measured from the table at load
+    /// ([`super::table::specular_half_width`]).
+    half_width: f64,
 }
 
 impl MerlBrdf {
@@ -129,8 +134,32 @@ impl MerlBrdf {
         let invalid = bad.iter().filter(|b| **b).count();
         let [nh, nd, np] = dims;
         let axes = vec![Axis::index(nh, Edge::Clamp), Axis::index(nd, Edge::Clamp), Axis::index(np, Edge::Periodic)];
+        let flat = invalid == 0 && (0..3).all(|c| super::table::is_flat(table.iter().map(|v| v[c])));
         let table = Table::new(axes, 3, table.into_iter().flatten().collect());
-        MerlBrdf { file, dims, table, invalid, interpolation, sampling: Sampling::rgb() }
+        let mut m = MerlBrdf {
+            file,
+            dims,
+            table,
+            invalid,
+            interpolation,
+            sampling: Sampling::rgb(),
+            flat,
+            half_width: f64::INFINITY,
+        };
+        m.half_width = super::table::specular_half_width(|wi, wo, out| m.eval(wi, wo, out), 3);
+        m
+    }
+
+    /// Whether every cell is valid and the same per channel, to `table::FLAT_RTOL` (a constant BRDF: [`Brdf::terms`] then states a
+    /// diffuse term, so the plan integrates it in the plain chart instead of splitting at the resolution).
+    pub fn is_flat(&self) -> bool {
+        self.flat
+    }
+
+    /// The lobe's half width at half maximum about the specular direction, as a slope, measured from the
+    /// table when it was loaded (`Tail::Table`).
+    pub fn half_width(&self) -> f64 {
+        self.half_width
     }
 
     /// (n_θh, n_θd, n_φd).
@@ -242,14 +271,22 @@ impl Brdf for MerlBrdf {
     }
 
     fn terms(&self) -> Vec<Term> {
-        let label = "measured (MERL)".to_string();
+        let lookup = self.interpolation.name();
+        if self.flat {
+            return vec![Term {
+                label: format!(
+                    "measured table (MERL, {lookup} lookup): every cell the same value per channel (to 1e-9)"
+                ),
+                kind: TermKind::Diffuse,
+            }];
+        }
         vec![Term {
-            label: format!("measured table (MERL, {} lookup)", self.interpolation.name()),
+            label: format!("measured table (MERL, {lookup} lookup)"),
             kind: TermKind::Lobe(Lobe {
                 slope_width: self.resolution_slope(),
                 medium_eta: 1.0,
-                label,
-                tail: crate::brdf::Tail::Unknown,
+                label: "measured (MERL)".to_string(),
+                tail: crate::brdf::Tail::Table { half_width: self.half_width },
             }),
         }]
     }

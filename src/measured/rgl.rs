@@ -405,6 +405,9 @@ pub struct RglBrdf {
     /// Wavelengths of the file not used (outside the CIE tables).
     dropped: usize,
     sampling: Sampling,
+    /// The lobe's half width at half maximum as a slope, measured from the table at load
+    /// ([`super::table::specular_half_width`]).
+    half_width: f64,
 }
 
 fn shape_err(file: &str, f: &Field, what: String) -> Error {
@@ -540,7 +543,7 @@ impl RglBrdf {
         let sigma_w = Warp2D::new(&sigma.f32s(), sigma.shape[1], sigma.shape[0], vec![], false);
         let vndf_w = Warp2D::new(&vndf.f32s(), vndf.shape[3], vndf.shape[2], vec![phis.clone(), thetas.clone()], true);
         let spectra_w = Warp2D::new(&spectra.f32s(), n, n, vec![phis, thetas, wl_axis], false);
-        Ok(RglBrdf {
+        let mut brdf = RglBrdf {
             file: file.to_string(),
             description: String::from_utf8_lossy(&description.bytes).trim_end_matches('\0').trim().to_string(),
             isotropic,
@@ -553,7 +556,17 @@ impl RglBrdf {
             channels,
             dropped,
             sampling,
-        })
+            half_width: f64::INFINITY,
+        };
+        let n = brdf.sampling.len();
+        brdf.half_width = super::table::specular_half_width(|wi, wo, out| brdf.eval(wi, wo, out), n);
+        Ok(brdf)
+    }
+
+    /// The lobe's half width at half maximum about the specular direction, as a slope, measured from the
+    /// table when it was loaded (`Tail::Table`).
+    pub fn half_width(&self) -> f64 {
+        self.half_width
     }
 
     pub fn is_isotropic(&self) -> bool {
@@ -612,7 +625,7 @@ impl Brdf for RglBrdf {
                 slope_width: self.resolution_slope(),
                 medium_eta: 1.0,
                 label: "measured (RGL)".into(),
-                tail: crate::brdf::Tail::Unknown,
+                tail: crate::brdf::Tail::Table { half_width: self.half_width },
             }),
         }]
     }

@@ -276,6 +276,79 @@ pub fn elevation(d: Vec3) -> f64 {
     2.0 * (0.5 * dist).min(1.0).asin()
 }
 
+/// How far apart (relative) a table's values may be and the table still count as flat, a constant BRDF
+/// stated as a diffuse term (issue 10): a file written with 13 significant digits of f·cos θo and divided
+/// by cos θo at load differs from a constant in the last bits only.
+pub const FLAT_RTOL: f64 = 1e-9;
+
+/// Whether `values` are all finite and within [`FLAT_RTOL`] of one another (relative to the largest).
+pub fn is_flat(values: impl IntoIterator<Item = f64>) -> bool {
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for v in values {
+        if !v.is_finite() {
+            return false;
+        }
+        lo = lo.min(v);
+        hi = hi.max(v);
+    }
+    hi >= lo && hi - lo <= FLAT_RTOL * hi.abs()
+}
+
+/// The angle of incidence at which [`specular_half_width`] scans a table (the D523 20° geometry's).
+pub const HALF_WIDTH_THETA_I_DEG: f64 = 20.0;
+/// The largest half-vector tilt [`specular_half_width`] scans, degrees.
+pub const HALF_WIDTH_MAX_TILT_DEG: f64 = 40.0;
+/// The scan's step in the half-vector tilt, degrees (then bisection to rounding).
+const HALF_WIDTH_STEP_DEG: f64 = 0.02;
+
+/// The half width at half maximum of a table's lobe about the specular direction, as a slope (issue 10:
+/// the lobe's own width, measured from the table rather than assumed): with ωi at θi =
+/// [`HALF_WIDTH_THETA_I_DEG`] in the plane of incidence, the half vector is tilted in that plane by τ on
+/// either side of the normal (ωo = 2(ωi·h)h − ωi) and the sum of the samples of f_r, as the table evaluates
+/// it, is scanned in steps of 0.02° from τ = 0 until it first falls to half its value at τ = 0, then
+/// bisected; the result is tan τ of the nearer side. Infinite when f_r at the specular pair is not positive
+/// or does not fall to half within [`HALF_WIDTH_MAX_TILT_DEG`] (a flat or retro-reflecting table).
+/// Deterministic: computed once when a table is loaded.
+pub fn specular_half_width(eval: impl Fn(Vec3, Vec3, &mut [f64]), samples: usize) -> f64 {
+    let ti = HALF_WIDTH_THETA_I_DEG.to_radians();
+    let wi = Vec3::new(-ti.sin(), 0.0, ti.cos());
+    let mut out = vec![0.0; samples];
+    let mut at = |tau: f64| -> Option<f64> {
+        let h = Vec3::new(tau.sin(), 0.0, tau.cos());
+        let wo = 2.0 * wi.dot(h) * h - wi;
+        if !(wo.z > 0.0) {
+            return None;
+        }
+        eval(wi, wo, &mut out);
+        Some(out.iter().sum())
+    };
+    let Some(peak) = at(0.0).filter(|f| *f > 0.0 && f.is_finite()) else { return f64::INFINITY };
+    let half = 0.5 * peak;
+    let step = HALF_WIDTH_STEP_DEG.to_radians();
+    let steps = (HALF_WIDTH_MAX_TILT_DEG / HALF_WIDTH_STEP_DEG).round() as usize;
+    let mut best = f64::INFINITY;
+    for sign in [1.0, -1.0] {
+        for k in 1..=steps {
+            let tau = sign * k as f64 * step;
+            let Some(v) = at(tau) else { break };
+            if v <= half {
+                // f(a) > half ≥ f(b): bisect (the interpolants are continuous).
+                let (mut a, mut b) = (sign * (k - 1) as f64 * step, tau);
+                for _ in 0..60 {
+                    let m = 0.5 * (a + b);
+                    match at(m) {
+                        Some(v) if v > half => a = m,
+                        _ => b = m,
+                    }
+                }
+                best = best.min(b.abs().tan());
+                break;
+            }
+        }
+    }
+    best
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -329,5 +402,19 @@ mod tests {
             let d = Vec3::new(t.sin(), 0.0, t.cos());
             assert!((elevation(d) - t).abs() < 1e-15);
         }
+    }
+
+    #[test]
+    fn half_width_of_a_known_lobe() {
+        // f = 1/(1 + (tan τ/a)²) in the half-vector tilt τ: half maximum at tan τ = a on both sides.
+        let a = 0.02;
+        let lobe = |wi: Vec3, wo: Vec3, out: &mut [f64]| {
+            let h = (wi + wo).normalize();
+            let t = (h.x * h.x + h.y * h.y).sqrt() / h.z;
+            out[0] = 1.0 / (1.0 + (t / a) * (t / a));
+        };
+        let w = specular_half_width(lobe, 1);
+        assert!((w - a).abs() < 1e-9 * a, "{w}");
+        assert_eq!(specular_half_width(|_, _, out: &mut [f64]| out[0] = 0.3, 1), f64::INFINITY);
     }
 }
