@@ -9,7 +9,9 @@
 //!   assumption; read from the in-plane CSV export and from ASTM E1392-style text tables (`e1392.rs`).
 //!
 //! Every reader tells the integrator the table's angular resolution as the lobe width (`Lobe::slope_width`),
-//! so the adaptive cubature splits at the table's finest structure and cannot step over its peak.
+//! so the adaptive cubature splits at the table's finest structure and cannot step over its peak, and the
+//! lobe's own half width at half maximum, measured from the table at load (`Tail::Table`,
+//! `table::specular_half_width`); a table that is a constant (`table::is_flat`) is a diffuse term instead.
 pub mod e1392;
 pub mod inplane;
 pub mod merl;
