@@ -1,6 +1,11 @@
 //! Probe (issue 10, measured tables): the cost of a measured table's gloss integrals with the lobe the table
 //! states and with other lobe descriptions, and the shape of the table's lobe in the plane of incidence.
-//! `cargo run --release --example measured_probe -- RECIPE... [--width W] [--diffuse]`.
+//! It exists to reproduce the counts of `docs/instrument.md` §Quadrature, *Measured tables*:
+//! `cargo run --release --example measured_probe -- RECIPE... [--width W] [--quartic | --gaussian]
+//! [--diffuse] [--max-evals N] [-g id,id]`; a RECIPE `merl-ggx:ALPHA` is a MERL-format table (90 × 90 × 180,
+//! trilinear) of the engine's own GGX on n = 1.5, written in memory. The overrides replace the lobe the
+//! table states (its width, its tail) or state a diffuse term instead, to measure what the planner would do
+//! with that description; the values are the table's own.
 use glossmeter::brdf::{Brdf, Lobe, Tail, Term, TermKind};
 use glossmeter::instrument::method::Method;
 use glossmeter::instrument::standards;
