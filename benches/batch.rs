@@ -3,14 +3,20 @@
 //! recipes), each beside the way they ran before `Plan::run_all` (the baseline: a parallel loop over recipes,
 //! each with a fresh planner and its own parallel loop over its integrals, `Plan::run`; for the sweep, the
 //! points in chunks of 16 × threads through `Sweep::run_point`). Plain `main` (harness = false): the
-//! configurations take turns, `REPS` rounds (default 11); the median is reported, and the readings of every
-//! run are compared bit for bit with the 1-thread run of the library path.
+//! configurations take turns, `REPS` rounds (default 11; in each round a strategy's 1- and 2-thread runs are
+//! back to back, in alternating order); the median time is reported, and the speed-up as the median of the
+//! rounds' own ratios; the readings of every run are compared bit for bit with the 1-thread run of the
+//! library path.
 //!
-//! Beside the wall time: the CPU time of all the process's threads per run and the time they waited on the
-//! run queue for a CPU (`/proc/self/task/*/schedstat`, Linux; "n/a" elsewhere). On a shared machine the wait
-//! says how much of a 2-thread time is other processes' load rather than the program.
+//! Beside the wall time: the CPU time of all the process's threads per run, the time they waited on the run
+//! queue for a CPU, of the pool's threads (`/proc/self/task/TID/schedstat`, Linux; "n/a" elsewhere), and the idle time, threads ×
+//! wall − CPU − wait: the time a pool thread had nothing to do (a serial phase, a tail). On a shared machine
+//! the wait is other processes' load, not the program; the "speed-up net of the wait" (CPU + idle on 1
+//! thread over (CPU + idle)/2 on 2) is what is left of the ratio without it, the figure that survives load
+//! (a thread preempted at the end still shows as the other's idle, so under load it is a lower bound).
 //!
-//! Run: `nice cargo bench --bench batch`; the tables go to stdout (copy them to docs/performance.md).
+//! Run: `cargo bench --bench batch` (at normal priority); the tables go to stdout (copy them to
+//! docs/performance.md).
 use std::time::Instant;
 
 use glossmeter::batch::measure_many;
@@ -27,16 +33,37 @@ fn bits(rs: &[Vec<Reading>]) -> Bits {
     rs.iter().flatten().map(|r| (r.value.map(f64::to_bits), r.error_estimate.to_bits(), r.evaluations)).collect()
 }
 
+/// The order of the thread counts in a round: 1 then 2, then 2 then 1, so that a load that drifts during a
+/// round does not always favour the same one.
+fn turns(round: usize) -> [usize; 2] {
+    if round % 2 == 0 {
+        [0, 1]
+    } else {
+        [1, 0]
+    }
+}
+
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);
     v[v.len() / 2]
 }
 
-/// CPU time and run-queue wait of every thread of the process so far (ns), if the kernel says.
-fn schedstat() -> Option<(u64, u64)> {
+/// The kernel's ids of a pool's threads (Linux: `/proc/thread-self` links to `PID/task/TID`).
+fn thread_ids(pool: &rayon::ThreadPool) -> Option<Vec<String>> {
+    let ids = std::sync::Mutex::new(vec![None; pool.current_num_threads()]);
+    pool.broadcast(|c| {
+        let id = std::fs::read_link("/proc/thread-self").ok().and_then(|l| l.to_str().map(str::to_string));
+        ids.lock().unwrap()[c.index()] = id.and_then(|l| l.rsplit('/').next().map(str::to_string));
+    });
+    ids.into_inner().unwrap().into_iter().collect()
+}
+
+/// CPU time and run-queue wait so far (ns) of the threads `ids` (a pool's: the other pool's idle threads
+/// and the blocked caller are not counted), if the kernel says.
+fn schedstat(ids: &Option<Vec<String>>) -> Option<(u64, u64)> {
     let mut out = (0, 0);
-    for t in std::fs::read_dir("/proc/self/task").ok()? {
-        let s = std::fs::read_to_string(t.ok()?.path().join("schedstat")).ok()?;
+    for t in ids.as_ref()? {
+        let s = std::fs::read_to_string(format!("/proc/self/task/{t}/schedstat")).ok()?;
         let mut f = s.split_whitespace().map(|x| x.parse::<u64>().ok());
         out.0 += f.next()??;
         out.1 += f.next()??;
@@ -44,13 +71,13 @@ fn schedstat() -> Option<(u64, u64)> {
     Some(out)
 }
 
-/// Wall seconds, CPU seconds and run-queue seconds of `f`.
-fn timed<T>(f: impl FnOnce() -> T) -> (T, f64, Option<(f64, f64)>) {
-    let s0 = schedstat();
+/// Wall seconds, and CPU seconds and run-queue seconds of the threads `ids`, of `f`.
+fn timed<T>(ids: &Option<Vec<String>>, f: impl FnOnce() -> T) -> (T, f64, Option<(f64, f64)>) {
+    let s0 = schedstat(ids);
     let t = Instant::now();
     let out = f();
     let wall = t.elapsed().as_secs_f64();
-    let s1 = schedstat();
+    let s1 = schedstat(ids);
     let cpu = s0.zip(s1).map(|(a, b)| ((b.0 - a.0) as f64 * 1e-9, (b.1 - a.1) as f64 * 1e-9));
     (out, wall, cpu)
 }
@@ -75,55 +102,91 @@ fn sweep_by_point(s: &Sweep, sink: &mut dyn FnMut(PointResult)) {
     }
 }
 
+/// One configuration's runs, round by round.
 struct Row {
+    threads: usize,
     walls: Vec<f64>,
-    cpus: Vec<f64>,
-    waits: Vec<f64>,
+    /// Per run: (CPU seconds of all threads, their run-queue wait), if the kernel says.
+    sched: Vec<Option<(f64, f64)>>,
 }
 
 impl Row {
-    fn new() -> Row {
-        Row { walls: vec![], cpus: vec![], waits: vec![] }
+    fn new(threads: usize) -> Row {
+        Row { threads, walls: vec![], sched: vec![] }
     }
-    fn push(&mut self, wall: f64, cpu: Option<(f64, f64)>) {
+    fn push(&mut self, wall: f64, sched: Option<(f64, f64)>) {
         self.walls.push(wall);
-        if let Some((c, w)) = cpu {
-            self.cpus.push(c);
-            self.waits.push(w);
-        }
+        self.sched.push(sched);
     }
-    fn cpu(&self) -> String {
-        if self.cpus.is_empty() {
-            return "n/a | n/a".into();
-        }
-        let n = self.cpus.len() as f64;
-        format!(
-            "{:.1} ms | {:.1} ms",
-            self.cpus.iter().sum::<f64>() / n * 1e3,
-            self.waits.iter().sum::<f64>() / n * 1e3
-        )
+    /// Per run: (CPU, wait, idle) seconds, idle = threads × wall − CPU − wait (the time the pool's threads
+    /// had neither work nor a wait for a CPU: serial phases and tails).
+    fn accounts(&self) -> Vec<Option<(f64, f64, f64)>> {
+        self.walls
+            .iter()
+            .zip(&self.sched)
+            .map(|(&w, s)| s.map(|(c, q)| (c, q, (self.threads as f64 * w - c - q).max(0.0))))
+            .collect()
+    }
+    fn mean_accounts(&self) -> Option<(f64, f64, f64)> {
+        let a: Vec<(f64, f64, f64)> = self.accounts().into_iter().collect::<Option<_>>()?;
+        let n = a.len() as f64;
+        Some(a.iter().fold((0.0, 0.0, 0.0), |s, x| (s.0 + x.0 / n, s.1 + x.1 / n, s.2 + x.2 / n)))
     }
 }
 
 /// The table rows of one section: per strategy and thread count, the median wall time, the throughput over
-/// `items`, the speed-up over the same strategy on 1 thread, CPU and wait, and `(size, identical)` from `tail`
-/// (evaluations or bytes, and whether the output equals the library path's on 1 thread).
+/// `items`, the median over the rounds of each round's speed-up (the 1- and 2-thread runs of a round are
+/// made back to back, so a round's ratio sees the same load), the mean CPU time, run-queue wait and idle time
+/// per run, the median over the rounds of the speed-up net of the wait ((CPU + idle) on 1 thread over
+/// (CPU + idle)/2 on 2: what the runs would take if no other process wanted the CPUs and the CPU times
+/// stayed as measured), and `(size, identical)` from `tail` (evaluations or bytes, and whether the output
+/// equals the library path's on 1 thread).
 fn print_rows(names: &[&str; 2], rows: &[Vec<Row>], items: f64, tail: impl Fn(usize, usize) -> (usize, bool)) {
     for (s, (name, row)) in names.iter().zip(rows).enumerate() {
-        let t1 = median(row[0].walls.clone());
         for (k, r) in row.iter().enumerate() {
             let t = median(r.walls.clone());
+            let ratio = median(row[0].walls.iter().zip(&r.walls).map(|(a, b)| a / b).collect());
+            let (one, this) = (row[0].accounts(), r.accounts());
+            let net: Option<Vec<f64>> = one
+                .iter()
+                .zip(&this)
+                .map(|(a, b)| {
+                    let (a, b) = (a.as_ref()?, b.as_ref()?);
+                    Some((a.0 + a.2) / ((b.0 + b.2) / r.threads as f64))
+                })
+                .collect();
+            let acc = match r.mean_accounts() {
+                Some((c, q, i)) => format!("{:.1} ms | {:.1} ms | {:.1} ms", c * 1e3, q * 1e3, i * 1e3),
+                None => "n/a | n/a | n/a".into(),
+            };
+            let net = net.map_or("n/a".into(), |v| format!("{:.2}×", median(v)));
             let (size, identical) = tail(s, k);
             println!(
-                "| {} | {} | {:.1} ms | {:.0} | {:.2}× | {} | {} | {} |",
+                "| {} | {} | {:.1} ms | {:.0} | {:.2}× | {} | {} | {} | {} |",
                 name,
-                k + 1,
+                r.threads,
                 t * 1e3,
                 items / t,
-                t1 / t,
-                r.cpu(),
+                ratio,
+                acc,
+                net,
                 size,
                 identical
+            );
+        }
+    }
+}
+
+/// The library path's CPU time over the baseline's, per thread count (the median over the rounds).
+fn cpu_line(rows: &[Vec<Row>]) {
+    for (lib, base) in rows[0].iter().zip(&rows[1]) {
+        let r: Option<Vec<f64>> =
+            lib.sched.iter().zip(&base.sched).map(|(a, b)| Some(a.as_ref()?.0 / b.as_ref()?.0)).collect();
+        if let Some(r) = r {
+            println!(
+                "\nCPU time of the library path over the baseline's on {} thread(s): {:.3}",
+                lib.threads,
+                median(r)
             );
         }
     }
@@ -144,18 +207,20 @@ fn main() {
     let opts = PlanOptions { rtol: 1e-6, ..PlanOptions::default() };
     let pools: Vec<rayon::ThreadPool> =
         [1usize, 2].iter().map(|&k| rayon::ThreadPoolBuilder::new().num_threads(k).build().expect("pool")).collect();
+    let tids: Vec<Option<Vec<String>>> = pools.iter().map(thread_ids).collect();
     let load = || std::fs::read_to_string("/proc/loadavg").unwrap_or_default().trim().to_string();
     println!("load average before: {}\n", load());
 
     // Batch: (strategy, threads) take turns.
     let names = ["`measure_many` (`Plan::run_all`)", "baseline: nested `Plan::run`"];
-    let mut rows: Vec<Vec<Row>> = (0..2).map(|_| (0..2).map(|_| Row::new()).collect()).collect();
+    let mut rows: Vec<Vec<Row>> = (0..2).map(|_| (1..=2).map(Row::new).collect()).collect();
     let mut out: Vec<Vec<Bits>> = vec![vec![vec![]; 2]; 2];
     let mut evals = [[0usize; 2]; 2];
-    for _ in 0..reps {
+    for round in 0..reps {
         for (s, row) in rows.iter_mut().enumerate() {
-            for (k, pool) in pools.iter().enumerate() {
-                let (rs, wall, cpu) = timed(|| {
+            for k in turns(round) {
+                let (pool, ids) = (&pools[k], &tids[k]);
+                let (rs, wall, cpu) = timed(ids, || {
                     pool.install(|| {
                         if s == 0 {
                             measure_many(&materials, &geos, &opts).expect("measure")
@@ -175,21 +240,23 @@ fn main() {
         }
     }
     println!("### Batch `measure`: {n} microfacet recipes (Beckmann/GGX, roughness 0.02–0.5, n = 1.5), default panel, rtol 1e-6, median of {reps}\n");
-    println!("| strategy | threads | median time | recipes / s | speed-up (same strategy) | CPU time / run | run-queue wait / run | evaluations | bit-identical to `measure_many` on 1 thread |");
-    println!("|---|---|---|---|---|---|---|---|---|");
+    println!("| strategy | threads | median time | recipes / s | speed-up (median of the rounds) | CPU time / run | run-queue wait / run | idle / run | speed-up net of the wait | evaluations | bit-identical to `measure_many` on 1 thread |");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|");
     print_rows(&names, &rows, n as f64, |s, k| (evals[s][k], out[s][k] == out[0][0]));
+    cpu_line(&rows);
 
     let template: serde_json::Value = serde_json::from_str(&texts[1]).expect("json");
     let axes = vec![parse_vary("/roughness=0.02..0.5:100").expect("axis")];
     let sw = Sweep::new(template, "bench.json", axes, Design::Grid, geos.clone(), opts.clone()).expect("sweep");
     let names = ["`Sweep::run` (`Plan::run_all` per chunk)", "baseline: chunks of `run_point`"];
-    let mut rows: Vec<Vec<Row>> = (0..2).map(|_| (0..2).map(|_| Row::new()).collect()).collect();
+    let mut rows: Vec<Vec<Row>> = (0..2).map(|_| (1..=2).map(Row::new).collect()).collect();
     let mut out: Vec<Vec<String>> = vec![vec![String::new(); 2]; 2];
-    for _ in 0..reps {
+    for round in 0..reps {
         for (s, row) in rows.iter_mut().enumerate() {
-            for (k, pool) in pools.iter().enumerate() {
+            for k in turns(round) {
+                let (pool, ids) = (&pools[k], &tids[k]);
                 let mut text = String::new();
-                let ((), wall, cpu) = timed(|| {
+                let ((), wall, cpu) = timed(ids, || {
                     pool.install(|| {
                         let mut sink = |r: PointResult| text.push_str(&sw.csv_row(&r, false));
                         if s == 0 {
@@ -212,8 +279,9 @@ fn main() {
         }
     }
     println!("\n### `sweep`: GGX roughness 0.02..0.5, 100 grid points, default panel, rtol 1e-6, CSV rows without timing, median of {reps}\n");
-    println!("| strategy | threads | median time | points / s | speed-up (same strategy) | CPU time / run | run-queue wait / run | bytes | byte-identical to `Sweep::run` on 1 thread |");
-    println!("|---|---|---|---|---|---|---|---|---|");
+    println!("| strategy | threads | median time | points / s | speed-up (median of the rounds) | CPU time / run | run-queue wait / run | idle / run | speed-up net of the wait | bytes | byte-identical to `Sweep::run` on 1 thread |");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|");
     print_rows(&names, &rows, sw.len() as f64, |s, k| (out[s][k].len(), out[s][k] == out[0][0]));
+    cpu_line(&rows);
     println!("\nload average after: {}", load());
 }

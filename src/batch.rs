@@ -50,7 +50,7 @@ pub fn measure_many(
     geometries: &[StandardGeometry],
     options: &PlanOptions,
 ) -> Result<Vec<Vec<Reading>>> {
-    Ok(run_many(materials, geometries, options)?.into_iter().map(|e| e.readings).collect())
+    Ok(run_many(materials, geometries, options)?.into_par_iter().map(|e| e.readings).collect())
 }
 
 /// [`measure_many`] keeping each material's execution (its readings and the fluxes of its plan, for the
@@ -67,5 +67,9 @@ pub fn run_many(
         .par_iter()
         .map(|m| planner.compile(m.brdf.clone(), geometries.to_vec(), options.clone()))
         .collect::<Result<_>>()?;
-    Ok(Plan::run_all(&plans))
+    let runs = Plan::run_all(&plans);
+    // Freed in parallel: a plan is a few hundred allocations (its methods' partitions and weightings), and
+    // a hundred of them freed on one thread were a serial tail of the batch (docs/performance.md).
+    plans.into_par_iter().for_each(drop);
+    Ok(runs)
 }

@@ -339,6 +339,8 @@ impl Sweep {
                 };
                 sink(PointResult { index: i, values, outcome, seconds })?;
             }
+            // Freed in parallel, as in `batch::run_many` (a plan is a few hundred allocations).
+            plans.into_par_iter().for_each(drop);
             start = end;
         }
         Ok(())

@@ -207,7 +207,12 @@ pub fn parse(text: &str, origin: &str) -> Result<StandardGeometry> {
         }
         other => return Err(o.err("kind", format!("unknown kind {other:?}; allowed: \"directional\", \"sphere\""))),
     };
-    Ok(StandardGeometry { geometry, reading_names, spec: spec.clone(), origin: origin.to_string() })
+    Ok(StandardGeometry {
+        geometry,
+        reading_names,
+        spec: std::sync::Arc::new(spec.clone()),
+        origin: origin.to_string(),
+    })
 }
 
 /// A colour geometry has no gloss standard; its readings are relative to the perfect reflecting diffuser, in
@@ -279,7 +284,7 @@ pub fn list_line(g: &StandardGeometry) -> String {
 /// value, status and source.
 pub fn describe(g: &StandardGeometry) -> String {
     let mut out = format!("{} — {}\n  origin: {}\n  {}\n", g.geometry.id, g.geometry.title, g.origin, list_line(g));
-    let text = serde_json::to_string_pretty(&g.spec).unwrap_or_default();
+    let text = serde_json::to_string_pretty(g.spec.as_ref()).unwrap_or_default();
     for line in text.lines() {
         out += &format!("  {line}\n");
     }

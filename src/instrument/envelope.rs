@@ -110,7 +110,7 @@ pub fn variants(g: &StandardGeometry) -> Result<(Vec<Variation>, Vec<StandardGeo
     let vars = variations(&g.spec);
     let mut out = Vec::new();
     for values in variant_values(&vars) {
-        let mut spec = g.spec.clone();
+        let mut spec = Value::clone(&g.spec);
         for (v, x) in vars.iter().zip(&values) {
             let slot = spec
                 .pointer_mut(&format!("{}/value", v.pointer))

@@ -21,7 +21,8 @@
 //! frozen after one adaptive execution ([`Plan::freeze`]); `explain()` prints the stored methods in plain
 //! words (`glossmeter measure --explain`).
 use std::collections::{BTreeMap, HashMap};
-use std::sync::{Arc, Mutex};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex, OnceLock, PoisonError};
 
 use rayon::prelude::*;
 
@@ -327,14 +328,20 @@ impl Planner {
         let mut queue: Vec<(StandardGeometry, bool)> = geometries.into_iter().map(|g| (g, true)).collect();
         let mut i = 0;
         while i < queue.len() {
-            let g = queue[i].0.clone();
-            for spec in &g.geometry.readings {
-                if let ReadingSpec::HazeIndex { minuend, subtrahend } = spec {
-                    for id in [minuend, subtrahend] {
-                        if !queue.iter().any(|(q, _)| &q.geometry.id == id) {
-                            queue.push((self.geometry(id)?, false));
-                        }
-                    }
+            let parts: Vec<String> = queue[i]
+                .0
+                .geometry
+                .readings
+                .iter()
+                .filter_map(|spec| match spec {
+                    ReadingSpec::HazeIndex { minuend, subtrahend } => Some([minuend.clone(), subtrahend.clone()]),
+                    _ => None,
+                })
+                .flatten()
+                .collect();
+            for id in parts {
+                if !queue.iter().any(|(q, _)| q.geometry.id == id) {
+                    queue.push((self.geometry(&id)?, false));
                 }
             }
             i += 1;
@@ -399,8 +406,8 @@ impl Planner {
         };
         let std_idx: Vec<usize> = (0..drafts.len()).filter(|&j| drafts[j].target == Target::Standard).collect();
         let std_methods: Vec<Method> = std_idx.iter().map(|&j| standard_method(&drafts[j])).collect();
-        let std_flux: Vec<Flux> =
-            std_idx.par_iter().zip(&std_methods).map(|(&j, m)| self.standard_flux(&drafts[j], m, &options)).collect();
+        let std_drafts: Vec<&Draft> = std_idx.iter().map(|&j| &drafts[j]).collect();
+        let std_flux = self.standard_fluxes(&std_drafts, &std_methods, &options);
         // Absolute floor per geometry angle: 1e-4·rtol of the largest standard flux at that angle, i.e.
         // 0.01·rtol GU on a gloss reading; it only matters for fluxes that are (nearly) zero. A colour flux's
         // floor is 1e-4·rtol of the perfect diffuser's Y flux (100·white), 0.01·rtol on X, Y, Z; a flux that
@@ -488,24 +495,40 @@ impl Planner {
         })
     }
 
-    /// The flux of a gloss standard, from the cache or computed (and cached). With sharing off, always
-    /// computed (the ablation measures what sharing saves).
-    fn standard_flux(&self, d: &Draft, method: &Method, options: &PlanOptions) -> Flux {
-        let std = d.scale.standard();
+    /// The fluxes of the gloss standards, from the cache or computed (and cached): the cache is read once,
+    /// under one lock, and only the fluxes it lacks are computed, in parallel (in a batch every plan after
+    /// the first finds them all, and then hands nothing to the pool). With sharing off, always computed (the
+    /// ablation measures what sharing saves).
+    fn standard_fluxes(&self, drafts: &[&Draft], methods: &[Method], options: &PlanOptions) -> Vec<Flux> {
+        let compute = |d: &Draft, m: &Method| m.execute(&d.scale.standard());
         if !options.share_fluxes {
-            return method.execute(&std);
+            return drafts.par_iter().zip(methods).map(|(d, m)| compute(d, m)).collect();
         }
-        let mut key = job_key(Target::Standard, d.integral, d.theta, d.viewing, d.scale, d.source, d.receptor);
-        key.0.extend([options.rtol.to_bits(), options.max_evals as u64]);
-        key.0.extend(options.max_seconds.map(f64::to_bits));
-        if let Some(f) = self.standards.lock().ok().and_then(|c| c.get(&key).cloned()) {
-            return f;
+        let keys: Vec<JobKey> = drafts
+            .iter()
+            .map(|d| {
+                let mut key = job_key(Target::Standard, d.integral, d.theta, d.viewing, d.scale, d.source, d.receptor);
+                key.0.extend([options.rtol.to_bits(), options.max_evals as u64]);
+                key.0.extend(options.max_seconds.map(f64::to_bits));
+                key
+            })
+            .collect();
+        let mut flux: Vec<Option<Flux>> = match self.standards.lock() {
+            Ok(c) => keys.iter().map(|k| c.get(k).cloned()).collect(),
+            Err(_) => vec![None; keys.len()],
+        };
+        let missing: Vec<usize> = (0..keys.len()).filter(|&i| flux[i].is_none()).collect();
+        if !missing.is_empty() {
+            let computed: Vec<Flux> = missing.par_iter().map(|&i| compute(drafts[i], &methods[i])).collect();
+            let mut cache = self.standards.lock().ok();
+            for (&i, f) in missing.iter().zip(computed) {
+                if let Some(c) = cache.as_mut() {
+                    c.insert(keys[i].clone(), f.clone());
+                }
+                flux[i] = Some(f);
+            }
         }
-        let f = method.execute(&std);
-        if let Ok(mut c) = self.standards.lock() {
-            c.insert(key, f.clone());
-        }
-        f
+        flux.into_iter().map(|f| f.expect("every standard computed")).collect()
     }
 }
 
@@ -687,50 +710,85 @@ impl Plan {
         for (&j, f) in todo.iter().zip(computed) {
             flux[j] = Some(f);
         }
-        let fluxes: Vec<Flux> = flux.into_iter().map(|f| f.expect("every job ran")).collect();
-        Execution { readings: self.readings_from(&fluxes), fluxes }
+        self.execution(flux)
     }
 
     /// Execute several plans as one pool of integrals: every specimen integral of every plan is one task of a
-    /// single flat parallel loop, so the thread pool balances integrals, not plans. A batch of plans whose
-    /// costs differ a hundredfold, each with one or two integrals that dominate it, then ends within one
-    /// integral on every thread; running plan after plan, each with its own parallel loop over its integrals
-    /// ([`Plan::run`] inside a parallel loop over plans), nests two loops whose inner one (14 integrals of
-    /// 6–20 µs for most recipes) costs more in hand-overs than it spreads, and ends when the last plan's
-    /// dominant integral does (docs/performance.md §Batch and sweep throughput). Each execution is the same
-    /// bits as [`Plan::run`] of that plan alone (each integral is the same method on the same material, on
-    /// one thread); each plan's wall-clock budget starts when its first integral does.
+    /// single work queue that the pool's threads drain, so the threads balance integrals, not plans. A batch
+    /// of plans whose costs differ a hundredfold, each with one or two integrals that dominate it, then ends
+    /// within one small integral on every thread; running plan after plan, each with its own parallel loop
+    /// over its integrals ([`Plan::run`] inside a parallel loop over plans), nests two loops whose inner one
+    /// (14 integrals of 6–20 µs for most recipes) costs more in hand-overs than it spreads, and ends when the
+    /// last plan's dominant integral does (docs/performance.md §Batch and sweep throughput).
+    ///
+    /// The queue is in order of expected cost, largest first ([`Method::expected_evaluations`]; ties in plan
+    /// order), the longest-processing-time rule: the few integrals of milliseconds start at once and the
+    /// last ones taken are of microseconds. Each thread takes the next integral from one shared atomic
+    /// counter, so the order does not depend on the number of threads or on how the range would be split.
+    /// The thread that completes a plan's last integral works out that plan's readings at once, so no serial
+    /// step follows the loop. Each execution is the same bits as [`Plan::run`] of that plan alone (each
+    /// integral is the same method on the same material, on one thread; the order only decides when);
+    /// each plan's wall-clock budget starts when its first integral does.
     pub fn run_all(plans: &[Plan]) -> Vec<Execution> {
         let tasks: Vec<(usize, usize)> = plans
             .iter()
             .enumerate()
             .flat_map(|(p, plan)| plan.specimen_jobs().into_iter().map(move |j| (p, j)))
             .collect();
-        let deadlines: Vec<std::sync::OnceLock<Option<std::time::Instant>>> =
-            plans.iter().map(|_| std::sync::OnceLock::new()).collect();
-        // One task per leaf (`with_max_len(1)`): an idle thread can always take the next integral, however
-        // the range was split.
-        let computed: Vec<Flux> = tasks
-            .par_iter()
-            .with_max_len(1)
-            .map(|&(p, j)| {
-                let plan = &plans[p];
-                let deadline = *deadlines[p].get_or_init(|| plan.deadline());
-                plan.jobs[j].method.execute_until(plan.material.as_ref(), deadline)
+        let mut order: Vec<(f64, usize)> =
+            tasks.iter().enumerate().map(|(t, &(p, j))| (plans[p].jobs[j].method.expected_evaluations(), t)).collect();
+        order.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
+        // Per plan: the integrals still to run and the fluxes so far (the standards' from compile time).
+        let pending: Vec<Mutex<(usize, Vec<Option<Flux>>)>> = plans
+            .iter()
+            .map(|plan| {
+                let known = plan.known_fluxes();
+                Mutex::new((known.iter().filter(|f| f.is_none()).count(), known))
             })
             .collect();
-        let mut flux: Vec<Vec<Option<Flux>>> = plans.iter().map(Plan::known_fluxes).collect();
-        for (&(p, j), f) in tasks.iter().zip(computed) {
-            flux[p][j] = Some(f);
-        }
+        let done: Vec<OnceLock<Execution>> = plans.iter().map(|_| OnceLock::new()).collect();
+        let deadlines: Vec<OnceLock<Option<std::time::Instant>>> = plans.iter().map(|_| OnceLock::new()).collect();
+        let next = AtomicUsize::new(0);
+        let drain = || {
+            while let Some(&(_, t)) = order.get(next.fetch_add(1, Ordering::Relaxed)) {
+                let (p, j) = tasks[t];
+                let plan = &plans[p];
+                let deadline = *deadlines[p].get_or_init(|| plan.deadline());
+                let f = plan.jobs[j].method.execute_until(plan.material.as_ref(), deadline);
+                let complete = {
+                    let mut slot = pending[p].lock().unwrap_or_else(PoisonError::into_inner);
+                    slot.1[j] = Some(f);
+                    slot.0 -= 1;
+                    (slot.0 == 0).then(|| std::mem::take(&mut slot.1))
+                };
+                if let Some(flux) = complete {
+                    let _ = done[p].set(plan.execution(flux));
+                }
+            }
+        };
+        let threads = rayon::current_num_threads().min(tasks.len()).max(1);
+        rayon::scope(|s| {
+            for _ in 1..threads {
+                s.spawn(|_| drain());
+            }
+            drain();
+        });
+        // Plans without specimen integrals (nothing ran) are worked out here.
         plans
             .iter()
-            .zip(flux)
-            .map(|(plan, fl)| {
-                let fluxes: Vec<Flux> = fl.into_iter().map(|f| f.expect("every job ran")).collect();
-                Execution { readings: plan.readings_from(&fluxes), fluxes }
+            .zip(done)
+            .zip(pending)
+            .map(|((plan, d), pend)| {
+                d.into_inner()
+                    .unwrap_or_else(|| plan.execution(pend.into_inner().unwrap_or_else(PoisonError::into_inner).1))
             })
             .collect()
+    }
+
+    /// The execution from the flux of every job (the standards' and the computed ones).
+    fn execution(&self, flux: Vec<Option<Flux>>) -> Execution {
+        let fluxes: Vec<Flux> = flux.into_iter().map(|f| f.expect("every job ran")).collect();
+        Execution { readings: self.readings_from(&fluxes), fluxes }
     }
 
     /// The jobs to run on the material, in plan order. Only these go to the thread pool: a plan with one

@@ -11,6 +11,7 @@ use crate::{Error, Result};
 use serde_json::Value;
 use std::collections::HashSet;
 use std::path::Path;
+use std::sync::Arc;
 
 /// Every shipped geometry file: (file name, text). A test checks this equals the set of `standards/*.json`.
 pub const BUILTIN: &[(&str, &str)] = &[
@@ -38,8 +39,10 @@ pub struct StandardGeometry {
     pub geometry: Geometry,
     /// One display name per entry of `geometry.readings` (the reading's `name`, or its quantity).
     pub reading_names: Vec<String>,
-    /// The original JSON, kept for provenance display ([`describe`]).
-    pub spec: Value,
+    /// The original JSON, kept for provenance display ([`describe`]). Shared, not copied: every plan keeps
+    /// its geometries, and a batch of a hundred recipes copying and freeing each file's JSON tree cost as
+    /// much as a tenth of its integrals (docs/performance.md §Batch and sweep throughput).
+    pub spec: Arc<Value>,
     /// `"builtin"` or the path of the user file.
     pub origin: String,
 }
@@ -355,7 +358,7 @@ pub fn parse(text: &str, origin: &str) -> Result<StandardGeometry> {
         integrals: vec![],
         readings,
     };
-    Ok(StandardGeometry { geometry, reading_names, spec, origin: origin.to_string() })
+    Ok(StandardGeometry { geometry, reading_names, spec: Arc::new(spec), origin: origin.to_string() })
 }
 
 /// Allowed range of a sourced number.
