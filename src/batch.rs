@@ -1,8 +1,9 @@
 //! Many recipes measured in one process: the recipe files of a list of files and directories, each read
 //! through the same geometries, in parallel: the plans are compiled in parallel by one [`Planner`], then the
-//! integrals of all of them run as one flat parallel loop ([`Plan::run_all`]). One integral always runs on
-//! one thread, so every reading is the same bits whatever the thread count or the
-//! number of recipes measured together (tests/sheets.rs compares a batch with one-by-one runs).
+//! integrals of all of them run as one work queue, largest expected first ([`Plan::run_all`]), and the plans
+//! are freed in parallel. One integral always runs on one thread, so every reading is the same bits whatever
+//! the thread count or the number of recipes measured together (tests/sheets.rs compares a batch with
+//! one-by-one runs).
 use std::path::{Path, PathBuf};
 
 use rayon::prelude::*;

@@ -11,7 +11,7 @@
 //! * **Shards are contiguous index ranges** `[⌊(K−1)·P/M⌋, ⌊K·P/M⌋)`, so the shards' outputs, concatenated in order,
 //!   are the unsharded output byte for byte (the CSV header is written by shard 1 only).
 //! * **Streaming**: points run in parallel in chunks (their plans compiled in parallel, then all their
-//!   integrals in one flat parallel loop) and are written in index order as each chunk ends, so memory does
+//!   integrals in one work queue, `Plan::run_all`) and are written in index order as each chunk ends, so memory does
 //!   not grow with the number of points.
 //! * **An invalid point is a row**, with the recipe's error in its `problem` column, not a failure of the sweep.
 use std::ops::Range;
@@ -291,9 +291,9 @@ impl Sweep {
 
     /// Run the points of `range` in parallel, in chunks, handing each result to `sink` in index order. In
     /// each chunk the points' plans are compiled in parallel (one [`Planner`] for the whole run, so the gloss
-    /// standards' fluxes are computed once), then every integral of every plan runs in one flat parallel
-    /// loop ([`Plan::run_all`]): the threads balance integrals, not points, and a chunk ends within one
-    /// integral on every thread. A point's `seconds` is its parsing and planning time plus the wall time of
+    /// standards' fluxes are computed once), then every integral of every plan runs in one work queue,
+    /// largest expected first ([`Plan::run_all`]): the threads balance integrals, not points, and a chunk
+    /// ends with small integrals on every thread. A point's `seconds` is its parsing and planning time plus the wall time of
     /// its integrals.
     pub fn run(&self, range: Range<u64>, mut sink: impl FnMut(PointResult) -> Result<()>) -> Result<()> {
         let planner = Planner::new()?;
