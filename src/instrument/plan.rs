@@ -1397,6 +1397,39 @@ mod tests {
         ids.iter().map(|id| standards::find(id).unwrap()).collect()
     }
 
+    /// The queue of `Plan::run_all` starts with the integrals `Method::expected_evaluations` ranks first; on
+    /// the batch bench's narrowest recipe the guess must rank the integrals as their actual costs do at the
+    /// ends: its first two are the two that cost most (in either order), and the six that cost least are
+    /// guessed at under a tenth of the first (so the milliseconds start first and the microseconds end the
+    /// queue).
+    #[test]
+    fn the_expected_cost_ranks_a_narrow_lobes_integrals_as_they_cost() {
+        let text = r#"{"model": "microfacet", "distribution": "beckmann", "roughness": 0.02, "ior": 1.5}"#;
+        let m = crate::recipe::parse_str(text, "narrow.json").unwrap();
+        let geos = crate::resolve_geometries(crate::DEFAULT_PANEL, &[] as &[&str]).unwrap();
+        let plan = Plan::compile(m.brdf, geos, PlanOptions { rtol: 1e-6, ..Default::default() }).unwrap();
+        let run = plan.run();
+        let jobs = plan.specimen_jobs();
+        let rank = |key: &dyn Fn(usize) -> f64| {
+            let mut v = jobs.clone();
+            v.sort_by(|&a, &b| key(b).total_cmp(&key(a)).then(a.cmp(&b)));
+            v
+        };
+        let expected = rank(&|j| plan.jobs[j].method.expected_evaluations());
+        let actual = rank(&|j| run.fluxes[j].evaluations as f64);
+        assert!(jobs.len() >= 12, "{} specimen integrals", jobs.len());
+        let top = |v: &[usize]| -> Vec<usize> {
+            let mut t = v[..2].to_vec();
+            t.sort();
+            t
+        };
+        assert_eq!(top(&expected), top(&actual), "expected order {expected:?}, actual {actual:?}");
+        let guess = |j: usize| plan.jobs[j].method.expected_evaluations();
+        for &j in &actual[actual.len() - 6..] {
+            assert!(guess(j) < 0.1 * guess(expected[0]), "job {j}: {} against {}", guess(j), guess(expected[0]));
+        }
+    }
+
     fn grey() -> Arc<dyn Brdf> {
         Arc::new(Lambert::new(vec![0.5], Sampling::grey()).unwrap())
     }
