@@ -404,7 +404,7 @@ fn raw_box_genz_malik(c: &Case, rtol: f64, max_evals: usize) -> glossmeter::quad
         glossmeter::quadrature::pointwise(1, |x: &[f64; 4], out: &mut [f64]| out[0] = p.f(x[0], x[1], x[2], x[3])),
         1,
         &[([s.p[0], s.q[0], r.p[0], r.q[0]], [s.p[1], s.q[1], r.p[1], r.q[1]])],
-        &glossmeter::quadrature::Options { rtol, atol: 0.0, max_evals, deadline: None },
+        &glossmeter::quadrature::Options { rtol, atol: 0.0, max_evals, deadline: None, ..Default::default() },
     )
 }
 

@@ -59,6 +59,71 @@ fn git_head() -> String {
         .unwrap_or_else(|| "unknown".into())
 }
 
+/// Every reading at `options` against the reference: returns the failures (readings outside their estimate)
+/// and prints the distribution of estimate/actual where the reference resolves the actual error. With
+/// `GLOSSMETER_RATIO_DUMP=1` (and `--nocapture`) one line per reading, `RR|rtol|key|value|estimate|actual|
+/// reference estimate|evaluations|resolved` (`docs/accuracy.md` §5 is made from them).
+fn compare(options: &PlanOptions) -> Vec<String> {
+    let text = std::fs::read_to_string(REFERENCE).expect("the reference fixture");
+    let doc: Value = serde_json::from_str(&text).unwrap();
+    let stored = doc["readings"].as_object().expect("readings");
+    let now = readings(options);
+    let mut fails = Vec::new();
+    let mut ratios = Vec::new();
+    for (k, r) in stored {
+        let Some(&(v, e, _, _)) = now.get(k) else {
+            fails.push(format!("{k}: missing now"));
+            continue;
+        };
+        match (v, r["value"].as_f64()) {
+            (None, None) => {}
+            (Some(v), Some(reference)) => {
+                if hue_undefined(stored, &now, k) {
+                    continue;
+                }
+                let re = r["error_estimate"].as_f64().unwrap();
+                let actual = (v - reference).abs();
+                if !(actual <= e + re + ROUNDING * reference.abs()) {
+                    fails.push(format!(
+                        "{k}: {v} vs reference {reference}: |diff| {actual:e} > estimate {e:e} + {re:e}"
+                    ));
+                }
+                // The ratio only where the difference resolves the actual error (well above the reference's
+                // own estimate and the rounding).
+                if actual > 10.0 * (re + ROUNDING * reference.abs()) {
+                    ratios.push(e / actual);
+                }
+                if std::env::var_os("GLOSSMETER_RATIO_DUMP").is_some() {
+                    let resolved = actual > 10.0 * (re + ROUNDING * reference.abs());
+                    println!("RR|{:e}|{k}|{v:e}|{e:e}|{actual:e}|{re:e}|{}|{resolved}", options.rtol, now[k].2);
+                }
+            }
+            (a, b) if hue_undefined(stored, &now, k) => {
+                let _ = (a, b);
+            }
+            (a, b) => fails.push(format!("{k}: value {a:?} now, {b:?} in the reference")),
+        }
+    }
+    for k in now.keys().filter(|k| !stored.contains_key(*k)) {
+        fails.push(format!("{k}: not in the reference"));
+    }
+    ratios.sort_by(f64::total_cmp);
+    if !ratios.is_empty() {
+        let q = |p: f64| ratios[((ratios.len() - 1) as f64 * p).round() as usize];
+        println!(
+            "rtol {:e}: estimate/actual over {} readings: min {:.3}, 10% {:.3}, median {:.3}, 90% {:.3}, max {:.3e}",
+            options.rtol,
+            ratios.len(),
+            q(0.0),
+            q(0.1),
+            q(0.5),
+            q(0.9),
+            q(1.0)
+        );
+    }
+    fails
+}
+
 #[test]
 fn every_default_reading_agrees_with_the_rtol_1e_10_reference_within_its_estimate() {
     if std::env::var_os("GLOSSMETER_REGENERATE_REFERENCE").is_some() {
@@ -89,57 +154,26 @@ fn every_default_reading_agrees_with_the_rtol_1e_10_reference_within_its_estimat
         );
         return;
     }
-    let text = std::fs::read_to_string(REFERENCE).expect("the reference fixture");
-    let doc: Value = serde_json::from_str(&text).unwrap();
-    let stored = doc["readings"].as_object().expect("readings");
-    let now = readings(&PlanOptions::default());
-    let mut fails = Vec::new();
-    let mut ratios = Vec::new();
-    for (k, r) in stored {
-        let Some(&(v, e, _, _)) = now.get(k) else {
-            fails.push(format!("{k}: missing now"));
-            continue;
-        };
-        match (v, r["value"].as_f64()) {
-            (None, None) => {}
-            (Some(v), Some(reference)) => {
-                if hue_undefined(stored, &now, k) {
-                    continue;
-                }
-                let re = r["error_estimate"].as_f64().unwrap();
-                let actual = (v - reference).abs();
-                if !(actual <= e + re + ROUNDING * reference.abs()) {
-                    fails.push(format!(
-                        "{k}: {v} vs reference {reference}: |diff| {actual:e} > estimate {e:e} + {re:e}"
-                    ));
-                }
-                // The ratio only where the difference resolves the actual error (well above the reference's
-                // own estimate and the rounding).
-                if actual > 10.0 * (re + ROUNDING * reference.abs()) {
-                    ratios.push(e / actual);
-                }
-            }
-            (a, b) if hue_undefined(stored, &now, k) => {
-                let _ = (a, b);
-            }
-            (a, b) => fails.push(format!("{k}: value {a:?} now, {b:?} in the reference")),
-        }
+    let fails = compare(&PlanOptions::default());
+    assert!(fails.is_empty(), "{} reading(s) outside their estimate:\n{}", fails.len(), fails.join("\n"));
+}
+
+/// The same check at rtol 10⁻⁴, 10⁻⁷ and 10⁻⁸: the calibrated estimate must stay honest away from the default
+/// too (at 10⁻⁷ and 10⁻⁸ the parent–children check, given to every material, fell below the actual error on
+/// the V-cavity GGX and the rough-coat paint: `docs/accuracy.md` §5). At 10⁻⁸ the reference's own estimate is
+/// still ~100× smaller than a reading's.
+#[test]
+fn every_reading_at_rtol_1e_4_1e_7_and_1e_8_agrees_with_the_reference_within_its_estimate() {
+    if std::env::var_os("GLOSSMETER_REGENERATE_REFERENCE").is_some() {
+        return;
     }
-    for k in now.keys().filter(|k| !stored.contains_key(*k)) {
-        fails.push(format!("{k}: not in the reference"));
-    }
-    ratios.sort_by(f64::total_cmp);
-    if !ratios.is_empty() {
-        let q = |p: f64| ratios[((ratios.len() - 1) as f64 * p).round() as usize];
-        println!(
-            "estimate/actual over {} readings: min {:.3}, 10% {:.3}, median {:.3}, 90% {:.3}, max {:.3e}",
-            ratios.len(),
-            q(0.0),
-            q(0.1),
-            q(0.5),
-            q(0.9),
-            q(1.0)
+    for rtol in [1e-4, 1e-7, 1e-8] {
+        let fails = compare(&PlanOptions { rtol, ..PlanOptions::default() });
+        assert!(
+            fails.is_empty(),
+            "rtol {rtol:e}: {} reading(s) outside their estimate:\n{}",
+            fails.len(),
+            fails.join("\n")
         );
     }
-    assert!(fails.is_empty(), "{} reading(s) outside their estimate:\n{}", fails.len(), fails.join("\n"));
 }

@@ -50,6 +50,11 @@ impl Brdf for SmoothConductor {
         super::fresnel_kinks(self.ior.iter().map(|e| critical_cosine_complex(*e)), true)
     }
 
+    /// Analytic everywhere but on its reported kinks (`Brdf::smooth`).
+    fn smooth(&self) -> bool {
+        true
+    }
+
     fn describe(&self) -> String {
         let parts: Vec<String> = self.ior.iter().map(|e| format!("{} + {}i", e.re, e.im)).collect();
         format!("smooth conductor (n = {})", parts.join("; "))

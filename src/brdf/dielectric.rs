@@ -115,6 +115,11 @@ impl Brdf for SmoothDielectric {
         super::fresnel_kinks([critical_cosine(self.ior)], true)
     }
 
+    /// Analytic everywhere but on its reported kinks (`Brdf::smooth`).
+    fn smooth(&self) -> bool {
+        true
+    }
+
     fn describe(&self) -> String {
         let surface = if self.ior == f64::INFINITY {
             "perfect mirror".to_string()
@@ -232,6 +237,11 @@ impl Brdf for MicrofacetSurface {
     /// smooth limit).
     fn kinks(&self) -> Vec<Kink> {
         super::fresnel_kinks(self.ior.iter().map(Ior::critical_cosine), self.facets.effectively_smooth())
+    }
+
+    /// Smooth with a Smith G; the V-cavity G is a min() of three terms, a kink it does not report.
+    fn smooth(&self) -> bool {
+        self.shadowing != Shadowing::VCavity
     }
 
     fn describe(&self) -> String {

@@ -39,6 +39,11 @@ impl Brdf for Lambert {
         vec![Term { label: "Lambertian".into(), kind: TermKind::Diffuse }]
     }
 
+    /// Analytic everywhere but on its reported kinks (`Brdf::smooth`).
+    fn smooth(&self) -> bool {
+        true
+    }
+
     fn describe(&self) -> String {
         format!("Lambert (albedo {})", fmt_values(&self.albedo))
     }

@@ -146,6 +146,12 @@ impl Brdf for CookTorranceLobes {
         t
     }
 
+    /// Smooth with a Smith G and no clear coat (the V-cavity G's min() is a kink it does not report; a coat
+    /// is not claimed).
+    fn smooth(&self) -> bool {
+        self.shadowing != Shadowing::VCavity && self.clear_coat.is_none()
+    }
+
     fn describe(&self) -> String {
         let lobes: Vec<String> = self
             .lobes

@@ -124,6 +124,11 @@ impl Brdf for Phong {
         t
     }
 
+    /// max(0, c)ⁿ has n − 1 continuous derivatives at c = 0: smooth enough for the degree-7 rule from n = 8.
+    fn smooth(&self) -> bool {
+        self.exponent >= 8.0
+    }
+
     fn describe(&self) -> String {
         format!(
             "normalised {} (n = {}, kd = {}, ks = {})",

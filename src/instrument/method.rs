@@ -25,7 +25,7 @@ use crate::instrument::geometry::{solid_angle_density, Axes, Integral, Stop};
 use crate::instrument::sphere;
 use crate::quadrature::{
     gauss_hermite_table, gauss_legendre_table, integrate_partition, legendre_on_into, mapped_legendre_into,
-    polar_rectangle_into, tensor, Cell, Estimate, Map, Options, PolarBuffers, Refine,
+    polar_rectangle_into, tensor, Cell, Estimate, Map, Options, PolarBuffers, Refine, MAX_SHRINK, MAX_SHRINK_LOBE,
 };
 use crate::spectrum::Weighting;
 use crate::Vec3;
@@ -520,6 +520,7 @@ impl Method {
             }
         };
         let mut flux = Flux::zero(k);
+        let smooth = brdf.smooth();
 
         // 1. The delta part: source points whose mirror (−p, −q) lies in the receptor.
         if let Some(part) = &self.delta {
@@ -549,7 +550,14 @@ impl Method {
                 },
                 ncomp,
                 &part.cells,
-                &Options { rtol: part.rtol, atol: part.atol, max_evals: self.max_evals, deadline },
+                &Options {
+                    rtol: part.rtol,
+                    atol: part.atol,
+                    max_evals: self.max_evals,
+                    deadline,
+                    checked: smooth,
+                    ..Default::default()
+                },
                 part.refine,
                 keep,
             );
@@ -623,7 +631,12 @@ impl Method {
                     store(&mut out[i * ncomp..(i + 1) * ncomp], v, weighting, g, projection);
                 }
             };
-            let opts = Options { rtol: part.rtol, atol, max_evals: self.max_evals, deadline };
+            // A smooth material's region estimates are trusted further (`docs/accuracy.md` §5): checked
+            // children, and on the lobe chart (whose boxes are cut to the lobe's widths and kinks) a deeper
+            // shrink.
+            let max_shrink = if smooth && part.chart == Chart::Lobe { MAX_SHRINK_LOBE } else { MAX_SHRINK };
+            let opts =
+                Options { rtol: part.rtol, atol, max_evals: self.max_evals, deadline, max_shrink, checked: smooth };
             // A shaped rule first (when the planner chose one), the Genz–Malik partition if it does not agree.
             let mut spent = 0;
             let shaped = match part.rule {

@@ -121,7 +121,7 @@ pub fn port_reflectance(brdf: &dyn Brdf, viewing: f64, beta: f64, rtol: f64, max
         }),
         n,
         &boxes,
-        &Options { rtol, atol: 1e-4 * rtol, max_evals, deadline: None },
+        &Options { rtol, atol: 1e-4 * rtol, max_evals, deadline: None, ..Default::default() },
     );
     let value = delta.iter().zip(&est.value).map(|(d, r)| d + r).collect();
     PerSample { value, error: est.error, evaluations: est.evaluations, converged: est.converged }

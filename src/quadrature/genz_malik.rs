@@ -15,11 +15,18 @@ pub struct Options {
     /// `converged: false` and `out_of_time: true`). None: no limit (the default; results are then the same
     /// bits on every machine).
     pub deadline: Option<std::time::Instant>,
+    /// The most a box's calibrated estimate may shrink below N₁ = |I₇ − I₅| ([`calibrated`]):
+    /// [`MAX_SHRINK`] (8) by default; [`MAX_SHRINK_LOBE`] (16) on the lobe chart of a smooth material.
+    pub max_shrink: f64,
+    /// Whether a split box's children have their estimates scaled from their parent's check
+    /// ([`child_scale`]); only for an integrand that is smooth inside every box (a material that says
+    /// `Brdf::smooth`), `docs/accuracy.md` §5.
+    pub checked: bool,
 }
 
 impl Default for Options {
     fn default() -> Self {
-        Options { rtol: 1e-6, atol: 0.0, max_evals: 20_000_000, deadline: None }
+        Options { rtol: 1e-6, atol: 0.0, max_evals: 20_000_000, deadline: None, max_shrink: MAX_SHRINK, checked: false }
     }
 }
 
@@ -28,7 +35,8 @@ impl Default for Options {
 pub struct Estimate {
     /// The integral, one value per component (degree-7 rule summed over all regions).
     pub value: Vec<f64>,
-    /// Error estimate per component: Σ over regions of the calibrated null-rule estimate ([`calibrated`]).
+    /// Error estimate per component: Σ over regions of the calibrated null-rule estimate ([`calibrated`]),
+    /// scaled by the region's parent check when `Options::checked` ([`child_scale`]).
     pub error: Vec<f64>,
     pub evaluations: usize,
     pub regions: usize,
@@ -140,6 +148,10 @@ impl<const D: usize> Rule<D> {
 pub struct Cell<const D: usize> {
     pub center: [f64; D],
     pub half: [f64; D],
+    /// The factor its parent's check put on the cell's calibrated estimate ([`child_scale`]; 1 for a cell
+    /// of an initial partition or of an unchecked run), kept with a frozen partition so that a re-run gives
+    /// the same estimate bits.
+    pub scale: f64,
 }
 
 impl<const D: usize> Cell<D> {
@@ -154,7 +166,7 @@ impl<const D: usize> Cell<D> {
                 return None;
             }
         }
-        Some(Cell { center: c, half: h })
+        Some(Cell { center: c, half: h, scale: 1.0 })
     }
 
     /// The cells of a list of boxes, degenerate ones dropped.
@@ -215,6 +227,11 @@ struct Region<const D: usize> {
     cell: Cell<D>,
     value: Comps,
     error: Comps,
+    /// N₁ = |I₇ − I₅| per component and the calibrated estimate before the cell's scale.
+    n1: Comps,
+    base: Comps,
+    /// Whether the region's parent passed its check ([`child_scale`] < 1).
+    checked: bool,
     /// Largest component error: the priority.
     worst: f64,
     split_axis: usize,
@@ -240,10 +257,12 @@ impl<const D: usize> Ord for Region<D> {
     }
 }
 
-/// Scratch of the batched driver: the points of one call and the integrand values they receive.
+/// Scratch of the batched driver: the points of one call and the integrand values they receive; and the
+/// run's cap on the calibrated shrink (`Options::max_shrink`).
 struct Batch<const D: usize> {
     points: Vec<[f64; D]>,
     values: Vec<f64>,
+    max_shrink: f64,
 }
 
 /// Apply the rule to the cells in one integrand call: all their points (57 per 4-D cell) are passed to `f`
@@ -274,7 +293,14 @@ fn apply<const D: usize, F: FnMut(&[[f64; D]], &mut [f64])>(
     f(&batch.points, &mut batch.values);
     out.clear();
     out.extend(cells.iter().enumerate().map(|(i, cell)| {
-        summarise(rule, *cell, &batch.values[i * npts * ncomp..(i + 1) * npts * ncomp], ncomp, first_id + i)
+        summarise(
+            rule,
+            *cell,
+            &batch.values[i * npts * ncomp..(i + 1) * npts * ncomp],
+            ncomp,
+            first_id + i,
+            batch.max_shrink,
+        )
     }));
 }
 
@@ -286,6 +312,8 @@ const MAX_SMALL: usize = 8;
 /// null rules fall by r per step, never less than N₁/`MAX_SHRINK`.
 pub const CALIBRATION: f64 = 3.0;
 pub const MAX_SHRINK: f64 = 8.0;
+/// The shrink limit on the lobe chart of a smooth material (`Options::max_shrink`, `docs/accuracy.md` §5).
+pub const MAX_SHRINK_LOBE: f64 = 16.0;
 
 /// The calibrated error of one region from three successive null rules, N₁ = |I₇ − I₅|, N₂ = |I₅ − I₃| and
 /// N₃ = |I₃ − I₁| (I₃ on the centre and the ±λ4 axial points, I₁ the centre alone), in the manner of DCUHRE
@@ -293,23 +321,86 @@ pub const MAX_SHRINK: f64 = 8.0;
 /// ACM TOMS 17 (1991) 437–451): when the differences fall fast and steadily, r = max(N₁/N₂, N₂/N₃) small,
 /// the integrand is in the asymptotic range of the rules and the error of the reported I₇ is about r·N₁, far
 /// below N₁ (which is the error of I₅). The estimate is then C·r·N₁ (C = [`CALIBRATION`] = 3), but at least
-/// N₁/[`MAX_SHRINK`] (8) and never below the rounding of the sum, 50 ε Σ|w₇ f| (`abs7`, scaled like the
+/// N₁/`max_shrink` ([`MAX_SHRINK`] = 8 by default) and never below the rounding of the sum, 50 ε Σ|w₇ f| (`abs7`, scaled like the
 /// value) unless N₁ itself is; otherwise (C·r ≥ 1) it stays N₁. Both limits were chosen on this project's
 /// integrands (`docs/accuracy.md` §5): requiring both ratios, and the cap, are what keep it honest on the
 /// heavy-tailed, tabulated and off-specular integrals of the shipped fixtures, where the first ratio alone
-/// shrank estimates 20× below the actual error.
+/// shrank estimates 20× below the actual error; a cap of 16 stays honest only on the lobe chart of a smooth
+/// material (`max_shrink` = [`MAX_SHRINK_LOBE`] there, `Options::max_shrink`, §5.1).
 #[inline]
-pub fn calibrated(n1: f64, n2: f64, n3: f64, abs7: f64) -> f64 {
+pub fn calibrated(n1: f64, n2: f64, n3: f64, abs7: f64, max_shrink: f64) -> f64 {
     let r = (n1 / n2).max(n2 / n3);
     if CALIBRATION * r < 1.0 {
-        (CALIBRATION * r * n1).max(n1 / MAX_SHRINK).max(n1.min(50.0 * f64::EPSILON * abs7))
+        (CALIBRATION * r * n1).max(n1 / max_shrink).max(n1.min(50.0 * f64::EPSILON * abs7))
     } else {
         n1
     }
 }
 
+/// The parent's check ([`child_scale`]): the children's estimates shrink only where the parent's estimate
+/// covered `CHECK_MARGIN` times its actual error.
+pub const CHECK_MARGIN: f64 = 4.0;
+/// The most one check shrinks the children's estimates (a factor on their calibrated estimates).
+pub const CHECK_SHRINK: f64 = 8.0;
+/// The most a checked box's estimate may shrink below N₁ in all.
+pub const CHECKED_MAX_SHRINK: f64 = 64.0;
+
+/// A cell's estimate from its calibrated one and its scale: base·scale, kept within
+/// [N₁/[`CHECKED_MAX_SHRINK`], N₁] (and exactly the calibrated estimate at scale 1).
+#[inline]
+fn scaled(n1: f64, base: f64, scale: f64) -> f64 {
+    if scale == 1.0 {
+        base
+    } else {
+        (base * scale).max(n1 / CHECKED_MAX_SHRINK).min(n1.max(base))
+    }
+}
+
+/// The scale of two children from their parent's check. When a box is bisected, its children's I₇ are far
+/// more accurate than its own on a smooth integrand, so D = |I₇(parent) − I₇(child 1) − I₇(child 2)| is about
+/// the parent's actual error, and e_parent/D says how pessimistic the parent's estimate was. The children's
+/// calibrated estimates are multiplied by m = [`CHECK_MARGIN`]·D/e_parent (the worst component), within
+/// [1/[`CHECK_SHRINK`], [`MAX_SHRINK`]]: shrunk where the parent's estimate covered 4× its actual error,
+/// enlarged where it did not (the null rules were misled there). The convergence-rate-aware step of the
+/// DCUHRE family (Berntsen, Espelid & Genz 1991 use successive null rules; this uses successive
+/// refinements), with constants chosen on this project's integrals (`docs/accuracy.md` §5). 1 when nothing is
+/// known (every component exact and zero).
+pub fn child_scale(parent_value: &[f64], parent_error: &[f64], a: &[f64], b: &[f64]) -> f64 {
+    let (mut m, mut any): (f64, bool) = (0.0, false);
+    for c in 0..parent_value.len() {
+        let d = (parent_value[c] - (a[c] + b[c])).abs();
+        let e = parent_error[c];
+        if e > 0.0 {
+            any = true;
+            m = m.max(CHECK_MARGIN * d / e);
+        } else if d > 0.0 {
+            any = true;
+            m = MAX_SHRINK;
+        }
+    }
+    if !any {
+        return 1.0;
+    }
+    m.clamp(1.0 / CHECK_SHRINK, MAX_SHRINK)
+}
+
+fn rescale<const D: usize>(r: &mut Region<D>, scale: f64) {
+    r.cell.scale = scale;
+    for c in 0..r.value.len() {
+        r.error[c] = scaled(r.n1[c], r.base[c], scale);
+    }
+    r.worst = r.error.iter().cloned().fold(0.0, f64::max);
+}
+
 /// The degree-7 and degree-5 sums of one cell from its integrand values (`npts × ncomp`, point-major).
-fn summarise<const D: usize>(rule: &Rule<D>, cell: Cell<D>, values: &[f64], ncomp: usize, id: usize) -> Region<D> {
+fn summarise<const D: usize>(
+    rule: &Rule<D>,
+    cell: Cell<D>,
+    values: &[f64],
+    ncomp: usize,
+    id: usize,
+    max_shrink: f64,
+) -> Region<D> {
     let half = cell.half;
     let vol: f64 = half.iter().map(|h| 2.0 * h).product();
     let mut s7 = Comps::zeros(ncomp);
@@ -347,13 +438,17 @@ fn summarise<const D: usize>(rule: &Rule<D>, cell: Cell<D>, values: &[f64], ncom
     }
     // The value and error in place of the two sums (no allocation per region beyond these two).
     let (mut value, mut error) = (s7, s5);
+    let mut n1s = Comps::zeros(ncomp);
+    let mut base = Comps::zeros(ncomp);
     for (c, (v, e)) in value.iter_mut().zip(error.iter_mut()).enumerate() {
         let n1 = ((*v - *e) * vol).abs();
-        *e = if small {
-            calibrated(n1, ((*e - s3[c]) * vol).abs(), ((s3[c] - s1[c]) * vol).abs(), abs7[c] * vol)
+        n1s[c] = n1;
+        base[c] = if small {
+            calibrated(n1, ((*e - s3[c]) * vol).abs(), ((s3[c] - s1[c]) * vol).abs(), abs7[c] * vol, max_shrink)
         } else {
             n1
         };
+        *e = scaled(n1, base[c], cell.scale);
         *v *= vol;
     }
     let worst = error.iter().cloned().fold(0.0, f64::max);
@@ -368,7 +463,7 @@ fn summarise<const D: usize>(rule: &Rule<D>, cell: Cell<D>, values: &[f64], ncom
             split_axis = k;
         }
     }
-    Region { cell, value, error, worst, split_axis, id }
+    Region { cell, value, error, n1: n1s, base, checked: false, worst, split_axis, id }
 }
 
 /// Integrate `f` (ncomp components) over the union of the boxes `initial` (each `(lo, hi)`), adaptively,
@@ -404,7 +499,11 @@ pub fn integrate_partition<const D: usize, F: FnMut(&[[f64; D]], &mut [f64])>(
 ) -> (Estimate, Vec<Cell<D>>) {
     let rule = Rule::<D>::new();
     let npts = rule.len();
-    let mut batch = Batch { points: Vec::with_capacity(2 * npts), values: Vec::with_capacity(2 * npts * ncomp) };
+    let mut batch = Batch {
+        points: Vec::with_capacity(2 * npts),
+        values: Vec::with_capacity(2 * npts * ncomp),
+        max_shrink: opts.max_shrink,
+    };
     let mut heap = BinaryHeap::new();
     let mut total = vec![0.0; ncomp];
     let mut err = vec![0.0; ncomp];
@@ -447,11 +546,24 @@ pub fn integrate_partition<const D: usize, F: FnMut(&[[f64; D]], &mut [f64])>(
         let mut c2 = r.cell.center;
         c1[ax] -= half[ax];
         c2[ax] += half[ax];
-        let children = [Cell { center: c1, half }, Cell { center: c2, half }];
+        let children = [Cell { center: c1, half, scale: 1.0 }, Cell { center: c2, half, scale: 1.0 }];
         apply(&rule, &mut f, &children, ncomp, &mut batch, next_id, &mut fresh);
         next_id += 2;
         evals += 2 * npts;
-        let (b, a) = (fresh.pop().expect("two children"), fresh.pop().expect("two children"));
+        let (mut b, mut a) = (fresh.pop().expect("two children"), fresh.pop().expect("two children"));
+        if opts.checked {
+            // Shrink only below a parent that passed its own parent's check (two consecutive checks): one
+            // check alone was fooled (blinn-phong at E2194 15°, `docs/accuracy.md` §5).
+            let mut m = child_scale(&r.value, &r.error, &a.value, &b.value);
+            (a.checked, b.checked) = (m < 1.0, m < 1.0);
+            if !r.checked {
+                m = m.max(1.0);
+            }
+            if m != 1.0 {
+                rescale(&mut a, m);
+                rescale(&mut b, m);
+            }
+        }
         for k in 0..ncomp {
             total[k] += a.value[k] + b.value[k] - r.value[k];
             err[k] += a.error[k] + b.error[k] - r.error[k];
@@ -542,18 +654,18 @@ mod tests {
     #[test]
     fn the_calibrated_estimate_shrinks_only_on_steadily_falling_differences_and_at_most_eightfold() {
         // Not asymptotic (N₂ ≤ 3 N₁, or N₃ ≤ 3 N₂): N₁ itself.
-        assert_eq!(calibrated(1.0, 2.0, 100.0, 0.0), 1.0);
-        assert_eq!(calibrated(1.0, 100.0, 150.0, 0.0), 1.0);
+        assert_eq!(calibrated(1.0, 2.0, 100.0, 0.0, MAX_SHRINK), 1.0);
+        assert_eq!(calibrated(1.0, 100.0, 150.0, 0.0, MAX_SHRINK), 1.0);
         // Steady fall by 10 per step: 3·0.1·N₁.
-        assert!((calibrated(1e-6, 1e-5, 1e-4, 0.0) - 3e-7).abs() < 1e-20);
+        assert!((calibrated(1e-6, 1e-5, 1e-4, 0.0, MAX_SHRINK) - 3e-7).abs() < 1e-20);
         // A fast fall shrinks by at most MAX_SHRINK.
-        assert_eq!(calibrated(1e-9, 1e-6, 1e-3, 0.0), 1e-9 / MAX_SHRINK);
+        assert_eq!(calibrated(1e-9, 1e-6, 1e-3, 0.0, MAX_SHRINK), 1e-9 / MAX_SHRINK);
         // Zero and degenerate differences keep N₁.
-        assert_eq!(calibrated(0.0, 0.0, 0.0, 1.0), 0.0);
-        assert_eq!(calibrated(1e-9, 0.0, 0.0, 1.0), 1e-9);
+        assert_eq!(calibrated(0.0, 0.0, 0.0, 1.0, MAX_SHRINK), 0.0);
+        assert_eq!(calibrated(1e-9, 0.0, 0.0, 1.0, MAX_SHRINK), 1e-9);
         // Never below the rounding of the sum (unless N₁ is).
-        assert_eq!(calibrated(1e-16, 1e-15, 1e-14, 1.0), 1e-16);
-        assert_eq!(calibrated(1e-14, 1e-12, 1e-10, 0.5), 25.0 * f64::EPSILON);
+        assert_eq!(calibrated(1e-16, 1e-15, 1e-14, 1.0, MAX_SHRINK), 1e-16);
+        assert_eq!(calibrated(1e-14, 1e-12, 1e-10, 0.5, MAX_SHRINK), 25.0 * f64::EPSILON);
     }
 
     #[test]
@@ -563,7 +675,7 @@ mod tests {
             pointwise(1, |x, o| o[0] = x[0].powi(6) + x[1].powi(4) * x[2].powi(2) + x[3].powi(7) + 1.0),
             1,
             &[([-1.0; 4], [1.0; 4])],
-            &Options { rtol: 1.0, atol: 1.0, max_evals: 57, deadline: None },
+            &Options { rtol: 1.0, atol: 1.0, max_evals: 57, deadline: None, ..Default::default() },
         );
         let exact = 16.0 * (1.0 / 7.0 + 1.0 / 5.0 / 3.0 + 0.0 + 1.0);
         assert!((est.value[0] - exact).abs() < 1e-13, "{} vs {exact}", est.value[0]);
@@ -582,7 +694,7 @@ mod tests {
                     ([-1.0, 0.0], [0.0, 1.0]),
                     ([0.0, 0.0], [1.0, 1.0]),
                 ],
-                &Options { rtol: 1e-9, atol: 0.0, max_evals: 10_000_000, deadline: None },
+                &Options { rtol: 1e-9, atol: 0.0, max_evals: 10_000_000, deadline: None, ..Default::default() },
             );
             let e = libm::erf(1.0 / (sigma * 2f64.sqrt()));
             let exact = 2.0 * std::f64::consts::PI * sigma * sigma * e * e;
@@ -603,7 +715,7 @@ mod tests {
                 }),
                 2,
                 &[([0.0; 4], [1.0; 4])],
-                &Options { rtol: 1e-7, atol: 0.0, max_evals: 2_000_000, deadline: None },
+                &Options { rtol: 1e-7, atol: 0.0, max_evals: 2_000_000, deadline: None, ..Default::default() },
             )
         };
         let (a, b) = (run(), run());
@@ -618,7 +730,7 @@ mod tests {
             pointwise(1, |x, o| o[0] = if x[0] > 0.3 { 1.0 } else { 0.0 }),
             1,
             &[([0.0, 0.0], [1.0, 1.0])],
-            &Options { rtol: 1e-14, atol: 0.0, max_evals: 1000, deadline: None },
+            &Options { rtol: 1e-14, atol: 0.0, max_evals: 1000, deadline: None, ..Default::default() },
         );
         assert!(!est.converged);
         assert!(est.evaluations <= 1000);
@@ -629,7 +741,7 @@ mod tests {
         let f = |a: f64| {
             pointwise(1, move |x: &[f64; 2], o: &mut [f64]| o[0] = (-a * (x[0] * x[0] + 3.0 * x[1] * x[1])).exp())
         };
-        let opts = Options { rtol: 1e-9, atol: 0.0, max_evals: 1_000_000, deadline: None };
+        let opts = Options { rtol: 1e-9, atol: 0.0, max_evals: 1_000_000, deadline: None, ..Default::default() };
         let start = Cell::from_boxes(&[([-1.0, -1.0], [1.0, 1.0])]);
         let (adaptive, cells) = integrate_partition(f(20.0), 1, &start, &opts, Refine::Adaptive, true);
         assert!(adaptive.regions > 1 && cells.len() == adaptive.regions);
@@ -658,7 +770,7 @@ mod tests {
             },
             1,
             &[([-1.0, -1.0], [1.0, 1.0])],
-            &Options { rtol: 1e-8, atol: 0.0, max_evals: 100_000, deadline: None },
+            &Options { rtol: 1e-8, atol: 0.0, max_evals: 100_000, deadline: None, ..Default::default() },
         );
         assert!(est.converged && sizes.len() > 2);
         assert_eq!(sizes[0], 17);
@@ -667,7 +779,13 @@ mod tests {
 
     #[test]
     fn a_passed_deadline_stops_refinement_with_the_estimate_so_far() {
-        let opts = Options { rtol: 1e-12, atol: 0.0, max_evals: 1_000_000, deadline: Some(std::time::Instant::now()) };
+        let opts = Options {
+            rtol: 1e-12,
+            atol: 0.0,
+            max_evals: 1_000_000,
+            deadline: Some(std::time::Instant::now()),
+            ..Default::default()
+        };
         let est = integrate::<2, _>(
             pointwise(1, |x, o| o[0] = (-50.0 * x[0] * x[0]).exp()),
             1,

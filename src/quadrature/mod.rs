@@ -20,7 +20,8 @@
 //! along the axis with the largest fourth difference. The error of a region is not hcubature's |I₇ − I₅| (the
 //! error of the degree-5 rule, 100–1000× above the actual error of the reported I₇ on smooth integrands) but
 //! a DCUHRE-style calibration from three successive null rules on the same points (`genz_malik::calibrated`,
-//! `docs/accuracy.md` §5).
+//! `docs/accuracy.md` §5), on a smooth integrand also checked against the refinement (a bisected box's
+//! children against their parent, `genz_malik::child_scale`, §5.1).
 mod gauss;
 mod genz_malik;
 mod hermite;
@@ -34,4 +35,6 @@ pub use polar::{
     PolarBuffers,
 };
 
-pub use genz_malik::{integrate, integrate_partition, pointwise, Cell, Estimate, Options, Refine, Rule};
+pub use genz_malik::{
+    integrate, integrate_partition, pointwise, Cell, Estimate, Options, Refine, Rule, MAX_SHRINK, MAX_SHRINK_LOBE,
+};

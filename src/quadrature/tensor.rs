@@ -351,7 +351,7 @@ mod tests {
     use super::*;
 
     fn opts(rtol: f64) -> Options {
-        Options { rtol, atol: 0.0, max_evals: 10_000_000, deadline: None }
+        Options { rtol, atol: 0.0, max_evals: 10_000_000, deadline: None, ..Default::default() }
     }
 
     /// A separable analytic integrand with one sharp axis: the sharp axis is raised, the others stay low, and
