@@ -987,6 +987,20 @@ impl Brdf for Paint {
         t
     }
 
+    /// Smooth in the physical form under a smooth (delta) coat: Fresnel T(θ) of the air → coat interface
+    /// (η ≥ 1.3, so refraction into the coat never meets total internal reflection and ωi', ωo' are analytic
+    /// in ωi, ωo over the whole upper hemisphere: the interior critical angle bounds which interior directions
+    /// are reached, it is no cutoff in the exterior directions the instrument integrates over), the
+    /// Kubelka–Munk body (a constant), the split light's τ = exp(−εX'/μ') (μ' ≥ √(1 − 1/η²)), and the flake
+    /// lobes' Beckmann D with the Smith height-correlated G (erfc, no min). The flake reflectances are read
+    /// from piecewise Chebyshev tables of smooth functions verified within `TABLE_TOLERANCE` (10⁻¹²) of the
+    /// direct evaluation, so a seam is a jump of at most ~2·10⁻¹², far below the tolerances a reading is asked
+    /// for. Not smooth: a rough coat (E(μ) from a table held constant below μ₀, measured dishonest when
+    /// checked, `docs/accuracy.md` §5.1) and the paper's Eq. (1) form (V-cavity G, a min()).
+    fn smooth(&self) -> bool {
+        self.spec.form == Form::Physical && self.rough_coat.is_none()
+    }
+
     fn is_reciprocal(&self) -> bool {
         // Physical: T(θi)T(θo) symmetric, f' symmetric (h' and ωi'·h' = ωo'·h' are). Paper Eq. 1 applies
         // τ(θi) once, which breaks the symmetry whenever anything lies under the coat.
