@@ -1213,3 +1213,19 @@ fn realistic_paints_read_in_the_real_meter_ranges() {
     assert!((41.0..=69.0).contains(&g60), "semigloss-white: 60° reads {g60}");
     assert!(g20 < g60, "semigloss-white: 20° {g20} vs 60° {g60}");
 }
+
+#[test]
+fn smooth_is_claimed_only_for_the_physical_form_under_a_smooth_coat() {
+    // `Brdf::smooth` lets the integrator check and shrink its region estimates (docs/accuracy.md §5.1). The
+    // physical form under a smooth coat is analytic in the exterior directions; the rough coat's E(μ) table
+    // and the printed Eq. (1)'s V-cavity G are not, and must keep the calibrated estimate.
+    for name in ["cerulean-blue-b-literal", "cerulean-blue-c-literal", "white-pearl-spectral"] {
+        assert!(load(name).smooth(), "{name}: physical form, smooth coat");
+    }
+    assert!(!load("semigloss-white").smooth(), "semigloss-white: rough clear coat");
+    let mut spec = rgb_spec(1.5, 0.1, [0.5; 3], [0.0; 3], [0.0; 3]);
+    spec.metallic = Some(MetallicFlakes { n: vec![0.05; 3], k: vec![4.0; 3], ..metal(2.0, 1.0, 0.0) });
+    assert!(Paint::new(spec.clone()).unwrap().smooth());
+    spec.form = Form::PaperEq1;
+    assert!(!Paint::new(spec).unwrap().smooth(), "paper Eq. (1): V-cavity G");
+}
