@@ -203,8 +203,9 @@ pub trait Brdf: Send + Sync + std::fmt::Debug {
     }
 
     /// Whether the model's value is smooth (analytic formulas, no min/max, clamp, table or interpolation
-    /// seam) everywhere in the upper hemispheres except on the kinks it reports ([`Brdf::kinks`]). False by
-    /// default. A smooth model lets the integrator trust its region estimates further
+    /// seam — short of a table of a smooth function verified far below any tolerance, as a paint's flake
+    /// reflectances within 10⁻¹²) everywhere in the upper hemispheres except on the kinks it reports
+    /// ([`Brdf::kinks`]). False by default. A smooth model lets the integrator trust its region estimates further
     /// (`quadrature::Options::checked`, `docs/accuracy.md` §5): on a model with a kink it does not report
     /// (the V-cavity G's min, a table's seams) the null rules and the parent–children check both miss the
     /// kink, and the deeper estimates fell below the actual error at rtol 10⁻⁷ and 10⁻⁸.
