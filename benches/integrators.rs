@@ -281,6 +281,7 @@ fn rule_label(m: &Method, brdf: &dyn Brdf) -> String {
             )
         }
         Rule::LobeGaussHermite { .. } => "Gauss–Hermite × Gauss–Legendre, lobe chart".into(),
+        Rule::LobeDelta { .. } => "delta limit of the lobe, lobe chart".into(),
         Rule::LobePolar { .. } => "polar + tail boxes, lobe chart".into(),
         Rule::TensorGauss { chart, .. } => format!(
             "tensor Gauss–Legendre, {} chart",

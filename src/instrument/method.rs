@@ -57,6 +57,17 @@ pub enum Rule {
     /// `levels.0..=levels.1` until two successive levels agree to the part's tolerance (their difference is
     /// the error estimate). If none do, the part's Genz–Malik partition is integrated instead (the fallback).
     LobeGaussHermite { width: [f64; 2], levels: (usize, usize) },
+    /// The delta limit of a narrow Gaussian-tailed lobe far from every kink of the overlap (issue 10 item 1;
+    /// [`delta_rule`], `docs/instrument.md` §Quadrature, "The delta limit of a narrow lobe"): in the scaled lobe
+    /// variables x = u/w_u, y = v/w_v, at each Gauss–Legendre node of (t_p, t_q), the lobe's mass is Laplace's
+    /// π·F(0)/√det B from its curvature B at the peak (measured on a ring of [`DELTA_FIT_RADIUS`] width), and the
+    /// error reported is the majorant of [`delta_node`] (second differences of the even part of F·e^{xᵀBx} on
+    /// rings of [`DELTA_RADII`] widths times [`DELTA_SAFETY`], the Gaussian tail beyond the outer ring) plus
+    /// the t rule's difference of orders ([`DELTA_T_ORDERS`]: the engine's usual estimate of a Gauss–Legendre
+    /// rule on a smooth integrand, as in [`Rule::LobeGaussHermite`]). It is accepted when that
+    /// majorant meets the part's tolerance; otherwise the lobe's [`Rule::LobeGaussHermite`] runs (and after
+    /// it, if it does not agree either, the Genz–Malik partition). A frozen method replays the same points.
+    LobeDelta { width: [f64; 2] },
     /// A narrow lobe with GGX's heavy u⁻⁴ tail (`Tail::InverseQuartic`) whose centre lies inside the kink square (issue 10; [`polar_rule`]): the
     /// (u, v) range is cut at the overlap kinks `u`, `v` (each axis: the range ends and the two kinks, in
     /// increasing order) into up to 3 × 3 pieces. The piece that holds u = v = 0 is integrated in the polar
@@ -132,6 +143,26 @@ pub const LOBE_LEVELS: [(usize, usize); 5] = [(4, 2), (6, 3), (8, 4), (12, 5), (
 /// axes, for [`Rule::LobeGaussHermite`]: the largest node of the 16-point rule is at 4.69 widths, and the
 /// Gaussian is below e⁻⁶⁴ of its peak at 8.
 pub const LOBE_REACH: f64 = 8.0;
+
+/// The radii (in lobe widths) of the rings on which [`Rule::LobeDelta`] samples the even part of h (four
+/// directions, 0°, 45°, 90°, 135°, each with its opposite point; with the curvature ring): the majorant's
+/// second differences.
+pub const DELTA_RADII: [f64; 2] = [2.5, 5.0];
+
+/// The radius (in lobe widths) of the disc inside which [`Rule::LobeDelta`] bounds the correction by second
+/// differences (in the metric of the fitted curvature B); beyond it the Gaussian tail, π·e^{−R²} of the
+/// peak's mass, is bounded by the largest |h| on that ring. It is the last of [`DELTA_RADII`]; the overlap
+/// kinks are ≥ [`LOBE_REACH`] = 8 widths away.
+pub const DELTA_RADIUS: f64 = 5.0;
+
+/// The factor by which [`Rule::LobeDelta`] multiplies the largest sampled second difference (and the sampled
+/// |h| on the outer ring) to stand for a bound over the whole disc:
+/// the one assumption of its majorant (`docs/instrument.md` §Quadrature).
+pub const DELTA_SAFETY: f64 = 4.0;
+
+/// The Gauss–Legendre orders per t axis of [`Rule::LobeDelta`]: the second-difference stencil on the lower's
+/// nodes, the value on the higher's, their difference the t rule's error.
+pub const DELTA_T_ORDERS: (usize, usize) = (2, 3);
 
 /// When the spectral weighting is applied.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -304,7 +335,8 @@ impl Method {
                 let share = 1.0 - DELTA_SHARE;
                 let rule = match chart {
                     Chart::Lobe if kinks.is_empty() && on_mirror_axis => {
-                        lobe_rule(d.lobes, d.has_diffuse, d.theta, src, rec)
+                        delta_rule(d.lobes, d.has_diffuse, d.theta, src, rec, share * d.rtol)
+                            .or_else(|| lobe_rule(d.lobes, d.has_diffuse, d.theta, src, rec))
                             .or_else(|| polar_rule(d.lobes, d.has_diffuse, d.theta, src, rec))
                             .or_else(|| smooth_rule(d.lobes, d.theta, src, rec))
                             .unwrap_or(Rule::GenzMalik75)
@@ -645,6 +677,22 @@ impl Method {
                     spent = r.1;
                     r.0.map(|(est, level)| (est, Rule::LobeGaussHermite { width, levels: (level - 1, level) }))
                 }
+                Rule::LobeDelta { width } => {
+                    let (est, n) = lobe_delta(&mut integrand, ncomp, width, &opts);
+                    spent = n;
+                    match est {
+                        Some(est) if est.converged || part.refine == Refine::Frozen => {
+                            Some((est, Rule::LobeDelta { width }))
+                        }
+                        _ => {
+                            // The majorant did not meet the tolerance: the lobe's Gauss–Hermite rule.
+                            let levels = (0, LOBE_LEVELS.len() - 1);
+                            let r = lobe_gauss_hermite(&mut integrand, ncomp, width, levels, &opts, part.refine);
+                            spent += r.1;
+                            r.0.map(|(est, level)| (est, Rule::LobeGaussHermite { width, levels: (level - 1, level) }))
+                        }
+                    }
+                }
                 Rule::LobePolar { width, u, v, levels } => {
                     let r = lobe_polar(&mut integrand, ncomp, width, [u, v], levels, &opts, part.refine);
                     spent = r.1;
@@ -712,6 +760,169 @@ pub fn lobe_rule(lobes: &[Lobe], has_diffuse: bool, theta: f64, src: Stop, rec: 
     };
     let fits = clear(AxisMap { s: src.p, r: rec.p }, width[0]) && clear(AxisMap { s: src.q, r: rec.q }, width[1]);
     fits.then_some(Rule::LobeGaussHermite { width, levels: (0, LOBE_LEVELS.len() - 1) })
+}
+
+/// The delta-limit rule of a lobe-chart part ([`Rule::LobeDelta`]), if the lobe fits [`lobe_rule`] (one
+/// Gaussian-tailed lobe, no diffuse term, ≥ [`LOBE_REACH`] widths from every overlap kink and range end on
+/// both axes) and is narrow enough that its majorant can meet the part's relative tolerance `rtol`: the
+/// relative correction of the delta limit is c·w² (w the larger lobe width in (u, v)), and the majorant is
+/// about [`DELTA_GATE`]·w² on the shipped geometries, so the rule is tried only when DELTA_GATE·w² ≤ rtol
+/// (otherwise its evaluations would be spent for nothing before the Gauss–Hermite rule). Whether the
+/// majorant meets the tolerance is decided when it runs, on the material.
+pub fn delta_rule(lobes: &[Lobe], has_diffuse: bool, theta: f64, src: Stop, rec: Stop, rtol: f64) -> Option<Rule> {
+    let Some(Rule::LobeGaussHermite { width, .. }) = lobe_rule(lobes, has_diffuse, theta, src, rec) else {
+        return None;
+    };
+    let w = width[0].max(width[1]);
+    (DELTA_GATE * w * w <= rtol).then_some(Rule::LobeDelta { width })
+}
+
+/// The design-time gate of [`delta_rule`]: the majorant of [`Rule::LobeDelta`] relative to the reading, per
+/// squared lobe width, taken above the largest measured on the shipped geometries (`docs/instrument.md`
+/// §Quadrature). Only a gate: the majorant itself is computed at run time.
+pub const DELTA_GATE: f64 = 1.0e3;
+
+/// Run [`Rule::LobeDelta`]: the delta limit and its majorant (see [`delta_node`]); `converged` when the
+/// majorant meets max(atol, rtol·|I|) in every component. None when an evaluation is not finite, the lobe is
+/// not log-concave at its peak (the curvature fit fails) or the budget would be exceeded; and the evaluations
+/// spent either way.
+fn lobe_delta(
+    f: &mut impl FnMut(&[[f64; 4]], &mut [f64]),
+    ncomp: usize,
+    width: [f64; 2],
+    opts: &Options,
+) -> (Option<Estimate>, usize) {
+    let (lo, hi) = DELTA_T_ORDERS;
+    // Per t node of the higher order: the centre and the curvature ring; of the lower: and the bound's rings.
+    let (ring, full) = (1 + 8, 1 + 8 * (1 + DELTA_RADII.len()));
+    let cost = hi * hi * ring + lo * lo * full;
+    if cost > opts.max_evals {
+        return (None, 0);
+    }
+    let radii: Vec<f64> = std::iter::once(DELTA_FIT_RADIUS).chain(DELTA_RADII).collect();
+    let mut pts = Vec::with_capacity(cost);
+    let mut wts = Vec::with_capacity(hi * hi + lo * lo);
+    let (mut t, mut w) = (Vec::new(), Vec::new());
+    for (order, rings) in [(hi, 1), (lo, radii.len())] {
+        legendre_on_into(order, 0.0, 1.0, &mut t, &mut w);
+        for (tp, wp) in t.iter().zip(&w) {
+            for (tq, wq) in t.iter().zip(&w) {
+                wts.push(wp * wq);
+                pts.push([0.0, *tp, 0.0, *tq]);
+                for r in &radii[..rings] {
+                    for d in DELTA_DIRECTIONS {
+                        for s in [1.0, -1.0] {
+                            pts.push([s * r * d[0] * width[0], *tp, s * r * d[1] * width[1], *tq]);
+                        }
+                    }
+                }
+            }
+        }
+    }
+    let mut vals = vec![0.0; pts.len() * ncomp];
+    f(&pts, &mut vals);
+    if vals.iter().any(|v| !v.is_finite()) {
+        return (None, cost);
+    }
+    let scale = std::f64::consts::PI * width[0] * width[1];
+    let (mut value, mut error) = (vec![0.0; ncomp], vec![0.0; ncomp]);
+    let mut converged = true;
+    for c in 0..ncomp {
+        let (mut v_hi, mut v_lo, mut bound) = (0.0, 0.0, 0.0);
+        let mut start = 0;
+        for (k, wt) in wts.iter().enumerate() {
+            let n = if k < hi * hi { ring } else { full };
+            let node: Vec<f64> = (start..start + n).map(|i| vals[i * ncomp + c]).collect();
+            start += n;
+            let Some((mass, b)) = delta_node(&node, &radii[..(n - 1) / 8]) else {
+                return (None, cost);
+            };
+            if k < hi * hi {
+                v_hi += wt * mass;
+            } else {
+                v_lo += wt * mass;
+                bound += wt * b;
+            }
+        }
+        value[c] = scale * v_hi;
+        error[c] = scale * bound + scale * (v_hi - v_lo).abs();
+        converged &= error[c] <= opts.atol.max(opts.rtol * value[c].abs());
+    }
+    let est = Estimate { value, error, evaluations: 0, regions: 1, converged, out_of_time: false };
+    (Some(est), cost)
+}
+
+/// The directions of the stencil of [`Rule::LobeDelta`] in the scaled lobe variables (each with its opposite
+/// point): 0°, 45°, 90°, 135°.
+const DELTA_DIRECTIONS: [[f64; 2]; 4] = [
+    [1.0, 0.0],
+    [std::f64::consts::FRAC_1_SQRT_2, std::f64::consts::FRAC_1_SQRT_2],
+    [0.0, 1.0],
+    [-std::f64::consts::FRAC_1_SQRT_2, std::f64::consts::FRAC_1_SQRT_2],
+];
+
+/// The radius (in lobe widths) of the ring on which [`Rule::LobeDelta`] measures the lobe's curvature.
+pub const DELTA_FIT_RADIUS: f64 = 1.0;
+
+/// One t node of [`Rule::LobeDelta`], relative to π (the caller multiplies by π·w_u·w_v): the delta limit's
+/// mass and (when `radii` holds the bound's rings too) its majorant, from the values `vals` at the centre
+/// and, per ring of `radii` (the first the curvature ring) and direction of [`DELTA_DIRECTIONS`], the point
+/// and its opposite. None when the values are not positive where the curvature is measured or the fitted
+/// curvature is not positive definite.
+///
+/// *The curvature*: along direction d at radius r, b(d) = −(½ ln(F(rd)·F(−rd)) − ln F(0))/r² (the even part
+/// of ln F, so the odd terms of the lobe and of the rest cancel); B = [[b(0°), β], [β, b(90°)]] with
+/// β = ½(b(45°) − b(135°)). *The delta limit* at this node is Laplace's: ∫ F ≈ π·F(0)/√det B (for the exact
+/// Gaussian lobe of the linearised widths, B = I and this is π·F(0), the one-node Gauss–Hermite rule).
+/// *The majorant*: with h = F·e^{xᵀBx}, h_e(x) = ½(h(x) + h(−x)) and the weight e^{−xᵀBx} even,
+///
+///   ∫ F − π F(0)/√det B = ∫ e^{−xᵀBx} (h_e(x) − h(0)) dx,
+///
+/// and if |h_e(x) − h(0)| ≤ Q·xᵀBx on the ellipse xᵀBx ≤ R² and |h| ≤ H outside it, then, in y = B^{1/2}x,
+///
+///   |∫_{xᵀBx≤R²}| ≤ Q ∫ |y|² e^{−|y|²} dy / √det B = π Q / √det B,
+///   |∫_{xᵀBx>R²}| ≤ (H + |h(0)|)·π e^{−R²} / √det B.
+///
+/// Q is [`DELTA_SAFETY`] times the largest sampled |h_e − h(0)|/xᵀBx on all rings, H [`DELTA_SAFETY`] times
+/// the largest |h| on the outer ring, R² the smallest xᵀBx there.
+fn delta_node(vals: &[f64], radii: &[f64]) -> Option<(f64, f64)> {
+    let f0 = vals[0];
+    if vals.iter().all(|v| *v == 0.0) {
+        return Some((0.0, 0.0));
+    }
+    if f0 <= 0.0 || vals[1..9].iter().any(|v| *v <= 0.0) {
+        return None;
+    }
+    let r = radii[0];
+    let b: Vec<f64> = (0..4).map(|k| -(0.5 * (vals[1 + 2 * k] * vals[2 + 2 * k]).ln() - f0.ln()) / (r * r)).collect();
+    let (bxx, byy, bxy) = (b[0], b[2], 0.5 * (b[1] - b[3]));
+    let det = bxx * byy - bxy * bxy;
+    if !(bxx > 0.0 && byy > 0.0 && det > 0.0) {
+        return None;
+    }
+    let root = det.sqrt();
+    let mass = f0 / root;
+    if radii.len() == 1 {
+        return Some((mass, 0.0));
+    }
+    let (mut q, mut h, mut r2) = (0.0f64, 0.0f64, f64::INFINITY);
+    let mut i = 1;
+    for (j, r) in radii.iter().enumerate() {
+        for d in DELTA_DIRECTIONS {
+            let (x, y) = (r * d[0], r * d[1]);
+            let quad = bxx * x * x + 2.0 * bxy * x * y + byy * y * y;
+            let grow = quad.exp();
+            let (a, c) = (vals[i] * grow, vals[i + 1] * grow);
+            q = q.max(((0.5 * (a + c) - f0) / quad).abs());
+            if j == radii.len() - 1 {
+                h = h.max(a.abs()).max(c.abs());
+                r2 = r2.min(quad);
+            }
+            i += 2;
+        }
+    }
+    let bound = (DELTA_SAFETY * q + (DELTA_SAFETY * h + f0) * (-r2).exp()) / root;
+    Some((mass, bound))
 }
 
 /// The smooth-integrand rule of a lobe-chart part without kinks, if it fits: [`Rule::TensorGauss`] in the

@@ -32,7 +32,8 @@ use crate::instrument::flux::{lobe_widths_uv, Chart, Flux, DELTA_SHARE};
 use crate::instrument::geometry::{ColourQuantity, Integral, ReadingSpec, Scale, Stop};
 pub use crate::instrument::method::Target;
 use crate::instrument::method::{
-    Design, Method, Projection, Rule, TensorChart, LOBE_LEVELS, LOBE_REACH, POLAR_LEVELS, POLAR_REACH, TENSOR_MAX_LEVEL,
+    Design, Method, Projection, Rule, TensorChart, DELTA_FIT_RADIUS, DELTA_RADII, DELTA_RADIUS, DELTA_SAFETY,
+    DELTA_T_ORDERS, LOBE_LEVELS, LOBE_REACH, POLAR_LEVELS, POLAR_REACH, TENSOR_MAX_LEVEL,
 };
 use crate::instrument::standards::{self, StandardGeometry};
 use crate::quadrature::{tensor, Refine};
@@ -1039,6 +1040,27 @@ fn describe_method(m: &Method, terms: &[Term]) -> String {
                     .collect::<Vec<_>>()
                     .join(" → "),
                 LOBE_REACH,
+                p.cells.len()
+            ),
+            Rule::LobeDelta { width } => format!(
+                "delta limit of the lobe ({:.3e} × {:.3e}): per Gauss–Legendre node of (t_p, t_q) ({}²), the mass \
+                 π·F(0)/√det B from the lobe's curvature B on a ring of {} width, accepted when its bound meets the \
+                 tolerance: {}× the largest |h_e(x) − h(0)|/xᵀBx of the even part of h = F·e^{{xᵀBx}} on rings of \
+                 {} and {:?} widths, + the Gaussian tail e^{{−R²}}·(|h(0)| + {}× max |h| at {} widths), + the t rule's \
+                 difference from {}² nodes (the lobe is ≥ {} widths from every overlap kink; else \
+                 Gauss–Hermite orders {}, then Genz–Malik 7/5 on {} initial box(es))",
+                width[0],
+                width[1],
+                DELTA_T_ORDERS.1,
+                DELTA_FIT_RADIUS,
+                DELTA_SAFETY,
+                DELTA_FIT_RADIUS,
+                DELTA_RADII,
+                DELTA_SAFETY,
+                DELTA_RADIUS,
+                DELTA_T_ORDERS.0,
+                LOBE_REACH,
+                LOBE_LEVELS.iter().map(|(h, l)| format!("{h}²×{l}²")).collect::<Vec<_>>().join(" → "),
                 p.cells.len()
             ),
             Rule::LobePolar { width, u, v, levels } => describe_polar(width, u, v, levels, p.cells.len()),
