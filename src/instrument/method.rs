@@ -432,6 +432,8 @@ impl Method {
         let delta = self.delta.as_ref().map_or(0.0, |d| genz_malik(17.0, d.cells.len(), d.refine));
         let regular = self.regular.as_ref().map_or(0.0, |r| match &r.rule {
             Rule::GenzMalik75 => genz_malik(57.0, r.cells.len(), r.refine),
+            // 9 × 9 points at the 3 × 3 t nodes and 4 × 25 at the 2 × 2 (`lobe_delta`).
+            Rule::LobeDelta { .. } => 181.0,
             Rule::LobeGaussHermite { levels, .. } => {
                 let points = |l: usize| {
                     let (h, g) = LOBE_LEVELS[l.min(LOBE_LEVELS.len() - 1)];
