@@ -452,3 +452,23 @@ fn sheet_rows_become_targets() {
     let e = targets_from_sheet(&sheet, Some("c")).unwrap_err().to_string();
     assert!(e.contains("--sample c"), "{e}");
 }
+
+#[test]
+fn cli_target_errors_escape_the_users_text_and_exit_2() {
+    // A quote and a newline in a --target must come back escaped (one line per error, nothing the user typed
+    // able to end or fake a line of the message), with exit status 2.
+    let recipe = tmp("escape.json");
+    std::fs::write(&recipe, glass("ggx", 0.1, 1.5).to_string()).unwrap();
+    let fit = |target: &str| {
+        glossmeter(&["fit", recipe.to_str().unwrap(), "--free", "/roughness=log:1e-3..0.5", "--target", target])
+    };
+    for (target, want) in [
+        ("astm-d523-60/gl\"o\nss=60±0.2", r#"has no reading "gl\"o\nss""#),
+        ("no\"such\n/gloss=60±0.2", r#"unknown geometry id "no\"such\n""#),
+    ] {
+        let (code, stdout, stderr) = fit(target);
+        assert_eq!(code, 2, "{target:?}: {stdout}{stderr}");
+        assert!(stderr.contains(want), "{target:?}: {stderr}");
+        assert_eq!(stderr.trim_end().lines().count(), 1, "{target:?}: the message spans lines: {stderr}");
+    }
+}

@@ -169,6 +169,18 @@ fn broken_files_are_refused_with_offset_and_field() {
     assert!(e.contains("truncated at byte offset"), "{e}");
     let e = try_rgl("empty.bsdf", b"");
     assert!(e.contains("truncated at byte offset 0"), "{e}");
+    // A field name is the file's text: a newline and a backquote in it come back escaped, on one line. The
+    // first field's name length is the u16 at byte 18 (after the 12-byte magic, the version and the field
+    // count), its name follows, then its rank, here made too large so that the error names the field.
+    let mut odd = good.clone();
+    let len = u16::from_le_bytes([odd[18], odd[19]]) as usize;
+    assert!(len >= 2, "the fixture's first field name has {len} bytes");
+    odd[20] = b'\n';
+    odd[21] = b'`';
+    odd[20 + len..22 + len].copy_from_slice(&u16::MAX.to_le_bytes());
+    let e = try_rgl("odd-name.bsdf", &odd);
+    assert!(e.contains("rank 65535") && e.contains("field `\\n`"), "{e}");
+    assert_eq!(e.lines().count(), 1, "{e}");
     // A mis-sized field: the luminance grid does not match the spectra's.
     let tf = glossmeter::measured::rgl::TensorFile::parse(&good, "g").unwrap();
     let lum = tf.field("luminance").unwrap();

@@ -202,17 +202,20 @@ impl TensorFile {
             let len = c.u16(&format!("the name length of field {k}"))? as usize;
             let name_bytes = c.take(len, &format!("the name of field {k}"))?;
             let name = String::from_utf8_lossy(name_bytes).into_owned();
+            // The name is the file's text, not ours: an error names it escaped (a newline or a backquote in
+            // it cannot end or fake a line of the message); plain names print unchanged.
+            let shown = name.escape_debug().to_string();
             let at = c.pos;
             let rank = c.u16(&format!("the rank of field {name:?}"))?;
             if rank > MAX_RANK {
-                return Err(Error::input(file, name, format!("rank {rank} at byte offset {at}; at most {MAX_RANK}")));
+                return Err(Error::input(file, shown, format!("rank {rank} at byte offset {at}; at most {MAX_RANK}")));
             }
             let at = c.pos;
             let code = c.u8(&format!("the type of field {name:?}"))?;
             let dtype = Dtype::from_code(code).ok_or_else(|| {
                 Error::input(
                     file,
-                    name.clone(),
+                    shown.clone(),
                     format!("unknown element type {code} at byte offset {at}; allowed 1–11"),
                 )
             })?;
@@ -229,7 +232,7 @@ impl TensorFile {
             if end > bytes.len() as u128 {
                 return Err(Error::input(
                     file,
-                    name,
+                    shown,
                     format!(
                         "truncated or mis-sized: the data of shape {shape:?} ({}) at byte offset {offset} needs {need} bytes, \
                          but the file ends at byte {}",
