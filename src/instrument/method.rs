@@ -153,7 +153,7 @@ pub const DELTA_RADII: [f64; 2] = [2.5, 5.0];
 /// differences (in the metric of the fitted curvature B); beyond it the Gaussian tail, π·e^{−R²} of the
 /// peak's mass, is bounded by the largest |h| on that ring. It is the last of [`DELTA_RADII`]; the overlap
 /// kinks are ≥ [`LOBE_REACH`] = 8 widths away.
-pub const DELTA_RADIUS: f64 = 5.0;
+pub const DELTA_RADIUS: f64 = DELTA_RADII[DELTA_RADII.len() - 1];
 
 /// The factor by which [`Rule::LobeDelta`] multiplies the largest sampled second difference (and the sampled
 /// |h| on the outer ring) to stand for a bound over the whole disc:
@@ -802,7 +802,7 @@ fn lobe_delta(
     if cost > opts.max_evals {
         return (None, 0);
     }
-    let radii: Vec<f64> = std::iter::once(DELTA_FIT_RADIUS).chain(DELTA_RADII).collect();
+    let radii = [DELTA_FIT_RADIUS, DELTA_RADII[0], DELTA_RADII[1]];
     let mut pts = Vec::with_capacity(cost);
     let mut wts = Vec::with_capacity(hi * hi + lo * lo);
     let (mut t, mut w) = (Vec::new(), Vec::new());
@@ -835,9 +835,13 @@ fn lobe_delta(
         let mut start = 0;
         for (k, wt) in wts.iter().enumerate() {
             let n = if k < hi * hi { ring } else { full };
-            let node: Vec<f64> = (start..start + n).map(|i| vals[i * ncomp + c]).collect();
+            // This node's values of component c (at most `full` of them), without allocating per node.
+            let mut node = [0.0; 1 + 8 * (1 + DELTA_RADII.len())];
+            for (slot, i) in node.iter_mut().zip(start..start + n) {
+                *slot = vals[i * ncomp + c];
+            }
             start += n;
-            let Some((mass, b)) = delta_node(&node, &radii[..(n - 1) / 8]) else {
+            let Some((mass, b)) = delta_node(&node[..n], &radii[..(n - 1) / 8]) else {
                 return (None, cost);
             };
             if k < hi * hi {
