@@ -59,8 +59,8 @@ pub enum Tail {
     /// (`docs/instrument.md` §Quadrature, *Measured tables*). `half_width` is the lobe's own half width at half
     /// maximum as a slope (tan of the half-vector tilt), measured from the table when it is loaded
     /// ([`crate::measured::table::specular_half_width`]); infinite when the table does not fall to half its
-    /// specular value within 40° of tilt. The lobe's `slope_width` stays the table's resolution (where the
-    /// partition must split).
+    /// specular value within `table::HALF_WIDTH_MAX_TILT_DEG` (40°) of tilt. The lobe's `slope_width` stays
+    /// the table's resolution (where the partition must split).
     Table { half_width: f64 },
 }
 

@@ -871,9 +871,11 @@ impl Plan {
                             ", a measured table's tail (its own half width at half maximum {half_width:.3e}, kinks at \
                              its cells; the partition)"
                         ),
-                        Tail::Table { .. } => ", a measured table's tail (it does not fall to half within 40° of \
-                                                tilt; kinks at its cells; the partition)"
-                            .to_string(),
+                        Tail::Table { .. } => format!(
+                            ", a measured table's tail (it does not fall to half within {}° of tilt; kinks at its \
+                             cells; the partition)",
+                            crate::measured::table::HALF_WIDTH_MAX_TILT_DEG
+                        ),
                         t if t.is_heavy() => ", heavy tail".to_string(),
                         _ => String::new(),
                     },
