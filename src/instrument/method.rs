@@ -62,7 +62,8 @@ pub enum Rule {
     /// variables x = u/w_u, y = v/w_v, at each Gauss–Legendre node of (t_p, t_q), the lobe's mass is Laplace's
     /// π·F(0)/√det B from its curvature B at the peak (measured on a ring of [`DELTA_FIT_RADIUS`] width), and the
     /// error reported is the majorant of [`delta_node`] (second differences of the even part of F·e^{xᵀBx} on
-    /// rings of [`DELTA_RADII`] widths times [`DELTA_SAFETY`], the Gaussian tail beyond the outer ring) plus
+    /// rings of [`DELTA_RADII`] widths times [`DELTA_SAFETY`], the tail beyond the outer ring at its measured
+    /// decay rate ÷ [`DELTA_TAIL_SAFETY`]) plus
     /// the t rule's difference of orders ([`DELTA_T_ORDERS`]: the engine's usual estimate of a Gauss–Legendre
     /// rule on a smooth integrand, as in [`Rule::LobeGaussHermite`]). It is accepted when that
     /// majorant meets the part's tolerance; otherwise the lobe's [`Rule::LobeGaussHermite`] runs (and after
@@ -150,15 +151,23 @@ pub const LOBE_REACH: f64 = 8.0;
 pub const DELTA_RADII: [f64; 2] = [2.5, 5.0];
 
 /// The radius (in lobe widths) of the disc inside which [`Rule::LobeDelta`] bounds the correction by second
-/// differences (in the metric of the fitted curvature B); beyond it the Gaussian tail, π·e^{−R²} of the
-/// peak's mass, is bounded by the largest |h| on that ring. It is the last of [`DELTA_RADII`]; the overlap
+/// differences (in the metric of the fitted curvature B); beyond it the tail, bounded by a Gaussian of the
+/// decay rate measured on that ring ([`DELTA_TAIL_SAFETY`]). It is the last of [`DELTA_RADII`]; the overlap
 /// kinks are ≥ [`LOBE_REACH`] = 8 widths away.
 pub const DELTA_RADIUS: f64 = DELTA_RADII[DELTA_RADII.len() - 1];
 
-/// The factor by which [`Rule::LobeDelta`] multiplies the largest sampled second difference (and the sampled
-/// |h| on the outer ring) to stand for a bound over the whole disc:
-/// the one assumption of its majorant (`docs/instrument.md` §Quadrature).
+/// The factor by which [`Rule::LobeDelta`] multiplies the largest sampled second difference to stand for a
+/// bound over the whole disc: one of the two assumptions of its majorant (`docs/instrument.md` §Quadrature;
+/// checked against a stencil of 24 directions × 30 radii by `tests/delta_limit.rs`, where the dense maximum
+/// is at most 1.1× the sampled one).
 pub const DELTA_SAFETY: f64 = 4.0;
+
+/// The factor by which [`Rule::LobeDelta`] divides the decay rate λ of the lobe measured on its outer ring
+/// (the smallest ln(F(0)/F(x))/xᵀBx there) before it bounds the tail beyond the ring by F(0)·e^{−λ·xᵀBx}: the
+/// other assumption of its majorant. (A Gaussian of the fitted curvature, |h| ≤ its largest value on the
+/// ring, does not hold: at grazing incidence the lobe's exponent in these variables falls a few per cent
+/// short of xᵀBx at 12 widths, and h = F·e^{xᵀBx} grows there by 100× — measured by the same test.)
+pub const DELTA_TAIL_SAFETY: f64 = 1.25;
 
 /// The Gauss–Legendre orders per t axis of [`Rule::LobeDelta`]: the second-difference stencil on the lower's
 /// nodes, the value on the higher's, their difference the t rule's error.
@@ -499,6 +508,105 @@ impl Method {
         (flux, frozen.expect("kept"))
     }
 
+    /// The number of components the regular part's integrand has per point (k weighted sums, or n samples
+    /// under [`Projection::Separate`]) and whether the material sums the one weighted component itself.
+    fn components(&self, brdf: &dyn Brdf) -> (usize, bool) {
+        let k = self.weighting.len();
+        let ncomp = match self.projection {
+            Projection::Fold | Projection::FoldInMaterial => k,
+            Projection::Separate => brdf.sampling().len(),
+        };
+        let in_material =
+            self.projection == Projection::FoldInMaterial && k == 1 && brdf.folds(&self.weighting.rows[0]);
+        (ncomp, in_material)
+    }
+
+    /// The integrand of the regular part `part` in the chart `vars` holds (the part's own, or a tensor rule's
+    /// while it runs): for each point of `pts`, `ncomp` values written to `out` — the weighted BRDF times
+    /// cos θi cos θo, the solid-angle densities of the two direction-cosine charts and the chart's Jacobian.
+    /// A point outside the overlap or below the horizon leaves its values as they were (the rules zero `out`).
+    fn regular_integrand<'a>(
+        &'a self,
+        brdf: &'a dyn Brdf,
+        part: &'a RegularPart,
+        (src, rec): (Stop, Stop),
+        (ncomp, in_material): (usize, bool),
+        vars: &'a std::cell::Cell<TensorChart>,
+    ) -> impl FnMut(&[[f64; 4]], &mut [f64]) + 'a {
+        let axes = Axes::new(self.theta);
+        let rec_axes = Axes::new(self.viewing);
+        let ap = AxisMap { s: src.p, r: rec.p };
+        let aq = AxisMap { s: src.q, r: rec.q };
+        let (weighting, projection) = (&self.weighting, self.projection);
+        let n = brdf.sampling().len();
+        let mut batch = PairBatch::default();
+        move |pts: &[[f64; 4]], out: &mut [f64]| {
+            batch.clear(pts.len());
+            for (i, x) in pts.iter().enumerate() {
+                let (ps, qs, pr, qr, jac) = if vars.get() == TensorChart::Plain {
+                    (x[0], x[1], x[2], x[3], 1.0)
+                } else if vars.get() == TensorChart::PlainPLobeQ {
+                    let (qs, qr, jq) = aq.at(x[2], x[3]);
+                    (x[0], qs, x[1], qr, jq)
+                } else if part.kinks.is_empty() {
+                    let (ps, pr, jp) = ap.at(x[0], x[1]);
+                    let (qs, qr, jq) = aq.at(x[2], x[3]);
+                    (ps, qs, pr, qr, jp * jq)
+                } else {
+                    let (qs, qr, jq) = aq.at(x[2], x[3]);
+                    let u = x[0];
+                    let (lo, hi) = ap.overlap(u);
+                    let (ps, jp) = kinked_position(x[1], lo, hi, part.kinks.len(), |k| {
+                        let c = part.kinks[k];
+                        half_angle_kink_point(&axes, 2.0 * c * c - 1.0, u, qs, qr, lo, hi)
+                    });
+                    (ps, qs, u - ps, qr, jp * jq)
+                };
+                if jac <= 0.0 {
+                    continue;
+                }
+                let wi = axes.source_dir(ps, qs);
+                let wo = rec_axes.receptor_dir(pr, qr);
+                if wi.z <= 0.0 || wo.z <= 0.0 {
+                    continue;
+                }
+                let g = wi.z * wo.z * solid_angle_density(ps, qs) * solid_angle_density(pr, qr) * jac;
+                batch.push(i, wi, wo, g);
+            }
+            batch.values.clear();
+            if in_material {
+                batch.values.resize(batch.wi.len(), 0.0);
+                brdf.eval_batch_folded(&weighting.rows[0], &batch.wi, &batch.wo, &mut batch.values);
+                for ((&i, &g), v) in batch.index.iter().zip(&batch.g).zip(&batch.values) {
+                    out[i] = v * g;
+                }
+                return;
+            }
+            batch.values.resize(batch.wi.len() * n, 0.0);
+            brdf.eval_batch(&batch.wi, &batch.wo, &mut batch.values);
+            for ((&i, &g), v) in batch.index.iter().zip(&batch.g).zip(batch.values.chunks_exact(n)) {
+                store(&mut out[i * ncomp..(i + 1) * ncomp], v, weighting, g, projection);
+            }
+        }
+    }
+
+    /// The regular part's integrand at points `pts` of its chart (u, t_p, v, t_q in the lobe chart; p_s, q_s,
+    /// p_r, q_r in the plain one): per point, the method's weighted components (or samples), exactly the
+    /// values its rules integrate. For checking a rule's assumptions against a denser sampling of the same
+    /// integrand (`tests/delta_limit.rs`) and for plotting it; empty when there is no regular part or the
+    /// stops are below the horizon.
+    pub fn sample_regular(&self, brdf: &dyn Brdf, pts: &[[f64; 4]]) -> Vec<f64> {
+        let (Some(part), Some(stops), Integral::Aperture) = (&self.regular, self.clipped, self.integral) else {
+            return Vec::new();
+        };
+        let chart = if part.chart == Chart::Plain { TensorChart::Plain } else { TensorChart::Lobe };
+        let vars = std::cell::Cell::new(chart);
+        let comps = self.components(brdf);
+        let mut out = vec![0.0; pts.len() * comps.0];
+        self.regular_integrand(brdf, part, stops, comps, &vars)(pts, &mut out);
+        out
+    }
+
     fn run(&self, brdf: &dyn Brdf, keep: bool, shared: Option<Instant>) -> (Flux, Option<Method>) {
         let start = Instant::now();
         let after = |s: f64| start + std::time::Duration::from_secs_f64(s);
@@ -533,14 +641,8 @@ impl Method {
             return (Flux::zero(k), frozen);
         };
         let axes = Axes::new(self.theta);
-        let rec_axes = Axes::new(self.viewing);
-        let ncomp = match self.projection {
-            Projection::Fold | Projection::FoldInMaterial => k,
-            Projection::Separate => n,
-        };
-        // The material sums the one weighted component itself.
-        let in_material =
-            self.projection == Projection::FoldInMaterial && k == 1 && brdf.folds(&self.weighting.rows[0]);
+        // The material sums the one weighted component itself when `in_material`.
+        let (ncomp, in_material) = self.components(brdf);
         let weighting = &self.weighting;
         let projection = self.projection;
         // The k weighted components of an estimate, and their error bounds.
@@ -609,62 +711,12 @@ impl Method {
 
         // 2. The regular part, in its chart.
         if let Some(part) = &self.regular {
-            let ap = AxisMap { s: src.p, r: rec.p };
-            let aq = AxisMap { s: src.q, r: rec.q };
             // The chart the integrand is evaluated in: the part's, or the shaped rule's while it runs.
             let part_vars = if part.chart == Chart::Plain { TensorChart::Plain } else { TensorChart::Lobe };
             let vars = std::cell::Cell::new(part_vars);
             let delta_min = flux.delta.iter().map(|d| d.abs()).fold(f64::INFINITY, f64::min);
             let atol = part.atol.max(part.rtol * delta_min);
-            let mut batch = PairBatch::default();
-            let mut integrand = |pts: &[[f64; 4]], out: &mut [f64]| {
-                batch.clear(pts.len());
-                for (i, x) in pts.iter().enumerate() {
-                    let (ps, qs, pr, qr, jac) = if vars.get() == TensorChart::Plain {
-                        (x[0], x[1], x[2], x[3], 1.0)
-                    } else if vars.get() == TensorChart::PlainPLobeQ {
-                        let (qs, qr, jq) = aq.at(x[2], x[3]);
-                        (x[0], qs, x[1], qr, jq)
-                    } else if part.kinks.is_empty() {
-                        let (ps, pr, jp) = ap.at(x[0], x[1]);
-                        let (qs, qr, jq) = aq.at(x[2], x[3]);
-                        (ps, qs, pr, qr, jp * jq)
-                    } else {
-                        let (qs, qr, jq) = aq.at(x[2], x[3]);
-                        let u = x[0];
-                        let (lo, hi) = ap.overlap(u);
-                        let (ps, jp) = kinked_position(x[1], lo, hi, part.kinks.len(), |k| {
-                            let c = part.kinks[k];
-                            half_angle_kink_point(&axes, 2.0 * c * c - 1.0, u, qs, qr, lo, hi)
-                        });
-                        (ps, qs, u - ps, qr, jp * jq)
-                    };
-                    if jac <= 0.0 {
-                        continue;
-                    }
-                    let wi = axes.source_dir(ps, qs);
-                    let wo = rec_axes.receptor_dir(pr, qr);
-                    if wi.z <= 0.0 || wo.z <= 0.0 {
-                        continue;
-                    }
-                    let g = wi.z * wo.z * solid_angle_density(ps, qs) * solid_angle_density(pr, qr) * jac;
-                    batch.push(i, wi, wo, g);
-                }
-                batch.values.clear();
-                if in_material {
-                    batch.values.resize(batch.wi.len(), 0.0);
-                    brdf.eval_batch_folded(&weighting.rows[0], &batch.wi, &batch.wo, &mut batch.values);
-                    for ((&i, &g), v) in batch.index.iter().zip(&batch.g).zip(&batch.values) {
-                        out[i] = v * g;
-                    }
-                    return;
-                }
-                batch.values.resize(batch.wi.len() * n, 0.0);
-                brdf.eval_batch(&batch.wi, &batch.wo, &mut batch.values);
-                for ((&i, &g), v) in batch.index.iter().zip(&batch.g).zip(batch.values.chunks_exact(n)) {
-                    store(&mut out[i * ncomp..(i + 1) * ncomp], v, weighting, g, projection);
-                }
-            };
+            let mut integrand = self.regular_integrand(brdf, part, (src, rec), (ncomp, in_material), &vars);
             // A smooth material's region estimates are trusted further (`docs/accuracy.md` §5): checked
             // children, and on the lobe chart (whose boxes are cut to the lobe's widths and kinks) a deeper
             // shrink.
@@ -861,7 +913,7 @@ fn lobe_delta(
 
 /// The directions of the stencil of [`Rule::LobeDelta`] in the scaled lobe variables (each with its opposite
 /// point): 0°, 45°, 90°, 135°.
-const DELTA_DIRECTIONS: [[f64; 2]; 4] = [
+pub const DELTA_DIRECTIONS: [[f64; 2]; 4] = [
     [1.0, 0.0],
     [std::f64::consts::FRAC_1_SQRT_2, std::f64::consts::FRAC_1_SQRT_2],
     [0.0, 1.0],
@@ -885,13 +937,15 @@ pub const DELTA_FIT_RADIUS: f64 = 1.0;
 ///
 ///   ∫ F − π F(0)/√det B = ∫ e^{−xᵀBx} (h_e(x) − h(0)) dx,
 ///
-/// and if |h_e(x) − h(0)| ≤ Q·xᵀBx on the ellipse xᵀBx ≤ R² and |h| ≤ H outside it, then, in y = B^{1/2}x,
+/// and if |h_e(x) − h(0)| ≤ Q·xᵀBx on the ellipse xᵀBx ≤ R² and 0 ≤ F(x) ≤ F(0)·e^{−λ·xᵀBx} outside it,
+/// then, in y = B^{1/2}x (and as e^{−xᵀBx}·h_e is the even part of F ≥ 0),
 ///
 ///   |∫_{xᵀBx≤R²}| ≤ Q ∫ |y|² e^{−|y|²} dy / √det B = π Q / √det B,
-///   |∫_{xᵀBx>R²}| ≤ (H + |h(0)|)·π e^{−R²} / √det B.
+///   |∫_{xᵀBx>R²}| ≤ ∫_{xᵀBx>R²} F + |h(0)| π e^{−R²} / √det B ≤ F(0)·π (e^{−λR²}/λ + e^{−R²}) / √det B.
 ///
-/// Q is [`DELTA_SAFETY`] times the largest sampled |h_e − h(0)|/xᵀBx on all rings, H [`DELTA_SAFETY`] times
-/// the largest |h| on the outer ring, R² the smallest xᵀBx there.
+/// Q is [`DELTA_SAFETY`] times the largest sampled |h_e − h(0)|/xᵀBx on all rings, R² the smallest xᵀBx on
+/// the outer ring and λ the smallest ln(F(0)/F(x))/xᵀBx there, divided by [`DELTA_TAIL_SAFETY`]; None also
+/// when λ is not positive (a lobe that does not fall by its outer ring).
 fn delta_node(vals: &[f64], radii: &[f64]) -> Option<(f64, f64)> {
     let f0 = vals[0];
     if vals.iter().all(|v| *v == 0.0) {
@@ -912,7 +966,7 @@ fn delta_node(vals: &[f64], radii: &[f64]) -> Option<(f64, f64)> {
     if radii.len() == 1 {
         return Some((mass, 0.0));
     }
-    let (mut q, mut h, mut r2) = (0.0f64, 0.0f64, f64::INFINITY);
+    let (mut q, mut lambda, mut r2) = (0.0f64, f64::INFINITY, f64::INFINITY);
     let mut i = 1;
     for (j, r) in radii.iter().enumerate() {
         for d in DELTA_DIRECTIONS {
@@ -922,13 +976,23 @@ fn delta_node(vals: &[f64], radii: &[f64]) -> Option<(f64, f64)> {
             let (a, c) = (vals[i] * grow, vals[i + 1] * grow);
             q = q.max(((0.5 * (a + c) - f0) / quad).abs());
             if j == radii.len() - 1 {
-                h = h.max(a.abs()).max(c.abs());
                 r2 = r2.min(quad);
+                for v in [vals[i], vals[i + 1]] {
+                    // A zero (outside the overlap, or underflow) decays as fast as any rate.
+                    if v != 0.0 {
+                        lambda = lambda.min((f0 / v.abs()).ln() / quad);
+                    }
+                }
             }
             i += 2;
         }
     }
-    let bound = (DELTA_SAFETY * q + (DELTA_SAFETY * h + f0) * (-r2).exp()) / root;
+    let lambda = lambda / DELTA_TAIL_SAFETY;
+    if !(lambda > 0.0) {
+        return None;
+    }
+    let tail = if lambda.is_finite() { (-lambda * r2).exp() / lambda } else { 0.0 };
+    let bound = (DELTA_SAFETY * q + f0 * (tail + (-r2).exp())) / root;
     Some((mass, bound))
 }
 

@@ -33,7 +33,7 @@ use crate::instrument::geometry::{ColourQuantity, Integral, ReadingSpec, Scale, 
 pub use crate::instrument::method::Target;
 use crate::instrument::method::{
     Design, Method, Projection, Rule, TensorChart, DELTA_FIT_RADIUS, DELTA_RADII, DELTA_RADIUS, DELTA_SAFETY,
-    DELTA_T_ORDERS, LOBE_LEVELS, LOBE_REACH, POLAR_LEVELS, POLAR_REACH, TENSOR_MAX_LEVEL,
+    DELTA_TAIL_SAFETY, DELTA_T_ORDERS, LOBE_LEVELS, LOBE_REACH, POLAR_LEVELS, POLAR_REACH, TENSOR_MAX_LEVEL,
 };
 use crate::instrument::standards::{self, StandardGeometry};
 use crate::quadrature::{tensor, Refine};
@@ -1048,8 +1048,8 @@ fn describe_method(m: &Method, terms: &[Term]) -> String {
                 "delta limit of the lobe ({:.3e} × {:.3e}): per Gauss–Legendre node of (t_p, t_q) ({}²), the mass \
                  π·F(0)/√det B from the lobe's curvature B on a ring of {} width, accepted when its bound meets the \
                  tolerance: {}× the largest |h_e(x) − h(0)|/xᵀBx of the even part of h = F·e^{{xᵀBx}} on rings of \
-                 {} and {:?} widths, + the Gaussian tail e^{{−R²}}·(|h(0)| + {}× max |h| at {} widths), + the t rule's \
-                 difference from {}² nodes (the lobe is ≥ {} widths from every overlap kink; else \
+                 {} and {:?} widths, + the tail beyond {} widths, F(0)·(e^{{−R²}} + e^{{−λR²}}/λ) with λ the lobe's \
+                 decay rate there ÷ {}, + the t rule's difference from {}² nodes (the lobe is ≥ {} widths from every overlap kink; else \
                  Gauss–Hermite orders {}, then Genz–Malik 7/5 on {} initial box(es))",
                 width[0],
                 width[1],
@@ -1058,8 +1058,8 @@ fn describe_method(m: &Method, terms: &[Term]) -> String {
                 DELTA_SAFETY,
                 DELTA_FIT_RADIUS,
                 DELTA_RADII,
-                DELTA_SAFETY,
                 DELTA_RADIUS,
+                DELTA_TAIL_SAFETY,
                 DELTA_T_ORDERS.0,
                 LOBE_REACH,
                 LOBE_LEVELS.iter().map(|(h, l)| format!("{h}²×{l}²")).collect::<Vec<_>>().join(" → "),
