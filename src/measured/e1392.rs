@@ -58,7 +58,7 @@ pub fn parse(text: &str, file: &str) -> Result<InPlaneBrdf> {
                             file,
                             format!("line {n}"),
                             format!(
-                                "unknown column `{c}`; allowed: theta_i, phi_i, theta_s, phi_s and one of BRDF, CCBRDF"
+                                "unknown column {c:?}; allowed: theta_i, phi_i, theta_s, phi_s and one of BRDF, CCBRDF"
                             ),
                         ));
                     }

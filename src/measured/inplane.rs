@@ -610,7 +610,7 @@ pub fn parse_csv(text: &str, file: &str) -> Result<InPlaneBrdf> {
     let hdr_err = |m: String| Error::input(file, format!("line {}", hline + 1), format!("{m}; {allowed}"));
     for c in &cols {
         if !["theta_i", "theta_o", "brdf", "brdf_cos"].contains(&c.as_str()) {
-            return Err(hdr_err(format!("unknown column `{c}`")));
+            return Err(hdr_err(format!("unknown column {c:?}")));
         }
     }
     let (Some(ci), Some(co)) = (find("theta_i"), find("theta_o")) else {
@@ -678,7 +678,10 @@ mod tests {
         let e = parse_csv("theta_i,theta_o,brdf\n20,10,x\n", "t.csv").unwrap_err().to_string();
         assert!(e.contains("line 2, column brdf"), "{e}");
         let e = parse_csv("theta_i,theta_o,value\n", "t.csv").unwrap_err().to_string();
-        assert!(e.contains("unknown column `value`"), "{e}");
+        assert!(e.contains("unknown column \"value\""), "{e}");
+        // A name from the file cannot close the quotes or hide in the message: it is quoted and escaped.
+        let e = parse_csv("theta_i,theta_o,a\"b`\u{7}\n", "t.csv").unwrap_err().to_string();
+        assert!(e.contains(r#"unknown column "a\"b`\u{7}""#) && !e.contains('\u{7}'), "{e}");
         let e = parse_csv("theta_i,theta_o,brdf,brdf_cos\n", "t.csv").unwrap_err().to_string();
         assert!(e.contains("both brdf and brdf_cos"), "{e}");
         let e = parse_csv("theta_i,theta_o,brdf\n20,10,1\n20,10,2\n", "t.csv").unwrap_err().to_string();
