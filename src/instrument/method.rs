@@ -593,8 +593,8 @@ impl Method {
     /// The regular part's integrand at points `pts` of its chart (u, t_p, v, t_q in the lobe chart; p_s, q_s,
     /// p_r, q_r in the plain one): per point, the method's weighted components (or samples), exactly the
     /// values its rules integrate. For checking a rule's assumptions against a denser sampling of the same
-    /// integrand (`tests/delta_limit.rs`) and for plotting it; empty when there is no regular part or the
-    /// stops are below the horizon.
+    /// integrand (`tests/delta_limit.rs`); empty when there is no regular part or the stops are below the
+    /// horizon.
     pub fn sample_regular(&self, brdf: &dyn Brdf, pts: &[[f64; 4]]) -> Vec<f64> {
         let (Some(part), Some(stops), Integral::Aperture) = (&self.regular, self.clipped, self.integral) else {
             return Vec::new();
