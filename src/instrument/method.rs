@@ -173,6 +173,15 @@ pub const DELTA_TAIL_SAFETY: f64 = 1.25;
 /// nodes, the value on the higher's, their difference the t rule's error.
 pub const DELTA_T_ORDERS: (usize, usize) = (2, 3);
 
+/// The points per t node of [`Rule::LobeDelta`]: the centre and the curvature ring (four directions, both
+/// signs) at the higher order's nodes, and with them the bound's rings at the lower order's.
+const DELTA_NODE_POINTS: (usize, usize) = (1 + 8, 1 + 8 * (1 + DELTA_RADII.len()));
+
+/// The evaluations of one [`Rule::LobeDelta`] (181).
+pub const DELTA_COST: usize = DELTA_T_ORDERS.1 * DELTA_T_ORDERS.1 * DELTA_NODE_POINTS.0
+    + DELTA_T_ORDERS.0 * DELTA_T_ORDERS.0 * DELTA_NODE_POINTS.1;
+const _: () = assert!(DELTA_COST == 181, "the docs and --explain's cost figures say 181");
+
 /// When the spectral weighting is applied.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Projection {
@@ -441,8 +450,7 @@ impl Method {
         let delta = self.delta.as_ref().map_or(0.0, |d| genz_malik(17.0, d.cells.len(), d.refine));
         let regular = self.regular.as_ref().map_or(0.0, |r| match &r.rule {
             Rule::GenzMalik75 => genz_malik(57.0, r.cells.len(), r.refine),
-            // 9 × 9 points at the 3 × 3 t nodes and 4 × 25 at the 2 × 2 (`lobe_delta`).
-            Rule::LobeDelta { .. } => 181.0,
+            Rule::LobeDelta { .. } => DELTA_COST as f64,
             Rule::LobeGaussHermite { levels, .. } => {
                 let points = |l: usize| {
                     let (h, g) = LOBE_LEVELS[l.min(LOBE_LEVELS.len() - 1)];
@@ -848,9 +856,7 @@ fn lobe_delta(
     opts: &Options,
 ) -> (Option<Estimate>, usize) {
     let (lo, hi) = DELTA_T_ORDERS;
-    // Per t node of the higher order: the centre and the curvature ring; of the lower: and the bound's rings.
-    let (ring, full) = (1 + 8, 1 + 8 * (1 + DELTA_RADII.len()));
-    let cost = hi * hi * ring + lo * lo * full;
+    let ((ring, full), cost) = (DELTA_NODE_POINTS, DELTA_COST);
     if cost > opts.max_evals {
         return (None, 0);
     }
