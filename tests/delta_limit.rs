@@ -299,7 +299,8 @@ fn node_check(method: &Method, brdf: &dyn Brdf, width: [f64; 2], tp: f64, tq: f6
     if f0 <= 0.0 || vals[1..9].iter().any(|v| *v <= 0.0) {
         return None;
     }
-    let b: Vec<f64> = (0..4).map(|k| -(0.5 * (vals[1 + 2 * k] * vals[2 + 2 * k]).ln() - f0.ln())).collect();
+    let r2_fit = DELTA_FIT_RADIUS * DELTA_FIT_RADIUS;
+    let b: Vec<f64> = (0..4).map(|k| -(0.5 * (vals[1 + 2 * k] * vals[2 + 2 * k]).ln() - f0.ln()) / r2_fit).collect();
     let b = [b[0], b[2], 0.5 * (b[1] - b[3])];
     if !(b[0] > 0.0 && b[1] > 0.0 && b[0] * b[1] - b[2] * b[2] > 0.0) {
         return None;
