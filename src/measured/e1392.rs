@@ -162,5 +162,8 @@ mod tests {
         assert!(e.contains("lacks `phi_s`"), "{e}");
         let e = parse("just a header\n", "t.txt").unwrap_err().to_string();
         assert!(e.contains("no column line"), "{e}");
+        // An unknown column is named quoted and escaped, whatever the file holds.
+        let e = parse("theta_i phi_i theta_s phi_s BRDF x\"`\u{1b}\n", "t.txt").unwrap_err().to_string();
+        assert!(e.contains(r#"unknown column "x\"`\u{1b}""#) && !e.contains('\u{1b}'), "{e}");
     }
 }
