@@ -9,8 +9,8 @@ use std::sync::Arc;
 
 use glossmeter::brdf::Brdf;
 use glossmeter::instrument::method::{
-    Method, Rule, DELTA_DIRECTIONS, DELTA_FIT_RADIUS, DELTA_RADII, DELTA_SAFETY, DELTA_TAIL_SAFETY, DELTA_T_ORDERS,
-    LOBE_LEVELS,
+    delta_fit, delta_stencil, DeltaFit, Method, Rule, DELTA_FIT_RADIUS, DELTA_RADII, DELTA_SAFETY, DELTA_TAIL_SAFETY,
+    DELTA_T_ORDERS, LOBE_LEVELS,
 };
 use glossmeter::instrument::plan::{Plan, PlanOptions};
 use glossmeter::instrument::standards;
@@ -248,80 +248,42 @@ fn the_delta_limit_costs_less_where_it_reads() {
 
 /// What the rule's stencil sees at one (t_p, t_q) node, and what a denser stencil sees there.
 struct NodeCheck {
-    /// The curvature B (b_xx, b_yy, b_xy) fitted on the ring of `DELTA_FIT_RADIUS`, and F(0).
-    b: [f64; 3],
-    f0: f64,
-    /// The rule's sampled constants (before `DELTA_SAFETY`, `DELTA_TAIL_SAFETY`): Q, λ and R² of `delta_node`.
-    q_rule: f64,
-    lambda_rule: f64,
-    r2: f64,
-    /// The same over the dense stencil: Q over the ellipse xᵀBx ≤ R², λ outside it (to 12 widths).
+    /// The rule's own fit and sampled constants (`delta_fit` on its stencil, before the safety factors).
+    fit: DeltaFit,
+    /// The same constants over the dense stencil: Q over the ellipse xᵀBx ≤ R², λ outside it (to 12 widths).
     q_dense: f64,
     lambda_dense: f64,
 }
 
 impl NodeCheck {
-    fn root(&self) -> f64 {
-        (self.b[0] * self.b[1] - self.b[2] * self.b[2]).sqrt()
-    }
-    /// `delta_node`'s majorant (relative to π w_u w_v) with the rule's constants times the safety factor.
+    /// `delta_node`'s majorant (relative to π w_u w_v): the rule's constants with the safety factors.
     fn rule_bound(&self) -> f64 {
-        self.bound(DELTA_SAFETY * self.q_rule, self.lambda_rule / DELTA_TAIL_SAFETY)
+        self.fit.majorant(DELTA_SAFETY * self.fit.q, self.fit.lambda / DELTA_TAIL_SAFETY)
     }
     /// The same majorant with the dense stencil's constants and no safety factors.
     fn dense_bound(&self) -> f64 {
-        self.bound(self.q_dense, self.lambda_dense)
-    }
-    fn bound(&self, q: f64, lambda: f64) -> f64 {
-        let tail = if lambda.is_finite() { (-lambda * self.r2).exp() / lambda } else { 0.0 };
-        (q + self.f0 * (tail + (-self.r2).exp())) / self.root()
+        self.fit.majorant(self.q_dense, self.lambda_dense)
     }
 }
 
-/// The rule's stencil and a dense one at node (t_p, t_q), from the method's own integrand
-/// (`Method::sample_regular`); None where the rule would refuse itself (values not positive on the curvature
-/// ring, or the curvature not positive definite). The dense stencil: 24 directions (every 7.5°, each with its
-/// opposite) at radii 0.25, 0.5, …, 6 and 7, 8, …, 12 widths.
+/// The rule's stencil (`delta_stencil`, read by `delta_fit`) and a dense one at node (t_p, t_q), from the
+/// method's own integrand (`Method::sample_regular`); None where the rule would refuse itself (values not
+/// positive on the curvature ring, the curvature not positive definite, or no decay by the outer ring). The
+/// dense stencil: 24 directions (every 7.5°, each with its opposite) at radii 0.25, 0.5, …, 6 and 7, 8, …,
+/// 12 widths.
 fn node_check(method: &Method, brdf: &dyn Brdf, width: [f64; 2], tp: f64, tq: f64) -> Option<NodeCheck> {
     let at = |x: [f64; 2]| [x[0] * width[0], tp, x[1] * width[1], tq];
-    let mut rule_pts = vec![at([0.0, 0.0])];
     let radii = [DELTA_FIT_RADIUS, DELTA_RADII[0], DELTA_RADII[1]];
-    for r in radii {
-        for d in DELTA_DIRECTIONS {
-            for s in [1.0, -1.0] {
-                rule_pts.push(at([s * r * d[0], s * r * d[1]]));
-            }
-        }
-    }
+    let mut rule_pts = Vec::new();
+    delta_stencil(width, tp, tq, &radii, &mut rule_pts);
     let ncomp = method.sample_regular(brdf, &rule_pts[..1]).len();
     let vals: Vec<f64> = method.sample_regular(brdf, &rule_pts).chunks(ncomp).map(|c| c[0]).collect();
-    let f0 = vals[0];
-    if f0 <= 0.0 || vals[1..9].iter().any(|v| *v <= 0.0) {
+    let fit = delta_fit(&vals, &radii)?;
+    if !(fit.lambda > 0.0) {
         return None;
     }
-    let r2_fit = DELTA_FIT_RADIUS * DELTA_FIT_RADIUS;
-    let b: Vec<f64> = (0..4).map(|k| -(0.5 * (vals[1 + 2 * k] * vals[2 + 2 * k]).ln() - f0.ln()) / r2_fit).collect();
-    let b = [b[0], b[2], 0.5 * (b[1] - b[3])];
-    if !(b[0] > 0.0 && b[1] > 0.0 && b[0] * b[1] - b[2] * b[2] > 0.0) {
-        return None;
-    }
-    let quad = |x: [f64; 2]| b[0] * x[0] * x[0] + 2.0 * b[2] * x[0] * x[1] + b[1] * x[1] * x[1];
-    let (mut q_rule, mut lambda_rule, mut r2) = (0.0f64, f64::INFINITY, f64::INFINITY);
-    for (j, r) in radii.iter().enumerate() {
-        for (k, d) in DELTA_DIRECTIONS.iter().enumerate() {
-            let x = [r * d[0], r * d[1]];
-            let e = quad(x).exp();
-            let i = 1 + 8 * j + 2 * k;
-            let (a, c) = (vals[i] * e, vals[i + 1] * e);
-            q_rule = q_rule.max(((0.5 * (a + c) - f0) / quad(x)).abs());
-            if j == radii.len() - 1 {
-                r2 = r2.min(quad(x));
-                for v in [vals[i], vals[i + 1]].into_iter().filter(|v| *v != 0.0) {
-                    lambda_rule = lambda_rule.min((f0 / v.abs()).ln() / quad(x));
-                }
-            }
-        }
-    }
+    let ([bxx, byy, bxy], f0) = (fit.b, fit.f0);
+    let quad = |x: [f64; 2]| bxx * x[0] * x[0] + 2.0 * bxy * x[0] * x[1] + byy * x[1] * x[1];
     let mut dense = Vec::new();
     let rs: Vec<f64> = (1..=24).map(|i| 0.25 * i as f64).chain((7..=12).map(f64::from)).collect();
     for r in &rs {
@@ -349,10 +311,11 @@ fn node_check(method: &Method, brdf: &dyn Brdf, width: [f64; 2], tp: f64, tq: f6
         let qx = quad(x[0]);
         let e = qx.exp();
         let (a, c) = (pair[0] * e, pair[1] * e);
-        if qx <= r2 {
+        if qx <= fit.r2 {
             // Less the rounding of F: four times the measured spread, a few ulps of the exponent and of
             // e^{xᵀBx}, and the cancellation in the half vector, ω_i + ω_o of O(1) terms cancelling to
-            // O(w·|x|), which rounds the lobe's exponent xᵀBx by ~4ε·|x|/w. Below it a denser stencil sees
+            // O(w·|x|), which rounds the lobe's exponent xᵀBx by ~4ε·|x|/w (allowed 4× that, 16ε·|x|/w,
+            // with |x| ≤ √(xᵀBx)·(1 + O(w)) as B ≈ I). Below it a denser stencil sees
             // only rounding (at 20°: F(±x) at a quarter width differ from their Gaussian by 2e-11 relative for
             // Beckmann 1e-6; by 2e-8 for Phong 1e8 at 85°, where 1e8·ε = 1.1e-8).
             let w = width[0].min(width[1]);
@@ -365,10 +328,7 @@ fn node_check(method: &Method, brdf: &dyn Brdf, width: [f64; 2], tp: f64, tq: f6
             }
         }
     }
-    if !(lambda_rule > 0.0) {
-        return None;
-    }
-    Some(NodeCheck { b, f0, q_rule, lambda_rule, r2, q_dense, lambda_dense })
+    Some(NodeCheck { fit, q_dense, lambda_dense })
 }
 
 /// Beckmann (three dielectrics, two conductors), Ward and Phong lobes over the widths where the rule can be
@@ -427,22 +387,22 @@ fn the_delta_bounds_sampled_constants_hold_on_a_dense_stencil() {
                             if is_bound {
                                 rule_bound += wp * wq * c.rule_bound();
                                 nodes += 1;
-                                worst_q = worst_q.max(c.q_dense / c.q_rule);
+                                worst_q = worst_q.max(c.q_dense / c.fit.q);
                                 if c.lambda_dense.is_finite() {
-                                    worst_lambda = worst_lambda.max(c.lambda_rule / c.lambda_dense);
+                                    worst_lambda = worst_lambda.max(c.fit.lambda / c.lambda_dense);
                                 }
                                 assert!(
-                                    c.q_dense <= DELTA_SAFETY * c.q_rule
-                                        && c.lambda_dense >= c.lambda_rule / DELTA_TAIL_SAFETY,
+                                    c.q_dense <= DELTA_SAFETY * c.fit.q
+                                        && c.lambda_dense >= c.fit.lambda / DELTA_TAIL_SAFETY,
                                     "{name} {geometry} {receptor} t = ({tp}, {tq}): dense Q {:e}, λ {:e} against \
                                      the rule's {:e}, {:e}",
                                     c.q_dense,
                                     c.lambda_dense,
-                                    c.q_rule,
-                                    c.lambda_rule
+                                    c.fit.q,
+                                    c.fit.lambda
                                 );
                             } else {
-                                value += wp * wq * c.f0 / c.root();
+                                value += wp * wq * c.fit.mass();
                             }
                         }
                     }

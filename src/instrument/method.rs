@@ -869,14 +869,7 @@ fn lobe_delta(
         for (tp, wp) in t.iter().zip(&w) {
             for (tq, wq) in t.iter().zip(&w) {
                 wts.push(wp * wq);
-                pts.push([0.0, *tp, 0.0, *tq]);
-                for r in &radii[..rings] {
-                    for d in DELTA_DIRECTIONS {
-                        for s in [1.0, -1.0] {
-                            pts.push([s * r * d[0] * width[0], *tp, s * r * d[1] * width[1], *tq]);
-                        }
-                    }
-                }
+                delta_stencil(width, *tp, *tq, &radii[..rings], &mut pts);
             }
         }
     }
@@ -953,53 +946,109 @@ pub const DELTA_FIT_RADIUS: f64 = 1.0;
 /// the outer ring and λ the smallest ln(F(0)/F(x))/xᵀBx there, divided by [`DELTA_TAIL_SAFETY`]; None also
 /// when λ is not positive (a lobe that does not fall by its outer ring).
 fn delta_node(vals: &[f64], radii: &[f64]) -> Option<(f64, f64)> {
-    let f0 = vals[0];
     if vals.iter().all(|v| *v == 0.0) {
         return Some((0.0, 0.0));
     }
+    let fit = delta_fit(vals, radii)?;
+    if radii.len() == 1 {
+        return Some((fit.mass(), 0.0));
+    }
+    let lambda = fit.lambda / DELTA_TAIL_SAFETY;
+    if !(lambda > 0.0) {
+        return None;
+    }
+    Some((fit.mass(), fit.majorant(DELTA_SAFETY * fit.q, lambda)))
+}
+
+/// What [`Rule::LobeDelta`] measures at one t node ([`delta_fit`]), before its safety factors.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DeltaFit {
+    /// The fitted curvature (b_xx, b_yy, b_xy).
+    pub b: [f64; 3],
+    /// F(0).
+    pub f0: f64,
+    /// The largest |h_e − h(0)|/xᵀBx on the rings (0 with the curvature ring only).
+    pub q: f64,
+    /// The smallest decay rate ln(F(0)/F(x))/xᵀBx on the outer ring (∞ with the curvature ring only).
+    pub lambda: f64,
+    /// The smallest xᵀBx on the outer ring (∞ with the curvature ring only).
+    pub r2: f64,
+}
+
+impl DeltaFit {
+    /// √det B.
+    pub fn root(&self) -> f64 {
+        (self.b[0] * self.b[1] - self.b[2] * self.b[2]).sqrt()
+    }
+
+    /// The delta limit's mass relative to π·w_u·w_v: F(0)/√det B.
+    pub fn mass(&self) -> f64 {
+        self.f0 / self.root()
+    }
+
+    /// The majorant of [`delta_node`] (relative to π·w_u·w_v) for the constants `q` and `lambda`:
+    /// (q + F(0)·(e^{−λR²}/λ + e^{−R²}))/√det B. The rule passes its sampled constants with
+    /// [`DELTA_SAFETY`] and [`DELTA_TAIL_SAFETY`] applied; `tests/delta_limit.rs` passes a denser stencil's.
+    pub fn majorant(&self, q: f64, lambda: f64) -> f64 {
+        let tail = if lambda.is_finite() { (-lambda * self.r2).exp() / lambda } else { 0.0 };
+        (q + self.f0 * (tail + (-self.r2).exp())) / self.root()
+    }
+}
+
+/// The curvature and the bound's sampled constants at one t node of [`Rule::LobeDelta`] from the values
+/// `vals` on its stencil ([`delta_stencil`] with `radii`; see [`delta_node`] for the formulas). None when
+/// the values are not positive where the curvature is measured or the fitted curvature is not positive
+/// definite.
+pub fn delta_fit(vals: &[f64], radii: &[f64]) -> Option<DeltaFit> {
+    let f0 = vals[0];
     if f0 <= 0.0 || vals[1..9].iter().any(|v| *v <= 0.0) {
         return None;
     }
     let r = radii[0];
-    let b: Vec<f64> = (0..4).map(|k| -(0.5 * (vals[1 + 2 * k] * vals[2 + 2 * k]).ln() - f0.ln()) / (r * r)).collect();
+    let b: [f64; 4] = std::array::from_fn(|k| -(0.5 * (vals[1 + 2 * k] * vals[2 + 2 * k]).ln() - f0.ln()) / (r * r));
     let (bxx, byy, bxy) = (b[0], b[2], 0.5 * (b[1] - b[3]));
     let det = bxx * byy - bxy * bxy;
     if !(bxx > 0.0 && byy > 0.0 && det > 0.0) {
         return None;
     }
-    let root = det.sqrt();
-    let mass = f0 / root;
-    if radii.len() == 1 {
-        return Some((mass, 0.0));
-    }
     let (mut q, mut lambda, mut r2) = (0.0f64, f64::INFINITY, f64::INFINITY);
-    let mut i = 1;
-    for (j, r) in radii.iter().enumerate() {
-        for d in DELTA_DIRECTIONS {
-            let (x, y) = (r * d[0], r * d[1]);
-            let quad = bxx * x * x + 2.0 * bxy * x * y + byy * y * y;
-            let grow = quad.exp();
-            let (a, c) = (vals[i] * grow, vals[i + 1] * grow);
-            q = q.max(((0.5 * (a + c) - f0) / quad).abs());
-            if j == radii.len() - 1 {
-                r2 = r2.min(quad);
-                for v in [vals[i], vals[i + 1]] {
-                    // A zero (outside the overlap, or underflow) decays as fast as any rate.
-                    if v != 0.0 {
-                        lambda = lambda.min((f0 / v.abs()).ln() / quad);
+    if radii.len() > 1 {
+        let mut i = 1;
+        for (j, r) in radii.iter().enumerate() {
+            for d in DELTA_DIRECTIONS {
+                let (x, y) = (r * d[0], r * d[1]);
+                let quad = bxx * x * x + 2.0 * bxy * x * y + byy * y * y;
+                let grow = quad.exp();
+                let (a, c) = (vals[i] * grow, vals[i + 1] * grow);
+                q = q.max(((0.5 * (a + c) - f0) / quad).abs());
+                if j == radii.len() - 1 {
+                    r2 = r2.min(quad);
+                    for v in [vals[i], vals[i + 1]] {
+                        // A zero (outside the overlap, or underflow) decays as fast as any rate.
+                        if v != 0.0 {
+                            lambda = lambda.min((f0 / v.abs()).ln() / quad);
+                        }
                     }
                 }
+                i += 2;
             }
-            i += 2;
         }
     }
-    let lambda = lambda / DELTA_TAIL_SAFETY;
-    if !(lambda > 0.0) {
-        return None;
+    Some(DeltaFit { b: [bxx, byy, bxy], f0, q, lambda, r2 })
+}
+
+/// Append the stencil of one t node (t_p, t_q) of [`Rule::LobeDelta`] to `pts`, in the order [`delta_fit`]
+/// reads it: the centre, then per ring of `radii` (in lobe widths) and direction of [`DELTA_DIRECTIONS`] the
+/// point and its opposite, in the chart (u, t_p, v, t_q) with the lobe widths `width`.
+pub fn delta_stencil(width: [f64; 2], tp: f64, tq: f64, radii: &[f64], pts: &mut Vec<[f64; 4]>) {
+    pts.push([0.0, tp, 0.0, tq]);
+    for r in radii {
+        for d in DELTA_DIRECTIONS {
+            for s in [1.0, -1.0] {
+                pts.push([s * r * d[0] * width[0], tp, s * r * d[1] * width[1], tq]);
+            }
+        }
     }
-    let tail = if lambda.is_finite() { (-lambda * r2).exp() / lambda } else { 0.0 };
-    let bound = (DELTA_SAFETY * q + f0 * (tail + (-r2).exp())) / root;
-    Some((mass, bound))
 }
 
 /// The smooth-integrand rule of a lobe-chart part without kinks, if it fits: [`Rule::TensorGauss`] in the

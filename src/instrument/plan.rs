@@ -1049,8 +1049,8 @@ fn describe_method(m: &Method, terms: &[Term]) -> String {
                  π·F(0)/√det B from the lobe's curvature B on a ring of {} width, accepted when its bound meets the \
                  tolerance: {}× the largest |h_e(x) − h(0)|/xᵀBx of the even part of h = F·e^{{xᵀBx}} on rings of \
                  {} and {:?} widths, + the tail beyond {} widths, F(0)·(e^{{−R²}} + e^{{−λR²}}/λ) with λ the lobe's \
-                 decay rate there ÷ {}, + the t rule's difference from {}² nodes (the lobe is ≥ {} widths from every overlap kink; else \
-                 Gauss–Hermite orders {}, then Genz–Malik 7/5 on {} initial box(es))",
+                 decay rate there ÷ {}, + the t rule's difference from {}² nodes (the lobe is ≥ {} widths from every \
+                 overlap kink; else Gauss–Hermite orders {}, then Genz–Malik 7/5 on {} initial box(es))",
                 width[0],
                 width[1],
                 DELTA_T_ORDERS.1,
