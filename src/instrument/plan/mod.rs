@@ -1,0 +1,442 @@
+//! The measurement plan: (material, geometries, requested readings) compiled once into the cheapest list
+//! of aperture integrals that produces them, in the manner of RustFFT's planner: step one designs a
+//! [`Method`] per integral (plain data: clipped stops, mirror visibility, chart, rule, initial partition,
+//! delta part, spectral weighting, tolerances, budget), step two executes the methods. The plan
+//!
+//! * keeps only the terms the material has (the model builds no flake term without flakes; the methods
+//!   integrate a smooth coat as an analytic delta, a diffuse body with no lobe splits, each lobe with splits
+//!   at its own width);
+//! * chooses the spectral weighting from the readings asked for (every reading says which it needs:
+//!   `ReadingSpec::weighting`) and folds it into the integrand, so a luminous flux is one component whatever
+//!   the number of samples;
+//! * computes each distinct flux once and shares it: the gloss standard's flux between gloss and haze
+//!   readings, a receptor between gloss and DOI, identical geometries (ASTM D523 and ISO 2813 at the same
+//!   angle) between themselves, and the gloss readings that a composite (ASTM D4039) needs;
+//! * computes the gloss standards' fluxes when it is compiled (they do not depend on the material; a
+//!   long-lived [`Planner`] keeps them for every plan it compiles);
+//! * runs the specimen integrals in parallel, collecting results in plan order, so the numbers are the same
+//!   bits whatever the thread count.
+//!
+//! A compiled plan can be executed on another material of the same shape ([`Plan::with_material`]) and
+//! frozen after one adaptive execution ([`Plan::freeze`]); `explain()` prints the stored methods in plain
+//! words (`glossmeter measure --explain`).
+//!
+//! The folder, one idea per file:
+//!
+//! * `mod.rs`: the plan's data and life: [`PlanOptions`], [`Job`], [`PlannedReading`], [`Reading`],
+//!   [`Execution`], [`Plan`] and its [`Plan::compile`], [`Plan::with_material`], [`Plan::freeze`],
+//!   [`Plan::execute`], [`Plan::run`], [`Plan::run_all`]; the tolerance shares ([`SPECIMEN_SHARE`],
+//!   [`STANDARD_SHARE`]) and limits ([`MIN_RTOL`], [`DEFAULT_MAX_SECONDS`]);
+//! * `compile.rs`: the planner, [`Planner`]: a plan's jobs designed from the material, the geometries and
+//!   the options, shared by key, and the gloss standards' fluxes computed and cached;
+//! * `readings.rs`: the reading formulas, in one place: [`reading_value`], [`haze_index_value`],
+//!   [`colour_xyz`], [`colour_value`], and a planned reading computed from its fluxes;
+//! * `explain.rs`: [`Plan::explain`], the stored methods in plain words (the text of `--explain`).
+use std::collections::BTreeMap;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex, OnceLock, PoisonError};
+
+use rayon::prelude::*;
+
+use crate::brdf::{Brdf, Term};
+use crate::colorimetry::Conditions;
+use crate::instrument::flux::Flux;
+use crate::instrument::geometry::{ReadingSpec, Scale};
+use crate::instrument::method::Method;
+pub use crate::instrument::method::Target;
+use crate::instrument::standards::StandardGeometry;
+use crate::spectrum::{Weighting, WeightingKind};
+use crate::{Error, Result};
+
+use compile::{shape, Shape};
+use readings::{compose_reading, compute_reading};
+
+mod compile;
+mod explain;
+mod readings;
+
+pub use compile::Planner;
+pub use readings::{colour_value, colour_xyz, haze_index_value, reading_value};
+
+/// Share of a reading's relative tolerance given to each specimen flux and to the gloss standard's flux. A
+/// gloss reading's propagated relative error is at most the sum of its two fluxes' (first order), so
+/// SPECIMEN_SHARE + STANDARD_SHARE ≤ 1 keeps it within rtol. The standard (an analytic 2-D integral) is cheap
+/// to converge tightly; the specimen's 4-D integral gets most of the budget.
+pub const SPECIMEN_SHARE: f64 = 0.9;
+pub const STANDARD_SHARE: f64 = 0.05;
+
+/// The smallest relative tolerance a plan accepts. A reading's tolerance is split down to 0.05 % of it for
+/// the analytic part of a specimen flux (DELTA_SHARE × SPECIMEN_SHARE) and 5 % for the standard, so at 1e-12
+/// those parts are asked for ~1e-15 relative: a few units of the double-precision rounding (2.2e-16) of
+/// their sums. Below that the error estimates are rounding noise and the cubature refines to its budget
+/// without ever meeting the tolerance (`--rtol 1e-300` ran for minutes on black glass). The convergence
+/// reference runs at this tolerance (`instrument::convergence`).
+pub const MIN_RTOL: f64 = 1e-12;
+
+/// The default wall-clock budget of one execution of a plan (all its aperture integrals together, run in
+/// parallel), seconds: far above what any shipped fixture needs (the golden suite of 396 readings runs in
+/// about a second), and short enough that the default panel of any valid input ends within 10 s of wall
+/// time (issue 8; with `method::LATE_START_SHARE`, ≤ 1.3 × 6 s on 2 threads, ≤ 1.6 × on one). An integral
+/// that hits it reports its best estimate, not converged.
+pub const DEFAULT_MAX_SECONDS: f64 = 6.0;
+
+/// Knobs of the planner. The defaults are what `measure` uses; the others exist to measure what each
+/// optimisation saves (`docs/performance.md`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct PlanOptions {
+    /// Relative tolerance of every reading.
+    pub rtol: f64,
+    /// Apply the spectral weighting in the integrand (k components) rather than after integrating every
+    /// sample (n components).
+    pub fold_spectral: bool,
+    /// With `fold_spectral`, let a material that can sum a luminous-only flux's samples itself do so
+    /// (`Brdf::eval_batch_folded`: the paint's folded flake tables); off, the integrand weights the n
+    /// samples the material returns (kept to measure what it saves, `docs/performance.md`).
+    pub fold_in_material: bool,
+    /// Compute each distinct flux once.
+    pub share_fluxes: bool,
+    /// Evaluation budget per flux integral (deterministic: a reading that hits it is the same bits on every
+    /// machine).
+    pub max_evals: usize,
+    /// Wall-clock budget of one execution of the plan, seconds (None: none): every integral of the plan stops
+    /// refining at the same deadline, [`Plan::execute`]'s start + this (an integral run on its own,
+    /// `Method::execute`, has it as its own budget). A reading whose integral hits it has the best estimate
+    /// as its value, is marked not converged, and depends on the machine's speed.
+    pub max_seconds: Option<f64>,
+    /// Illuminant and observer of colour readings (default D65 and the CIE 1964 10° observer, as colour QC
+    /// uses; gloss readings are luminous whatever this says).
+    pub colour: Conditions,
+}
+
+impl Default for PlanOptions {
+    fn default() -> Self {
+        PlanOptions {
+            rtol: 1e-6,
+            fold_spectral: true,
+            fold_in_material: true,
+            share_fluxes: true,
+            max_evals: 50_000_000,
+            max_seconds: Some(DEFAULT_MAX_SECONDS),
+            colour: Conditions::default(),
+        }
+    }
+}
+
+/// One aperture integral of the plan: its method and where it is used.
+#[derive(Clone, Debug)]
+pub struct Job {
+    pub method: Method,
+    /// The scale of the standard (used by standard jobs only).
+    pub scale: Scale,
+    /// Where it is used: "geometry-id/receptor".
+    pub used_by: Vec<String>,
+}
+
+/// A reading of the plan, referring to jobs by index.
+#[derive(Clone, Debug)]
+pub struct PlannedReading {
+    pub geometry: String,
+    pub name: String,
+    pub spec: ReadingSpec,
+    /// Job index of each specimen flux and each standard flux, by receptor name.
+    pub specimen_jobs: BTreeMap<String, usize>,
+    pub standard_jobs: BTreeMap<String, usize>,
+    /// The spectral weighting this reading uses; it reads its components from that kind's offset in each of
+    /// its specimen jobs' weighting (a job carries the kinds of the readings that use it; the standards'
+    /// fluxes are luminous, component 0).
+    pub kind: WeightingKind,
+    /// For composites: indices of the gloss readings combined.
+    pub parts: Vec<usize>,
+    /// Whether the user asked for it (dependencies of composites are computed but not reported).
+    pub reported: bool,
+}
+
+/// A computed reading. `value` is None when no finite value exists (then `problem` says why): a NaN or
+/// an infinity is never reported as a reading.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Reading {
+    pub geometry: String,
+    pub name: String,
+    pub quantity: String,
+    pub unit: String,
+    pub value: Option<f64>,
+    pub error_estimate: f64,
+    pub evaluations: usize,
+    pub seconds: f64,
+    pub converged: bool,
+    /// Why there is no value (or why it may be inaccurate: budget exhausted).
+    pub problem: Option<String>,
+    /// A caveat on a valid value (e.g. a specimen outside the scope of the standard's formula).
+    pub note: Option<String>,
+}
+
+/// One execution of a plan ([`Plan::run`]): the readings, and the flux of every integral of the plan.
+#[derive(Clone, Debug)]
+pub struct Execution {
+    pub readings: Vec<Reading>,
+    /// One flux per job of the plan, in plan order (`Plan::jobs`): the specimen integrals computed by this
+    /// execution and the gloss standards' fluxes computed when the plan was compiled.
+    pub fluxes: Vec<Flux>,
+}
+
+impl Execution {
+    /// The BRDF evaluations of the whole plan: every distinct integral (job) counted once, the gloss
+    /// standards' integrals included (as in each reading's own count). A reading's `evaluations` counts
+    /// every integral it uses, so an integral shared by several readings is in each of their counts but
+    /// only once here. A frozen plan's integrals count what its fixed partitions cost.
+    pub fn evaluations(&self) -> usize {
+        self.fluxes.iter().map(|f| f.evaluations).sum()
+    }
+}
+
+/// The compiled plan.
+#[derive(Clone)]
+pub struct Plan {
+    pub material: Arc<dyn Brdf>,
+    pub options: PlanOptions,
+    pub geometries: Vec<StandardGeometry>,
+    pub jobs: Vec<Job>,
+    pub readings: Vec<PlannedReading>,
+    /// The spectral weighting of the specimen fluxes (stacked from the readings' kinds).
+    pub weighting: Weighting,
+    /// The material's terms, as the methods were designed for.
+    pub terms: Vec<Term>,
+    shape: Shape,
+    /// The standards' fluxes, computed at compile time (None for specimen jobs).
+    standard_flux: Vec<Option<Flux>>,
+    /// X, Y, Z of the perfect reflecting diffuser under the colour conditions, from the material's own grid
+    /// (the row sums of its weights, so a white diffuser reads L* = 100 exactly); None without colour readings.
+    white_point: Option<(Conditions, [f64; 3])>,
+}
+
+impl Plan {
+    /// Compile a plan with a fresh [`Planner`] (use one long-lived planner to share its caches).
+    pub fn compile(material: Arc<dyn Brdf>, geometries: Vec<StandardGeometry>, options: PlanOptions) -> Result<Plan> {
+        Planner::new()?.compile(material, geometries, options)
+    }
+
+    /// The same plan (the same methods, partitions included, and the same standards' fluxes) for another
+    /// material of the same shape: the same spectral sampling and the same kinds of terms in the same order.
+    /// The split points stay those of the material the plan was compiled for: right for a nearby material
+    /// (a fitter's step, a sweep's neighbour); for a very different one compile a new plan.
+    pub fn with_material(&self, material: Arc<dyn Brdf>) -> Result<Plan> {
+        let s = shape(material.as_ref());
+        if s != self.shape {
+            return Err(Error::Usage(format!(
+                "the plan was compiled for a material of another shape ({} samples, terms {:?}); this one has {} \
+                 samples, terms {:?}",
+                self.shape.sampling.len(),
+                self.shape.kinds,
+                s.sampling.len(),
+                s.kinds
+            )));
+        }
+        let mut p = self.clone();
+        p.material = material;
+        Ok(p)
+    }
+
+    /// Whether every specimen method is frozen.
+    pub fn is_frozen(&self) -> bool {
+        self.jobs.iter().all(|j| j.method.target == Target::Standard || j.method.is_frozen())
+    }
+
+    /// Execute the plan adaptively and return its readings together with the frozen plan: every specimen
+    /// method keeps its final partition and is re-executed with the same rule and no refinement. Executing
+    /// the frozen plan on the same material gives the same value and error bits (fewer evaluations: the
+    /// refined-away parents are not evaluated again); on a nearby material ([`Plan::with_material`]) the
+    /// readings move smoothly with the material's parameters, as finite differences need. A frozen plan's
+    /// error estimates are those of its fixed partition: check `converged` before trusting one far from
+    /// the material it was frozen on.
+    pub fn freeze(&self) -> (Vec<Reading>, Plan) {
+        let deadline = self.deadline();
+        let todo = self.specimen_jobs();
+        let results: Vec<(Flux, Method)> = todo
+            .par_iter()
+            .map(|&j| self.jobs[j].method.execute_and_freeze_until(self.material.as_ref(), deadline))
+            .collect();
+        let mut frozen = self.clone();
+        let mut flux = self.known_fluxes();
+        for (&j, (f, m)) in todo.iter().zip(results) {
+            frozen.jobs[j].method = m;
+            flux[j] = Some(f);
+        }
+        let flux: Vec<Flux> = flux.into_iter().map(|f| f.expect("every job ran")).collect();
+        (self.readings_from(&flux), frozen)
+    }
+
+    /// The shared deadline of one execution: now + the wall-clock budget.
+    fn deadline(&self) -> Option<std::time::Instant> {
+        self.options.max_seconds.map(|s| std::time::Instant::now() + std::time::Duration::from_secs_f64(s))
+    }
+
+    /// Execute the plan: every specimen method on the material (the standards' fluxes were computed when the
+    /// plan was compiled), then the readings. The specimen integrals share one wall-clock deadline.
+    pub fn execute(&self) -> Vec<Reading> {
+        self.run().readings
+    }
+
+    /// [`Plan::execute`], keeping the flux of every integral with the readings: what the whole plan cost
+    /// ([`Execution::evaluations`], each distinct integral counted once).
+    pub fn run(&self) -> Execution {
+        let deadline = self.deadline();
+        let todo = self.specimen_jobs();
+        let computed: Vec<Flux> =
+            todo.par_iter().map(|&j| self.jobs[j].method.execute_until(self.material.as_ref(), deadline)).collect();
+        let mut flux = self.known_fluxes();
+        for (&j, f) in todo.iter().zip(computed) {
+            flux[j] = Some(f);
+        }
+        self.execution(flux)
+    }
+
+    /// Execute several plans as one pool of integrals: every specimen integral of every plan is one task of a
+    /// single work queue that the pool's threads drain, so the threads balance integrals, not plans. A batch
+    /// of plans whose costs differ a hundredfold, each with one or two integrals that dominate it, then ends
+    /// within one small integral on every thread; running plan after plan, each with its own parallel loop
+    /// over its integrals ([`Plan::run`] inside a parallel loop over plans), nests two loops whose inner one
+    /// (14 integrals of 6–20 µs for most recipes) costs more in hand-overs than it spreads, and ends when the
+    /// last plan's dominant integral does (docs/performance.md §Batch and sweep throughput).
+    ///
+    /// The queue is in order of expected cost, largest first ([`Method::expected_evaluations`]; ties in plan
+    /// order), the longest-processing-time rule: the few integrals of milliseconds start at once and the
+    /// last ones taken are of microseconds. Each thread takes the next integral from one shared atomic
+    /// counter, so the order does not depend on the number of threads or on how the range would be split.
+    /// The thread that completes a plan's last integral works out that plan's readings at once, so no serial
+    /// step follows the loop. Each execution is the same bits as [`Plan::run`] of that plan alone (each
+    /// integral is the same method on the same material, on one thread; the order only decides when);
+    /// each plan's wall-clock budget starts when its first integral does.
+    pub fn run_all(plans: &[Plan]) -> Vec<Execution> {
+        let tasks: Vec<(usize, usize)> = plans
+            .iter()
+            .enumerate()
+            .flat_map(|(p, plan)| plan.specimen_jobs().into_iter().map(move |j| (p, j)))
+            .collect();
+        let mut order: Vec<(f64, usize)> =
+            tasks.iter().enumerate().map(|(t, &(p, j))| (plans[p].jobs[j].method.expected_evaluations(), t)).collect();
+        order.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
+        // Per plan: the integrals still to run and the fluxes so far (the standards' from compile time).
+        let pending: Vec<Mutex<(usize, Vec<Option<Flux>>)>> = plans
+            .iter()
+            .map(|plan| {
+                let known = plan.known_fluxes();
+                Mutex::new((known.iter().filter(|f| f.is_none()).count(), known))
+            })
+            .collect();
+        let done: Vec<OnceLock<Execution>> = plans.iter().map(|_| OnceLock::new()).collect();
+        let deadlines: Vec<OnceLock<Option<std::time::Instant>>> = plans.iter().map(|_| OnceLock::new()).collect();
+        let next = AtomicUsize::new(0);
+        let drain = || {
+            while let Some(&(_, t)) = order.get(next.fetch_add(1, Ordering::Relaxed)) {
+                let (p, j) = tasks[t];
+                let plan = &plans[p];
+                let deadline = *deadlines[p].get_or_init(|| plan.deadline());
+                let f = plan.jobs[j].method.execute_until(plan.material.as_ref(), deadline);
+                let complete = {
+                    let mut slot = pending[p].lock().unwrap_or_else(PoisonError::into_inner);
+                    slot.1[j] = Some(f);
+                    slot.0 -= 1;
+                    (slot.0 == 0).then(|| std::mem::take(&mut slot.1))
+                };
+                if let Some(flux) = complete {
+                    let _ = done[p].set(plan.execution(flux));
+                }
+            }
+        };
+        let threads = rayon::current_num_threads().min(tasks.len()).max(1);
+        rayon::scope(|s| {
+            for _ in 1..threads {
+                s.spawn(|_| drain());
+            }
+            drain();
+        });
+        // Plans without specimen integrals (nothing ran) are worked out here.
+        plans
+            .iter()
+            .zip(done)
+            .zip(pending)
+            .map(|((plan, d), pend)| {
+                d.into_inner()
+                    .unwrap_or_else(|| plan.execution(pend.into_inner().unwrap_or_else(PoisonError::into_inner).1))
+            })
+            .collect()
+    }
+
+    /// The execution from the flux of every job (the standards' and the computed ones).
+    fn execution(&self, flux: Vec<Option<Flux>>) -> Execution {
+        let fluxes: Vec<Flux> = flux.into_iter().map(|f| f.expect("every job ran")).collect();
+        Execution { readings: self.readings_from(&fluxes), fluxes }
+    }
+
+    /// The jobs to run on the material, in plan order. Only these go to the thread pool: a plan with one
+    /// specimen integral runs it on the calling thread (rayon runs a one-item parallel iterator in place),
+    /// which spares a one-off small plan the hand-over to the pool and back (tens of µs).
+    fn specimen_jobs(&self) -> Vec<usize> {
+        (0..self.jobs.len()).filter(|&j| self.standard_flux[j].is_none()).collect()
+    }
+
+    /// The fluxes known before execution: the standards', by job index.
+    fn known_fluxes(&self) -> Vec<Option<Flux>> {
+        self.standard_flux.clone()
+    }
+
+    /// The readings from the fluxes of every job. Direct readings first, then composites, which combine
+    /// direct readings (their parts may come later in plan order when the user asked for the composite
+    /// before its parts, or only for it).
+    fn readings_from(&self, flux: &[Flux]) -> Vec<Reading> {
+        let mut out: Vec<Option<Reading>> = vec![None; self.readings.len()];
+        for (i, r) in self.readings.iter().enumerate() {
+            if r.parts.is_empty() {
+                out[i] = Some(compute_reading(r, flux, &self.jobs, self.white_point));
+            }
+        }
+        for (i, r) in self.readings.iter().enumerate() {
+            if !r.parts.is_empty() {
+                out[i] = Some(compose_reading(r, &out));
+            }
+        }
+        out.into_iter()
+            .zip(&self.readings)
+            .filter(|(_, p)| p.reported)
+            .map(|(r, _)| r.expect("every reading computed"))
+            .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The queue of `Plan::run_all` starts with the integrals `Method::expected_evaluations` ranks first; on
+    /// the batch bench's narrowest recipe the guess must rank the integrals as their actual costs do at the
+    /// ends: its first two are the two that cost most (in either order), and the six that cost least are
+    /// guessed at under a tenth of the first (so the milliseconds start first and the microseconds end the
+    /// queue).
+    #[test]
+    fn the_expected_cost_ranks_a_narrow_lobes_integrals_as_they_cost() {
+        let text = r#"{"model": "microfacet", "distribution": "beckmann", "roughness": 0.02, "ior": 1.5}"#;
+        let m = crate::recipe::parse_str(text, "narrow.json").unwrap();
+        let geos = crate::resolve_geometries(crate::DEFAULT_PANEL, &[] as &[&str]).unwrap();
+        let plan = Plan::compile(m.brdf, geos, PlanOptions { rtol: 1e-6, ..Default::default() }).unwrap();
+        let run = plan.run();
+        let jobs = plan.specimen_jobs();
+        let rank = |key: &dyn Fn(usize) -> f64| {
+            let mut v = jobs.clone();
+            v.sort_by(|&a, &b| key(b).total_cmp(&key(a)).then(a.cmp(&b)));
+            v
+        };
+        let expected = rank(&|j| plan.jobs[j].method.expected_evaluations());
+        let actual = rank(&|j| run.fluxes[j].evaluations as f64);
+        assert!(jobs.len() >= 12, "{} specimen integrals", jobs.len());
+        let top = |v: &[usize]| -> Vec<usize> {
+            let mut t = v[..2].to_vec();
+            t.sort();
+            t
+        };
+        assert_eq!(top(&expected), top(&actual), "expected order {expected:?}, actual {actual:?}");
+        let guess = |j: usize| plan.jobs[j].method.expected_evaluations();
+        for &j in &actual[actual.len() - 6..] {
+            assert!(guess(j) < 0.1 * guess(expected[0]), "job {j}: {} against {}", guess(j), guess(expected[0]));
+        }
+    }
+}
