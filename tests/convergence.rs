@@ -71,7 +71,7 @@ fn lambertian_sweep_actual_error_is_within_the_estimate_and_decreases() {
         );
         // For ratios of fluxes (gloss, haze) the estimate honours the requested tolerance: the specimen
         // flux is asked for SPECIMEN_SHARE·rtol = 0.9·rtol, the standard for STANDARD_SHARE·rtol = 0.05·rtol
-        // (src/instrument/plan.rs), plus the absolute floor 1e-4·rtol·Φ_std (≤ 0.01·rtol GU).
+        // (src/instrument/plan/mod.rs), plus the absolute floor 1e-4·rtol·Φ_std (≤ 0.01·rtol GU).
         // (Not for DOI, log-haze or haze index: rtol applies to the fluxes, not to those derived numbers.)
         if matches!(r.quantity.as_str(), "gloss" | "haze") {
             let bound = r.rtol * (0.95 * v.abs() + 0.01) * (1.0 + 1e-9);
