@@ -17,27 +17,7 @@ use crate::instrument::standards::{self, StandardGeometry};
 use crate::spectrum::{Sampling, Weighting, WeightingKind};
 use crate::{Error, Result};
 
-use super::{Job, Plan, PlanOptions, PlannedReading, MIN_RTOL, SPECIMEN_SHARE, STANDARD_SHARE};
-
-/// The shape of a material, which a plan's methods depend on: its sampling and the kinds of its terms.
-#[derive(Clone, Debug, PartialEq)]
-pub(super) struct Shape {
-    pub(super) sampling: Sampling,
-    pub(super) kinds: Vec<u8>,
-}
-
-pub(super) fn shape(m: &dyn Brdf) -> Shape {
-    let kinds = m
-        .terms()
-        .iter()
-        .map(|t| match t.kind {
-            TermKind::Delta => 0,
-            TermKind::Diffuse => 1,
-            TermKind::Lobe(_) => 2,
-        })
-        .collect();
-    Shape { sampling: m.sampling().clone(), kinds }
-}
+use super::{shape, Job, Plan, PlanOptions, PlannedReading, MIN_RTOL, SPECIMEN_SHARE, STANDARD_SHARE};
 
 /// The identity of a job for sharing: every input of its design, as bits.
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
@@ -459,6 +439,13 @@ fn add_geometry(
         readings.push(pr);
     }
     Ok(())
+}
+
+impl Plan {
+    /// Compile a plan with a fresh [`Planner`] (use one long-lived planner to share its caches).
+    pub fn compile(material: Arc<dyn Brdf>, geometries: Vec<StandardGeometry>, options: PlanOptions) -> Result<Plan> {
+        Planner::new()?.compile(material, geometries, options)
+    }
 }
 
 #[cfg(test)]

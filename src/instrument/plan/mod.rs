@@ -38,18 +38,15 @@ use std::sync::{Arc, Mutex, OnceLock, PoisonError};
 
 use rayon::prelude::*;
 
-use crate::brdf::{Brdf, Term};
+use crate::brdf::{Brdf, Term, TermKind};
 use crate::colorimetry::Conditions;
 use crate::instrument::flux::Flux;
 use crate::instrument::geometry::{ReadingSpec, Scale};
 use crate::instrument::method::Method;
 pub use crate::instrument::method::Target;
 use crate::instrument::standards::StandardGeometry;
-use crate::spectrum::{Weighting, WeightingKind};
+use crate::spectrum::{Sampling, Weighting, WeightingKind};
 use crate::{Error, Result};
-
-use compile::{shape, Shape};
-use readings::{compose_reading, compute_reading};
 
 mod compile;
 mod explain;
@@ -189,6 +186,26 @@ impl Execution {
     }
 }
 
+/// The shape of a material, which a plan's methods depend on: its sampling and the kinds of its terms.
+#[derive(Clone, Debug, PartialEq)]
+struct Shape {
+    sampling: Sampling,
+    kinds: Vec<u8>,
+}
+
+fn shape(m: &dyn Brdf) -> Shape {
+    let kinds = m
+        .terms()
+        .iter()
+        .map(|t| match t.kind {
+            TermKind::Delta => 0,
+            TermKind::Diffuse => 1,
+            TermKind::Lobe(_) => 2,
+        })
+        .collect();
+    Shape { sampling: m.sampling().clone(), kinds }
+}
+
 /// The compiled plan.
 #[derive(Clone)]
 pub struct Plan {
@@ -210,11 +227,6 @@ pub struct Plan {
 }
 
 impl Plan {
-    /// Compile a plan with a fresh [`Planner`] (use one long-lived planner to share its caches).
-    pub fn compile(material: Arc<dyn Brdf>, geometries: Vec<StandardGeometry>, options: PlanOptions) -> Result<Plan> {
-        Planner::new()?.compile(material, geometries, options)
-    }
-
     /// The same plan (the same methods, partitions included, and the same standards' fluxes) for another
     /// material of the same shape: the same spectral sampling and the same kinds of terms in the same order.
     /// The split points stay those of the material the plan was compiled for: right for a nearby material
@@ -378,28 +390,6 @@ impl Plan {
     /// The fluxes known before execution: the standards', by job index.
     fn known_fluxes(&self) -> Vec<Option<Flux>> {
         self.standard_flux.clone()
-    }
-
-    /// The readings from the fluxes of every job. Direct readings first, then composites, which combine
-    /// direct readings (their parts may come later in plan order when the user asked for the composite
-    /// before its parts, or only for it).
-    fn readings_from(&self, flux: &[Flux]) -> Vec<Reading> {
-        let mut out: Vec<Option<Reading>> = vec![None; self.readings.len()];
-        for (i, r) in self.readings.iter().enumerate() {
-            if r.parts.is_empty() {
-                out[i] = Some(compute_reading(r, flux, &self.jobs, self.white_point));
-            }
-        }
-        for (i, r) in self.readings.iter().enumerate() {
-            if !r.parts.is_empty() {
-                out[i] = Some(compose_reading(r, &out));
-            }
-        }
-        out.into_iter()
-            .zip(&self.readings)
-            .filter(|(_, p)| p.reported)
-            .map(|(r, _)| r.expect("every reading computed"))
-            .collect()
     }
 }
 

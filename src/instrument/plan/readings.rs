@@ -5,7 +5,7 @@ use crate::instrument::flux::Flux;
 use crate::instrument::geometry::{ColourQuantity, ReadingSpec};
 use crate::spectrum::WeightingKind;
 
-use super::{Job, PlannedReading, Reading};
+use super::{Job, Plan, PlannedReading, Reading};
 
 /// A reading with a value `(v, e)`, no problem and no note (callers override those with struct update).
 fn valued_reading(
@@ -173,7 +173,7 @@ pub fn colour_value(
 }
 
 /// Combine fluxes into a direct reading, with first-order error propagation.
-pub(super) fn compute_reading(
+fn compute_reading(
     r: &PlannedReading,
     flux: &[Flux],
     jobs: &[Job],
@@ -229,7 +229,7 @@ pub(super) fn compute_reading(
 }
 
 /// A composite reading (haze index) from the readings it combines.
-pub(super) fn compose_reading(r: &PlannedReading, done: &[Option<Reading>]) -> Reading {
+fn compose_reading(r: &PlannedReading, done: &[Option<Reading>]) -> Reading {
     let (Some(a), Some(b)) = (&done[r.parts[0]], &done[r.parts[1]]) else {
         return problem_reading(r, "a gloss reading it combines was not computed".into());
     };
@@ -277,4 +277,28 @@ fn ratio(a: f64, ea: f64, b: f64, eb: f64, den: Denominator) -> std::result::Res
     let e = ea / b + a.abs() * eb / (b * b);
     let e = if e.is_finite() { e } else { ea / b + (a.abs() / b) * (eb / b) };
     Ok((a / b, e))
+}
+
+impl Plan {
+    /// The readings from the fluxes of every job. Direct readings first, then composites, which combine
+    /// direct readings (their parts may come later in plan order when the user asked for the composite
+    /// before its parts, or only for it).
+    pub(super) fn readings_from(&self, flux: &[Flux]) -> Vec<Reading> {
+        let mut out: Vec<Option<Reading>> = vec![None; self.readings.len()];
+        for (i, r) in self.readings.iter().enumerate() {
+            if r.parts.is_empty() {
+                out[i] = Some(compute_reading(r, flux, &self.jobs, self.white_point));
+            }
+        }
+        for (i, r) in self.readings.iter().enumerate() {
+            if !r.parts.is_empty() {
+                out[i] = Some(compose_reading(r, &out));
+            }
+        }
+        out.into_iter()
+            .zip(&self.readings)
+            .filter(|(_, p)| p.reported)
+            .map(|(r, _)| r.expect("every reading computed"))
+            .collect()
+    }
 }
