@@ -30,9 +30,8 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use glossmeter::brdf::{Brdf, Lobe, Tail, Term, TermKind};
-use glossmeter::instrument::flux::Flux;
 use glossmeter::instrument::geometry::{solid_angle_density, Axes, Stop};
-use glossmeter::instrument::method::{Method, Rule, Target, TensorChart};
+use glossmeter::instrument::method::{Flux, Method, Rule, Target, TensorChart};
 use glossmeter::instrument::plan::{Plan, PlanOptions, Reading};
 use glossmeter::instrument::standards::{self, StandardGeometry};
 use glossmeter::optics::fresnel::fr_dielectric;
@@ -254,8 +253,8 @@ fn rule_label(m: &Method, brdf: &dyn Brdf) -> String {
     let (_, frozen) = m.execute_and_freeze(brdf);
     let Some(part) = frozen.regular.as_ref() else { return "no regular part".into() };
     let chart = match part.chart {
-        glossmeter::instrument::flux::Chart::Plain => "plain (p_s, q_s, p_r, q_r)",
-        glossmeter::instrument::flux::Chart::Lobe => "lobe (u, t_p, v, t_q)",
+        glossmeter::instrument::aperture::Chart::Plain => "plain (p_s, q_s, p_r, q_r)",
+        glossmeter::instrument::aperture::Chart::Lobe => "lobe (u, t_p, v, t_q)",
     };
     match part.rule {
         Rule::GenzMalik75 => {
@@ -942,7 +941,7 @@ impl Brdf for Recording {
 
 /// Histogram of the evaluation points of our rtol-1e-6 runs over max(|u|/w_u, |v|/w_v), for the lobed cases.
 fn where_the_evaluations_go(md: &mut String, cases: &[Case]) {
-    use glossmeter::instrument::flux::lobe_widths_uv;
+    use glossmeter::instrument::aperture::lobe_widths_uv;
     let _ = writeln!(md, "\n## Where our evaluations go (rtol 1e-6)\n");
     let _ = writeln!(
         md,

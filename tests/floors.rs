@@ -140,10 +140,11 @@ fn prev_is_ident(b: &[char], i: usize) -> bool {
     i > 0 && (b[i - 1].is_alphanumeric() || b[i - 1] == '_')
 }
 
-/// Removes every `#[cfg(test)]` item (its tests travel with the code they test and are not part of the floors).
+/// Removes every `#[cfg(test)]` and `#[cfg(doc)]` item (tests travel with the code they test, and an import
+/// that only a doc link uses is no dependency: neither is part of the floors).
 fn drop_test_items(code: &str) -> String {
     let mut out = code.to_string();
-    while let Some(at) = out.find("#[cfg(test)]") {
+    while let Some(at) = out.find("#[cfg(test)]").or_else(|| out.find("#[cfg(doc)]")) {
         let rest = &out[at..];
         let end = match (rest.find('{'), rest.find(';')) {
             (Some(brace), semi) if semi.is_none_or(|s| brace < s) => {
@@ -211,7 +212,10 @@ fn split_path(s: &str) -> Vec<String> {
 
 /// The statements `[pub[(…)]] use …;` of a file: (is a re-export, the expanded paths), and the code with
 /// them removed.
-fn use_statements(code: &str) -> (Vec<(bool, Vec<Vec<String>>)>, String) {
+/// A `use` statement: whether it is a re-export, and its expanded paths.
+type Use = (bool, Vec<Vec<String>>);
+
+fn use_statements(code: &str) -> (Vec<Use>, String) {
     let mut uses = Vec::new();
     let mut rest = String::with_capacity(code.len());
     let bytes = code.as_bytes();
@@ -280,7 +284,7 @@ struct Crate {
     /// Per file: its `pub use` re-exports, name → absolute path of the target; and its glob re-exports.
     reexports: Vec<BTreeMap<String, Vec<String>>>,
     globs: Vec<Vec<Vec<String>>>,
-    uses: Vec<Vec<(bool, Vec<Vec<String>>)>>,
+    uses: Vec<Vec<Use>>,
     body: Vec<String>,
 }
 
@@ -407,8 +411,19 @@ impl Crate {
         for i in 0..self.files.len() {
             let mut paths: Vec<Vec<String>> = Vec::new();
             for (public, ps) in &self.uses[i] {
-                if !public {
-                    paths.extend(ps.iter().cloned());
+                for p in ps {
+                    // A re-export is a dependency only where the file's own code uses the name it brings in.
+                    let used = |name: &str| {
+                        self.body[i].match_indices(name).any(|(at, _)| {
+                            let before = self.body[i][..at].chars().next_back();
+                            let after = self.body[i][at + name.len()..].chars().next();
+                            let ident = |c: Option<char>| c.is_some_and(|c| c.is_alphanumeric() || c == '_');
+                            !ident(before) && !ident(after)
+                        })
+                    };
+                    if !public || p.last().is_some_and(|n| n != "*" && used(n)) {
+                        paths.push(p.clone());
+                    }
                 }
             }
             let here = &self.files[i].module;

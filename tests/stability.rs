@@ -510,7 +510,7 @@ fn microfacet_roughness_sweep_and_switches() {
             );
         }
     }
-    // Split sharing: a lobe within a factor 3 of a narrower one shares its splits (flux.rs `splits`).
+    // Split sharing: a lobe within a factor 3 of a narrower one shares its splits (aperture.rs `splits`).
     let lobes = |m2: f64| {
         recipe(&json!({"model": "cook-torrance-lobes", "kd": 0.0,
             "lobes": [{"ks": 0.5, "r": 0.04, "m": 0.003}, {"ks": 0.5, "r": 0.04, "m": m2}]}))

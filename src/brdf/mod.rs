@@ -87,7 +87,7 @@ impl Lobe {
 /// A kink of a model: a surface in (ωi, ωo) across which its value is continuous but its derivative is not
 /// (a Fresnel critical angle: `optics::fresnel::critical_cosine`). Adaptive cubature converges only slowly
 /// on a kink that crosses its boxes (a √-shaped knee costs refinement down to rounding on every box it
-/// crosses), so the plan puts every reported kink on partition boundaries (`instrument::flux::kink_point`).
+/// crosses), so the plan puts every reported kink on partition boundaries (`instrument::aperture::kink_point`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Kink {
     /// The delta term's weight R(cos θi) kinks at cos θi = `cos`.

@@ -1,5 +1,5 @@
 //! Independent references for the instrument integral: closed forms and plain Gauss–Legendre rules that
-//! share no code with the engine's quadrature (`flux.rs`, `method.rs`, `quadrature/`): they keep their own
+//! share no code with the engine's quadrature (`aperture.rs`, `method/`, `quadrature/`): they keep their own
 //! Gauss–Legendre generator, horizon clipping and mirror overlap on purpose. Used by `glossmeter convergence`
 //! to measure the actual error of Lambertian readings, and by the tests. (The stiff and extreme suite,
 //! `tests/stability.rs`, keeps its own copy on purpose, with its own horizon clipping.)

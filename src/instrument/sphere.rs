@@ -19,7 +19,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 
 use crate::brdf::albedo::directional_albedo;
 use crate::brdf::{Brdf, Term, TermKind};
-use crate::instrument::flux::lobe_widths_uv;
+use crate::instrument::aperture::lobe_widths_uv;
 use crate::quadrature::{integrate, pointwise, Options};
 use crate::spectrum::Sampling;
 use crate::Vec3;
@@ -85,7 +85,7 @@ pub fn port_reflectance(brdf: &dyn Brdf, viewing: f64, beta: f64, rtol: f64, max
         return PerSample { value: delta, error: vec![0.0; n], evaluations: 0, converged: true };
     }
     let tmax = beta.tan();
-    // Radial splits at 3ᵏ multiples of each lobe's width in the reflected direction (u of `flux::lobe_widths_uv`).
+    // Radial splits at 3ᵏ multiples of each lobe's width in the reflected direction (u of `aperture::lobe_widths_uv`).
     let mut ts = vec![0.0, tmax];
     for l in brdf.lobes() {
         let w = lobe_widths_uv(&l, viewing)[0];

@@ -10,8 +10,8 @@ use rayon::prelude::*;
 
 use crate::brdf::{Brdf, Lobe, TermKind};
 use crate::colorimetry::Conditions;
-use crate::instrument::flux::Flux;
 use crate::instrument::geometry::{Integral, ReadingSpec, Scale, Stop};
+use crate::instrument::method::Flux;
 use crate::instrument::method::{Design, Method, Projection, Target};
 use crate::instrument::standards::{self, StandardGeometry};
 use crate::spectrum::{Sampling, Weighting, WeightingKind};
@@ -452,7 +452,7 @@ impl Plan {
 mod tests {
     use super::*;
     use crate::brdf::lambert::Lambert;
-    use crate::instrument::flux::Chart;
+    use crate::instrument::aperture::Chart;
 
     fn geometries(ids: &[&str]) -> Vec<StandardGeometry> {
         ids.iter().map(|id| standards::find(id).unwrap()).collect()

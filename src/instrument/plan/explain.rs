@@ -3,7 +3,7 @@
 use std::collections::BTreeMap;
 
 use crate::brdf::{Lobe, Tail, Term, TermKind};
-use crate::instrument::flux::{lobe_widths_uv, Chart, DELTA_SHARE};
+use crate::instrument::aperture::{lobe_widths_uv, Chart, DELTA_SHARE};
 use crate::instrument::geometry::{Integral, ReadingSpec};
 use crate::instrument::method::{
     Method, Projection, Rule, Target, TensorChart, DELTA_FIT_RADIUS, DELTA_RADII, DELTA_RADIUS, DELTA_SAFETY,

@@ -40,8 +40,8 @@ use rayon::prelude::*;
 
 use crate::brdf::{Brdf, Term, TermKind};
 use crate::colorimetry::Conditions;
-use crate::instrument::flux::Flux;
 use crate::instrument::geometry::{ReadingSpec, Scale};
+use crate::instrument::method::Flux;
 use crate::instrument::method::Method;
 pub use crate::instrument::method::Target;
 use crate::instrument::standards::StandardGeometry;

@@ -1,7 +1,7 @@
 //! The geometry of one aperture integral Φ = ∫_source ∫_receptor f(ωi, ωo) cos θi cos θo dωi dωo: the
 //! charts it can be integrated in, where their split points go, the clipping of the stops at the horizon,
-//! the mirror overlap of an ideal-mirror term, and the [`Flux`] an integral produces. The plan designs each
-//! integral from these pieces ([`crate::instrument::method`]); this module only answers questions about it.
+//! the mirror overlap of an ideal-mirror term, and where the material's kinks cross the domain. The plan
+//! designs each integral from these pieces (`instrument::method`); this module only answers questions about it.
 //!
 //! Why the lobe chart: the glossy mass of a paint lies on the specular manifold p_s + p_r = 0,
 //! q_s + q_r = 0, a 2-D ridge in the 4-D domain. Axis-aligned cubature over (p_s, q_s, p_r, q_r) cannot see
@@ -22,50 +22,6 @@ use crate::instrument::geometry::{Axes, Stop};
 /// converges to near machine precision in a few hundred evaluations, so it is asked for much more than its
 /// half and the expensive 4-D regular part gets the rest.
 pub const DELTA_SHARE: f64 = 0.01;
-
-/// The result of one aperture integral: k components, one per row of the method's spectral weighting
-/// (one, the luminous flux, for gloss readings).
-#[derive(Clone, Debug, PartialEq)]
-pub struct Flux {
-    /// Weighted flux per component (sr² units of the BRDF integral; the same units for specimen and
-    /// standard).
-    pub value: Vec<f64>,
-    /// Error estimate per component (absolute).
-    pub error: Vec<f64>,
-    /// The analytic (delta) and numerical (regular) parts, per component.
-    pub delta: Vec<f64>,
-    pub regular: Vec<f64>,
-    /// Integrand evaluations spent (both parts).
-    pub evaluations: usize,
-    /// Regions of the final partitions (both parts).
-    pub regions: usize,
-    /// Whether both parts met their tolerances within the budget.
-    pub converged: bool,
-    /// Whether a part stopped at the wall-clock budget (`Method::max_seconds`).
-    pub out_of_time: bool,
-    /// Wall time of the integral.
-    pub seconds: f64,
-    /// The chart the regular part was integrated in (None: there was no regular part).
-    pub chart: Option<Chart>,
-}
-
-impl Flux {
-    /// The flux of an empty integral (stops below the horizon, or nothing to integrate), k components.
-    pub fn zero(k: usize) -> Flux {
-        Flux {
-            value: vec![0.0; k],
-            error: vec![0.0; k],
-            delta: vec![0.0; k],
-            regular: vec![0.0; k],
-            evaluations: 0,
-            regions: 0,
-            converged: true,
-            out_of_time: false,
-            seconds: 0.0,
-            chart: None,
-        }
-    }
-}
 
 /// Width in u (in-plane) and v (perpendicular) of a lobe at geometry angle θ.
 /// A facet/flake tilt δ inside a medium of index η turns the internal reflected ray by 2δ; leaving the

@@ -1,0 +1,337 @@
+//! Design: how [`Method::design`] turns the facts about one integral into a [`Method`] — the clipped stops,
+//! the mirror overlap, the kink cuts, the chart, the initial partition, the tolerance split — and which
+//! shaped rule it tries before the Genz–Malik partition ([`delta_rule`], [`lobe_rule`], [`polar_rule`],
+//! [`smooth_rule`], tried in that order), with the gates that decide.
+use super::delta::DELTA_COST;
+#[cfg(doc)]
+use super::gauss::TENSOR_MAX_LEVEL;
+use super::gauss::{tensor_boxes, LOBE_LEVELS};
+use super::polar::{POLAR_LEVELS, TAIL_LEVELS};
+use super::{DeltaPart, Design, Method, Projection, RegularPart, Rule, Target, TensorChart};
+use crate::brdf::{Brdf, Lobe, Tail, TermKind};
+use crate::instrument::aperture::{
+    choose_chart, clip, delta_kinks, lobe_boxes, lobe_splits, lobe_widths_uv, mirror_overlap, regular_kinks, AxisMap,
+    Chart, DELTA_SHARE,
+};
+use crate::instrument::geometry::{Integral, Stop};
+use crate::quadrature::{tensor, Cell, Refine};
+use crate::spectrum::Weighting;
+
+/// How far (in lobe widths, on both axes and both sides) the overlap kinks must be from the lobe centre for
+/// [`Rule::LobePolar`]: the polar piece then holds the peak and the tail pieces only the tail.
+pub const POLAR_REACH: f64 = 2.0;
+
+/// [`Rule::TensorGauss`] is chosen ([`smooth_rule`]) when every lobe is at least [`TENSOR_MIN_WIDTH_U`]
+/// times the u-range wide (smooth in the plane of incidence) and between [`TENSOR_MIN_WIDTH`] and
+/// [`TENSOR_MAX_WIDTH_V`] of the v-range (a lobe the v axis must resolve, but not so narrow that its order
+/// passes [`TENSOR_MAX_LEVEL`]). The bounds are where the rule was measured to cost fewer evaluations than the
+/// calibrated Genz–Malik partition on the shipped fixtures (`docs/instrument.md` §Quadrature): B4's GGX
+/// α = 0.3 at 85° (7.2 × the u-range, 0.35 of the v-range) 2 159 against 2 639; it cost more at every
+/// other wide-lobe integral tried (B4 at 75°: 2.9 and 0.63, 2 204 against 986; GGX α = 0.3 conductor at
+/// 60°: 4.5 and 0.81, 3 023 against 872; Blinn–Phong at 20°: 2.0 and 0.79, 1 574 against 530).
+pub const TENSOR_MIN_WIDTH: f64 = 0.25;
+/// See [`TENSOR_MIN_WIDTH`].
+pub const TENSOR_MAX_WIDTH_V: f64 = 0.5;
+/// See [`TENSOR_MIN_WIDTH`].
+pub const TENSOR_MIN_WIDTH_U: f64 = 4.0;
+
+/// How far (in lobe widths) the nearest overlap kink or range end must be from the lobe centre, on both
+/// axes, for [`Rule::LobeGaussHermite`]: the largest node of the 16-point rule is at 4.69 widths, and the
+/// Gaussian is below e⁻⁶⁴ of its peak at 8.
+pub const LOBE_REACH: f64 = 8.0;
+
+/// The design-time gate of [`delta_rule`]: a majorant of [`Rule::LobeDelta`] relative to the reading, per
+/// squared lobe width, above the 50–270 measured at 20°, 60°, E430 and ISO 13803 (at 85°, ≈ 1.8·10⁴, the
+/// rule is tried and may refuse itself; `docs/instrument.md` §Quadrature). Only a gate: the majorant itself
+/// is computed at run time.
+pub const DELTA_GATE: f64 = 1.0e3;
+
+impl Method {
+    /// Design the method of one integral.
+    pub fn design(d: Design<'_>) -> Method {
+        let aperture = d.integral == Integral::Aperture;
+        let clipped = match (clip(d.source, d.theta, true), clip(d.receptor, d.viewing, false)) {
+            (Some(s), Some(r)) if aperture => Some((s, r)),
+            _ => None,
+        };
+        // The mirror image is only ever seen by a receptor on the mirror axis.
+        let on_mirror_axis = d.viewing == d.theta;
+        let mirror = clipped.filter(|_| on_mirror_axis).and_then(|(s, r)| mirror_overlap(s, r));
+        let delta_share = if d.has_regular { DELTA_SHARE } else { 1.0 };
+        let delta = match (d.has_delta, mirror) {
+            (true, Some((lo, hi))) => {
+                let kinks = delta_kinks(d.kinks, d.theta, Stop { p: [lo[0], hi[0]], q: [lo[1], hi[1]] });
+                let boxes = if kinks.is_empty() {
+                    vec![(lo, hi)]
+                } else {
+                    let m = (kinks.len() + 1) as f64;
+                    (0..=kinks.len()).map(|j| ([j as f64 / m, lo[1]], [(j + 1) as f64 / m, hi[1]])).collect()
+                };
+                Some(DeltaPart {
+                    rule: Rule::GenzMalik75,
+                    kinks,
+                    cells: Cell::from_boxes(&boxes),
+                    refine: Refine::Adaptive,
+                    rtol: delta_share * d.rtol,
+                    atol: delta_share * d.atol,
+                })
+            }
+            _ => None,
+        };
+        let regular = match (d.has_regular, clipped) {
+            (true, Some((src, rec))) => {
+                // Off the mirror axis no lobe is centred in the stops: the plain variables (and no kink cuts:
+                // the cut's chart is the lobe chart, whose variables assume the mirror axis).
+                let kinks = if on_mirror_axis { regular_kinks(d.kinks, d.theta, src, rec) } else { Vec::new() };
+                let chart = if !on_mirror_axis {
+                    Chart::Plain
+                } else if kinks.is_empty() {
+                    choose_chart(d.lobes, d.theta, src, rec)
+                } else {
+                    Chart::Lobe
+                };
+                let (splits, boxes) = match chart {
+                    Chart::Lobe => {
+                        let splits = lobe_splits(d.lobes, d.theta, src, rec);
+                        let boxes = kinked_boxes(lobe_boxes(&splits), kinks.len());
+                        (splits, boxes)
+                    }
+                    Chart::Plain => (
+                        [vec![], vec![]],
+                        vec![([src.p[0], src.q[0], rec.p[0], rec.q[0]], [src.p[1], src.q[1], rec.p[1], rec.q[1]])],
+                    ),
+                };
+                let share = 1.0 - DELTA_SHARE;
+                let rule = match chart {
+                    Chart::Lobe if kinks.is_empty() && on_mirror_axis => {
+                        delta_rule(d.lobes, d.has_diffuse, d.theta, src, rec, share * d.rtol)
+                            .or_else(|| lobe_rule(d.lobes, d.has_diffuse, d.theta, src, rec))
+                            .or_else(|| polar_rule(d.lobes, d.has_diffuse, d.theta, src, rec))
+                            .or_else(|| smooth_rule(d.lobes, d.theta, src, rec))
+                            .unwrap_or(Rule::GenzMalik75)
+                    }
+                    _ => Rule::GenzMalik75,
+                };
+                Some(RegularPart {
+                    chart,
+                    rule,
+                    splits,
+                    kinks,
+                    cells: Cell::from_boxes(&boxes),
+                    refine: Refine::Adaptive,
+                    rtol: share * d.rtol,
+                    atol: share * d.atol,
+                })
+            }
+            _ => None,
+        };
+        Method {
+            target: d.target,
+            integral: d.integral,
+            theta: d.theta,
+            viewing: d.viewing,
+            source: d.source,
+            receptor: d.receptor,
+            clipped,
+            mirror,
+            delta,
+            regular,
+            weighting: d.weighting,
+            projection: d.projection,
+            rtol: d.rtol,
+            max_evals: d.max_evals,
+            max_seconds: d.max_seconds,
+        }
+    }
+
+    /// A one-off method for the specimen flux of `brdf` alone (no plan): its own terms, the luminous weighting
+    /// applied in the integrand.
+    pub fn for_material(
+        brdf: &dyn Brdf,
+        theta: f64,
+        source: Stop,
+        receptor: Stop,
+        tolerance: (f64, f64),
+        max_evals: usize,
+    ) -> crate::Result<Method> {
+        Ok(Method::design(Design {
+            target: Target::Specimen,
+            integral: Integral::Aperture,
+            theta,
+            viewing: theta,
+            source,
+            receptor,
+            lobes: &brdf.lobes(),
+            kinks: &brdf.kinks(),
+            has_delta: brdf.has_delta(),
+            has_regular: brdf.has_regular(),
+            has_diffuse: brdf.terms().iter().any(|t| t.kind == TermKind::Diffuse),
+            weighting: Weighting::luminous(brdf.sampling())?,
+            projection: Projection::FoldInMaterial,
+            rtol: tolerance.0,
+            atol: tolerance.1,
+            max_evals,
+            max_seconds: None,
+        }))
+    }
+}
+
+/// The shaped rule of a lobe-chart part, if one fits: [`Rule::LobeGaussHermite`] for a material whose regular
+/// part is one Gaussian-tailed lobe (no diffuse term, no heavy tail) whose centre u = v = 0 is inside the
+/// range of the lobe variables and at least
+/// [`LOBE_REACH`] widths from every kink of the overlap length and every end of the range, on both axes.
+pub fn lobe_rule(lobes: &[Lobe], has_diffuse: bool, theta: f64, src: Stop, rec: Stop) -> Option<Rule> {
+    let [lobe] = lobes else { return None };
+    if has_diffuse || lobe.tail.is_heavy() {
+        return None;
+    }
+    let width = lobe_widths_uv(lobe, theta);
+    let clear = |a: AxisMap, w: f64| {
+        let [lo, hi] = a.range();
+        let kinks = [lo, hi, a.s[1] + a.r[0], a.s[0] + a.r[1]];
+        w > 0.0 && w.is_finite() && lo < 0.0 && hi > 0.0 && kinks.iter().all(|k| k.abs() >= LOBE_REACH * w)
+    };
+    let fits = clear(AxisMap { s: src.p, r: rec.p }, width[0]) && clear(AxisMap { s: src.q, r: rec.q }, width[1]);
+    fits.then_some(Rule::LobeGaussHermite { width, levels: (0, LOBE_LEVELS.len() - 1) })
+}
+
+/// The delta-limit rule of a lobe-chart part ([`Rule::LobeDelta`]), if the lobe fits [`lobe_rule`] (one
+/// Gaussian-tailed lobe, no diffuse term, ≥ [`LOBE_REACH`] widths from every overlap kink and range end on
+/// both axes) and is narrow enough that its majorant can meet the part's relative tolerance `rtol`: the
+/// relative correction of the delta limit is c·w² (w the larger lobe width in (u, v)), and the majorant was
+/// measured at 50–270·w² at 20°, 60°, E430 and ISO 13803 (≈ 1.8·10⁴·w² at 85°), so the rule is tried only
+/// when [`DELTA_GATE`]·w² ≤ rtol (otherwise its evaluations would be spent for nothing before the
+/// Gauss–Hermite rule). Whether the majorant meets the tolerance is decided when it runs, on the material.
+pub fn delta_rule(lobes: &[Lobe], has_diffuse: bool, theta: f64, src: Stop, rec: Stop, rtol: f64) -> Option<Rule> {
+    let Some(Rule::LobeGaussHermite { width, .. }) = lobe_rule(lobes, has_diffuse, theta, src, rec) else {
+        return None;
+    };
+    let w = width[0].max(width[1]);
+    (DELTA_GATE * w * w <= rtol).then_some(Rule::LobeDelta { width })
+}
+
+/// The smooth-integrand rule of a lobe-chart part without kinks, if it fits: [`Rule::TensorGauss`] in the
+/// variables (p_s, p_r, v, t_q) ([`TensorChart::PlainPLobeQ`]: plain in the plane of incidence, where the
+/// lobe is far wider than the stops, the lobe variable across it, where the ridge v = q_s + q_r becomes an
+/// axis) within the bounds of [`TENSOR_MIN_WIDTH`] (B4's GGX α = 0.3 at 85°: 0.6 wide in u against a u-range
+/// of 0.083, 0.052 in v against 0.15). The levels start at 1 (2 points) on every axis.
+pub fn smooth_rule(lobes: &[Lobe], theta: f64, src: Stop, rec: Stop) -> Option<Rule> {
+    let range = [(src.p[1] - src.p[0]) + (rec.p[1] - rec.p[0]), (src.q[1] - src.q[0]) + (rec.q[1] - rec.q[0])];
+    let fits = |l: &Lobe| {
+        let w = lobe_widths_uv(l, theta);
+        w.iter().all(|w| w.is_finite())
+            && w[0] >= TENSOR_MIN_WIDTH_U * range[0]
+            && (TENSOR_MIN_WIDTH * range[1]..=TENSOR_MAX_WIDTH_V * range[1]).contains(&w[1])
+    };
+    if lobes.is_empty() || !lobes.iter().all(fits) {
+        return None;
+    }
+    Some(Rule::TensorGauss { chart: TensorChart::PlainPLobeQ, levels: [1; 4], path: tensor::Path::default() })
+}
+
+/// The polar rule of a lobe-chart part, if one fits ([`Rule::LobePolar`]): a material whose regular part is
+/// one lobe with GGX's tail (`Tail::InverseQuartic`: not a lobe over a diffuse body; a Gaussian tail gets
+/// [`Rule::LobeGaussHermite`] or the partition; a measured table's lobe, `Tail::Table`, keeps the partition:
+/// the rule was measured on every shipped table and on MERL-format GGX tables and lost or fell back on each,
+/// because the table's interpolation kinks at its cells, not its tail, set the cost, see
+/// `docs/instrument.md` §Quadrature, *Measured tables*) whose centre u = v = 0 is inside the range of the lobe variables and at least
+/// [`POLAR_REACH`] widths from every kink of the overlap length and every end of the range, on both axes.
+pub fn polar_rule(lobes: &[Lobe], has_diffuse: bool, theta: f64, src: Stop, rec: Stop) -> Option<Rule> {
+    let [lobe] = lobes else { return None };
+    if has_diffuse || lobe.tail != Tail::InverseQuartic {
+        return None;
+    }
+    let width = lobe_widths_uv(lobe, theta);
+    let breaks = |a: AxisMap, w: f64| {
+        let [lo, hi] = a.range();
+        let mut b = [lo, a.s[1] + a.r[0], a.s[0] + a.r[1], hi];
+        b.sort_by(f64::total_cmp);
+        let clear = w > 0.0 && w.is_finite() && lo < 0.0 && hi > 0.0 && b.iter().all(|k| k.abs() >= POLAR_REACH * w);
+        clear.then_some(b)
+    };
+    let u = breaks(AxisMap { s: src.p, r: rec.p }, width[0])?;
+    let v = breaks(AxisMap { s: src.q, r: rec.q }, width[1])?;
+    Some(Rule::LobePolar { width, u, v, levels: [1; 9] })
+}
+
+/// The initial boxes of a lobe chart with `kinks` kinks: every box cut on t_p into kinks + 1 equal pieces
+/// (the pieces of `aperture::kinked_position`); the boxes unchanged without kinks.
+fn kinked_boxes(boxes: Vec<([f64; 4], [f64; 4])>, kinks: usize) -> Vec<([f64; 4], [f64; 4])> {
+    if kinks == 0 {
+        return boxes;
+    }
+    let m = (kinks + 1) as f64;
+    let mut out = Vec::with_capacity(boxes.len() * (kinks + 1));
+    for (lo, hi) in boxes {
+        for j in 0..=kinks {
+            let (mut a, mut b) = (lo, hi);
+            a[1] = j as f64 / m;
+            b[1] = (j + 1) as f64 / m;
+            out.push((a, b));
+        }
+    }
+    out
+}
+
+impl Method {
+    /// A rough estimate, before running, of the integrand evaluations this method will spend: for scheduling
+    /// only ([`Plan::run_all`](crate::instrument::plan::Plan::run_all) starts the integrals it expects to be
+    /// largest first, so that a batch ends with small integrals on every thread). It changes no result, and a
+    /// wrong guess only costs balance. An adaptive Genz–Malik part is guessed from its initial partition: the
+    /// rule's points per cell (57 in 4-D, 17 in 2-D) × cells × (1 + cells/8), the refinement growing with the
+    /// number of lobe splits (fitted by eye to the 1 400 integrals of the batch bench, where 1, 9, 18, 24 and 60
+    /// initial cells spent 1.1–2.4, 1.4–2.0, 1.9–4.5, 3.9–5.2 and 4.4 times their first pass; docs/performance.md
+    /// §Batch and sweep throughput); a frozen part costs exactly its partition; the shaped rules are guessed
+    /// from their first two levels (what they evaluate before they can first stop), doubled for one raise; a
+    /// sphere integral is a flat guess (4 096).
+    pub fn expected_evaluations(&self) -> f64 {
+        if self.integral != Integral::Aperture {
+            return 4096.0;
+        }
+        let genz_malik = |points: f64, cells: usize, refine: Refine| -> f64 {
+            let c = cells as f64;
+            points * c * if refine == Refine::Frozen { 1.0 } else { 1.0 + c / 8.0 }
+        };
+        let delta = self.delta.as_ref().map_or(0.0, |d| genz_malik(17.0, d.cells.len(), d.refine));
+        let regular = self.regular.as_ref().map_or(0.0, |r| match &r.rule {
+            Rule::GenzMalik75 => genz_malik(57.0, r.cells.len(), r.refine),
+            Rule::LobeDelta { .. } => DELTA_COST as f64,
+            Rule::LobeGaussHermite { levels, .. } => {
+                let points = |l: usize| {
+                    let (h, g) = LOBE_LEVELS[l.min(LOBE_LEVELS.len() - 1)];
+                    (h * h * g * g) as f64
+                };
+                2.0 * (points(levels.0) + points(levels.0 + 1))
+            }
+            Rule::LobePolar { u, v, levels, .. } => {
+                let mut sum = 0.0;
+                for i in 0..3 {
+                    for j in 0..3 {
+                        if !(u[i + 1] > u[i] && v[j + 1] > v[j]) {
+                            continue;
+                        }
+                        let central = u[i] < 0.0 && u[i + 1] > 0.0 && v[j] < 0.0 && v[j + 1] > 0.0;
+                        let points = |l: usize| -> f64 {
+                            if central {
+                                let (a, b, t) = POLAR_LEVELS[l.min(POLAR_LEVELS.len() - 1)];
+                                (4 * a * b * t * t) as f64
+                            } else {
+                                let (a, b, t) = TAIL_LEVELS[l.min(TAIL_LEVELS.len() - 1)];
+                                (a * b * t * t) as f64
+                            }
+                        };
+                        let l = (levels[3 * i + j] as usize).max(1);
+                        sum += points(l - 1) + points(l);
+                    }
+                }
+                2.0 * sum
+            }
+            Rule::TensorGauss { chart, levels, .. } => {
+                let boxes = self.clipped.map_or(1, |(s, r)| tensor_boxes(*chart, s, r).len()) as f64;
+                let points: usize = levels.iter().map(|&l| tensor::ORDERS[l.min(tensor::ORDERS.len() - 1)]).product();
+                2.0 * boxes * points as f64
+            }
+        });
+        delta + regular
+    }
+}

@@ -1,0 +1,388 @@
+//! Execution: [`Method::execute`] and its variants run a designed method on a material — the delta part on
+//! its partition, the regular part by its shaped rule (falling back to the Genz–Malik partition) — and return
+//! the [`Flux`]; with freezing, also the method with its final partitions. The regular part's integrand (the
+//! BRDF batch in the chart's variables, times the geometric factor and the weighting) is built here once
+//! per execution and handed to the rules of `delta.rs`, `gauss.rs` and `polar.rs`.
+use super::delta::lobe_delta;
+use super::gauss::{lobe_gauss_hermite, tensor_boxes, tensor_gauss, LOBE_LEVELS};
+use super::polar::lobe_polar;
+use super::{Flux, Method, Projection, RegularPart, Rule, TensorChart};
+use crate::brdf::Brdf;
+use crate::instrument::aperture::{half_angle_kink_point, incidence_kink_point, kinked_position, AxisMap, Chart};
+use crate::instrument::geometry::{solid_angle_density, Axes, Integral, Stop};
+use crate::instrument::sphere;
+use crate::quadrature::{integrate_partition, Estimate, Options, Refine, MAX_SHRINK, MAX_SHRINK_LOBE};
+use crate::spectrum::Weighting;
+use crate::Vec3;
+use std::time::Instant;
+
+/// The share of its wall-clock budget an integral gets when it starts at or after the deadline it shares
+/// with the other integrals of a plan ([`Method::execute_until`]). A plan of J integrals on T threads then
+/// ends within about max_seconds·(1 + ⌈J/T⌉·LATE_START_SHARE) of wall time: the default panel's 12
+/// specimen integrals on 2 threads, 1.3 × the budget.
+pub const LATE_START_SHARE: f64 = 0.05;
+
+impl Method {
+    /// Execute the method on `brdf` (whose sampling has as many samples as the weighting has columns).
+    pub fn execute(&self, brdf: &dyn Brdf) -> Flux {
+        self.run(brdf, false, None).0
+    }
+
+    /// [`Method::execute`] under a deadline shared with other integrals (`Plan::execute`): the integral stops
+    /// refining at that deadline, or [`LATE_START_SHARE`] of its own budget after it starts if that is
+    /// later (so an integral queued behind slow ones still gets a moment to converge), and never later than
+    /// its own budget.
+    pub fn execute_until(&self, brdf: &dyn Brdf, deadline: Option<Instant>) -> Flux {
+        self.run(brdf, false, deadline).0
+    }
+
+    /// Execute the method and return, with the flux, the frozen method: the same method with each part's
+    /// final partition and `Refine::Frozen`. Executing the frozen method on the same material gives the same
+    /// value and error bits; on a nearby material it gives a smooth function of the change.
+    pub fn execute_and_freeze(&self, brdf: &dyn Brdf) -> (Flux, Method) {
+        self.execute_and_freeze_until(brdf, None)
+    }
+
+    /// [`Method::execute_and_freeze`] with a shared deadline as in [`Method::execute_until`].
+    pub fn execute_and_freeze_until(&self, brdf: &dyn Brdf, deadline: Option<Instant>) -> (Flux, Method) {
+        let (flux, frozen) = self.run(brdf, true, deadline);
+        (flux, frozen.expect("kept"))
+    }
+
+    /// The number of components the regular part's integrand has per point (k weighted sums, or n samples
+    /// under [`Projection::Separate`]) and whether the material sums the one weighted component itself.
+    fn components(&self, brdf: &dyn Brdf) -> (usize, bool) {
+        let k = self.weighting.len();
+        let ncomp = match self.projection {
+            Projection::Fold | Projection::FoldInMaterial => k,
+            Projection::Separate => brdf.sampling().len(),
+        };
+        let in_material =
+            self.projection == Projection::FoldInMaterial && k == 1 && brdf.folds(&self.weighting.rows[0]);
+        (ncomp, in_material)
+    }
+
+    /// The integrand of the regular part `part` in the chart `vars` holds (the part's own, or a tensor rule's
+    /// while it runs): for each point of `pts`, `ncomp` values written to `out` — the weighted BRDF times
+    /// cos θi cos θo, the solid-angle densities of the two direction-cosine charts and the chart's Jacobian.
+    /// A point outside the overlap or below the horizon leaves its values as they were (the rules zero `out`).
+    fn regular_integrand<'a>(
+        &'a self,
+        brdf: &'a dyn Brdf,
+        part: &'a RegularPart,
+        (src, rec): (Stop, Stop),
+        (ncomp, in_material): (usize, bool),
+        vars: &'a std::cell::Cell<TensorChart>,
+    ) -> impl FnMut(&[[f64; 4]], &mut [f64]) + 'a {
+        let axes = Axes::new(self.theta);
+        let rec_axes = Axes::new(self.viewing);
+        let ap = AxisMap { s: src.p, r: rec.p };
+        let aq = AxisMap { s: src.q, r: rec.q };
+        let (weighting, projection) = (&self.weighting, self.projection);
+        let n = brdf.sampling().len();
+        let mut batch = PairBatch::default();
+        move |pts: &[[f64; 4]], out: &mut [f64]| {
+            batch.clear(pts.len());
+            for (i, x) in pts.iter().enumerate() {
+                let (ps, qs, pr, qr, jac) = if vars.get() == TensorChart::Plain {
+                    (x[0], x[1], x[2], x[3], 1.0)
+                } else if vars.get() == TensorChart::PlainPLobeQ {
+                    let (qs, qr, jq) = aq.at(x[2], x[3]);
+                    (x[0], qs, x[1], qr, jq)
+                } else if part.kinks.is_empty() {
+                    let (ps, pr, jp) = ap.at(x[0], x[1]);
+                    let (qs, qr, jq) = aq.at(x[2], x[3]);
+                    (ps, qs, pr, qr, jp * jq)
+                } else {
+                    let (qs, qr, jq) = aq.at(x[2], x[3]);
+                    let u = x[0];
+                    let (lo, hi) = ap.overlap(u);
+                    let (ps, jp) = kinked_position(x[1], lo, hi, part.kinks.len(), |k| {
+                        let c = part.kinks[k];
+                        half_angle_kink_point(&axes, 2.0 * c * c - 1.0, u, qs, qr, lo, hi)
+                    });
+                    (ps, qs, u - ps, qr, jp * jq)
+                };
+                if jac <= 0.0 {
+                    continue;
+                }
+                let wi = axes.source_dir(ps, qs);
+                let wo = rec_axes.receptor_dir(pr, qr);
+                if wi.z <= 0.0 || wo.z <= 0.0 {
+                    continue;
+                }
+                let g = wi.z * wo.z * solid_angle_density(ps, qs) * solid_angle_density(pr, qr) * jac;
+                batch.push(i, wi, wo, g);
+            }
+            batch.values.clear();
+            if in_material {
+                batch.values.resize(batch.wi.len(), 0.0);
+                brdf.eval_batch_folded(&weighting.rows[0], &batch.wi, &batch.wo, &mut batch.values);
+                for ((&i, &g), v) in batch.index.iter().zip(&batch.g).zip(&batch.values) {
+                    out[i] = v * g;
+                }
+                return;
+            }
+            batch.values.resize(batch.wi.len() * n, 0.0);
+            brdf.eval_batch(&batch.wi, &batch.wo, &mut batch.values);
+            for ((&i, &g), v) in batch.index.iter().zip(&batch.g).zip(batch.values.chunks_exact(n)) {
+                store(&mut out[i * ncomp..(i + 1) * ncomp], v, weighting, g, projection);
+            }
+        }
+    }
+
+    /// The regular part's integrand at points `pts` of its chart (u, t_p, v, t_q in the lobe chart; p_s, q_s,
+    /// p_r, q_r in the plain one): per point, the method's weighted components (or samples), exactly the
+    /// values its rules integrate. For checking a rule's assumptions against a denser sampling of the same
+    /// integrand (`tests/delta_limit.rs`); empty when there is no regular part or the stops are below the
+    /// horizon.
+    pub fn sample_regular(&self, brdf: &dyn Brdf, pts: &[[f64; 4]]) -> Vec<f64> {
+        let (Some(part), Some(stops), Integral::Aperture) = (&self.regular, self.clipped, self.integral) else {
+            return Vec::new();
+        };
+        let chart = if part.chart == Chart::Plain { TensorChart::Plain } else { TensorChart::Lobe };
+        let vars = std::cell::Cell::new(chart);
+        let comps = self.components(brdf);
+        let mut out = vec![0.0; pts.len() * comps.0];
+        self.regular_integrand(brdf, part, stops, comps, &vars)(pts, &mut out);
+        out
+    }
+
+    fn run(&self, brdf: &dyn Brdf, keep: bool, shared: Option<Instant>) -> (Flux, Option<Method>) {
+        let start = Instant::now();
+        let after = |s: f64| start + std::time::Duration::from_secs_f64(s);
+        let deadline = match (self.max_seconds, shared) {
+            (Some(s), Some(d)) => Some(after(s).min(d.max(after(LATE_START_SHARE * s)))),
+            (Some(s), None) => Some(after(s)),
+            (None, d) => d,
+        };
+        let k = self.weighting.len();
+        let n = brdf.sampling().len();
+        let mut frozen = keep.then(|| self.clone());
+        if self.integral != Integral::Aperture {
+            // A sphere's integrals: per sample, then weighted (their integrators have no partition to freeze,
+            // so the frozen method is the method).
+            let r = match self.integral {
+                Integral::Hemisphere => sphere::hemisphere_reflectance(brdf, self.theta),
+                Integral::Port { half_angle } => {
+                    sphere::port_reflectance(brdf, self.theta, half_angle, self.rtol, self.max_evals)
+                }
+                Integral::Aperture => unreachable!("handled below"),
+            };
+            let mut flux = Flux::zero(k);
+            flux.regular = self.weighting.apply(&r.value);
+            flux.error = (0..k).map(|c| self.weighting.component_error(c, &r.error)).collect();
+            flux.value = flux.regular.clone();
+            flux.evaluations = r.evaluations;
+            flux.converged = r.converged;
+            flux.seconds = start.elapsed().as_secs_f64();
+            return (flux, frozen);
+        }
+        let Some((src, rec)) = self.clipped else {
+            return (Flux::zero(k), frozen);
+        };
+        let axes = Axes::new(self.theta);
+        // The material sums the one weighted component itself when `in_material`.
+        let (ncomp, in_material) = self.components(brdf);
+        let weighting = &self.weighting;
+        let projection = self.projection;
+        // The k weighted components of an estimate, and their error bounds.
+        let weighted = |e: &Estimate| -> (Vec<f64>, Vec<f64>) {
+            match projection {
+                Projection::Fold | Projection::FoldInMaterial => (e.value.clone(), e.error.clone()),
+                Projection::Separate => (
+                    (0..k).map(|c| weighting.component(c, &e.value)).collect(),
+                    (0..k).map(|c| weighting.component_error(c, &e.error)).collect(),
+                ),
+            }
+        };
+        let mut flux = Flux::zero(k);
+        let smooth = brdf.smooth();
+
+        // 1. The delta part: source points whose mirror (−p, −q) lies in the receptor.
+        if let Some(part) = &self.delta {
+            let mut scratch = vec![0.0; n];
+            let (lo, hi) = self.mirror.expect("a delta part has a mirror overlap");
+            let (p_lo, p_hi) = (lo[0], hi[0]);
+            let (est, cells) = integrate_partition::<2, _>(
+                |pts, out| {
+                    for (x, o) in pts.iter().zip(out.chunks_exact_mut(ncomp)) {
+                        let (p, q, jac) = if part.kinks.is_empty() {
+                            (x[0], x[1], 1.0)
+                        } else {
+                            let (p, jac) = kinked_position(x[0], p_lo, p_hi, part.kinks.len(), |k| {
+                                incidence_kink_point(&axes, part.kinks[k], x[1], p_lo, p_hi)
+                            });
+                            (p, x[1], jac)
+                        };
+                        if jac <= 0.0 {
+                            continue;
+                        }
+                        let wi = axes.source_dir(p, q);
+                        if wi.z <= 0.0 || !brdf.delta_reflectance(wi, &mut scratch) {
+                            continue;
+                        }
+                        store(o, &scratch, weighting, wi.z * solid_angle_density(p, q) * jac, projection);
+                    }
+                },
+                ncomp,
+                &part.cells,
+                &Options {
+                    rtol: part.rtol,
+                    atol: part.atol,
+                    max_evals: self.max_evals,
+                    deadline,
+                    checked: smooth,
+                    ..Default::default()
+                },
+                part.refine,
+                keep,
+            );
+            (flux.delta, flux.error) = weighted(&est);
+            flux.evaluations += est.evaluations;
+            flux.regions += est.regions;
+            flux.converged &= est.converged;
+            flux.out_of_time |= est.out_of_time;
+            if let Some(m) = frozen.as_mut() {
+                let p = m.delta.as_mut().expect("the same parts");
+                p.cells = cells;
+                p.refine = Refine::Frozen;
+            }
+        }
+
+        // 2. The regular part, in its chart.
+        if let Some(part) = &self.regular {
+            // The chart the integrand is evaluated in: the part's, or the shaped rule's while it runs.
+            let part_vars = if part.chart == Chart::Plain { TensorChart::Plain } else { TensorChart::Lobe };
+            let vars = std::cell::Cell::new(part_vars);
+            let delta_min = flux.delta.iter().map(|d| d.abs()).fold(f64::INFINITY, f64::min);
+            let atol = part.atol.max(part.rtol * delta_min);
+            let mut integrand = self.regular_integrand(brdf, part, (src, rec), (ncomp, in_material), &vars);
+            // A smooth material's region estimates are trusted further (`docs/accuracy.md` §5): checked
+            // children, and on the lobe chart (whose boxes are cut to the lobe's widths and kinks) a deeper
+            // shrink.
+            let max_shrink = if smooth && part.chart == Chart::Lobe { MAX_SHRINK_LOBE } else { MAX_SHRINK };
+            let opts =
+                Options { rtol: part.rtol, atol, max_evals: self.max_evals, deadline, max_shrink, checked: smooth };
+            // A shaped rule first (when the planner chose one), the Genz–Malik partition if it does not agree.
+            let mut spent = 0;
+            let shaped = match part.rule {
+                Rule::LobeGaussHermite { width, levels } => {
+                    let r = lobe_gauss_hermite(&mut integrand, ncomp, width, levels, &opts, part.refine);
+                    spent = r.1;
+                    r.0.map(|(est, level)| (est, Rule::LobeGaussHermite { width, levels: (level - 1, level) }))
+                }
+                Rule::LobeDelta { width } => {
+                    let (est, n) = lobe_delta(&mut integrand, ncomp, width, &opts);
+                    spent = n;
+                    match est {
+                        Some(est) if est.converged || part.refine == Refine::Frozen => {
+                            Some((est, Rule::LobeDelta { width }))
+                        }
+                        _ => {
+                            // The majorant did not meet the tolerance: the lobe's Gauss–Hermite rule.
+                            let levels = (0, LOBE_LEVELS.len() - 1);
+                            let r = lobe_gauss_hermite(&mut integrand, ncomp, width, levels, &opts, part.refine);
+                            spent += r.1;
+                            r.0.map(|(est, level)| (est, Rule::LobeGaussHermite { width, levels: (level - 1, level) }))
+                        }
+                    }
+                }
+                Rule::LobePolar { width, u, v, levels } => {
+                    let r = lobe_polar(&mut integrand, ncomp, width, [u, v], levels, &opts, part.refine);
+                    spent = r.1;
+                    r.0.map(|(est, levels)| (est, Rule::LobePolar { width, u, v, levels }))
+                }
+                Rule::TensorGauss { chart, levels, path } => {
+                    vars.set(chart);
+                    let replay = (part.refine == Refine::Frozen).then_some(path);
+                    let boxes = tensor_boxes(chart, src, rec);
+                    let r = tensor_gauss(&mut integrand, ncomp, chart, boxes, levels, &opts, replay);
+                    vars.set(part_vars);
+                    spent = r.1;
+                    r.0
+                }
+                Rule::GenzMalik75 => None,
+            };
+            let (mut est, cells, rule) = match shaped {
+                Some((est, rule)) => (est, part.cells.clone(), rule),
+                None => {
+                    let (est, cells) =
+                        integrate_partition::<4, _>(&mut integrand, ncomp, &part.cells, &opts, part.refine, keep);
+                    (est, cells, Rule::GenzMalik75)
+                }
+            };
+            est.evaluations += spent;
+            let (regular, regular_err) = weighted(&est);
+            flux.regular = regular;
+            flux.error = flux.error.iter().zip(&regular_err).map(|(a, b)| a + b).collect();
+            flux.evaluations += est.evaluations;
+            flux.regions += est.regions;
+            flux.converged &= est.converged;
+            flux.out_of_time |= est.out_of_time;
+            flux.chart = Some(match rule {
+                Rule::TensorGauss { chart: TensorChart::Plain, .. } => Chart::Plain,
+                Rule::TensorGauss { .. } => Chart::Lobe,
+                _ => part.chart,
+            });
+            if let Some(m) = frozen.as_mut() {
+                let p = m.regular.as_mut().expect("the same parts");
+                p.cells = cells;
+                p.rule = rule;
+                p.refine = Refine::Frozen;
+            }
+        }
+        flux.value = flux.delta.iter().zip(&flux.regular).map(|(a, b)| a + b).collect();
+        flux.seconds = start.elapsed().as_secs_f64();
+        (flux, frozen)
+    }
+}
+
+/// The direction pairs of one batch above the horizon, with the point index and geometric factor of each.
+#[derive(Default)]
+struct PairBatch {
+    index: Vec<usize>,
+    wi: Vec<Vec3>,
+    wo: Vec<Vec3>,
+    g: Vec<f64>,
+    values: Vec<f64>,
+}
+
+impl PairBatch {
+    /// Empty, with room for `m` pairs (so the hot loop never grows a vector).
+    fn clear(&mut self, m: usize) {
+        self.index.clear();
+        self.wi.clear();
+        self.wo.clear();
+        self.g.clear();
+        self.index.reserve(m);
+        self.wi.reserve(m);
+        self.wo.reserve(m);
+        self.g.reserve(m);
+    }
+
+    fn push(&mut self, i: usize, wi: Vec3, wo: Vec3, g: f64) {
+        self.index.push(i);
+        self.wi.push(wi);
+        self.wo.push(wo);
+        self.g.push(g);
+    }
+}
+
+/// Write the integrand at one point: the per-sample values times the geometric factor `g`, either one
+/// component per sample ([`Projection::Separate`]) or the k weighted sums Σ_j W\[c\]\[j\] f_j·g (Fold).
+#[inline]
+fn store(out: &mut [f64], values: &[f64], weighting: &Weighting, g: f64, projection: Projection) {
+    match projection {
+        Projection::Separate => {
+            for (o, v) in out.iter_mut().zip(values) {
+                *o = v * g;
+            }
+        }
+        Projection::Fold | Projection::FoldInMaterial => {
+            for (c, o) in out.iter_mut().enumerate() {
+                *o = weighting.component(c, values) * g;
+            }
+        }
+    }
+}

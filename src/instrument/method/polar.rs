@@ -1,0 +1,213 @@
+//! [`Rule::LobePolar`]: a lobe with GGX's heavy tail, its (u, v) range cut at the overlap kinks into up to
+//! 3 × 3 pieces — the one that holds the lobe centre in polar variables, the others in tail variables — each
+//! raised level by level ([`POLAR_LEVELS`], [`TAIL_LEVELS`]) where the error is largest.
+#[cfg(doc)]
+use super::Rule;
+use crate::quadrature::{
+    legendre_on_into, mapped_legendre_into, polar_rectangle_into, Estimate, Map, Options, PolarBuffers, Refine,
+};
+
+/// The (φ nodes per sector, β nodes, t nodes per axis) of the polar piece of [`Rule::LobePolar`], level by
+/// level: 4·3·6·2² = 288 points, then 512, 1 152, 4 608, 18 432, 51 200.
+pub const POLAR_LEVELS: [(usize, usize, usize); 6] =
+    [(3, 6, 2), (4, 8, 2), (6, 12, 2), (8, 16, 3), (12, 24, 4), (16, 32, 5)];
+
+/// The (tail-axis nodes, cross-axis nodes, t nodes per axis) of a tail piece of [`Rule::LobePolar`], level by
+/// level: 3·3·2² = 36 points, then 64, 144, 576, 2 304, 6 400.
+pub const TAIL_LEVELS: [(usize, usize, usize); 6] =
+    [(3, 3, 2), (4, 4, 2), (6, 6, 2), (8, 8, 3), (12, 12, 4), (16, 16, 5)];
+
+/// One piece of [`Rule::LobePolar`]: its u and v intervals, whether it holds the lobe centre (the polar
+/// piece), its level and its sums at that level and the one below.
+struct PolarPiece {
+    index: usize,
+    interval: [[f64; 2]; 2],
+    central: bool,
+    level: usize,
+    below: Vec<f64>,
+    at: Vec<f64>,
+}
+
+/// The buffers [`Rule::LobePolar`] works in, made once per execution and reused level after level (issue 10
+/// item 4: nothing in the hot path allocates; they only grow, to the largest level reached).
+#[derive(Default)]
+struct PolarScratch {
+    /// (x, y, weight) in the scaled lobe variables.
+    plane: Vec<(f64, f64, f64)>,
+    rect: Vec<([f64; 2], f64)>,
+    buffers: PolarBuffers,
+    outer: (Vec<f64>, Vec<f64>),
+    inner: (Vec<f64>, Vec<f64>),
+    t: (Vec<f64>, Vec<f64>),
+    pts: Vec<[f64; 4]>,
+    wts: Vec<f64>,
+    vals: Vec<f64>,
+}
+
+/// The points of a piece of [`Rule::LobePolar`] at one level, in the lobe chart's variables (u, t_p, v, t_q),
+/// with their weights, in a fixed order, into `s.pts` and `s.wts`.
+fn polar_piece_points(width: [f64; 2], interval: [[f64; 2]; 2], central: bool, level: usize, s: &mut PolarScratch) {
+    let [w0, w1] = width;
+    let scaled = [[interval[0][0] / w0, interval[0][1] / w0], [interval[1][0] / w1, interval[1][1] / w1]];
+    // (x, y, weight) in the scaled lobe variables x = u/w_u, y = v/w_v.
+    s.plane.clear();
+    let nt = if central {
+        let (nphi, nr, nt) = POLAR_LEVELS[level];
+        let lo = [scaled[0][0], scaled[1][0]];
+        let hi = [scaled[0][1], scaled[1][1]];
+        polar_rectangle_into(lo, hi, nphi, nr, Map::Tan { scale: 1.0 }, &mut s.buffers, &mut s.rect);
+        s.plane.extend(s.rect.iter().map(|&([x, y], w)| (x, y, w)));
+        nt
+    } else {
+        // The tail coordinate is the axis whose interval does not hold 0 (the first when neither does): σ = 1/x
+        // along it; across it the kernel 1/(c² + y²)² (c² = 1 + x²) in y = c·tan γ.
+        let (no, ni, nt) = TAIL_LEVELS[level];
+        let outer = if scaled[0][0] < 0.0 && scaled[0][1] > 0.0 { 1 } else { 0 };
+        let inner = 1 - outer;
+        let (xo, wo) = &mut s.outer;
+        mapped_legendre_into(no, scaled[outer][0], scaled[outer][1], Map::Reciprocal, xo, wo);
+        let (y, wy) = &mut s.inner;
+        for (x, wx) in xo.iter().zip(wo.iter()) {
+            let map = Map::Tan { scale: (1.0 + x * x).sqrt() };
+            mapped_legendre_into(ni, scaled[inner][0], scaled[inner][1], map, y, wy);
+            for (y, wy) in y.iter().zip(wy.iter()) {
+                s.plane.push(if outer == 0 { (*x, *y, wx * wy) } else { (*y, *x, wx * wy) });
+            }
+        }
+        nt
+    };
+    let (tl, wl) = &mut s.t;
+    legendre_on_into(nt, 0.0, 1.0, tl, wl);
+    s.pts.clear();
+    s.wts.clear();
+    for &(x, y, w) in &s.plane {
+        for (tp, wp) in tl.iter().zip(wl.iter()) {
+            for (tq, wq) in tl.iter().zip(wl.iter()) {
+                s.pts.push([w0 * x, *tp, w1 * y, *tq]);
+                s.wts.push(w * w0 * w1 * wp * wq);
+            }
+        }
+    }
+}
+
+/// The sum of the points in `s` per component into `sum` (non-finite values count as 0, as in
+/// `gauss::lobe_tensor_sum`).
+fn polar_piece_sum(f: &mut impl FnMut(&[[f64; 4]], &mut [f64]), ncomp: usize, s: &mut PolarScratch, sum: &mut [f64]) {
+    s.vals.clear();
+    s.vals.resize(s.pts.len() * ncomp, 0.0);
+    f(&s.pts, &mut s.vals);
+    sum.iter_mut().for_each(|x| *x = 0.0);
+    for (w, v) in s.wts.iter().zip(s.vals.chunks_exact(ncomp)) {
+        for c in 0..ncomp {
+            if v[c].is_finite() {
+                sum[c] += w * v[c];
+            }
+        }
+    }
+}
+
+/// Run [`Rule::LobePolar`]: every piece at its level and the one below; while the summed differences exceed
+/// max(atol, rtol·|I|) in some component, the piece with the largest difference (relative to that tolerance;
+/// the first on ties) goes one level up (adaptive; a frozen rule keeps its levels). Returns the estimate and
+/// the pieces' levels when the sum meets the tolerance, None when the piece to raise has no level left or the
+/// budget would be exceeded, and the evaluations spent either way. Its buffers are made once here (per
+/// piece and per execution, not per level).
+pub(super) fn lobe_polar(
+    f: &mut impl FnMut(&[[f64; 4]], &mut [f64]),
+    ncomp: usize,
+    width: [f64; 2],
+    breaks: [[f64; 4]; 2],
+    levels: [u8; 9],
+    opts: &Options,
+    refine: Refine,
+) -> (Option<(Estimate, [u8; 9])>, usize) {
+    let mut evals = 0;
+    let mut pieces = Vec::with_capacity(9);
+    for i in 0..3 {
+        for j in 0..3 {
+            let interval = [[breaks[0][i], breaks[0][i + 1]], [breaks[1][j], breaks[1][j + 1]]];
+            if !(interval[0][1] > interval[0][0] && interval[1][1] > interval[1][0]) {
+                continue;
+            }
+            let holds = |a: [f64; 2]| a[0] < 0.0 && a[1] > 0.0;
+            let central = holds(interval[0]) && holds(interval[1]);
+            let top = if central { POLAR_LEVELS.len() } else { TAIL_LEVELS.len() } - 1;
+            let level = (levels[3 * i + j] as usize).clamp(1, top);
+            let (below, at) = (vec![0.0; ncomp], vec![0.0; ncomp]);
+            pieces.push(PolarPiece { index: 3 * i + j, interval, central, level, below, at });
+        }
+    }
+    let mut scratch = PolarScratch::default();
+    // The sums of one piece at one level into `sum`; false when the budget would be exceeded.
+    let mut run = |p: &PolarPiece, level: usize, evals: &mut usize, sum: &mut [f64]| -> bool {
+        polar_piece_points(width, p.interval, p.central, level, &mut scratch);
+        if *evals + scratch.pts.len() > opts.max_evals {
+            return false;
+        }
+        *evals += scratch.pts.len();
+        polar_piece_sum(f, ncomp, &mut scratch, sum);
+        true
+    };
+    for p in &mut pieces {
+        let mut below = std::mem::take(&mut p.below);
+        let mut at = std::mem::take(&mut p.at);
+        if !run(p, p.level - 1, &mut evals, &mut below) || !run(p, p.level, &mut evals, &mut at) {
+            return (None, evals);
+        }
+        p.below = below;
+        p.at = at;
+    }
+    let (mut value, mut error, mut tol) = (vec![0.0; ncomp], vec![0.0; ncomp], vec![0.0; ncomp]);
+    loop {
+        for c in 0..ncomp {
+            value[c] = pieces.iter().map(|p| p.at[c]).sum();
+            error[c] = pieces.iter().map(|p| (p.at[c] - p.below[c]).abs()).sum();
+            tol[c] = opts.atol.max(opts.rtol * value[c].abs());
+        }
+        let converged = error.iter().zip(&tol).all(|(e, t)| e <= t);
+        if converged || refine == Refine::Frozen {
+            let mut reached = [1u8; 9];
+            for p in &pieces {
+                reached[p.index] = p.level as u8;
+            }
+            let regions = pieces.len();
+            let est = Estimate { value, error, evaluations: 0, regions, converged, out_of_time: false };
+            return (Some((est, reached)), evals);
+        }
+        let excess = |p: &PolarPiece| {
+            (0..ncomp)
+                .map(|c| {
+                    let e = (p.at[c] - p.below[c]).abs();
+                    if tol[c] > 0.0 {
+                        e / tol[c]
+                    } else if e > 0.0 {
+                        f64::INFINITY
+                    } else {
+                        0.0
+                    }
+                })
+                .fold(0.0, f64::max)
+        };
+        let mut worst = 0;
+        for k in 1..pieces.len() {
+            if excess(&pieces[k]) > excess(&pieces[worst]) {
+                worst = k;
+            }
+        }
+        let top = if pieces[worst].central { POLAR_LEVELS.len() } else { TAIL_LEVELS.len() } - 1;
+        if pieces[worst].level >= top {
+            return (None, evals);
+        }
+        let level = pieces[worst].level + 1;
+        // The level below becomes the old level: its buffer is reused for the new sums.
+        let p = &mut pieces[worst];
+        std::mem::swap(&mut p.below, &mut p.at);
+        let mut at = std::mem::take(&mut p.at);
+        if !run(&pieces[worst], level, &mut evals, &mut at) {
+            return (None, evals);
+        }
+        let p = &mut pieces[worst];
+        p.at = at;
+        p.level = level;
+    }
+}
