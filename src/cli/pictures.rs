@@ -10,10 +10,10 @@ use serde_json::Value;
 
 use super::plot::plot_err;
 use crate::brdf::{mirror, Brdf};
+use crate::colorimetry::weighting::Weighting;
 use crate::comparison::Comparison;
 use crate::instrument::plan::{Plan, PlanOptions};
 use crate::instrument::standards::StandardGeometry;
-use crate::spectrum::Weighting;
 use crate::{recipe, Error, Result, Vec3};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]

@@ -9,7 +9,7 @@
 //! reading Y = 100), L*, a*, b*, C*ab and hab. What they integrate:
 //!
 //! * **Directional** (`kind: "directional"`): the aperture integral of gloss, Φ_c = ∫_source ∫_receptor
-//!   Σ_k W_ck f_k cos θi cos θo dωi dωo with the X, Y, Z rows of the weighting (`spectrum::WeightingKind::Xyz`),
+//!   Σ_k W_ck f_k cos θi cos θo dωi dωo with the X, Y, Z rows of the weighting (`colorimetry::weighting::WeightingKind::Xyz`),
 //!   the receptor lens on its own axis at θv = θi − aspecular (signed, positive on the specular side). The
 //!   receptor must not see the mirror image of the source (checked here), so the method has no delta part and
 //!   uses the plain chart. X = Φ_X / Φ_PRD with Φ_PRD = P_s P_r / π the perfect diffuser's flux (projected

@@ -7,8 +7,8 @@
 //! is the direction normalize(axis + p·e∥ + q·e⊥) with e⊥ = (0, 1, 0), e∥ = e⊥ × axis, and solid-angle
 //! element dω = dp dq / (1 + p² + q²)^{3/2}. The mirror image of source point (p, q) is receptor point
 //! (−p, −q), so the specular manifold is p_s + p_r = 0, q_s + q_r = 0.
+use crate::colorimetry::weighting::WeightingKind;
 use crate::colorimetry::Conditions;
-use crate::spectrum::WeightingKind;
 use crate::Vec3;
 
 /// A rectangular field stop in tangent coordinates: p ∈ [p0, p1] in the plane of measurement (positive p
@@ -200,7 +200,7 @@ impl ReadingSpec {
 
     /// The spectral weighting the reading's fluxes need: gloss, haze and DOI are luminous (ISO 2813 and
     /// ASTM D523 weight the flux by V(λ) under CIE illuminant C); a colour reading needs X, Y, Z under the
-    /// plan's colour conditions (`spectrum::WeightingKind::Xyz`).
+    /// plan's colour conditions (`colorimetry::weighting::WeightingKind::Xyz`).
     pub fn weighting(&self, colour: Conditions) -> WeightingKind {
         match self {
             ReadingSpec::Colour { .. } => WeightingKind::Xyz(colour),

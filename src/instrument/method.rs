@@ -17,6 +17,7 @@
 //! one quantity formed at run time (the smallest |Φ_δ| component, which keeps every component within its
 //! tolerance).
 use crate::brdf::{Brdf, Kink, Lobe, Tail, TermKind};
+use crate::colorimetry::weighting::Weighting;
 use crate::instrument::flux::{
     choose_chart, clip, delta_kinks, half_angle_kink_point, incidence_kink_point, kinked_position, lobe_boxes,
     lobe_splits, lobe_widths_uv, mirror_overlap, regular_kinks, AxisMap, Chart, Flux, DELTA_SHARE,
@@ -27,7 +28,6 @@ use crate::quadrature::{
     gauss_hermite_table, gauss_legendre_table, integrate_partition, legendre_on_into, mapped_legendre_into,
     polar_rectangle_into, tensor, Cell, Estimate, Map, Options, PolarBuffers, Refine, MAX_SHRINK, MAX_SHRINK_LOBE,
 };
-use crate::spectrum::Weighting;
 use crate::Vec3;
 use std::time::Instant;
 

@@ -27,6 +27,7 @@ use std::sync::{Arc, Mutex, OnceLock, PoisonError};
 use rayon::prelude::*;
 
 use crate::brdf::{Brdf, Lobe, Tail, Term, TermKind};
+use crate::colorimetry::weighting::{Weighting, WeightingKind};
 use crate::colorimetry::{cielab, Conditions};
 use crate::instrument::flux::{lobe_widths_uv, Chart, Flux, DELTA_SHARE};
 use crate::instrument::geometry::{ColourQuantity, Integral, ReadingSpec, Scale, Stop};
@@ -37,7 +38,7 @@ use crate::instrument::method::{
 };
 use crate::instrument::standards::{self, StandardGeometry};
 use crate::quadrature::{tensor, Refine};
-use crate::spectrum::{Sampling, Weighting, WeightingKind};
+use crate::spectrum::Sampling;
 use crate::{Error, Result};
 
 /// Share of a reading's relative tolerance given to each specimen flux and to the gloss standard's flux. A
