@@ -1,7 +1,7 @@
 //! Input files (recipes, geometry files, sheets) read as text with a size limit. It exists so that a file
 //! that is not a recipe at all (`/dev/zero`, a multi-gigabyte log given by mistake) is refused with a clear
 //! message instead of being read until memory runs out. (MERL tables are binary and checked against their
-//! own header in `brdf::measured`.)
+//! own header in `measured::merl`.)
 use std::io::Read;
 use std::path::Path;
 
