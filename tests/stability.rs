@@ -605,7 +605,7 @@ fn dir(theta_deg: f64) -> Vec3 {
 
 /// The recipe as a `Paint` (to reach R_l and r_i), through the same parser as `parse_str`.
 fn paint_of(v: &Value) -> glossmeter::brdf::paint::Paint {
-    let obj = glossmeter::recipe::fields::Obj::new("<stability>", "", v).unwrap();
+    let obj = glossmeter::input::json::Obj::new("<stability>", "", v).unwrap();
     glossmeter::brdf::paint::Paint::new(glossmeter::recipe::paint::parse_paint_spec(&obj).unwrap()).unwrap()
 }
 

@@ -18,10 +18,10 @@
 //!   specular port (SCE), relative to the perfect diffuser under full-hemisphere illumination (Φ_PRD = 1).
 use std::f64::consts::PI;
 
+use crate::input::json::{parse_json, Obj};
 use crate::instrument::geometry::{ColourQuantity, Geometry, Integral, ReadingSpec, Scale, Stop};
 use crate::instrument::reference::projected_solid_angle;
 use crate::instrument::standards::{aperture, header, sourced, Range, StandardGeometry};
-use crate::recipe::fields::{parse_json, Obj};
 use crate::{Error, Result, Vec3};
 
 /// Every shipped colour geometry: (file name, text).

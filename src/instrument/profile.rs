@@ -14,10 +14,10 @@
 use std::sync::Arc;
 
 use crate::brdf::Brdf;
+use crate::input::json::Obj;
 use crate::instrument::geometry::{ReadingSpec, Stop};
 use crate::instrument::plan::{Plan, PlanOptions, Reading};
 use crate::instrument::standards::{sourced, Range, StandardGeometry};
-use crate::recipe::fields::Obj;
 use crate::Result;
 
 /// The largest pixel count a profile may have (a guard against a typo's hours of work: 65 536 aperture

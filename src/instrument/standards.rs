@@ -5,8 +5,8 @@
 //! Every number in a geometry file carries its provenance:
 //! `{"value": 1.8, "source": "…citation or reason…", "status": "verified" | "secondary" | "assumed"}`.
 //! Errors name the file, the field path and what is allowed.
+use crate::input::json::{kind, parse_json, Obj};
 use crate::instrument::geometry::{Geometry, ReadingSpec, Scale, Stop};
-use crate::recipe::fields::{kind, parse_json, Obj};
 use crate::{Error, Result};
 use serde_json::Value;
 use std::collections::HashSet;
