@@ -21,7 +21,8 @@ use std::f64::consts::PI;
 use crate::input::json::{parse_json, Obj};
 use crate::instrument::geometry::{ColourQuantity, Geometry, Integral, ReadingSpec, Scale, Stop};
 use crate::instrument::reference::projected_solid_angle;
-use crate::instrument::standards::{aperture, header, sourced, Range, StandardGeometry};
+use crate::instrument::standards::{aperture, header, sourced, StandardGeometry};
+use crate::registry::Range;
 use crate::{Error, Result, Vec3};
 
 /// Every shipped colour geometry: (file name, text).
@@ -94,11 +95,11 @@ pub fn parse(text: &str, origin: &str) -> Result<StandardGeometry> {
     let (geometry, reading_names) = match o.str("kind")? {
         "directional" => {
             o.deny_unknown(&allowed(&["illumination_deg", "aspecular_deg", "source", "receptor"]))?;
-            let ill = sourced(&o, "illumination_deg", Range::Open(0.0, 90.0), "the illumination angle in degrees")?;
+            let ill = sourced(&o, "illumination_deg", Range::open(0.0, 90.0), "the illumination angle in degrees")?;
             let asp = sourced(
                 &o,
                 "aspecular_deg",
-                Range::Closed(-90.0, 180.0),
+                Range::closed(-90.0, 180.0),
                 "the aspecular angle in degrees (positive towards the illuminator)",
             )?;
             let view = ill - asp;
@@ -154,7 +155,7 @@ pub fn parse(text: &str, origin: &str) -> Result<StandardGeometry> {
         }
         "sphere" => {
             o.deny_unknown(&allowed(&["viewing_deg", "specular", "specular_port_half_angle_deg"]))?;
-            let view = sourced(&o, "viewing_deg", Range::Closed(0.0, 60.0), "the viewing angle in degrees")?;
+            let view = sourced(&o, "viewing_deg", Range::closed(0.0, 60.0), "the viewing angle in degrees")?;
             let port = match o.str("specular")? {
                 "included" => {
                     if o.get("specular_port_half_angle_deg").is_some() {
@@ -169,7 +170,7 @@ pub fn parse(text: &str, origin: &str) -> Result<StandardGeometry> {
                     let b = sourced(
                         &o,
                         "specular_port_half_angle_deg",
-                        Range::Open(0.0, 30.0),
+                        Range::open(0.0, 30.0),
                         "the half-angle of the specular port in degrees",
                     )?;
                     if view + b >= 90.0 {

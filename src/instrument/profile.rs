@@ -17,7 +17,8 @@ use crate::brdf::Brdf;
 use crate::input::json::Obj;
 use crate::instrument::geometry::{ReadingSpec, Stop};
 use crate::instrument::plan::{Plan, PlanOptions, Reading};
-use crate::instrument::standards::{sourced, Range, StandardGeometry};
+use crate::instrument::standards::{sourced, StandardGeometry};
+use crate::registry::Range;
 use crate::Result;
 
 /// The largest pixel count a profile may have (a guard against a typo's hours of work: 65 536 aperture
@@ -66,12 +67,12 @@ impl ProfileSpec {
 /// must stay above the specimen plane.
 pub fn parse_spec(o: &Obj, angle_deg: f64) -> Result<ProfileSpec> {
     o.deny_unknown(&["pixels", "pixel_deg", "perpendicular_deg", "notes"])?;
-    let n = sourced(o, "pixels", Range::Closed(1.0, MAX_PIXELS as f64), "the number of pixels of the profile array")?;
+    let n = sourced(o, "pixels", Range::closed(1.0, MAX_PIXELS as f64), "the number of pixels of the profile array")?;
     if n.fract() != 0.0 {
         return Err(o.obj("pixels")?.err("value", format!("{n} is not a whole number of pixels")));
     }
-    let w = sourced(o, "pixel_deg", Range::Open(0.0, 5.0), "the in-plane size of one pixel in degrees")?;
-    let h = sourced(o, "perpendicular_deg", Range::Open(0.0, 20.0), "the height of the pixels in degrees")?;
+    let w = sourced(o, "pixel_deg", Range::open(0.0, 5.0), "the in-plane size of one pixel in degrees")?;
+    let h = sourced(o, "perpendicular_deg", Range::open(0.0, 20.0), "the height of the pixels in degrees")?;
     let half = 0.5 * n * w;
     if angle_deg + half >= 90.0 || half > 45.0 {
         return Err(o.obj("pixels")?.err(

@@ -7,6 +7,7 @@
 //! Errors name the file, the field path and what is allowed.
 use crate::input::json::{kind, parse_json, Obj};
 use crate::instrument::geometry::{Geometry, ReadingSpec, Scale, Stop};
+use crate::registry::Range;
 use crate::{Error, Result};
 use serde_json::Value;
 use std::collections::HashSet;
@@ -69,7 +70,7 @@ pub const SCALE_KINDS: &[&str] = &["black-glass", "mirror"];
 /// `{"kind": "mirror", "assigned_gu": {…}}`, each number sourced. A file that gives only the older top-level
 /// `reference_index` is on the black-glass scale with that glass assigned 100 GU (as D523).
 fn scale(o: &Obj) -> Result<Scale> {
-    let index_range = Range::Closed(1.3, 2.0);
+    let index_range = Range::closed(1.3, 2.0);
     let index_what = "the refractive index of the black-glass gloss standard";
     match (o.get("scale").is_some(), o.get("reference_index").is_some()) {
         (true, true) => Err(o.err(
@@ -90,12 +91,12 @@ fn scale(o: &Obj) -> Result<Scale> {
                 "black-glass" => {
                     s.deny_unknown(&["kind", "reference_index", "assigned_gu", "notes"])?;
                     let index = sourced(&s, "reference_index", index_range, index_what)?;
-                    let value = sourced(&s, "assigned_gu", Range::Open(0.0, 1e4), value_what)?;
+                    let value = sourced(&s, "assigned_gu", Range::open(0.0, 1e4), value_what)?;
                     Ok(Scale::BlackGlass { index, value })
                 }
                 "mirror" => {
                     s.deny_unknown(&["kind", "assigned_gu", "notes"])?;
-                    let value = sourced(&s, "assigned_gu", Range::Open(0.0, 1e4), value_what)?;
+                    let value = sourced(&s, "assigned_gu", Range::open(0.0, 1e4), value_what)?;
                     Ok(Scale::Mirror { value })
                 }
                 other => {
@@ -279,7 +280,7 @@ pub fn parse(text: &str, origin: &str) -> Result<StandardGeometry> {
         }
         (0.0, Scale::Mirror { value: 100.0 }, Stop { p: [0.0, 0.0], q: [0.0, 0.0] }, Vec::new())
     } else {
-        let angle = sourced(&o, "angle_deg", Range::Open(0.0, 90.0), "the angle of incidence in degrees")?;
+        let angle = sourced(&o, "angle_deg", Range::open(0.0, 90.0), "the angle of incidence in degrees")?;
         let n = scale(&o)?;
         let src = o.obj("source")?;
         let (s_in, s_perp) = aperture(&src, &["shape", "in_plane_deg", "perpendicular_deg"])?;
@@ -312,7 +313,7 @@ pub fn parse(text: &str, origin: &str) -> Result<StandardGeometry> {
             let off = sourced(
                 &r,
                 "offset_deg",
-                Range::Closed(-45.0, 45.0),
+                Range::closed(-45.0, 45.0),
                 "the in-plane offset of the stop centre from the specular axis in degrees (positive towards grazing)",
             )?;
             let top = angle + off + 0.5 * r_in;
@@ -361,28 +362,18 @@ pub fn parse(text: &str, origin: &str) -> Result<StandardGeometry> {
     Ok(StandardGeometry { geometry, reading_names, spec: Arc::new(spec), origin: origin.to_string() })
 }
 
-/// Allowed range of a sourced number.
-#[derive(Clone, Copy)]
-pub(crate) enum Range {
-    /// lo < x < hi
-    Open(f64, f64),
-    /// lo ≤ x ≤ hi
-    Closed(f64, f64),
-}
-
-/// The value of a `{"value", "source", "status"}` object at `o.key`, with its provenance checked.
+/// The value of a `{"value", "source", "status"}` object at `o.key`, with its provenance checked. The value
+/// must lie in `range` (finite ends): outside [lo, hi] it gets the message of `Obj::num`, at an open end this
+/// one ("must be > lo and < hi").
 pub(crate) fn sourced(o: &Obj, key: &str, range: Range, what: &str) -> Result<f64> {
     let s = o.obj(key)?;
     s.deny_unknown(&["value", "source", "status", "tolerance", "plausible"])?;
     check_variation(&s)?;
-    let (lo, hi) = match range {
-        Range::Open(lo, hi) | Range::Closed(lo, hi) => (lo, hi),
-    };
+    let (lo, hi) = (range.lo, range.hi);
     let value = s.num("value", lo, hi, what)?;
-    if let Range::Open(lo, hi) = range {
-        if value <= lo || value >= hi {
-            return Err(s.err("value", format!("{value} is out of range: {what} must be > {lo} and < {hi}")));
-        }
+    if !range.contains(value) {
+        let (above, below) = (if range.lo_closed { "≥" } else { ">" }, if range.hi_closed { "≤" } else { "<" });
+        return Err(s.err("value", format!("{value} is out of range: {what} must be {above} {lo} and {below} {hi}")));
     }
     let source = s.str("source")?;
     if source.trim().is_empty() {
@@ -444,8 +435,8 @@ pub(crate) fn aperture(o: &Obj, allowed: &[&str]) -> Result<(f64, f64)> {
     }
     o.deny_unknown(allowed)?;
     let what = "a full aperture angle in degrees";
-    let a = sourced(o, "in_plane_deg", Range::Open(0.0, 20.0), what)?;
-    let b = sourced(o, "perpendicular_deg", Range::Open(0.0, 20.0), what)?;
+    let a = sourced(o, "in_plane_deg", Range::open(0.0, 20.0), what)?;
+    let b = sourced(o, "perpendicular_deg", Range::open(0.0, 20.0), what)?;
     Ok((a, b))
 }
 
@@ -593,7 +584,7 @@ fn reading(
         "log-haze" => ReadingSpec::LogHaze {
             receptors: receptor_list(r, "receptors", names)?,
             specular: receptor_ref(r, "specular", names)?,
-            k: sourced(r, "k", Range::Open(0.0, 1e6), "the log-haze scale factor K")?,
+            k: sourced(r, "k", Range::open(0.0, 1e6), "the log-haze scale factor K")?,
         },
         "haze-compensated" | "log-haze-compensated" => {
             let receptors = receptor_list(r, "receptors", names)?;
@@ -603,7 +594,7 @@ fn reading(
             if q == "haze-compensated" {
                 ReadingSpec::HazeCompensated { receptors, specular, compensation, factor }
             } else {
-                let k = sourced(r, "k", Range::Open(0.0, 1e6), "the log-haze scale factor K")?;
+                let k = sourced(r, "k", Range::open(0.0, 1e6), "the log-haze scale factor K")?;
                 ReadingSpec::LogHazeCompensated { receptors, specular, compensation, factor, k }
             }
         }
