@@ -16,9 +16,10 @@ use std::sync::Arc;
 
 use glossmeter::brdf::albedo::directional_albedo;
 use glossmeter::brdf::{Brdf, TermKind};
-use glossmeter::instrument::geometry::{Geometry, ReadingSpec, Scale, Stop};
+use glossmeter::instrument::geometry::{Geometry, Stop};
 use glossmeter::instrument::method::Method;
 use glossmeter::instrument::plan::{Plan, PlanOptions, Reading};
+use glossmeter::instrument::reading::{ReadingSpec, Scale};
 use glossmeter::instrument::standards::{self, StandardGeometry};
 use glossmeter::optics::microfacet::Microfacet;
 use glossmeter::optics::thin_film::{stack, FilmLayer};

@@ -19,7 +19,8 @@
 use std::f64::consts::PI;
 
 use crate::input::json::{parse_json, Obj};
-use crate::instrument::geometry::{ColourQuantity, Geometry, Integral, ReadingSpec, Scale, Stop};
+use crate::instrument::geometry::{Geometry, Integral, Stop};
+use crate::instrument::reading::{ColourQuantity, ReadingSpec, Scale};
 use crate::instrument::reference::projected_solid_angle;
 use crate::instrument::standards::{aperture, header, sourced, StandardGeometry};
 use crate::registry::Range;

@@ -37,10 +37,10 @@ use std::time::Instant;
 
 use crate::brdf::{Brdf, TermKind};
 use crate::colorimetry::weighting::Weighting;
-use crate::instrument::geometry::ReadingSpec;
 use crate::instrument::plan::{
     haze_index_value, reading_value, Job, Plan, PlanOptions, PlannedReading, Reading, Target, MIN_RTOL,
 };
+use crate::instrument::reading::ReadingSpec;
 use crate::instrument::reference::{lambertian_flux_reference, mirror_flux_reference};
 use crate::instrument::standards::StandardGeometry;
 use crate::{Error, Result, Vec3};

@@ -1,6 +1,7 @@
 //! The virtual instrument: what a glossmeter, haze meter or DOI meter would read on a BRDF.
 //!
-//! `geometry` states the instrument model (axes, field stops, tangent coordinates); `standards` holds the
+//! `geometry` states the instrument model (axes, field stops, tangent coordinates); `reading` what a geometry
+//! reads (the reading specs and the scale they are on); `standards` holds the
 //! shipped geometries as data with the provenance of every number; `flux` answers questions about one
 //! aperture integral (charts, split points, clipping, mirror overlap) and holds its result; `method` is
 //! one integral designed as plain data, and its executor; `plan` compiles (material, geometries) into the
@@ -15,6 +16,7 @@ pub mod geometry;
 pub mod method;
 pub mod plan;
 pub mod profile;
+pub mod reading;
 pub mod reference;
 pub mod sheet;
 pub mod sphere;

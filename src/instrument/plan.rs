@@ -30,12 +30,13 @@ use crate::brdf::{Brdf, Lobe, Tail, Term, TermKind};
 use crate::colorimetry::weighting::{Weighting, WeightingKind};
 use crate::colorimetry::{cielab, Conditions};
 use crate::instrument::flux::{lobe_widths_uv, Chart, Flux, DELTA_SHARE};
-use crate::instrument::geometry::{ColourQuantity, Integral, ReadingSpec, Scale, Stop};
+use crate::instrument::geometry::{Integral, Stop};
 pub use crate::instrument::method::Target;
 use crate::instrument::method::{
     Design, Method, Projection, Rule, TensorChart, DELTA_FIT_RADIUS, DELTA_RADII, DELTA_RADIUS, DELTA_SAFETY,
     DELTA_TAIL_SAFETY, DELTA_T_ORDERS, LOBE_LEVELS, LOBE_REACH, POLAR_LEVELS, POLAR_REACH, TENSOR_MAX_LEVEL,
 };
+use crate::instrument::reading::{ColourQuantity, ReadingSpec, Scale};
 use crate::instrument::standards::{self, StandardGeometry};
 use crate::quadrature::{tensor, Refine};
 use crate::spectrum::Sampling;

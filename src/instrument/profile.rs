@@ -15,8 +15,9 @@ use std::sync::Arc;
 
 use crate::brdf::Brdf;
 use crate::input::json::Obj;
-use crate::instrument::geometry::{ReadingSpec, Stop};
+use crate::instrument::geometry::Stop;
 use crate::instrument::plan::{Plan, PlanOptions, Reading};
+use crate::instrument::reading::ReadingSpec;
 use crate::instrument::standards::{sourced, StandardGeometry};
 use crate::registry::Range;
 use crate::Result;

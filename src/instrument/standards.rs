@@ -6,7 +6,8 @@
 //! `{"value": 1.8, "source": "…citation or reason…", "status": "verified" | "secondary" | "assumed"}`.
 //! Errors name the file, the field path and what is allowed.
 use crate::input::json::{kind, parse_json, Obj};
-use crate::instrument::geometry::{Geometry, ReadingSpec, Scale, Stop};
+use crate::instrument::geometry::{Geometry, Stop};
+use crate::instrument::reading::{ReadingSpec, Scale};
 use crate::registry::Range;
 use crate::{Error, Result};
 use serde_json::Value;
