@@ -8,7 +8,6 @@
 //! cheapest set of methods and combines their fluxes into readings; `reference` gives independent closed forms to check them against; `convergence` measures
 //! error against run time; `sheet` reads real instruments' readings for comparison. The contract is
 //! written out in `docs/instrument.md`.
-pub mod colour;
 pub mod convergence;
 pub mod envelope;
 pub mod flux;

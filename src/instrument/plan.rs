@@ -273,7 +273,6 @@ impl Planner {
     /// a builtin file that does not parse is this error rather than a missing geometry later.
     pub fn new() -> Result<Planner> {
         standards::builtin_static()?;
-        crate::instrument::colour::builtin_static()?;
         Ok(Planner { builtin: std::sync::OnceLock::new(), standards: Mutex::new(HashMap::new()) })
     }
 
@@ -1467,8 +1466,7 @@ mod tests {
         let p = Planner::new().unwrap();
         let ids: Vec<String> = p.builtin().unwrap().iter().map(|g| g.geometry.id.clone()).collect();
         let gloss: Vec<String> = standards::builtin().unwrap().into_iter().map(|g| g.geometry.id).collect();
-        let colour: Vec<String> =
-            crate::instrument::colour::builtin().unwrap().into_iter().map(|g| g.geometry.id).collect();
+        let colour: Vec<String> = standards::builtin_colour().unwrap().into_iter().map(|g| g.geometry.id).collect();
         assert!(!colour.is_empty() && !gloss.is_empty());
         assert_eq!(ids, [gloss, colour].concat());
         assert_eq!(p.builtin().unwrap().len(), ids.len(), "the second call borrows the same list");

@@ -16,8 +16,9 @@ pub enum ReadingSpec {
     LogHaze { receptors: Vec<String>, specular: String, k: f64 },
     /// Brightness-compensated haze, HU: 100·(mean_r Φ(specimen, r) − factor·Φ(specimen, compensation)) /
     /// Φ(standard, `specular`). `factor` = mean_r Ω⊥(r) / Ω⊥(compensation), the ratio of the receptors'
-    /// projected solid angles ([`Stop::projected_solid_angle`](crate::instrument::geometry::Stop::projected_solid_angle)), is what makes a Lambertian body read 0
-    /// (`docs/instrument.md` §1.7).
+    /// projected solid angles
+    /// ([`Stop::projected_solid_angle`](crate::instrument::geometry::Stop::projected_solid_angle)), is what
+    /// makes a Lambertian body read 0 (`docs/instrument.md` §1.7).
     HazeCompensated { receptors: Vec<String>, specular: String, compensation: String, factor: f64 },
     /// Logarithmic compensated haze: k·log10(H_c/20 + 1) of the compensated linear haze H_c above.
     LogHazeCompensated { receptors: Vec<String>, specular: String, compensation: String, factor: f64, k: f64 },
