@@ -333,7 +333,8 @@ impl<'a> Plain<'a> {
     fn new(c: &'a Case) -> Self {
         let b: &dyn Brdf = c.brdf.as_ref();
         let weights =
-            glossmeter::spectrum::Weighting::luminous(b.sampling()).expect("luminous weighting").rows[0].clone();
+            glossmeter::colorimetry::weighting::Weighting::luminous(b.sampling()).expect("luminous weighting").rows[0]
+                .clone();
         Plain { brdf: b, axes: Axes::new(c.theta), scratch: vec![0.0; weights.len()], weights }
     }
     #[inline]

@@ -600,7 +600,7 @@ fn check_free(recipe: &Value, free: &[FreeParameter]) -> Result<Vec<f64>> {
             Error::Usage(format!(
                 "{arg}: the value at {} is {}, not a number; address one number (e.g. {}/0)",
                 p.pointer,
-                recipe::fields::kind(v),
+                crate::input::json::kind(v),
                 p.pointer
             ))
         })?;

@@ -40,7 +40,9 @@ pub const MODELS: &[&str] = &[
     "e1392",
 ];
 
-/// An interval of allowed values; either end open or closed. An infinite end is always open.
+/// An interval of allowed values; either end open or closed. An infinite end is always open. The crate's one
+/// interval type: the range of a registry entry here, and that of a geometry file's sourced numbers
+/// (`instrument::standards`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Range {
     pub lo: f64,
@@ -53,6 +55,10 @@ impl Range {
     /// [lo, hi].
     pub const fn closed(lo: f64, hi: f64) -> Range {
         Range { lo, lo_closed: true, hi, hi_closed: true }
+    }
+    /// (lo, hi).
+    pub const fn open(lo: f64, hi: f64) -> Range {
+        Range { lo, lo_closed: false, hi, hi_closed: false }
     }
     /// [lo, ∞).
     pub const fn at_least(lo: f64) -> Range {
@@ -1102,6 +1108,8 @@ mod tests {
         assert_eq!(Range::above(0.0).describe(), "> 0");
         assert!(!Range::above(0.0).contains(0.0) && Range::above(0.0).contains(1e-300));
         assert!(!Range::closed(0.0, 1.0).contains(f64::NAN));
+        assert_eq!(Range::open(0.0, 90.0).describe(), "in (0, 90)");
+        assert!(!Range::open(0.0, 90.0).contains(0.0) && !Range::open(0.0, 90.0).contains(90.0));
         let half = Range { lo: 0.0, lo_closed: false, hi: 1.0, hi_closed: true };
         assert_eq!(half.describe(), "in (0, 1]");
         assert_eq!(short_number(1e-6), "1e-6");

@@ -6,8 +6,8 @@ use std::sync::Arc;
 
 use glossmeter::brdf::Brdf;
 use glossmeter::colorimetry::{Conditions, Illuminant, Observer};
-use glossmeter::instrument::colour::{self, ColourKind};
 use glossmeter::instrument::plan::{Plan, PlanOptions, Reading};
+use glossmeter::instrument::standards::colour::{self, ColourKind};
 use glossmeter::instrument::standards::{self, StandardGeometry};
 use glossmeter::recipe;
 use serde_json::Value;

@@ -6,8 +6,9 @@
 //! * a glossy lobe on a black body keeps its compensated haze within 1 % of its raw one;
 //! * the log form is K·log10(H_c/20 + 1) of the linear one;
 //! * a compensation receptor that overlaps the specular (or a haze) receptor is refused, naming file and field.
-use glossmeter::instrument::geometry::{solid_angle_density, Axes, ReadingSpec, Stop};
+use glossmeter::instrument::geometry::{solid_angle_density, Axes, Stop};
 use glossmeter::instrument::plan::{PlanOptions, Reading};
+use glossmeter::instrument::reading::ReadingSpec;
 use glossmeter::instrument::standards;
 use glossmeter::{api, recipe, Error};
 

@@ -7,9 +7,9 @@ use std::path::Path;
 use std::sync::Arc;
 
 use glossmeter::brdf::Brdf;
+use glossmeter::colorimetry::weighting::Weighting;
 use glossmeter::instrument::plan::{Plan, PlanOptions};
 use glossmeter::instrument::standards;
-use glossmeter::spectrum::Weighting;
 use glossmeter::Vec3;
 use serde_json::Value;
 

@@ -190,7 +190,7 @@ fn haze_index_alone_or_first_is_g60_minus_g20() {
 fn d2457_45_reads_on_the_mirror_scale() {
     let id = "astm-d2457-45";
     let g = geometry(id);
-    assert_eq!(g.scale, glossmeter::instrument::geometry::Scale::Mirror { value: 1000.0 });
+    assert_eq!(g.scale, glossmeter::instrument::reading::Scale::Mirror { value: 1000.0 });
     let r = gloss_of(Arc::new(TestMirror(Some(1.54), Sampling::grey())), id, 1e-9);
     let v = r.value.unwrap();
     assert!((v - 55.9).abs() <= 0.1, "n = 1.540 glass reads {v} at 45°, want 55.9 ± 0.1");

@@ -5,10 +5,10 @@
 // Channels index several parallel arrays (values, scales, expected values) at once.
 #![allow(clippy::needless_range_loop)]
 
-use glossmeter::brdf::measured::{fold_phi_d, half_diff, Interpolation, MerlBrdf, MERL_DIMS, MERL_SCALE};
 use glossmeter::brdf::{Brdf, TermKind};
 use glossmeter::instrument::plan::{Plan, PlanOptions};
 use glossmeter::instrument::standards;
+use glossmeter::measured::merl::{fold_phi_d, half_diff, Interpolation, MerlBrdf, MERL_DIMS, MERL_SCALE};
 use glossmeter::recipe;
 use glossmeter::Vec3;
 use std::f64::consts::{FRAC_PI_2, PI};

@@ -9,9 +9,9 @@ use glossmeter::brdf::paint::{
     Pigment, PigmentedLayer, Spread, MAX_SAMPLES,
 };
 use glossmeter::brdf::{Brdf, TermKind};
+use glossmeter::input::json::{parse_json, Obj};
 use glossmeter::optics::microfacet::Distribution;
 use glossmeter::optics::thin_film::{stack, FilmLayer};
-use glossmeter::recipe::fields::{parse_json, Obj};
 use glossmeter::recipe::paint::parse_paint;
 use glossmeter::spectrum::Sampling;
 use glossmeter::Vec3;

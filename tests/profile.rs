@@ -72,7 +72,7 @@ fn rspec20() -> standards::StandardGeometry {
 
 #[test]
 fn the_shipped_array_is_512_pixels_of_0_02832_degrees_about_the_specular_direction() {
-    let p = profile::of(&rspec20()).unwrap();
+    let p = standards::profile::of(&rspec20()).unwrap();
     assert_eq!(p.pixels, 512);
     assert_eq!(p.pixel_deg, 0.02832);
     // Centres at ±255.5 pixels, edges at ±256 pixels = ±7.24992°.
@@ -88,7 +88,7 @@ fn the_shipped_array_is_512_pixels_of_0_02832_degrees_about_the_specular_directi
 #[test]
 fn a_smooth_dielectric_profile_is_each_pixels_share_of_the_mirror_image() {
     let g = rspec20();
-    let spec = profile::of(&g).unwrap();
+    let spec = standards::profile::of(&g).unwrap();
     let geo = &g.geometry;
     let reference = Stop::from_angles(spec.pixel, spec.perpendicular, 0.0);
     let standard = mirror_flux(geo.theta, geo.source, reference, 1.567);
@@ -122,7 +122,7 @@ fn a_lambertian_profile_is_its_closed_form_pixel_by_pixel() {
     // (ρ/π)·Ω⊥(pixel)·P_source, Ω⊥ and P_source by the closed-form projected solid angle of a stop
     // (the source lens is the receptor's mirror: its cos θ is (cos θ + p sin θ)/√…, i.e. the formula at −θ).
     let g = rspec20();
-    let spec = profile::of(&g).unwrap();
+    let spec = standards::profile::of(&g).unwrap();
     let geo = &g.geometry;
     let reference = Stop::from_angles(spec.pixel, spec.perpendicular, 0.0);
     let standard = mirror_flux(geo.theta, geo.source, reference, 1.567);

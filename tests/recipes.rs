@@ -32,7 +32,7 @@ fn every_fixture_loads() {
         assert!(!m.name.is_empty());
         assert_eq!(
             m.brdf.sampling().len(),
-            glossmeter::spectrum::Weighting::luminous(m.brdf.sampling()).unwrap().rows[0].len()
+            glossmeter::colorimetry::weighting::Weighting::luminous(m.brdf.sampling()).unwrap().rows[0].len()
         );
     }
 }

@@ -16,9 +16,10 @@ use std::sync::Arc;
 
 use glossmeter::brdf::albedo::directional_albedo;
 use glossmeter::brdf::{Brdf, TermKind};
-use glossmeter::instrument::geometry::{Geometry, ReadingSpec, Scale, Stop};
+use glossmeter::instrument::geometry::{Geometry, Stop};
 use glossmeter::instrument::method::Method;
 use glossmeter::instrument::plan::{Plan, PlanOptions, Reading};
+use glossmeter::instrument::reading::{ReadingSpec, Scale};
 use glossmeter::instrument::standards::{self, StandardGeometry};
 use glossmeter::optics::microfacet::Microfacet;
 use glossmeter::optics::thin_film::{stack, FilmLayer};
@@ -605,7 +606,7 @@ fn dir(theta_deg: f64) -> Vec3 {
 
 /// The recipe as a `Paint` (to reach R_l and r_i), through the same parser as `parse_str`.
 fn paint_of(v: &Value) -> glossmeter::brdf::paint::Paint {
-    let obj = glossmeter::recipe::fields::Obj::new("<stability>", "", v).unwrap();
+    let obj = glossmeter::input::json::Obj::new("<stability>", "", v).unwrap();
     glossmeter::brdf::paint::Paint::new(glossmeter::recipe::paint::parse_paint_spec(&obj).unwrap()).unwrap()
 }
 

@@ -1,6 +1,7 @@
 //! The standards as data: every builtin loads, ids and key numbers are as documented, stops match an
 //! independent closed form, user geometry files load, and bad files are refused with file + field.
-use glossmeter::instrument::geometry::{ReadingSpec, Scale, Stop};
+use glossmeter::instrument::geometry::Stop;
+use glossmeter::instrument::reading::{ReadingSpec, Scale};
 use glossmeter::instrument::standards::{self, BUILTIN};
 use glossmeter::Error;
 use std::collections::BTreeSet;

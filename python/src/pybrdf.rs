@@ -11,9 +11,10 @@
 use std::sync::Mutex;
 
 use glossmeter::brdf::{Brdf, Lobe, Tail, Term, TermKind};
+use glossmeter::colorimetry::weighting::Weighting;
 use glossmeter::instrument::plan::{Plan, PlanOptions, Target};
 use glossmeter::recipe::Material;
-use glossmeter::spectrum::{Sampling, Weighting};
+use glossmeter::spectrum::Sampling;
 use glossmeter::Vec3;
 use numpy::{PyArray1, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyTypeError, PyValueError};

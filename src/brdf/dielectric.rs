@@ -65,7 +65,7 @@ fn describe_iors(ior: &[Ior]) -> String {
 /// An ideally smooth, opaque (black-backed) dielectric: a delta reflection of weight gain·F(cos θi, n).
 ///
 /// The one smooth-dielectric type: a specimen (`"model": "smooth-dielectric"`, gain 1) and every gloss
-/// standard (`instrument::geometry::Scale::standard`): polished black glass of the scale's index with gain
+/// standard (`instrument::reading::Scale::standard`): polished black glass of the scale's index with gain
 /// 100/V when the scale assigns it V GU (gain 1 for the usual 100 GU, so that standard is the specimen of the
 /// same index to the bit), or the perfect mirror of the mirror scale, n = ∞ (the n → ∞ limit of Fresnel,
 /// R = 1 at every angle) with gain 100/V.

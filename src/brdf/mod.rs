@@ -17,7 +17,6 @@ pub mod albedo;
 pub mod conductor;
 pub mod dielectric;
 pub mod lambert;
-pub mod measured;
 pub mod multilobe;
 pub mod paint;
 pub mod phong;

@@ -21,6 +21,7 @@
 //! the Smith height-correlated masking-shadowing function. The alternative `Form::PaperEq1` evaluates Eq. (1)
 //! as printed, for comparison only.
 use super::{Brdf, Lobe, Term, TermKind};
+use crate::colorimetry::weighting::Weighting;
 use crate::optics::coat_albedo::{CoatAlbedo, OutOfTable, ALPHA_BREAKS, ETA_MAX, ETA_MIN};
 use crate::optics::fresnel::{fr_conductor, fr_dielectric, fresnel_dielectric, refract_into};
 use crate::optics::kubelka_munk::{self, Layer};
@@ -29,7 +30,7 @@ use crate::optics::tabulated::{basis, dot, ChebTable};
 use crate::optics::thin_film::{stack, FilmLayer};
 use crate::quadrature::gauss_legendre;
 use crate::registry::{self as reg, Param, Range};
-use crate::spectrum::{Sampling, Weighting};
+use crate::spectrum::Sampling;
 use crate::{Error, Result, Vec3};
 use num_complex::Complex64;
 use std::f64::consts::PI;

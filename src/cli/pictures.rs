@@ -10,10 +10,10 @@ use serde_json::Value;
 
 use super::plot::plot_err;
 use crate::brdf::{mirror, Brdf};
+use crate::colorimetry::weighting::Weighting;
 use crate::comparison::Comparison;
 use crate::instrument::plan::{Plan, PlanOptions};
 use crate::instrument::standards::StandardGeometry;
-use crate::spectrum::Weighting;
 use crate::{recipe, Error, Result, Vec3};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -80,14 +80,14 @@ pub fn run(a: PlotArgs) -> Result<()> {
             }
             let file = a.recipe.display().to_string();
             let text = std::fs::read_to_string(&a.recipe).map_err(|source| Error::Io { file: file.clone(), source })?;
-            let json: Value = recipe::fields::parse_json(&text, &file)?;
+            let json: Value = crate::input::json::parse_json(&text, &file)?;
             match json.pointer(&pointer) {
                 Some(Value::Number(_)) => {}
                 Some(v) => {
                     return Err(Error::input(
                         &file,
                         &pointer,
-                        format!("--vary needs a number here, got {}", recipe::fields::kind(v)),
+                        format!("--vary needs a number here, got {}", crate::input::json::kind(v)),
                     ))
                 }
                 None => return Err(Error::input(&file, &pointer, "--vary: no such field in the recipe")),

@@ -67,7 +67,7 @@ pub fn run(args: ProfileArgs) -> Result<()> {
         None => crate::instrument::standards::find(args.geometry.as_deref().unwrap_or(DEFAULT_GEOMETRY))?,
     };
     // Checked before any work: the geometry must have a profile array.
-    profile::of(&g)?;
+    crate::instrument::standards::profile::of(&g)?;
     let options = PlanOptions { rtol: args.rtol, ..PlanOptions::default() };
     let prof = profile::measure(material.brdf.clone(), &g, options)?;
     let text = match args.format {

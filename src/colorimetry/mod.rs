@@ -25,10 +25,14 @@
 //!
 //! Tables: `standards/cie/*.csv`, each with its source in its header, exported by `tools/export_cie_tables.py`
 //! from colour-science 0.4.7 (the independent reference; tested against its `sd_to_XYZ` and `XYZ_to_Lab`).
+//!
+//! Files: `cielab.rs` (X, Y, Z to CIELAB, LCh and CIEDE2000) and `weighting.rs` (the matrix a reading takes from
+//! the spectral samples: luminous, one component per sample, or X, Y, Z through [`weights`]).
 use crate::spectrum::{interp, parse_columns, parse_table, Sampling, SamplingKind};
 use crate::{Error, Result};
 
 pub mod cielab;
+pub mod weighting;
 
 pub use cielab::{ciede2000, lab_to_lch, xyz_to_lab, Lab, Lch};
 

@@ -36,13 +36,13 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use crate::brdf::{Brdf, TermKind};
-use crate::instrument::geometry::ReadingSpec;
+use crate::colorimetry::weighting::Weighting;
 use crate::instrument::plan::{
     haze_index_value, reading_value, Job, Plan, PlanOptions, PlannedReading, Reading, Target, MIN_RTOL,
 };
+use crate::instrument::reading::ReadingSpec;
 use crate::instrument::reference::{lambertian_flux_reference, mirror_flux_reference};
 use crate::instrument::standards::StandardGeometry;
-use crate::spectrum::Weighting;
 use crate::{Error, Result, Vec3};
 
 /// The default sweep: 1e-2, 1e-3, …, 1e-10.

@@ -3,123 +3,22 @@
 //! gloss and haze, and a profile says *where* near the specular direction a material scatters, which a few
 //! fixed receptors cannot.
 //!
-//! The array is data: a geometry file's `profile` block (`standards/rspec-20.json`) gives the number of pixels,
-//! the in-plane size of one pixel and their height, each sourced. The pixels sit side by side on the receptor
-//! lens, centred on the specular direction: pixel k (0-based, of N) is centred at (k − (N − 1)/2)·w in plane.
-//! Each pixel is an aperture integral through the geometry's source stop, like any receptor
-//! (`instrument::plan`), and reads [`ReadingSpec::Profile`]: 100·Φ(specimen, pixel) / Φ(standard, a
-//! pixel-sized window centred on the specular direction), so the black-glass standard reads 100 in every
-//! pixel that lies inside its source image, and a smooth specimen reads its 20° gloss there
+//! The array is data (`instrument::standards::profile`): a geometry file's `profile` block
+//! (`standards/rspec-20.json`) gives the number of pixels, the in-plane size of one pixel and their height, each
+//! sourced. The pixels sit side by side on the receptor lens, centred on the specular direction: pixel k
+//! (0-based, of N) is centred at (k − (N − 1)/2)·w in plane. Each pixel is an aperture integral through the
+//! geometry's source stop, like any receptor (`instrument::plan`), and reads
+//! [`ReadingSpec::Profile`](crate::instrument::reading::ReadingSpec::Profile): 100·Φ(specimen, pixel) /
+//! Φ(standard, a pixel-sized window centred on the specular direction), so the black-glass standard reads 100 in
+//! every pixel that lies inside its source image, and a smooth specimen reads its 20° gloss there
 //! (`docs/instrument.md` §1.8).
 use std::sync::Arc;
 
 use crate::brdf::Brdf;
-use crate::instrument::geometry::{ReadingSpec, Stop};
 use crate::instrument::plan::{Plan, PlanOptions, Reading};
-use crate::instrument::standards::{sourced, Range, StandardGeometry};
-use crate::recipe::fields::Obj;
+use crate::instrument::standards::profile::{geometry, of, ProfileSpec};
+use crate::instrument::standards::StandardGeometry;
 use crate::Result;
-
-/// The largest pixel count a profile may have (a guard against a typo's hours of work: 65 536 aperture
-/// integrals).
-pub const MAX_PIXELS: usize = 65_536;
-
-/// The name of the normalising window (a pixel-sized stop centred on the specular direction).
-pub const REFERENCE: &str = "profile-reference";
-
-/// A profile array, compiled: pixel count, pixel size and height (radians).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ProfileSpec {
-    pub pixels: usize,
-    /// In-plane size of one pixel, radians.
-    pub pixel: f64,
-    /// Height of the pixels (perpendicular to the plane of measurement), radians.
-    pub perpendicular: f64,
-    /// In-plane size of one pixel, degrees, as given.
-    pub pixel_deg: f64,
-}
-
-impl ProfileSpec {
-    /// The in-plane centre of pixel k from the specular direction, degrees: (k − (N − 1)/2)·w.
-    pub fn centre_deg(&self, k: usize) -> f64 {
-        (k as f64 - 0.5 * (self.pixels as f64 - 1.0)) * self.pixel_deg
-    }
-
-    /// The in-plane centre of pixel k from the specular direction, radians.
-    pub fn centre(&self, k: usize) -> f64 {
-        self.centre_deg(k).to_radians()
-    }
-
-    /// The stop of pixel k on the receptor lens.
-    pub fn stop(&self, k: usize) -> Stop {
-        Stop::from_angles(self.pixel, self.perpendicular, self.centre(k))
-    }
-
-    /// The name of pixel k (and of its reading): `pixel-0000` … (four digits at least, sorted as numbers).
-    pub fn name(&self, k: usize) -> String {
-        format!("pixel-{k:04}")
-    }
-}
-
-/// Parse a `profile` block (`o` is the block) of a geometry of angle `angle_deg`: `pixels` (an integer ≥ 1),
-/// `pixel_deg` and `perpendicular_deg`, each `{"value", "source", "status"}`, and optional `notes`. The array
-/// must stay above the specimen plane.
-pub fn parse_spec(o: &Obj, angle_deg: f64) -> Result<ProfileSpec> {
-    o.deny_unknown(&["pixels", "pixel_deg", "perpendicular_deg", "notes"])?;
-    let n = sourced(o, "pixels", Range::Closed(1.0, MAX_PIXELS as f64), "the number of pixels of the profile array")?;
-    if n.fract() != 0.0 {
-        return Err(o.obj("pixels")?.err("value", format!("{n} is not a whole number of pixels")));
-    }
-    let w = sourced(o, "pixel_deg", Range::Open(0.0, 5.0), "the in-plane size of one pixel in degrees")?;
-    let h = sourced(o, "perpendicular_deg", Range::Open(0.0, 20.0), "the height of the pixels in degrees")?;
-    let half = 0.5 * n * w;
-    if angle_deg + half >= 90.0 || half > 45.0 {
-        return Err(o.obj("pixels")?.err(
-            "value",
-            format!(
-                "{n} pixels of {w}° span ±{half:.4}° about the specular direction: the array must stay within ±45° \
-                 and above the specimen plane (angle + half-span < 90°)"
-            ),
-        ));
-    }
-    Ok(ProfileSpec { pixels: n as usize, pixel: w.to_radians(), perpendicular: h.to_radians(), pixel_deg: w })
-}
-
-/// The profile array of a geometry (its `profile` block); a geometry without one is an error naming its file.
-pub fn of(g: &StandardGeometry) -> Result<ProfileSpec> {
-    let label = match g.origin.as_str() {
-        "builtin" => format!("<builtin:{}.json>", g.geometry.id),
-        other => other.to_string(),
-    };
-    let o = Obj::new(&label, "", &g.spec)?;
-    if o.get("profile").is_none() || g.geometry.is_composite() || g.geometry.is_colour() {
-        return Err(o.err(
-            "profile",
-            format!(
-                "geometry \"{}\" has no profile array; give a `profile` block (pixels, pixel_deg, perpendicular_deg: \
-                 docs/instrument.md §1.8) or use the shipped rspec-20",
-                g.geometry.id
-            ),
-        ));
-    }
-    parse_spec(&o.obj("profile")?, g.geometry.theta.to_degrees())
-}
-
-/// The geometry the plan measures for a profile: the geometry's angle, scale and source, the N pixels and
-/// the normalising window as receptors, one [`ReadingSpec::Profile`] reading per pixel.
-pub fn geometry(g: &StandardGeometry, p: &ProfileSpec) -> StandardGeometry {
-    let mut geo = g.geometry.clone();
-    geo.receptors = (0..p.pixels).map(|k| (p.name(k), p.stop(k))).collect();
-    geo.receptors.push((REFERENCE.to_string(), Stop::from_angles(p.pixel, p.perpendicular, 0.0)));
-    geo.readings =
-        (0..p.pixels).map(|k| ReadingSpec::Profile { receptor: p.name(k), reference: REFERENCE.to_string() }).collect();
-    StandardGeometry {
-        geometry: geo,
-        reading_names: (0..p.pixels).map(|k| p.name(k)).collect(),
-        spec: g.spec.clone(),
-        origin: g.origin.clone(),
-    }
-}
 
 /// One pixel of a measured profile.
 #[derive(Clone, Debug, PartialEq)]

@@ -2,8 +2,8 @@
 //! the recipe. A relative path is resolved against the recipe file's directory, so that a recipe
 //! and its table can be moved together; for a label that is not a path (`<stdin>`, `<builtin:…>`) against
 //! the current directory.
-use super::Obj;
 use crate::brdf::Brdf;
+use crate::input::json::Obj;
 use crate::measured::merl::{Interpolation, MerlBrdf};
 use crate::measured::rgl::RglBrdf;
 use crate::measured::{e1392, inplane};

@@ -3,7 +3,7 @@
 //! One file holds one material, a JSON object whose `"model"` field selects the model (the format, every
 //! field, its unit and its allowed range: `docs/recipe-format.md`; the JSON Schema: [`schema::schema`]).
 //! Every parameter is read through its entry in [`crate::registry`] (pointer, range, description), and
-//! every value is checked with the file, the field's JSON Pointer and what is allowed ([`fields::Obj`]);
+//! every value is checked with the file, the field's JSON Pointer and what is allowed ([`crate::input::json::Obj`]);
 //! unknown fields are refused (the allowed keys come from the registry) so that a typo cannot silently fall
 //! back to a default.
 use crate::brdf::conductor::SmoothConductor;
@@ -13,11 +13,12 @@ use crate::brdf::multilobe::{CookTorranceLobes, CtLobe};
 use crate::brdf::phong::{Phong, PhongVariant};
 use crate::brdf::ward::Ward;
 use crate::brdf::Brdf;
+use crate::input::json::{kind, parse_json, Obj};
 use crate::optics::microfacet::{Distribution, Microfacet, Shadowing};
 use crate::registry::{self as reg, Param};
 use crate::spectrum::Sampling;
 use crate::{Error, Result};
-use fields::{kind, param_number, Obj};
+use fields::param_number;
 use num_complex::Complex64;
 use serde_json::Value;
 use std::sync::Arc;
@@ -57,7 +58,7 @@ pub fn load_file(path: &std::path::Path) -> Result<Material> {
 
 /// Validate recipe text; `file` names it in messages.
 pub fn parse_str(text: &str, file: &str) -> Result<Material> {
-    let json = fields::parse_json(text, file)?;
+    let json = parse_json(text, file)?;
     let (name, brdf) = {
         let obj = Obj::new(file, "", &json)?;
         let brdf = parse_brdf(&obj)?;

@@ -7,9 +7,10 @@ use crate::brdf::paint::{
     MAX_SAMPLES,
 };
 use crate::brdf::Brdf;
+use crate::input::json::{kind, Obj};
 use crate::optics::kubelka_munk::invert_white_black;
 use crate::optics::microfacet::Distribution;
-use crate::recipe::fields::{kind, param_number, Obj};
+use crate::recipe::fields::param_number;
 use crate::registry::{self as reg, Param};
 use crate::spectrum::Sampling;
 use crate::{Error, Result};

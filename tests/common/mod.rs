@@ -59,11 +59,11 @@ pub fn every_fixture_reading(
     options: &glossmeter::instrument::plan::PlanOptions,
 ) -> Vec<(String, glossmeter::instrument::plan::Reading)> {
     use glossmeter::instrument::plan::Plan;
-    use glossmeter::instrument::{colour, standards};
+    use glossmeter::instrument::standards;
     use glossmeter::spectrum::SamplingKind;
     let gloss = standards::builtin().unwrap();
     let mut all = gloss.clone();
-    all.extend(colour::builtin().unwrap());
+    all.extend(standards::builtin_colour().unwrap());
     let mut recipes: Vec<_> = std::fs::read_dir("fixtures/recipes")
         .unwrap()
         .map(|e| e.unwrap().path())

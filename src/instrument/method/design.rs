@@ -9,13 +9,13 @@ use super::gauss::{tensor_boxes, LOBE_LEVELS};
 use super::polar::{POLAR_LEVELS, TAIL_LEVELS};
 use super::{DeltaPart, Design, Method, Projection, RegularPart, Rule, Target, TensorChart};
 use crate::brdf::{Brdf, Lobe, Tail, TermKind};
+use crate::colorimetry::weighting::Weighting;
 use crate::instrument::aperture::{
     choose_chart, clip, delta_kinks, lobe_boxes, lobe_splits, lobe_widths_uv, mirror_overlap, regular_kinks, AxisMap,
     Chart, DELTA_SHARE,
 };
 use crate::instrument::geometry::{Integral, Stop};
 use crate::quadrature::{tensor, Cell, Refine};
-use crate::spectrum::Weighting;
 
 /// How far (in lobe widths, on both axes and both sides) the overlap kinks must be from the lobe centre for
 /// [`Rule::LobePolar`]: the polar piece then holds the peak and the tail pieces only the tail.

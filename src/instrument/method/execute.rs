@@ -8,11 +8,11 @@ use super::gauss::{lobe_gauss_hermite, tensor_boxes, tensor_gauss, LOBE_LEVELS};
 use super::polar::lobe_polar;
 use super::{Flux, Method, Projection, RegularPart, Rule, TensorChart};
 use crate::brdf::Brdf;
+use crate::colorimetry::weighting::Weighting;
 use crate::instrument::aperture::{half_angle_kink_point, incidence_kink_point, kinked_position, AxisMap, Chart};
 use crate::instrument::geometry::{solid_angle_density, Axes, Integral, Stop};
 use crate::instrument::sphere;
 use crate::quadrature::{integrate_partition, Estimate, Options, Refine, MAX_SHRINK, MAX_SHRINK_LOBE};
-use crate::spectrum::Weighting;
 use crate::Vec3;
 use std::time::Instant;
 

@@ -57,10 +57,10 @@ use crate::instrument::aperture::DELTA_SHARE;
 use delta::delta_node;
 
 use crate::brdf::{Kink, Lobe};
+use crate::colorimetry::weighting::Weighting;
 use crate::instrument::aperture::Chart;
 use crate::instrument::geometry::{Integral, Stop};
 use crate::quadrature::{tensor, Cell, Refine};
-use crate::spectrum::Weighting;
 
 /// Which material a flux is taken on.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]

@@ -9,12 +9,14 @@ use std::sync::{Arc, Mutex};
 use rayon::prelude::*;
 
 use crate::brdf::{Brdf, Lobe, TermKind};
+use crate::colorimetry::weighting::{Weighting, WeightingKind};
 use crate::colorimetry::Conditions;
-use crate::instrument::geometry::{Integral, ReadingSpec, Scale, Stop};
+use crate::instrument::geometry::{Integral, Stop};
 use crate::instrument::method::Flux;
 use crate::instrument::method::{Design, Method, Projection, Target};
+use crate::instrument::reading::{ReadingSpec, Scale};
 use crate::instrument::standards::{self, StandardGeometry};
-use crate::spectrum::{Sampling, Weighting, WeightingKind};
+use crate::spectrum::Sampling;
 use crate::{Error, Result};
 
 use super::{shape, Job, Plan, PlanOptions, PlannedReading, MIN_RTOL, SPECIMEN_SHARE, STANDARD_SHARE};
@@ -79,7 +81,6 @@ impl Planner {
     /// a builtin file that does not parse is this error rather than a missing geometry later.
     pub fn new() -> Result<Planner> {
         standards::builtin_static()?;
-        crate::instrument::colour::builtin_static()?;
         Ok(Planner { builtin: std::sync::OnceLock::new(), standards: Mutex::new(HashMap::new()) })
     }
 
@@ -469,8 +470,7 @@ mod tests {
         let p = Planner::new().unwrap();
         let ids: Vec<String> = p.builtin().unwrap().iter().map(|g| g.geometry.id.clone()).collect();
         let gloss: Vec<String> = standards::builtin().unwrap().into_iter().map(|g| g.geometry.id).collect();
-        let colour: Vec<String> =
-            crate::instrument::colour::builtin().unwrap().into_iter().map(|g| g.geometry.id).collect();
+        let colour: Vec<String> = standards::builtin_colour().unwrap().into_iter().map(|g| g.geometry.id).collect();
         assert!(!colour.is_empty() && !gloss.is_empty());
         assert_eq!(ids, [gloss, colour].concat());
         assert_eq!(p.builtin().unwrap().len(), ids.len(), "the second call borrows the same list");

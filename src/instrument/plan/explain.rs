@@ -3,14 +3,15 @@
 use std::collections::BTreeMap;
 
 use crate::brdf::{Lobe, Tail, Term, TermKind};
+use crate::colorimetry::weighting::Weighting;
 use crate::instrument::aperture::{lobe_widths_uv, Chart, DELTA_SHARE};
-use crate::instrument::geometry::{Integral, ReadingSpec};
+use crate::instrument::geometry::Integral;
 use crate::instrument::method::{
     Method, Projection, Rule, Target, TensorChart, DELTA_FIT_RADIUS, DELTA_RADII, DELTA_RADIUS, DELTA_SAFETY,
     DELTA_TAIL_SAFETY, DELTA_T_ORDERS, LOBE_LEVELS, LOBE_REACH, POLAR_LEVELS, POLAR_REACH, TENSOR_MAX_LEVEL,
 };
+use crate::instrument::reading::ReadingSpec;
 use crate::quadrature::{tensor, Refine};
-use crate::spectrum::Weighting;
 
 use super::{Plan, SPECIMEN_SHARE, STANDARD_SHARE};
 

@@ -39,13 +39,14 @@ use std::sync::{Arc, Mutex, OnceLock, PoisonError};
 use rayon::prelude::*;
 
 use crate::brdf::{Brdf, Term, TermKind};
+use crate::colorimetry::weighting::{Weighting, WeightingKind};
 use crate::colorimetry::Conditions;
-use crate::instrument::geometry::{ReadingSpec, Scale};
 use crate::instrument::method::Flux;
 use crate::instrument::method::Method;
 pub use crate::instrument::method::Target;
+use crate::instrument::reading::{ReadingSpec, Scale};
 use crate::instrument::standards::StandardGeometry;
-use crate::spectrum::{Sampling, Weighting, WeightingKind};
+use crate::spectrum::Sampling;
 use crate::{Error, Result};
 
 mod compile;

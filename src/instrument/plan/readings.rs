@@ -1,9 +1,9 @@
 //! The reading formulas, in one place: a reading's value and first-order error from its fluxes (gloss,
 //! haze, log-haze, compensated haze, DOI, profile, colour) or from the readings it combines (haze index).
+use crate::colorimetry::weighting::WeightingKind;
 use crate::colorimetry::{cielab, Conditions};
-use crate::instrument::geometry::{ColourQuantity, ReadingSpec};
 use crate::instrument::method::Flux;
-use crate::spectrum::WeightingKind;
+use crate::instrument::reading::{ColourQuantity, ReadingSpec};
 
 use super::{Job, Plan, PlannedReading, Reading};
 

@@ -9,36 +9,39 @@
 //! reading Y = 100), L*, a*, b*, C*ab and hab. What they integrate:
 //!
 //! * **Directional** (`kind: "directional"`): the aperture integral of gloss, Φ_c = ∫_source ∫_receptor
-//!   Σ_k W_ck f_k cos θi cos θo dωi dωo with the X, Y, Z rows of the weighting (`spectrum::WeightingKind::Xyz`),
-//!   the receptor lens on its own axis at θv = θi − aspecular (signed, positive on the specular side). The
-//!   receptor must not see the mirror image of the source (checked here), so the method has no delta part and
-//!   uses the plain chart. X = Φ_X / Φ_PRD with Φ_PRD = P_s P_r / π the perfect diffuser's flux (projected
-//!   solid angles in closed form, Lambert's polygon formula, `reference::projected_solid_angle`).
+//!   Σ_k W_ck f_k cos θi cos θo dωi dωo with the X, Y, Z rows of the weighting
+//!   (`colorimetry::weighting::WeightingKind::Xyz`), the receptor lens on its own axis at θv = θi − aspecular
+//!   (signed, positive on the specular side). The receptor must not see the mirror image of the source (checked
+//!   here), so the method has no delta part and uses the plain chart. X = Φ_X / Φ_PRD with Φ_PRD = P_s P_r / π
+//!   the perfect diffuser's flux (projected solid angles in closed form, Lambert's polygon formula,
+//!   `reference::projected_solid_angle`).
 //! * **Sphere** (`kind: "sphere"`): the integrals of `instrument::sphere`, the hemisphere (SCI) minus the
 //!   specular port (SCE), relative to the perfect diffuser under full-hemisphere illumination (Φ_PRD = 1).
 use std::f64::consts::PI;
 
-use crate::instrument::geometry::{ColourQuantity, Geometry, Integral, ReadingSpec, Scale, Stop};
+use crate::input::json::{parse_json, Obj};
+use crate::instrument::geometry::{Geometry, Integral, Stop};
+use crate::instrument::reading::{ColourQuantity, ReadingSpec, Scale};
 use crate::instrument::reference::projected_solid_angle;
-use crate::instrument::standards::{aperture, header, sourced, Range, StandardGeometry};
-use crate::recipe::fields::{parse_json, Obj};
-use crate::{Error, Result, Vec3};
+use crate::instrument::standards::sourced::{aperture, header, sourced, StandardGeometry};
+use crate::registry::Range;
+use crate::{Result, Vec3};
 
 /// Every shipped colour geometry: (file name, text).
 pub const BUILTIN: &[(&str, &str)] = &[
-    ("astm-e2194-15.json", include_str!("../../standards/colour/astm-e2194-15.json")),
-    ("astm-e2194-25.json", include_str!("../../standards/colour/astm-e2194-25.json")),
-    ("astm-e2194-45.json", include_str!("../../standards/colour/astm-e2194-45.json")),
-    ("astm-e2194-75.json", include_str!("../../standards/colour/astm-e2194-75.json")),
-    ("astm-e2194-110.json", include_str!("../../standards/colour/astm-e2194-110.json")),
-    ("astm-e2539-m15.json", include_str!("../../standards/colour/astm-e2539-m15.json")),
-    ("astm-e2539-15.json", include_str!("../../standards/colour/astm-e2539-15.json")),
-    ("astm-e2539-25.json", include_str!("../../standards/colour/astm-e2539-25.json")),
-    ("astm-e2539-45.json", include_str!("../../standards/colour/astm-e2539-45.json")),
-    ("astm-e2539-75.json", include_str!("../../standards/colour/astm-e2539-75.json")),
-    ("astm-e2539-110.json", include_str!("../../standards/colour/astm-e2539-110.json")),
-    ("d8-sci.json", include_str!("../../standards/colour/d8-sci.json")),
-    ("d8-sce.json", include_str!("../../standards/colour/d8-sce.json")),
+    ("astm-e2194-15.json", include_str!("../../../standards/colour/astm-e2194-15.json")),
+    ("astm-e2194-25.json", include_str!("../../../standards/colour/astm-e2194-25.json")),
+    ("astm-e2194-45.json", include_str!("../../../standards/colour/astm-e2194-45.json")),
+    ("astm-e2194-75.json", include_str!("../../../standards/colour/astm-e2194-75.json")),
+    ("astm-e2194-110.json", include_str!("../../../standards/colour/astm-e2194-110.json")),
+    ("astm-e2539-m15.json", include_str!("../../../standards/colour/astm-e2539-m15.json")),
+    ("astm-e2539-15.json", include_str!("../../../standards/colour/astm-e2539-15.json")),
+    ("astm-e2539-25.json", include_str!("../../../standards/colour/astm-e2539-25.json")),
+    ("astm-e2539-45.json", include_str!("../../../standards/colour/astm-e2539-45.json")),
+    ("astm-e2539-75.json", include_str!("../../../standards/colour/astm-e2539-75.json")),
+    ("astm-e2539-110.json", include_str!("../../../standards/colour/astm-e2539-110.json")),
+    ("d8-sci.json", include_str!("../../../standards/colour/d8-sci.json")),
+    ("d8-sce.json", include_str!("../../../standards/colour/d8-sce.json")),
 ];
 
 /// How a colour geometry illuminates and views (what `glossmeter standards` prints).
@@ -94,11 +97,11 @@ pub fn parse(text: &str, origin: &str) -> Result<StandardGeometry> {
     let (geometry, reading_names) = match o.str("kind")? {
         "directional" => {
             o.deny_unknown(&allowed(&["illumination_deg", "aspecular_deg", "source", "receptor"]))?;
-            let ill = sourced(&o, "illumination_deg", Range::Open(0.0, 90.0), "the illumination angle in degrees")?;
+            let ill = sourced(&o, "illumination_deg", Range::open(0.0, 90.0), "the illumination angle in degrees")?;
             let asp = sourced(
                 &o,
                 "aspecular_deg",
-                Range::Closed(-90.0, 180.0),
+                Range::closed(-90.0, 180.0),
                 "the aspecular angle in degrees (positive towards the illuminator)",
             )?;
             let view = ill - asp;
@@ -154,7 +157,7 @@ pub fn parse(text: &str, origin: &str) -> Result<StandardGeometry> {
         }
         "sphere" => {
             o.deny_unknown(&allowed(&["viewing_deg", "specular", "specular_port_half_angle_deg"]))?;
-            let view = sourced(&o, "viewing_deg", Range::Closed(0.0, 60.0), "the viewing angle in degrees")?;
+            let view = sourced(&o, "viewing_deg", Range::closed(0.0, 60.0), "the viewing angle in degrees")?;
             let port = match o.str("specular")? {
                 "included" => {
                     if o.get("specular_port_half_angle_deg").is_some() {
@@ -169,7 +172,7 @@ pub fn parse(text: &str, origin: &str) -> Result<StandardGeometry> {
                     let b = sourced(
                         &o,
                         "specular_port_half_angle_deg",
-                        Range::Open(0.0, 30.0),
+                        Range::open(0.0, 30.0),
                         "the half-angle of the specular port in degrees",
                     )?;
                     if view + b >= 90.0 {
@@ -218,33 +221,6 @@ pub fn parse(text: &str, origin: &str) -> Result<StandardGeometry> {
 /// A colour geometry has no gloss standard; its readings are relative to the perfect reflecting diffuser, in
 /// closed form. (The scale is never used: no colour reading has a standard flux.)
 const NO_SCALE: Scale = Scale::Mirror { value: 100.0 };
-
-/// Every builtin colour geometry (each file's id equals its name), parsed once per process.
-pub fn builtin() -> Result<Vec<StandardGeometry>> {
-    builtin_static().map(<[StandardGeometry]>::to_vec)
-}
-
-/// [`builtin`] without the copy: parsed once per process, borrowed for the rest of it.
-pub fn builtin_static() -> Result<&'static [StandardGeometry]> {
-    static PARSED: std::sync::OnceLock<Vec<StandardGeometry>> = std::sync::OnceLock::new();
-    if let Some(all) = PARSED.get() {
-        return Ok(all);
-    }
-    let mut out: Vec<StandardGeometry> = Vec::with_capacity(BUILTIN.len());
-    for (file, text) in BUILTIN {
-        let label = format!("<builtin:colour/{file}>");
-        let mut g = parse(text, &label)?;
-        if g.geometry.id != file.trim_end_matches(".json") {
-            return Err(Error::input(label, "/id", format!("id {:?} must equal the file name", g.geometry.id)));
-        }
-        if out.iter().any(|o| o.geometry.id == g.geometry.id) {
-            return Err(Error::input(label, "/id", format!("duplicate id {:?}", g.geometry.id)));
-        }
-        g.origin = "builtin".into();
-        out.push(g);
-    }
-    Ok(PARSED.get_or_init(|| out))
-}
 
 /// Ids of the builtin colour geometries, in table order (without parsing them).
 pub fn builtin_ids() -> Vec<&'static str> {
@@ -306,22 +282,8 @@ mod tests {
     use super::*;
 
     fn find(id: &str) -> StandardGeometry {
-        builtin().unwrap().into_iter().find(|g| g.geometry.id == id).unwrap()
-    }
-
-    #[test]
-    fn builtin_colour_geometries_parse() {
-        let all = builtin().unwrap();
-        assert_eq!(all.len(), BUILTIN.len());
-        let v = |id: &str| match colour_kind(&find(id).geometry) {
-            Some(ColourKind::Directional { viewing, .. }) => viewing.to_degrees(),
-            _ => panic!("directional"),
-        };
-        assert!((v("astm-e2194-110") + 65.0).abs() < 1e-12);
-        assert!((v("astm-e2539-m15") - 60.0).abs() < 1e-12);
-        assert!(matches!(colour_kind(&find("d8-sce").geometry), Some(ColourKind::Sphere { port: Some(_), .. })));
-        assert!(matches!(colour_kind(&find("d8-sci").geometry), Some(ColourKind::Sphere { port: None, .. })));
-        assert!(is_colour_id("d8-sce") && !is_colour_id("astm-d523-60"));
+        let (file, text) = BUILTIN.iter().find(|(f, _)| f.trim_end_matches(".json") == id).unwrap();
+        parse(text, file).unwrap()
     }
 
     #[test]

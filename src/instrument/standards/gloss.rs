@@ -1,51 +1,37 @@
-//! The standards as data: every shipped instrument geometry is a JSON file in `standards/`, embedded in
-//! the binary, parsed and validated here into a compiled [`Geometry`]. User geometry files use the same
-//! format (documented in `docs/instrument.md`).
-//!
-//! Every number in a geometry file carries its provenance:
-//! `{"value": 1.8, "source": "…citation or reason…", "status": "verified" | "secondary" | "assumed"}`.
-//! Errors name the file, the field path and what is allowed.
-use crate::instrument::geometry::{Geometry, ReadingSpec, Scale, Stop};
-use crate::recipe::fields::{kind, parse_json, Obj};
+//! The gloss geometry format: a file of `standards/*.json` (or a user file of the same format) gives an angle,
+//! the scale (the gloss standard and what it is assigned), a source stop, named receptor stops, an optional
+//! `profile` block and the readings taken through them (gloss, haze, log-haze, compensated haze, DOI, or a
+//! composite's haze index); [`parse`] validates it into a [`StandardGeometry`], [`describe`] and [`list_line`]
+//! show it. The format is documented in `docs/instrument.md`; every number is sourced (`sourced.rs`). Errors
+//! name the file, the field path and what is allowed.
+use crate::input::json::{parse_json, Obj};
+use crate::instrument::geometry::{Geometry, Stop};
+use crate::instrument::reading::{ReadingSpec, Scale};
+use crate::instrument::standards::sourced::{
+    aperture, header, nonempty_str, sourced, sourced_text, string_list, StandardGeometry,
+};
+use crate::registry::Range;
 use crate::{Error, Result};
 use serde_json::Value;
 use std::collections::HashSet;
-use std::path::Path;
 use std::sync::Arc;
 
-/// Every shipped geometry file: (file name, text). A test checks this equals the set of `standards/*.json`.
+/// Every shipped gloss geometry file: (file name, text). A test checks this equals the set of `standards/*.json`.
 pub const BUILTIN: &[(&str, &str)] = &[
-    ("astm-d523-20.json", include_str!("../../standards/astm-d523-20.json")),
-    ("astm-d523-60.json", include_str!("../../standards/astm-d523-60.json")),
-    ("astm-d523-85.json", include_str!("../../standards/astm-d523-85.json")),
-    ("iso-2813-20.json", include_str!("../../standards/iso-2813-20.json")),
-    ("iso-2813-60.json", include_str!("../../standards/iso-2813-60.json")),
-    ("iso-2813-85.json", include_str!("../../standards/iso-2813-85.json")),
-    ("astm-e430-30.json", include_str!("../../standards/astm-e430-30.json")),
-    ("astm-e430-20.json", include_str!("../../standards/astm-e430-20.json")),
-    ("iso-13803-20.json", include_str!("../../standards/iso-13803-20.json")),
-    ("astm-d4039.json", include_str!("../../standards/astm-d4039.json")),
-    ("astm-d2457-45.json", include_str!("../../standards/astm-d2457-45.json")),
-    ("tappi-t480-75.json", include_str!("../../standards/tappi-t480-75.json")),
-    ("rspec-20.json", include_str!("../../standards/rspec-20.json")),
+    ("astm-d523-20.json", include_str!("../../../standards/astm-d523-20.json")),
+    ("astm-d523-60.json", include_str!("../../../standards/astm-d523-60.json")),
+    ("astm-d523-85.json", include_str!("../../../standards/astm-d523-85.json")),
+    ("iso-2813-20.json", include_str!("../../../standards/iso-2813-20.json")),
+    ("iso-2813-60.json", include_str!("../../../standards/iso-2813-60.json")),
+    ("iso-2813-85.json", include_str!("../../../standards/iso-2813-85.json")),
+    ("astm-e430-30.json", include_str!("../../../standards/astm-e430-30.json")),
+    ("astm-e430-20.json", include_str!("../../../standards/astm-e430-20.json")),
+    ("iso-13803-20.json", include_str!("../../../standards/iso-13803-20.json")),
+    ("astm-d4039.json", include_str!("../../../standards/astm-d4039.json")),
+    ("astm-d2457-45.json", include_str!("../../../standards/astm-d2457-45.json")),
+    ("tappi-t480-75.json", include_str!("../../../standards/tappi-t480-75.json")),
+    ("rspec-20.json", include_str!("../../../standards/rspec-20.json")),
 ];
-
-/// The allowed provenance words of a sourced number.
-pub const STATUSES: &[&str] = &["verified", "secondary", "assumed"];
-
-/// A compiled geometry together with its display names and the original specification.
-#[derive(Clone, Debug)]
-pub struct StandardGeometry {
-    pub geometry: Geometry,
-    /// One display name per entry of `geometry.readings` (the reading's `name`, or its quantity).
-    pub reading_names: Vec<String>,
-    /// The original JSON, kept for provenance display ([`describe`]). Shared, not copied: every plan keeps
-    /// its geometries, and a batch of a hundred recipes copying and freeing each file's JSON tree cost as
-    /// much as a tenth of its integrals (docs/performance.md §Batch and sweep throughput).
-    pub spec: Arc<Value>,
-    /// `"builtin"` or the path of the user file.
-    pub origin: String,
-}
 
 const TOP_FIELDS: &[&str] = &[
     "id",
@@ -60,6 +46,7 @@ const TOP_FIELDS: &[&str] = &[
     "notes",
     "profile",
 ];
+
 const GEOMETRY_ONLY: &[&str] = &["angle_deg", "scale", "reference_index", "source", "receptors", "profile"];
 
 /// The allowed `scale.kind` values.
@@ -69,7 +56,7 @@ pub const SCALE_KINDS: &[&str] = &["black-glass", "mirror"];
 /// `{"kind": "mirror", "assigned_gu": {…}}`, each number sourced. A file that gives only the older top-level
 /// `reference_index` is on the black-glass scale with that glass assigned 100 GU (as D523).
 fn scale(o: &Obj) -> Result<Scale> {
-    let index_range = Range::Closed(1.3, 2.0);
+    let index_range = Range::closed(1.3, 2.0);
     let index_what = "the refractive index of the black-glass gloss standard";
     match (o.get("scale").is_some(), o.get("reference_index").is_some()) {
         (true, true) => Err(o.err(
@@ -90,12 +77,12 @@ fn scale(o: &Obj) -> Result<Scale> {
                 "black-glass" => {
                     s.deny_unknown(&["kind", "reference_index", "assigned_gu", "notes"])?;
                     let index = sourced(&s, "reference_index", index_range, index_what)?;
-                    let value = sourced(&s, "assigned_gu", Range::Open(0.0, 1e4), value_what)?;
+                    let value = sourced(&s, "assigned_gu", Range::open(0.0, 1e4), value_what)?;
                     Ok(Scale::BlackGlass { index, value })
                 }
                 "mirror" => {
                     s.deny_unknown(&["kind", "assigned_gu", "notes"])?;
-                    let value = sourced(&s, "assigned_gu", Range::Open(0.0, 1e4), value_what)?;
+                    let value = sourced(&s, "assigned_gu", Range::open(0.0, 1e4), value_what)?;
                     Ok(Scale::Mirror { value })
                 }
                 other => {
@@ -104,143 +91,6 @@ fn scale(o: &Obj) -> Result<Scale> {
             }
         }
     }
-}
-
-/// Parse and validate every builtin geometry, and check that they are consistent with each other (each
-/// file's id equals its file name, ids are unique, composites name existing non-composite geometries).
-/// Parsed once per process (the files are embedded, so the result cannot change); an error is returned
-/// again on every call.
-pub fn builtin() -> Result<Vec<StandardGeometry>> {
-    builtin_static().map(<[StandardGeometry]>::to_vec)
-}
-
-/// [`builtin`] without the copy: the geometries parsed once per process, borrowed for the rest of it
-/// (`find` copies only the one it returns).
-pub fn builtin_static() -> Result<&'static [StandardGeometry]> {
-    static PARSED: std::sync::OnceLock<Vec<StandardGeometry>> = std::sync::OnceLock::new();
-    if let Some(all) = PARSED.get() {
-        return Ok(all);
-    }
-    let all = parse_builtin()?;
-    Ok(PARSED.get_or_init(|| all))
-}
-
-fn parse_builtin() -> Result<Vec<StandardGeometry>> {
-    let mut out = Vec::with_capacity(BUILTIN.len());
-    for (file, text) in BUILTIN {
-        let label = format!("<builtin:{file}>");
-        let mut g = parse(text, &label)?;
-        let stem = file.trim_end_matches(".json");
-        if g.geometry.id != stem {
-            return Err(Error::input(label, "id", format!("id {:?} must equal the file name {stem:?}", g.geometry.id)));
-        }
-        if out.iter().any(|o: &StandardGeometry| o.geometry.id == g.geometry.id) {
-            return Err(Error::input(label, "/id", format!("duplicate id {:?}", g.geometry.id)));
-        }
-        g.origin = "builtin".to_string();
-        out.push(g);
-    }
-    for g in &out {
-        for (i, r) in g.geometry.readings.iter().enumerate() {
-            if let ReadingSpec::HazeIndex { minuend, subtrahend } = r {
-                for (key, id) in [("minuend", minuend), ("subtrahend", subtrahend)] {
-                    let ok = out.iter().any(|o| &o.geometry.id == id && !o.geometry.is_composite());
-                    if !ok {
-                        return Err(Error::input(
-                            format!("<builtin:{}.json>", g.geometry.id),
-                            format!("/readings/{i}/{key}"),
-                            format!("{id:?} is not a builtin non-composite geometry id; known: {}", ids(&out)),
-                        ));
-                    }
-                }
-            }
-        }
-    }
-    Ok(out)
-}
-
-fn ids(gs: &[StandardGeometry]) -> String {
-    gs.iter().map(|g| g.geometry.id.as_str()).collect::<Vec<_>>().join(", ")
-}
-
-/// The builtin geometry (gloss, or colour: `instrument::colour`) with this id; an unknown id is a usage error
-/// listing the known ids.
-pub fn find(id: &str) -> Result<StandardGeometry> {
-    let all = builtin_static()?;
-    if let Some(g) = all.iter().find(|g| g.geometry.id == id) {
-        return Ok(g.clone());
-    }
-    let colour = crate::instrument::colour::builtin_static()?;
-    match colour.iter().find(|g| g.geometry.id == id) {
-        Some(g) => Ok(g.clone()),
-        None => {
-            Err(Error::Usage(format!("unknown geometry id {id:?}; known ids: {}; colour: {}", ids(all), ids(colour))))
-        }
-    }
-}
-
-/// Every builtin geometry: the gloss ones, then the colour ones (`standards/colour/`).
-pub fn builtin_all() -> Result<Vec<StandardGeometry>> {
-    let mut all = builtin()?;
-    all.extend(crate::instrument::colour::builtin()?);
-    Ok(all)
-}
-
-/// Load a user geometry file (same format as the builtin ones: a gloss geometry, or a colour geometry when it
-/// has a `kind`, `docs/colour.md`).
-pub fn load_file(path: &Path) -> Result<StandardGeometry> {
-    let name = path.display().to_string();
-    let text = crate::input::read_text(path, "geometry file")?;
-    let is_colour = parse_json(&text, &name).map(|v| crate::instrument::colour::is_colour_spec(&v)).unwrap_or(false);
-    let g = if is_colour { crate::instrument::colour::parse(&text, &name)? } else { parse(&text, &name)? };
-    check_user(&g, &builtin_all()?)?;
-    Ok(g)
-}
-
-/// [`describe`] for gloss geometries, `colour::describe` for colour ones.
-pub fn describe_any(g: &StandardGeometry) -> String {
-    if g.geometry.is_colour() {
-        crate::instrument::colour::describe(g)
-    } else {
-        describe(g)
-    }
-}
-
-/// [`list_line`] for gloss geometries, `colour::list_line` for colour ones.
-pub fn list_line_any(g: &StandardGeometry) -> String {
-    if g.geometry.is_colour() {
-        crate::instrument::colour::list_line(g)
-    } else {
-        list_line(g)
-    }
-}
-
-/// A user geometry may not take a shipped id (a reading would be labelled as the standard's while measuring
-/// something else), and its composite readings must name shipped non-composite geometries (they are the
-/// ones the plan can look up).
-pub fn check_user(g: &StandardGeometry, shipped: &[StandardGeometry]) -> Result<()> {
-    let id = &g.geometry.id;
-    if shipped.iter().any(|s| &s.geometry.id == id) {
-        return Err(Error::input(
-            &g.origin,
-            "/id",
-            format!("{id:?} is the id of a shipped geometry; give a user geometry an id of its own"),
-        ));
-    }
-    for (i, r) in g.geometry.readings.iter().enumerate() {
-        if let ReadingSpec::HazeIndex { minuend, subtrahend } = r {
-            for (key, part) in [("minuend", minuend), ("subtrahend", subtrahend)] {
-                if !shipped.iter().any(|o| &o.geometry.id == part && !o.geometry.is_composite()) {
-                    return Err(Error::input(
-                        &g.origin,
-                        format!("/readings/{i}/{key}"),
-                        format!("{part:?} is not a shipped non-composite geometry id; known: {}", ids(shipped)),
-                    ));
-                }
-            }
-        }
-    }
-    Ok(())
 }
 
 /// Parse and validate a geometry from JSON text; `origin` names the file in errors and in `origin`.
@@ -279,7 +129,7 @@ pub fn parse(text: &str, origin: &str) -> Result<StandardGeometry> {
         }
         (0.0, Scale::Mirror { value: 100.0 }, Stop { p: [0.0, 0.0], q: [0.0, 0.0] }, Vec::new())
     } else {
-        let angle = sourced(&o, "angle_deg", Range::Open(0.0, 90.0), "the angle of incidence in degrees")?;
+        let angle = sourced(&o, "angle_deg", Range::open(0.0, 90.0), "the angle of incidence in degrees")?;
         let n = scale(&o)?;
         let src = o.obj("source")?;
         let (s_in, s_perp) = aperture(&src, &["shape", "in_plane_deg", "perpendicular_deg"])?;
@@ -295,7 +145,7 @@ pub fn parse(text: &str, origin: &str) -> Result<StandardGeometry> {
         }
         let source = Stop::from_angles(s_in.to_radians(), s_perp.to_radians(), 0.0);
         if let Some(p) = o.opt_obj("profile")? {
-            crate::instrument::profile::parse_spec(&p, angle)?;
+            crate::instrument::standards::profile::parse_spec(&p, angle)?;
         }
         let rec_v = o.array("receptors")?;
         if rec_v.is_empty() {
@@ -312,7 +162,7 @@ pub fn parse(text: &str, origin: &str) -> Result<StandardGeometry> {
             let off = sourced(
                 &r,
                 "offset_deg",
-                Range::Closed(-45.0, 45.0),
+                Range::closed(-45.0, 45.0),
                 "the in-plane offset of the stop centre from the specular axis in degrees (positive towards grazing)",
             )?;
             let top = angle + off + 0.5 * r_in;
@@ -359,134 +209,6 @@ pub fn parse(text: &str, origin: &str) -> Result<StandardGeometry> {
         readings,
     };
     Ok(StandardGeometry { geometry, reading_names, spec: Arc::new(spec), origin: origin.to_string() })
-}
-
-/// Allowed range of a sourced number.
-#[derive(Clone, Copy)]
-pub(crate) enum Range {
-    /// lo < x < hi
-    Open(f64, f64),
-    /// lo ≤ x ≤ hi
-    Closed(f64, f64),
-}
-
-/// The value of a `{"value", "source", "status"}` object at `o.key`, with its provenance checked.
-pub(crate) fn sourced(o: &Obj, key: &str, range: Range, what: &str) -> Result<f64> {
-    let s = o.obj(key)?;
-    s.deny_unknown(&["value", "source", "status", "tolerance", "plausible"])?;
-    check_variation(&s)?;
-    let (lo, hi) = match range {
-        Range::Open(lo, hi) | Range::Closed(lo, hi) => (lo, hi),
-    };
-    let value = s.num("value", lo, hi, what)?;
-    if let Range::Open(lo, hi) = range {
-        if value <= lo || value >= hi {
-            return Err(s.err("value", format!("{value} is out of range: {what} must be > {lo} and < {hi}")));
-        }
-    }
-    let source = s.str("source")?;
-    if source.trim().is_empty() {
-        return Err(s.err("source", "must not be empty: cite where the number comes from, or why it was chosen"));
-    }
-    let status = s.str("status")?;
-    if !STATUSES.contains(&status) {
-        return Err(s.err("status", format!("{status:?} is not a status; allowed: {}", STATUSES.join(", "))));
-    }
-    Ok(value)
-}
-
-/// The optional variations of a sourced number, for the tolerance envelope (`instrument::envelope`):
-/// `"tolerance": {"value": t ≥ 0, "source", "status"}` (the standard allows value ± t) and, for a number
-/// whose value is itself uncertain, `"plausible": {"low", "high", "source", "status"}` (low ≤ value ≤ high).
-fn check_variation(s: &Obj) -> Result<()> {
-    let provenance = |t: &Obj| -> Result<()> {
-        t.deny_unknown(&["value", "low", "high", "source", "status"])?;
-        if t.str("source")?.trim().is_empty() {
-            return Err(t.err("source", "must not be empty: cite where the tolerance comes from, or why it was chosen"));
-        }
-        let status = t.str("status")?;
-        if !STATUSES.contains(&status) {
-            return Err(t.err("status", format!("{status:?} is not a status; allowed: {}", STATUSES.join(", "))));
-        }
-        Ok(())
-    };
-    if let Some(t) = s.opt_obj("tolerance")? {
-        t.deny_unknown(&["value", "source", "status"])?;
-        t.num("value", 0.0, 10.0, "a tolerance in the number's unit")?;
-        provenance(&t)?;
-    }
-    if let Some(t) = s.opt_obj("plausible")? {
-        t.deny_unknown(&["low", "high", "source", "status"])?;
-        let lo = t.num("low", f64::MIN, f64::MAX, "the low end of the plausible range")?;
-        let hi = t.num("high", f64::MIN, f64::MAX, "the high end of the plausible range")?;
-        let v = s.num("value", f64::MIN, f64::MAX, "the value")?;
-        if !(lo <= v && v <= hi) {
-            return Err(t.err("low", format!("the plausible range [{lo}, {hi}] must contain the value {v}")));
-        }
-        provenance(&t)?;
-    }
-    Ok(())
-}
-
-/// The shape and size of a stop: (in-plane, perpendicular) full angles in degrees. The shape is checked
-/// before unknown fields, so a circle's `diameter_deg` gets the circle message, not "unknown field".
-pub(crate) fn aperture(o: &Obj, allowed: &[&str]) -> Result<(f64, f64)> {
-    let shape = o.str("shape")?;
-    match shape {
-        "rectangle" => {}
-        "circle" => return Err(o.err(
-            "shape",
-            "circular stops are not supported yet; give the rectangle circumscribing the circle (side = diameter), \
-                 the inscribed one (side = diameter/√2) or the square of equal solid angle (side ≈ 0.886 × diameter), \
-                 and say which in the numbers' \"source\"",
-        )),
-        other => return Err(o.err("shape", format!("unknown shape {other:?}; allowed: rectangle"))),
-    }
-    o.deny_unknown(allowed)?;
-    let what = "a full aperture angle in degrees";
-    let a = sourced(o, "in_plane_deg", Range::Open(0.0, 20.0), what)?;
-    let b = sourced(o, "perpendicular_deg", Range::Open(0.0, 20.0), what)?;
-    Ok((a, b))
-}
-
-/// The fields every geometry file opens with, gloss and colour alike: `id` (lower-case letters, digits, '-' and
-/// '.'), a non-empty `title`, the `standards` it follows (strings) and optional `notes` (a string).
-pub(crate) fn header<'a>(o: &Obj<'a>) -> Result<(&'a str, String)> {
-    let id = o.str("id")?;
-    if id.is_empty() || !id.chars().all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '-' || c == '.') {
-        return Err(o.err("id", format!("{id:?} is not a valid id: use lower-case letters, digits, '-' and '.'")));
-    }
-    let title = nonempty_str(o, "title")?;
-    string_list(o, "standards")?;
-    if let Some(v) = o.get("notes") {
-        if !v.is_string() {
-            return Err(o.err("notes", format!("expected a string, got {}", kind(v))));
-        }
-    }
-    Ok((id, title))
-}
-
-pub(crate) fn nonempty_str(o: &Obj, key: &str) -> Result<String> {
-    let s = o.str(key)?;
-    if s.trim().is_empty() {
-        return Err(o.err(key, "must not be empty"));
-    }
-    Ok(s.to_string())
-}
-
-/// A non-empty array of non-empty strings.
-pub(crate) fn string_list(o: &Obj, key: &str) -> Result<Vec<String>> {
-    let a = o.array(key)?;
-    if a.is_empty() {
-        return Err(o.err(key, "must list at least one entry"));
-    }
-    a.iter()
-        .enumerate()
-        .map(|(i, v)| match v.as_str() {
-            Some(s) if !s.trim().is_empty() => Ok(s.to_string()),
-            _ => Err(Error::input(o.file, o.element(key, i), format!("expected a non-empty string, got {}", kind(v)))),
-        })
-        .collect()
 }
 
 fn receptor_ref(o: &Obj, key: &str, names: &[&str]) -> Result<String> {
@@ -593,7 +315,7 @@ fn reading(
         "log-haze" => ReadingSpec::LogHaze {
             receptors: receptor_list(r, "receptors", names)?,
             specular: receptor_ref(r, "specular", names)?,
-            k: sourced(r, "k", Range::Open(0.0, 1e6), "the log-haze scale factor K")?,
+            k: sourced(r, "k", Range::open(0.0, 1e6), "the log-haze scale factor K")?,
         },
         "haze-compensated" | "log-haze-compensated" => {
             let receptors = receptor_list(r, "receptors", names)?;
@@ -603,7 +325,7 @@ fn reading(
             if q == "haze-compensated" {
                 ReadingSpec::HazeCompensated { receptors, specular, compensation, factor }
             } else {
-                let k = sourced(r, "k", Range::Open(0.0, 1e6), "the log-haze scale factor K")?;
+                let k = sourced(r, "k", Range::open(0.0, 1e6), "the log-haze scale factor K")?;
                 ReadingSpec::LogHazeCompensated { receptors, specular, compensation, factor, k }
             }
         }
@@ -628,15 +350,6 @@ fn reading(
 // ---------------------------------------------------------------------------------------------------------
 // Display
 // ---------------------------------------------------------------------------------------------------------
-
-/// One sourced number from the spec as "value unit [status] source".
-fn sourced_text(v: Option<&Value>, unit: &str) -> String {
-    let Some(v) = v else { return "(absent)".to_string() };
-    let value = v.get("value").map(|x| x.to_string()).unwrap_or_default();
-    let status = v.get("status").and_then(Value::as_str).unwrap_or("?");
-    let source = v.get("source").and_then(Value::as_str).unwrap_or("");
-    format!("{value}{unit} [{status}]\n        source: {source}")
-}
 
 /// A multi-line description: title, standards, every number with its value, unit, status and source.
 pub fn describe(g: &StandardGeometry) -> String {

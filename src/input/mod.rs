@@ -1,11 +1,16 @@
 //! Input files (recipes, geometry files, sheets) read as text with a size limit. It exists so that a file
 //! that is not a recipe at all (`/dev/zero`, a multi-gigabyte log given by mistake) is refused with a clear
 //! message instead of being read until memory runs out. (MERL tables are binary and checked against their
-//! own header in `brdf::measured`.)
+//! own header in `measured::merl`.)
+//!
+//! Files: `mod.rs` (this: [`read_text`], [`read_bytes`], the size limit) and `json.rs` (a JSON document read
+//! with errors that name the file and the field's JSON Pointer: `Obj`, `parse_json`, `kind`, `show`).
 use std::io::Read;
 use std::path::Path;
 
 use crate::{Error, Result};
+
+pub mod json;
 
 /// The largest text input file: 16 MiB. A recipe or a geometry file is a few kB; a sheet of 16 MiB holds
 /// some 300 000 readings.
