@@ -1,6 +1,6 @@
 //! `glossmeter compare`: predictions set beside an instrument sheet, one table, one summary and one exit
 //! status for all its samples. The reading of the sheet, the statistics, the verdicts and the baseline checks
-//! are library functions (`instrument::sheet`, `comparison`); this module parses the arguments and formats.
+//! are library functions (`comparison::sheet`, `comparison`); this module parses the arguments and formats.
 //! Colour sheets (L*, a*, b* on colour geometries) are predicted by the same plan, and each (sample, geometry)
 //! gets its CIEDE2000 ΔE00 (`comparison::colour_differences`; `--max-de00` makes it the check).
 use std::path::PathBuf;
@@ -9,9 +9,9 @@ use serde_json::json;
 
 use crate::cli::format::plain;
 use crate::cli::{check_rtol, junit, pad_table, readings_status, ColourArgs, Target};
+use crate::comparison::sheet::{self, Sheet, SheetOptions};
 use crate::comparison::{self, ColourDifference, Comparison, Drift, Recipes, Rule, Verdict};
 use crate::instrument::plan::PlanOptions;
-use crate::instrument::sheet::{self, Sheet, SheetOptions};
 use crate::{Error, Result};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]

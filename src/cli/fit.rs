@@ -7,8 +7,8 @@ use serde_json::{json, Value};
 use crate::cli::compare::parse_delimiter;
 use crate::cli::output::{print, Target};
 use crate::cli::{check_rtol, Format};
+use crate::comparison::sheet::{self, SheetOptions};
 use crate::fit::{self, FitOptions, FitReport, FreeParameter, TargetReading};
-use crate::instrument::sheet::{self, SheetOptions};
 use crate::{recipe, Error, Result};
 
 #[derive(clap::Args, Debug)]

@@ -5,7 +5,7 @@
 //! aperture integral (charts, split points, clipping, mirror overlap) and holds its result; `method` is
 //! one integral designed as plain data, and its executor; `plan` compiles (material, geometries) into the
 //! cheapest set of methods and combines their fluxes into readings; `reference` gives independent closed forms to check them against; `convergence` measures
-//! error against run time; `sheet` reads real instruments' readings for comparison. The contract is
+//! error against run time. The contract is
 //! written out in `docs/instrument.md`.
 pub mod colour;
 pub mod convergence;
@@ -16,6 +16,5 @@ pub mod method;
 pub mod plan;
 pub mod profile;
 pub mod reference;
-pub mod sheet;
 pub mod sphere;
 pub mod standards;

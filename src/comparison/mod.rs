@@ -14,13 +14,20 @@
 //! k·s/√n being k standard errors of the mean (k = 2 by default, about 95 % for a normal mean) and u the
 //! stated uncertainty (the largest of the rows' `uncertainty`, else `--tolerance`). With n = 1 and no stated
 //! uncertainty there is no allowance: the row is unchecked, which fails the check like an outside row.
+//!
+//! The folder:
+//! * `mod.rs`: the statistics, the verdict rule ([`VerdictRule`]), the comparison of a sheet's samples with
+//!   their recipes' predictions, colour differences, and baselines;
+//! * [`sheet`]: the input format, instrument sheets as instruments and spreadsheets write them.
+pub mod sheet;
+
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 use rayon::prelude::*;
 
+use self::sheet::{Layout, Sheet, SheetOptions, SheetRow};
 use crate::instrument::plan::{Plan, PlanOptions, Reading};
-use crate::instrument::sheet::{self, Layout, Sheet, SheetOptions, SheetRow};
 use crate::instrument::standards::{self, StandardGeometry};
 use crate::recipe::{self, Material};
 use crate::{Error, Result};
