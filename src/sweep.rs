@@ -23,7 +23,7 @@ use serde_json::{json, Value};
 use crate::instrument::method::Target;
 use crate::instrument::plan::{Execution, Plan, PlanOptions, Planner, Reading};
 use crate::instrument::standards::StandardGeometry;
-use crate::{recipe, registry, Error, Result};
+use crate::{recipe, registry, report, Error, Result};
 
 /// Points per thread in one chunk of [`Sweep::run`]: the rows of a chunk are kept until it ends (constant
 /// memory: a few hundred rows), and each chunk ends with at most one integral running alone per thread.
@@ -371,8 +371,8 @@ impl Sweep {
         for c in cells {
             match c {
                 Some((v, e)) => {
-                    row.push(v.to_string());
-                    row.push(e.to_string());
+                    row.push(report::plain(v));
+                    row.push(report::plain(e));
                 }
                 None => {
                     row.push(String::new());
@@ -387,24 +387,14 @@ impl Sweep {
         csv_line(&row)
     }
 
-    /// One JSON line.
+    /// One JSON line (each reading's object is the report's, [`report::sweep_reading_json`]).
     pub fn jsonl_row(&self, r: &PointResult, timing: bool) -> String {
         let params: serde_json::Map<String, Value> =
             self.axes.iter().zip(&r.values).map(|(a, v)| (a.path.clone(), json!(v))).collect();
         let mut o = json!({"index": r.index, "parameters": params});
         match &r.outcome {
             Ok(readings) => {
-                o["readings"] = readings
-                    .iter()
-                    .map(|x| {
-                        let mut j = json!({"geometry": x.geometry, "name": x.name, "unit": x.unit, "value": x.value,
-                                           "error_estimate": x.value.map(|_| x.error_estimate), "converged": x.converged});
-                        if let Some(p) = &x.problem {
-                            j["problem"] = json!(p);
-                        }
-                        j
-                    })
-                    .collect();
+                o["readings"] = readings.iter().map(report::sweep_reading_json).collect();
             }
             Err(e) => o["problem"] = json!(e),
         }

@@ -7,11 +7,11 @@ use std::path::PathBuf;
 
 use serde_json::json;
 
-use crate::cli::format::plain;
 use crate::cli::{check_rtol, junit, pad_table, readings_status, ColourArgs, Target};
 use crate::comparison::sheet::{self, Sheet, SheetOptions};
 use crate::comparison::{self, ColourDifference, Comparison, Drift, Recipes, Rule, Verdict};
 use crate::instrument::plan::PlanOptions;
+use crate::report::plain;
 use crate::{Error, Result};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -417,5 +417,5 @@ fn csv_text(cmp: &[Comparison]) -> Result<String> {
             },
         ]
     });
-    crate::cli::format::csv_text(&head, rows)
+    crate::report::csv_text(&head, rows)
 }

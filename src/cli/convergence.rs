@@ -5,10 +5,10 @@ use std::path::PathBuf;
 
 use serde_json::json;
 
-use super::format::plain;
 use super::{plot, Format, Target};
 use crate::instrument::convergence::{self, ReferenceKind, Sweep, SweepOptions, DEFAULT_TOLERANCES};
 use crate::recipe::{self, Material};
+use crate::report::plain;
 use crate::{Error, Result};
 
 /// The geometries swept when none is given.
@@ -216,7 +216,7 @@ pub fn csv(sweep: &Sweep) -> Result<String> {
             r.problem.clone().unwrap_or_default(),
         ]
     });
-    super::format::csv_text(&head, rows)
+    crate::report::csv_text(&head, rows)
 }
 
 /// JSON: the sweep's settings and one object per row (null where there is no value).

@@ -10,7 +10,7 @@ use clap::{Parser, Subcommand, ValueEnum};
 use crate::colorimetry::{Conditions, Illuminant, Observer};
 use crate::instrument::plan::{Plan, PlanOptions};
 use crate::instrument::standards;
-use crate::{recipe, resolve_geometries, Error, Result};
+use crate::{recipe, report, resolve_geometries, Error, Result};
 
 pub mod batch;
 pub mod compare;
@@ -259,15 +259,15 @@ fn dispatch(cli: Cli) -> Result<()> {
                     format::table(&material, &readings, !no_timing) + &format::envelope_table(&readings, e)
                 }
                 (Format::Json, e) => {
-                    let mut doc = format::json_doc(&material, &readings, !no_timing);
+                    let mut doc = report::json_doc(&material, &readings, !no_timing);
                     doc["evaluations"] = serde_json::json!(evaluations);
                     let doc = with_baseline(doc, drift.as_deref(), baseline_file.clone());
-                    format::pretty(&match e {
+                    report::pretty(&match e {
                         None => doc,
-                        Some(e) => format::json_with_envelope(doc, e),
+                        Some(e) => report::json_with_envelope(doc, e),
                     })
                 }
-                (Format::Csv, _) => format::csv(&readings, !no_timing)?,
+                (Format::Csv, _) => report::csv(&readings, !no_timing)?,
             });
             if let (Format::Table, Some(d)) = (format, &drift) {
                 text.push_str(&batch::drift_text(d));
@@ -292,10 +292,10 @@ fn dispatch(cli: Cli) -> Result<()> {
         Command::Schema { output_format } => {
             let schema = match output_format {
                 None => recipe::schema::schema(),
-                Some(OutputSchema::Measure) => crate::output_schema::measure(),
-                Some(OutputSchema::Compare) => crate::output_schema::compare(),
-                Some(OutputSchema::Sweep) => crate::output_schema::sweep(),
-                Some(OutputSchema::Fit) => crate::output_schema::fit(),
+                Some(OutputSchema::Measure) => crate::report::schema::measure(),
+                Some(OutputSchema::Compare) => crate::report::schema::compare(),
+                Some(OutputSchema::Sweep) => crate::report::schema::sweep(),
+                Some(OutputSchema::Fit) => crate::report::schema::fit(),
             };
             let text = serde_json::to_string_pretty(&schema)
                 .map_err(|e| Error::Numeric(format!("the schema does not serialise: {e}")))?;
@@ -430,7 +430,7 @@ fn measure_batch(
             }
             t
         }
-        Format::Json => format::pretty(&with_baseline(
+        Format::Json => report::pretty(&with_baseline(
             batch::with_evaluations(batch::json_doc(&materials, &readings, how.timing), &evaluations),
             drift.as_deref(),
             how.baseline.as_ref().map(|(_, f)| f.clone()),

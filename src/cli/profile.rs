@@ -8,12 +8,12 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use serde_json::json;
 
-use super::format::plain;
 use super::plot::plot_err;
 use super::Target;
 use crate::instrument::plan::PlanOptions;
 use crate::instrument::profile::{self, Profile};
 use crate::recipe::{self, Material};
+use crate::report::plain;
 use crate::{Error, Result};
 
 /// The geometry profiled when none is given.
@@ -102,7 +102,7 @@ pub fn csv(p: &Profile) -> Result<String> {
             r.reading.evaluations.to_string(),
         ]
     });
-    super::format::csv_text(COLUMNS, rows)
+    crate::report::csv_text(COLUMNS, rows)
 }
 
 /// JSON: the material, the array and one object per pixel (null where there is no value).
