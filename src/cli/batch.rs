@@ -2,7 +2,8 @@
 //! or JSON with a material column; and `--baseline PREVIOUS.json` for one or many recipes.
 use serde_json::{json, Value};
 
-use crate::cli::{format, pad_table};
+use crate::cli::common::pad_table;
+use crate::cli::format;
 use crate::comparison::Drift;
 use crate::instrument::plan::Reading;
 use crate::recipe::Material;

@@ -7,7 +7,9 @@ use std::path::PathBuf;
 
 use serde_json::json;
 
-use crate::cli::{check_rtol, junit, pad_table, readings_status, ColourArgs, Target};
+use crate::cli::common::{check_rtol, pad_table, readings_status, ColourArgs};
+use crate::cli::junit;
+use crate::cli::output::Target;
 use crate::comparison::sheet::{self, Sheet, SheetOptions};
 use crate::comparison::{self, ColourDifference, Comparison, Drift, Recipes, Rule, Verdict};
 use crate::instrument::plan::PlanOptions;

@@ -5,7 +5,9 @@ use std::path::PathBuf;
 
 use serde_json::json;
 
-use super::{plot, Format, Target};
+use super::common::{pad_table, Format};
+use super::output::Target;
+use super::plot;
 use crate::instrument::convergence::{self, ReferenceKind, Sweep, SweepOptions, DEFAULT_TOLERANCES};
 use crate::recipe::{self, Material};
 use crate::report::plain;
@@ -163,7 +165,7 @@ pub fn table(material: &Material, sweep: &Sweep) -> String {
         sweep.options.min_seconds * 1e3,
         sweep.options.max_repetitions
     ));
-    s.push_str(&super::pad_table(&rows, &[0, 3, 4, 5, 6, 7]));
+    s.push_str(&pad_table(&rows, &[0, 3, 4, 5, 6, 7]));
     if sweep.rows.iter().any(|r| !r.converged) {
         s.push_str("* evaluation budget exhausted before the tolerance was met\n");
     }

@@ -4,9 +4,9 @@ use std::path::PathBuf;
 
 use serde_json::{json, Value};
 
+use crate::cli::common::{check_rtol, Format};
 use crate::cli::compare::parse_delimiter;
 use crate::cli::output::{print, Target};
-use crate::cli::{check_rtol, Format};
 use crate::comparison::sheet::{self, SheetOptions};
 use crate::fit::{self, FitOptions, FitReport, FreeParameter, TargetReading};
 use crate::{recipe, Error, Result};

@@ -1,6 +1,7 @@
 //! The text tables of `measure` for people (the JSON and CSV documents are the library's, `crate::report`): the
 //! readings, the tolerance envelope, durations. A reading without a finite value is printed as "—", with the
 //! reason: never as NaN or inf.
+use crate::cli::common::pad_table;
 use crate::instrument::envelope::Envelope;
 use crate::instrument::plan::Reading;
 use crate::recipe::Material;
@@ -65,7 +66,7 @@ pub fn table(material: &Material, readings: &[Reading], timing: bool) -> String 
     }
     let mut s = format!("{} ({})\n{}\n\n", material.name, material.file, material.brdf.describe());
     // numbers right-aligned, words left-aligned
-    s.push_str(&super::pad_table(&rows, &[2, 4, 5, 6]));
+    s.push_str(&pad_table(&rows, &[2, 4, 5, 6]));
     if readings.iter().any(|r| !r.converged && r.value.is_some()) {
         s.push_str("* not converged: a budget (evaluations or wall-clock time, see the notes) ran out before the tolerance was met\n");
     }

@@ -8,8 +8,9 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use serde_json::json;
 
+use super::common::{check_rtol, readings_status};
+use super::output::Target;
 use super::plot::plot_err;
-use super::Target;
 use crate::instrument::plan::PlanOptions;
 use crate::instrument::profile::{self, Profile};
 use crate::recipe::{self, Material};
@@ -53,7 +54,7 @@ pub struct ProfileArgs {
 }
 
 pub fn run(args: ProfileArgs) -> Result<()> {
-    super::check_rtol(args.rtol)?;
+    check_rtol(args.rtol)?;
     let target = Target::new(args.output.as_deref(), "--output")?;
     if let Some(p) = &args.plot {
         super::plot::check_plot_path(p, "--plot")?;
@@ -81,7 +82,7 @@ pub fn run(args: ProfileArgs) -> Result<()> {
     }
     target.write(&text)?;
     let readings: Vec<crate::Reading> = prof.rows.iter().map(|r| r.reading.clone()).collect();
-    super::readings_status(&readings, args.allow_unconverged)
+    readings_status(&readings, args.allow_unconverged)
 }
 
 /// The columns of the CSV, in order (also the keys of a JSON row).

@@ -4,7 +4,8 @@
 use std::io::IsTerminal;
 use std::path::PathBuf;
 
-use crate::cli::{check_rtol, Target};
+use crate::cli::common::check_rtol;
+use crate::cli::output::Target;
 use crate::instrument::plan::PlanOptions;
 use crate::sweep::{self, Design, Sweep};
 use crate::{resolve_geometries, Error, Result};
