@@ -9,9 +9,9 @@ use serde_json::json;
 
 use crate::cli::common::{check_rtol, pad_table, readings_status, ColourArgs};
 use crate::cli::junit;
-use crate::cli::output::Target;
+use crate::cli::output::OutputTarget;
 use crate::comparison::sheet::{self, Sheet, SheetOptions};
-use crate::comparison::{self, ColourDifference, Comparison, Drift, Recipes, Rule, Verdict};
+use crate::comparison::{self, ColourDifference, Comparison, Drift, Recipes, Verdict, VerdictRule};
 use crate::instrument::plan::PlanOptions;
 use crate::report::plain;
 use crate::{Error, Result};
@@ -85,7 +85,7 @@ pub fn parse_delimiter(s: &str) -> Result<u8> {
 }
 
 pub fn run(a: CompareArgs) -> Result<()> {
-    let rule = Rule { k: a.k, tolerance: a.tolerance };
+    let rule = VerdictRule { k: a.k, tolerance: a.tolerance };
     rule.check()?;
     check_rtol(a.rtol)?;
     if let Some(p) = &a.plot {
@@ -100,7 +100,7 @@ pub fn run(a: CompareArgs) -> Result<()> {
         }
     }
     let colour = a.colour.conditions()?;
-    let target = Target::new(a.output.as_deref(), "--output")?;
+    let target = OutputTarget::new(a.output.as_deref(), "--output")?;
     let (default, sheet_path) = match a.paths.as_slice() {
         [s] => (None, s.clone()),
         [r, s] => (Some(r.clone()), s.clone()),
@@ -192,7 +192,7 @@ pub fn summary(cmp: &[Comparison]) -> String {
     )
 }
 
-fn table(sheet: &Sheet, cmp: &[Comparison], rule: &Rule, drift: &[Drift], with_baseline: bool) -> String {
+fn table(sheet: &Sheet, cmp: &[Comparison], rule: &VerdictRule, drift: &[Drift], with_baseline: bool) -> String {
     let head = [
         "sample",
         "material",
@@ -329,7 +329,7 @@ fn de_table(des: &[ColourDifference]) -> String {
 fn json_text(
     sheet: &Sheet,
     cmp: &[Comparison],
-    rule: &Rule,
+    rule: &VerdictRule,
     drift: &[Drift],
     baseline: Option<&PathBuf>,
     des: &[ColourDifference],

@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use serde_json::json;
 
 use super::common::{pad_table, Format};
-use super::output::Target;
+use super::output::OutputTarget;
 use super::plot;
 use crate::instrument::convergence::{self, ReferenceKind, Sweep, SweepOptions, DEFAULT_TOLERANCES};
 use crate::recipe::{self, Material};
@@ -63,7 +63,7 @@ pub fn run(args: ConvergenceArgs) -> Result<()> {
     if args.max_repetitions == 0 {
         return Err(Error::Usage("--max-repetitions must be at least 1".into()));
     }
-    let target = Target::new(args.output.as_deref(), "--output")?;
+    let target = OutputTarget::new(args.output.as_deref(), "--output")?;
     if let Some(p) = &args.plot {
         plot::check_plot_path(p, "--plot")?;
         if args.output.as_deref() == Some(p.as_path()) {

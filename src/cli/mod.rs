@@ -33,7 +33,7 @@ pub mod sweep;
 
 use args::{Cli, Command, OutputSchema};
 use common::{check_rtol, readings_status, Format};
-use output::{print, Target, STDOUT};
+use output::{print, OutputTarget, STDOUT};
 
 /// Run the CLI; returns the process exit status.
 pub fn run<I, T>(args: I) -> i32
@@ -104,7 +104,7 @@ fn dispatch(cli: Cli) -> Result<()> {
                     "--envelope is reported in the table and JSON formats; use --format table or json".into(),
                 ));
             }
-            let target = Target::new(output.as_deref(), "--output")?;
+            let target = OutputTarget::new(output.as_deref(), "--output")?;
             let baseline_file = baseline.as_ref().map(|p| p.display().to_string());
             let baseline = baseline.as_deref().map(crate::comparison::load_baseline).transpose()?;
             let options = PlanOptions { rtol, max_evals, max_seconds, colour, ..PlanOptions::default() };
@@ -236,7 +236,7 @@ fn measure_batch(
     geometry_files: &[PathBuf],
     options: &PlanOptions,
     how: &Batch,
-    target: &Target,
+    target: &OutputTarget,
 ) -> Result<()> {
     let files = crate::batch::recipe_files(paths)?;
     let materials = crate::batch::load_all(&files)?;

@@ -9,7 +9,7 @@ use plotters::prelude::*;
 use serde_json::json;
 
 use super::common::{check_rtol, readings_status};
-use super::output::Target;
+use super::output::OutputTarget;
 use super::plot::plot_err;
 use crate::instrument::plan::PlanOptions;
 use crate::instrument::profile::{self, Profile};
@@ -55,7 +55,7 @@ pub struct ProfileArgs {
 
 pub fn run(args: ProfileArgs) -> Result<()> {
     check_rtol(args.rtol)?;
-    let target = Target::new(args.output.as_deref(), "--output")?;
+    let target = OutputTarget::new(args.output.as_deref(), "--output")?;
     if let Some(p) = &args.plot {
         super::plot::check_plot_path(p, "--plot")?;
         if args.output.as_deref() == Some(p.as_path()) {
