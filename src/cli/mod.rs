@@ -1,12 +1,12 @@
 //! The command-line layer: argument parsing and output formatting only. Every computation lives in the
-//! library modules; this module turns their results into tables, JSON or CSV, and their errors into a
-//! message on stderr and a non-zero exit status: 2 for bad input, unreadable files or usage; 1 when a reading has
-//! no finite value or a comparison fails.
+//! library modules; this module turns their results into tables, JSON or CSV (the readings' documents are
+//! written by `crate::report`), and their errors into a message on stderr and a non-zero exit status: 2 for bad
+//! input, unreadable files or usage; 1 when a reading has no finite value or a comparison fails.
 //!
 //! The folder, by stage: [`args`] defines the command line (clap), [`common`] holds what the subcommands
 //! share, this file runs a command line ([`run`]) and dispatches it; a file per subcommand (`batch` for
 //! `measure` of many recipes, [`compare`], [`convergence`], [`fit`], [`pictures`] for `plot`, [`profile`],
-//! [`sweep`]) parses its own arguments and formats its results; [`format`] writes the text tables of
+//! [`sweep`]) parses its own arguments and formats its results; [`format`](mod@format) writes the text tables of
 //! `measure`, [`output`] the files, [`plot`] the pictures, [`junit`] the JUnit XML of `compare`.
 use std::io::Write;
 use std::path::PathBuf;

@@ -6,8 +6,8 @@
 //!
 //! The folder:
 //! * `mod.rs`: the numbers ([`decimals`], [`plain`]), one reading and one material's readings as JSON
-//!   ([`reading_json`], [`json_doc`], [`json`], [`pretty`], [`json_with_envelope`]), a sweep's reading
-//!   ([`sweep_reading_json`]), and CSV ([`csv`], [`csv_text`]);
+//!   ([`reading_json`], [`json_doc`], [`json()`], [`pretty`], [`json_with_envelope`]), a sweep's reading
+//!   ([`sweep_reading_json`]), and CSV ([`csv()`], [`csv_text`]);
 //! * [`schema`]: the JSON Schemas of the outputs.
 pub mod schema;
 
@@ -98,12 +98,11 @@ pub fn json_with_envelope(mut doc: serde_json::Value, envelopes: &[Option<Envelo
     doc
 }
 
-/// The fields of a reading in a line of `sweep --format jsonl` (the schema is [`schema::sweep`]): those of
-/// [`reading_json`] without the quantity, the evaluation count, the note and the time.
+/// The fields [`sweep_reading_json`] keeps.
 const SWEEP_READING_FIELDS: [&str; 7] = ["geometry", "name", "unit", "value", "error_estimate", "converged", "problem"];
 
-/// One reading as a line of `sweep --format jsonl` writes it: [`reading_json`]'s object, [`SWEEP_READING_FIELDS`]
-/// only.
+/// One reading as a line of `sweep --format jsonl` writes it (the schema is [`schema::sweep`]): the object of
+/// [`reading_json`] without the quantity, the evaluation count, the note and the time.
 pub fn sweep_reading_json(r: &Reading) -> serde_json::Value {
     let mut o = reading_json(r, false);
     if let Some(fields) = o.as_object_mut() {
