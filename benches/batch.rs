@@ -23,7 +23,7 @@ use glossmeter::batch::measure_many;
 use glossmeter::instrument::plan::{Plan, PlanOptions, Reading};
 use glossmeter::instrument::standards::StandardGeometry;
 use glossmeter::recipe::{self, Material};
-use glossmeter::sweep::{parse_vary, Design, PointResult, Sweep};
+use glossmeter::sweep::{parse_vary, PointResult, Sweep, SweepDesign};
 use glossmeter::{resolve_geometries, DEFAULT_PANEL};
 use rayon::prelude::*;
 
@@ -247,7 +247,7 @@ fn main() {
 
     let template: serde_json::Value = serde_json::from_str(&texts[1]).expect("json");
     let axes = vec![parse_vary("/roughness=0.02..0.5:100").expect("axis")];
-    let sw = Sweep::new(template, "bench.json", axes, Design::Grid, geos.clone(), opts.clone()).expect("sweep");
+    let sw = Sweep::new(template, "bench.json", axes, SweepDesign::Grid, geos.clone(), opts.clone()).expect("sweep");
     let names = ["`Sweep::run` (`Plan::run_all` per chunk)", "baseline: chunks of `run_point`"];
     let mut rows: Vec<Vec<Row>> = (0..2).map(|_| (1..=2).map(Row::new).collect()).collect();
     let mut out: Vec<Vec<String>> = vec![vec![String::new(); 2]; 2];

@@ -154,7 +154,7 @@ impl TargetReading {
     }
 }
 
-/// Targets from a parsed glossmeter sheet (`instrument::sheet`, every layout `compare` reads): the rows of one
+/// Targets from a parsed glossmeter sheet (`comparison::sheet`, every layout `compare` reads): the rows of one
 /// sample (`sample`, or the sheet's only sample), grouped by reading as `compare` groups them
 /// ([`crate::comparison::group_rows`]). A group's value is the mean x̄ of its n repeated readings and its
 /// uncertainty is √(u² + s²/n), u the largest stated `uncertainty` of its rows (an allowance that averaging
@@ -163,7 +163,7 @@ impl TargetReading {
 /// sheet reader marks them) are left out and named in the returned notes. A sample the sheet lacks, or a
 /// sheet of several samples without `sample`, is a usage error naming `--sample`.
 pub fn targets_from_sheet(
-    sheet: &crate::instrument::sheet::Sheet,
+    sheet: &crate::comparison::sheet::Sheet,
     sample: Option<&str>,
 ) -> Result<(Vec<TargetReading>, Vec<String>)> {
     let mut samples: Vec<&str> = Vec::new();

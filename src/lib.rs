@@ -17,7 +17,7 @@
 //! * [`instrument`]: aperture geometry, the standards as data, the measurement plan and the readings.
 //! * [`api`]: the one-call API ([`measure`], the default panel, geometry resolution).
 //! * [`batch`], [`sweep`]: many recipes at once, and sweeps over a template's JSON Pointer paths (streamed, sharded).
-//! * [`output_schema`]: JSON Schemas of the `measure`, `compare` and `sweep` outputs.
+//! * [`report`]: the readings as documents (JSON, JSON lines, CSV) and the JSON Schemas of the outputs.
 //! * [`comparison`]: predictions beside instrument sheets: statistics, verdicts, many samples, baselines.
 //! * `cli` (feature `cli`, on by default): the thin command-line layer. The library builds and works without
 //!   it and its dependencies (clap, plotters): `cargo build --lib --no-default-features`.
@@ -36,10 +36,10 @@ pub mod input;
 pub mod instrument;
 pub mod measured;
 pub mod optics;
-pub mod output_schema;
 pub mod quadrature;
 pub mod recipe;
 pub mod registry;
+pub mod report;
 pub mod spectrum;
 pub mod sweep;
 

@@ -23,7 +23,7 @@ use serde_json::{json, Value};
 use crate::instrument::method::Target;
 use crate::instrument::plan::{Execution, Plan, PlanOptions, Planner, Reading};
 use crate::instrument::standards::StandardGeometry;
-use crate::{recipe, registry, Error, Result};
+use crate::{recipe, registry, report, Error, Result};
 
 /// Points per thread in one chunk of [`Sweep::run`]: the rows of a chunk are kept until it ends (constant
 /// memory: a few hundred rows), and each chunk ends with at most one integral running alone per thread.
@@ -31,7 +31,7 @@ const CHUNK_PER_THREAD: u64 = 64;
 
 /// One varied parameter: a JSON Pointer into the template, its range and (for a grid) its number of values.
 #[derive(Clone, Debug, PartialEq)]
-pub struct Axis {
+pub struct SweepAxis {
     pub path: String,
     pub lo: f64,
     pub hi: f64,
@@ -42,7 +42,7 @@ pub struct Axis {
 }
 
 /// `PATH=LO..HI:N` (grid) or `PATH=LO..HI` (Latin hypercube).
-pub fn parse_vary(s: &str) -> Result<Axis> {
+pub fn parse_vary(s: &str) -> Result<SweepAxis> {
     let bad =
         |m: &str| Error::Usage(format!("--vary `{s}`: {m} (expected PATH=LO..HI:N, e.g. /coat/roughness=0.01..0.3:8)"));
     let (path, range) = s.rsplit_once('=').ok_or_else(|| bad("no `=`"))?;
@@ -64,7 +64,7 @@ pub fn parse_vary(s: &str) -> Result<Axis> {
     if n == Some(0) {
         return Err(bad("N must be at least 1"));
     }
-    Ok(Axis { path: path.to_string(), lo, hi, n, log: false })
+    Ok(SweepAxis { path: path.to_string(), lo, hi, n, log: false })
 }
 
 /// `K/M` with 1 ≤ K ≤ M.
@@ -81,7 +81,7 @@ pub fn parse_shard(s: &str) -> Result<(u64, u64)> {
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Design {
+pub enum SweepDesign {
     /// The Cartesian product of the axes' grids.
     Grid,
     /// A Latin hypercube of n points drawn with a seed.
@@ -129,8 +129,8 @@ pub struct Sweep {
     pub template: Value,
     /// The template's file (for messages and the rows' provenance).
     pub file: String,
-    pub axes: Vec<Axis>,
-    pub design: Design,
+    pub axes: Vec<SweepAxis>,
+    pub design: SweepDesign,
     pub geometries: Vec<StandardGeometry>,
     pub options: PlanOptions,
 }
@@ -141,8 +141,8 @@ impl Sweep {
     pub fn new(
         template: Value,
         file: &str,
-        axes: Vec<Axis>,
-        design: Design,
+        axes: Vec<SweepAxis>,
+        design: SweepDesign,
         geometries: Vec<StandardGeometry>,
         options: PlanOptions,
     ) -> Result<Sweep> {
@@ -168,10 +168,10 @@ impl Sweep {
                 return Err(Error::Usage(format!("--log {}: logarithmic spacing needs LO > 0, got {}", a.path, a.lo)));
             }
             match (design, a.n) {
-                (Design::Grid, None) => {
+                (SweepDesign::Grid, None) => {
                     return Err(Error::Usage(format!("--vary {}: a grid needs :N (or use --lhs N)", a.path)))
                 }
-                (Design::Lhs { .. }, Some(_)) => {
+                (SweepDesign::Lhs { .. }, Some(_)) => {
                     return Err(Error::Usage(format!(
                         "--vary {}: with --lhs the number of points is --lhs N; drop :N",
                         a.path
@@ -180,7 +180,7 @@ impl Sweep {
                 _ => {}
             }
         }
-        if let Design::Lhs { n: 0, .. } = design {
+        if let SweepDesign::Lhs { n: 0, .. } = design {
             return Err(Error::Usage("--lhs N must be at least 1".into()));
         }
         let s = Sweep { template, file: file.to_string(), axes, design, geometries, options };
@@ -190,8 +190,8 @@ impl Sweep {
 
     fn checked_len(&self) -> Result<u64> {
         match self.design {
-            Design::Lhs { n, .. } => Ok(n),
-            Design::Grid => self.axes.iter().try_fold(1u64, |p, a| {
+            SweepDesign::Lhs { n, .. } => Ok(n),
+            SweepDesign::Grid => self.axes.iter().try_fold(1u64, |p, a| {
                 p.checked_mul(a.n.expect("grid axes have n"))
                     .ok_or_else(|| Error::Usage("the grid has more than 2^64 points".into()))
             }),
@@ -216,7 +216,7 @@ impl Sweep {
 
     /// The parameter values of point i.
     pub fn point(&self, i: u64) -> Vec<f64> {
-        let map = |a: &Axis, t: f64| -> f64 {
+        let map = |a: &SweepAxis, t: f64| -> f64 {
             // The ends exactly (exp(ln LO) is not always LO).
             if t <= 0.0 {
                 return a.lo;
@@ -231,7 +231,7 @@ impl Sweep {
             }
         };
         match self.design {
-            Design::Grid => {
+            SweepDesign::Grid => {
                 let mut rest = i;
                 let mut out = vec![0.0; self.axes.len()];
                 for (d, a) in self.axes.iter().enumerate().rev() {
@@ -242,7 +242,7 @@ impl Sweep {
                 }
                 out
             }
-            Design::Lhs { n, seed } => self
+            SweepDesign::Lhs { n, seed } => self
                 .axes
                 .iter()
                 .enumerate()
@@ -371,8 +371,8 @@ impl Sweep {
         for c in cells {
             match c {
                 Some((v, e)) => {
-                    row.push(v.to_string());
-                    row.push(e.to_string());
+                    row.push(report::plain(v));
+                    row.push(report::plain(e));
                 }
                 None => {
                     row.push(String::new());
@@ -387,24 +387,14 @@ impl Sweep {
         csv_line(&row)
     }
 
-    /// One JSON line.
+    /// One JSON line (each reading's object is the report's, [`report::sweep_reading_json`]).
     pub fn jsonl_row(&self, r: &PointResult, timing: bool) -> String {
         let params: serde_json::Map<String, Value> =
             self.axes.iter().zip(&r.values).map(|(a, v)| (a.path.clone(), json!(v))).collect();
         let mut o = json!({"index": r.index, "parameters": params});
         match &r.outcome {
             Ok(readings) => {
-                o["readings"] = readings
-                    .iter()
-                    .map(|x| {
-                        let mut j = json!({"geometry": x.geometry, "name": x.name, "unit": x.unit, "value": x.value,
-                                           "error_estimate": x.value.map(|_| x.error_estimate), "converged": x.converged});
-                        if let Some(p) = &x.problem {
-                            j["problem"] = json!(p);
-                        }
-                        j
-                    })
-                    .collect();
+                o["readings"] = readings.iter().map(report::sweep_reading_json).collect();
             }
             Err(e) => o["problem"] = json!(e),
         }
@@ -535,7 +525,7 @@ mod tests {
         }
     }
 
-    fn sweep(axes: Vec<Axis>, design: Design) -> Result<Sweep> {
+    fn sweep(axes: Vec<SweepAxis>, design: SweepDesign) -> Result<Sweep> {
         let t: Value = serde_json::from_str(r#"{"model": "lambert", "albedo": 0.5}"#).unwrap();
         Sweep::new(t, "t.json", axes, design, vec![], PlanOptions::default())
     }
@@ -543,21 +533,21 @@ mod tests {
     #[test]
     fn grid_and_hypercube_points() {
         let a = parse_vary("/albedo=0.1..0.9:5").unwrap();
-        let s = sweep(vec![a.clone()], Design::Grid).unwrap();
+        let s = sweep(vec![a.clone()], SweepDesign::Grid).unwrap();
         let v: Vec<f64> = (0..5).map(|i| s.point(i)[0]).collect();
         assert_eq!(v, [0.1, 0.30000000000000004, 0.5, 0.7000000000000001, 0.9]);
         let mut l = a.clone();
         l.log = true;
-        let s = sweep(vec![l], Design::Grid).unwrap();
+        let s = sweep(vec![l], SweepDesign::Grid).unwrap();
         assert!((s.point(2)[0] - 0.3).abs() < 1e-15 && s.point(4)[0] == 0.9);
         // A Latin hypercube puts exactly one point in each of the n cells of every axis.
-        let b = Axis { n: None, ..a.clone() };
-        let s = sweep(vec![b], Design::Lhs { n: 8, seed: 7 }).unwrap();
+        let b = SweepAxis { n: None, ..a.clone() };
+        let s = sweep(vec![b], SweepDesign::Lhs { n: 8, seed: 7 }).unwrap();
         let mut cells: Vec<usize> = (0..8).map(|i| ((s.point(i)[0] - 0.1) / 0.8 * 8.0) as usize).collect();
         cells.sort();
         assert_eq!(cells, (0..8).collect::<Vec<_>>());
         // Shards tile the range.
-        let s = sweep(vec![parse_vary("/albedo=0..1:10").unwrap()], Design::Grid).unwrap();
+        let s = sweep(vec![parse_vary("/albedo=0..1:10").unwrap()], SweepDesign::Grid).unwrap();
         let r: Vec<_> = (1..=3).map(|k| s.shard(k, 3)).collect();
         assert_eq!(r, [0..3, 3..6, 6..10]);
     }
@@ -570,8 +560,8 @@ mod tests {
         for bad in ["0/3", "4/3", "1/0", "x"] {
             assert!(parse_shard(bad).is_err(), "{bad}");
         }
-        assert!(sweep(vec![parse_vary("/nope=0..1:2").unwrap()], Design::Grid).is_err());
-        assert!(sweep(vec![parse_vary("/model=0..1:2").unwrap()], Design::Grid).is_err());
-        assert!(sweep(vec![parse_vary("/albedo=0..1").unwrap()], Design::Grid).is_err());
+        assert!(sweep(vec![parse_vary("/nope=0..1:2").unwrap()], SweepDesign::Grid).is_err());
+        assert!(sweep(vec![parse_vary("/model=0..1:2").unwrap()], SweepDesign::Grid).is_err());
+        assert!(sweep(vec![parse_vary("/albedo=0..1").unwrap()], SweepDesign::Grid).is_err());
     }
 }

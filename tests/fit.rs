@@ -433,8 +433,8 @@ fn bad_input_is_refused_with_exit_2_naming_the_argument() {
 /// the fit's default (None); a sheet of two samples needs --sample.
 #[test]
 fn sheet_rows_become_targets() {
+    use glossmeter::comparison::sheet::{parse, SheetOptions};
     use glossmeter::fit::targets_from_sheet;
-    use glossmeter::instrument::sheet::{parse, SheetOptions};
     let text = "sample,geometry,quantity,value,uncertainty\n\
                 a,astm-d523-60,gloss,60,0.3\na,astm-d523-60,gloss,61,0.3\na,astm-d523-60,gloss,62,0.3\n\
                 a,astm-d523-20,gloss,30,\nb,astm-d523-60,gloss,40,0.2\n";

@@ -158,7 +158,7 @@ fn sheet_seed_14908795379597200520_is_not_a_false_positive() {
 }
 
 fn sheet_error(text: &str) -> Result<(), String> {
-    glossmeter::instrument::sheet::parse(text, "fuzz.csv", &Default::default()).map(|_| ()).map_err(|e| e.to_string())
+    glossmeter::comparison::sheet::parse(text, "fuzz.csv", &Default::default()).map(|_| ()).map_err(|e| e.to_string())
 }
 
 /// Found by the campaign (seed 7, case 550): a sheet cell holding quotes (`89."NaN"`) was echoed inside

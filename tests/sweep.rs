@@ -253,14 +253,14 @@ fn the_progress_bar_is_drawn_on_a_terminal_only() {
 #[test]
 fn sweep_rows_are_those_of_points_run_alone() {
     use glossmeter::instrument::plan::PlanOptions;
-    use glossmeter::sweep::{parse_vary, Design, Sweep};
+    use glossmeter::sweep::{parse_vary, Sweep, SweepDesign};
     let template: serde_json::Value =
         serde_json::from_str(r#"{"model": "microfacet", "distribution": "ggx", "roughness": 0.1, "ior": 1.5}"#)
             .unwrap();
     let geos = glossmeter::resolve_geometries(&["astm-d523-20", "astm-e430-30"], &[] as &[&str]).unwrap();
     let axes = vec![parse_vary("/roughness=-0.05..0.5:12").unwrap()];
     let opts = PlanOptions { rtol: 1e-5, ..Default::default() };
-    let s = Sweep::new(template, "t.json", axes, Design::Grid, geos, opts).unwrap();
+    let s = Sweep::new(template, "t.json", axes, SweepDesign::Grid, geos, opts).unwrap();
     let alone: String = (0..s.len()).map(|i| s.csv_row(&s.run_point(i), false)).collect();
     assert!(alone.contains("out of range"), "point 0 is invalid: {alone}");
     for k in [1, 2] {

@@ -14,7 +14,7 @@ use std::sync::{Arc, OnceLock};
 use glossmeter::instrument::plan::{PlanOptions, Reading};
 use glossmeter::instrument::standards::{self as stds, StandardGeometry};
 use glossmeter::recipe::{self, Material};
-use glossmeter::Error;
+use glossmeter::{report, Error};
 use pyo3::exceptions::{PyFileNotFoundError, PyOSError, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyString};
@@ -61,10 +61,37 @@ fn json_text(py: Python<'_>, obj: &Bound<'_, PyAny>) -> PyResult<String> {
     json.call_method1("dumps", (obj,))?.extract()
 }
 
-/// JSON text as Python objects (`json.loads`).
+/// A JSON value as the Python objects `json.loads` makes of its text, built directly: null → None, a boolean →
+/// bool, an integer → int, any other number → float (the same double: serde_json writes the shortest decimal
+/// that reads back to it), a string → str, an array → list, an object → dict with the keys in the value's
+/// order (the order of its text).
 fn from_json<'py>(py: Python<'py>, v: &serde_json::Value) -> PyResult<Bound<'py, PyAny>> {
-    let text = serde_json::to_string(v).map_err(|e| PyRuntimeError::new_err(e.to_string()))?;
-    py.import("json")?.call_method1("loads", (text,))
+    use serde_json::Value;
+    Ok(match v {
+        Value::Null => py.None().into_bound(py),
+        Value::Bool(b) => b.into_pyobject(py)?.to_owned().into_any(),
+        Value::Number(n) => match (n.as_u64(), n.as_i64(), n.as_f64()) {
+            (Some(u), _, _) => u.into_pyobject(py)?.into_any(),
+            (None, Some(i), _) => i.into_pyobject(py)?.into_any(),
+            (None, None, Some(f)) => f.into_pyobject(py)?.into_any(),
+            (None, None, None) => return Err(PyRuntimeError::new_err(format!("a JSON number out of range: {n}"))),
+        },
+        Value::String(s) => s.into_pyobject(py)?.into_any(),
+        Value::Array(items) => {
+            let list = PyList::empty(py);
+            for x in items {
+                list.append(from_json(py, x)?)?;
+            }
+            list.into_any()
+        }
+        Value::Object(fields) => {
+            let dict = PyDict::new(py);
+            for (k, x) in fields {
+                dict.set_item(k, from_json(py, x)?)?;
+            }
+            dict.into_any()
+        }
+    })
 }
 
 /// A recipe given as a dict, a JSON string or a path (str or os.PathLike).
@@ -161,17 +188,14 @@ pub(crate) fn load_geometries(
     }
 }
 
-/// The readings as the list of dicts of `measure --format json` (through the CLI's own formatter, so the
-/// fields cannot drift apart).
-pub(crate) fn readings_to_py<'py>(
-    py: Python<'py>,
-    material: &Material,
-    readings: &[Reading],
-    timing: bool,
-) -> PyResult<Bound<'py, PyList>> {
-    let text = glossmeter::cli::format::json(material, readings, timing);
-    let doc = py.import("json")?.call_method1("loads", (text,))?;
-    Ok(doc.get_item("readings")?.cast_into::<PyList>()?)
+/// The readings as the list of dicts of `measure --format json` (each built from the library's reading object,
+/// `report::reading_json`, which that output writes, so the fields cannot drift apart).
+pub(crate) fn readings_to_py<'py>(py: Python<'py>, readings: &[Reading], timing: bool) -> PyResult<Bound<'py, PyList>> {
+    let list = PyList::empty(py);
+    for r in readings {
+        list.append(from_json(py, &report::reading_json(r, timing))?)?;
+    }
+    Ok(list)
 }
 
 /// Compile and run the plan without holding the GIL (the BRDF of `measure_brdf` takes it back per batch).
@@ -223,7 +247,7 @@ fn measure<'py>(
     let material = guarded(|| load_recipe(py, recipe))?;
     let geos = guarded(|| load_geometries(py, geometries))?;
     let readings = run_plan(py, material.brdf.clone(), geos, rtol, false)?;
-    guarded(|| readings_to_py(py, &material, &readings, timing))
+    guarded(|| readings_to_py(py, &readings, timing))
 }
 
 /// standards() -> list[dict]: every shipped geometry, as in `standards/*.json` (with the provenance of

@@ -13,7 +13,6 @@ use std::sync::Mutex;
 use glossmeter::brdf::{Brdf, Lobe, Tail, Term, TermKind};
 use glossmeter::colorimetry::weighting::Weighting;
 use glossmeter::instrument::plan::{Plan, PlanOptions, Target};
-use glossmeter::recipe::Material;
 use glossmeter::spectrum::Sampling;
 use glossmeter::Vec3;
 use numpy::{PyArray1, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArrayMethods};
@@ -448,9 +447,7 @@ pub fn measure_brdf<'py>(
     if let Some(e) = brdf.take_error() {
         return Err(e);
     }
-    let material =
-        Material { name: name.clone(), file: "<python>".into(), brdf: brdf.clone(), json: serde_json::Value::Null };
-    let list = guarded(|| readings_to_py(py, &material, &readings, timing))?;
+    let list = guarded(|| readings_to_py(py, &readings, timing))?;
     if let Some(note) = probe_note {
         for d in list.iter() {
             let note = match d.get_item("note") {

@@ -2,10 +2,12 @@
 //! or JSON with a material column; and `--baseline PREVIOUS.json` for one or many recipes.
 use serde_json::{json, Value};
 
-use crate::cli::{format, pad_table};
+use crate::cli::common::pad_table;
+use crate::cli::format;
 use crate::comparison::Drift;
 use crate::instrument::plan::Reading;
 use crate::recipe::Material;
+use crate::report;
 use crate::{Error, Result};
 
 pub fn table(materials: &[Material], readings: &[Vec<Reading>], timing: bool) -> String {
@@ -20,7 +22,7 @@ pub fn table(materials: &[Material], readings: &[Vec<Reading>], timing: bool) ->
             let mut row = vec![m.name.clone(), r.geometry.clone(), r.name.clone()];
             match r.value {
                 Some(v) => {
-                    row.push(format!("{:.*}", format::decimals(r.error_estimate), v));
+                    row.push(format!("{:.*}", report::decimals(r.error_estimate), v));
                     row.push(r.unit.clone());
                     row.push(format!("{:.1e}", r.error_estimate));
                 }
@@ -68,7 +70,7 @@ pub fn json_doc(materials: &[Material], readings: &[Vec<Reading>], timing: bool)
     let mut all = vec![];
     for (m, rs) in materials.iter().zip(readings) {
         for r in rs {
-            let mut r = format::reading_json(r, timing);
+            let mut r = report::reading_json(r, timing);
             r["material"] = json!(m.name);
             r["file"] = json!(m.file);
             all.push(r);
@@ -98,7 +100,7 @@ pub fn csv(materials: &[Material], readings: &[Vec<Reading>], timing: bool) -> R
     let mut head: Option<Vec<String>> = None;
     let mut rows = vec![];
     for (m, rs) in materials.iter().zip(readings) {
-        let one = format::csv(rs, timing)?;
+        let one = report::csv(rs, timing)?;
         let mut rdr = csv::ReaderBuilder::new().has_headers(false).from_reader(one.as_bytes());
         for (j, rec) in rdr.records().enumerate() {
             let rec = rec.map_err(err)?;
@@ -114,7 +116,7 @@ pub fn csv(materials: &[Material], readings: &[Vec<Reading>], timing: bool) -> R
         }
     }
     match head {
-        Some(h) => format::csv_text(&h.iter().map(String::as_str).collect::<Vec<_>>(), rows),
+        Some(h) => report::csv_text(&h.iter().map(String::as_str).collect::<Vec<_>>(), rows),
         None => Ok(String::new()),
     }
 }

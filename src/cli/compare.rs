@@ -1,17 +1,19 @@
 //! `glossmeter compare`: predictions set beside an instrument sheet, one table, one summary and one exit
 //! status for all its samples. The reading of the sheet, the statistics, the verdicts and the baseline checks
-//! are library functions (`instrument::sheet`, `comparison`); this module parses the arguments and formats.
+//! are library functions (`comparison::sheet`, `comparison`); this module parses the arguments and formats.
 //! Colour sheets (L*, a*, b* on colour geometries) are predicted by the same plan, and each (sample, geometry)
 //! gets its CIEDE2000 ΔE00 (`comparison::colour_differences`; `--max-de00` makes it the check).
 use std::path::PathBuf;
 
 use serde_json::json;
 
-use crate::cli::format::plain;
-use crate::cli::{check_rtol, junit, pad_table, readings_status, ColourArgs, Target};
-use crate::comparison::{self, ColourDifference, Comparison, Drift, Recipes, Rule, Verdict};
+use crate::cli::common::{check_rtol, pad_table, readings_status, ColourArgs};
+use crate::cli::junit;
+use crate::cli::output::OutputTarget;
+use crate::comparison::sheet::{self, Sheet, SheetOptions};
+use crate::comparison::{self, ColourDifference, Comparison, Drift, Recipes, Verdict, VerdictRule};
 use crate::instrument::plan::PlanOptions;
-use crate::instrument::sheet::{self, Sheet, SheetOptions};
+use crate::report::plain;
 use crate::{Error, Result};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -83,7 +85,7 @@ pub fn parse_delimiter(s: &str) -> Result<u8> {
 }
 
 pub fn run(a: CompareArgs) -> Result<()> {
-    let rule = Rule { k: a.k, tolerance: a.tolerance };
+    let rule = VerdictRule { k: a.k, tolerance: a.tolerance };
     rule.check()?;
     check_rtol(a.rtol)?;
     if let Some(p) = &a.plot {
@@ -98,7 +100,7 @@ pub fn run(a: CompareArgs) -> Result<()> {
         }
     }
     let colour = a.colour.conditions()?;
-    let target = Target::new(a.output.as_deref(), "--output")?;
+    let target = OutputTarget::new(a.output.as_deref(), "--output")?;
     let (default, sheet_path) = match a.paths.as_slice() {
         [s] => (None, s.clone()),
         [r, s] => (Some(r.clone()), s.clone()),
@@ -190,7 +192,7 @@ pub fn summary(cmp: &[Comparison]) -> String {
     )
 }
 
-fn table(sheet: &Sheet, cmp: &[Comparison], rule: &Rule, drift: &[Drift], with_baseline: bool) -> String {
+fn table(sheet: &Sheet, cmp: &[Comparison], rule: &VerdictRule, drift: &[Drift], with_baseline: bool) -> String {
     let head = [
         "sample",
         "material",
@@ -327,7 +329,7 @@ fn de_table(des: &[ColourDifference]) -> String {
 fn json_text(
     sheet: &Sheet,
     cmp: &[Comparison],
-    rule: &Rule,
+    rule: &VerdictRule,
     drift: &[Drift],
     baseline: Option<&PathBuf>,
     des: &[ColourDifference],
@@ -417,5 +419,5 @@ fn csv_text(cmp: &[Comparison]) -> Result<String> {
             },
         ]
     });
-    crate::cli::format::csv_text(&head, rows)
+    crate::report::csv_text(&head, rows)
 }

@@ -5,10 +5,12 @@ use std::path::PathBuf;
 
 use serde_json::json;
 
-use super::format::plain;
-use super::{plot, Format, Target};
+use super::common::{pad_table, Format};
+use super::output::OutputTarget;
+use super::plot;
 use crate::instrument::convergence::{self, ReferenceKind, Sweep, SweepOptions, DEFAULT_TOLERANCES};
 use crate::recipe::{self, Material};
+use crate::report::plain;
 use crate::{Error, Result};
 
 /// The geometries swept when none is given.
@@ -61,7 +63,7 @@ pub fn run(args: ConvergenceArgs) -> Result<()> {
     if args.max_repetitions == 0 {
         return Err(Error::Usage("--max-repetitions must be at least 1".into()));
     }
-    let target = Target::new(args.output.as_deref(), "--output")?;
+    let target = OutputTarget::new(args.output.as_deref(), "--output")?;
     if let Some(p) = &args.plot {
         plot::check_plot_path(p, "--plot")?;
         if args.output.as_deref() == Some(p.as_path()) {
@@ -163,7 +165,7 @@ pub fn table(material: &Material, sweep: &Sweep) -> String {
         sweep.options.min_seconds * 1e3,
         sweep.options.max_repetitions
     ));
-    s.push_str(&super::pad_table(&rows, &[0, 3, 4, 5, 6, 7]));
+    s.push_str(&pad_table(&rows, &[0, 3, 4, 5, 6, 7]));
     if sweep.rows.iter().any(|r| !r.converged) {
         s.push_str("* evaluation budget exhausted before the tolerance was met\n");
     }
@@ -216,7 +218,7 @@ pub fn csv(sweep: &Sweep) -> Result<String> {
             r.problem.clone().unwrap_or_default(),
         ]
     });
-    super::format::csv_text(&head, rows)
+    crate::report::csv_text(&head, rows)
 }
 
 /// JSON: the sweep's settings and one object per row (null where there is no value).

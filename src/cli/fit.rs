@@ -4,11 +4,11 @@ use std::path::PathBuf;
 
 use serde_json::{json, Value};
 
+use crate::cli::common::{check_rtol, Format};
 use crate::cli::compare::parse_delimiter;
-use crate::cli::output::{print, Target};
-use crate::cli::{check_rtol, Format};
+use crate::cli::output::{print, OutputTarget};
+use crate::comparison::sheet::{self, SheetOptions};
 use crate::fit::{self, FitOptions, FitReport, FreeParameter, TargetReading};
-use crate::instrument::sheet::{self, SheetOptions};
 use crate::{recipe, Error, Result};
 
 #[derive(clap::Args, Debug)]
@@ -64,7 +64,7 @@ pub fn run(a: FitArgs) -> Result<()> {
         )));
     }
     // Refused before any work if it exists (or its directory does not); written whole or not at all.
-    let output = Target::new(a.output.as_deref(), "-o")?;
+    let output = OutputTarget::new(a.output.as_deref(), "-o")?;
     let free: Vec<FreeParameter> = a.free.iter().map(|f| FreeParameter::parse(f)).collect::<Result<_>>()?;
     let targets: Vec<TargetReading> = match &a.sheet {
         Some(s) => {

@@ -4,8 +4,8 @@
 //! baseline reading that moved is a failure. Each message gives measured, predicted, allowance and error estimate.
 use quick_junit::{NonSuccessKind, Report, TestCase, TestCaseStatus, TestSuite};
 
+use crate::comparison::sheet::Sheet;
 use crate::comparison::{Comparison, Drift, Verdict};
-use crate::instrument::sheet::Sheet;
 use crate::{Error, Result};
 
 fn g(v: Option<f64>) -> String {

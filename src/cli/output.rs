@@ -5,7 +5,7 @@
 //! A file is written to a temporary file in the same directory, flushed and synced, then hard-linked to its
 //! name (`link(2)` fails if the name exists, so nothing is ever clobbered, even by a file that appeared during
 //! the run), and the temporary name is removed. The target is checked before any work is done
-//! ([`Target::new`]), so a long computation is not wasted on a name that would be refused.
+//! ([`OutputTarget::new`]), so a long computation is not wasted on a name that would be refused.
 use std::fs::{File, OpenOptions};
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -18,17 +18,17 @@ pub const STDOUT: &str = "<stdout>";
 
 /// Standard output, or a file that must not exist yet.
 #[derive(Clone, Debug)]
-pub struct Target {
+pub struct OutputTarget {
     path: Option<PathBuf>,
 }
 
-impl Target {
+impl OutputTarget {
     /// `None` is standard output. A path is refused now if it exists or its directory does not.
-    pub fn new(path: Option<&Path>, option: &str) -> Result<Target> {
+    pub fn new(path: Option<&Path>, option: &str) -> Result<OutputTarget> {
         if let Some(p) = path {
             check_new_file(p, option)?;
         }
-        Ok(Target { path: path.map(Path::to_path_buf) })
+        Ok(OutputTarget { path: path.map(Path::to_path_buf) })
     }
 
     pub fn path(&self) -> Option<&Path> {
@@ -50,7 +50,7 @@ impl Target {
 
     /// Stream output through `body` (for output too large to hold, `sweep`): standard output as it comes, or
     /// a file that still appears whole or not at all (the temporary file is linked to its name only when
-    /// `body` succeeded). `body`'s I/O errors should name [`Target::name`].
+    /// `body` succeeded). `body`'s I/O errors should name [`OutputTarget::name`].
     pub fn stream(&self, body: impl FnOnce(&mut dyn Write) -> Result<()>) -> Result<()> {
         let io = |source| Error::Io { file: self.name(), source };
         match &self.path {
@@ -180,9 +180,9 @@ mod tests {
     fn an_existing_file_is_never_overwritten_even_if_it_appears_during_the_run() {
         let d = dir("race");
         let p = d.join("out.txt");
-        assert!(Target::new(Some(&p), "-o").is_ok());
+        assert!(OutputTarget::new(Some(&p), "-o").is_ok());
         std::fs::write(&p, "user data").unwrap();
-        assert!(Target::new(Some(&p), "-o").is_err(), "checked before the work");
+        assert!(OutputTarget::new(Some(&p), "-o").is_err(), "checked before the work");
         let e = write_new_file(&p, b"new").unwrap_err().to_string();
         assert!(e.contains("already exists"), "{e}");
         assert_eq!(std::fs::read_to_string(&p).unwrap(), "user data");
@@ -193,7 +193,7 @@ mod tests {
 
     #[test]
     fn a_missing_directory_is_refused_before_the_work() {
-        let e = Target::new(Some(Path::new("/nonexistent-dir-glossmeter/x.json")), "-o").unwrap_err();
+        let e = OutputTarget::new(Some(Path::new("/nonexistent-dir-glossmeter/x.json")), "-o").unwrap_err();
         assert!(e.to_string().contains("does not exist"), "{e}");
     }
 }

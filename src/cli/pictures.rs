@@ -8,6 +8,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use serde_json::Value;
 
+use super::common::check_rtol;
 use super::plot::plot_err;
 use crate::brdf::{mirror, Brdf};
 use crate::colorimetry::weighting::Weighting;
@@ -52,7 +53,7 @@ const DEFAULT: &[&str] = &["astm-d523-20", "astm-d523-60", "astm-d523-85"];
 
 pub fn run(a: PlotArgs) -> Result<()> {
     super::plot::check_plot_path(&a.output, "--output")?;
-    super::check_rtol(a.rtol)?;
+    check_rtol(a.rtol)?;
     let geos = crate::resolve_geometries_or(&a.geometries, &[] as &[&str], DEFAULT)?;
     match a.kind {
         PlotKind::Section => {

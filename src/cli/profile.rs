@@ -8,12 +8,13 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use serde_json::json;
 
-use super::format::plain;
+use super::common::{check_rtol, readings_status};
+use super::output::OutputTarget;
 use super::plot::plot_err;
-use super::Target;
 use crate::instrument::plan::PlanOptions;
 use crate::instrument::profile::{self, Profile};
 use crate::recipe::{self, Material};
+use crate::report::plain;
 use crate::{Error, Result};
 
 /// The geometry profiled when none is given.
@@ -53,8 +54,8 @@ pub struct ProfileArgs {
 }
 
 pub fn run(args: ProfileArgs) -> Result<()> {
-    super::check_rtol(args.rtol)?;
-    let target = Target::new(args.output.as_deref(), "--output")?;
+    check_rtol(args.rtol)?;
+    let target = OutputTarget::new(args.output.as_deref(), "--output")?;
     if let Some(p) = &args.plot {
         super::plot::check_plot_path(p, "--plot")?;
         if args.output.as_deref() == Some(p.as_path()) {
@@ -81,7 +82,7 @@ pub fn run(args: ProfileArgs) -> Result<()> {
     }
     target.write(&text)?;
     let readings: Vec<crate::Reading> = prof.rows.iter().map(|r| r.reading.clone()).collect();
-    super::readings_status(&readings, args.allow_unconverged)
+    readings_status(&readings, args.allow_unconverged)
 }
 
 /// The columns of the CSV, in order (also the keys of a JSON row).
@@ -102,7 +103,7 @@ pub fn csv(p: &Profile) -> Result<String> {
             r.reading.evaluations.to_string(),
         ]
     });
-    super::format::csv_text(COLUMNS, rows)
+    crate::report::csv_text(COLUMNS, rows)
 }
 
 /// JSON: the material, the array and one object per pixel (null where there is no value).

@@ -4,9 +4,10 @@
 use std::io::IsTerminal;
 use std::path::PathBuf;
 
-use crate::cli::{check_rtol, Target};
+use crate::cli::common::check_rtol;
+use crate::cli::output::OutputTarget;
 use crate::instrument::plan::PlanOptions;
-use crate::sweep::{self, Design, Sweep};
+use crate::sweep::{self, Sweep, SweepDesign};
 use crate::{resolve_geometries, Error, Result};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -64,14 +65,14 @@ pub fn run(a: SweepArgs) -> Result<()> {
         }
     }
     let design = match a.lhs {
-        Some(n) => Design::Lhs { n, seed: a.seed },
-        None => Design::Grid,
+        Some(n) => SweepDesign::Lhs { n, seed: a.seed },
+        None => SweepDesign::Grid,
     };
     let (k, m) = a.shard.as_deref().map(sweep::parse_shard).transpose()?.unwrap_or((1, 1));
     if a.max_evals == 0 {
         return Err(Error::Usage("--max-evals must be at least 1".into()));
     }
-    let target = Target::new(a.output.as_deref(), "--output")?;
+    let target = OutputTarget::new(a.output.as_deref(), "--output")?;
     let file = a.template.display().to_string();
     let text = crate::input::read_text(&a.template, "recipe")?;
     let text = text.strip_prefix('\u{feff}').unwrap_or(&text);

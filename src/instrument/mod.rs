@@ -6,7 +6,7 @@
 //! points, clipping, mirror overlap, kinks); `method` is one integral designed as plain data, its executor and
 //! its result (the flux); `plan` compiles (material, geometries) into the cheapest set of methods and combines
 //! their fluxes into readings; `reference` gives independent closed forms to check them against; `convergence`
-//! measures error against run time; `sheet` reads real instruments' readings for comparison. The contract is
+//! measures error against run time. The contract is
 //! written out in `docs/instrument.md`.
 pub mod aperture;
 pub mod convergence;
@@ -17,6 +17,5 @@ pub mod plan;
 pub mod profile;
 pub mod reading;
 pub mod reference;
-pub mod sheet;
 pub mod sphere;
 pub mod standards;

@@ -38,7 +38,7 @@
 //! Q(θh, θd*)·Q(0, θd)/Q(0, θd*), θd* the largest difference angle at which (θh, θd*) is measured — exact
 //! when Q is a product of a function of θh and one of θd (a constant; F(θd)·D(θh)), and the specular row
 //! Q(0, ·) carrying the θd dependence.
-use super::table::{file_name, reflection_half_diff, Axis, Nodes, Table};
+use super::table::{file_name, reflection_half_diff, Nodes, Table, TableAxis};
 use crate::brdf::{Brdf, Lobe, Term, TermKind};
 use crate::spectrum::Sampling;
 use crate::{Error, Result, Vec3};
@@ -111,7 +111,7 @@ impl Domain {
         if !(ti >= lo && ti <= hi) {
             return false;
         }
-        // The bracketing rows as `Axis::linear` gives them: rows[i] ≤ θi ≤ rows[i + 1].
+        // The bracketing rows as `TableAxis::linear` gives them: rows[i] ≤ θi ≤ rows[i + 1].
         let i = self.rows[..self.rows.len() - 1].partition_point(|&x| x <= ti).saturating_sub(1);
         if self.rows[i] == ti || self.rows.len() == 1 {
             return self.row_holds(i, ti, to);
@@ -256,7 +256,7 @@ enum Row {
 pub struct InPlaneBrdf {
     file: String,
     format: &'static str,
-    theta_i: Axis,
+    theta_i: TableAxis,
     /// One 1-D table per θi row, over signed θo in radians.
     rows: Vec<Table>,
     /// Smallest θo step of any row (radians).
@@ -337,7 +337,7 @@ impl InPlaneBrdf {
             lo = lo.min(first);
             hi = hi.max(last);
             row_ranges.push((first, last));
-            let axis = Axis::values(tos);
+            let axis = TableAxis::values(tos);
             min_step = min_step.min(axis.min_spacing());
             thetas.push(ti.to_radians());
             rows.push(Table::new(vec![axis], 1, vals));
@@ -350,7 +350,7 @@ impl InPlaneBrdf {
         let mut brdf = InPlaneBrdf {
             file: file.to_string(),
             format,
-            theta_i: Axis::values(thetas),
+            theta_i: TableAxis::values(thetas),
             rows,
             min_step,
             points: points.len(),

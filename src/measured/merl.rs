@@ -19,7 +19,7 @@
 //! This file only decodes the bytes and chooses those coordinates; the table and its interpolation are the
 //! shared layer in `table.rs`. `docs/model.md` §Measured tables (MERL) gives the details and the known limits
 //! of the data.
-use super::table::{file_name, floor_index, reflection_half_diff, Axis, Edge, Table};
+use super::table::{file_name, floor_index, reflection_half_diff, Edge, Table, TableAxis};
 pub use super::table::{fold_phi_d, half_diff, HalfDiff};
 use crate::brdf::{Brdf, Lobe, Term, TermKind};
 use crate::spectrum::Sampling;
@@ -133,7 +133,11 @@ impl MerlBrdf {
         }
         let invalid = bad.iter().filter(|b| **b).count();
         let [nh, nd, np] = dims;
-        let axes = vec![Axis::index(nh, Edge::Clamp), Axis::index(nd, Edge::Clamp), Axis::index(np, Edge::Periodic)];
+        let axes = vec![
+            TableAxis::index(nh, Edge::Clamp),
+            TableAxis::index(nd, Edge::Clamp),
+            TableAxis::index(np, Edge::Periodic),
+        ];
         let flat = invalid == 0 && (0..3).all(|c| super::table::is_flat(table.iter().map(|v| v[c])));
         let table = Table::new(axes, 3, table.into_iter().flatten().collect());
         let mut m = MerlBrdf {

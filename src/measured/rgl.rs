@@ -26,7 +26,7 @@
 //! f·cos θ' itself (Mitsuba 3's `measured` plugin): f = spectra / cos θ'. Every 2-D table is bilinear on its
 //! grid, every parameter linear between its values (clamped), exactly as `PiecewiseLinear2D`; the
 //! arithmetic here is f64 on the files' f32 values.
-use super::table::{elevation, Axis};
+use super::table::{elevation, TableAxis};
 use crate::brdf::{Brdf, Lobe, Term, TermKind};
 use crate::spectrum::Sampling;
 use crate::{Error, Result, Vec3};
@@ -259,7 +259,7 @@ impl TensorFile {
 struct Warp2D {
     nx: usize,
     ny: usize,
-    params: Vec<Axis>,
+    params: Vec<TableAxis>,
     /// Slice stride of each parameter (0 for a parameter of one value).
     strides: Vec<usize>,
     data: Vec<f64>,
@@ -278,7 +278,7 @@ impl Warp2D {
             slices *= params[k].len();
         }
         assert!(params.len() <= 3, "at most 3 parameters");
-        let params: Vec<Axis> = params.into_iter().map(Axis::values).collect();
+        let params: Vec<TableAxis> = params.into_iter().map(TableAxis::values).collect();
         let n = nx * ny;
         let mut out = data.to_vec();
         let (mut marginal, mut conditional) = (Vec::new(), Vec::new());

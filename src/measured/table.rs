@@ -28,18 +28,18 @@ pub enum Edge {
 
 /// One axis of a table.
 #[derive(Clone, Debug, PartialEq)]
-pub struct Axis {
+pub struct TableAxis {
     pub nodes: Nodes,
     pub edge: Edge,
 }
 
-impl Axis {
+impl TableAxis {
     pub fn index(n: usize, edge: Edge) -> Self {
-        Axis { nodes: Nodes::Index(n), edge }
+        TableAxis { nodes: Nodes::Index(n), edge }
     }
 
     pub fn values(v: Vec<f64>) -> Self {
-        Axis { nodes: Nodes::Values(v), edge: Edge::Clamp }
+        TableAxis { nodes: Nodes::Values(v), edge: Edge::Clamp }
     }
 
     pub fn len(&self) -> usize {
@@ -132,7 +132,7 @@ fn value_pair(v: &[f64], u: f64) -> (usize, usize, f64) {
 /// innermost.
 #[derive(Clone, Debug)]
 pub struct Table {
-    axes: Vec<Axis>,
+    axes: Vec<TableAxis>,
     strides: Vec<usize>,
     channels: usize,
     data: Vec<f64>,
@@ -140,7 +140,7 @@ pub struct Table {
 
 impl Table {
     /// `data.len()` must be channels × Π axis lengths (the readers check their files before this).
-    pub fn new(axes: Vec<Axis>, channels: usize, data: Vec<f64>) -> Self {
+    pub fn new(axes: Vec<TableAxis>, channels: usize, data: Vec<f64>) -> Self {
         let mut strides = vec![0; axes.len()];
         let mut s = channels;
         for (k, a) in axes.iter().enumerate().rev() {
@@ -151,7 +151,7 @@ impl Table {
         Table { axes, strides, channels, data }
     }
 
-    pub fn axes(&self) -> &[Axis] {
+    pub fn axes(&self) -> &[TableAxis] {
         &self.axes
     }
 
@@ -355,7 +355,7 @@ mod tests {
 
     #[test]
     fn value_axis_brackets_and_clamps() {
-        let a = Axis::values(vec![0.0, 1.0, 3.0]);
+        let a = TableAxis::values(vec![0.0, 1.0, 3.0]);
         assert_eq!(a.linear(-1.0), (0, 1, 0.0));
         assert_eq!(a.linear(0.5), (0, 1, 0.5));
         assert_eq!(a.linear(2.0), (1, 2, 0.5));
@@ -368,18 +368,18 @@ mod tests {
 
     #[test]
     fn index_axes() {
-        let c = Axis::index(4, Edge::Clamp);
+        let c = TableAxis::index(4, Edge::Clamp);
         assert_eq!(c.linear(1.25), (1, 2, 0.25));
         assert_eq!(c.linear(7.0), (3, 3, 0.0));
-        let p = Axis::index(4, Edge::Periodic);
+        let p = TableAxis::index(4, Edge::Periodic);
         assert_eq!(p.linear(3.5), (3, 0, 0.5));
         assert_eq!(c.floor(3.9), 3);
     }
 
     #[test]
     fn bilinear_reproduces_a_bilinear_function() {
-        let ax = Axis::values(vec![0.0, 1.0, 2.0]);
-        let ay = Axis::values(vec![0.0, 2.0]);
+        let ax = TableAxis::values(vec![0.0, 1.0, 2.0]);
+        let ay = TableAxis::values(vec![0.0, 2.0]);
         let f = |x: f64, y: f64| 1.0 + 2.0 * x + 3.0 * y + 0.5 * x * y;
         let mut data = Vec::new();
         for x in [0.0, 1.0, 2.0] {

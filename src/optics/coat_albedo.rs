@@ -94,7 +94,7 @@ pub const TRUNCATION_BUDGET: f64 = 1e-11;
 pub const DISTRIBUTIONS: [Distribution; 2] = [Distribution::Beckmann, Distribution::Ggx];
 
 /// The rule's fixed nodes.
-struct Rule {
+struct AlbedoNodes {
     phi: (Vec<f64>, Vec<f64>),
     core: (Vec<f64>, Vec<f64>),
     tail: (Vec<f64>, Vec<f64>),
@@ -120,23 +120,27 @@ fn graded_towards_end(len: f64, finest: f64) -> Vec<f64> {
     b
 }
 
-impl Rule {
-    fn new() -> Rule {
-        Rule { phi: gauss_legendre(PHI_NODES), core: gauss_legendre(CORE_NODES), tail: gauss_legendre(TAIL_NODES) }
+impl AlbedoNodes {
+    fn new() -> AlbedoNodes {
+        AlbedoNodes {
+            phi: gauss_legendre(PHI_NODES),
+            core: gauss_legendre(CORE_NODES),
+            tail: gauss_legendre(TAIL_NODES),
+        }
     }
 }
 
 /// E(μ) by the fixed rule (module docs).
 pub fn lobe_albedo(mf: &Microfacet, eta: f64, mu: f64) -> f64 {
-    lobe_albedo_with(&Rule::new(), mf, eta, mu).0
+    lobe_albedo_with(&AlbedoNodes::new(), mf, eta, mu).0
 }
 
 /// E(μ) and the number of lobe evaluations the rule spent.
 pub fn lobe_albedo_counted(mf: &Microfacet, eta: f64, mu: f64) -> (f64, usize) {
-    lobe_albedo_with(&Rule::new(), mf, eta, mu)
+    lobe_albedo_with(&AlbedoNodes::new(), mf, eta, mu)
 }
 
-fn lobe_albedo_with(rule: &Rule, mf: &Microfacet, eta: f64, mu: f64) -> (f64, usize) {
+fn lobe_albedo_with(rule: &AlbedoNodes, mf: &Microfacet, eta: f64, mu: f64) -> (f64, usize) {
     let c = mu.clamp(1e-12, 1.0);
     let s = (1.0 - c * c).max(0.0).sqrt();
     let wi = Vec3::new(s, 0.0, c);
@@ -364,7 +368,7 @@ impl CoatAlbedo {
     /// evaluations, so for tests and the table's generator, never a paint); `None` if the rule gave a
     /// non-finite value.
     pub fn from_rule(mf: &Microfacet, eta: f64) -> Option<CoatAlbedo> {
-        let rule = Rule::new();
+        let rule = AlbedoNodes::new();
         let mut evaluations = 0usize;
         let mut coeffs = Vec::with_capacity(PIECES * NODES);
         for p in 0..PIECES {

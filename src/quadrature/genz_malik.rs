@@ -48,7 +48,7 @@ pub struct Estimate {
 
 /// The Genz–Malik point set and weights for dimension `D` (2 ≤ D ≤ 8).
 #[derive(Clone, Debug)]
-pub struct Rule<const D: usize> {
+pub struct GenzMalikRule<const D: usize> {
     /// Points of the unit cube [−1, 1]^D with their weight index (0..5) and, for the axial points
     /// (classes 1 and 2), their axis (0 otherwise).
     points: Vec<([f64; D], usize, usize)>,
@@ -63,13 +63,13 @@ const L2: f64 = 0.358_568_582_800_318_1; // sqrt(9/70)
 const L4: f64 = 0.948_683_298_050_513_8; // sqrt(9/10)
 const L5: f64 = 0.688_247_201_611_685_3; // sqrt(9/19)
 
-impl<const D: usize> Default for Rule<D> {
+impl<const D: usize> Default for GenzMalikRule<D> {
     fn default() -> Self {
         Self::new()
     }
 }
 
-impl<const D: usize> Rule<D> {
+impl<const D: usize> GenzMalikRule<D> {
     /// The rule exists for 2 ≤ D ≤ 8 (Genz & Malik 1980); another D is refused at compile time.
     const DIMENSION_SUPPORTED: () = assert!(D >= 2 && D <= 8, "Genz–Malik needs 2 ≤ D ≤ 8");
 
@@ -128,7 +128,7 @@ impl<const D: usize> Rule<D> {
         // [−1, 1]), the centre takes the rest.
         let w3_axial = 1.0 / (6.0 * L4 * L4);
         let w3 = [1.0 - 2.0 * d * w3_axial, 0.0, w3_axial, 0.0, 0.0];
-        Rule { points, w7, w5, w3 }
+        GenzMalikRule { points, w7, w5, w3 }
     }
 
     /// Number of integrand evaluations per region: 2^D + 2D² + 2D + 1.
@@ -269,7 +269,7 @@ struct Batch<const D: usize> {
 /// together, `values` zeroed, and each cell's sums are then formed in the rule's point order (the same
 /// order, hence the same bits, as one call per point).
 fn apply<const D: usize, F: FnMut(&[[f64; D]], &mut [f64])>(
-    rule: &Rule<D>,
+    rule: &GenzMalikRule<D>,
     f: &mut F,
     cells: &[Cell<D>],
     ncomp: usize,
@@ -394,7 +394,7 @@ fn rescale<const D: usize>(r: &mut Region<D>, scale: f64) {
 
 /// The degree-7 and degree-5 sums of one cell from its integrand values (`npts × ncomp`, point-major).
 fn summarise<const D: usize>(
-    rule: &Rule<D>,
+    rule: &GenzMalikRule<D>,
     cell: Cell<D>,
     values: &[f64],
     ncomp: usize,
@@ -497,7 +497,7 @@ pub fn integrate_partition<const D: usize, F: FnMut(&[[f64; D]], &mut [f64])>(
     refine: Refine,
     keep: bool,
 ) -> (Estimate, Vec<Cell<D>>) {
-    let rule = Rule::<D>::new();
+    let rule = GenzMalikRule::<D>::new();
     let npts = rule.len();
     let mut batch = Batch {
         points: Vec::with_capacity(2 * npts),
@@ -622,7 +622,7 @@ mod tests {
     fn weights_sum_to_one() {
         for_dims();
         fn check<const D: usize>() {
-            let r = Rule::<D>::new();
+            let r = GenzMalikRule::<D>::new();
             let (mut s7, mut s5) = (0.0, 0.0);
             for (_, c, _) in &r.points {
                 s7 += r.w7[*c];
@@ -642,7 +642,7 @@ mod tests {
     #[test]
     fn the_embedded_degree_three_rule_is_exact_for_cubics() {
         fn check<const D: usize>() {
-            let r = Rule::<D>::new();
+            let r = GenzMalikRule::<D>::new();
             let f = |x: &[f64; D]| 1.0 + x[0] * x[0] + 2.0 * x[D - 1].powi(3) + x[0] * x[1];
             let s3: f64 = r.points.iter().map(|(x, c, _)| r.w3[*c] * f(x)).sum();
             assert!((s3 - (1.0 + 1.0 / 3.0)).abs() < 1e-14, "D={D}: {s3}");

@@ -36,5 +36,6 @@ pub use polar::{
 };
 
 pub use genz_malik::{
-    integrate, integrate_partition, pointwise, Cell, Estimate, Options, Refine, Rule, MAX_SHRINK, MAX_SHRINK_LOBE,
+    integrate, integrate_partition, pointwise, Cell, Estimate, GenzMalikRule, Options, Refine, MAX_SHRINK,
+    MAX_SHRINK_LOBE,
 };

@@ -8,7 +8,8 @@
 #![allow(dead_code)]
 use std::path::{Path, PathBuf};
 
-use glossmeter::instrument::{sheet, standards};
+use glossmeter::comparison::sheet;
+use glossmeter::instrument::standards;
 use glossmeter::{recipe, Error};
 
 /// A small deterministic generator (xorshift64*), so every case can be replayed from its seed.

@@ -74,7 +74,7 @@ pub enum Target {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Rule {
     /// Genz & Malik's degree-7 rule with its embedded null rules for the error estimate
-    /// (`quadrature::Rule`), globally adaptive on the part's partition. The fallback of every other rule.
+    /// (`quadrature::GenzMalikRule`), globally adaptive on the part's partition. The fallback of every other rule.
     GenzMalik75,
     /// A narrow Gaussian-tailed lobe far from every kink of the overlap (issue 10): a tensor product of
     /// Gauss–Hermite rules in u and v scaled to the lobe's widths (u = width\[0\]·x, v = width\[1\]·y, weight

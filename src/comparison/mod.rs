@@ -14,13 +14,20 @@
 //! k·s/√n being k standard errors of the mean (k = 2 by default, about 95 % for a normal mean) and u the
 //! stated uncertainty (the largest of the rows' `uncertainty`, else `--tolerance`). With n = 1 and no stated
 //! uncertainty there is no allowance: the row is unchecked, which fails the check like an outside row.
+//!
+//! The folder:
+//! * `mod.rs`: the statistics, the verdict rule ([`VerdictRule`]), the comparison of a sheet's samples with
+//!   their recipes' predictions, colour differences, and baselines;
+//! * [`sheet`]: the input format, instrument sheets as instruments and spreadsheets write them.
+pub mod sheet;
+
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 use rayon::prelude::*;
 
+use self::sheet::{Layout, Sheet, SheetOptions, SheetRow};
 use crate::instrument::plan::{Plan, PlanOptions, Reading};
-use crate::instrument::sheet::{self, Layout, Sheet, SheetOptions, SheetRow};
 use crate::instrument::standards::{self, StandardGeometry};
 use crate::recipe::{self, Material};
 use crate::{Error, Result};
@@ -111,20 +118,20 @@ pub fn read_targets(path: &Path, options: &SheetOptions) -> Result<(Sheet, Vec<G
 
 /// How verdicts are reached.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Rule {
+pub struct VerdictRule {
     /// Standard errors of the mean allowed (default 2).
     pub k: f64,
     /// The uncertainty of rows that state none.
     pub tolerance: Option<f64>,
 }
 
-impl Default for Rule {
+impl Default for VerdictRule {
     fn default() -> Self {
-        Rule { k: 2.0, tolerance: None }
+        VerdictRule { k: 2.0, tolerance: None }
     }
 }
 
-impl Rule {
+impl VerdictRule {
     pub fn check(&self) -> Result<()> {
         if !(self.k.is_finite() && self.k >= 0.0) {
             return Err(Error::Usage(format!("-k must be a finite number ≥ 0, got {}", crate::error::given(self.k))));
@@ -216,7 +223,7 @@ impl Comparison {
 }
 
 /// The verdict of one group against the readings of its material.
-pub fn judge(group: Group, material: &Material, readings: &[Reading], rule: &Rule) -> Comparison {
+pub fn judge(group: Group, material: &Material, readings: &[Reading], rule: &VerdictRule) -> Comparison {
     let mk = |predicted, allowance, verdict| Comparison {
         material: material.name.clone(),
         recipe: material.file.clone(),
@@ -292,7 +299,12 @@ impl Recipes {
 
 /// Compare a sheet with the predictions for every sample: each sample's recipe is found through `recipes`,
 /// each distinct recipe is measured once (in parallel) through the geometries its rows name.
-pub fn compare_sheet(sheet: &Sheet, recipes: &Recipes, rule: &Rule, options: &PlanOptions) -> Result<Vec<Comparison>> {
+pub fn compare_sheet(
+    sheet: &Sheet,
+    recipes: &Recipes,
+    rule: &VerdictRule,
+    options: &PlanOptions,
+) -> Result<Vec<Comparison>> {
     rule.check()?;
     let groups = group_rows(&sheet.rows);
     // Geometries: a shipped id, else "not predicted" for a recognised column, else an error at its row.
@@ -551,7 +563,7 @@ mod tests {
     #[test]
     fn verdict_rule() {
         let m = recipe::parse_str(r#"{"model": "lambert", "albedo": 0.5}"#, "m.json").unwrap();
-        let rule = Rule::default();
+        let rule = VerdictRule::default();
         // mean 90, s = 1, n = 4: k s/√n = 1; + e 0.1 → inside up to 1.1.
         let g = group(&[89.0, 91.0, 89.0, 91.0], None);
         assert!((g.stats.std - (4.0f64 / 3.0).sqrt()).abs() < 1e-15);

@@ -1,0 +1,105 @@
+//! The command line's definition for clap: the program ([`Cli`]), its subcommands ([`Command`], with the
+//! arguments of `measure`, `standards` and `schema`; the other subcommands' arguments are in their own files)
+//! and the outputs `schema --output-format` names ([`OutputSchema`]). `glossmeter --help` is written from here.
+use std::path::PathBuf;
+
+use clap::{Parser, Subcommand, ValueEnum};
+
+use super::common::{ColourArgs, Format};
+use super::{compare, convergence, fit, pictures, profile, sweep};
+use crate::instrument::plan::PlanOptions;
+
+#[derive(Parser, Debug)]
+#[command(
+    name = "glossmeter",
+    version,
+    about = "A virtual gloss, haze and DOI meter: reads a BRDF through the apertures of ASTM D523 / ISO 2813 / ASTM E430 / ISO 13803 instruments."
+)]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+/// The outputs whose JSON Schema `glossmeter schema --output-format` prints.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum OutputSchema {
+    Measure,
+    Compare,
+    Sweep,
+    Fit,
+}
+
+#[derive(Subcommand, Debug)]
+pub enum Command {
+    /// Read materials (recipe JSON files, or directories of them) through instrument geometries.
+    Measure {
+        /// The recipe (JSON; see `glossmeter schema` and docs/recipe-format.md); several recipes or a directory
+        /// are measured together in parallel, in one table / CSV / JSON with a material column.
+        #[arg(required = true, num_args = 1..)]
+        recipes: Vec<PathBuf>,
+        /// A previous `measure` or `compare` JSON: exit 1 if a reading moved by more than both error estimates.
+        #[arg(long, value_name = "PREVIOUS.json")]
+        baseline: Option<PathBuf>,
+        /// A shipped geometry id (repeatable); see `glossmeter standards`. Default: ASTM D523 20°/60°/85°,
+        /// ASTM E430 30° (gloss, haze, DOI), ISO 13803 20° haze and the ASTM D4039 haze index.
+        #[arg(long = "geometry", short = 'g')]
+        geometries: Vec<String>,
+        /// A user geometry file in the standards format (repeatable).
+        #[arg(long = "geometry-file")]
+        geometry_files: Vec<PathBuf>,
+        /// Relative tolerance of every reading.
+        #[arg(long, default_value_t = 1e-6)]
+        rtol: f64,
+        #[arg(long, value_enum, default_value_t = Format::Table)]
+        format: Format,
+        /// Print the measurement plan before measuring.
+        #[arg(long)]
+        explain: bool,
+        /// Leave the wall-time column out (everything else is reproducible bit for bit).
+        #[arg(long)]
+        no_timing: bool,
+        /// Write the result to this new file instead of stdout (an existing file is refused before any work).
+        #[arg(long, short = 'o')]
+        output: Option<PathBuf>,
+        /// Exit 0 even if a reading did not converge within its budget (it is still marked in the output).
+        #[arg(long)]
+        allow_unconverged: bool,
+        /// Evaluation budget of each aperture integral; a reading whose integral runs out is "not converged".
+        #[arg(long, default_value_t = PlanOptions::default().max_evals)]
+        max_evals: usize,
+        #[command(flatten)]
+        colour: ColourArgs,
+        /// Wall-clock budget of the whole measurement, seconds (all its integrals share it); a reading whose
+        /// integral runs out is "not converged" and its value depends on the machine's speed. 0: none.
+        #[arg(long, default_value_t = crate::instrument::plan::DEFAULT_MAX_SECONDS)]
+        max_seconds: f64,
+        /// Also read every reading at the corners of the tolerances the standard data allow (and across the
+        /// plausible range of assumed numbers); reports the minimum and maximum (table and JSON).
+        #[arg(long)]
+        envelope: bool,
+    },
+    /// List the shipped geometries, or show one with the provenance of every number.
+    Standards {
+        /// A geometry id.
+        id: Option<String>,
+    },
+    /// Print the JSON Schema of the recipe format, or of an output (`--output-format measure|compare|sweep|fit`).
+    Schema {
+        #[arg(long, value_enum)]
+        output_format: Option<OutputSchema>,
+    },
+    /// Measure a template recipe over a grid or a Latin hypercube of JSON Pointer paths (CSV or JSON lines).
+    Sweep(sweep::SweepArgs),
+    /// Set predictions beside a glossmeter sheet (CSV); exits 1 if a reading falls outside its uncertainty.
+    Compare(compare::CompareArgs),
+    /// Error against run time over a sweep of tolerances (table, CSV, JSON, and a log–log plot).
+    Convergence(convergence::ConvergenceArgs),
+    /// Fit recipe parameters (JSON Pointers) to readings, with standard errors and an identifiability
+    /// verdict; exits 1 if the fit did not converge, hit a bound or is not identifiable (docs/inverse.md).
+    Fit(fit::FitArgs),
+    /// Draw a picture (PNG or SVG): the in-plane BRDF section with the apertures, or readings against a parameter.
+    Plot(pictures::PlotArgs),
+    /// The goniophotometric profile about the 20° specular direction (Rhopoint IQ-class 512-pixel array):
+    /// one row per pixel, angle and normalised reading with their error estimates (CSV or JSON).
+    Profile(profile::ProfileArgs),
+}

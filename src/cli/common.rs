@@ -1,0 +1,92 @@
+//! What the subcommands share: the `--format` and colour arguments ([`Format`], [`ColourArgs`]), the check of
+//! `--rtol`, the verdict on a set of readings (the exit status), and the text table's padding.
+use clap::ValueEnum;
+
+use crate::colorimetry::{Conditions, Illuminant, Observer};
+use crate::{Error, Result};
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Format {
+    Table,
+    Json,
+    Csv,
+}
+
+/// The conditions of colour readings (colour geometries only; gloss is luminous whatever they say).
+#[derive(clap::Args, Debug, Clone)]
+pub struct ColourArgs {
+    /// Illuminant of colour readings: D65, D50, A or C.
+    #[arg(long, default_value = "D65")]
+    pub illuminant: String,
+    /// Observer of colour readings: 10 (CIE 1964 10°) or 2 (CIE 1931 2°).
+    #[arg(long, default_value = "10")]
+    pub observer: String,
+}
+
+impl ColourArgs {
+    pub fn conditions(&self) -> Result<Conditions> {
+        Ok(Conditions { illuminant: Illuminant::parse(&self.illuminant)?, observer: Observer::parse(&self.observer)? })
+    }
+}
+
+/// The verdict on a set of readings (docs/instrument.md §Exit statuses): an error (exit 1) if one has no
+/// finite value, or did not converge (unless allowed).
+pub fn readings_status(readings: &[crate::Reading], allow_unconverged: bool) -> Result<()> {
+    // The hue of a neutral colour has no value by definition, not by failure.
+    let neutral_hue = |r: &crate::Reading| r.problem.as_deref().is_some_and(|p| p.starts_with(NEUTRAL_HUE));
+    let missing = readings.iter().filter(|r| r.value.is_none() && !neutral_hue(r)).count();
+    if missing > 0 {
+        return Err(Error::Numeric(format!(
+            "{missing} of {} reading(s) have no finite value (see the notes in the output)",
+            readings.len()
+        )));
+    }
+    let unconverged = readings.iter().filter(|r| !r.converged).count();
+    if unconverged > 0 && !allow_unconverged {
+        return Err(Error::Check(format!(
+            "{unconverged} of {} reading(s) did not converge to the tolerance within the budgets (evaluations \
+             or wall-clock time; their values are best estimates; --allow-unconverged exits 0 anyway)",
+            readings.len()
+        )));
+    }
+    Ok(())
+}
+
+/// How the hue reading of a neutral colour (C*ab = 0) explains its missing value (`plan::colour_value`).
+pub const NEUTRAL_HUE: &str = "neutral colour";
+
+/// `--rtol` in (0, 1), checked before any work.
+pub fn check_rtol(rtol: f64) -> Result<()> {
+    if !(rtol.is_finite() && rtol > 0.0 && rtol < 1.0) {
+        return Err(Error::Usage(format!("--rtol must be a number in (0, 1), got {}", crate::error::given(rtol))));
+    }
+    Ok(())
+}
+/// A text table: a header row, a rule, then the rows; columns listed in `right` are right-aligned. Padding
+/// is done by hand (a `format!` width is limited to 65 535).
+pub fn pad_table(rows: &[Vec<String>], right: &[usize]) -> String {
+    let ncol = rows.first().map(|r| r.len()).unwrap_or(0);
+    let w: Vec<usize> = (0..ncol).map(|i| rows.iter().map(|r| r[i].chars().count()).max().unwrap_or(0)).collect();
+    let mut s = String::new();
+    for (k, r) in rows.iter().enumerate() {
+        let cells: Vec<String> = r
+            .iter()
+            .enumerate()
+            .map(|(i, v)| {
+                let pad = " ".repeat(w[i] - v.chars().count());
+                if right.contains(&i) {
+                    format!("{pad}{v}")
+                } else {
+                    format!("{v}{pad}")
+                }
+            })
+            .collect();
+        s.push_str(cells.join("  ").trim_end());
+        s.push('\n');
+        if k == 0 {
+            s.push_str(&w.iter().map(|n| "-".repeat(*n)).collect::<Vec<_>>().join("  "));
+            s.push('\n');
+        }
+    }
+    s
+}
