@@ -196,6 +196,15 @@ pub trait Brdf: Send + Sync + std::fmt::Debug {
         Vec::new()
     }
 
+    /// The cosines at which the regular part, as a function of cos θi or of cos θo, has a seam: a point where
+    /// a tabulated factor of one direction changes piece or is held constant (the rough coat's E(μ),
+    /// `optics::coat_albedo`), so that its value or derivative jumps by more than rounding. Sorted, in (0, 1);
+    /// none by default. The directional albedo (`brdf::albedo`) puts them on its panel boundaries: a
+    /// Gauss–Kronrod panel across a seam underestimates its own error (docs/accuracy.md §Sphere readings).
+    fn seams(&self) -> Vec<f64> {
+        Vec::new()
+    }
+
     /// Whether f_r(ωi, ωo) = f_r(ωo, ωi) holds for this model (Helmholtz reciprocity).
     fn is_reciprocal(&self) -> bool {
         true

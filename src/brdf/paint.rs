@@ -1062,8 +1062,23 @@ impl Brdf for Paint {
     /// direct evaluation, so a seam is a jump of at most ~2·10⁻¹², far below the tolerances a reading is asked
     /// for. Not smooth: a rough coat (E(μ) from a table held constant below μ₀, measured dishonest when
     /// checked, `docs/accuracy.md` §5.1) and the paper's Eq. (1) form (V-cavity G, a min()).
+    ///
+    /// Nor is a flake whose reflectance ρ kinks at a critical angle of total internal reflection (mica below
+    /// the resin's index, `FlakeTerm::rho_kinks`): its table fit fails on the kink, and the direct ρ the lobe
+    /// then evaluates is not smooth at the local cosine μc, which is no [`Kink`] of the exterior directions.
     fn smooth(&self) -> bool {
-        self.spec.form == Form::Physical && self.rough_coat.is_none()
+        self.spec.form == Form::Physical
+            && self.rough_coat.is_none()
+            && self.flakes().all(|f| (0..f.cover.len()).all(|k| f.rho_kinks(k).is_empty()))
+    }
+
+    /// The rough coat's E(μ) (`optics::coat_albedo`) changes Chebyshev piece at its μ breaks and is held at
+    /// E(μ₀) below μ₀: the coat transmittance 1 − E(μ) of both directions seams there.
+    fn seams(&self) -> Vec<f64> {
+        if self.coat_albedo.is_none() {
+            return Vec::new();
+        }
+        crate::optics::coat_albedo::BREAKS.iter().copied().filter(|&c| c > 0.0 && c < 1.0).collect()
     }
 
     fn is_reciprocal(&self) -> bool {

@@ -18,7 +18,7 @@ use std::f64::consts::PI;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use crate::brdf::albedo::directional_albedo;
-use crate::brdf::{Brdf, Term, TermKind};
+use crate::brdf::{Brdf, Kink, Term, TermKind};
 use crate::instrument::aperture::lobe_widths_uv;
 use crate::quadrature::{integrate, pointwise, Options};
 use crate::spectrum::Sampling;
@@ -51,6 +51,15 @@ impl Brdf for Transposed<'_> {
     }
     fn terms(&self) -> Vec<Term> {
         self.0.terms()
+    }
+    fn seams(&self) -> Vec<f64> {
+        // Seams are in the cosine of either direction, so the transposition keeps them.
+        self.0.seams()
+    }
+    fn kinks(&self) -> Vec<Kink> {
+        // ωi·h = ωo·h: a half-angle kink is symmetric; the delta term's kink is in the polar angle of ωi,
+        // which the mirror pair shares.
+        self.0.kinks()
     }
     fn describe(&self) -> String {
         format!("transposed {}", self.0.describe())
