@@ -165,7 +165,11 @@ pub fn kind(v: &Value) -> String {
 pub fn parse_json(text: &str, file: &str) -> Result<Value> {
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let value = serde_json::from_str(text).map_err(|e| {
-        Error::input(file, "", format!("malformed JSON at line {}, column {}: {e}", e.line(), e.column()))
+        // serde_json's message ends with the position, which this message already leads with.
+        let message = e.to_string();
+        let position = format!(" at line {} column {}", e.line(), e.column());
+        let reason = message.strip_suffix(&position).unwrap_or(&message);
+        Error::input(file, "", format!("malformed JSON at line {}, column {}: {reason}", e.line(), e.column()))
     })?;
     let duplicate = std::cell::RefCell::new(None);
     let mut de = serde_json::Deserializer::from_str(text);
@@ -267,6 +271,15 @@ mod tests {
     #[test]
     fn a_byte_order_mark_is_skipped() {
         assert_eq!(parse_json("\u{feff}{\"x\": 1}", "r.json").unwrap()["x"], 1);
+    }
+
+    #[test]
+    fn a_malformed_document_names_its_position_once() {
+        let e = parse_json(r#"{"albedo": 1e309}"#, "r.json").unwrap_err().to_string();
+        assert_eq!(e.matches("line 1").count(), 1, "{e}");
+        assert!(e.contains("malformed JSON at line 1, column 16: number out of range"), "{e}");
+        let e = parse_json(r#"{"model": "lambert","#, "r.json").unwrap_err().to_string();
+        assert_eq!(e.matches("line 1").count(), 1, "{e}");
     }
 
     #[test]

@@ -16,6 +16,10 @@ pub mod json;
 /// some 300 000 readings.
 pub const MAX_TEXT_BYTES: u64 = 16 * 1024 * 1024;
 
+/// The largest measured table (RGL `.bsdf`, in-plane CSV, ASTM E1392 text): 256 MiB. A MERL-resolution
+/// isotropic table is 34 MB (90 × 90 × 180 × 3 doubles); RGL files of measured materials are 1–60 MB.
+pub const MAX_TABLE_BYTES: u64 = 256 * 1024 * 1024;
+
 /// Read a UTF-8 text file of at most [`MAX_TEXT_BYTES`]; `what` names the kind of file in messages.
 pub fn read_text(path: &Path, what: &str) -> Result<String> {
     read_text_limited(path, what, MAX_TEXT_BYTES)
@@ -26,7 +30,9 @@ pub fn read_bytes(path: &Path, what: &str) -> Result<Vec<u8>> {
     read_bytes_limited(path, what, MAX_TEXT_BYTES)
 }
 
-fn read_bytes_limited(path: &Path, what: &str, limit: u64) -> Result<Vec<u8>> {
+/// The bytes of a file of at most `limit` bytes; a larger one (or an endless one, `/dev/zero`) is refused
+/// after reading `limit` + 1 bytes, naming the file and the limit.
+pub fn read_bytes_limited(path: &Path, what: &str, limit: u64) -> Result<Vec<u8>> {
     let file = path.display().to_string();
     let io = |source| Error::Io { file: file.clone(), source };
     let f = std::fs::File::open(path).map_err(io)?;
@@ -69,6 +75,22 @@ mod tests {
         }
         let e = read_text_limited(Path::new("/dev/zero"), "recipe", 1024 * 1024).unwrap_err().to_string();
         assert!(e.contains("/dev/zero") && e.contains("larger than 1 MiB"), "{e}");
+    }
+
+    #[test]
+    fn every_table_reader_refuses_an_endless_file() {
+        if !Path::new("/dev/zero").exists() {
+            return;
+        }
+        let zero = Path::new("/dev/zero");
+        for e in [
+            crate::measured::inplane::load_csv(zero).map(|_| ()).unwrap_err(),
+            crate::measured::e1392::load(zero).map(|_| ()).unwrap_err(),
+            crate::measured::rgl::RglBrdf::load(zero).map(|_| ()).unwrap_err(),
+        ] {
+            let e = e.to_string();
+            assert!(e.contains("/dev/zero") && e.contains("larger than 256 MiB"), "{e}");
+        }
     }
 
     #[test]

@@ -38,6 +38,8 @@ struct Columns {
 
 /// Parse E1392-style text; `file` names it in messages.
 pub fn parse(text: &str, file: &str) -> Result<InPlaneBrdf> {
+    // A UTF-8 byte-order mark is no part of the first line.
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let names = ["theta_i", "phi_i", "theta_s", "phi_s"];
     let mut cols: Option<Columns> = None;
     let mut points = Vec::new();
@@ -136,7 +138,7 @@ pub fn parse(text: &str, file: &str) -> Result<InPlaneBrdf> {
 /// Read an E1392-style text file.
 pub fn load(path: &Path) -> Result<InPlaneBrdf> {
     let file = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|source| Error::Io { file: file.clone(), source })?;
+    let text = crate::input::read_text_limited(path, "table", crate::input::MAX_TABLE_BYTES)?;
     parse(&text, &file)
 }
 

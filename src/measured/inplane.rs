@@ -599,6 +599,8 @@ impl Brdf for InPlaneBrdf {
 /// the specular side) and exactly one of `brdf` (f_r, sr⁻¹) or `brdf_cos` (f_r·cos θo, sr⁻¹), in any order
 /// (other columns are refused); one point per row; lines starting with `#` are comments.
 pub fn parse_csv(text: &str, file: &str) -> Result<InPlaneBrdf> {
+    // A UTF-8 byte-order mark (Excel's "CSV UTF-8", PowerShell 5's `-Encoding utf8`) is no part of the header.
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let mut lines = text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty() && !l.trim_start().starts_with('#'));
     let Some((hline, header)) = lines.next() else {
         return Err(Error::input(file, "", "empty: expected a header `theta_i,theta_o,brdf` (or `brdf_cos`)"));
@@ -651,13 +653,27 @@ pub fn parse_csv(text: &str, file: &str) -> Result<InPlaneBrdf> {
 /// Read an in-plane CSV file.
 pub fn load_csv(path: &Path) -> Result<InPlaneBrdf> {
     let file = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|source| Error::Io { file: file.clone(), source })?;
+    let text = crate::input::read_text_limited(path, "table", crate::input::MAX_TABLE_BYTES)?;
     parse_csv(&text, &file)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_byte_order_mark_is_read_as_nothing_in_both_text_formats() {
+        let csv = "theta_i,theta_o,brdf\n20,10,1\n20,20,3\n20,30,2\n60,50,4\n60,60,8\n60,70,6\n";
+        let plain = parse_csv(csv, "t.csv").unwrap();
+        let bom = parse_csv(&format!("\u{feff}{csv}"), "t.csv").unwrap();
+        let (wi, wo) = (Vec3::new(-0.3, 0.0, 0.95).normalize(), Vec3::new(0.3, 0.0, 0.95).normalize());
+        let (mut a, mut b) = ([0.0], [0.0]);
+        plain.eval(wi, wo, &mut a);
+        bom.eval(wi, wo, &mut b);
+        assert_eq!(a, b);
+        let e1392 = std::fs::read_to_string("fixtures/materials/inplane/beckmann-e1392.txt").unwrap();
+        assert!(crate::measured::e1392::parse(&format!("\u{feff}{e1392}"), "t.txt").is_ok());
+    }
 
     #[test]
     fn in_plane_pairs_are_read_back_exactly() {

@@ -429,7 +429,7 @@ fn shape_err(file: &str, f: &Field, what: String) -> Error {
 impl RglBrdf {
     pub fn load(path: &Path) -> Result<Self> {
         let file = path.display().to_string();
-        let bytes = std::fs::read(path).map_err(|source| Error::Io { file: file.clone(), source })?;
+        let bytes = crate::input::read_bytes_limited(path, "table", crate::input::MAX_TABLE_BYTES)?;
         Self::from_bytes(&bytes, &file)
     }
 
