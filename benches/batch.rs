@@ -1,12 +1,12 @@
 //! Throughput of the batch `measure` (`glossmeter::batch::measure_many`) and of `sweep`
-//! (`glossmeter::sweep::Sweep::run`) in rayon pools of 1 and 2 threads (issue 12, item 5: ≥ 1.8× on 100
-//! recipes), each beside the way they ran before `Plan::run_all` (the baseline: a parallel loop over recipes,
-//! each with a fresh planner and its own parallel loop over its integrals, `Plan::run`; for the sweep, the
-//! points in chunks of 16 × threads through `Sweep::run_point`). Plain `main` (harness = false): the
-//! configurations take turns, `REPS` rounds (default 11; in each round a strategy's 1- and 2-thread runs are
-//! back to back, in alternating order); the median time is reported, and the speed-up as the median of the
-//! rounds' own ratios; the readings of every run are compared bit for bit with the 1-thread run of the
-//! library path.
+//! (`glossmeter::sweep::Sweep::run`) in rayon pools of 1 and 2 threads (`docs/performance.md` §"Batch and sweep
+//! throughput, 1 against 2 threads": ≥ 1.8× on 100 recipes), each beside the way they ran before `Plan::run_all` (the
+//! baseline: a parallel loop over recipes, each with a fresh planner and its own parallel loop over its integrals,
+//! `Plan::run`; for the sweep, the points in chunks of 16 × threads through `Sweep::run_point`). Plain `main`
+//! (harness = false): the configurations take turns, `REPS` rounds (default 11; in each round a strategy's 1- and
+//! 2-thread runs are back to back, in alternating order); the median time is reported, and the speed-up as the median
+//! of the rounds' own ratios; the readings of every run are compared bit for bit with the 1-thread run of the library
+//! path.
 //!
 //! Beside the wall time: the CPU time of all the process's threads per run, the time they waited on the run
 //! queue for a CPU, of the pool's threads (`/proc/self/task/TID/schedstat`, Linux; "n/a" elsewhere), and the idle time, threads ×

@@ -1,6 +1,6 @@
 //! Benchmarks of the aperture integrator against the baselines a grid- or sampling-based tool would use
-//! (issue 4). Plain `main` (harness = false), `std::time::Instant`, every measurement repeated until it has
-//! taken ≥ 100 ms in total and reported as the median time per run.
+//! (`docs/performance.md`). Plain `main` (harness = false), `std::time::Instant`, every measurement repeated until it
+//! has taken ≥ 100 ms in total and reported as the median time per run.
 //!
 //! Run: `cargo bench --bench integrators` (release). `BENCH_QUICK=1` shrinks the baselines for a smoke
 //! test. `BENCH_CASES=B1,B3,NARROW,B5,BATCH` runs only the sections named (the cases B1–B4, the narrow-GGX
@@ -294,7 +294,7 @@ fn rule_label(m: &Method, brdf: &dyn Brdf) -> String {
 }
 
 /// The rows of one case with each rule of `rules` forced on its regular part (None: the planner's choice),
-/// side by side in one run (issue 10; review D2: one helper for every case and section).
+/// side by side in one run (review D2: one helper for every case and section).
 fn rule_rows(c: &Case, rtol: f64, rules: &[(&str, Option<Rule>)], reference: f64) -> Vec<Row> {
     let mut rows = Vec::new();
     for (label, rule) in rules {
@@ -644,7 +644,7 @@ fn main() {
                 format!("{} regions{}", f.regions, if f.converged { "" } else { ", NOT converged" }),
             ));
         }
-        // The two rules forced on the same integral at rtol 1e-6 (issue 10): the tensor rule (in (p_s, p_r, v,
+        // The two rules forced on the same integral at rtol 1e-6: the tensor rule (in (p_s, p_r, v,
         // t_q), whatever the planner chooses) and the Genz–Malik 7/5 engine on the planner's lobe-variable
         // partition (the fallback; hcubature's algorithm with our variables and splits).
         rows.extend(rule_rows(
@@ -856,10 +856,10 @@ fn main() {
     }
 }
 
-/// Narrow GGX (issue 10): the polar rule the planner chooses (`Rule::LobePolar`) beside the Genz–Malik 7/5
-/// partition forced on the same method (same lobe chart, same initial boxes: the engine before the polar
-/// rule), in one run, at α = 1e-3, 1e-5, 1e-7 on astm-d523-20 (n = 1.5). Reference: the forced partition at
-/// rtol 1e-11, cross-checked against the polar rule at 1e-11.
+/// Narrow GGX (`docs/performance.md` §"Narrow GGX: the polar rule beside the forced partition"): the polar rule the
+/// planner chooses (`Rule::LobePolar`) beside the Genz–Malik 7/5 partition forced on the same method (same lobe chart,
+/// same initial boxes: the engine before the polar rule), in one run, at α = 1e-3, 1e-5, 1e-7 on astm-d523-20
+/// (n = 1.5). Reference: the forced partition at rtol 1e-11, cross-checked against the polar rule at 1e-11.
 fn narrow_ggx(md: &mut String) {
     let _ = writeln!(md, "\n## Narrow GGX: the polar rule beside the forced Genz–Malik partition (same chart)\n");
     let _ = writeln!(
@@ -1155,11 +1155,12 @@ fn force_plan_rule(plan: &mut Plan, rule: Option<Rule>) {
 }
 
 /// B5 with the narrow flake lobes (cerulean-blue-c-literal) over the default panel, side by side in one run
-/// (issue 10): the planner's methods, Genz–Malik 7/5 forced on every specimen integral (the engine before
-/// issue 10's rules), and the tensor Gauss–Legendre rule with p-refinement forced on the overlap-kink partition
-/// (`TensorChart::Lobe`, orders shared by its boxes; its fallback is the Genz–Malik partition). Whole-panel
-/// evaluations (exact, counted by a wrapper) and single-core times; then, per specimen integral, where the
-/// evaluations go and each rule's actual error against a Genz–Malik run at 10⁻⁴ of the integral's tolerance.
+/// (`docs/performance.md` §"B5 with narrow flake lobes"): the planner's methods, Genz–Malik 7/5 forced on every
+/// specimen integral (the engine before the shaped, delta and tensor rules), and the tensor Gauss–Legendre rule with
+/// p-refinement forced on the overlap-kink partition (`TensorChart::Lobe`, orders shared by its boxes; its fallback is
+/// the Genz–Malik partition). Whole-panel evaluations (exact, counted by a wrapper) and single-core times; then, per
+/// specimen integral, where the evaluations go and each rule's actual error against a Genz–Malik run at 10⁻⁴ of the
+/// integral's tolerance.
 fn b5_rules(md: &mut String) {
     let file = "cerulean-blue-c-literal.json";
     let Some(brdf) = recipe(file) else { return };

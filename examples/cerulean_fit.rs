@@ -1,4 +1,4 @@
-//! The worked example of `docs/inverse.md` (issue 11, item 3): the paper's metallic paint fitted back from
+//! The worked example of `docs/inverse.md` (§Worked example): the paper's metallic paint fitted back from
 //! its readings. Run by hand:
 //!
 //! ```text

@@ -1,4 +1,4 @@
-//! The fuzz driver (issue 8), run by hand in release mode (the command-line category runs the binary, so
+//! The fuzz driver (`docs/reliability.md`), run by hand in release mode (the command-line category runs the binary, so
 //! build it first):
 //!
 //! ```text

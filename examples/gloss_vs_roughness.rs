@@ -1,4 +1,4 @@
-//! Gloss ↔ roughness (issue 11, item 2): the tables and the plot of `docs/gloss-vs-roughness.md`, run by hand:
+//! Gloss ↔ roughness: the tables and the plot of `docs/gloss-vs-roughness.md`, run by hand:
 //!
 //! ```text
 //! nice cargo run --release --example gloss_vs_roughness -- docs/figures/gloss-vs-roughness.svg > tables.md

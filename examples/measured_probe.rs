@@ -1,4 +1,4 @@
-//! Probe (issue 10, measured tables): the cost of a measured table's gloss integrals with the lobe the table
+//! Probe (measured tables): the cost of a measured table's gloss integrals with the lobe the table
 //! states and with other lobe descriptions, and the shape of the table's lobe in the plane of incidence.
 //! It exists to reproduce the counts of `docs/instrument.md` §Quadrature, *Measured tables*:
 //! `cargo run --release --example measured_probe -- RECIPE... [--width W] [--quartic | --gaussian]

@@ -29,7 +29,8 @@ pub type Result<T> = std::result::Result<T, Error>;
 
 /// A number the user gave, shown in an error message in backquotes as the user's own value (`` `NaN` ``,
 /// `` `inf` ``, `` `0` ``): glossmeter's own text never shows a non-finite number, so a reader (or the fuzz
-/// checker, tests/common/fuzz_cases.rs) can tell an echoed input from a computed NaN (issue 8).
+/// checker, tests/common/fuzz_cases.rs) can tell an echoed input from a computed NaN (`docs/reliability.md` §The
+/// checks).
 pub fn given(x: f64) -> String {
     format!("`{x}`")
 }

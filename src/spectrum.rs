@@ -18,7 +18,7 @@ pub const YBAR_CSV: &str = include_str!("../standards/cie/cie1931-ybar.csv");
 /// so they are weighted by those primaries' luminances: the Y row of the CIE 1931 RGB→XYZ matrix,
 /// Y = 0.17697 R + 0.81240 G + 0.01063 B (CIE 1931; CIE 15:2004 §3; the luminance ratio 1 : 4.5907 : 0.0601 of
 /// Wright–Guild's primaries, Wyszecki & Stiles, *Color Science*, 2nd ed., §3.3.2). They sum to 1, so a grey
-/// material's reading does not depend on them. (Until issue 9 these were the sRGB / BT.709 weights
+/// material's reading does not depend on them. (Earlier these were the sRGB / BT.709 weights
 /// 0.2126/0.7152/0.0722, which belong to different primaries; `docs/model.md` §Spectral gives the effect.)
 pub const RGB_LUMINANCE_WEIGHTS: [f64; 3] = [0.17697, 0.81240, 0.01063];
 
@@ -221,7 +221,8 @@ pub fn interp(table: &[(f64, f64)], x: f64) -> Option<f64> {
 mod tests {
     use super::*;
 
-    /// Issue 8 item 4: 781–830 nm were allowed by the docs and the schema but refused by the tables.
+    /// 781–830 nm were allowed by the docs and the schema (`docs/recipe-format.md` §Paint) but once refused by the
+    /// tables.
     #[test]
     fn the_whole_documented_range_is_accepted() {
         let grid: Vec<f64> = (0..=94).map(|k| 360.0 + 5.0 * k as f64).collect();

@@ -1,8 +1,8 @@
-//! Nothing in the hot path allocates (issue 10 item 4): executing one aperture integral makes a number of
-//! heap allocations that does not grow with the number of regions refined, apart from the amortised growth
-//! of the region heap and the integrand's buffers (O(log regions) reallocations). Counted with a counting
-//! global allocator around `Method::execute` on the calling thread (a thread-local count, so the tests of this
-//! file, which the harness runs in parallel, do not count each other's allocations).
+//! Nothing in the hot path allocates (`docs/instrument.md` §Quadrature, "Allocation in the shaped rules"): executing
+//! one aperture integral makes a number of heap allocations that does not grow with the number of regions refined,
+//! apart from the amortised growth of the region heap and the integrand's buffers (O(log regions) reallocations).
+//! Counted with a counting global allocator around `Method::execute` on the calling thread (a thread-local count, so
+//! the tests of this file, which the harness runs in parallel, do not count each other's allocations).
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 

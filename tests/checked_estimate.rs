@@ -1,4 +1,4 @@
-//! The checked region estimate (issue 10 item 2, `docs/accuracy.md` §5) at the level of the quadrature: with
+//! The checked region estimate (`docs/accuracy.md` §5.1) at the level of the quadrature: with
 //! `Options::checked` a bisected box's children have their calibrated estimates scaled from their parent's
 //! check. Against closed forms, the estimate stays at or above the actual error, it is smaller than the
 //! unchecked one (so the check does something), and a frozen re-run of the kept partition gives the same value

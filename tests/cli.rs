@@ -127,7 +127,8 @@ fn write(name: &str, text: &str) -> String {
     p.to_str().unwrap().to_string()
 }
 
-/// Issue 8 item 1: a row whose prediction has no value was "—", no note, exit 0.
+/// A row whose prediction has no value was once "—", no note, exit 0; it is unchecked, exit 1 (`docs/instrument.md`
+/// §Exit statuses).
 #[test]
 fn compare_fails_a_check_it_could_not_make() {
     let black = write("black-lambert.json", r#"{"model":"lambert","albedo":0}"#);
@@ -144,12 +145,12 @@ fn compare_fails_a_check_it_could_not_make() {
     assert_eq!(run(["glossmeter", "compare", glass, &sheet, "--tolerance", "0.01"]), 0);
 }
 
-/// Issue 8 items 6 and 7: an unconverged reading exits 1 unless --allow-unconverged; DOI of a black
+/// An unconverged reading exits 1 unless --allow-unconverged (`docs/instrument.md` §Exit statuses); DOI of a black
 /// specimen says that the specimen's specular flux is zero, not that the stops miss the mirror direction.
 #[test]
 fn unconverged_readings_exit_1_and_reasons_say_what_is_zero() {
     let rough = "fixtures/recipes/rough-dielectric-beckmann.json";
-    // rtol 1e-9: at the default the calibrated estimate (issue 10) already converges on the initial boxes.
+    // rtol 1e-9: at the default the calibrated estimate (`docs/accuracy.md` §5) already converges on the initial boxes.
     let base = ["measure", rough, "-g", "astm-d523-60", "--max-evals", "200", "--rtol", "1e-9", "--no-timing"];
     let (code, out, err) = stderr_of(&base);
     assert_eq!(code, Some(1), "{out}{err}");
@@ -171,7 +172,8 @@ fn unconverged_readings_exit_1_and_reasons_say_what_is_zero() {
     assert!(v["readings"].as_array().unwrap().iter().all(|r| r["value"].is_number()), "{out}");
 }
 
-/// Issue 8: `-o` naming an existing file is refused before any work (here: before the recipe is even read).
+/// `-o` naming an existing file is refused before any work (here: before the recipe is even read;
+/// `docs/instrument.md` §Exit statuses).
 #[test]
 fn output_is_checked_before_the_work() {
     let existing = write("existing.txt", "user data");
@@ -185,7 +187,7 @@ fn output_is_checked_before_the_work() {
     assert_eq!(std::fs::read_to_string(&existing).unwrap(), "user data");
 }
 
-/// Issue 8 item 3: a table cell longer than 65 535 characters panicked in `format!`'s width.
+/// A table cell longer than 65 535 characters once panicked in `format!`'s width.
 #[test]
 fn a_huge_table_cell_does_not_panic() {
     let name = "s".repeat(70_000);
@@ -195,7 +197,7 @@ fn a_huge_table_cell_does_not_panic() {
     assert!(out.contains(&name) && out.contains("predicted − measured"));
 }
 
-/// Issue 8: CSV numbers are plain decimals and the notes are kept.
+/// CSV numbers are plain decimals and the notes are kept (`docs/instrument.md` §Output).
 #[test]
 fn csv_has_plain_decimals_and_notes() {
     let (code, out, _) =
@@ -216,7 +218,8 @@ fn csv_has_plain_decimals_and_notes() {
     assert_eq!(notes, 1, "the D4039 scope note is kept");
 }
 
-/// Issue 8 item 8 (smaller): duplicate keys, a BOM, a user geometry reusing a shipped id.
+/// Smaller input cases (`docs/instrument.md` §Exit statuses, status 2): duplicate keys, a BOM, a user geometry reusing
+/// a shipped id.
 #[test]
 fn smaller_input_cases_exit_2_naming_file_and_field() {
     let dup = write("dup.json", r#"{"model":"lambert","albedo":0.5,"albedo":0.9}"#);

@@ -1,4 +1,4 @@
-//! Issue 9 item 2: brightness-compensated haze on every haze geometry (docs/instrument.md §1.7).
+//! Brightness-compensated haze on every haze geometry (docs/instrument.md §1.7).
 //!
 //! * the factor is the ratio of projected solid angles, checked against an independent quadrature;
 //! * a smooth coat over a diffuse body (no lobe) reads a compensated haze within 5 % of zero relative to its

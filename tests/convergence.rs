@@ -1,4 +1,4 @@
-//! Tests of `glossmeter convergence` (issue 4, item 1): the sweep on a Lambertian material, whose
+//! Tests of `glossmeter convergence` (`docs/accuracy.md` §2): the sweep on a Lambertian material, whose
 //! reference is an independent closed form, and the command line (JSON fields, the SVG plot, refusal to
 //! overwrite, refusal of bad tolerances).
 #![cfg(feature = "cli")]

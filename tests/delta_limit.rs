@@ -1,4 +1,4 @@
-//! Issue 10 item 1, the delta limit of a narrow Gaussian-tailed lobe (`Rule::LobeDelta`): its reported error
+//! The delta limit of a narrow Gaussian-tailed lobe (`Rule::LobeDelta`): its reported error
 //! (the majorant of `docs/instrument.md` §Quadrature, "The delta limit of a narrow lobe") is never below its
 //! actual error, bounded by the difference from the lobe's own Gauss–Hermite rule run to rtol 1e-12 … 1e-10
 //! (the partition at rtol 1e-10 where it tops out) plus that reference's own estimate,

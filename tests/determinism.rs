@@ -1,6 +1,6 @@
-//! Reproducibility (issue 4): the same readings, bit for bit, whatever the number of threads the plan runs
-//! on, and from one run to the next in the same thread. Compared: `f64::to_bits` of every value and error
-//! estimate, the evaluation counts and the convergence flags.
+//! Reproducibility (`docs/instrument.md` §Quadrature, "Determinism"): the same readings, bit for bit, whatever the
+//! number of threads the plan runs on, and from one run to the next in the same thread. Compared: `f64::to_bits` of
+//! every value and error estimate, the evaluation counts and the convergence flags.
 mod common;
 use common::TestBeckmann;
 use std::path::Path;
@@ -101,8 +101,8 @@ fn cerulean_blue_c_is_bitwise_reproducible_across_thread_counts() {
     check(recipe("cerulean-blue-c.json"), "cerulean-blue-c");
 }
 
-/// Issue 12 item 5: running many plans as one flat loop of integrals (`Plan::run_all`, behind the batch
-/// `measure` and `sweep`) gives every plan the bits of its own `Plan::run`, fluxes included, on 1, 2 and 4
+/// Running many plans as one flat loop of integrals (`Plan::run_all`, behind the batch `measure` and `sweep`;
+/// `docs/instrument.md` §Many recipes) gives every plan the bits of its own `Plan::run`, fluxes included, on 1, 2 and 4
 /// threads; and a batch through one shared planner (`batch::measure_many`) the bits of one-by-one plans.
 #[test]
 fn many_plans_in_one_flat_loop_give_each_plans_own_bits() {

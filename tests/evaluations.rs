@@ -1,5 +1,5 @@
-//! The cost of a whole plan (issue 10 item 5): `Execution::evaluations` and the top-level `"evaluations"` of
-//! `measure --format json` count every distinct integral of the plan once, while each reading keeps counting
+//! The cost of a whole plan (`docs/instrument.md` §Output): `Execution::evaluations` and the top-level `"evaluations"`
+//! of `measure --format json` count every distinct integral of the plan once, while each reading keeps counting
 //! every integral it uses.
 use std::collections::BTreeSet;
 use std::path::Path;

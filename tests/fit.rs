@@ -1,4 +1,4 @@
-//! `glossmeter fit` (issue 11): round trips (forward at known parameters → fit from a perturbed start →
+//! `glossmeter fit` (`docs/inverse.md`): round trips (forward at known parameters → fit from a perturbed start →
 //! the known parameters within 3 standard errors), a Monte Carlo check that the standard errors match the
 //! spread of fits over noisy targets, degenerate cases reported as not identifiable, bounds that hold, and
 //! every bad input refused with exit status 2.
@@ -299,7 +299,7 @@ fn cli_fits_writes_json_and_never_overwrites() {
     ]);
     assert_eq!(code, 0, "{stdout}{stderr}");
     let v: Value = serde_json::from_str(&stdout).unwrap();
-    // The contract of issue 11, exactly (plus `verdict`, the identifiability in words).
+    // The contract of `docs/inverse.md` §Output, exactly (plus `verdict`, the identifiability in words).
     let keys = |v: &Value| -> Vec<String> {
         let mut k: Vec<String> = v.as_object().unwrap().keys().cloned().collect();
         k.sort();

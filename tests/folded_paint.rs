@@ -1,4 +1,4 @@
-//! The paint's folded luminous evaluation (issue 10 item 3, `Brdf::eval_batch_folded`, docs/model.md §Folded
+//! The paint's folded luminous evaluation (`Brdf::eval_batch_folded`, docs/model.md §Folded
 //! evaluation) against its per-sample evaluation weighted afterwards: the same function, summed in another
 //! order, so equal to rounding. Stated tolerance: 1e-13 relative to the luminous value (plus 1e-13 of the
 //! largest weighted sample term, for values near 0), pointwise; and the readings of every paint fixture with

@@ -1,5 +1,5 @@
-//! The fuzz campaign in `cargo test` (issue 8): property tests over generated and mutated recipes, geometry
-//! files and sheets, in bounded time (a few hundred cases per category, a few seconds). Every case is either
+//! The fuzz campaign in `cargo test` (`docs/reliability.md`): property tests over generated and mutated recipes,
+//! geometry files and sheets, in bounded time (a few hundred cases per category, a few seconds). Every case is either
 //! accepted or refused with an error naming the file and a field or line; nothing panics; a recipe that is
 //! accepted is measured (cheap tolerance, small budget) and no reading is NaN or infinite, in the library and
 //! through the command line (exit 0, 1 or 2; no "NaN"/"inf" in the output). The 10⁶-case run by hand is

@@ -1,5 +1,5 @@
 //! Golden readings: every reading of every shipped fixture recipe, on every builtin geometry, stored as bits
-//! (`fixtures/golden/readings.json`) and compared bit for bit. A refactor (issue 7) must leave them identical;
+//! (`fixtures/golden/readings.json`) and compared bit for bit. A refactor must leave them identical;
 //! a change that moves readings on purpose regenerates the file with
 //! `GLOSSMETER_BLESS=1 cargo test --test golden` and explains every moved reading in its commit and the docs.
 //!

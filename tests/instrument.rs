@@ -1,4 +1,4 @@
-//! Acceptance tests of the virtual instrument (issue 3). Every reference here is computed independently
+//! Acceptance tests of the virtual instrument (`docs/instrument.md` §1). Every reference here is computed independently
 //! of the engine (`glossmeter::instrument::reference`, which shares no code with the quadrature): Lambert's
 //! closed form for the projected solid angle of a spherical polygon, or a separate nested Gauss–Legendre
 //! integration of the mirror overlap.
@@ -183,8 +183,8 @@ fn haze_index_alone_or_first_is_g60_minus_g20() {
     assert_eq!(h, g("astm-d523-60") - g("astm-d523-20"));
 }
 
-/// Issue 9 item 1: the 45° geometry is on C346's mirror scale (reflectance × 1000), so polished black glass of
-/// n = 1.540 reads 55.9 GU as on real 45° meters (BYK micro-gloss 45°), and a perfect mirror reads 1000.
+/// The 45° geometry is on C346's mirror scale (reflectance × 1000; `docs/instrument.md` §1.5), so polished black glass
+/// of n = 1.540 reads 55.9 GU as on real 45° meters (BYK micro-gloss 45°), and a perfect mirror reads 1000.
 /// The reference is 1000 × the aperture-averaged Fresnel reflectance (Gauss–Legendre, no shared code).
 #[test]
 fn d2457_45_reads_on_the_mirror_scale() {

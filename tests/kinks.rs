@@ -1,6 +1,6 @@
-//! Issue 8, bounded work: a Fresnel critical angle inside the stops is a kink of the integrand, and the plan
-//! puts it on partition boundaries (`Brdf::kinks`, `instrument::aperture::kinked_position`). The issue's
-//! reproducer, `{"model":"microfacet","distribution":"beckmann","roughness":1e-7,"ior":[0.3375,0.0]}` at
+//! Bounded work (`docs/instrument.md` §Quadrature, "Kinks"): a Fresnel critical angle inside the stops is a kink of the
+//! integrand, and the plan puts it on partition boundaries (`Brdf::kinks`, `instrument::aperture::kinked_position`).
+//! The reproducer, `{"model":"microfacet","distribution":"beckmann","roughness":1e-7,"ior":[0.3375,0.0]}` at
 //! 20° (θc = 19.72°, inside the 20° stops), ran 18 s to the 50 M budget without converging.
 //!
 //! The reference here is independent of the engine: its own kink position (the quadratic cos θi = cos θc on

@@ -197,8 +197,8 @@ fn lambertian_table_reads_rho_over_pi_with_both_lookups() {
         let desc = m.brdf.describe();
         assert!(desc.contains("lambert.binary") && desc.contains("90 × 90 × 180") && desc.contains(interp), "{desc}");
         assert!(desc.contains("0 invalid"), "{desc}");
-        // Every cell the same per channel: a constant BRDF, stated as a diffuse term (issue 10: the plain
-        // chart, 57 evaluations at D523 20°/60°/85°, instead of splits at the resolution).
+        // Every cell the same per channel: a constant BRDF, stated as a diffuse term (`docs/instrument.md` §Quadrature,
+        // "Measured tables": the plain chart, 57 evaluations at D523 20°/60°/85°, instead of splits at the resolution).
         let terms = m.brdf.terms();
         assert_eq!(terms.len(), 1);
         assert_eq!(terms[0].kind, TermKind::Diffuse, "{terms:?}");

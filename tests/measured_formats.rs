@@ -369,11 +369,11 @@ fn inplane_microfacet_error_is_the_tables_resolution() {
     let _ = std::fs::remove_dir_all(&d);
 }
 
-/// Issue 10, measured tables: every table states its lobe's own half width at half maximum, measured from the
-/// table at load (`Tail::Table`); the shipped Beckmann α = 0.15 tables all read ≈ 0.122 (the closed form's
-/// in-plane f at 20° halves at a half-vector tilt of ≈ 6.9°), the Lambertian RGL table never halves (∞).
-/// A constant table is a diffuse term: the plain chart, 57 evaluations per flux at D523 20°/60°/85° (6 840 /
-/// 7 980 / 9 120 on the resolution splits before), the reading unchanged within its estimate.
+/// Measured tables (`docs/instrument.md` §Quadrature, "Measured tables"): every table states its lobe's own half width
+/// at half maximum, measured from the table at load (`Tail::Table`); the shipped Beckmann α = 0.15 tables all
+/// read ≈ 0.122 (the closed form's in-plane f at 20° halves at a half-vector tilt of ≈ 6.9°), the Lambertian RGL table
+/// never halves (∞). A constant table is a diffuse term: the plain chart, 57 evaluations per flux at D523 20°/60°/85°
+/// (6 840 / 7 980 / 9 120 on the resolution splits before), the reading unchanged within its estimate.
 #[test]
 fn tables_state_their_half_width_and_a_flat_table_is_diffuse() {
     use glossmeter::brdf::{Tail, TermKind};

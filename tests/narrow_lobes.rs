@@ -1,8 +1,9 @@
-//! Issue 10, narrow lobes: the cost of a GGX or Beckmann lobe of roughness 1e-3 … 1e-8 at ASTM D523 20°
-//! (n = 1.5, the default rtol 1e-6) stops growing as the lobe narrows, the readings agree with the engine's
-//! own rtol-1e-10 values from before the polar rule (`fixtures/reference/narrow-lobes-d523-20.json`, with
-//! its provenance) within their estimates, and the plan names the rule it chose. Evaluation counts are exact
-//! and reproducible, so the cost targets are tests here; times are measured in `benches/integrators.rs`.
+//! Narrow lobes (`docs/performance.md` §"Cost against roughness (narrow lobes)"): the cost of a GGX or Beckmann lobe of
+//! roughness 1e-3 … 1e-8 at ASTM D523 20° (n = 1.5, the default rtol 1e-6) stops growing as the lobe narrows, the
+//! readings agree with the engine's own rtol-1e-10 values from before the polar rule
+//! (`fixtures/reference/narrow-lobes-d523-20.json`, with its provenance) within their estimates, and the plan names the
+//! rule it chose. Evaluation counts are exact and reproducible, so the cost targets are tests here; times are measured
+//! in `benches/integrators.rs`.
 use std::sync::Arc;
 
 use glossmeter::brdf::Brdf;
@@ -69,10 +70,10 @@ fn narrow_lobe_readings_agree_with_the_rtol_1e_10_reference_within_their_estimat
     }
 }
 
-/// The issue's target: Beckmann and GGX cost at roughness 1e-8 within 1.5× of 1e-3. Below
-/// `Microfacet::SMOOTH_THRESHOLD` = 1e-7 the model itself is its delta limit (a 2-D integral), so the
-/// narrowest lobe actually integrated is 1e-7: it is held to the same target, and the counts from 1e-5 to
-/// 1e-7 are equal (nothing grows with 1/α any more).
+/// The target of `docs/performance.md` §"Cost against roughness (narrow lobes)": Beckmann and GGX cost at roughness
+/// 1e-8 within 1.5× of 1e-3. Below `Microfacet::SMOOTH_THRESHOLD` = 1e-7 the model itself is its delta limit (a 2-D
+/// integral), so the narrowest lobe actually integrated is 1e-7: it is held to the same target, and the counts from
+/// 1e-5 to 1e-7 are equal (nothing grows with 1/α any more).
 #[test]
 fn the_cost_stops_growing_as_the_lobe_narrows() {
     for d in ["ggx", "beckmann"] {

@@ -1,5 +1,5 @@
-//! Output that cannot be written (issue 7 item 1, issue 8 items 2–3): a reader that went away ends the run
-//! quietly with status 0, as ripgrep does; a full disk is an error (status 2) with the file named, never a
+//! Output that cannot be written (`docs/reliability.md` §Output that cannot be written): a reader that went away ends
+//! the run quietly with status 0, as ripgrep does; a full disk is an error (status 2) with the file named, never a
 //! panic (101) and never a silent success.
 #![cfg(feature = "cli")]
 use std::process::{Command, Stdio};
@@ -30,7 +30,7 @@ const CASES: &[&[&str]] = &[
     CONVERGENCE,
 ];
 
-/// A quick `convergence` (issue 8 item 3: it was not among the closed-pipe cases).
+/// A quick `convergence` (once missing from the closed-pipe cases).
 const CONVERGENCE: &[&str] = &[
     "convergence",
     "fixtures/recipes/grey-lambert.json",
@@ -113,7 +113,7 @@ impl Drop for FullDisk {
     }
 }
 
-/// Issue 8 item 2: `-o` and `--plot` on a full filesystem left a 0-byte file (and exited 0 for `-o`). Now:
+/// `-o` and `--plot` on a full filesystem once left a 0-byte file (and exited 0 for `-o`). Now:
 /// status 2, the file named with the system's reason, and no file (not even an empty one, nor the
 /// temporary) left behind, so a rerun under the same name is not blocked.
 #[test]

@@ -1,5 +1,5 @@
-//! The measurement plan as a designer (issue 7): its switches give the same readings, a long-lived planner
-//! caches the standards, a plan is reused on another material of the same shape, and a frozen plan re-runs
+//! The measurement plan as a designer (`docs/architecture.md`): its switches give the same readings, a long-lived
+//! planner caches the standards, a plan is reused on another material of the same shape, and a frozen plan re-runs
 //! the same partition (same bits on the same material; a smooth function of the material's parameters).
 mod common;
 use common::TestBeckmann;
@@ -131,7 +131,8 @@ fn a_frozen_plan_repeats_its_bits_and_moves_smoothly() {
     }
 }
 
-/// Issue 8, bounded work: the paper-eq1 pearl that ran 80 s to the 50 M budget without converging.
+/// Bounded work (`docs/instrument.md` §Quadrature, "Bounded work"): the paper-eq1 pearl that ran 80 s to the 50 M
+/// budget without converging.
 fn pearl() -> Arc<dyn Brdf> {
     let recipe = r#"{"model": "paint", "form": "paper-eq1",
         "clear_coat": {"index": 1.5},
@@ -160,9 +161,9 @@ fn a_budget_ends_in_not_converged_with_the_best_estimate() {
     assert!(r.evaluations < PlanOptions::default().max_evals, "{r:?}");
 }
 
-/// The wall-clock budget is one deadline for the whole plan (issue 8: the default panel of the pearl ran
-/// minutes, each of its 12 integrals with a budget of its own): the default panel ends near the budget, not
-/// near 12 × the budget / threads, and every reading still has a finite best estimate.
+/// The wall-clock budget is one deadline for the whole plan (`docs/instrument.md` §Quadrature, "Bounded work": the
+/// default panel of the pearl ran minutes, each of its 12 integrals with a budget of its own): the default panel ends
+/// near the budget, not near 12 × the budget / threads, and every reading still has a finite best estimate.
 #[test]
 fn the_wall_clock_budget_is_shared_by_the_plan() {
     let budget = 0.5;
@@ -202,9 +203,9 @@ fn the_tolerance_floor_is_stated_and_enforced() {
     assert!(glossmeter::instrument::convergence::validate_tolerances(&[1e-6, 1e-10]).is_ok());
 }
 
-/// Issue 10: a narrow Gaussian lobe far from the overlap kinks is read by the Gauss–Hermite lobe rule, which
-/// `--explain` names with its fallback; a lobe over a diffuse body keeps Genz–Malik; a frozen re-run of the
-/// shaped rule gives the same bits.
+/// A narrow Gaussian lobe far from the overlap kinks is read by the Gauss–Hermite lobe rule (`docs/instrument.md`
+/// §Quadrature, "A shaped rule for a narrow Gaussian lobe"), which `--explain` names with its fallback; a lobe over a
+/// diffuse body keeps Genz–Malik; a frozen re-run of the shaped rule gives the same bits.
 #[test]
 fn the_planner_names_the_shaped_rule_it_chooses_and_freezes_it() {
     let g = vec![standards::find("astm-d523-20").unwrap()];

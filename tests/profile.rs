@@ -1,4 +1,4 @@
-//! Rspec and the 20° goniophotometric profile (issue 9 item 3): the profile of a smooth dielectric and of a
+//! Rspec and the 20° goniophotometric profile (`docs/instrument.md` §1.8): the profile of a smooth dielectric and of a
 //! Lambertian body against closed forms computed here independently of the engine, Rspec of smooth
 //! specimens, the CSV / JSON schema of `glossmeter profile`, its picture, and bad input (exit 2 naming the
 //! file and the field).

@@ -229,7 +229,8 @@ fn schema_ranges_agree_with_validator() {
     assert!(Path::new(&root().join("docs/recipe-format.md")).exists(), "docs/recipe-format.md documents the format");
 }
 
-/// Issue 8 item 4: the schema stated 360–830 nm but not the validator's limit of 128 wavelengths.
+/// The schema once stated 360–830 nm but not the validator's limit of 128 wavelengths (`docs/recipe-format.md`
+/// §Paint).
 #[test]
 fn schema_states_the_wavelength_count_limit() {
     let s = schema();

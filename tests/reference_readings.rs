@@ -1,8 +1,8 @@
-//! The safety net of issue 10: every reading of every shipped fixture recipe, on every builtin geometry (the set
-//! of `tests/golden.rs`), computed once by the engine *before* its rules changed, at rtol 1e-10 with no wall-clock
-//! budget, and stored with its own error estimate and its provenance (`fixtures/reference/readings-rtol1e-10.json`).
-//! Whatever rule the planner chooses now, every reading at the default settings must agree with that value within
-//! its error estimate:
+//! The safety net of the calibrated estimate (`docs/accuracy.md` §5): every reading of every shipped fixture recipe, on
+//! every builtin geometry (the set of `tests/golden.rs`), computed once by the engine *before* its rules changed, at
+//! rtol 1e-10 with no wall-clock budget, and stored with its own error estimate and its provenance
+//! (`fixtures/reference/readings-rtol1e-10.json`). Whatever rule the planner chooses now, every reading at the default
+//! settings must agree with that value within its error estimate:
 //!
 //!     |value − reference| ≤ estimate + reference estimate
 //!

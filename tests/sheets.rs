@@ -1,5 +1,5 @@
-//! Instrument sheets end to end (issue 12): every shipped dialect under fixtures/sheets/, repeated readings and
-//! their statistics, many samples with their own recipes, JUnit XML (parsed back), baselines, and every
+//! Instrument sheets end to end (`docs/instrument.md` §Sheets): every shipped dialect under fixtures/sheets/, repeated
+//! readings and their statistics, many samples with their own recipes, JUnit XML (parsed back), baselines, and every
 //! malformed sheet (exit 2 with the file, the line and the column).
 use std::process::Command;
 

@@ -1,4 +1,4 @@
-//! The stiff and extreme suite (issue 4, item 2). For every case: every reading has a finite value, its
+//! The stiff and extreme suite (`docs/stability.md`). For every case: every reading has a finite value, its
 //! actual error lies within its error estimate, and results are continuous across every internal switch.
 //!
 //! "Actual error" is measured against an independent reference written in this file (it shares only the

@@ -237,8 +237,8 @@ fn bad_geometry_files_name_file_and_field() {
     expect_input_error(&fixture("bad-unknown-field.json"), "/source/in_plane", "unknown field");
     expect_input_error(&fixture("bad-below-horizon.json"), "/receptors/0/offset_deg", "below");
     expect_input_error(&fixture("bad-empty-source.json"), "/angle_deg/source", "must not be empty");
-    // Issue 8: a composite naming an unknown id was an error with neither file nor field; a user file could
-    // take a shipped id.
+    // A composite naming an unknown id was once an error with neither file nor field, and a user file could
+    // take a shipped id (`docs/instrument.md` §2.5: every error names the file and the field).
     expect_input_error(
         &fixture("bad-composite-unknown-part.json"),
         "/readings/0/minuend",
@@ -285,7 +285,7 @@ fn range_checks() {
     assert_eq!(field(missing_readings), "/readingz");
 }
 
-/// Scales as data (issue 9 item 1): every shipped non-composite geometry states its scale; a user file may
+/// Scales as data (`docs/instrument.md` §1.5): every shipped non-composite geometry states its scale; a user file may
 /// choose the mirror scale; unknown kinds and a doubly given scale are refused with the field named.
 #[test]
 fn scales_are_data_and_user_files_choose() {

@@ -161,7 +161,8 @@ fn a_measure_baseline_fails_readings_that_moved() {
     assert!(out.contains("1 moved"), "{out}");
 }
 
-/// Issue 12 item 5: the batch's bytes do not depend on the thread count (integrals never split across threads).
+/// The batch's bytes do not depend on the thread count (integrals never split across threads; `docs/instrument.md`
+/// §Many recipes).
 #[test]
 fn a_batch_is_bit_identical_on_one_and_two_threads() {
     let args = [

@@ -1,6 +1,7 @@
-//! Issue 10: the smooth-integrand rule `Rule::TensorGauss` (anisotropic tensor Gauss–Legendre with per-axis
-//! p-refinement, `quadrature::tensor`): closed forms, the estimate against the actual error, the planner's
-//! choice and `--explain`, frozen replays and determinism.
+//! The smooth-integrand rule `Rule::TensorGauss` (anisotropic tensor Gauss–Legendre with per-axis
+//! p-refinement, `quadrature::tensor`; `docs/instrument.md` §Quadrature, "A tensor rule for smooth anisotropic
+//! integrands"): closed forms, the estimate against the actual error, the planner's choice and `--explain`, frozen
+//! replays and determinism.
 use std::sync::Arc;
 
 use glossmeter::brdf::Brdf;

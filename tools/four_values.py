@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The paper's four-value claim, tested (issue 14 item 5; docs/inverse.md §The four-value claim).
+"""The paper's four-value claim, tested (docs/inverse.md §The four-value claim).
 
 Ďurikovič & Ágošton (2007) claim that a metallic or pearlescent paint is reproduced from four values: one gloss
 reading and colorimetric readings in three directions. This script takes two truth recipes, generates exactly

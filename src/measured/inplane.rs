@@ -271,7 +271,7 @@ pub struct InPlaneBrdf {
     lambda: SmithLambda,
     sampling: Sampling,
     /// Every value of the file the same (to `table::FLAT_RTOL`): with the `f` extension a constant BRDF, stated as a diffuse term
-    /// (issue 10).
+    /// (`docs/instrument.md` §Quadrature, "Measured tables").
     flat: bool,
     /// The lobe's half width at half maximum as a slope, measured from the table (with its extension) when
     /// it is built ([`super::table::specular_half_width`]).

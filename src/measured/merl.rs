@@ -69,7 +69,8 @@ pub struct MerlBrdf {
     invalid: usize,
     interpolation: Interpolation,
     sampling: Sampling,
-    /// Every cell valid and equal per channel (to `table::FLAT_RTOL`): a constant BRDF, stated as a diffuse term (issue 10).
+    /// Every cell valid and equal per channel (to `table::FLAT_RTOL`): a constant BRDF, stated as a diffuse term
+    /// (`docs/instrument.md` §Quadrature, "Measured tables").
     flat: bool,
     /// The lobe's half width at half maximum as a slope, measured from the table at load
     /// ([`super::table::specular_half_width`]).

@@ -277,8 +277,8 @@ pub fn elevation(d: Vec3) -> f64 {
 }
 
 /// How far apart (relative) a table's values may be and the table still count as flat, a constant BRDF
-/// stated as a diffuse term (issue 10): a file written with 13 significant digits of f·cos θo and divided
-/// by cos θo at load differs from a constant in the last bits only.
+/// stated as a diffuse term (`docs/instrument.md` §Quadrature, "Measured tables"): a file written with 13 significant
+/// digits of f·cos θo and divided by cos θo at load differs from a constant in the last bits only.
 pub const FLAT_RTOL: f64 = 1e-9;
 
 /// Whether `values` are all finite and within [`FLAT_RTOL`] of one another (relative to the largest).
@@ -301,11 +301,11 @@ pub const HALF_WIDTH_MAX_TILT_DEG: f64 = 40.0;
 /// The scan's step in the half-vector tilt, degrees (then bisection to rounding).
 const HALF_WIDTH_STEP_DEG: f64 = 0.02;
 
-/// The half width at half maximum of a table's lobe about the specular direction, as a slope (issue 10:
-/// the lobe's own width, measured from the table rather than assumed): with ωi at θi =
-/// [`HALF_WIDTH_THETA_I_DEG`] in the plane of incidence, the half vector is tilted in that plane by τ on
-/// either side of the normal (ωo = 2(ωi·h)h − ωi) and the sum of the samples of f_r, as the table evaluates
-/// it, is scanned in steps of 0.02° from τ = 0 until it first falls to half its value at τ = 0, then
+/// The half width at half maximum of a table's lobe about the specular direction, as a slope
+/// (`docs/instrument.md` §Quadrature, "Measured tables": the lobe's own width, measured from the table rather than
+/// assumed): with ωi at θi = [`HALF_WIDTH_THETA_I_DEG`] in the plane of incidence, the half vector is tilted in that
+/// plane by τ on either side of the normal (ωo = 2(ωi·h)h − ωi) and the sum of the samples of f_r, as the table
+/// evaluates it, is scanned in steps of 0.02° from τ = 0 until it first falls to half its value at τ = 0, then
 /// bisected; the result is tan τ of the nearer side. Infinite when f_r at the specular pair is not positive
 /// or does not fall to half within [`HALF_WIDTH_MAX_TILT_DEG`] (a flat or retro-reflecting table).
 /// Deterministic: computed once when a table is loaded.

@@ -187,8 +187,9 @@ pub enum Refine {
 /// Components stored inline up to this many (a luminous flux has 1, a colour flux 3, a flux both use 4).
 const INLINE: usize = 4;
 
-/// A region's ncomp sums: inline for ncomp ≤ [`INLINE`], so that refining a region allocates nothing (issue
-/// 10: nothing in the hot path allocates); on the heap beyond.
+/// A region's ncomp sums: inline for ncomp ≤ [`INLINE`], so that refining a region allocates nothing
+/// (`docs/performance.md` §"Folded paint evaluation and fixed costs": nothing in the hot path allocates); on the heap
+/// beyond.
 struct Comps {
     len: usize,
     inline: [f64; INLINE],

@@ -1,11 +1,12 @@
 //! Product rules for a heavy-tailed peak inside a rectangle: polar variables about the peak with the radius
 //! mapped by ρ = tan β, and the tensor Gauss–Legendre rule of a box (the pieces around it).
 //!
-//! Why: a GGX lobe of width w (issue 10) is, in its scaled lobe variables x = u/w_u, y = v/w_v, to leading
-//! order the kernel 1/(1 + x² + y²)² (Walter et al., EGSR 2007, Eq. 33): a peak of width 1 with an algebraic
-//! tail out to the edges of the domain, 10⁶ widths away at α = 10⁻⁸. No box partition of fixed size resolves
-//! both the peak and the tail, and an adaptive one needs more boxes for every decade of α (the splits of
-//! `instrument::aperture` at ±3ᵏ w). In polar variables x = ρ cos φ, y = ρ sin φ with ρ = tan β the kernel's
+//! Why: a GGX lobe of width w (`docs/instrument.md` §Quadrature, "Polar variables for a narrow GGX lobe") is, in its
+//! scaled lobe variables x = u/w_u, y = v/w_v, to leading order the kernel 1/(1 + x² + y²)² (Walter et al., EGSR 2007,
+//! Eq. 33): a peak of width 1 with an algebraic tail out to the edges of the domain, 10⁶ widths away at α = 10⁻⁸. No
+//! box partition of fixed size resolves both the peak and the tail, and an adaptive one needs more boxes for every
+//! decade of α (the splits of `instrument::aperture` at ±3ᵏ w). In polar variables x = ρ cos φ, y = ρ sin φ with
+//! ρ = tan β the kernel's
 //! area element becomes ρ dρ dφ / (1 + ρ²)² = sin β cos β dβ dφ, a polynomial-like function on β ∈ [0, π/2) whatever the width, so a Gauss–Legendre rule in β with a fixed
 //! number of nodes integrates the lobe to the same relative accuracy at every α: the cost stops growing as
 //! α → 0. The rectangle [x0, x1] × [y0, y1] (containing 0) is cut into four sectors at its corners' angles;

@@ -1,5 +1,6 @@
 //! Anisotropic tensor Gauss–Legendre rules with per-axis order adaptation (p-refinement), for smooth
-//! integrands over a small fixed partition (issue 10).
+//! integrands over a small fixed partition (`docs/instrument.md` §Quadrature, "A tensor rule for smooth anisotropic
+//! integrands").
 //!
 //! Why: on an integrand that is analytic over each box, a product of Gauss–Legendre rules converges
 //! geometrically in the order of every axis, and the orders an axis needs differ widely (a lobe narrower

@@ -74,8 +74,8 @@ pub(super) fn tensor_gauss(
     (r, spent)
 }
 
-/// The buffers of [`Rule::LobeGaussHermite`], made once per execution and reused level after level (issue 10
-/// item 4: nothing in the hot path allocates).
+/// The buffers of [`Rule::LobeGaussHermite`], made once per execution and reused level after level
+/// (`docs/instrument.md` §Quadrature, "Allocation in the shaped rules": nothing in the hot path allocates).
 #[derive(Default)]
 struct HermiteScratch {
     wh: Vec<f64>,

@@ -76,14 +76,15 @@ pub enum Rule {
     /// Genz & Malik's degree-7 rule with its embedded null rules for the error estimate
     /// (`quadrature::GenzMalikRule`), globally adaptive on the part's partition. The fallback of every other rule.
     GenzMalik75,
-    /// A narrow Gaussian-tailed lobe far from every kink of the overlap (issue 10): a tensor product of
-    /// Gauss–Hermite rules in u and v scaled to the lobe's widths (u = width\[0\]·x, v = width\[1\]·y, weight
-    /// e^{−x²−y²}) and Gauss–Legendre rules in t_p and t_q, the orders raised through [`LOBE_LEVELS`]
-    /// `levels.0..=levels.1` until two successive levels agree to the part's tolerance (their difference is
-    /// the error estimate). If none do, the part's Genz–Malik partition is integrated instead (the fallback).
+    /// A narrow Gaussian-tailed lobe far from every kink of the overlap (`docs/instrument.md` §Quadrature, "A shaped
+    /// rule for a narrow Gaussian lobe"): a tensor product of Gauss–Hermite rules in u and v scaled to the lobe's
+    /// widths (u = width\[0\]·x, v = width\[1\]·y, weight e^{−x²−y²}) and Gauss–Legendre rules in t_p and t_q, the
+    /// orders raised through [`LOBE_LEVELS`] `levels.0..=levels.1` until two successive levels agree to the part's
+    /// tolerance (their difference is the error estimate). If none do, the part's Genz–Malik partition is integrated
+    /// instead (the fallback).
     LobeGaussHermite { width: [f64; 2], levels: (usize, usize) },
-    /// The delta limit of a narrow Gaussian-tailed lobe far from every kink of the overlap (issue 10 item 1;
-    /// [`delta_rule`], `docs/instrument.md` §Quadrature, "The delta limit of a narrow lobe"): in the scaled lobe
+    /// The delta limit of a narrow Gaussian-tailed lobe far from every kink of the overlap ([`delta_rule`],
+    /// `docs/instrument.md` §Quadrature, "The delta limit of a narrow lobe"): in the scaled lobe
     /// variables x = u/w_u, y = v/w_v, at each Gauss–Legendre node of (t_p, t_q), the lobe's mass is Laplace's
     /// π·F(0)/√det B from its curvature B at the peak (measured on a ring of [`DELTA_FIT_RADIUS`] width), and the
     /// error reported is the majorant of [`delta_node`] (second differences of the even part of F·e^{xᵀBx} on
@@ -94,7 +95,8 @@ pub enum Rule {
     /// majorant meets the part's tolerance; otherwise the lobe's [`Rule::LobeGaussHermite`] runs (and after
     /// it, if it does not agree either, the Genz–Malik partition). A frozen method replays the same points.
     LobeDelta { width: [f64; 2] },
-    /// A narrow lobe with GGX's heavy u⁻⁴ tail (`Tail::InverseQuartic`) whose centre lies inside the kink square (issue 10; [`polar_rule`]): the
+    /// A narrow lobe with GGX's heavy u⁻⁴ tail (`Tail::InverseQuartic`) whose centre lies inside the kink square
+    /// ([`polar_rule`]; `docs/instrument.md` §Quadrature, "Polar variables for a narrow GGX lobe"): the
     /// (u, v) range is cut at the overlap kinks `u`, `v` (each axis: the range ends and the two kinks, in
     /// increasing order) into up to 3 × 3 pieces. The piece that holds u = v = 0 is integrated in the polar
     /// variables of `quadrature::polar_rectangle` scaled to the lobe's `width` (x = u/w_u = ρ cos φ,
@@ -105,14 +107,14 @@ pub enum Rule {
     /// is raised until the sum meets the part's tolerance. If a piece runs out of levels, the part's
     /// Genz–Malik partition is integrated instead (the fallback).
     LobePolar { width: [f64; 2], u: [f64; 4], v: [f64; 4], levels: [u8; 9] },
-    /// A smooth integrand (issue 10: no lobe much narrower than the stops, no Fresnel kink): the anisotropic
-    /// tensor Gauss–Legendre rule of `quadrature::tensor` with the same per-axis orders on every box of
-    /// `chart`'s kink partition ([`tensor_boxes`]: the one box of the stops' product in the plain chart, the
-    /// boxes between the overlap kinks of u and v in the lobe chart), the orders `tensor::ORDERS[levels[k]]`
-    /// raised one axis at a time (up to [`TENSOR_MAX_LEVEL`]) until the sum of the per-axis differences of
-    /// successive orders (the error estimate) meets the part's tolerance. If they do not, the part's
-    /// Genz–Malik partition is integrated instead (the fallback). `path` is empty when designed; a frozen
-    /// method keeps the raises of its run and replays them (the same points, the same bits).
+    /// A smooth integrand (`docs/instrument.md` §Quadrature, "A tensor rule for smooth anisotropic integrands": no lobe
+    /// much narrower than the stops, no Fresnel kink): the anisotropic tensor Gauss–Legendre rule of
+    /// `quadrature::tensor` with the same per-axis orders on every box of `chart`'s kink partition ([`tensor_boxes`]:
+    /// the one box of the stops' product in the plain chart, the boxes between the overlap kinks of u and v in the lobe
+    /// chart), the orders `tensor::ORDERS[levels[k]]` raised one axis at a time (up to [`TENSOR_MAX_LEVEL`]) until the
+    /// sum of the per-axis differences of successive orders (the error estimate) meets the part's tolerance. If they do
+    /// not, the part's Genz–Malik partition is integrated instead (the fallback). `path` is empty when designed; a
+    /// frozen method keeps the raises of its run and replays them (the same points, the same bits).
     TensorGauss { chart: TensorChart, levels: [usize; 4], path: tensor::Path },
 }
 

@@ -28,8 +28,9 @@ struct PolarPiece {
     at: Vec<f64>,
 }
 
-/// The buffers [`Rule::LobePolar`] works in, made once per execution and reused level after level (issue 10
-/// item 4: nothing in the hot path allocates; they only grow, to the largest level reached).
+/// The buffers [`Rule::LobePolar`] works in, made once per execution and reused level after level
+/// (`docs/instrument.md` §Quadrature, "Allocation in the shaped rules": nothing in the hot path allocates; they only
+/// grow, to the largest level reached).
 #[derive(Default)]
 struct PolarScratch {
     /// (x, y, weight) in the scaled lobe variables.

@@ -74,8 +74,8 @@ pub const MIN_RTOL: f64 = 1e-12;
 /// The default wall-clock budget of one execution of a plan (all its aperture integrals together, run in
 /// parallel), seconds: far above what any shipped fixture needs (the golden suite of 396 readings runs in
 /// about a second), and short enough that the default panel of any valid input ends within 10 s of wall
-/// time (issue 8; with `method::LATE_START_SHARE`, ≤ 1.3 × 6 s on 2 threads, ≤ 1.6 × on one). An integral
-/// that hits it reports its best estimate, not converged.
+/// time (`docs/instrument.md` §Quadrature, "Bounded work"; with `method::LATE_START_SHARE`, ≤ 1.3 × 6 s on 2
+/// threads, ≤ 1.6 × on one). An integral that hits it reports its best estimate, not converged.
 pub const DEFAULT_MAX_SECONDS: f64 = 6.0;
 
 /// Knobs of the planner. The defaults are what `measure` uses; the others exist to measure what each
