@@ -1,4 +1,4 @@
-//! Tests of the paint model (src/brdf/paint.rs, docs/model.md): fixtures, energy conservation, reciprocity,
+//! Tests of the paint model (src/brdf/paint/, docs/model.md): fixtures, energy conservation, reciprocity,
 //! closed-form limits, the delta switch of the flakes, the corrections to the paper, and recipe errors.
 //!
 //! Independent references used here (not the crate's optics): the Fresnel equations written out from the

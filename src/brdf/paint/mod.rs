@@ -1,7 +1,7 @@
 //! The paint model of Ďurikovič & Ágošton (2007), "Prediction of optical properties of paints",
 //! Cent. Eur. J. Phys. 5(3):416, Eqs. (1)–(8), with the typesetting errors of the paper corrected and the
 //! layering made physically consistent. The whole model, every formula with its source, the corrections to
-//! the paper and every choice where the paper is silent are in `docs/model.md`; this file follows it.
+//! the paper and every choice where the paper is silent are in `docs/model.md`; this folder follows it.
 //!
 //! Structure (exterior directions ωi, ωo; interior directions ωi' = refract(ωi), ωo' = refract(ωo)):
 //!
@@ -20,400 +20,65 @@
 //! corrected) or thin-film reflectance ρ_p (Eqs. 6–8 corrected), D normalised Beckmann distributions and G
 //! the Smith height-correlated masking-shadowing function. The alternative `Form::PaperEq1` evaluates Eq. (1)
 //! as printed, for comparison only.
+//!
+//! The folder, one idea per file (no file imports `mod.rs`; `folded.rs` imports `flake.rs`, which imports
+//! `hemisphere.rs`; `spec.rs` imports none of them):
+//! - `mod.rs`: the model, [`Paint`]: [`Paint::new`] (the checks and everything that does not depend on
+//!   direction), the folded evaluation `Paint::eval_folded`, the [`Brdf`] impl (`eval`, `delta_reflectance`,
+//!   `terms`, `smooth`, `seams`, `describe`) and [`MAX_SAMPLES`];
+//! - `spec.rs`: what a paint is made of, [`PaintSpec`] and its parts ([`ClearCoat`], [`PigmentedLayer`],
+//!   [`Pigment`], [`MetallicFlakes`], [`PearlescentFlakes`], [`Spread`], [`spread_to_slope`]), the readings
+//!   [`Form`] and [`FlakeLight`], and the range checks `Paint::new` runs on them;
+//! - `flake.rs`: one kind of flake under its cover, precomputed (`FlakeTerm`, `FlakeOptics`): ρ and its kinks,
+//!   the cover's reflectance over it and its verified tables ([`TABLE_TOLERANCE`]), the split light's τ and
+//!   diffuse weight;
+//! - `folded.rs`: the flake tables and direction-independent sums folded for one weighted sum of the samples
+//!   (`Folded`, `FoldedFlake`);
+//! - `hemisphere.rs`: hemispherical means by Gauss–Legendre in the cosine ([`DIFFUSE_FRESNEL_NODES`]): the
+//!   coat's [`diffuse_fresnel_reflectance`] r_e and [`internal_diffuse_reflectance`] r_i, and
+//!   [`hemispherical_mean`], the rule cut at total-internal-reflection kinks.
+//!
+//! Two placements are choices. The hemispherical means have a file of their own rather than a place in
+//! `flake.rs`: r_e and r_i are the coat's (`Paint::new` reads them, no flake does), ρ_d is the flake's, and
+//! all three are the same 64-point rule, which the kink test checks on the coat's r_i against Stern's closed
+//! form; so the rule sits below both users. `Paint::eval_folded` stays in `mod.rs` beside `eval`: it reads
+//! the coat (its index, its rough lobe, its transmittance 1 − E(μ) or T(μ)) and the flake terms of the
+//! `Paint` that holds the `Folded` tables, so in `folded.rs` it would make `folded.rs` and `mod.rs` import
+//! each other; `folded.rs` holds the data it reads, built from the flake terms and the body alone.
+mod flake;
+mod folded;
+mod hemisphere;
+mod spec;
+
+pub use flake::TABLE_TOLERANCE;
+pub use hemisphere::{
+    diffuse_fresnel_reflectance, hemispherical_mean, internal_diffuse_reflectance, DIFFUSE_FRESNEL_NODES,
+};
+pub use spec::{
+    spread_to_slope, ClearCoat, FlakeLight, Form, MetallicFlakes, PaintSpec, PearlescentFlakes, Pigment,
+    PigmentedLayer, Spread,
+};
+
 use super::{Brdf, Lobe, Term, TermKind};
 use crate::colorimetry::weighting::Weighting;
 use crate::optics::coat_albedo::{CoatAlbedo, OutOfTable, ALPHA_BREAKS, ETA_MAX, ETA_MIN};
-use crate::optics::fresnel::{critical_cosine_complex, fr_conductor, fr_dielectric, fresnel_dielectric, refract_into};
+use crate::optics::fresnel::{fr_dielectric, fresnel_dielectric, refract_into};
 use crate::optics::kubelka_munk::{self, Layer};
 use crate::optics::microfacet::{Distribution, Microfacet, Shadowing};
-use crate::optics::tabulated::{basis, dot, ChebTable};
-use crate::optics::thin_film::{stack, FilmLayer};
-use crate::quadrature::gauss_legendre;
+use crate::optics::tabulated::{basis, dot};
+use crate::optics::thin_film::FilmLayer;
 use crate::registry::{self as reg, Param, Range};
 use crate::spectrum::Sampling;
-use crate::{Error, Result, Vec3};
+use crate::{Result, Vec3};
+use flake::{FlakeOptics, FlakeTerm};
+use folded::{Folded, FoldedFlake};
 use num_complex::Complex64;
+use spec::{check_in, check_range, check_spectral, usage};
 use std::f64::consts::PI;
 
 /// Largest number of spectral samples a paint accepts. It bounds the per-evaluation work (a pearlescent
 /// paint evaluates a thin-film stack per sample and direction pair); recipes with more samples are refused.
 pub const MAX_SAMPLES: usize = 128;
-
-/// Gauss–Legendre order used for the diffuse Fresnel reflectance r_e (the integrand is smooth in cos θ on
-/// [0, 1], so 64 nodes give it to rounding; checked against an independent Simpson rule in `tests/paint.rs`).
-pub const DIFFUSE_FRESNEL_NODES: usize = 64;
-
-/// Which reading of the paper's Eq. (1) is evaluated.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Form {
-    /// The physically consistent reading (default): refraction into the coat, Fresnel transmittance in and
-    /// out, radiance factor 1/η², energy-normalised lobes, Saunderson factor. Energy-conserving, reciprocal.
-    Physical,
-    /// Eq. (1) as printed: Cook–Torrance (1982) π normalisation, exterior directions, τ = T(θi) applied once,
-    /// V-cavity G, R_l as a Lambertian R_l/π. Neither energy-conserving nor reciprocal; for comparison only.
-    PaperEq1,
-}
-
-/// Where the light that a flake's covering pigment scatters goes (`docs/model.md` §Flake light through the
-/// pigment). Only the physical form uses it; the paper-literal form keeps Eq. (5) as printed.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum FlakeLight {
-    /// Physically split (default): the flake lobe carries ρ·τ(θi')·τ(θo'), the flake's reflectance
-    /// attenuated by the unscattered (collimated) transmission of the pigment above it along the refracted
-    /// paths in and out; the light the pigment scatters joins the diffuse body as a reciprocal diffuse term.
-    Split,
-    /// The paper's Eq. (5): the Kubelka–Munk reflectance R of the pigment over the flake (diffuse back-scatter
-    /// included) inside the flake's narrow lobe.
-    PaperEq5,
-}
-
-/// The clear coat: a non-absorbing resin over the pigmented layer.
-#[derive(Clone, Debug, PartialEq)]
-pub struct ClearCoat {
-    /// Refractive index η of the resin (relative to air), 1.3–1.8.
-    pub index: f64,
-    /// Thickness in µm. Recorded only: a non-absorbing coat's thickness does not change the reading (the
-    /// coat is far thicker than the coherence length of the instrument's light, so no interference either).
-    pub thickness_um: f64,
-    /// Surface roughness (Beckmann rms slope or GGX α); 0 = optically smooth.
-    pub roughness: f64,
-    pub distribution: Distribution,
-}
-
-/// One pigment of the pigmented layer: concentration and per-sample absorption and scattering.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Pigment {
-    pub name: String,
-    pub concentration: f64,
-    /// Absorption coefficient K per mm, one per spectral sample.
-    pub k_per_mm: Vec<f64>,
-    /// Scattering coefficient S per mm, one per spectral sample.
-    pub s_per_mm: Vec<f64>,
-}
-
-/// The pigmented (base) layer over the primer.
-#[derive(Clone, Debug, PartialEq)]
-pub struct PigmentedLayer {
-    /// Thickness X in mm.
-    pub thickness_mm: f64,
-    /// Primer reflectance Rg per spectral sample.
-    pub primer_reflectance: Vec<f64>,
-    pub pigments: Vec<Pigment>,
-}
-
-/// Metallic flakes embedded in the pigmented layer.
-#[derive(Clone, Debug, PartialEq)]
-pub struct MetallicFlakes {
-    /// Complex index n + ik of the metal per spectral sample.
-    pub n: Vec<f64>,
-    pub k: Vec<f64>,
-    /// Orientation spread: an angle σ (m = tan σ) or the Beckmann rms slope m itself.
-    pub spread: Spread,
-    /// Visible area ratio Am.
-    pub area_ratio: f64,
-    /// Mean depth X' of the visible flakes in mm (0 ≤ X' ≤ X).
-    pub depth_mm: f64,
-}
-
-/// How a recipe gives the flake orientation spread (`docs/model.md` §Two readings of the flake spread).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Spread {
-    /// `spread_deg`: an angle σ in degrees, read as the tilt whose tangent is the Beckmann rms slope, m = tan σ.
-    Degrees(f64),
-    /// `spread_slope`: the Cook–Torrance / Beckmann rms slope m itself (dimensionless).
-    Slope(f64),
-}
-
-impl Spread {
-    /// Largest accepted spread angle in degrees, and the slope it corresponds to (tan 60° = 1.732); the
-    /// registry's ranges (`crate::registry::SPREAD_DEG_RANGE`, `SPREAD_SLOPE_RANGE`).
-    pub const MAX_DEG: f64 = reg::SPREAD_DEG_RANGE.hi;
-    pub const MAX_SLOPE: f64 = reg::SPREAD_SLOPE_RANGE.hi;
-
-    /// The Beckmann rms slope m.
-    pub fn slope(self) -> f64 {
-        match self {
-            Spread::Degrees(d) => spread_to_slope(d),
-            Spread::Slope(m) => m,
-        }
-    }
-
-    /// Check against the registry entries of the two forms.
-    fn check(self, deg: &Param, slope: &Param) -> Result<()> {
-        match self {
-            Spread::Degrees(d) => check_range(deg, d),
-            Spread::Slope(m) => check_range(slope, m),
-        }
-    }
-}
-
-/// Pearlescent flakes: TiO2 / mica / TiO2 platelets embedded in the resin.
-#[derive(Clone, Debug, PartialEq)]
-pub struct PearlescentFlakes {
-    /// Orientation spread: an angle σ (m = tan σ) or the Beckmann rms slope m itself.
-    pub spread: Spread,
-    /// Visible area ratio Ap.
-    pub area_ratio: f64,
-    /// Mean depth X'' of the visible flakes in mm (0 ≤ X'' ≤ X).
-    pub depth_mm: f64,
-    /// TiO2 film thickness in nm (each of the two films).
-    pub tio2_thickness_nm: f64,
-    /// TiO2 refractive index (anatase ≈ 2.5, rutile ≈ 2.7).
-    pub tio2_index: f64,
-    /// Mica platelet thickness in nm (treated incoherently).
-    pub mica_thickness_nm: f64,
-    pub mica_index: f64,
-}
-
-/// Everything a paint is made of, as read from a recipe.
-#[derive(Clone, Debug, PartialEq)]
-pub struct PaintSpec {
-    pub sampling: Sampling,
-    pub coat: ClearCoat,
-    pub layer: PigmentedLayer,
-    pub metallic: Option<MetallicFlakes>,
-    pub pearlescent: Option<PearlescentFlakes>,
-    pub form: Form,
-    /// How the flake light is split between the lobe and the diffuse body (physical form only).
-    pub flake_light: FlakeLight,
-    /// Apply the Saunderson multiple-internal-reflection factor 1/(1 − r_i R_l) to the body term.
-    pub internal_reflection: bool,
-}
-
-/// Per-kind optics of a flake.
-#[derive(Clone, Debug, PartialEq)]
-enum FlakeOptics {
-    /// Relative complex index (n + ik)/η_medium per sample.
-    Metal(Vec<Complex64>),
-    /// The film stack TiO2 / mica / TiO2, entered from and exited into resin of index `medium`.
-    Pearl { layers: [FilmLayer; 3], medium: f64 },
-}
-
-/// A flake term, precomputed.
-#[derive(Clone, Debug, PartialEq)]
-struct FlakeTerm {
-    label: &'static str,
-    area: f64,
-    facets: Microfacet,
-    /// Spread below `Microfacet::SMOOTH_THRESHOLD`: evaluated as its delta limit.
-    smooth: bool,
-    /// KM operator of the pigment above the flake (thickness X' or X''), per sample.
-    cover: Vec<Layer>,
-    optics: FlakeOptics,
-    /// R_m or R_p (paper Eq. 5) — or, for the split flake light, the bare flake reflectance ρ — per sample as a
-    /// verified Chebyshev table over the local cosine ∈ [0, 1] (max deviation from the direct evaluation ≤
-    /// `TABLE_TOLERANCE` at check points), or None when no table met it.
-    table: Option<Vec<ChebTable>>,
-    /// Split flake light: per sample, the optical depth ε·X' of the cover for collimated light, ε = (K + S)/2.
-    depth: Vec<f64>,
-    /// Split flake light: per sample, the diffuse part's weight R_d/(π(1 − τ̄)): R_d = KM cover over the
-    /// flake's hemispherical reflectance, τ̄ = 2∫τ(μ)μ dμ. 0 where the cover does not scatter or absorb.
-    diffuse: Vec<f64>,
-    split: bool,
-}
-
-/// Largest accepted deviation of a flake-reflectance table from the direct evaluation (absolute, on a
-/// reflectance ≤ 1): far below any tolerance a reading is asked for.
-pub const TABLE_TOLERANCE: f64 = 1e-12;
-
-/// The paint prepared for one weighted sum of its samples, Σ_j w_j f_j (the luminous row of its sampling:
-/// what gloss, haze and DOI read; `Brdf::eval_batch_folded`). Everything that does not depend on direction is
-/// summed over the samples once, here, so an evaluation does one sample's work where the per-sample path
-/// does n (`docs/model.md` §Folded evaluation).
-#[derive(Clone, Debug, PartialEq)]
-struct Folded {
-    /// The row w it was prepared for.
-    weights: Vec<f64>,
-    /// Σ_j w_j: the weight of the rough coat's grey lobe.
-    coat: f64,
-    /// Σ_j w_j·body_j.
-    body: f64,
-    /// One per flake term, in the order of `Paint::flakes`.
-    flakes: Vec<FoldedFlake>,
-    /// The second flake term's cover has the same optical depths as the first's (the same pigment at the same
-    /// depth): the transmissions computed for the first serve the second.
-    shared_depth: bool,
-}
-
-/// A flake term prepared for a weighted sum.
-#[derive(Clone, Debug, PartialEq)]
-struct FoldedFlake {
-    /// Split light: w_j·(the diffuse weight of sample j).
-    diffuse: Vec<f64>,
-    /// The lobe's reflectance folded into one table, Σ_j w_j·T_j, when the per-sample factors in front of the
-    /// tables do not depend on direction (light not split, or a grey cover: one τ for every sample).
-    table: Option<ChebTable>,
-    /// Otherwise the samples' tables on one grid: an evaluation sums their coefficients with the weights
-    /// w_j·τ_j(θi')·τ_j(θo') and runs one Clenshaw recurrence (the interpolant is linear in its coefficients).
-    grid: Option<Vec<ChebTable>>,
-    /// Split light with a grey cover: every sample's τ is sample 0's.
-    grey_cover: bool,
-}
-
-impl Folded {
-    /// Prepare `paint` for the row `w` (n weights).
-    fn new(paint: &Paint, w: &[f64]) -> Folded {
-        let lambdas = &paint.spec.sampling.wavelengths_nm;
-        let flakes = paint
-            .flakes()
-            .map(|fl| {
-                let grey_cover = fl.depth.iter().all(|d| d.to_bits() == fl.depth[0].to_bits());
-                let grid = fl.table.as_ref().and_then(|t| {
-                    let pieces = t.iter().map(ChebTable::pieces).max().expect("one table per sample");
-                    t.iter()
-                        .enumerate()
-                        .map(|(k, tk)| match tk.pieces() == pieces {
-                            true => Some(tk.clone()),
-                            false => ChebTable::fit_with_pieces(
-                                |c| fl.reflectance_direct(k, c, lambdas[k]),
-                                0.0,
-                                1.0,
-                                pieces,
-                                TABLE_TOLERANCE,
-                            ),
-                        })
-                        .collect::<Option<Vec<_>>>()
-                });
-                let constant = !fl.split || grey_cover;
-                let table = grid.as_ref().filter(|_| constant).and_then(|g| ChebTable::combine(g, w));
-                FoldedFlake {
-                    diffuse: fl.diffuse.iter().zip(w).map(|(d, w)| w * d).collect(),
-                    grid: if table.is_some() { None } else { grid },
-                    table,
-                    grey_cover,
-                }
-            })
-            .collect();
-        let shared_depth = match (&paint.metallic, &paint.pearlescent) {
-            (Some(a), Some(b)) => {
-                a.split && b.split && a.depth.iter().zip(&b.depth).all(|(x, y)| x.to_bits() == y.to_bits())
-            }
-            _ => false,
-        };
-        Folded {
-            weights: w.to_vec(),
-            coat: w.iter().sum(),
-            body: paint.body.iter().zip(w).map(|(b, w)| w * b).sum(),
-            flakes,
-            shared_depth,
-        }
-    }
-}
-
-impl FlakeTerm {
-    /// Flake reflectance ρ at the local cosine `cos_local` for sample `k` (before the pigment above it).
-    #[inline]
-    fn rho(&self, k: usize, cos_local: f64, wavelength_nm: f64) -> f64 {
-        match &self.optics {
-            FlakeOptics::Metal(eta) => fr_conductor(cos_local, eta[k]),
-            FlakeOptics::Pearl { layers, medium } => {
-                stack(*medium, layers, Complex64::new(*medium, 0.0), cos_local, wavelength_nm).r()
-            }
-        }
-    }
-
-    /// R_m or R_p: the KM reflectance of the pigment above the flake over the flake (Eqs. 5, 8 corrected),
-    /// from the verified table when there is one.
-    #[inline]
-    fn reflectance(&self, k: usize, cos_local: f64, wavelength_nm: f64) -> f64 {
-        match &self.table {
-            Some(t) => t[k].eval(cos_local),
-            None => self.reflectance_direct(k, cos_local, wavelength_nm),
-        }
-    }
-
-    /// What the lobe carries per unit D·G/(4 cos cos), evaluated directly (no table): R_m or R_p (paper Eq. 5),
-    /// or the bare flake reflectance ρ for the split flake light (the cover's attenuation is applied by the
-    /// caller, it depends on both directions).
-    fn reflectance_direct(&self, k: usize, cos_local: f64, wavelength_nm: f64) -> f64 {
-        let rho = self.rho(k, cos_local, wavelength_nm).clamp(0.0, 1.0);
-        if self.split {
-            rho
-        } else {
-            self.cover[k].over(rho)
-        }
-    }
-
-    /// Unscattered transmission τ = exp(−ε X'/μ) of the cover along an interior direction of cosine μ.
-    #[inline]
-    fn tau(&self, k: usize, mu: f64) -> f64 {
-        if mu <= 0.0 {
-            0.0
-        } else {
-            (-self.depth[k] / mu).exp()
-        }
-    }
-
-    /// e = τ − 1 = expm1(−ε X'/μ) (−1 where μ ≤ 0, τ = 0 there): τ = 1 + e and 1 − τ = −e from one call.
-    #[inline]
-    fn expm1_tau(&self, k: usize, mu: f64) -> f64 {
-        if mu <= 0.0 {
-            -1.0
-        } else {
-            (-self.depth[k] / mu).exp_m1()
-        }
-    }
-
-    /// 1 − τ without cancellation.
-    #[inline]
-    fn one_minus_tau(&self, k: usize, mu: f64) -> f64 {
-        if mu <= 0.0 {
-            1.0
-        } else {
-            -(-self.depth[k] / mu).exp_m1()
-        }
-    }
-
-    /// The cosines in (0, 1) at which the flake reflectance ρ(μ) of sample `k` has a kink: the critical angles
-    /// of total internal reflection (docs/model.md §Pearlescent flakes). Light in the resin of index η_r meets
-    /// every layer of the stack at the same Snell invariant η_r sin θ, so a lossless layer of index n < η_r
-    /// reflects totally below cos θc = √(1 − (n/η_r)²) (`optics::fresnel::critical_cosine`), and a metal whose
-    /// relative index is real and below 1 likewise; an absorbing layer has no kink. Sorted, distinct.
-    fn rho_kinks(&self, k: usize) -> Vec<f64> {
-        let mut kinks: Vec<f64> = match &self.optics {
-            FlakeOptics::Metal(eta) => critical_cosine_complex(eta[k]).into_iter().collect(),
-            FlakeOptics::Pearl { layers, medium } => {
-                layers.iter().filter_map(|l| critical_cosine_complex(l.n / *medium)).collect()
-            }
-        };
-        kinks.retain(|&c| c > 0.0 && c < 1.0);
-        kinks.sort_by(f64::total_cmp);
-        kinks.dedup();
-        kinks
-    }
-
-    /// Precompute the split flake light's per-sample constants (`depth`, `diffuse`).
-    fn split_constants(&mut self, k_mix: &[f64], s_mix: &[f64], depth_mm: f64, wavelengths_nm: &[f64]) {
-        let (x, w) = gauss_legendre(DIFFUSE_FRESNEL_NODES);
-        let n = self.cover.len();
-        self.depth = (0..n).map(|j| 0.5 * (k_mix[j] + s_mix[j]) * depth_mm).collect();
-        self.diffuse = (0..n)
-            .map(|j| {
-                // ρ_d = 2∫ρ(μ)μ dμ (split at ρ's kinks) and 1 − τ̄ = 2∫(1 − τ(μ))μ dμ (smooth on [0, 1]), by
-                // Gauss–Legendre in μ.
-                let rho_d =
-                    hemispherical_mean(|mu| self.rho(j, mu, wavelengths_nm[j]).clamp(0.0, 1.0), &self.rho_kinks(j));
-                let mut one_minus_tau_bar = 0.0;
-                for (&xi, &wi) in x.iter().zip(&w) {
-                    let mu = 0.5 * (xi + 1.0);
-                    one_minus_tau_bar += wi * mu * self.one_minus_tau(j, mu);
-                }
-                if one_minus_tau_bar <= 0.0 {
-                    return 0.0;
-                }
-                self.cover[j].over(rho_d.clamp(0.0, 1.0)) / (PI * one_minus_tau_bar)
-            })
-            .collect();
-    }
-
-    /// Build the per-sample tables; all or none.
-    fn tabulate(&mut self, wavelengths_nm: &[f64]) {
-        let tables: Option<Vec<ChebTable>> = (0..self.cover.len())
-            .map(|k| ChebTable::fit(|c| self.reflectance_direct(k, c, wavelengths_nm[k]), 0.0, 1.0, TABLE_TOLERANCE))
-            .collect();
-        self.table = tables;
-    }
-}
 
 /// The paint BRDF.
 #[derive(Clone, Debug)]
@@ -434,102 +99,6 @@ pub struct Paint {
     pearlescent: Option<FlakeTerm>,
     /// Prepared for the luminous row of the sampling (None if the sampling has none).
     folded: Option<Folded>,
-}
-
-/// The hemispherical mean 2∫₀¹ f(μ) μ dμ of a function of the cosine that is smooth on [0, 1] except at the
-/// cosines `kinks` (sorted, in (0, 1)), where it is continuous but its derivative is not.
-///
-/// Without kinks: the [`DIFFUSE_FRESNEL_NODES`]-point Gauss–Legendre rule on [0, 1] (the rule the smooth
-/// integrands of this module use, to rounding). With kinks, a single rule across one converges only
-/// algebraically (a Fresnel reflectance behaves like √(μ − μc) beside its critical cosine μc, and a 64-point
-/// rule across it is off by ~10⁻³ for mica in a denser resin): the interval is cut at every kink and at the
-/// midpoints between them, and each piece that ends on a kink is mapped by μ = μc ± h·s² (s ∈ [0, 1]), which
-/// turns √(μ − μc) into the smooth h^½·s, so that each piece's rule again converges like a smooth integrand's
-/// (docs/model.md §Pearlescent flakes).
-pub fn hemispherical_mean(f: impl Fn(f64) -> f64, kinks: &[f64]) -> f64 {
-    let (x, w) = gauss_legendre(DIFFUSE_FRESNEL_NODES);
-    if kinks.is_empty() {
-        let mut sum = 0.0;
-        for (&xi, &wi) in x.iter().zip(&w) {
-            let mu = 0.5 * (xi + 1.0);
-            sum += wi * mu * f(mu);
-        }
-        return sum;
-    }
-    // Pieces (from, to) with `from` a kink: μ = from + (to − from)·s², from the kink towards the piece's
-    // other end (which is 0, 1 or a midpoint between kinks).
-    let mut pieces = Vec::with_capacity(2 * kinks.len());
-    for (i, &c) in kinks.iter().enumerate() {
-        let below = if i == 0 { 0.0 } else { 0.5 * (kinks[i - 1] + c) };
-        let above = if i + 1 == kinks.len() { 1.0 } else { 0.5 * (c + kinks[i + 1]) };
-        pieces.push((c, below));
-        pieces.push((c, above));
-    }
-    let mut sum = 0.0;
-    for (from, to) in pieces {
-        let h = to - from;
-        let mut piece = 0.0;
-        for (&xi, &wi) in x.iter().zip(&w) {
-            let s = 0.5 * (xi + 1.0);
-            let mu = from + h * s * s;
-            // dμ = 2h·s ds, and ds = wi/2 on [0, 1]: 2 f μ dμ = 2 f μ · h s wi.
-            piece += wi * 2.0 * h.abs() * s * mu * f(mu);
-        }
-        sum += piece;
-    }
-    sum
-}
-
-/// Diffuse (hemispherical) reflectance of the air → coat interface for light incident from air,
-/// r_e = ∫₀^{π/2} F(θ) 2 sin θ cos θ dθ = ∫₀¹ F(μ) 2μ dμ (Judd 1942; Stern 1964), by Gauss–Legendre.
-pub fn diffuse_fresnel_reflectance(eta: f64) -> f64 {
-    let (x, w) = gauss_legendre(DIFFUSE_FRESNEL_NODES);
-    x.iter()
-        .zip(&w)
-        .map(|(&xi, &wi)| {
-            let mu = 0.5 * (xi + 1.0);
-            0.5 * wi * fr_dielectric(mu, eta) * 2.0 * mu
-        })
-        .sum()
-}
-
-/// Diffuse reflectance of the coat–air interface for diffuse light incident from inside the coat:
-/// r_i = 1 − (1 − r_e)/η² (the exit cone carries 1/η² of the internal diffuse flux, and Fresnel
-/// transmittance is the same both ways; Saunderson 1942, Stern 1964). For η = 1.5, r_i ≈ 0.596.
-pub fn internal_diffuse_reflectance(eta: f64) -> f64 {
-    1.0 - (1.0 - diffuse_fresnel_reflectance(eta)) / (eta * eta)
-}
-
-fn usage(msg: impl Into<String>) -> Error {
-    Error::Usage(format!("paint: {}", msg.into()))
-}
-
-/// `v` against the range of registry entry `p`; the message names the entry's JSON Pointer.
-fn check_range(p: &Param, v: f64) -> Result<()> {
-    check_in(p.pointer, v, p.range())
-}
-
-fn check_in(what: &str, v: f64, r: Range) -> Result<()> {
-    if r.contains(v) {
-        Ok(())
-    } else {
-        Err(usage(format!("{what} = {v} must be a finite number {}", r.describe())))
-    }
-}
-
-fn check_spectral(p: &Param, v: &[f64], n: usize) -> Result<()> {
-    if v.len() != n {
-        return Err(usage(format!("{} has {} values; the sampling has {n}", p.pointer, v.len())));
-    }
-    for (i, &x) in v.iter().enumerate() {
-        check_in(&format!("{}/{i}", p.pointer), x, p.range())?;
-    }
-    Ok(())
-}
-
-/// Beckmann rms slope m = tan σ of a flake spread σ in degrees.
-pub fn spread_to_slope(spread_deg: f64) -> f64 {
-    spread_deg.to_radians().tan()
 }
 
 impl Paint {
@@ -675,7 +244,15 @@ impl Paint {
             folded: None,
         };
         let luminous = Weighting::luminous(&paint.spec.sampling).ok().and_then(|w| w.rows.into_iter().next());
-        paint.folded = luminous.map(|w| Folded::new(&paint, &w));
+        paint.folded = luminous.map(|w| {
+            Folded::new(
+                paint.metallic.as_ref(),
+                paint.pearlescent.as_ref(),
+                &paint.body,
+                &paint.spec.sampling.wavelengths_nm,
+                &w,
+            )
+        });
         Ok(paint)
     }
 
@@ -1135,50 +712,5 @@ impl Brdf for Paint {
             ));
         }
         d
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::optics::fresnel::critical_cosine;
-
-    /// Inside a coat of index η, the hemispherical reflectance of the coat–air interface is
-    /// r_i = 1 − (1 − r_e)/η² (Stern 1964; r_e from the smooth outside rule): an independent closed form of
-    /// 2∫F(μ, 1/η)μ dμ, whose integrand kinks at the critical cosine.
-    #[test]
-    fn the_kinked_internal_reflectance_meets_stern_s_closed_form_to_rounding() {
-        for eta in [1.3, 1.5, 1.8, 2.4] {
-            let closed = internal_diffuse_reflectance(eta);
-            let mu_c = critical_cosine(1.0 / eta).unwrap();
-            let split = hemispherical_mean(|mu| fr_dielectric(mu, 1.0 / eta), &[mu_c]);
-            assert!((split - closed).abs() < 2e-15, "η = {eta}: split {split} vs closed form {closed}");
-            // The rule across the kink is not good enough: the test would fail without the split.
-            let across = hemispherical_mean(|mu| fr_dielectric(mu, 1.0 / eta), &[]);
-            assert!((across - closed).abs() > 1e-7, "η = {eta}: the unsplit rule is already exact?");
-        }
-    }
-
-    /// The pearl flake's ρ_d for mica (1.55) below the resin (1.8): the split rule against an adaptive
-    /// Gauss–Kronrod integral with the kink as a break point, to 1e-13.
-    #[test]
-    fn the_pearl_flake_s_hemispherical_reflectance_is_right_below_the_resin_index() {
-        let medium = 1.8;
-        let tio2 = FilmLayer { n: Complex64::new(2.5, 0.0), thickness_nm: 60.0, coherent: true };
-        let mica = FilmLayer { n: Complex64::new(1.55, 0.0), thickness_nm: 400.0, coherent: false };
-        let layers = [tio2, mica, tio2];
-        for wavelength in [450.0, 550.0, 650.0] {
-            let rho = |mu: f64| stack(medium, &layers, Complex64::new(medium, 0.0), mu, wavelength).r().clamp(0.0, 1.0);
-            let mu_c = critical_cosine(1.55 / medium).unwrap();
-            let mut f = |mu: f64, out: &mut [f64]| out[0] = 2.0 * mu * rho(mu);
-            let (reference, err) =
-                crate::quadrature::gauss_kronrod_adaptive(&mut f, &[0.0, mu_c, 1.0], 1, 1, 1e-15, 4000);
-            assert!(err < 1e-13, "reference error {err}");
-            let split = hemispherical_mean(rho, &[mu_c]);
-            assert!((split - reference[0]).abs() < 1e-13, "{wavelength} nm: {split} vs {}", reference[0]);
-            let across = hemispherical_mean(rho, &[]);
-            eprintln!("{wavelength} nm: ρ_d {split:.15}, the rule across the kink is off by {:.2e}", across - split);
-            assert!((across - split).abs() > 1e-6, "{wavelength} nm: the unsplit rule is already exact?");
-        }
     }
 }

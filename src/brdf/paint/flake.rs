@@ -1,0 +1,165 @@
+//! The optics of one kind of flake under its cover of pigment, precomputed per sample ([`FlakeTerm`]): the
+//! flake's reflectance ρ (a metal's Fresnel reflectance or the pearl's thin-film stack) and the cosines where
+//! it kinks, the cover's Kubelka–Munk reflectance over it (paper Eqs. 5–8 corrected) and its verified
+//! Chebyshev tables, and the split flake light's unscattered transmission τ and diffuse weight
+//! (`docs/model.md` §Metallic flakes, §Pearlescent flakes, §Flake light through the pigment).
+use super::hemisphere::{hemispherical_mean, DIFFUSE_FRESNEL_NODES};
+use crate::optics::fresnel::{critical_cosine_complex, fr_conductor};
+use crate::optics::kubelka_munk::Layer;
+use crate::optics::microfacet::Microfacet;
+use crate::optics::tabulated::ChebTable;
+use crate::optics::thin_film::{stack, FilmLayer};
+use crate::quadrature::gauss_legendre;
+use num_complex::Complex64;
+use std::f64::consts::PI;
+
+/// Largest accepted deviation of a flake-reflectance table from the direct evaluation (absolute, on a
+/// reflectance ≤ 1): far below any tolerance a reading is asked for.
+pub const TABLE_TOLERANCE: f64 = 1e-12;
+
+/// Per-kind optics of a flake.
+#[derive(Clone, Debug, PartialEq)]
+pub(super) enum FlakeOptics {
+    /// Relative complex index (n + ik)/η_medium per sample.
+    Metal(Vec<Complex64>),
+    /// The film stack TiO2 / mica / TiO2, entered from and exited into resin of index `medium`.
+    Pearl { layers: [FilmLayer; 3], medium: f64 },
+}
+
+/// A flake term, precomputed.
+#[derive(Clone, Debug, PartialEq)]
+pub(super) struct FlakeTerm {
+    pub(super) label: &'static str,
+    pub(super) area: f64,
+    pub(super) facets: Microfacet,
+    /// Spread below `Microfacet::SMOOTH_THRESHOLD`: evaluated as its delta limit.
+    pub(super) smooth: bool,
+    /// KM operator of the pigment above the flake (thickness X' or X''), per sample.
+    pub(super) cover: Vec<Layer>,
+    pub(super) optics: FlakeOptics,
+    /// R_m or R_p (paper Eq. 5) — or, for the split flake light, the bare flake reflectance ρ — per sample as a
+    /// verified Chebyshev table over the local cosine ∈ [0, 1] (max deviation from the direct evaluation ≤
+    /// `TABLE_TOLERANCE` at check points), or None when no table met it.
+    pub(super) table: Option<Vec<ChebTable>>,
+    /// Split flake light: per sample, the optical depth ε·X' of the cover for collimated light, ε = (K + S)/2.
+    pub(super) depth: Vec<f64>,
+    /// Split flake light: per sample, the diffuse part's weight R_d/(π(1 − τ̄)): R_d = KM cover over the
+    /// flake's hemispherical reflectance, τ̄ = 2∫τ(μ)μ dμ. 0 where the cover does not scatter or absorb.
+    pub(super) diffuse: Vec<f64>,
+    pub(super) split: bool,
+}
+
+impl FlakeTerm {
+    /// Flake reflectance ρ at the local cosine `cos_local` for sample `k` (before the pigment above it).
+    #[inline]
+    fn rho(&self, k: usize, cos_local: f64, wavelength_nm: f64) -> f64 {
+        match &self.optics {
+            FlakeOptics::Metal(eta) => fr_conductor(cos_local, eta[k]),
+            FlakeOptics::Pearl { layers, medium } => {
+                stack(*medium, layers, Complex64::new(*medium, 0.0), cos_local, wavelength_nm).r()
+            }
+        }
+    }
+
+    /// R_m or R_p: the KM reflectance of the pigment above the flake over the flake (Eqs. 5, 8 corrected),
+    /// from the verified table when there is one.
+    #[inline]
+    pub(super) fn reflectance(&self, k: usize, cos_local: f64, wavelength_nm: f64) -> f64 {
+        match &self.table {
+            Some(t) => t[k].eval(cos_local),
+            None => self.reflectance_direct(k, cos_local, wavelength_nm),
+        }
+    }
+
+    /// What the lobe carries per unit D·G/(4 cos cos), evaluated directly (no table): R_m or R_p (paper Eq. 5),
+    /// or the bare flake reflectance ρ for the split flake light (the cover's attenuation is applied by the
+    /// caller, it depends on both directions).
+    pub(super) fn reflectance_direct(&self, k: usize, cos_local: f64, wavelength_nm: f64) -> f64 {
+        let rho = self.rho(k, cos_local, wavelength_nm).clamp(0.0, 1.0);
+        if self.split {
+            rho
+        } else {
+            self.cover[k].over(rho)
+        }
+    }
+
+    /// Unscattered transmission τ = exp(−ε X'/μ) of the cover along an interior direction of cosine μ.
+    #[inline]
+    pub(super) fn tau(&self, k: usize, mu: f64) -> f64 {
+        if mu <= 0.0 {
+            0.0
+        } else {
+            (-self.depth[k] / mu).exp()
+        }
+    }
+
+    /// e = τ − 1 = expm1(−ε X'/μ) (−1 where μ ≤ 0, τ = 0 there): τ = 1 + e and 1 − τ = −e from one call.
+    #[inline]
+    pub(super) fn expm1_tau(&self, k: usize, mu: f64) -> f64 {
+        if mu <= 0.0 {
+            -1.0
+        } else {
+            (-self.depth[k] / mu).exp_m1()
+        }
+    }
+
+    /// 1 − τ without cancellation.
+    #[inline]
+    pub(super) fn one_minus_tau(&self, k: usize, mu: f64) -> f64 {
+        if mu <= 0.0 {
+            1.0
+        } else {
+            -(-self.depth[k] / mu).exp_m1()
+        }
+    }
+
+    /// The cosines in (0, 1) at which the flake reflectance ρ(μ) of sample `k` has a kink: the critical angles
+    /// of total internal reflection (docs/model.md §Pearlescent flakes). Light in the resin of index η_r meets
+    /// every layer of the stack at the same Snell invariant η_r sin θ, so a lossless layer of index n < η_r
+    /// reflects totally below cos θc = √(1 − (n/η_r)²) (`optics::fresnel::critical_cosine`), and a metal whose
+    /// relative index is real and below 1 likewise; an absorbing layer has no kink. Sorted, distinct.
+    pub(super) fn rho_kinks(&self, k: usize) -> Vec<f64> {
+        let mut kinks: Vec<f64> = match &self.optics {
+            FlakeOptics::Metal(eta) => critical_cosine_complex(eta[k]).into_iter().collect(),
+            FlakeOptics::Pearl { layers, medium } => {
+                layers.iter().filter_map(|l| critical_cosine_complex(l.n / *medium)).collect()
+            }
+        };
+        kinks.retain(|&c| c > 0.0 && c < 1.0);
+        kinks.sort_by(f64::total_cmp);
+        kinks.dedup();
+        kinks
+    }
+
+    /// Precompute the split flake light's per-sample constants (`depth`, `diffuse`).
+    pub(super) fn split_constants(&mut self, k_mix: &[f64], s_mix: &[f64], depth_mm: f64, wavelengths_nm: &[f64]) {
+        let (x, w) = gauss_legendre(DIFFUSE_FRESNEL_NODES);
+        let n = self.cover.len();
+        self.depth = (0..n).map(|j| 0.5 * (k_mix[j] + s_mix[j]) * depth_mm).collect();
+        self.diffuse = (0..n)
+            .map(|j| {
+                // ρ_d = 2∫ρ(μ)μ dμ (split at ρ's kinks) and 1 − τ̄ = 2∫(1 − τ(μ))μ dμ (smooth on [0, 1]), by
+                // Gauss–Legendre in μ.
+                let rho_d =
+                    hemispherical_mean(|mu| self.rho(j, mu, wavelengths_nm[j]).clamp(0.0, 1.0), &self.rho_kinks(j));
+                let mut one_minus_tau_bar = 0.0;
+                for (&xi, &wi) in x.iter().zip(&w) {
+                    let mu = 0.5 * (xi + 1.0);
+                    one_minus_tau_bar += wi * mu * self.one_minus_tau(j, mu);
+                }
+                if one_minus_tau_bar <= 0.0 {
+                    return 0.0;
+                }
+                self.cover[j].over(rho_d.clamp(0.0, 1.0)) / (PI * one_minus_tau_bar)
+            })
+            .collect();
+    }
+
+    /// Build the per-sample tables; all or none.
+    pub(super) fn tabulate(&mut self, wavelengths_nm: &[f64]) {
+        let tables: Option<Vec<ChebTable>> = (0..self.cover.len())
+            .map(|k| ChebTable::fit(|c| self.reflectance_direct(k, c, wavelengths_nm[k]), 0.0, 1.0, TABLE_TOLERANCE))
+            .collect();
+        self.table = tables;
+    }
+}
