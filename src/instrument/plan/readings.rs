@@ -207,16 +207,20 @@ fn compute_reading(
         }
         _ => reading_value(&r.spec, &specimen, &standard),
     };
+    if out_of_time {
+        // A value cut off by the clock would depend on the machine's speed and load: none is reported
+        // (docs/instrument.md §Bounded work).
+        return problem_reading(
+            r,
+            "the wall-clock limit was reached before the tolerance was met; no value is reported, since it would \
+             depend on the machine's speed and load (the evaluation budget is the deterministic bound)"
+                .into(),
+        );
+    }
     match value {
         Ok((v, e)) if v.is_finite() && e.is_finite() => Reading {
             problem: (!converged).then(|| {
-                if out_of_time {
-                    "wall-clock budget exhausted before the tolerance was met (the value is the best estimate so \
-                     far and depends on the machine's speed)"
-                        .into()
-                } else {
-                    "evaluation budget exhausted before the tolerance was met (the value is the best estimate)".into()
-                }
+                "evaluation budget exhausted before the tolerance was met (the value is the best estimate)".into()
             }),
             ..valued_reading(r, (v, e), evaluations, seconds, converged)
         },
