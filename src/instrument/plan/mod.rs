@@ -54,7 +54,9 @@ mod explain;
 mod readings;
 
 pub use compile::Planner;
-pub use readings::{colour_value, colour_xyz, haze_index_value, reading_value};
+pub use readings::{
+    colour_value, colour_xyz, haze_index_value, neutral_chroma, reading_value, NEUTRAL_CHROMA_FLOOR, NEUTRAL_HUE,
+};
 
 /// Share of a reading's relative tolerance given to each specimen flux and to the gloss standard's flux. A
 /// gloss reading's propagated relative error is at most the sum of its two fluxes' (first order), so
