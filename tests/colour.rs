@@ -299,3 +299,26 @@ fn fit_takes_colour_targets() {
     let (x, se) = (p["value"].as_f64().unwrap(), p["std_error"].as_f64().unwrap());
     assert!((x - 0.5).abs() < 1e-6 && (x - 0.5).abs() <= 3.0 * se + 1e-9, "{p}");
 }
+
+/// A neutral colour's hue is undefined on every shipped colour geometry (docs/colour.md §Neutral colours): no
+/// value, the reason as its note, converged, and no failed reading for the exit status; a chroma of rounding
+/// noise (C* ≈ 5e-14 on the directional geometries) is neutral too, never a hue of 0°, 90° or 348.7°.
+#[test]
+fn a_neutral_colour_has_no_hue_on_any_geometry_and_fails_nothing() {
+    let colour: Vec<String> =
+        glossmeter::instrument::standards::builtin_colour().unwrap().into_iter().map(|g| g.geometry.id).collect();
+    let ids: Vec<&str> = colour.iter().map(String::as_str).collect();
+    for recipe in [
+        r#"{"model": "lambert", "wavelengths_nm": [400, 550, 700], "albedo": [0.5, 0.5, 0.5]}"#,
+        r#"{"model": "lambert", "albedo": 1.0}"#,
+        r#"{"model": "phong", "exponent": 754.36, "ks": 0.26, "kd": 0.56}"#,
+        r#"{"model": "microfacet", "distribution": "beckmann", "roughness": 0.2, "ior": [0.685, 1.174]}"#,
+    ] {
+        let rs = measure(brdf(recipe), &ids, Conditions::default(), 1e-6);
+        for r in rs.iter().filter(|r| r.quantity == "h") {
+            assert!(r.value.is_none() && r.converged && r.problem.is_none(), "{recipe} {}: {r:?}", r.geometry);
+            assert!(r.note.as_deref().is_some_and(|n| n.starts_with("neutral colour")), "{r:?}");
+        }
+        glossmeter::cli::common::readings_status(&rs, false).unwrap_or_else(|e| panic!("{recipe}: {e}"));
+    }
+}

@@ -64,14 +64,16 @@ pub enum Command {
         /// Exit 0 even if a reading did not converge within its budget (it is still marked in the output).
         #[arg(long)]
         allow_unconverged: bool,
-        /// Evaluation budget of each aperture integral; a reading whose integral runs out is "not converged".
+        /// Evaluation budget of each aperture integral (deterministic: the same bits on every machine); a
+        /// reading whose integral runs out is "not converged".
         #[arg(long, default_value_t = PlanOptions::default().max_evals)]
         max_evals: usize,
         #[command(flatten)]
         colour: ColourArgs,
-        /// Wall-clock budget of the whole measurement, seconds (all its integrals share it); a reading whose
-        /// integral runs out is "not converged" and its value depends on the machine's speed. 0: none.
-        #[arg(long, default_value_t = crate::instrument::plan::DEFAULT_MAX_SECONDS)]
+        /// Wall-clock limit of the whole measurement, seconds (all its integrals share it; 0: none, the
+        /// default). A reading whose integral meets it gets no value (it would depend on the machine's speed)
+        /// and the command exits 1; the evaluation budget is the deterministic bound.
+        #[arg(long, default_value_t = 0.0)]
         max_seconds: f64,
         /// Also read every reading at the corners of the tolerances the standard data allow (and across the
         /// plausible range of assumed numbers); reports the minimum and maximum (table and JSON).

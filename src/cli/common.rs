@@ -33,7 +33,7 @@ impl ColourArgs {
 /// finite value, or did not converge (unless allowed).
 pub fn readings_status(readings: &[crate::Reading], allow_unconverged: bool) -> Result<()> {
     // The hue of a neutral colour has no value by definition, not by failure.
-    let neutral_hue = |r: &crate::Reading| r.problem.as_deref().is_some_and(|p| p.starts_with(NEUTRAL_HUE));
+    let neutral_hue = |r: &crate::Reading| r.note.as_deref().is_some_and(|p| p.starts_with(NEUTRAL_HUE));
     let missing = readings.iter().filter(|r| r.value.is_none() && !neutral_hue(r)).count();
     if missing > 0 {
         return Err(Error::Numeric(format!(
@@ -52,8 +52,7 @@ pub fn readings_status(readings: &[crate::Reading], allow_unconverged: bool) -> 
     Ok(())
 }
 
-/// How the hue reading of a neutral colour (C*ab = 0) explains its missing value (`plan::colour_value`).
-pub const NEUTRAL_HUE: &str = "neutral colour";
+pub use crate::instrument::plan::NEUTRAL_HUE;
 
 /// `--rtol` in (0, 1), checked before any work.
 pub fn check_rtol(rtol: f64) -> Result<()> {

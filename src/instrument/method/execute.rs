@@ -150,10 +150,17 @@ impl Method {
 
     fn run(&self, brdf: &dyn Brdf, keep: bool, shared: Option<Instant>) -> (Flux, Option<Method>) {
         let start = Instant::now();
-        let after = |s: f64| start + std::time::Duration::from_secs_f64(s);
+        // None stands for "no deadline" (also a budget too long to be an instant: never reached).
+        let after = |s: f64| deadline_after(start, s);
         let deadline = match (self.max_seconds, shared) {
-            (Some(s), Some(d)) => Some(after(s).min(d.max(after(LATE_START_SHARE * s)))),
-            (Some(s), None) => Some(after(s)),
+            (Some(s), Some(d)) => {
+                let late = after(LATE_START_SHARE * s).map(|l| d.max(l));
+                match (after(s), late) {
+                    (Some(a), Some(b)) => Some(a.min(b)),
+                    (a, b) => a.or(b),
+                }
+            }
+            (Some(s), None) => after(s),
             (None, d) => d,
         };
         let k = self.weighting.len();
@@ -385,4 +392,10 @@ fn store(out: &mut [f64], values: &[f64], weighting: &Weighting, g: f64, project
             }
         }
     }
+}
+
+/// The instant `seconds` after `start`; None (no deadline) when the budget is not a finite non-negative
+/// number of seconds or lies beyond what an `Instant` can hold (`--max-seconds 1e19` is, in effect, none).
+pub fn deadline_after(start: Instant, seconds: f64) -> Option<Instant> {
+    std::time::Duration::try_from_secs_f64(seconds).ok().and_then(|d| start.checked_add(d))
 }

@@ -47,7 +47,7 @@ pub use design::{
     delta_rule, lobe_rule, polar_rule, smooth_rule, DELTA_GATE, LOBE_REACH, POLAR_REACH, TENSOR_MAX_WIDTH_V,
     TENSOR_MIN_WIDTH, TENSOR_MIN_WIDTH_U,
 };
-pub use execute::LATE_START_SHARE;
+pub use execute::{deadline_after, LATE_START_SHARE};
 pub use gauss::{tensor_boxes, LOBE_LEVELS, TENSOR_MAX_LEVEL};
 pub use polar::{POLAR_LEVELS, TAIL_LEVELS};
 

@@ -26,7 +26,7 @@
 //! * `mod.rs`: the plan's data and life: [`PlanOptions`], [`Job`], [`PlannedReading`], [`Reading`],
 //!   [`Execution`], [`Plan`] and its [`Plan::compile`], [`Plan::with_material`], [`Plan::freeze`],
 //!   [`Plan::execute`], [`Plan::run`], [`Plan::run_all`]; the tolerance shares ([`SPECIMEN_SHARE`],
-//!   [`STANDARD_SHARE`]) and limits ([`MIN_RTOL`], [`DEFAULT_MAX_SECONDS`]);
+//!   [`STANDARD_SHARE`]) and limits ([`MIN_RTOL`], [`DEFAULT_MAX_EVALS`]);
 //! * `compile.rs`: the planner, [`Planner`]: a plan's jobs designed from the material, the geometries and
 //!   the options, shared by key, and the gloss standards' fluxes computed and cached;
 //! * `readings.rs`: the reading formulas, in one place: [`reading_value`], [`haze_index_value`],
@@ -54,7 +54,9 @@ mod explain;
 mod readings;
 
 pub use compile::Planner;
-pub use readings::{colour_value, colour_xyz, haze_index_value, reading_value};
+pub use readings::{
+    colour_value, colour_xyz, haze_index_value, neutral_chroma, reading_value, NEUTRAL_CHROMA_FLOOR, NEUTRAL_HUE,
+};
 
 /// Share of a reading's relative tolerance given to each specimen flux and to the gloss standard's flux. A
 /// gloss reading's propagated relative error is at most the sum of its two fluxes' (first order), so
@@ -71,12 +73,12 @@ pub const STANDARD_SHARE: f64 = 0.05;
 /// reference runs at this tolerance (`instrument::convergence`).
 pub const MIN_RTOL: f64 = 1e-12;
 
-/// The default wall-clock budget of one execution of a plan (all its aperture integrals together, run in
-/// parallel), seconds: far above what any shipped fixture needs (the golden suite of 396 readings runs in
-/// about a second), and short enough that the default panel of any valid input ends within 10 s of wall
-/// time (`docs/instrument.md` §Quadrature, "Bounded work"; with `method::LATE_START_SHARE`, ≤ 1.3 × 6 s on 2
-/// threads, ≤ 1.6 × on one). An integral that hits it reports its best estimate, not converged.
-pub const DEFAULT_MAX_SECONDS: f64 = 6.0;
+/// The default evaluation budget of each part of an aperture integral: 2·10⁶ evaluations, a bound in work, so
+/// that a reading that reaches it is the same bits on every machine and under any load
+/// (docs/instrument.md §Bounded work). Every shipped fixture reading needs at most 7.3·10⁴; a measured table
+/// read at 85° (the kinks at every cell boundary) reaches it in about 4–8 s on one core. There is no default
+/// wall-clock budget: [`PlanOptions::max_seconds`] is opt-in, and an integral that meets it gives no value.
+pub const DEFAULT_MAX_EVALS: usize = 2_000_000;
 
 /// Knobs of the planner. The defaults are what `measure` uses; the others exist to measure what each
 /// optimisation saves (`docs/performance.md`).
@@ -113,8 +115,8 @@ impl Default for PlanOptions {
             fold_spectral: true,
             fold_in_material: true,
             share_fluxes: true,
-            max_evals: 50_000_000,
-            max_seconds: Some(DEFAULT_MAX_SECONDS),
+            max_evals: DEFAULT_MAX_EVALS,
+            max_seconds: None,
             colour: Conditions::default(),
         }
     }
@@ -280,7 +282,8 @@ impl Plan {
 
     /// The shared deadline of one execution: now + the wall-clock budget.
     fn deadline(&self) -> Option<std::time::Instant> {
-        self.options.max_seconds.map(|s| std::time::Instant::now() + std::time::Duration::from_secs_f64(s))
+        let now = std::time::Instant::now();
+        self.options.max_seconds.and_then(|s| crate::instrument::method::deadline_after(now, s))
     }
 
     /// Execute the plan: every specimen method on the material (the standards' fluxes were computed when the

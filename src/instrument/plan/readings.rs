@@ -166,10 +166,31 @@ pub fn colour_value(
         ColourQuantity::B => (lab.b, le[2]),
         ColourQuantity::C => (lch.c, ec),
         ColourQuantity::H => match lch.h {
-            Some(h) => (h, eh),
-            None => return Err("neutral colour (C*ab = 0): the hue angle is undefined".into()),
+            Some(h) if lch.c > neutral_chroma(ec) => (h, eh),
+            _ => {
+                return Err(format!(
+                    "{NEUTRAL_HUE} (C*ab = {:.2e} ≤ {:.2e}, a chroma the integration cannot tell from 0): the \
+                     hue angle is undefined",
+                    lch.c,
+                    neutral_chroma(ec)
+                ))
+            }
         },
     })
+}
+
+/// How the hue reading of a neutral colour explains its missing value: the first words of its note.
+pub const NEUTRAL_HUE: &str = "neutral colour";
+
+/// The rounding floor of C*ab: L*a*b* values of order 100 computed in double precision carry ~10⁻¹³ of
+/// rounding, so a chroma below 10⁻⁹ is noise whatever the integration's error (docs/colour.md §Neutral colours).
+pub const NEUTRAL_CHROMA_FLOOR: f64 = 1e-9;
+
+/// The chroma at or below which a colour is neutral and its hue undefined: 3 × the chroma's error estimate
+/// (the error ellipse of (a*, b*) then reaches the origin, so the integration does not determine the hue;
+/// docs/colour.md §Neutral colours), and never below [`NEUTRAL_CHROMA_FLOOR`].
+pub fn neutral_chroma(chroma_error: f64) -> f64 {
+    (3.0 * chroma_error).max(NEUTRAL_CHROMA_FLOOR)
 }
 
 /// Combine fluxes into a direct reading, with first-order error propagation.
@@ -207,16 +228,20 @@ fn compute_reading(
         }
         _ => reading_value(&r.spec, &specimen, &standard),
     };
+    if out_of_time {
+        // A value cut off by the clock would depend on the machine's speed and load: none is reported
+        // (docs/instrument.md §Bounded work).
+        return problem_reading(
+            r,
+            "the wall-clock limit was reached before the tolerance was met; no value is reported, since it would \
+             depend on the machine's speed and load (the evaluation budget is the deterministic bound)"
+                .into(),
+        );
+    }
     match value {
         Ok((v, e)) if v.is_finite() && e.is_finite() => Reading {
             problem: (!converged).then(|| {
-                if out_of_time {
-                    "wall-clock budget exhausted before the tolerance was met (the value is the best estimate so \
-                     far and depends on the machine's speed)"
-                        .into()
-                } else {
-                    "evaluation budget exhausted before the tolerance was met (the value is the best estimate)".into()
-                }
+                "evaluation budget exhausted before the tolerance was met (the value is the best estimate)".into()
             }),
             ..valued_reading(r, (v, e), evaluations, seconds, converged)
         },
@@ -224,6 +249,15 @@ fn compute_reading(
             r,
             format!("the reading's arithmetic overflowed (value {v}, error estimate {e}); the fluxes are out of range"),
         ),
+        // The hue of a neutral colour has no value by definition, not by failure: null, with the reason as
+        // its note, converged as its fluxes are (it changes no exit status).
+        Err(why) if why.starts_with(NEUTRAL_HUE) => Reading {
+            value: None,
+            error_estimate: 0.0,
+            problem: None,
+            note: Some(why),
+            ..valued_reading(r, (0.0, 0.0), evaluations, seconds, converged)
+        },
         Err(why) => problem_reading(r, why),
     }
 }
