@@ -9,6 +9,23 @@
 //! `wi` points from the surface towards the source, `wo` towards the receptor; both are unit vectors with
 //! z > 0. `eval` returns the *regular* part of f_r in sr⁻¹ (no cosine factor); a delta component is reported
 //! separately by [`Brdf::delta_reflectance`].
+//!
+//! The folder:
+//! * `mod.rs` (this): the contract, [`Brdf`] (`sampling`, `eval`, `eval_batch` and its batched contract,
+//!   `folds` and `eval_batch_folded`, `delta_reflectance`, `terms`, `kinks`, `seams`, `is_reciprocal`,
+//!   `smooth`, `describe`), what a model tells the integrator ([`Term`], [`TermKind`], [`Lobe`], [`Tail`],
+//!   [`Kink`]) and [`mirror`];
+//! * the models, one per file, each over the optics it cites: `lambert.rs` ([`lambert::Lambert`]),
+//!   `dielectric.rs` (the smooth dielectric [`dielectric::SmoothDielectric`] and the rough interface of a
+//!   dielectric or a conductor [`dielectric::MicrofacetSurface`], with its [`dielectric::Ior`]), `conductor.rs`
+//!   ([`conductor::SmoothConductor`]), `phong.rs` ([`phong::Phong`]), `ward.rs` ([`ward::Ward`]),
+//!   `multilobe.rs` ([`multilobe::CookTorranceLobes`]) and `paint`, the paint model of Ďurikovič & Ágošton
+//!   (2007) ([`paint::Paint`] built from a [`paint::PaintSpec`]);
+//! * `albedo.rs`: the directional albedo that resolves narrow lobes
+//!   ([`albedo::directional_albedo`], [`albedo::directional_albedo_to`]): a d/8 sphere's hemisphere
+//!   reading (`instrument::sphere`) and the tests' white furnace.
+//!
+//! Measured materials are `crate::measured`'s: its readers implement this trait over their tables.
 use crate::optics::microfacet::{Distribution, Microfacet};
 use crate::spectrum::Sampling;
 use crate::{Error, Result, Vec3};

@@ -3,11 +3,17 @@
 //! written by `crate::report`), and their errors into a message on stderr and a non-zero exit status: 2 for bad
 //! input, unreadable files or usage; 1 when a reading has no finite value or a comparison fails.
 //!
-//! The folder, by stage: [`args`] defines the command line (clap), [`common`] holds what the subcommands
-//! share, this file runs a command line ([`run`]) and dispatches it; a file per subcommand (`batch` for
-//! `measure` of many recipes, [`compare`], [`convergence`], [`fit`], [`pictures`] for `plot`, [`profile`],
-//! [`sweep`]) parses its own arguments and formats its results; [`format`](mod@format) writes the text tables of
-//! `measure`, [`output`] the files, [`plot`] the pictures, [`junit`] the JUnit XML of `compare`.
+//! The folder, by stage:
+//! * [`args`]: the command line's definitions (clap: [`args::Cli`], [`args::Command`], [`args::OutputSchema`]);
+//! * [`common`]: what the subcommands share ([`common::Format`], [`common::ColourArgs`], [`common::check_rtol`],
+//!   [`common::readings_status`], and [`common::pad_table`], through which every text table goes);
+//! * `mod.rs` (this): [`run`] runs a command line and dispatches it, [`exit_status`] maps an error to its status;
+//! * a file per subcommand, which parses its own arguments and formats its results: [`batch`] (`measure` of
+//!   many recipes), [`compare`], [`convergence`], [`fit`], [`pictures`] (`plot`), [`profile`], [`sweep`];
+//! * the writers: [`format`](mod@format) the text tables of `measure` ([`format::table`],
+//!   [`format::envelope_table`]), [`output`] the files ([`output::OutputTarget`]: a new file whole or not at
+//!   all, never overwriting, or standard output), [`plot`] the pictures (PNG or SVG with an embedded font),
+//!   [`junit`] the JUnit XML of `compare`.
 use std::io::Write;
 use std::path::PathBuf;
 

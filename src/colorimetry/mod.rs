@@ -26,8 +26,14 @@
 //! Tables: `standards/cie/*.csv`, each with its source in its header, exported by `tools/export_cie_tables.py`
 //! from colour-science 0.4.7 (the independent reference; tested against its `sd_to_XYZ` and `XYZ_to_Lab`).
 //!
-//! Files: `cielab.rs` (X, Y, Z to CIELAB, LCh and CIEDE2000) and `weighting.rs` (the matrix a reading takes from
-//! the spectral samples: luminous, one component per sample, or X, Y, Z through [`weights`]).
+//! The folder:
+//! * `mod.rs` (this): the tristimulus weights of a sampling ([`weights`] → [`Weights`], [`Weights::xyz`]),
+//!   the viewing [`Conditions`] ([`Illuminant`], [`Observer`]) and the CIE tables;
+//! * `cielab.rs`: X, Y, Z to CIELAB and LCh ([`xyz_to_lab`], [`lab_to_lch`], [`Lab`], [`Lch`]) and CIEDE2000
+//!   ([`ciede2000`]);
+//! * `weighting.rs`: the matrix a reading takes from the spectral samples, luminous, one component per sample,
+//!   or X, Y, Z through [`weights`] ([`weighting::WeightingKind`], [`weighting::Weighting`]: `rows_of`,
+//!   `stack`, `luminous`, `component`).
 use crate::spectrum::{interp, parse_columns, parse_table, Sampling, SamplingKind};
 use crate::{Error, Result};
 

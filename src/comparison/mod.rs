@@ -16,9 +16,15 @@
 //! uncertainty there is no allowance: the row is unchecked, which fails the check like an outside row.
 //!
 //! The folder:
-//! * `mod.rs`: the statistics, the verdict rule ([`VerdictRule`]), the comparison of a sheet's samples with
-//!   their recipes' predictions, colour differences, and baselines;
-//! * [`sheet`]: the input format, instrument sheets as instruments and spreadsheets write them.
+//! * `mod.rs`: the statistics of repeated readings ([`statistics`], [`group_rows`]), the verdict rule
+//!   ([`VerdictRule`], [`Verdict`]), one sample judged against its prediction ([`judge`] → [`Comparison`]) and
+//!   a whole sheet, each distinct recipe measured once and in parallel ([`compare_sheet`]), a sheet read as
+//!   targets for other callers ([`read_targets`]), colour differences ([`colour_differences`]), and baselines
+//!   ([`load_baseline`], [`check_baseline`] → [`Drift`]);
+//! * [`sheet`]: the input format, instrument sheets as instruments and spreadsheets write them (encodings,
+//!   separators, decimal commas, header aliases, metadata, repeats: [`sheet::load`], [`sheet::parse`] →
+//!   [`sheet::Sheet`] of [`sheet::SheetRow`]s, [`sheet::READING_COLUMNS`]), with errors naming file, line and
+//!   column. It imports nothing of the crate but `input` and `error`.
 pub mod sheet;
 
 use std::collections::HashMap;

@@ -3,8 +3,13 @@
 //! message instead of being read until memory runs out. (MERL tables are binary and checked against their
 //! own header in `measured::merl`.)
 //!
-//! Files: `mod.rs` (this: [`read_text`], [`read_bytes`], the size limit) and `json.rs` (a JSON document read
-//! with errors that name the file and the field's JSON Pointer: `Obj`, `parse_json`, `kind`, `show`).
+//! The folder:
+//! * `mod.rs` (this): [`read_text`] and [`read_bytes`] with the text limit [`MAX_TEXT_BYTES`], and their
+//!   `_limited` forms ([`read_text_limited`], [`read_bytes_limited`]) that the measured tables use with
+//!   [`MAX_TABLE_BYTES`];
+//! * `json.rs`: a JSON document read with errors that name the file and the field's JSON Pointer
+//!   ([`json::parse_json`], which refuses duplicate keys, [`json::Obj`] and its typed accessors, [`json::kind`],
+//!   [`json::show`]); every recipe and geometry-file parser reads through it.
 use std::io::Read;
 use std::path::Path;
 

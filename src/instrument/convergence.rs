@@ -6,7 +6,7 @@
 //! against a reference, integrand evaluations, time and the converged flag.
 //!
 //! **The reference.** Where a closed form exists it is used, computed here independently of the engine
-//! (no code shared with `aperture.rs` or `plan.rs` except the Fresnel reflectance of the gloss standard, which
+//! (no code shared with `aperture.rs` or `plan/` except the Fresnel reflectance of the gloss standard, which
 //! is tested on its own in `optics::fresnel`):
 //!
 //! * a *Lambertian* material (f_r = ρ/π, detected by [`lambertian_value`]): the specimen flux through a

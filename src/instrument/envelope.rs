@@ -2,7 +2,7 @@
 //! built to the standard's tolerances, not to its nominal numbers, and several numbers in the shipped
 //! geometries are assumed; a user comparing with a real meter needs the spread, not only the nominal value.
 //!
-//! The standards files carry the variations beside each number (`standards.rs`, `check_variation`):
+//! The standards files carry the variations beside each number (`standards/sourced.rs`, `check_variation`):
 //! `"tolerance"` (the number ± t, as a standard's Table gives it) and `"plausible"` (the range an assumed
 //! number may lie in). Each variation has its own source and status. The envelope is read at the corners of
 //! the box they span: every number at its low or high end, all combinations (2^k geometries), when

@@ -2,11 +2,19 @@
 //! the instrument, not only analytic models. One file per format decodes its bytes or text and names its
 //! source; `table.rs` is the one table/interpolation layer they all use.
 //!
-//! * `merl.rs`: MERL `.binary` (Matusik et al. 2003), isotropic, RGB.
+//! * `table.rs`: axes ([`table::TableAxis`]: clamped or periodic linear weights), N-D multilinear tables
+//!   ([`table::Table`]), half/difference angles, the lobe's half width at half maximum measured from a table
+//!   ([`table::specular_half_width`]) and the flat-table test ([`table::is_flat`]);
+//! * `merl.rs`: MERL `.binary` (Matusik et al. 2003), isotropic, RGB ([`merl::MerlBrdf`]);
 //! * `rgl.rs`: the RGL material database's `.bsdf` tensor files (Dupuy & Jakob 2018), as pbrt-v4's
-//!   `MeasuredBxDF` evaluates them; isotropic and anisotropic, spectral or RGB.
+//!   `MeasuredBxDF` evaluates them; isotropic and anisotropic, spectral or RGB ([`rgl::RglBrdf`] over a
+//!   [`rgl::TensorFile`]);
 //! * `inplane.rs`: in-plane goniometer tables f_r(θi, θo), extended off the plane by an explicit isotropy
-//!   assumption; read from the in-plane CSV export and from ASTM E1392-style text tables (`e1392.rs`).
+//!   assumption ([`inplane::InPlaneBrdf`]); read from the in-plane CSV export ([`inplane::parse_csv`]);
+//! * `e1392.rs`: ASTM E1392-style text tables, read into the same in-plane model ([`e1392::parse`]).
+//!
+//! The RGL, in-plane CSV and E1392 files are read with the tables' size limit (`crate::input::MAX_TABLE_BYTES`);
+//! a MERL file is checked against its own header.
 //!
 //! Every reader tells the integrator the table's angular resolution as the lobe width (`Lobe::slope_width`),
 //! so the adaptive cubature splits at the table's finest structure and cannot step over its peak, and the

@@ -1,6 +1,25 @@
 //! Physical optics as small pure functions named after the physics (in the manner of pbrt-v4's
 //! `scattering.h`): Fresnel equations, Kubelka–Munk layers, thin-film stacks and microfacet distributions.
 //! Each function cites its source in its doc comment and in `docs/model.md`.
+//!
+//! The folder (`thin_film.rs` builds on `fresnel.rs`; `coat_albedo.rs` on `fresnel.rs`, `microfacet.rs`,
+//! `tabulated.rs` and the quadrature's Gauss–Legendre rule; the others only the crate's `Vec3`):
+//! * `fresnel.rs`: dielectric and conducting interfaces, the decaying-wave branch, refraction into a coat and
+//!   the critical angles ([`fresnel::fresnel_dielectric`], [`fresnel::fr_dielectric`],
+//!   [`fresnel::fresnel_conductor`], [`fresnel::fr_conductor`], [`fresnel::amplitudes`],
+//!   [`fresnel::refract_into`], [`fresnel::critical_cosine`]);
+//! * `kubelka_munk.rs`: two-flux layers: [`kubelka_munk::r_infinity`], a layer over a background
+//!   ([`kubelka_munk::layer`] → [`kubelka_munk::Layer`]), [`kubelka_munk::mix`],
+//!   [`kubelka_munk::invert_white_black`];
+//! * `thin_film.rs`: coherent and incoherent layer stacks, the pearlescent flake ([`thin_film::stack`],
+//!   [`thin_film::FilmLayer`], [`thin_film::StackResult`]);
+//! * `microfacet.rs`: Beckmann and GGX distributions with Smith and V-cavity masking
+//!   ([`microfacet::Microfacet`], [`microfacet::Distribution`], [`microfacet::Shadowing`]);
+//! * `tabulated.rs`: piecewise Chebyshev tables of smooth functions of one variable, accepted only with their
+//!   error verified when built ([`tabulated::ChebTable`]; the node and basis helpers the coat-albedo table uses);
+//! * `coat_albedo.rs`: the directional albedo E(μ) of a rough coat's lobe and its mean Ē
+//!   ([`coat_albedo::CoatAlbedo`], read from the shipped table `assets/coat-albedo-table.bin` or computed by
+//!   the module's reference rule; [`coat_albedo::lobe_albedo`]).
 pub mod coat_albedo;
 pub mod fresnel;
 pub mod kubelka_munk;

@@ -9,10 +9,7 @@
 //! global absolute/relative tolerance across all pieces, (c) vector values with a stated error norm, and
 //! (d) a fixed, single-threaded order of work. The Rust crates looked at (bilby 0.3: scalar only, no initial
 //! split; scirs2-integrate: very heavy) offer none of (a)–(c) together, so the rule is implemented here
-//! (`genz_malik.rs`, tested against closed forms in its own test module). `gauss.rs` holds the crate's
-//! one-dimensional Gauss–Legendre and Gauss–Kronrod rules, `hermite.rs` the Gauss–Hermite rules of narrow lobes, `polar.rs` the polar (ρ = tan β) and
-//! box product rules of narrow heavy-tailed lobes, `tensor.rs` the anisotropic tensor Gauss–Legendre rules with
-//! per-axis p-refinement of smooth integrands.
+//! (`genz_malik.rs`, tested against closed forms in its own test module).
 //!
 //! The rule is Genz & Malik's degree-7 rule with an embedded degree-5 rule (A. C. Genz, A. A. Malik,
 //! "An adaptive algorithm for numerical integration over an n-dimensional rectangular region",
@@ -22,6 +19,20 @@
 //! a DCUHRE-style calibration from three successive null rules on the same points (`genz_malik::calibrated`,
 //! `docs/accuracy.md` §5), on a smooth integrand also checked against the refinement (a bisected box's
 //! children against their parent, `genz_malik::child_scale`, §5.1).
+//!
+//! The folder (the items of its private files are re-exported here):
+//! * `genz_malik.rs`: the cubature: [`integrate`] over boxes, [`integrate_partition`] over a caller's partition
+//!   of [`Cell`]s, adaptive or frozen ([`Refine`]), [`pointwise`], its [`Options`] and [`Estimate`], the rule's
+//!   points and weights ([`GenzMalikRule`]) and the calibration's limits ([`MAX_SHRINK`], [`MAX_SHRINK_LOBE`]);
+//! * `gauss.rs`: the crate's one Gauss–Legendre rule ([`gauss_legendre`], per-process tables up to
+//!   [`TABLE_MAX_ORDER`]: [`gauss_legendre_table`]) and the adaptive Gauss–Kronrod G7/K15
+//!   ([`gauss_kronrod_adaptive`]);
+//! * `hermite.rs`: the Gauss–Hermite rules of narrow Gaussian lobes ([`gauss_hermite`], [`gauss_hermite_table`]);
+//! * `polar.rs`: the polar (ρ = tan β) and mapped (σ = 1/x, y = c·tan γ) Gauss–Legendre rules of narrow
+//!   heavy-tailed lobes ([`polar_rectangle`], [`mapped_legendre`] with its [`Map`], [`legendre_on`], each with
+//!   an `_into` form that fills caller buffers, [`PolarBuffers`]);
+//! * [`tensor`]: the anisotropic tensor Gauss–Legendre rule with per-axis p-refinement of smooth integrands
+//!   ([`tensor::integrate`], [`tensor::ORDERS`], [`tensor::Path`]).
 mod gauss;
 mod genz_malik;
 mod hermite;

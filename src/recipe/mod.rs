@@ -6,6 +6,17 @@
 //! every value is checked with the file, the field's JSON Pointer and what is allowed ([`crate::input::json::Obj`]);
 //! unknown fields are refused (the allowed keys come from the registry) so that a typo cannot silently fall
 //! back to a default.
+//!
+//! The folder:
+//! * `mod.rs` (this): a recipe file or text read into a [`Material`] ([`load_file`], [`parse_str`]), the
+//!   dispatch on `"model"` ([`parse_brdf`]) and the analytic models' fields (Lambert, the smooth and rough
+//!   interfaces, Phong, Ward, the Cook–Torrance lobes), [`META_FIELDS`];
+//! * `fields.rs`: the registry-driven reading of a parameter (`Obj::param`, `opt_param`, `param_array`,
+//!   `param_key`, `deny_unknown_in`, [`fields::param_number`]) on `input::json`'s reader;
+//! * `paint.rs`: `"model": "paint"` recipes ([`paint::parse_paint`], [`paint::parse_paint_spec`]);
+//! * `measured.rs`: the measured tables' recipes, a path resolved against the recipe's directory
+//!   ([`measured::resolve`], [`measured::parse_merl`], [`measured::parse_rgl`], [`measured::parse_inplane`]);
+//! * `schema.rs`: the JSON Schema of the format, generated from the registry ([`schema::schema`]).
 use crate::brdf::conductor::SmoothConductor;
 use crate::brdf::dielectric::{Ior, MicrofacetSurface, SmoothDielectric};
 use crate::brdf::lambert::Lambert;

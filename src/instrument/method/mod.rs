@@ -19,11 +19,11 @@
 //!
 //! The folder, one idea per file:
 //! - `mod.rs`: the method as plain data ([`Method`], [`Design`], [`Rule`], [`TensorChart`], [`DeltaPart`],
-//!   [`RegularPart`], [`Projection`], [`Target`]), the [`Flux`] it produces, [`Method::is_frozen`] and
-//!   [`Method::expected_evaluations`];
-//! - `design.rs`: [`Method::design`] and [`Method::for_material`], the rule choosers ([`delta_rule`],
-//!   [`lobe_rule`], [`polar_rule`], [`smooth_rule`]) and the gates they choose by ([`DELTA_GATE`],
-//!   [`LOBE_REACH`], [`POLAR_REACH`], [`TENSOR_MIN_WIDTH`], [`TENSOR_MAX_WIDTH_V`], [`TENSOR_MIN_WIDTH_U`]);
+//!   [`RegularPart`], [`Projection`], [`Target`]), the [`Flux`] it produces and [`Method::is_frozen`];
+//! - `design.rs`: [`Method::design`], [`Method::for_material`] and [`Method::expected_evaluations`] (the
+//!   scheduling guess of `Plan::run_all`), the rule choosers ([`delta_rule`], [`lobe_rule`], [`polar_rule`],
+//!   [`smooth_rule`]) and the gates they choose by ([`DELTA_GATE`], [`LOBE_REACH`], [`POLAR_REACH`],
+//!   [`TENSOR_MIN_WIDTH`], [`TENSOR_MAX_WIDTH_V`], [`TENSOR_MIN_WIDTH_U`]);
 //! - `execute.rs`: [`Method::execute`] and its variants (a deadline, freezing), [`Method::sample_regular`],
 //!   the regular part's integrand and [`LATE_START_SHARE`];
 //! - `delta.rs`: [`Rule::LobeDelta`]'s executor, its fit ([`DeltaFit`], [`delta_fit`], [`delta_stencil`]) and

@@ -24,11 +24,11 @@
 //! The folder, one idea per file:
 //!
 //! * `mod.rs`: the plan's data and life: [`PlanOptions`], [`Job`], [`PlannedReading`], [`Reading`],
-//!   [`Execution`], [`Plan`] and its [`Plan::compile`], [`Plan::with_material`], [`Plan::freeze`],
+//!   [`Execution`], [`Plan`] and its [`Plan::with_material`], [`Plan::freeze`],
 //!   [`Plan::execute`], [`Plan::run`], [`Plan::run_all`]; the tolerance shares ([`SPECIMEN_SHARE`],
 //!   [`STANDARD_SHARE`]) and limits ([`MIN_RTOL`], [`DEFAULT_MAX_EVALS`]);
 //! * `compile.rs`: the planner, [`Planner`]: a plan's jobs designed from the material, the geometries and
-//!   the options, shared by key, and the gloss standards' fluxes computed and cached;
+//!   the options, shared by key, and the gloss standards' fluxes computed and cached; [`Plan::compile`];
 //! * `readings.rs`: the reading formulas, in one place: [`reading_value`], [`haze_index_value`],
 //!   [`colour_xyz`], [`colour_value`], and a planned reading computed from its fluxes;
 //! * `explain.rs`: [`Plan::explain`], the stored methods in plain words (the text of `--explain`).
