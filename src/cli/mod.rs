@@ -149,15 +149,15 @@ fn dispatch(cli: Cli) -> Result<()> {
                     format::table(&material, &readings, !no_timing) + &format::envelope_table(&readings, e)
                 }
                 (Format::Json, e) => {
-                    let mut doc = report::json_doc(&material, &readings, !no_timing);
+                    let mut doc = report::measure::json_doc(&material, &readings, !no_timing);
                     doc["evaluations"] = serde_json::json!(evaluations);
-                    let doc = with_baseline(doc, drift.as_deref(), baseline_file.clone());
+                    let doc = report::measure::with_baseline(doc, drift.as_deref(), baseline_file.clone());
                     report::pretty(&match e {
                         None => doc,
-                        Some(e) => report::json_with_envelope(doc, e),
+                        Some(e) => report::measure::json_with_envelope(doc, e),
                     })
                 }
-                (Format::Csv, _) => report::csv(&readings, !no_timing)?,
+                (Format::Csv, _) => report::measure::csv(&readings, !no_timing)?,
             });
             if let (Format::Table, Some(d)) = (format, &drift) {
                 text.push_str(&batch::drift_text(d));
@@ -192,22 +192,6 @@ fn dispatch(cli: Cli) -> Result<()> {
             print(&(text + "\n"))
         }
     }
-}
-
-/// Add the baseline checks to a JSON document (when a baseline was given).
-fn with_baseline(
-    mut doc: serde_json::Value,
-    drift: Option<&[crate::comparison::Drift]>,
-    file: Option<String>,
-) -> serde_json::Value {
-    if let (Some(d), Some(file)) = (drift, file) {
-        doc["baseline"] = serde_json::json!({
-            "file": file,
-            "checks": d.iter().map(compare::drift_json).collect::<Vec<_>>(),
-            "moved": d.iter().filter(|x| x.moved).count(),
-        });
-    }
-    doc
 }
 
 /// Exit status 1 when a baseline reading moved.
@@ -258,12 +242,15 @@ fn measure_batch(
             }
             t
         }
-        Format::Json => report::pretty(&with_baseline(
-            batch::with_evaluations(batch::json_doc(&materials, &readings, how.timing), &evaluations),
+        Format::Json => report::pretty(&report::measure::with_baseline(
+            report::measure::with_evaluations(
+                report::measure::batch_json_doc(&materials, &readings, how.timing),
+                &evaluations,
+            ),
             drift.as_deref(),
             how.baseline.as_ref().map(|(_, f)| f.clone()),
         )),
-        Format::Csv => batch::csv(&materials, &readings, how.timing)?,
+        Format::Csv => report::measure::batch_csv(&materials, &readings, how.timing)?,
     };
     target.write(&text)?;
     check_drift(drift.as_deref())?;
