@@ -54,7 +54,8 @@ where
         // ripgrep does. Only standard output is treated so; a file that cannot be written is an error.
         Err(Error::Io { file, source }) if file == STDOUT && source.kind() == std::io::ErrorKind::BrokenPipe => 0,
         Err(e) => {
-            let _ = writeln!(std::io::stderr(), "error: {e}");
+            // The library names arguments in its own words; the command line writes them as its flags.
+            let _ = writeln!(std::io::stderr(), "error: {}", e.naming(&common::flag));
             exit_status(&e)
         }
     }
@@ -64,7 +65,7 @@ where
 /// files and usage; 1 for a result that is not one (no finite value, not converged, a failed check).
 pub fn exit_status(e: &Error) -> i32 {
     match e {
-        Error::Input { .. } | Error::Usage(_) | Error::Io { .. } => 2,
+        Error::Input { .. } | Error::Usage(_) | Error::Argument(_) | Error::Io { .. } => 2,
         Error::Numeric(_) | Error::Check(_) => 1,
     }
 }

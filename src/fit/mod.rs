@@ -42,6 +42,7 @@ use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt, TerminationRe
 use nalgebra::{DMatrix, DVector};
 use serde_json::Value;
 
+use crate::error::Words;
 use crate::instrument::plan::{PlanOptions, Planner};
 use crate::instrument::standards::StandardGeometry;
 use crate::{recipe, Error, Result};
@@ -179,8 +180,9 @@ impl FitReport {
 }
 
 /// Fit the free parameters of `recipe` (the JSON of a recipe file named `file`) to the targets.
-/// Bad arguments (paths, bounds, starts, targets, counts) are `Error::Usage` naming the argument; a fit
-/// that runs returns its report whatever its outcome (see [`FitReport::ok`]).
+/// Bad arguments (paths, bounds, starts, targets, counts) are usage errors, [`Error::Argument`] where they
+/// name the argument (`free`, `target`, `sheet`); a fit that runs returns its report whatever its outcome
+/// (see [`FitReport::ok`]).
 pub fn fit(
     recipe_json: &Value,
     file: &str,
@@ -190,10 +192,15 @@ pub fn fit(
 ) -> Result<FitReport> {
     let clock = Instant::now();
     if targets.is_empty() {
-        return Err(Error::Usage("no targets: give --target GEOMETRY/READING=VALUE[±U] or --sheet".into()));
+        return Err(Error::Argument(
+            Words::from("no targets: give ")
+                .and_argument("target")
+                .and(" GEOMETRY/READING=VALUE[±U] or ")
+                .and_argument("sheet"),
+        ));
     }
     if free.is_empty() {
-        return Err(Error::Usage("no free parameters: give --free PATH=LO..HI".into()));
+        return Err(Error::Argument(Words::from("no free parameters: give ").and_argument("free").and(" PATH=LO..HI")));
     }
     if free.len() > targets.len() {
         return Err(Error::Usage(format!(
@@ -218,7 +225,7 @@ pub fn fit(
     }
     let geometries: Vec<StandardGeometry> = ids
         .iter()
-        .map(|id| planner.geometry(id).map_err(|e| Error::Usage(format!("--target {id:?}: {e}"))))
+        .map(|id| planner.geometry(id).map_err(|e| Error::argument("target", format!(" {id:?}: {e}"))))
         .collect::<Result<_>>()?;
     let plan_options = PlanOptions { rtol: options.rtol, ..PlanOptions::default() };
     // Match every target to a reading of the plan.
@@ -242,24 +249,30 @@ pub fn fit(
             .ok_or_else(|| {
                 let has: Vec<&str> =
                     names.iter().filter(|(g, _, _)| *g == t.geometry).map(|(_, n, _)| n.as_str()).collect();
-                Error::Usage(format!(
-                    "--target {:?}: geometry {:?} has no reading {:?}; its readings are {}",
-                    format!("{}/{}", t.geometry, t.name),
-                    t.geometry,
-                    t.name,
-                    has.join(", ")
-                ))
+                Error::argument(
+                    "target",
+                    format!(
+                        " {:?}: geometry {:?} has no reading {:?}; its readings are {}",
+                        format!("{}/{}", t.geometry, t.name),
+                        t.geometry,
+                        t.name,
+                        has.join(", ")
+                    ),
+                )
             })?;
         index.push(i);
     }
     let mut seen: HashMap<usize, usize> = HashMap::new();
     for (k, i) in index.iter().enumerate() {
         if let Some(prev) = seen.insert(*i, k) {
-            return Err(Error::Usage(format!(
-                "--target {:?}: the same reading is targeted twice (also target {})",
-                format!("{}/{}", targets[k].geometry, targets[k].name),
-                prev + 1
-            )));
+            return Err(Error::argument(
+                "target",
+                format!(
+                    " {:?}: the same reading is targeted twice (also target {})",
+                    format!("{}/{}", targets[k].geometry, targets[k].name),
+                    prev + 1
+                ),
+            ));
         }
     }
 

@@ -3,6 +3,7 @@
 //! the free parameters against the recipe and the parameter registry.
 use serde_json::Value;
 
+use crate::error::Words;
 use crate::registry;
 use crate::{Error, Result};
 
@@ -18,7 +19,7 @@ pub struct FreeParameter {
 impl FreeParameter {
     /// Parse `PATH=LO..HI` or `PATH=log:LO..HI` (the `--free` argument).
     pub fn parse(arg: &str) -> Result<FreeParameter> {
-        let bad = |m: String| Error::Usage(format!("--free {arg}: {m}"));
+        let bad = |m: String| Error::argument("free", format!(" {arg}: {m}"));
         let (pointer, bounds) = arg
             .split_once('=')
             .ok_or_else(|| bad("expected PATH=LO..HI (or PATH=log:LO..HI), e.g. /roughness=log:1e-3..0.5".into()))?;
@@ -83,7 +84,7 @@ pub struct TargetReading {
 impl TargetReading {
     /// Parse `GEOMETRY/READING=VALUE`, `…=VALUE±U` or `…=VALUE+-U` (the `--target` argument).
     pub fn parse(arg: &str) -> Result<TargetReading> {
-        let bad = |m: String| Error::Usage(format!("--target {arg}: {m}"));
+        let bad = |m: String| Error::argument("target", format!(" {arg}: {m}"));
         let (left, right) = arg
             .split_once('=')
             .ok_or_else(|| bad("expected GEOMETRY/READING=VALUE[±U], e.g. astm-d523-60/gloss=85±0.5".into()))?;
@@ -124,7 +125,7 @@ impl TargetReading {
 /// does not reduce) and s/√n the standard error of the mean (n ≥ 2); a group with neither (one reading, no
 /// stated uncertainty) gets `None`, the fit's default. Rows whose reading glossmeter does not predict (the
 /// sheet reader marks them) are left out and named in the returned notes. A sample the sheet lacks, or a
-/// sheet of several samples without `sample`, is a usage error naming `--sample`.
+/// sheet of several samples without `sample`, is an [`Error::Argument`] naming `sample`.
 pub fn targets_from_sheet(
     sheet: &crate::comparison::sheet::Sheet,
     sample: Option<&str>,
@@ -138,20 +139,23 @@ pub fn targets_from_sheet(
     let chosen = match sample {
         Some(s) if samples.contains(&s) => s,
         Some(s) => {
-            return Err(Error::Usage(format!(
-                "--sample {s}: {} has no sample {s:?}; it has {}",
-                sheet.file,
-                samples.join(", ")
-            )))
+            return Err(Error::argument(
+                "sample",
+                format!(" {s}: {} has no sample {s:?}; it has {}", sheet.file, samples.join(", ")),
+            ))
         }
         None if samples.len() == 1 => samples[0],
         None => {
-            return Err(Error::Usage(format!(
-                "--sheet {}: the sheet has {} samples ({}); choose one with --sample",
-                sheet.file,
-                samples.len(),
-                samples.join(", ")
-            )))
+            return Err(Error::Argument(
+                Words::argument("sheet")
+                    .and(format!(
+                        " {}: the sheet has {} samples ({}); choose one with ",
+                        sheet.file,
+                        samples.len(),
+                        samples.join(", ")
+                    ))
+                    .and_argument("sample"),
+            ))
         }
     };
     let rows: Vec<_> = sheet.rows.iter().filter(|r| r.sample == chosen).cloned().collect();
@@ -179,10 +183,10 @@ pub fn targets_from_sheet(
         });
     }
     if targets.is_empty() {
-        return Err(Error::Usage(format!(
-            "--sheet {}: sample {chosen:?} has no reading glossmeter predicts, so no targets",
-            sheet.file
-        )));
+        return Err(Error::argument(
+            "sheet",
+            format!(" {}: sample {chosen:?} has no reading glossmeter predicts, so no targets", sheet.file),
+        ));
     }
     Ok((targets, notes))
 }
@@ -193,36 +197,33 @@ pub(super) fn check_free(recipe: &Value, free: &[FreeParameter]) -> Result<Vec<f
     let model = recipe.get("model").and_then(Value::as_str).unwrap_or("");
     let mut start = Vec::new();
     for (i, p) in free.iter().enumerate() {
-        let arg = format!("--free {}", p.pointer);
+        let bad = |m: String| Error::argument("free", format!(" {}: {m}", p.pointer));
         if free[..i].iter().any(|q| q.pointer == p.pointer) {
-            return Err(Error::Usage(format!("{arg}: the same parameter is free twice")));
+            return Err(bad("the same parameter is free twice".into()));
         }
         let entry = registry::lookup(model, &p.pointer).ok_or_else(|| {
             let numeric: Vec<&str> =
                 registry::of_model(model).filter(|e| e.ty.is_numeric()).map(|e| e.pointer).collect();
-            Error::Usage(format!(
-                "{arg}: not a parameter of a {model:?} recipe; its numeric parameters are {}",
-                numeric.join(", ")
-            ))
+            bad(format!("not a parameter of a {model:?} recipe; its numeric parameters are {}", numeric.join(", ")))
         })?;
         let v = recipe.pointer(&p.pointer).ok_or_else(|| {
-            Error::Usage(format!(
-                "{arg}: the recipe has no value at {} (add it with a starting value: the fit starts from the recipe)",
+            bad(format!(
+                "the recipe has no value at {} (add it with a starting value: the fit starts from the recipe)",
                 p.pointer
             ))
         })?;
         let x = v.as_f64().filter(|_| v.is_number()).ok_or_else(|| {
-            Error::Usage(format!(
-                "{arg}: the value at {} is {}, not a number; address one number (e.g. {}/0)",
+            bad(format!(
+                "the value at {} is {}, not a number; address one number (e.g. {}/0)",
                 p.pointer,
                 crate::input::json::kind(v),
                 p.pointer
             ))
         })?;
-        let r = entry.range.ok_or_else(|| Error::Usage(format!("{arg}: {} is not numeric", entry.pointer)))?;
+        let r = entry.range.ok_or_else(|| bad(format!("{} is not numeric", entry.pointer)))?;
         if !(r.contains(p.lower) || p.lower == r.lo) || !(r.contains(p.upper) || p.upper == r.hi) {
-            return Err(Error::Usage(format!(
-                "{arg}: bounds {}..{} leave the allowed range of {} ({}: {})",
+            return Err(bad(format!(
+                "bounds {}..{} leave the allowed range of {} ({}: {})",
                 p.lower,
                 p.upper,
                 entry.pointer,
@@ -231,8 +232,8 @@ pub(super) fn check_free(recipe: &Value, free: &[FreeParameter]) -> Result<Vec<f
             )));
         }
         if !(x > p.lower && x < p.upper) {
-            return Err(Error::Usage(format!(
-                "{arg}: the start (the recipe's value {x}) is outside the bounds; it must lie strictly between {} and {}",
+            return Err(bad(format!(
+                "the start (the recipe's value {x}) is outside the bounds; it must lie strictly between {} and {}",
                 p.lower, p.upper
             )));
         }

@@ -53,7 +53,7 @@ mod compile;
 mod explain;
 mod readings;
 
-pub use compile::Planner;
+pub use compile::{rtol_refusal, Planner};
 pub use readings::{colour_value, colour_xyz, haze_index_value, reading_value};
 
 /// Share of a reading's relative tolerance given to each specimen flux and to the gloss standard's flux. A
