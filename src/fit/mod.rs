@@ -50,7 +50,7 @@ use params::check_free;
 use problem::{describe_point, Forward, Mode, Problem};
 
 /// Uncertainty of a target given without one, in the reading's unit: the 0.2 GU repeatability that
-/// `docs/inverse.md` assumes for a glossmeter (issue 11's example), used for haze and DOI units alike.
+/// `docs/inverse.md` assumes for a glossmeter (its opening list, "Weights"), used for haze and DOI units alike.
 pub const DEFAULT_UNCERTAINTY: f64 = 0.2;
 
 /// The largest Gauss–Newton step, in standard uncertainties of the targets, that may remain at a fit called
