@@ -1,7 +1,9 @@
 //! One error type for the whole crate. Bad input must be reported with the file, the field and what is
 //! allowed, so every input error carries those three things; the CLI turns any error into a message and a
-//! non-zero exit, never a panic.
+//! non-zero exit, never a panic. The library never names a command-line flag: a message that names an argument
+//! of a call keeps it apart from its other words ([`Words`]), and the command line writes it as its flag.
 use std::fmt;
+use std::ops::{Deref, Range};
 
 #[derive(Debug)]
 pub enum Error {
@@ -13,12 +15,15 @@ pub enum Error {
         /// whole file is at fault (for sheets: `line N`).
         field: String,
         /// What is wrong and what is allowed.
-        message: String,
+        message: Words,
     },
     /// An operating-system error while reading or writing a file.
     Io { file: String, source: std::io::Error },
     /// A request that cannot be carried out (unknown geometry id, bad tolerance, ...).
     Usage(String),
+    /// An argument of a call that is missing or malformed (a sweep's `vary`, a fit's `target`, a comparison's
+    /// `tolerance`): a usage error whose message names the arguments ([`Words`]).
+    Argument(Words),
     /// A computation that did not produce a finite result.
     Numeric(String),
     /// A comparison with a sheet found readings outside their allowed difference (exit status 1).
@@ -35,22 +40,112 @@ pub fn given(x: f64) -> String {
     format!("`{x}`")
 }
 
+/// The words of a message that names arguments of a call (a sweep's `vary`, a fit's `target`, a comparison's
+/// `tolerance`) apart from its other words, so that each front end names them its own way and the library
+/// never writes a command-line flag (ripgrep's rule: the parser adds the flag to a flag's error). As text (it
+/// derefs to `str`, and [`Display`](fmt::Display) writes it) an argument is its name in backquotes,
+/// `` `vary` ``; [`Words::naming`] writes each one otherwise (the command line: as its flag, `--vary`).
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Words {
+    text: String,
+    /// The arguments named, and where their names (in backquotes) stand in `text`.
+    arguments: Vec<(Range<usize>, &'static str)>,
+}
+
+impl Words {
+    /// Words that begin with an argument.
+    pub fn argument(name: &'static str) -> Words {
+        Words::default().and_argument(name)
+    }
+
+    /// These words, then `text`.
+    pub fn and(mut self, text: impl AsRef<str>) -> Words {
+        self.text.push_str(text.as_ref());
+        self
+    }
+
+    /// These words, then an argument.
+    pub fn and_argument(mut self, name: &'static str) -> Words {
+        let start = self.text.len();
+        self.text.push_str(&format!("`{name}`"));
+        self.arguments.push((start..self.text.len(), name));
+        self
+    }
+
+    /// The words with each argument written by `name`.
+    pub fn naming(&self, name: &dyn Fn(&'static str) -> String) -> String {
+        let mut out = String::with_capacity(self.text.len());
+        let mut at = 0;
+        for (span, argument) in &self.arguments {
+            out.push_str(&self.text[at..span.start]);
+            out.push_str(&name(argument));
+            at = span.end;
+        }
+        out.push_str(&self.text[at..]);
+        out
+    }
+}
+
+impl Deref for Words {
+    type Target = str;
+    fn deref(&self) -> &str {
+        &self.text
+    }
+}
+
+impl fmt::Display for Words {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.text)
+    }
+}
+
+impl From<String> for Words {
+    fn from(text: String) -> Words {
+        Words { text, arguments: Vec::new() }
+    }
+}
+
+impl From<&str> for Words {
+    fn from(text: &str) -> Words {
+        Words::from(text.to_string())
+    }
+}
+
+impl From<&String> for Words {
+    fn from(text: &String) -> Words {
+        Words::from(text.clone())
+    }
+}
+
 impl Error {
-    pub fn input(file: impl Into<String>, field: impl Into<String>, message: impl Into<String>) -> Self {
+    pub fn input(file: impl Into<String>, field: impl Into<String>, message: impl Into<Words>) -> Self {
         Error::Input { file: file.into(), field: field.into(), message: message.into() }
+    }
+
+    /// An [`Error::Argument`] whose message begins with the argument `name`, followed directly by `rest` (which
+    /// begins with its own space or colon: `` `lhs` N must be at least 1 ``, `` `vary`: not a parameter ``).
+    pub fn argument(name: &'static str, rest: impl AsRef<str>) -> Self {
+        Error::Argument(Words::argument(name).and(rest))
+    }
+
+    /// The message with each argument it names written by `name` (see [`Words`]; the command line passes its
+    /// flags). The [`Display`](fmt::Display) of an error is the message in the library's words.
+    pub fn naming(&self, name: &dyn Fn(&'static str) -> String) -> String {
+        match self {
+            Error::Input { file, field, message } if field.is_empty() => format!("{file}: {}", message.naming(name)),
+            Error::Input { file, field, message } => format!("{file}: field `{field}`: {}", message.naming(name)),
+            Error::Io { file, source } => format!("{file}: {source}"),
+            Error::Usage(m) => m.clone(),
+            Error::Argument(words) => words.naming(name),
+            Error::Numeric(m) => format!("numerical failure: {m}"),
+            Error::Check(m) => format!("check failed: {m}"),
+        }
     }
 }
 
 impl fmt::Display for Error {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            Error::Input { file, field, message } if field.is_empty() => write!(f, "{file}: {message}"),
-            Error::Input { file, field, message } => write!(f, "{file}: field `{field}`: {message}"),
-            Error::Io { file, source } => write!(f, "{file}: {source}"),
-            Error::Usage(m) => write!(f, "{m}"),
-            Error::Numeric(m) => write!(f, "numerical failure: {m}"),
-            Error::Check(m) => write!(f, "check failed: {m}"),
-        }
+        f.write_str(&self.naming(&|name| format!("`{name}`")))
     }
 }
 
@@ -60,5 +155,23 @@ impl std::error::Error for Error {
             Error::Io { source, .. } => Some(source),
             _ => None,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn words_keep_the_arguments_apart_from_the_text() {
+        let w = Words::from("give at least one ").and_argument("vary").and(" PATH (or ").and_argument("lhs").and(" N)");
+        assert_eq!(&*w, "give at least one `vary` PATH (or `lhs` N)");
+        assert_eq!(w.naming(&|n| format!("--{n}")), "give at least one --vary PATH (or --lhs N)");
+        let e = Error::input("s.csv", "line 1", Words::from("pass ").and_argument("ignore_columns").and(" 'x'"));
+        assert_eq!(e.to_string(), "s.csv: field `line 1`: pass `ignore_columns` 'x'");
+        assert_eq!(e.naming(&|_| "-i".into()), "s.csv: field `line 1`: pass -i 'x'");
+        // A user's text in backquotes is not an argument.
+        let e = Error::argument("vary", " `lhs`: no `=`");
+        assert_eq!(e.naming(&|n| format!("--{n}")), "--vary `lhs`: no `=`");
     }
 }

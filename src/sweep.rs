@@ -20,6 +20,7 @@ use std::time::Instant;
 use rayon::prelude::*;
 use serde_json::{json, Value};
 
+use crate::error::Words;
 use crate::instrument::method::Target;
 use crate::instrument::plan::{Execution, Plan, PlanOptions, Planner, Reading};
 use crate::instrument::standards::StandardGeometry;
@@ -43,8 +44,9 @@ pub struct SweepAxis {
 
 /// `PATH=LO..HI:N` (grid) or `PATH=LO..HI` (Latin hypercube).
 pub fn parse_vary(s: &str) -> Result<SweepAxis> {
-    let bad =
-        |m: &str| Error::Usage(format!("--vary `{s}`: {m} (expected PATH=LO..HI:N, e.g. /coat/roughness=0.01..0.3:8)"));
+    let bad = |m: &str| {
+        Error::argument("vary", format!(" `{s}`: {m} (expected PATH=LO..HI:N, e.g. /coat/roughness=0.01..0.3:8)"))
+    };
     let (path, range) = s.rsplit_once('=').ok_or_else(|| bad("no `=`"))?;
     if !(path.is_empty() || path.starts_with('/')) {
         return Err(bad("the path must be a JSON Pointer starting with `/`"));
@@ -69,7 +71,7 @@ pub fn parse_vary(s: &str) -> Result<SweepAxis> {
 
 /// `K/M` with 1 ≤ K ≤ M.
 pub fn parse_shard(s: &str) -> Result<(u64, u64)> {
-    let bad = |m: &str| Error::Usage(format!("--shard `{s}`: {m} (expected K/M with 1 ≤ K ≤ M)"));
+    let bad = |m: &str| Error::argument("shard", format!(" `{s}`: {m} (expected K/M with 1 ≤ K ≤ M)"));
     let (k, m) = s.split_once('/').ok_or_else(|| bad("no `/`"))?;
     let (Ok(k), Ok(m)) = (k.trim().parse::<u64>(), m.trim().parse::<u64>()) else {
         return Err(bad("K and M must be whole numbers"));
@@ -147,7 +149,7 @@ impl Sweep {
         options: PlanOptions,
     ) -> Result<Sweep> {
         if axes.is_empty() {
-            return Err(Error::Usage("give at least one --vary PATH=LO..HI:N".into()));
+            return Err(Error::Argument(Words::from("give at least one ").and_argument("vary").and(" PATH=LO..HI:N")));
         }
         let model = match template.get("model") {
             Some(Value::String(m)) => m.clone(),
@@ -162,26 +164,38 @@ impl Sweep {
         for (i, a) in axes.iter().enumerate() {
             check_path(&template, file, &model, &a.path)?;
             if axes[..i].iter().any(|b| b.path == a.path) {
-                return Err(Error::Usage(format!("--vary {}: the path is varied twice", a.path)));
+                return Err(Error::argument("vary", format!(" {}: the path is varied twice", a.path)));
             }
             if a.log && !(a.lo > 0.0) {
-                return Err(Error::Usage(format!("--log {}: logarithmic spacing needs LO > 0, got {}", a.path, a.lo)));
+                return Err(Error::argument(
+                    "log",
+                    format!(" {}: logarithmic spacing needs LO > 0, got {}", a.path, a.lo),
+                ));
             }
             match (design, a.n) {
                 (SweepDesign::Grid, None) => {
-                    return Err(Error::Usage(format!("--vary {}: a grid needs :N (or use --lhs N)", a.path)))
+                    return Err(Error::Argument(
+                        Words::argument("vary")
+                            .and(format!(" {}: a grid needs :N (or use ", a.path))
+                            .and_argument("lhs")
+                            .and(" N)"),
+                    ))
                 }
                 (SweepDesign::Lhs { .. }, Some(_)) => {
-                    return Err(Error::Usage(format!(
-                        "--vary {}: with --lhs the number of points is --lhs N; drop :N",
-                        a.path
-                    )))
+                    return Err(Error::Argument(
+                        Words::argument("vary")
+                            .and(format!(" {}: with ", a.path))
+                            .and_argument("lhs")
+                            .and(" the number of points is ")
+                            .and_argument("lhs")
+                            .and(" N; drop :N"),
+                    ))
                 }
                 _ => {}
             }
         }
         if let SweepDesign::Lhs { n: 0, .. } = design {
-            return Err(Error::Usage("--lhs N must be at least 1".into()));
+            return Err(Error::argument("lhs", " N must be at least 1"));
         }
         let s = Sweep { template, file: file.to_string(), axes, design, geometries, options };
         s.checked_len()?;
@@ -441,18 +455,18 @@ fn check_path(template: &Value, file: &str, model: &str, path: &str) -> Result<(
         return Err(Error::input(
             file,
             path,
-            format!(
-                "--vary: not a parameter of a `{model}` recipe (its numeric parameters include {}; the full list is \
-                 in docs/recipe-format.md)",
+            Words::argument("vary").and(format!(
+                ": not a parameter of a `{model}` recipe (its numeric parameters include {}; the full list is in \
+                 docs/recipe-format.md)",
                 examples.join(", ")
-            ),
+            )),
         ));
     };
     if !param.ty.is_numeric() {
         return Err(Error::input(
             file,
             path,
-            format!("--vary: the parameter is {}, not a number", param.ty.describe()),
+            Words::argument("vary").and(format!(": the parameter is {}, not a number", param.ty.describe())),
         ));
     }
     let one_number_allowed = matches!(
@@ -468,7 +482,10 @@ fn check_path(template: &Value, file: &str, model: &str, path: &str) -> Result<(
         Some(_) => Err(Error::input(
             file,
             path,
-            format!("--vary needs one number: the parameter is {}; vary one element ({path}/0)", param.ty.describe()),
+            Words::argument("vary").and(format!(
+                " needs one number: the parameter is {}; vary one element ({path}/0)",
+                param.ty.describe()
+            )),
         )),
         None => {
             let (parent, _) = path.rsplit_once('/').expect("a registered pointer has a /");
@@ -477,8 +494,10 @@ fn check_path(template: &Value, file: &str, model: &str, path: &str) -> Result<(
                 _ => Err(Error::input(
                     file,
                     path,
-                    "--vary: the template has no value here and no object to add it to (give the parameter in the \
-                     template)",
+                    Words::argument("vary").and(
+                        ": the template has no value here and no object to add it to (give the parameter in the \
+                         template)",
+                    ),
                 )),
             }
         }

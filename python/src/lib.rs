@@ -23,12 +23,13 @@ mod probe;
 mod pybrdf;
 
 /// A library error as the Python exception a caller expects, with the message the CLI prints after
-/// "error: ". Bad input and bad requests are `ValueError`; files that cannot be read are `OSError`
-/// (`FileNotFoundError` when missing); a computation without a finite result is `RuntimeError`.
+/// "error: " (an argument it names in the library's words, `` `vary` ``, where the CLI writes `--vary`). Bad
+/// input and bad requests are `ValueError`; files that cannot be read are `OSError` (`FileNotFoundError` when
+/// missing); a computation without a finite result is `RuntimeError`.
 pub(crate) fn to_py_err(e: Error) -> PyErr {
     let msg = e.to_string();
     match &e {
-        Error::Input { .. } | Error::Usage(_) => PyValueError::new_err(msg),
+        Error::Input { .. } | Error::Usage(_) | Error::Argument(_) => PyValueError::new_err(msg),
         Error::Io { source, .. } if source.kind() == std::io::ErrorKind::NotFound => PyFileNotFoundError::new_err(msg),
         Error::Io { .. } => PyOSError::new_err(msg),
         Error::Numeric(_) | Error::Check(_) => PyRuntimeError::new_err(msg),

@@ -1,8 +1,10 @@
 //! What the subcommands share: the `--format` and colour arguments ([`Format`], [`ColourArgs`]), the check of
-//! `--rtol`, the verdict on a set of readings (the exit status), and the text table's padding.
+//! `--rtol`, the flags of the arguments library errors name ([`flag`]), the verdict on a set of readings (the
+//! exit status), and the text table's padding.
 use clap::ValueEnum;
 
 use crate::colorimetry::{Conditions, Illuminant, Observer};
+use crate::instrument::plan::rtol_refusal;
 use crate::{Error, Result};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -54,13 +56,26 @@ pub fn readings_status(readings: &[crate::Reading], allow_unconverged: bool) -> 
 
 pub use crate::instrument::plan::NEUTRAL_HUE;
 
-/// `--rtol` in (0, 1), checked before any work.
+/// `--rtol` in (0, 1), checked before any work (the planner's check, `plan::rtol_refusal`, with the flag's name).
 pub fn check_rtol(rtol: f64) -> Result<()> {
-    if !(rtol.is_finite() && rtol > 0.0 && rtol < 1.0) {
-        return Err(Error::Usage(format!("--rtol must be a number in (0, 1), got {}", crate::error::given(rtol))));
+    match rtol_refusal(rtol) {
+        Some(why) => Err(Error::Usage(format!("--rtol {why}"))),
+        None => Ok(()),
     }
-    Ok(())
 }
+
+/// The flag of an argument that a library error names ([`crate::error::Words`]): the library says `tolerance`,
+/// the command line `--tolerance` (the library never names a flag; the parser adds it, as ripgrep's does).
+pub fn flag(argument: &'static str) -> String {
+    match argument {
+        "k" => "-k".into(),
+        "ignore_columns" => "--ignore-column".into(),
+        "per_sample" => "--recipe".into(),
+        // free, lhs, log, sample, shard, sheet, target, tolerance, vary: the flag is the name.
+        name => format!("--{}", name.replace('_', "-")),
+    }
+}
+
 /// A text table: a header row, a rule, then the rows; columns listed in `right` are right-aligned. Padding
 /// is done by hand (a `format!` width is limited to 65 535).
 pub fn pad_table(rows: &[Vec<String>], right: &[usize]) -> String {
@@ -88,4 +103,20 @@ pub fn pad_table(rows: &[Vec<String>], right: &[usize]) -> String {
         }
     }
     s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::error::Words;
+
+    #[test]
+    fn the_arguments_library_errors_name_are_written_as_flags() {
+        let words = ["ignore_columns", "k", "per_sample", "tolerance"]
+            .iter()
+            .fold(Words::default(), |w, a| w.and(" ").and_argument(a));
+        let e = Error::Argument(words);
+        assert_eq!(e.naming(&flag), " --ignore-column -k --recipe --tolerance");
+        assert_eq!(e.to_string(), " `ignore_columns` `k` `per_sample` `tolerance`");
+    }
 }

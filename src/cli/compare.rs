@@ -5,15 +5,13 @@
 //! gets its CIEDE2000 ΔE00 (`comparison::colour_differences`; `--max-de00` makes it the check).
 use std::path::PathBuf;
 
-use serde_json::json;
-
 use crate::cli::common::{check_rtol, pad_table, readings_status, ColourArgs};
 use crate::cli::junit;
 use crate::cli::output::OutputTarget;
 use crate::comparison::sheet::{self, Sheet, SheetOptions};
 use crate::comparison::{self, ColourDifference, Comparison, Drift, Recipes, Verdict, VerdictRule};
 use crate::instrument::plan::PlanOptions;
-use crate::report::plain;
+use crate::report;
 use crate::{Error, Result};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -142,8 +140,10 @@ pub fn run(a: CompareArgs) -> Result<()> {
     };
     let text = match a.format {
         CompareFormat::Table => table(&sheet, &cmp, &rule, &drift, baseline.is_some()) + &de_table(&des),
-        CompareFormat::Json => json_text(&sheet, &cmp, &rule, &drift, a.baseline.as_ref(), &des),
-        CompareFormat::Csv => csv_text(&cmp)?,
+        CompareFormat::Json => {
+            report::pretty(&report::compare::json_doc(&sheet, &cmp, &rule, &drift, a.baseline.as_deref(), &des))
+        }
+        CompareFormat::Csv => report::compare::csv(&cmp)?,
         CompareFormat::Junit => junit::compare(&sheet, &cmp, &drift)?,
     };
     target.write(&text)?;
@@ -269,35 +269,6 @@ fn table(sheet: &Sheet, cmp: &[Comparison], rule: &VerdictRule, drift: &[Drift],
     s
 }
 
-pub fn comparison_json(c: &Comparison) -> serde_json::Value {
-    let p = c.predicted.as_ref();
-    let s = c.group.stats;
-    json!({
-        "sample": c.group.sample, "material": c.material, "recipe": c.recipe,
-        "geometry": c.group.geometry, "reading": c.group.reading,
-        "predicted_reading": p.map(|p| p.name.clone()),
-        "lines": c.group.lines, "columns": c.group.columns,
-        "values": c.group.values,
-        "n": s.n, "mean": s.mean, "std": s.std, "min": s.min, "max": s.max,
-        "uncertainty": c.group.uncertainty,
-        "predicted": p.and_then(|p| p.value),
-        "error_estimate": p.filter(|p| p.value.is_some()).map(|p| p.error_estimate),
-        "difference": c.difference(),
-        "allowance": c.allowance.map(|a| json!({
-            "statistical": a.statistical, "stated": a.stated, "prediction": a.prediction, "total": a.total()
-        })),
-        "verdict": c.verdict.label(),
-        "inside": match c.verdict { Verdict::Inside => Some(true), Verdict::Outside => Some(false), _ => None },
-        "reason": match &c.verdict { Verdict::NotPredicted(w) | Verdict::NoValue(w) => Some(w.clone()), _ => None },
-        "unchecked": c.verdict.why_unchecked(),
-    })
-}
-
-pub fn drift_json(d: &Drift) -> serde_json::Value {
-    json!({"material": d.material, "geometry": d.geometry, "reading": d.reading,
-           "now": d.now, "then": d.then, "allowed": d.allowed, "moved": d.moved})
-}
-
 fn de_table(des: &[ColourDifference]) -> String {
     if des.is_empty() {
         return String::new();
@@ -324,100 +295,4 @@ fn de_table(des: &[ColourDifference]) -> String {
         ));
     }
     s
-}
-
-fn json_text(
-    sheet: &Sheet,
-    cmp: &[Comparison],
-    rule: &VerdictRule,
-    drift: &[Drift],
-    baseline: Option<&PathBuf>,
-    des: &[ColourDifference],
-) -> String {
-    let mut doc = json!({
-        "sheet": {
-            "file": sheet.file, "encoding": sheet.encoding, "delimiter": (sheet.delimiter as char).to_string(),
-            "layout": match sheet.layout {
-                sheet::Layout::Long => "long",
-                sheet::Layout::Wide => "wide",
-                sheet::Layout::Colour => "colour",
-            },
-            "metadata": sheet.metadata_json(), "ignored_columns": sheet.ignored_columns,
-        },
-        "rule": {"k": rule.k, "tolerance": rule.tolerance},
-        "comparisons": cmp.iter().map(comparison_json).collect::<Vec<_>>(),
-        "summary": {
-            "readings": cmp.len(),
-            "inside": cmp.iter().filter(|c| c.verdict == Verdict::Inside).count(),
-            "outside": cmp.iter().filter(|c| c.verdict == Verdict::Outside).count(),
-            "no_value": cmp.iter().filter(|c| matches!(c.verdict, Verdict::NoValue(_))).count(),
-            "no_allowance": cmp.iter().filter(|c| c.verdict == Verdict::NoAllowance).count(),
-            "not_predicted": cmp.iter().filter(|c| matches!(c.verdict, Verdict::NotPredicted(_))).count(),
-        },
-    });
-    doc["colour_differences"] = des
-        .iter()
-        .map(|d| {
-            json!({
-                "sample": d.sample, "geometry": d.geometry, "line": d.line,
-                "measured": [d.measured.l, d.measured.a, d.measured.b],
-                "predicted": [d.predicted.l, d.predicted.a, d.predicted.b],
-                "de00": d.de00, "inside": d.inside,
-            })
-        })
-        .collect::<Vec<_>>()
-        .into();
-    if let Some(b) = baseline {
-        doc["baseline"] = json!({"file": b.display().to_string(), "checks": drift.iter().map(drift_json).collect::<Vec<_>>(),
-                                 "moved": drift.iter().filter(|d| d.moved).count()});
-    }
-    serde_json::to_string_pretty(&doc).expect("finite") + "\n"
-}
-
-fn csv_text(cmp: &[Comparison]) -> Result<String> {
-    let head = [
-        "line",
-        "sample",
-        "material",
-        "geometry",
-        "reading",
-        "n",
-        "mean",
-        "std",
-        "min",
-        "max",
-        "predicted",
-        "error_estimate",
-        "difference",
-        "allowance",
-        "verdict",
-        "note",
-    ];
-    let e = |v: Option<f64>| v.map(plain).unwrap_or_default();
-    let rows = cmp.iter().map(|c| {
-        let p = c.predicted.as_ref();
-        let s = c.group.stats;
-        [
-            c.group.lines[0].to_string(),
-            c.group.sample.clone(),
-            c.material.clone(),
-            c.group.geometry.clone(),
-            c.group.reading.clone(),
-            s.n.to_string(),
-            e(Some(s.mean)),
-            e(Some(s.std)),
-            e(Some(s.min)),
-            e(Some(s.max)),
-            e(p.and_then(|p| p.value)),
-            e(p.filter(|p| p.value.is_some()).map(|p| p.error_estimate)),
-            e(c.difference()),
-            e(c.allowance.map(|a| a.total())),
-            c.verdict.label().to_string(),
-            match &c.verdict {
-                Verdict::NotPredicted(why) => format!("not predicted: {why}"),
-                v => v.why_unchecked().map(|w| format!("not checked: {w}")).unwrap_or_default(),
-            },
-        ]
-    });
-    crate::report::csv_text(&head, rows)
 }

@@ -1,8 +1,7 @@
-//! `glossmeter fit`: recipe parameters from readings (the inverse problem). Argument parsing and output
-//! only; the fit itself is `glossmeter::fit` (docs/inverse.md).
+//! `glossmeter fit`: recipe parameters from readings (the inverse problem). Argument parsing, the table for
+//! people and the output only; the fit itself is `glossmeter::fit` (docs/inverse.md), its JSON document
+//! `report::fit`.
 use std::path::PathBuf;
-
-use serde_json::{json, Value};
 
 use crate::cli::common::{check_rtol, Format};
 use crate::cli::compare::parse_delimiter;
@@ -86,7 +85,7 @@ pub fn run(a: FitArgs) -> Result<()> {
     let report = fit::fit(&material.json, &material.file, &free, &targets, &options)?;
     let text = match a.format {
         Format::Json => {
-            serde_json::to_string_pretty(&json_report(&report, !a.no_timing))
+            serde_json::to_string_pretty(&crate::report::fit::json(&report, !a.no_timing))
                 .map_err(|e| Error::Numeric(format!("the report does not serialise: {e}")))?
                 + "\n"
         }
@@ -112,36 +111,6 @@ pub fn run(a: FitArgs) -> Result<()> {
         return Err(Error::Check(format!("the fit is not to be trusted: {}", why.join("; "))));
     }
     Ok(())
-}
-
-fn num(x: f64) -> Value {
-    if x.is_finite() {
-        json!(x)
-    } else {
-        Value::Null
-    }
-}
-
-/// The JSON contract of issue 11 (docs/inverse.md §Output), and `verdict`: the same words as the table's.
-pub fn json_report(r: &FitReport, timing: bool) -> Value {
-    json!({
-        "parameters": r.parameters.iter().map(|p| json!({
-            "path": p.pointer, "value": num(p.value), "std_error": p.std_error.map(num), "lower": p.lower,
-            "upper": p.upper, "at_bound": p.at_bound,
-        })).collect::<Vec<_>>(),
-        "targets": r.targets.iter().map(|t| json!({
-            "geometry": t.target.geometry, "name": t.target.name, "measured": t.target.value,
-            "uncertainty": t.uncertainty, "predicted": num(t.predicted), "residual": num(t.residual),
-        })).collect::<Vec<_>>(),
-        "converged": r.converged,
-        "identifiable": r.identifiable,
-        "singular_values": r.singular_values.iter().map(|s| num(*s)).collect::<Vec<_>>(),
-        "correlation": r.correlation.iter().map(|row| row.iter().map(|c| c.map(num)).collect::<Vec<_>>()).collect::<Vec<_>>(),
-        "verdict": r.verdict,
-        "evaluations": r.evaluations,
-        "seconds": if timing { num(r.seconds) } else { Value::Null },
-        "recipe": r.recipe,
-    })
 }
 
 fn sig(x: f64) -> String {

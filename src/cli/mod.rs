@@ -60,7 +60,8 @@ where
         // ripgrep does. Only standard output is treated so; a file that cannot be written is an error.
         Err(Error::Io { file, source }) if file == STDOUT && source.kind() == std::io::ErrorKind::BrokenPipe => 0,
         Err(e) => {
-            let _ = writeln!(std::io::stderr(), "error: {e}");
+            // The library names arguments in its own words; the command line writes them as its flags.
+            let _ = writeln!(std::io::stderr(), "error: {}", e.naming(&common::flag));
             exit_status(&e)
         }
     }
@@ -70,7 +71,7 @@ where
 /// files and usage; 1 for a result that is not one (no finite value, not converged, a failed check).
 pub fn exit_status(e: &Error) -> i32 {
     match e {
-        Error::Input { .. } | Error::Usage(_) | Error::Io { .. } => 2,
+        Error::Input { .. } | Error::Usage(_) | Error::Argument(_) | Error::Io { .. } => 2,
         Error::Numeric(_) | Error::Check(_) => 1,
     }
 }
@@ -155,15 +156,15 @@ fn dispatch(cli: Cli) -> Result<()> {
                     format::table(&material, &readings, !no_timing) + &format::envelope_table(&readings, e)
                 }
                 (Format::Json, e) => {
-                    let mut doc = report::json_doc(&material, &readings, !no_timing);
+                    let mut doc = report::measure::json_doc(&material, &readings, !no_timing);
                     doc["evaluations"] = serde_json::json!(evaluations);
-                    let doc = with_baseline(doc, drift.as_deref(), baseline_file.clone());
+                    let doc = report::measure::with_baseline(doc, drift.as_deref(), baseline_file.clone());
                     report::pretty(&match e {
                         None => doc,
-                        Some(e) => report::json_with_envelope(doc, e),
+                        Some(e) => report::measure::json_with_envelope(doc, e),
                     })
                 }
-                (Format::Csv, _) => report::csv(&readings, !no_timing)?,
+                (Format::Csv, _) => report::measure::csv(&readings, !no_timing)?,
             });
             if let (Format::Table, Some(d)) = (format, &drift) {
                 text.push_str(&batch::drift_text(d));
@@ -198,22 +199,6 @@ fn dispatch(cli: Cli) -> Result<()> {
             print(&(text + "\n"))
         }
     }
-}
-
-/// Add the baseline checks to a JSON document (when a baseline was given).
-fn with_baseline(
-    mut doc: serde_json::Value,
-    drift: Option<&[crate::comparison::Drift]>,
-    file: Option<String>,
-) -> serde_json::Value {
-    if let (Some(d), Some(file)) = (drift, file) {
-        doc["baseline"] = serde_json::json!({
-            "file": file,
-            "checks": d.iter().map(compare::drift_json).collect::<Vec<_>>(),
-            "moved": d.iter().filter(|x| x.moved).count(),
-        });
-    }
-    doc
 }
 
 /// Exit status 1 when a baseline reading moved.
@@ -264,12 +249,15 @@ fn measure_batch(
             }
             t
         }
-        Format::Json => report::pretty(&with_baseline(
-            batch::with_evaluations(batch::json_doc(&materials, &readings, how.timing), &evaluations),
+        Format::Json => report::pretty(&report::measure::with_baseline(
+            report::measure::with_evaluations(
+                report::measure::batch_json_doc(&materials, &readings, how.timing),
+                &evaluations,
+            ),
             drift.as_deref(),
             how.baseline.as_ref().map(|(_, f)| f.clone()),
         )),
-        Format::Csv => batch::csv(&materials, &readings, how.timing)?,
+        Format::Csv => report::measure::batch_csv(&materials, &readings, how.timing)?,
     };
     target.write(&text)?;
     check_drift(drift.as_deref())?;

@@ -33,6 +33,7 @@ use std::path::{Path, PathBuf};
 use rayon::prelude::*;
 
 use self::sheet::{Layout, Sheet, SheetOptions, SheetRow};
+use crate::error::Words;
 use crate::instrument::plan::{Plan, PlanOptions, Reading};
 use crate::instrument::standards::{self, StandardGeometry};
 use crate::recipe::{self, Material};
@@ -140,14 +141,17 @@ impl Default for VerdictRule {
 impl VerdictRule {
     pub fn check(&self) -> Result<()> {
         if !(self.k.is_finite() && self.k >= 0.0) {
-            return Err(Error::Usage(format!("-k must be a finite number ≥ 0, got {}", crate::error::given(self.k))));
+            return Err(Error::argument(
+                "k",
+                format!(" must be a finite number ≥ 0, got {}", crate::error::given(self.k)),
+            ));
         }
         if let Some(t) = self.tolerance {
             if !(t.is_finite() && t >= 0.0) {
-                return Err(Error::Usage(format!(
-                    "--tolerance must be a finite number ≥ 0, got {}",
-                    crate::error::given(t)
-                )));
+                return Err(Error::argument(
+                    "tolerance",
+                    format!(" must be a finite number ≥ 0, got {}", crate::error::given(t)),
+                ));
             }
         }
         Ok(())
@@ -349,7 +353,9 @@ pub fn compare_sheet(
             return Err(Error::input(
                 &sheet.file,
                 sheet.cell(row.line, sheet.sample_column, "sample"),
-                format!("sample `{}` has no recipe ({where_}; give one with --recipe '{}=FILE')", g.sample, g.sample),
+                Words::from(format!("sample `{}` has no recipe ({where_}; give one with ", g.sample))
+                    .and_argument("per_sample")
+                    .and(format!(" '{}=FILE')", g.sample)),
             ));
         };
         samples.push((g.sample.clone(), p));

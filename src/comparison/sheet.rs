@@ -20,6 +20,7 @@
 //! is silently dropped. Every error names the file, the line and the column.
 use std::path::Path;
 
+use crate::error::Words;
 use crate::{Error, Result};
 
 /// A reading column an instrument writes, and the glossmeter reading it stands for. `not_predicted` is set for
@@ -509,10 +510,12 @@ pub fn parse(text: &str, file: &str, options: &SheetOptions) -> Result<Sheet> {
                 return Err(Error::input(
                     file,
                     at(hline, j, h),
-                    format!(
+                    Words::from(format!(
                         "unrecognised column `{h}` (the columns glossmeter reads are listed in docs/instrument.md \
-                         §Sheets; pass --ignore-column '{h}' to skip it)"
-                    ),
+                         §Sheets; pass "
+                    ))
+                    .and_argument("ignore_columns")
+                    .and(format!(" '{h}' to skip it)")),
                 ))
             }
         }
@@ -877,7 +880,7 @@ mod tests {
         let e = p("geometry,value,uncertainty\nastm-d523-60,1,-2\n").unwrap_err().to_string();
         assert!(e.contains("uncertainty") && e.contains("≥ 0"), "{e}");
         let e = p("foo,bar\n1,2\n").unwrap_err().to_string();
-        assert!(e.contains("line 1, column 1 (foo)") && e.contains("--ignore-column"), "{e}");
+        assert!(e.contains("line 1, column 1 (foo)") && e.contains("`ignore_columns`"), "{e}");
         let e = p("geometry,value\nastm-d523-60,1,3\n").unwrap_err().to_string();
         assert!(e.contains("line 2, column 3") && e.contains("3 fields"), "{e}");
         let e = p("sample,20°,G20\np,1,2\n").unwrap_err().to_string();

@@ -36,7 +36,7 @@ impl<'a> Obj<'a> {
     }
 
     pub fn err(&self, key: &str, message: impl Into<String>) -> Error {
-        Error::input(self.file, self.field(key), message)
+        Error::input(self.file, self.field(key), message.into())
     }
 
     /// Refuse any key not in `allowed` (typos must not be silently ignored).

@@ -2,18 +2,26 @@
 //! written by the library so that every program (the command line, the Python bindings) gets the same fields.
 //! The JSON form is a contract for scripts and CI (docs/instrument.md §Output), and its schemas are beside the
 //! writers. A reading without a finite value is null in JSON and empty in CSV, with the reason: never NaN or
-//! inf. The text tables for people are the command line's (`cli::format`).
+//! inf. The text tables for people and the JUnit XML are the command line's (`cli::format`, `cli::junit`); the
+//! command line chooses a document, prints it and writes it.
 //!
-//! The folder:
-//! * `mod.rs`: the numbers ([`decimals`], [`plain`]), one reading and one material's readings as JSON
-//!   ([`reading_json`], [`json_doc`], [`json()`], [`pretty`], [`json_with_envelope`]), a sweep's reading
-//!   ([`sweep_reading_json`]), and CSV ([`csv()`], [`csv_text`]);
+//! The folder, a file per family of documents:
+//! * `mod.rs`: what the documents share: the numbers ([`decimals`], [`plain`]), one reading as JSON
+//!   ([`reading_json`]) and as a sweep writes it ([`sweep_reading_json`]; the sweep's lines are
+//!   `crate::sweep`'s), one baseline check ([`drift_json`]), JSON printed ([`pretty`]) and CSV text
+//!   ([`csv_text`]);
+//! * [`measure`]: one recipe's readings as JSON and CSV, with the envelope, the baseline and, for many
+//!   recipes, each reading's material;
+//! * [`compare`]: the predictions beside a sheet, as JSON and CSV;
+//! * [`fit`]: the fit's report as JSON;
 //! * [`schema`]: the JSON Schemas of the outputs.
+pub mod compare;
+pub mod fit;
+pub mod measure;
 pub mod schema;
 
-use crate::instrument::envelope::Envelope;
+use crate::comparison::Drift;
 use crate::instrument::plan::Reading;
-use crate::recipe::Material;
 use crate::{Error, Result};
 use serde_json::json;
 
@@ -57,13 +65,10 @@ pub fn reading_json(r: &Reading, timing: bool) -> serde_json::Value {
     o
 }
 
-/// The JSON document of one material's readings (built as a value, never re-parsed: serde_json's default
-/// float parser is not exact to the last bit).
-pub fn json_doc(material: &Material, readings: &[Reading], timing: bool) -> serde_json::Value {
-    json!({
-        "material": {"name": material.name, "file": material.file, "model": material.brdf.describe()},
-        "readings": readings.iter().map(|r| reading_json(r, timing)).collect::<Vec<_>>(),
-    })
+/// One baseline check (a reading then and now, and whether it moved), as `measure` and `compare` list them.
+pub fn drift_json(d: &Drift) -> serde_json::Value {
+    json!({"material": d.material, "geometry": d.geometry, "reading": d.reading,
+           "now": d.now, "then": d.then, "allowed": d.allowed, "moved": d.moved})
 }
 
 /// A JSON value as the CLI prints it: pretty, with a final newline.
@@ -71,31 +76,6 @@ pub fn pretty(doc: &serde_json::Value) -> String {
     let mut s = serde_json::to_string_pretty(doc).expect("finite values serialise");
     s.push('\n');
     s
-}
-
-pub fn json(material: &Material, readings: &[Reading], timing: bool) -> String {
-    pretty(&json_doc(material, readings, timing))
-}
-
-/// Add `"envelope_min"`, `"envelope_max"` and the variations to each reading of a `json` document (null where
-/// the standard data give no tolerance), and the envelope's method at the top.
-pub fn json_with_envelope(mut doc: serde_json::Value, envelopes: &[Option<Envelope>]) -> serde_json::Value {
-    if let Some(rs) = doc["readings"].as_array_mut() {
-        for (r, e) in rs.iter_mut().zip(envelopes) {
-            r["envelope_min"] = json!(e.as_ref().map(|e| e.min));
-            r["envelope_max"] = json!(e.as_ref().map(|e| e.max));
-            if let Some(e) = e {
-                r["envelope"] = json!({
-                    "variants": e.variants,
-                    "method": if e.corners { "all corners" } else { "one number at a time" },
-                    "varied": e.variations.iter().map(|v| json!({
-                        "pointer": v.pointer, "kind": v.kind, "nominal": v.nominal, "low": v.low, "high": v.high, "status": v.status
-                    })).collect::<Vec<_>>(),
-                });
-            }
-        }
-    }
-    doc
 }
 
 /// The fields [`sweep_reading_json`] keeps.
@@ -109,35 +89,6 @@ pub fn sweep_reading_json(r: &Reading) -> serde_json::Value {
         fields.retain(|k, _| SWEEP_READING_FIELDS.contains(&k.as_str()));
     }
     o
-}
-
-/// The CSV of `measure`: a header, then one record per reading (the fields of [`reading_json`]).
-pub fn csv(readings: &[Reading], timing: bool) -> Result<String> {
-    let mut head = vec!["geometry", "name", "quantity", "value", "unit", "error_estimate", "evaluations", "converged"];
-    if timing {
-        head.push("seconds");
-    }
-    head.push("problem");
-    head.push("note");
-    let rows = readings.iter().map(|r| {
-        let mut rec = vec![
-            r.geometry.clone(),
-            r.name.clone(),
-            r.quantity.clone(),
-            r.value.map(plain).unwrap_or_default(),
-            r.unit.clone(),
-            r.value.map(|_| plain(r.error_estimate)).unwrap_or_default(),
-            r.evaluations.to_string(),
-            r.converged.to_string(),
-        ];
-        if timing {
-            rec.push(plain(r.seconds));
-        }
-        rec.push(r.problem.clone().unwrap_or_default());
-        rec.push(r.note.clone().unwrap_or_default());
-        rec
-    });
-    csv_text(&head, rows)
 }
 
 /// CSV text in memory: the header, then one record per row (quoted where the csv crate must). Every CSV that

@@ -178,7 +178,7 @@ pub fn sweep() -> Value {
     })
 }
 
-/// `fit --format json` (docs/inverse.md §Output): the contract of issue 11, and `verdict` (the table's words).
+/// `fit --format json`: the contract of docs/inverse.md §Output, and `verdict` (the table's words).
 pub fn fit() -> Value {
     let num = json!({"type": "number"});
     let stderr = json!({"type": ["number", "null"], "minimum": 0,

@@ -21,6 +21,13 @@ use crate::{Error, Result};
 
 use super::{shape, Job, Plan, PlanOptions, PlannedReading, MIN_RTOL, SPECIMEN_SHARE, STANDARD_SHARE};
 
+/// Why `rtol` is not a relative tolerance (a number in (0, 1)), if it is not: the words after its name, which
+/// [`Planner::compile`] calls "the relative tolerance (rtol)" and the command line `--rtol`.
+pub fn rtol_refusal(rtol: f64) -> Option<String> {
+    (!(rtol.is_finite() && rtol > 0.0 && rtol < 1.0))
+        .then(|| format!("must be a number in (0, 1), got {}", crate::error::given(rtol)))
+}
+
 /// The identity of a job for sharing: every input of its design, as bits.
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
 struct JobKey(Vec<u64>);
@@ -112,11 +119,8 @@ impl Planner {
         geometries: Vec<StandardGeometry>,
         options: PlanOptions,
     ) -> Result<Plan> {
-        if !(options.rtol.is_finite() && options.rtol > 0.0 && options.rtol < 1.0) {
-            return Err(Error::Usage(format!(
-                "the relative tolerance (rtol) must be a number in (0, 1), got {}",
-                crate::error::given(options.rtol)
-            )));
+        if let Some(why) = rtol_refusal(options.rtol) {
+            return Err(Error::Usage(format!("the relative tolerance (rtol) {why}")));
         }
         if options.rtol < MIN_RTOL {
             return Err(Error::Usage(format!(

@@ -53,7 +53,7 @@ mod compile;
 mod explain;
 mod readings;
 
-pub use compile::Planner;
+pub use compile::{rtol_refusal, Planner};
 pub use readings::{
     colour_value, colour_xyz, haze_index_value, neutral_chroma, reading_value, NEUTRAL_CHROMA_FLOOR, NEUTRAL_HUE,
 };

@@ -21,208 +21,41 @@
 //!   its parameter's bound width, and a verdict in plain words on what the targets cannot determine.
 //!
 //! The formulas and the worked example are in `docs/inverse.md`.
+//!
+//! The folder:
+//! * `mod.rs`: the options ([`FitOptions`]), the result ([`FitReport`], [`FittedParameter`],
+//!   [`FittedTarget`]), the deterministic restarts ([`restart_fractions`]) and [`fit`] itself: the checks, the
+//!   solver run, the error analysis and its checks, the restarts and the verdict;
+//! * `params.rs`: what is fitted to what: [`FreeParameter`], [`TargetReading`], [`targets_from_sheet`], and
+//!   the check of the free parameters against the recipe and the registry;
+//! * `problem.rs`: the forward model (recipe values → predictions, on adaptive or frozen methods) and the
+//!   least-squares problem the solver sees, with its Jacobian.
+mod params;
+mod problem;
+
+pub use params::{targets_from_sheet, FreeParameter, TargetReading};
+
 use std::collections::HashMap;
-use std::sync::Arc;
 use std::time::Instant;
 
 use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt, TerminationReason};
-use nalgebra::{DMatrix, DVector, Dyn, Owned};
+use nalgebra::{DMatrix, DVector};
 use serde_json::Value;
 
-use crate::brdf::Brdf;
-use crate::instrument::plan::{Plan, PlanOptions, Planner, Reading};
+use crate::error::Words;
+use crate::instrument::plan::{PlanOptions, Planner};
 use crate::instrument::standards::StandardGeometry;
-use crate::registry;
 use crate::{recipe, Error, Result};
+use params::check_free;
+use problem::{describe_point, Forward, Mode, Problem};
 
 /// Uncertainty of a target given without one, in the reading's unit: the 0.2 GU repeatability that
-/// `docs/inverse.md` assumes for a glossmeter (issue 11's example), used for haze and DOI units alike.
+/// `docs/inverse.md` assumes for a glossmeter (its opening list, "Weights"), used for haze and DOI units alike.
 pub const DEFAULT_UNCERTAINTY: f64 = 0.2;
 
 /// The largest Gauss–Newton step, in standard uncertainties of the targets, that may remain at a fit called
 /// converged (an independent check of the solver's own stopping rule; see [`fit`]).
 pub const STEP_TOLERANCE: f64 = 0.01;
-
-/// A free parameter: a JSON Pointer into the recipe, bounds, and whether its logarithm is fitted.
-#[derive(Clone, Debug, PartialEq)]
-pub struct FreeParameter {
-    pub pointer: String,
-    pub lower: f64,
-    pub upper: f64,
-    pub log: bool,
-}
-
-impl FreeParameter {
-    /// Parse `PATH=LO..HI` or `PATH=log:LO..HI` (the `--free` argument).
-    pub fn parse(arg: &str) -> Result<FreeParameter> {
-        let bad = |m: String| Error::Usage(format!("--free {arg}: {m}"));
-        let (pointer, bounds) = arg
-            .split_once('=')
-            .ok_or_else(|| bad("expected PATH=LO..HI (or PATH=log:LO..HI), e.g. /roughness=log:1e-3..0.5".into()))?;
-        if !pointer.starts_with('/') {
-            return Err(bad(format!("{pointer:?} is not a JSON Pointer (RFC 6901); it starts with '/'")));
-        }
-        let (log, range) = match bounds.strip_prefix("log:") {
-            Some(r) => (true, r),
-            None => (false, bounds),
-        };
-        let (lo, hi) = range.split_once("..").ok_or_else(|| bad(format!("bounds {bounds:?} are not LO..HI")))?;
-        let num = |s: &str, what: &str| -> Result<f64> {
-            s.trim()
-                .parse::<f64>()
-                .ok()
-                .filter(|x| x.is_finite())
-                .ok_or_else(|| bad(format!("{what} bound {s:?} is not a finite number")))
-        };
-        let (lower, upper) = (num(lo, "lower")?, num(hi, "upper")?);
-        if lower >= upper {
-            return Err(bad(format!("the lower bound {lower} must be below the upper bound {upper} (LO < HI)")));
-        }
-        if log && lower <= 0.0 {
-            return Err(bad(format!("log: bounds must be positive, got {lower}..{upper}")));
-        }
-        Ok(FreeParameter { pointer: pointer.to_string(), lower, upper, log })
-    }
-
-    /// The fitted variable t of a value x (x or ln x).
-    fn t_of_x(&self, x: f64) -> f64 {
-        if self.log {
-            x.ln()
-        } else {
-            x
-        }
-    }
-
-    fn x_of(&self, t: f64) -> f64 {
-        if self.log {
-            t.exp()
-        } else {
-            t
-        }
-    }
-
-    /// Bounds in t.
-    fn t_bounds(&self) -> (f64, f64) {
-        (self.t_of_x(self.lower), self.t_of_x(self.upper))
-    }
-}
-
-/// A target: a reading of a geometry with its measured value and (optional) uncertainty.
-#[derive(Clone, Debug, PartialEq)]
-pub struct TargetReading {
-    pub geometry: String,
-    /// A reading name (`gloss`, `haze-narrow`, `doi`, …) or quantity, as `compare` matches them.
-    pub name: String,
-    pub value: f64,
-    pub uncertainty: Option<f64>,
-}
-
-impl TargetReading {
-    /// Parse `GEOMETRY/READING=VALUE`, `…=VALUE±U` or `…=VALUE+-U` (the `--target` argument).
-    pub fn parse(arg: &str) -> Result<TargetReading> {
-        let bad = |m: String| Error::Usage(format!("--target {arg}: {m}"));
-        let (left, right) = arg
-            .split_once('=')
-            .ok_or_else(|| bad("expected GEOMETRY/READING=VALUE[±U], e.g. astm-d523-60/gloss=85±0.5".into()))?;
-        let (geometry, name) = left
-            .split_once('/')
-            .ok_or_else(|| bad(format!("{left:?} is not GEOMETRY/READING (e.g. astm-d523-20/gloss)")))?;
-        if geometry.is_empty() || name.is_empty() {
-            return Err(bad("the geometry and the reading must both be given".into()));
-        }
-        let (v, u) = match right.split_once('±').or_else(|| right.split_once("+-")) {
-            Some((v, u)) => (v, Some(u)),
-            None => (right, None),
-        };
-        let value = v
-            .trim()
-            .parse::<f64>()
-            .ok()
-            .filter(|x| x.is_finite())
-            .ok_or_else(|| bad(format!("value {v:?} is not a finite number")))?;
-        let uncertainty = match u {
-            None => None,
-            Some(u) => Some(
-                u.trim()
-                    .parse::<f64>()
-                    .ok()
-                    .filter(|x| x.is_finite() && *x > 0.0)
-                    .ok_or_else(|| bad(format!("uncertainty {u:?} is not a finite number > 0")))?,
-            ),
-        };
-        Ok(TargetReading { geometry: geometry.to_string(), name: name.to_string(), value, uncertainty })
-    }
-}
-
-/// Targets from a parsed glossmeter sheet (`comparison::sheet`, every layout `compare` reads): the rows of one
-/// sample (`sample`, or the sheet's only sample), grouped by reading as `compare` groups them
-/// ([`crate::comparison::group_rows`]). A group's value is the mean x̄ of its n repeated readings and its
-/// uncertainty is √(u² + s²/n), u the largest stated `uncertainty` of its rows (an allowance that averaging
-/// does not reduce) and s/√n the standard error of the mean (n ≥ 2); a group with neither (one reading, no
-/// stated uncertainty) gets `None`, the fit's default. Rows whose reading glossmeter does not predict (the
-/// sheet reader marks them) are left out and named in the returned notes. A sample the sheet lacks, or a
-/// sheet of several samples without `sample`, is a usage error naming `--sample`.
-pub fn targets_from_sheet(
-    sheet: &crate::comparison::sheet::Sheet,
-    sample: Option<&str>,
-) -> Result<(Vec<TargetReading>, Vec<String>)> {
-    let mut samples: Vec<&str> = Vec::new();
-    for r in &sheet.rows {
-        if !samples.contains(&r.sample.as_str()) {
-            samples.push(&r.sample);
-        }
-    }
-    let chosen = match sample {
-        Some(s) if samples.contains(&s) => s,
-        Some(s) => {
-            return Err(Error::Usage(format!(
-                "--sample {s}: {} has no sample {s:?}; it has {}",
-                sheet.file,
-                samples.join(", ")
-            )))
-        }
-        None if samples.len() == 1 => samples[0],
-        None => {
-            return Err(Error::Usage(format!(
-                "--sheet {}: the sheet has {} samples ({}); choose one with --sample",
-                sheet.file,
-                samples.len(),
-                samples.join(", ")
-            )))
-        }
-    };
-    let rows: Vec<_> = sheet.rows.iter().filter(|r| r.sample == chosen).cloned().collect();
-    let mut targets = Vec::new();
-    let mut notes = Vec::new();
-    for g in crate::comparison::group_rows(&rows) {
-        if let Some(why) = &g.not_predicted {
-            notes.push(format!(
-                "{} line {}: column {} is not a target: {why}",
-                sheet.file,
-                g.lines[0],
-                g.columns.join(", ")
-            ));
-            continue;
-        }
-        let n = g.stats.n as f64;
-        let sem2 = if g.stats.n > 1 { g.stats.std * g.stats.std / n } else { 0.0 };
-        let u2 = g.uncertainty.map_or(0.0, |u| u * u);
-        let combined = (u2 + sem2).sqrt();
-        targets.push(TargetReading {
-            geometry: g.geometry,
-            name: g.reading,
-            value: g.stats.mean,
-            uncertainty: (combined > 0.0 && combined.is_finite()).then_some(combined),
-        });
-    }
-    if targets.is_empty() {
-        return Err(Error::Usage(format!(
-            "--sheet {}: sample {chosen:?} has no reading glossmeter predicts, so no targets",
-            sheet.file
-        )));
-    }
-    Ok((targets, notes))
-}
 
 /// Knobs of the fit.
 #[derive(Clone, Debug)]
@@ -346,289 +179,10 @@ impl FitReport {
     }
 }
 
-/// The forward model: recipe values → predictions (value, error) of the targets.
-struct Forward<'a> {
-    recipe: &'a Value,
-    file: &'a str,
-    free: &'a [FreeParameter],
-    planner: Planner,
-    geometries: Vec<StandardGeometry>,
-    options: PlanOptions,
-    /// Index of each target in the plan's readings.
-    index: Vec<usize>,
-    runs: std::cell::Cell<usize>,
-}
-
-/// How a forward run integrates.
-enum Mode<'p> {
-    /// Adaptively, keeping the final partitions: the solver's trial points and every Jacobian's centre.
-    Freeze,
-    /// On the centre's frozen methods (a Jacobian's displaced points). `None` from [`Forward::run`] when the
-    /// material at the displaced point has another shape than the centre's (another kind of term), so the
-    /// frozen methods do not apply to it.
-    Frozen(&'p Plan),
-}
-
-/// Predictions (value, error estimate) of the targets, and the frozen plan of a `Mode::Freeze` run.
-type Predictions = (Vec<(f64, f64)>, Option<Plan>);
-
-impl Forward<'_> {
-    fn recipe_at(&self, x: &[f64]) -> Value {
-        let mut v = self.recipe.clone();
-        for (p, xi) in self.free.iter().zip(x) {
-            if let Some(slot) = v.pointer_mut(&p.pointer) {
-                *slot = serde_json::json!(xi);
-            }
-        }
-        v
-    }
-
-    fn material(&self, x: &[f64]) -> Result<Arc<dyn Brdf>> {
-        let v = self.recipe_at(x);
-        let text = v.to_string();
-        Ok(recipe::parse_str(&text, self.file)?.brdf)
-    }
-
-    /// Predictions of the targets at x (see [`Mode`]); `Ok(None)` only for `Mode::Frozen` on a material of
-    /// another shape.
-    fn run(&self, x: &[f64], mode: Mode) -> Result<Option<Predictions>> {
-        self.runs.set(self.runs.get() + 1);
-        let brdf = self.material(x)?;
-        let (readings, frozen): (Vec<Reading>, Option<Plan>) = match mode {
-            Mode::Freeze => {
-                let (r, p) = self.planner.compile(brdf, self.geometries.clone(), self.options.clone())?.freeze();
-                (r, Some(p))
-            }
-            Mode::Frozen(plan) => match plan.with_material(brdf) {
-                Ok(p) => (p.execute(), None),
-                Err(_) => return Ok(None),
-            },
-        };
-        let mut out = Vec::with_capacity(self.index.len());
-        for &i in &self.index {
-            let r = &readings[i];
-            match r.value {
-                Some(v) if v.is_finite() && r.error_estimate.is_finite() => out.push((v, r.error_estimate)),
-                _ => {
-                    return Err(Error::Numeric(format!(
-                        "{}/{} has no finite value at {}: {}",
-                        r.geometry,
-                        r.name,
-                        describe_point(self.free, x),
-                        r.problem.clone().unwrap_or_default()
-                    )))
-                }
-            }
-        }
-        Ok(Some((out, frozen)))
-    }
-}
-
-fn describe_point(free: &[FreeParameter], x: &[f64]) -> String {
-    free.iter().zip(x).map(|(p, v)| format!("{} = {v}", p.pointer)).collect::<Vec<_>>().join(", ")
-}
-
-/// The solver's current point: the predictions and the frozen plan of its adaptive run.
-struct Current {
-    predictions: Vec<(f64, f64)>,
-    frozen: Plan,
-}
-
-/// The least-squares problem seen by the solver, in the unbounded variables u.
-struct Problem<'a> {
-    fwd: &'a Forward<'a>,
-    targets: &'a [TargetReading],
-    u_sigma: Vec<f64>,
-    u: DVector<f64>,
-    /// The current point (computed in `set_params`), or the error that prevented it.
-    current: std::result::Result<Current, String>,
-    last_error: std::cell::RefCell<Option<String>>,
-}
-
-impl Problem<'_> {
-    fn t_of_u(&self, u: &DVector<f64>) -> Vec<f64> {
-        self.fwd
-            .free
-            .iter()
-            .zip(u.iter())
-            .map(|(p, &ui)| {
-                let (a, b) = p.t_bounds();
-                a + (b - a) * 0.5 * (1.0 + ui.sin())
-            })
-            .collect()
-    }
-
-    fn x_of_t(&self, t: &[f64]) -> Vec<f64> {
-        self.fwd.free.iter().zip(t).map(|(p, &ti)| p.x_of(ti).clamp(p.lower, p.upper)).collect()
-    }
-
-    fn sigma(&self, i: usize, e: f64) -> f64 {
-        (self.u_sigma[i].powi(2) + e * e).sqrt()
-    }
-
-    fn weighted(&self, pred: &[(f64, f64)]) -> DVector<f64> {
-        DVector::from_iterator(
-            pred.len(),
-            pred.iter().enumerate().map(|(i, &(v, e))| (v - self.targets[i].value) / self.sigma(i, e)),
-        )
-    }
-
-    /// The weighted Jacobian in t (m × n) at t, whose adaptive run gave `centre` and `frozen`: central
-    /// differences on the frozen methods, so that every displaced point of one Jacobian is integrated on the
-    /// same partitions and the differences see the change of the material only, not a change of partition.
-    /// The step balances the O(h²) truncation of a central difference against the O(ε/h) error of the
-    /// readings, ε their largest relative error estimate: h = ε^{1/3}·scale. A displaced point outside the
-    /// bounds, or whose material has another shape (the frozen methods do not apply), is replaced by the
-    /// centre (a one-sided difference); a parameter with neither side usable is an error.
-    fn jacobian_t(&self, t: &[f64], centre: &[(f64, f64)], frozen: &Plan) -> Result<DMatrix<f64>> {
-        let m = centre.len();
-        let n = t.len();
-        let eps = centre.iter().map(|&(v, e)| e / v.abs().max(1e-300)).fold(1e-13, f64::max).min(1e-2);
-        let mut j = DMatrix::zeros(m, n);
-        for k in 0..n {
-            let p = &self.fwd.free[k];
-            let (a, b) = p.t_bounds();
-            let scale = if p.log { 1.0 } else { t[k].abs().max(1e-3 * (b - a)) };
-            let h = (eps.cbrt() * scale).clamp(1e-9 * (b - a), 0.05 * (b - a));
-            let eval = |tk: f64| -> Result<Option<Vec<(f64, f64)>>> {
-                if !(a..=b).contains(&tk) {
-                    return Ok(None);
-                }
-                let mut tt = t.to_vec();
-                tt[k] = tk;
-                Ok(self.fwd.run(&self.x_of_t(&tt), Mode::Frozen(frozen))?.map(|r| r.0))
-            };
-            let (lo, hi) = (eval(t[k] - h)?, eval(t[k] + h)?);
-            let (f_lo, t_lo, f_hi, t_hi) = match (lo, hi) {
-                (Some(l), Some(u)) => (l, t[k] - h, u, t[k] + h),
-                (Some(l), None) => (l, t[k] - h, centre.to_vec(), t[k]),
-                (None, Some(u)) => (centre.to_vec(), t[k], u, t[k] + h),
-                (None, None) => {
-                    return Err(Error::Numeric(format!(
-                        "{}: the Jacobian has no usable point on either side of {} (step {h:e} in the fitted \
-                         variable): the material changes kind there",
-                        p.pointer,
-                        p.x_of(t[k])
-                    )))
-                }
-            };
-            for i in 0..m {
-                let s = self.sigma(i, centre[i].1);
-                j[(i, k)] = (f_hi[i].0 - f_lo[i].0) / (t_hi - t_lo) / s;
-            }
-        }
-        Ok(j)
-    }
-}
-
-impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_> {
-    type ResidualStorage = Owned<f64, Dyn>;
-    type JacobianStorage = Owned<f64, Dyn, Dyn>;
-    type ParameterStorage = Owned<f64, Dyn>;
-
-    fn set_params(&mut self, u: &DVector<f64>) {
-        self.u.copy_from(u);
-        let x = self.x_of_t(&self.t_of_u(u));
-        self.current = match self.fwd.run(&x, Mode::Freeze) {
-            Ok(Some((predictions, Some(frozen)))) => Ok(Current { predictions, frozen }),
-            Ok(_) => Err("an adaptive run returned no frozen plan".into()),
-            Err(e) => Err(e.to_string()),
-        };
-    }
-
-    fn params(&self) -> DVector<f64> {
-        self.u.clone()
-    }
-
-    fn residuals(&self) -> Option<DVector<f64>> {
-        match &self.current {
-            Ok(c) => Some(self.weighted(&c.predictions)),
-            Err(e) => {
-                *self.last_error.borrow_mut() = Some(e.clone());
-                None
-            }
-        }
-    }
-
-    fn jacobian(&self) -> Option<DMatrix<f64>> {
-        let c = self.current.as_ref().ok()?;
-        let t = self.t_of_u(&self.u);
-        match self.jacobian_t(&t, &c.predictions, &c.frozen) {
-            Ok(jt) => {
-                // Chain rule: dt/du = (b − a)/2 · cos u.
-                let mut ju = jt;
-                for (k, p) in self.fwd.free.iter().enumerate() {
-                    let (a, b) = p.t_bounds();
-                    let d = 0.5 * (b - a) * self.u[k].cos();
-                    ju.column_mut(k).scale_mut(d);
-                }
-                Some(ju)
-            }
-            Err(e) => {
-                *self.last_error.borrow_mut() = Some(e.to_string());
-                None
-            }
-        }
-    }
-}
-
-/// Check the free parameters against the recipe and the registry: an unknown or non-numeric path, bounds
-/// outside the registry's range, a start outside its bounds are usage errors naming the argument.
-fn check_free(recipe: &Value, free: &[FreeParameter]) -> Result<Vec<f64>> {
-    let model = recipe.get("model").and_then(Value::as_str).unwrap_or("");
-    let mut start = Vec::new();
-    for (i, p) in free.iter().enumerate() {
-        let arg = format!("--free {}", p.pointer);
-        if free[..i].iter().any(|q| q.pointer == p.pointer) {
-            return Err(Error::Usage(format!("{arg}: the same parameter is free twice")));
-        }
-        let entry = registry::lookup(model, &p.pointer).ok_or_else(|| {
-            let numeric: Vec<&str> =
-                registry::of_model(model).filter(|e| e.ty.is_numeric()).map(|e| e.pointer).collect();
-            Error::Usage(format!(
-                "{arg}: not a parameter of a {model:?} recipe; its numeric parameters are {}",
-                numeric.join(", ")
-            ))
-        })?;
-        let v = recipe.pointer(&p.pointer).ok_or_else(|| {
-            Error::Usage(format!(
-                "{arg}: the recipe has no value at {} (add it with a starting value: the fit starts from the recipe)",
-                p.pointer
-            ))
-        })?;
-        let x = v.as_f64().filter(|_| v.is_number()).ok_or_else(|| {
-            Error::Usage(format!(
-                "{arg}: the value at {} is {}, not a number; address one number (e.g. {}/0)",
-                p.pointer,
-                crate::input::json::kind(v),
-                p.pointer
-            ))
-        })?;
-        let r = entry.range.ok_or_else(|| Error::Usage(format!("{arg}: {} is not numeric", entry.pointer)))?;
-        if !(r.contains(p.lower) || p.lower == r.lo) || !(r.contains(p.upper) || p.upper == r.hi) {
-            return Err(Error::Usage(format!(
-                "{arg}: bounds {}..{} leave the allowed range of {} ({}: {})",
-                p.lower,
-                p.upper,
-                entry.pointer,
-                r.describe(),
-                entry.description
-            )));
-        }
-        if !(x > p.lower && x < p.upper) {
-            return Err(Error::Usage(format!(
-                "{arg}: the start (the recipe's value {x}) is outside the bounds; it must lie strictly between {} and {}",
-                p.lower, p.upper
-            )));
-        }
-        start.push(x);
-    }
-    Ok(start)
-}
-
 /// Fit the free parameters of `recipe` (the JSON of a recipe file named `file`) to the targets.
-/// Bad arguments (paths, bounds, starts, targets, counts) are `Error::Usage` naming the argument; a fit
-/// that runs returns its report whatever its outcome (see [`FitReport::ok`]).
+/// Bad arguments (paths, bounds, starts, targets, counts) are usage errors, [`Error::Argument`] where they
+/// name the argument (`free`, `target`, `sheet`); a fit that runs returns its report whatever its outcome
+/// (see [`FitReport::ok`]).
 pub fn fit(
     recipe_json: &Value,
     file: &str,
@@ -638,10 +192,15 @@ pub fn fit(
 ) -> Result<FitReport> {
     let clock = Instant::now();
     if targets.is_empty() {
-        return Err(Error::Usage("no targets: give --target GEOMETRY/READING=VALUE[±U] or --sheet".into()));
+        return Err(Error::Argument(
+            Words::from("no targets: give ")
+                .and_argument("target")
+                .and(" GEOMETRY/READING=VALUE[±U] or ")
+                .and_argument("sheet"),
+        ));
     }
     if free.is_empty() {
-        return Err(Error::Usage("no free parameters: give --free PATH=LO..HI".into()));
+        return Err(Error::Argument(Words::from("no free parameters: give ").and_argument("free").and(" PATH=LO..HI")));
     }
     if free.len() > targets.len() {
         return Err(Error::Usage(format!(
@@ -666,7 +225,7 @@ pub fn fit(
     }
     let geometries: Vec<StandardGeometry> = ids
         .iter()
-        .map(|id| planner.geometry(id).map_err(|e| Error::Usage(format!("--target {id:?}: {e}"))))
+        .map(|id| planner.geometry(id).map_err(|e| Error::argument("target", format!(" {id:?}: {e}"))))
         .collect::<Result<_>>()?;
     let plan_options = PlanOptions { rtol: options.rtol, ..PlanOptions::default() };
     // Match every target to a reading of the plan.
@@ -690,24 +249,30 @@ pub fn fit(
             .ok_or_else(|| {
                 let has: Vec<&str> =
                     names.iter().filter(|(g, _, _)| *g == t.geometry).map(|(_, n, _)| n.as_str()).collect();
-                Error::Usage(format!(
-                    "--target {:?}: geometry {:?} has no reading {:?}; its readings are {}",
-                    format!("{}/{}", t.geometry, t.name),
-                    t.geometry,
-                    t.name,
-                    has.join(", ")
-                ))
+                Error::argument(
+                    "target",
+                    format!(
+                        " {:?}: geometry {:?} has no reading {:?}; its readings are {}",
+                        format!("{}/{}", t.geometry, t.name),
+                        t.geometry,
+                        t.name,
+                        has.join(", ")
+                    ),
+                )
             })?;
         index.push(i);
     }
     let mut seen: HashMap<usize, usize> = HashMap::new();
     for (k, i) in index.iter().enumerate() {
         if let Some(prev) = seen.insert(*i, k) {
-            return Err(Error::Usage(format!(
-                "--target {:?}: the same reading is targeted twice (also target {})",
-                format!("{}/{}", targets[k].geometry, targets[k].name),
-                prev + 1
-            )));
+            return Err(Error::argument(
+                "target",
+                format!(
+                    " {:?}: the same reading is targeted twice (also target {})",
+                    format!("{}/{}", targets[k].geometry, targets[k].name),
+                    prev + 1
+                ),
+            ));
         }
     }
 

@@ -1,0 +1,240 @@
+//! The forward model and the least-squares problem: recipe values → predictions of the targets (adaptively,
+//! keeping the final partitions, or on a Jacobian centre's frozen methods), and the weighted residuals and
+//! Jacobian that the Levenberg–Marquardt solver sees in the unbounded variables u.
+use std::sync::Arc;
+
+use levenberg_marquardt::LeastSquaresProblem;
+use nalgebra::{DMatrix, DVector, Dyn, Owned};
+use serde_json::Value;
+
+use super::params::{FreeParameter, TargetReading};
+use crate::brdf::Brdf;
+use crate::instrument::plan::{Plan, PlanOptions, Planner, Reading};
+use crate::instrument::standards::StandardGeometry;
+use crate::{recipe, Error, Result};
+
+/// The forward model: recipe values → predictions (value, error) of the targets.
+pub(super) struct Forward<'a> {
+    pub(super) recipe: &'a Value,
+    pub(super) file: &'a str,
+    pub(super) free: &'a [FreeParameter],
+    pub(super) planner: Planner,
+    pub(super) geometries: Vec<StandardGeometry>,
+    pub(super) options: PlanOptions,
+    /// Index of each target in the plan's readings.
+    pub(super) index: Vec<usize>,
+    pub(super) runs: std::cell::Cell<usize>,
+}
+
+/// How a forward run integrates.
+pub(super) enum Mode<'p> {
+    /// Adaptively, keeping the final partitions: the solver's trial points and every Jacobian's centre.
+    Freeze,
+    /// On the centre's frozen methods (a Jacobian's displaced points). `None` from [`Forward::run`] when the
+    /// material at the displaced point has another shape than the centre's (another kind of term), so the
+    /// frozen methods do not apply to it.
+    Frozen(&'p Plan),
+}
+
+/// Predictions (value, error estimate) of the targets, and the frozen plan of a `Mode::Freeze` run.
+pub(super) type Predictions = (Vec<(f64, f64)>, Option<Plan>);
+
+impl Forward<'_> {
+    pub(super) fn recipe_at(&self, x: &[f64]) -> Value {
+        let mut v = self.recipe.clone();
+        for (p, xi) in self.free.iter().zip(x) {
+            if let Some(slot) = v.pointer_mut(&p.pointer) {
+                *slot = serde_json::json!(xi);
+            }
+        }
+        v
+    }
+
+    fn material(&self, x: &[f64]) -> Result<Arc<dyn Brdf>> {
+        let v = self.recipe_at(x);
+        let text = v.to_string();
+        Ok(recipe::parse_str(&text, self.file)?.brdf)
+    }
+
+    /// Predictions of the targets at x (see [`Mode`]); `Ok(None)` only for `Mode::Frozen` on a material of
+    /// another shape.
+    pub(super) fn run(&self, x: &[f64], mode: Mode) -> Result<Option<Predictions>> {
+        self.runs.set(self.runs.get() + 1);
+        let brdf = self.material(x)?;
+        let (readings, frozen): (Vec<Reading>, Option<Plan>) = match mode {
+            Mode::Freeze => {
+                let (r, p) = self.planner.compile(brdf, self.geometries.clone(), self.options.clone())?.freeze();
+                (r, Some(p))
+            }
+            Mode::Frozen(plan) => match plan.with_material(brdf) {
+                Ok(p) => (p.execute(), None),
+                Err(_) => return Ok(None),
+            },
+        };
+        let mut out = Vec::with_capacity(self.index.len());
+        for &i in &self.index {
+            let r = &readings[i];
+            match r.value {
+                Some(v) if v.is_finite() && r.error_estimate.is_finite() => out.push((v, r.error_estimate)),
+                _ => {
+                    return Err(Error::Numeric(format!(
+                        "{}/{} has no finite value at {}: {}",
+                        r.geometry,
+                        r.name,
+                        describe_point(self.free, x),
+                        r.problem.clone().unwrap_or_default()
+                    )))
+                }
+            }
+        }
+        Ok(Some((out, frozen)))
+    }
+}
+
+pub(super) fn describe_point(free: &[FreeParameter], x: &[f64]) -> String {
+    free.iter().zip(x).map(|(p, v)| format!("{} = {v}", p.pointer)).collect::<Vec<_>>().join(", ")
+}
+
+/// The solver's current point: the predictions and the frozen plan of its adaptive run.
+pub(super) struct Current {
+    pub(super) predictions: Vec<(f64, f64)>,
+    pub(super) frozen: Plan,
+}
+
+/// The least-squares problem seen by the solver, in the unbounded variables u.
+pub(super) struct Problem<'a> {
+    pub(super) fwd: &'a Forward<'a>,
+    pub(super) targets: &'a [TargetReading],
+    pub(super) u_sigma: Vec<f64>,
+    pub(super) u: DVector<f64>,
+    /// The current point (computed in `set_params`), or the error that prevented it.
+    pub(super) current: std::result::Result<Current, String>,
+    pub(super) last_error: std::cell::RefCell<Option<String>>,
+}
+
+impl Problem<'_> {
+    pub(super) fn t_of_u(&self, u: &DVector<f64>) -> Vec<f64> {
+        self.fwd
+            .free
+            .iter()
+            .zip(u.iter())
+            .map(|(p, &ui)| {
+                let (a, b) = p.t_bounds();
+                a + (b - a) * 0.5 * (1.0 + ui.sin())
+            })
+            .collect()
+    }
+
+    pub(super) fn x_of_t(&self, t: &[f64]) -> Vec<f64> {
+        self.fwd.free.iter().zip(t).map(|(p, &ti)| p.x_of(ti).clamp(p.lower, p.upper)).collect()
+    }
+
+    fn sigma(&self, i: usize, e: f64) -> f64 {
+        (self.u_sigma[i].powi(2) + e * e).sqrt()
+    }
+
+    pub(super) fn weighted(&self, pred: &[(f64, f64)]) -> DVector<f64> {
+        DVector::from_iterator(
+            pred.len(),
+            pred.iter().enumerate().map(|(i, &(v, e))| (v - self.targets[i].value) / self.sigma(i, e)),
+        )
+    }
+
+    /// The weighted Jacobian in t (m × n) at t, whose adaptive run gave `centre` and `frozen`: central
+    /// differences on the frozen methods, so that every displaced point of one Jacobian is integrated on the
+    /// same partitions and the differences see the change of the material only, not a change of partition.
+    /// The step balances the O(h²) truncation of a central difference against the O(ε/h) error of the
+    /// readings, ε their largest relative error estimate: h = ε^{1/3}·scale. A displaced point outside the
+    /// bounds, or whose material has another shape (the frozen methods do not apply), is replaced by the
+    /// centre (a one-sided difference); a parameter with neither side usable is an error.
+    pub(super) fn jacobian_t(&self, t: &[f64], centre: &[(f64, f64)], frozen: &Plan) -> Result<DMatrix<f64>> {
+        let m = centre.len();
+        let n = t.len();
+        let eps = centre.iter().map(|&(v, e)| e / v.abs().max(1e-300)).fold(1e-13, f64::max).min(1e-2);
+        let mut j = DMatrix::zeros(m, n);
+        for k in 0..n {
+            let p = &self.fwd.free[k];
+            let (a, b) = p.t_bounds();
+            let scale = if p.log { 1.0 } else { t[k].abs().max(1e-3 * (b - a)) };
+            let h = (eps.cbrt() * scale).clamp(1e-9 * (b - a), 0.05 * (b - a));
+            let eval = |tk: f64| -> Result<Option<Vec<(f64, f64)>>> {
+                if !(a..=b).contains(&tk) {
+                    return Ok(None);
+                }
+                let mut tt = t.to_vec();
+                tt[k] = tk;
+                Ok(self.fwd.run(&self.x_of_t(&tt), Mode::Frozen(frozen))?.map(|r| r.0))
+            };
+            let (lo, hi) = (eval(t[k] - h)?, eval(t[k] + h)?);
+            let (f_lo, t_lo, f_hi, t_hi) = match (lo, hi) {
+                (Some(l), Some(u)) => (l, t[k] - h, u, t[k] + h),
+                (Some(l), None) => (l, t[k] - h, centre.to_vec(), t[k]),
+                (None, Some(u)) => (centre.to_vec(), t[k], u, t[k] + h),
+                (None, None) => {
+                    return Err(Error::Numeric(format!(
+                        "{}: the Jacobian has no usable point on either side of {} (step {h:e} in the fitted \
+                         variable): the material changes kind there",
+                        p.pointer,
+                        p.x_of(t[k])
+                    )))
+                }
+            };
+            for i in 0..m {
+                let s = self.sigma(i, centre[i].1);
+                j[(i, k)] = (f_hi[i].0 - f_lo[i].0) / (t_hi - t_lo) / s;
+            }
+        }
+        Ok(j)
+    }
+}
+
+impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_> {
+    type ResidualStorage = Owned<f64, Dyn>;
+    type JacobianStorage = Owned<f64, Dyn, Dyn>;
+    type ParameterStorage = Owned<f64, Dyn>;
+
+    fn set_params(&mut self, u: &DVector<f64>) {
+        self.u.copy_from(u);
+        let x = self.x_of_t(&self.t_of_u(u));
+        self.current = match self.fwd.run(&x, Mode::Freeze) {
+            Ok(Some((predictions, Some(frozen)))) => Ok(Current { predictions, frozen }),
+            Ok(_) => Err("an adaptive run returned no frozen plan".into()),
+            Err(e) => Err(e.to_string()),
+        };
+    }
+
+    fn params(&self) -> DVector<f64> {
+        self.u.clone()
+    }
+
+    fn residuals(&self) -> Option<DVector<f64>> {
+        match &self.current {
+            Ok(c) => Some(self.weighted(&c.predictions)),
+            Err(e) => {
+                *self.last_error.borrow_mut() = Some(e.clone());
+                None
+            }
+        }
+    }
+
+    fn jacobian(&self) -> Option<DMatrix<f64>> {
+        let c = self.current.as_ref().ok()?;
+        let t = self.t_of_u(&self.u);
+        match self.jacobian_t(&t, &c.predictions, &c.frozen) {
+            Ok(jt) => {
+                // Chain rule: dt/du = (b − a)/2 · cos u.
+                let mut ju = jt;
+                for (k, p) in self.fwd.free.iter().enumerate() {
+                    let (a, b) = p.t_bounds();
+                    let d = 0.5 * (b - a) * self.u[k].cos();
+                    ju.column_mut(k).scale_mut(d);
+                }
+                Some(ju)
+            }
+            Err(e) => {
+                *self.last_error.borrow_mut() = Some(e.to_string());
+                None
+            }
+        }
+    }
+}

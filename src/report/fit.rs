@@ -1,0 +1,37 @@
+//! The document of `fit`: the fitted parameters, the targets with their residuals, the verdict and the fitted
+//! recipe as JSON. The table for people is the command line's.
+use serde_json::{json, Value};
+
+use crate::fit::FitReport;
+
+/// A finite number, or null.
+fn num(x: f64) -> Value {
+    if x.is_finite() {
+        json!(x)
+    } else {
+        Value::Null
+    }
+}
+
+/// The fit's report as `fit --format json` writes it: the JSON contract of docs/inverse.md §Output (the schema
+/// is [`super::schema::fit`]), and `verdict`: the same words as the table's.
+pub fn json(r: &FitReport, timing: bool) -> Value {
+    json!({
+        "parameters": r.parameters.iter().map(|p| json!({
+            "path": p.pointer, "value": num(p.value), "std_error": p.std_error.map(num), "lower": p.lower,
+            "upper": p.upper, "at_bound": p.at_bound,
+        })).collect::<Vec<_>>(),
+        "targets": r.targets.iter().map(|t| json!({
+            "geometry": t.target.geometry, "name": t.target.name, "measured": t.target.value,
+            "uncertainty": t.uncertainty, "predicted": num(t.predicted), "residual": num(t.residual),
+        })).collect::<Vec<_>>(),
+        "converged": r.converged,
+        "identifiable": r.identifiable,
+        "singular_values": r.singular_values.iter().map(|s| num(*s)).collect::<Vec<_>>(),
+        "correlation": r.correlation.iter().map(|row| row.iter().map(|c| c.map(num)).collect::<Vec<_>>()).collect::<Vec<_>>(),
+        "verdict": r.verdict,
+        "evaluations": r.evaluations,
+        "seconds": if timing { num(r.seconds) } else { Value::Null },
+        "recipe": r.recipe,
+    })
+}
