@@ -138,7 +138,7 @@ fn every_default_reading_agrees_with_the_rtol_1e_10_reference_within_its_estimat
             "provenance": {
                 "commit": git_head(),
                 "command": "GLOSSMETER_REGENERATE_REFERENCE=1 cargo test --test reference_readings -- --nocapture",
-                "engine": "adaptive Genz-Malik 7/5 on the lobe/plain charts, error sum of |I7 - I5| (before issue 10's rules)",
+                "engine": "adaptive Genz-Malik 7/5 on the lobe/plain charts, error sum of |I7 - I5| (before the lobe rules of docs/instrument.md §Quadrature: delta limit, Gauss–Hermite, polar, tensor)",
                 "rtol": REFERENCE_RTOL,
                 "max_seconds": null,
                 "seconds": start.elapsed().as_secs_f64(),
