@@ -13,8 +13,10 @@ use crate::instrument::standards::StandardGeometry;
 use crate::recipe::{self, Material};
 use crate::{Error, Result};
 
-/// The recipe files named by `paths`: files as given, directories replaced by their `*.json` files (not
-/// recursive), sorted by name.
+/// The recipe files named by `paths`: files as given, directories replaced by their `*.json` entries (not
+/// recursive, sub-directories left out), sorted by name. A `*.json` entry that cannot be read, a dangling
+/// symbolic link or a link loop, stays in the list, so that loading it is the error naming it: a recipe moved
+/// away behind a link never drops out of a batch without a word.
 pub fn recipe_files(paths: &[PathBuf]) -> Result<Vec<PathBuf>> {
     let mut out = vec![];
     for p in paths {
@@ -24,7 +26,7 @@ pub fn recipe_files(paths: &[PathBuf]) -> Result<Vec<PathBuf>> {
             for e in rd {
                 let e = e.map_err(|source| Error::Io { file: p.display().to_string(), source })?;
                 let f = e.path();
-                if f.is_file() && f.extension().is_some_and(|x| x == "json") {
+                if !f.is_dir() && f.extension().is_some_and(|x| x == "json") {
                     files.push(f);
                 }
             }
@@ -73,4 +75,27 @@ pub fn run_many(
     // a hundred of them freed on one thread were a serial tail of the batch (docs/performance.md).
     plans.into_par_iter().for_each(drop);
     Ok(runs)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_dangling_link_in_a_directory_is_an_error_naming_it() {
+        let dir = std::env::temp_dir().join(format!("glossmeter-batch-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(dir.join("sub.json")).unwrap();
+        std::fs::copy("fixtures/recipes/grey-lambert.json", dir.join("a.json")).unwrap();
+        #[cfg(unix)]
+        std::os::unix::fs::symlink(dir.join("missing.json"), dir.join("b.json")).unwrap();
+        let files = recipe_files(std::slice::from_ref(&dir)).unwrap();
+        assert!(!files.iter().any(|f| f.ends_with("sub.json")), "{files:?}");
+        if cfg!(unix) {
+            assert_eq!(files.len(), 2, "{files:?}");
+            let e = load_all(&files).map(|_| ()).unwrap_err().to_string();
+            assert!(e.contains("b.json"), "{e}");
+        }
+        let _ = std::fs::remove_dir_all(&dir);
+    }
 }

@@ -163,3 +163,23 @@ fn a_full_disk_leaves_no_file_and_exits_2() {
         assert_eq!(disk.entries(), ["filler"], "{args:?}: a file was left behind");
     }
 }
+
+/// Help and version on a full disk: the write fails, so the exit status is 2 with a message, never a silent 0
+/// (docs/instrument.md §Exit statuses); on a working stdout they still exit 0.
+#[test]
+fn help_and_version_on_a_full_disk_exit_2() {
+    if !std::path::Path::new("/dev/full").exists() {
+        return;
+    }
+    for args in [&["--help"][..], &["--version"], &["measure", "--help"]] {
+        let full = std::fs::OpenOptions::new().write(true).open("/dev/full").unwrap();
+        let out =
+            std::process::Command::new(env!("CARGO_BIN_EXE_glossmeter")).args(args).stdout(full).output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains("<stdout>") && err.contains("No space left"), "{args:?}: {err}");
+        let ok = std::process::Command::new(env!("CARGO_BIN_EXE_glossmeter")).args(args).output().unwrap();
+        assert_eq!(ok.status.code(), Some(0), "{args:?}");
+        assert!(!ok.stdout.is_empty());
+    }
+}

@@ -50,8 +50,17 @@ where
     let cli = match Cli::try_parse_from(args) {
         Ok(c) => c,
         Err(e) => {
-            let _ = e.print();
-            return if e.use_stderr() { 2 } else { 0 };
+            // Help and version go to standard output: a write that fails there (a full disk) is an error like
+            // any other output's, not a silent exit 0 (docs/instrument.md §Exit statuses).
+            let printed = e.print().and_then(|()| std::io::stdout().flush());
+            return match printed {
+                Err(source) if !e.use_stderr() && source.kind() != std::io::ErrorKind::BrokenPipe => {
+                    let _ = writeln!(std::io::stderr(), "error: {STDOUT}: {source}");
+                    2
+                }
+                _ if e.use_stderr() => 2,
+                _ => 0,
+            };
         }
     };
     match dispatch(cli) {
