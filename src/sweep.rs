@@ -314,7 +314,8 @@ impl Sweep {
         let chunk = CHUNK_PER_THREAD * rayon::current_num_threads().max(1) as u64;
         let mut start = range.start;
         while start < range.end {
-            let end = (start + chunk).min(range.end);
+            // Saturating: a shard that ends at or near u64::MAX must not wrap around (it looped for ever).
+            let end = start.saturating_add(chunk).min(range.end);
             let planned: Vec<(Vec<f64>, std::result::Result<Plan, String>, f64)> = (start..end)
                 .into_par_iter()
                 .map(|i| {

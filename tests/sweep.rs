@@ -277,3 +277,35 @@ fn sweep_rows_are_those_of_points_run_alone() {
         assert_eq!(rows, alone, "{k} thread(s)");
     }
 }
+
+/// The last shard of a Latin hypercube of 2⁶⁴ − 1 points holds one point and ends (its chunk's end once
+/// wrapped around u64::MAX and the loop never ended): bounded by a watchdog, not by trust.
+#[test]
+fn the_last_shard_of_a_two_to_the_64_hypercube_ends() {
+    let n = u64::MAX.to_string();
+    let shard = format!("{n}/{n}");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_glossmeter"))
+        .args(["sweep", "fixtures/recipes/bench-b2-beckmann-0.1.json", "--vary", "/roughness=0.01..0.5"])
+        .args(["--lhs", &n, "--seed", "1", "--shard", &shard, "-g", "astm-d523-60", "--no-timing"])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = std::time::Instant::now();
+    let status = loop {
+        if let Some(s) = child.try_wait().unwrap() {
+            break s;
+        }
+        if start.elapsed().as_secs() > 60 {
+            child.kill().unwrap();
+            panic!("the last shard did not end in 60 s");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    };
+    let out = child.wait_with_output().unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(status.success(), "{status:?} {}", String::from_utf8_lossy(&out.stderr));
+    // The one point (a later shard has no header: the shards concatenate into the whole run).
+    assert_eq!(text.lines().count(), 1, "{text}");
+    assert!(text.starts_with(&format!("{},", u64::MAX - 1)), "{text}");
+}
