@@ -258,3 +258,20 @@ fn malformed_sheets_name_the_file_line_and_column() {
     assert_eq!(code, 0);
     assert_eq!(doc["sheet"]["ignored_columns"], serde_json::json!(["Colour"]));
 }
+
+/// A sample whose name holds `=` (a BYK-style name "glass; n = 1,50") can be given its recipe with
+/// `--recipe 'NAME=FILE'`: the argument splits at its last `=`, and the advice the error gives works.
+#[test]
+fn a_sample_name_with_an_equals_sign_takes_its_recipe() {
+    let dir = std::env::temp_dir().join(format!("glossmeter-eq-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let sheet = dir.join("eq.csv");
+    std::fs::write(&sheet, "sample;geometry;value;uncertainty\na=b;astm-d523-60;100;0.1\n").unwrap();
+    let sheet = sheet.to_str().unwrap();
+    let (code, _, err) = gm(&["compare", sheet, "--recipe", "other=fixtures/recipes/black-glass.json"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("--recipe 'a=b=FILE'"), "{err}");
+    let (code, out, err) = gm(&["compare", sheet, "--recipe", "a=b=fixtures/recipes/black-glass.json"]);
+    assert_eq!(code, 0, "{out}{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

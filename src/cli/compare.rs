@@ -111,7 +111,9 @@ pub fn run(a: CompareArgs) -> Result<()> {
     }
     let mut per_sample = vec![];
     for r in &a.recipes {
-        let Some((s, f)) = r.split_once('=') else {
+        // Split at the last `=`: a sample name may hold `=` (instrument sheets' names are free text), a
+        // recipe's file name seldom does.
+        let Some((s, f)) = r.rsplit_once('=') else {
             return Err(Error::Usage(format!("--recipe takes SAMPLE=FILE, got `{r}`")));
         };
         per_sample.push((s.to_string(), PathBuf::from(f)));
