@@ -235,3 +235,41 @@ fn smaller_input_cases_exit_2_naming_file_and_field() {
     assert_eq!(code, Some(2));
     assert!(err.contains("/dev/zero") && err.contains("MiB"), "{err}");
 }
+
+/// A `--baseline` that checks nothing never passes (docs/instrument.md §Exit statuses): one that matches no
+/// reading exits 1; one with no reading, a non-number where a number belongs, or a negative error estimate is
+/// malformed (exit 2, naming the field); a BOM and a good baseline pass.
+#[test]
+fn a_baseline_that_checks_nothing_never_passes() {
+    let glass = "fixtures/recipes/glass-n1.5.json";
+    let (code, good, _) = stderr_of(&["measure", glass, "-g", "astm-d523-60", "--format", "json", "--no-timing"]);
+    assert_eq!(code, Some(0));
+    let doc: serde_json::Value = serde_json::from_str(&good).unwrap();
+    let variant = |name: &str, f: &dyn Fn(&mut serde_json::Value)| {
+        let mut d = doc.clone();
+        f(&mut d);
+        write(name, &serde_json::to_string(&d).unwrap())
+    };
+    let base = |b: &str| stderr_of(&["measure", glass, "-g", "astm-d523-60", "--baseline", b]);
+    assert_eq!(base(&write("base-good.json", &good)).0, Some(0));
+    assert_eq!(base(&write("base-bom.json", &format!("\u{feff}{good}"))).0, Some(0), "a BOM is no part of JSON");
+    let renamed = variant("base-renamed.json", &|d| d["material"]["name"] = "another panel".into());
+    let (code, _, err) = base(&renamed);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(err.contains("nothing was checked"), "{err}");
+    let strings = variant("base-strings.json", &|d| {
+        let v = d["readings"][0]["value"].to_string();
+        d["readings"][0]["value"] = v.into();
+    });
+    let (code, _, err) = base(&strings);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(err.contains("/readings/0/value") && err.contains("number"), "{err}");
+    let negative = variant("base-negative.json", &|d| d["readings"][0]["error_estimate"] = (-1.0).into());
+    let (code, _, err) = base(&negative);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(err.contains("/readings/0/error_estimate"), "{err}");
+    let empty = variant("base-empty.json", &|d| d["readings"] = serde_json::json!([]));
+    let (code, _, err) = base(&empty);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(err.contains("check nothing"), "{err}");
+}

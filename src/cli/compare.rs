@@ -155,6 +155,13 @@ pub fn run(a: CompareArgs) -> Result<()> {
     let outside = cmp.iter().filter(|c| c.verdict == Verdict::Outside).count();
     let unchecked = cmp.iter().filter(|c| c.verdict.why_unchecked().is_some()).count();
     let moved = drift.iter().filter(|d| d.moved).count();
+    if baseline.is_some() && drift.is_empty() {
+        return Err(Error::Check(
+            "the baseline matched none of the predictions (no material, geometry and reading in common): nothing \
+             was checked"
+                .into(),
+        ));
+    }
     let de_outside = des.iter().filter(|d| d.inside == Some(false)).count();
     if de_outside > 0 {
         return Err(Error::Check(format!("{de_outside} of {} colour(s) with ΔE00 above --max-de00", des.len())));

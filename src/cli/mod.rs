@@ -212,6 +212,13 @@ fn dispatch(cli: Cli) -> Result<()> {
 
 /// Exit status 1 when a baseline reading moved.
 fn check_drift(drift: Option<&[crate::comparison::Drift]>) -> Result<()> {
+    if drift.is_some_and(|d| d.is_empty()) {
+        return Err(Error::Check(
+            "the baseline matched none of the readings (no material, geometry and reading in common): nothing \
+             was checked"
+                .into(),
+        ));
+    }
     let moved = drift.map(|d| d.iter().filter(|x| x.moved).count()).unwrap_or(0);
     if moved > 0 {
         return Err(Error::Check(format!(

@@ -427,14 +427,32 @@ pub struct BaselineEntry {
 /// Read a baseline file: the JSON of `measure` (one or many recipes) or of `compare`.
 pub fn load_baseline(path: &Path) -> Result<Vec<BaselineEntry>> {
     let file = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|source| Error::Io { file: file.clone(), source })?;
-    let doc: serde_json::Value =
-        serde_json::from_str(&text).map_err(|e| Error::input(&file, "", format!("not JSON: {e}")))?;
-    parse_baseline(&doc, &file)
+    // Read as every JSON input is: the size limit, a BOM, duplicate keys refused.
+    let text = crate::input::read_text(path, "baseline")?;
+    let doc = crate::input::json::parse_json(&text, &file)?;
+    let entries = parse_baseline(&doc, &file)?;
+    if entries.is_empty() {
+        return Err(Error::input(&file, "", "the baseline holds no reading with a value, so it would check nothing"));
+    }
+    Ok(entries)
 }
 
 pub fn parse_baseline(doc: &serde_json::Value, file: &str) -> Result<Vec<BaselineEntry>> {
     let bad = |ptr: String, m: &str| Error::input(file, ptr, m.to_string());
+    // A number, or absent / null (no value then); anything else is not a `measure` or `compare` JSON.
+    let number_at = |v: &serde_json::Value, k: &str, ptr: &str| -> Result<Option<f64>> {
+        match v.get(k) {
+            None | Some(serde_json::Value::Null) => Ok(None),
+            Some(x) => x.as_f64().map(Some).ok_or_else(|| bad(format!("{ptr}/{k}"), "expected a number or null")),
+        }
+    };
+    let check_estimate = |e: f64, ptr: &str| -> Result<()> {
+        if e.is_finite() && e >= 0.0 {
+            Ok(())
+        } else {
+            Err(bad(ptr.to_string(), "an error estimate is a finite number ≥ 0"))
+        }
+    };
     let mut out = vec![];
     let str_at = |v: &serde_json::Value, k: &str, ptr: &str| -> Result<String> {
         v.get(k)
@@ -451,11 +469,10 @@ pub fn parse_baseline(doc: &serde_json::Value, file: &str) -> Result<Vec<Baselin
                 Some(m) => m.to_string(),
                 None => top.clone().ok_or_else(|| bad(format!("{ptr}/material"), "no material name"))?,
             };
-            let (Some(value), Some(e)) =
-                (r.get("value").and_then(|v| v.as_f64()), r.get("error_estimate").and_then(|v| v.as_f64()))
-            else {
+            let (Some(value), Some(e)) = (number_at(r, "value", &ptr)?, number_at(r, "error_estimate", &ptr)?) else {
                 continue; // a reading without a value then: nothing to compare with
             };
+            check_estimate(e, &format!("{ptr}/error_estimate"))?;
             out.push(BaselineEntry {
                 material,
                 geometry: str_at(r, "geometry", &ptr)?,
@@ -467,11 +484,11 @@ pub fn parse_baseline(doc: &serde_json::Value, file: &str) -> Result<Vec<Baselin
     } else if let Some(cs) = doc.get("comparisons").and_then(|r| r.as_array()) {
         for (i, c) in cs.iter().enumerate() {
             let ptr = format!("/comparisons/{i}");
-            let (Some(value), Some(e)) =
-                (c.get("predicted").and_then(|v| v.as_f64()), c.get("error_estimate").and_then(|v| v.as_f64()))
+            let (Some(value), Some(e)) = (number_at(c, "predicted", &ptr)?, number_at(c, "error_estimate", &ptr)?)
             else {
                 continue;
             };
+            check_estimate(e, &format!("{ptr}/error_estimate"))?;
             out.push(BaselineEntry {
                 material: str_at(c, "material", &ptr)?,
                 geometry: str_at(c, "geometry", &ptr)?,
