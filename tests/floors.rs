@@ -140,11 +140,12 @@ fn prev_is_ident(b: &[char], i: usize) -> bool {
     i > 0 && (b[i - 1].is_alphanumeric() || b[i - 1] == '_')
 }
 
-/// Removes every `#[cfg(test)]` and `#[cfg(doc)]` item (tests travel with the code they test, and an import
-/// that only a doc link uses is no dependency: neither is part of the floors).
+/// Removes every `#[cfg(test)]` item (tests travel with the code they test and are not part of the floors). A
+/// `#[cfg(doc)]` import stays: it is an import like any other, and a doc link that must not make one names its
+/// target by path instead (`[`X`](super::X)`).
 fn drop_test_items(code: &str) -> String {
     let mut out = code.to_string();
-    while let Some(at) = out.find("#[cfg(test)]").or_else(|| out.find("#[cfg(doc)]")) {
+    while let Some(at) = out.find("#[cfg(test)]") {
         let rest = &out[at..];
         let end = match (rest.find('{'), rest.find(';')) {
             (Some(brace), semi) if semi.is_none_or(|s| brace < s) => {

@@ -1,49 +1,47 @@
-//! [`Rule::LobeDelta`]: the delta limit of a narrow Gaussian-tailed lobe and its majorant, at the
-//! Gauss–Legendre nodes of (t_p, t_q) — the executor ([`lobe_delta`]), the fit at one node ([`delta_fit`],
+//! [`Rule::LobeDelta`](super::Rule::LobeDelta): the delta limit of a narrow Gaussian-tailed lobe and its majorant, at
+//! the Gauss–Legendre nodes of (t_p, t_q) — the executor ([`lobe_delta`]), the fit at one node ([`delta_fit`],
 //! [`DeltaFit`], on the points of [`delta_stencil`]) and the constants of its stencil and bound.
-#[cfg(doc)]
-use super::{design::LOBE_REACH, Rule};
 use crate::quadrature::{legendre_on_into, Estimate, Options};
 
-/// The radii (in lobe widths) of the rings on which [`Rule::LobeDelta`] samples the even part of h (four
-/// directions, 0°, 45°, 90°, 135°, each with its opposite point; with the curvature ring): the majorant's
+/// The radii (in lobe widths) of the rings on which [`Rule::LobeDelta`](super::Rule::LobeDelta) samples the even part
+/// of h (four directions, 0°, 45°, 90°, 135°, each with its opposite point; with the curvature ring): the majorant's
 /// second differences.
 pub const DELTA_RADII: [f64; 2] = [2.5, 5.0];
 
-/// The radius (in lobe widths) of the disc inside which [`Rule::LobeDelta`] bounds the correction by second
-/// differences (in the metric of the fitted curvature B); beyond it the tail, bounded by a Gaussian of the
-/// decay rate measured on that ring ([`DELTA_TAIL_SAFETY`]). It is the last of [`DELTA_RADII`]; the overlap
-/// kinks are ≥ [`LOBE_REACH`] = 8 widths away.
+/// The radius (in lobe widths) of the disc inside which [`Rule::LobeDelta`](super::Rule::LobeDelta) bounds the
+/// correction by second differences (in the metric of the fitted curvature B); beyond it the tail, bounded by a
+/// Gaussian of the decay rate measured on that ring ([`DELTA_TAIL_SAFETY`]). It is the last of [`DELTA_RADII`]; the
+/// overlap kinks are ≥ [`LOBE_REACH`](super::LOBE_REACH) = 8 widths away.
 pub const DELTA_RADIUS: f64 = DELTA_RADII[DELTA_RADII.len() - 1];
 
-/// The factor by which [`Rule::LobeDelta`] multiplies the largest sampled second difference to stand for a
-/// bound over the whole disc: one of the two assumptions of its majorant (`docs/instrument.md` §Quadrature;
+/// The factor by which [`Rule::LobeDelta`](super::Rule::LobeDelta) multiplies the largest sampled second difference to
+/// stand for a bound over the whole disc: one of the two assumptions of its majorant (`docs/instrument.md` §Quadrature;
 /// checked against a stencil of 24 directions × 30 radii by `tests/delta_limit.rs`, where the dense maximum
 /// is at most 1.1× the sampled one).
 pub const DELTA_SAFETY: f64 = 4.0;
 
-/// The factor by which [`Rule::LobeDelta`] divides the decay rate λ of the lobe measured on its outer ring
-/// (the smallest ln(F(0)/F(x))/xᵀBx there) before it bounds the tail beyond the ring by F(0)·e^{−λ·xᵀBx}: the
-/// other assumption of its majorant. (A Gaussian of the fitted curvature, |h| ≤ its largest value on the
+/// The factor by which [`Rule::LobeDelta`](super::Rule::LobeDelta) divides the decay rate λ of the lobe measured on its
+/// outer ring (the smallest ln(F(0)/F(x))/xᵀBx there) before it bounds the tail beyond the ring by F(0)·e^{−λ·xᵀBx}:
+/// the other assumption of its majorant. (A Gaussian of the fitted curvature, |h| ≤ its largest value on the
 /// ring, does not hold: at grazing incidence the lobe's exponent in these variables falls a few per cent
 /// short of xᵀBx at 12 widths, and h = F·e^{xᵀBx} grows there by 100× — measured by the same test.)
 pub const DELTA_TAIL_SAFETY: f64 = 1.25;
 
-/// The Gauss–Legendre orders per t axis of [`Rule::LobeDelta`]: the second-difference stencil on the lower's
-/// nodes, the value on the higher's, their difference the t rule's error.
+/// The Gauss–Legendre orders per t axis of [`Rule::LobeDelta`](super::Rule::LobeDelta): the second-difference stencil
+/// on the lower's nodes, the value on the higher's, their difference the t rule's error.
 pub const DELTA_T_ORDERS: (usize, usize) = (2, 3);
 
-/// The points per t node of [`Rule::LobeDelta`]: the centre and the curvature ring (four directions, both
-/// signs) at the higher order's nodes, and with them the bound's rings at the lower order's.
+/// The points per t node of [`Rule::LobeDelta`](super::Rule::LobeDelta): the centre and the curvature ring (four
+/// directions, both signs) at the higher order's nodes, and with them the bound's rings at the lower order's.
 const DELTA_NODE_POINTS: (usize, usize) = (1 + 8, 1 + 8 * (1 + DELTA_RADII.len()));
 
-/// The evaluations of one [`Rule::LobeDelta`] (181).
+/// The evaluations of one [`Rule::LobeDelta`](super::Rule::LobeDelta) (181).
 pub const DELTA_COST: usize = DELTA_T_ORDERS.1 * DELTA_T_ORDERS.1 * DELTA_NODE_POINTS.0
     + DELTA_T_ORDERS.0 * DELTA_T_ORDERS.0 * DELTA_NODE_POINTS.1;
 const _: () = assert!(DELTA_COST == 181, "the docs and --explain's cost figures say 181");
 
-/// The directions of the stencil of [`Rule::LobeDelta`] in the scaled lobe variables (each with its opposite
-/// point): 0°, 45°, 90°, 135°.
+/// The directions of the stencil of [`Rule::LobeDelta`](super::Rule::LobeDelta) in the scaled lobe variables (each with
+/// its opposite point): 0°, 45°, 90°, 135°.
 pub const DELTA_DIRECTIONS: [[f64; 2]; 4] = [
     [1.0, 0.0],
     [std::f64::consts::FRAC_1_SQRT_2, std::f64::consts::FRAC_1_SQRT_2],
@@ -51,11 +49,12 @@ pub const DELTA_DIRECTIONS: [[f64; 2]; 4] = [
     [-std::f64::consts::FRAC_1_SQRT_2, std::f64::consts::FRAC_1_SQRT_2],
 ];
 
-/// The radius (in lobe widths) of the ring on which [`Rule::LobeDelta`] measures the lobe's curvature.
+/// The radius (in lobe widths) of the ring on which [`Rule::LobeDelta`](super::Rule::LobeDelta) measures the lobe's
+/// curvature.
 pub const DELTA_FIT_RADIUS: f64 = 1.0;
 
-/// Run [`Rule::LobeDelta`]: the delta limit and its majorant (see [`delta_node`]); `converged` when the
-/// majorant meets max(atol, rtol·|I|) in every component. None when an evaluation is not finite, the lobe is
+/// Run [`Rule::LobeDelta`](super::Rule::LobeDelta): the delta limit and its majorant (see [`delta_node`]); `converged`
+/// when the majorant meets max(atol, rtol·|I|) in every component. None when an evaluation is not finite, the lobe is
 /// not log-concave at its peak (the curvature fit fails) or the budget would be exceeded; and the evaluations
 /// spent either way.
 pub(super) fn lobe_delta(
@@ -119,8 +118,8 @@ pub(super) fn lobe_delta(
     (Some(est), cost)
 }
 
-/// One t node of [`Rule::LobeDelta`], relative to π (the caller multiplies by π·w_u·w_v): the delta limit's
-/// mass and (when `radii` holds the bound's rings too) its majorant, from the values `vals` at the centre
+/// One t node of [`Rule::LobeDelta`](super::Rule::LobeDelta), relative to π (the caller multiplies by π·w_u·w_v): the
+/// delta limit's mass and (when `radii` holds the bound's rings too) its majorant, from the values `vals` at the centre
 /// and, per ring of `radii` (the first the curvature ring) and direction of [`DELTA_DIRECTIONS`], the point
 /// and its opposite. None when the values are not positive where the curvature is measured or the fitted
 /// curvature is not positive definite.
@@ -157,7 +156,7 @@ pub(super) fn delta_node(vals: &[f64], radii: &[f64]) -> Option<(f64, f64)> {
     Some((fit.mass(), fit.majorant(DELTA_SAFETY * fit.q, lambda)))
 }
 
-/// What [`Rule::LobeDelta`] measures at one t node ([`delta_fit`]), before its safety factors.
+/// What [`Rule::LobeDelta`](super::Rule::LobeDelta) measures at one t node ([`delta_fit`]), before its safety factors.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct DeltaFit {
     /// The fitted curvature (b_xx, b_yy, b_xy).
@@ -192,8 +191,8 @@ impl DeltaFit {
     }
 }
 
-/// The curvature and the bound's sampled constants at one t node of [`Rule::LobeDelta`] from the values
-/// `vals` on its stencil ([`delta_stencil`] with `radii`; see [`delta_node`] for the formulas). None when
+/// The curvature and the bound's sampled constants at one t node of [`Rule::LobeDelta`](super::Rule::LobeDelta) from
+/// the values `vals` on its stencil ([`delta_stencil`] with `radii`; see [`delta_node`] for the formulas). None when
 /// the values are not positive where the curvature is measured or the fitted curvature is not positive
 /// definite.
 pub fn delta_fit(vals: &[f64], radii: &[f64]) -> Option<DeltaFit> {
@@ -234,9 +233,9 @@ pub fn delta_fit(vals: &[f64], radii: &[f64]) -> Option<DeltaFit> {
     Some(DeltaFit { b: [bxx, byy, bxy], f0, q, lambda, r2 })
 }
 
-/// Append the stencil of one t node (t_p, t_q) of [`Rule::LobeDelta`] to `pts`, in the order [`delta_fit`]
-/// reads it: the centre, then per ring of `radii` (in lobe widths) and direction of [`DELTA_DIRECTIONS`] the
-/// point and its opposite, in the chart (u, t_p, v, t_q) with the lobe widths `width`.
+/// Append the stencil of one t node (t_p, t_q) of [`Rule::LobeDelta`](super::Rule::LobeDelta) to `pts`, in the order
+/// [`delta_fit`] reads it: the centre, then per ring of `radii` (in lobe widths) and direction of [`DELTA_DIRECTIONS`]
+/// the point and its opposite, in the chart (u, t_p, v, t_q) with the lobe widths `width`.
 pub fn delta_stencil(width: [f64; 2], tp: f64, tq: f64, radii: &[f64], pts: &mut Vec<[f64; 4]>) {
     pts.push([0.0, tp, 0.0, tq]);
     for r in radii {
