@@ -214,6 +214,14 @@ fn compute_reading(
     let seconds = used.iter().map(|f| f.seconds).sum();
     let converged = used.iter().all(|f| f.converged);
     let out_of_time = used.iter().any(|f| f.out_of_time);
+    if out_of_time {
+        // A value cut off by the clock would depend on the machine's speed and load: none is reported
+        // (docs/instrument.md §Bounded work).
+        let why = "the wall-clock limit was reached before the tolerance was met; no value is reported, since it \
+                   would depend on the machine's speed and load (the evaluation budget is the deterministic bound)";
+        // The work done is reported as it was: only the value is withheld.
+        return Reading { evaluations, seconds, ..problem_reading(r, why.into()) };
+    }
     let value = match (&r.spec, r.kind) {
         (ReadingSpec::Colour { quantity, terms, white }, WeightingKind::Xyz(cond)) => {
             let (xyz, err) = colour_xyz(terms, *white, &|rx, k| {
@@ -228,16 +236,6 @@ fn compute_reading(
         }
         _ => reading_value(&r.spec, &specimen, &standard),
     };
-    if out_of_time {
-        // A value cut off by the clock would depend on the machine's speed and load: none is reported
-        // (docs/instrument.md §Bounded work).
-        return problem_reading(
-            r,
-            "the wall-clock limit was reached before the tolerance was met; no value is reported, since it would \
-             depend on the machine's speed and load (the evaluation budget is the deterministic bound)"
-                .into(),
-        );
-    }
     match value {
         Ok((v, e)) if v.is_finite() && e.is_finite() => Reading {
             problem: (!converged).then(|| {
