@@ -786,3 +786,64 @@ fn plateau_stops_are_reported_as_plateaus() {
     assert!(r.verdict.iter().any(|l| l.contains("plateau")), "{:?}", r.verdict);
     assert!(r.verdict.iter().any(|l| l.contains("beyond the model's reach")), "{:?}", r.verdict);
 }
+
+/// A user geometry (`--geometry-file`) is a fit target like a shipped one, from `--target` and from a sheet:
+/// readings of GGX α = 0.01 on two user geometries are fitted back from α = 0.03. A geometry file that is
+/// invalid, or a reading the user geometry lacks, is bad input (exit 2, naming the file and field, or the
+/// argument).
+#[test]
+fn cli_user_geometries_are_targets() {
+    let files = ["fixtures/geometry/user-e430-like.json", "fixtures/geometry/user-grazing-89.json"];
+    let truth = recipe::parse_str(&glass("ggx", 0.01, 1.5).to_string(), "truth.json").unwrap();
+    let geos = resolve_geometries(&[] as &[&str], &files.map(|f| root().join(f))).unwrap();
+    let r = measure(&truth, &geos, &PlanOptions { rtol: 1e-10, ..PlanOptions::default() }).unwrap();
+    let value = |g: &str, n: &str| r.iter().find(|x| x.geometry == g && x.name == n).unwrap().value.unwrap();
+    let (doi, gloss) = (value("user-doi-45", "doi-0.5"), value("user-grazing-89", "gloss"));
+    let recipe = tmp("user-geo.json");
+    std::fs::write(&recipe, glass("ggx", 0.03, 1.5).to_string()).unwrap();
+    let base = ["fit", recipe.to_str().unwrap(), "--geometry-file", files[0], "--geometry-file", files[1]];
+    let with = |extra: &[&str]| -> (i32, String, String) {
+        let mut a: Vec<&str> = base.to_vec();
+        a.extend_from_slice(&["--free", "/roughness=log:1e-3..0.5", "--rtol", "1e-6", "--format", "json"]);
+        a.extend_from_slice(extra);
+        glossmeter(&a)
+    };
+    let (t1, t2) = (format!("user-doi-45/doi-0.5={doi}±0.2"), format!("user-grazing-89/gloss={gloss}±0.2"));
+    let (code, stdout, stderr) = with(&["--target", &t1, "--target", &t2]);
+    assert_eq!(code, 0, "{stdout}{stderr}");
+    let v: Value = serde_json::from_str(&stdout).unwrap();
+    assert!((v["parameters"][0]["value"].as_f64().unwrap() - 0.01).abs() < 1e-4, "{v}");
+    assert_eq!(v["targets"][0]["geometry"], "user-doi-45");
+    // The same targets from a sheet in the long layout.
+    let sheet = tmp("user-geo.csv");
+    std::fs::write(
+        &sheet,
+        format!(
+            "geometry,quantity,value,uncertainty\nuser-doi-45,doi-0.5,{doi},0.2\nuser-grazing-89,gloss,{gloss},0.2\n"
+        ),
+    )
+    .unwrap();
+    let (code, stdout, stderr) = with(&["--sheet", sheet.to_str().unwrap()]);
+    assert_eq!(code, 0, "{stdout}{stderr}");
+    let w: Value = serde_json::from_str(&stdout).unwrap();
+    assert_eq!(w["parameters"][0]["value"], v["parameters"][0]["value"], "{w}");
+    // Bad input.
+    let (code, _, stderr) = with(&["--target", "user-doi-45/gloss-20=3"]);
+    assert_eq!(code, 2, "{stderr}");
+    assert!(stderr.contains("--target") && stderr.contains("no reading \"gloss-20\""), "{stderr}");
+    let (code, _, stderr) = with(&["--target", "user-doi-46/gloss=3"]);
+    assert_eq!(code, 2, "{stderr}");
+    assert!(stderr.contains("user-doi-46") && stderr.contains("the user geometries given are user-doi-45"), "{stderr}");
+    let (code, _, stderr) = glossmeter(&[
+        "fit",
+        recipe.to_str().unwrap(),
+        "--geometry-file",
+        "fixtures/geometry/bad-missing-angle.json",
+        "--free",
+        "/roughness=log:1e-3..0.5",
+        "--target",
+        "user-doi-45/gloss=3",
+    ]);
+    assert_eq!(code, 2, "{stderr}");
+    assert!(stderr.contains("bad-missing-angle.json") && stderr.contains("/angle_deg"), "{stderr}");
+}

@@ -33,6 +33,10 @@ pub struct FitArgs {
     /// A sheet column to skip (repeatable), as in `compare`.
     #[arg(long = "ignore-column", value_name = "HEADER", requires = "sheet")]
     pub ignore_columns: Vec<String>,
+    /// A user geometry file (JSON, the format of `measure --geometry-file`) whose readings may be targets,
+    /// named by its id (repeatable).
+    #[arg(long = "geometry-file", value_name = "FILE")]
+    pub geometry_files: Vec<PathBuf>,
     /// Uncertainty of a target given without one, in the reading's unit.
     #[arg(long, default_value_t = fit::DEFAULT_UNCERTAINTY)]
     pub uncertainty: f64,
@@ -80,8 +84,14 @@ pub fn run(a: FitArgs) -> Result<()> {
         None => a.targets.iter().map(|t| TargetReading::parse(t)).collect::<Result<_>>()?,
     };
     let material = recipe::load_file(&a.recipe)?;
-    let options =
-        FitOptions { rtol: a.rtol, default_uncertainty: a.uncertainty, restarts: a.restarts, ..FitOptions::default() };
+    let geometries = crate::resolve_geometries_or::<&str, _>(&[], &a.geometry_files, &[])?;
+    let options = FitOptions {
+        rtol: a.rtol,
+        default_uncertainty: a.uncertainty,
+        restarts: a.restarts,
+        geometries,
+        ..FitOptions::default()
+    };
     let report = fit::fit(&material.json, &material.file, &free, &targets, &options)?;
     let text = match a.format {
         Format::Json => {

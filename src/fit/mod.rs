@@ -78,8 +78,12 @@ pub struct FitOptions {
     pub max_iterations: usize,
     /// For an exactly determined fit (as many targets as free parameters), how many further solver runs
     /// from deterministic starts check that the solution is the only one ([`restart_fractions`]); 0 says
-    /// in the verdict that uniqueness is not checked. Ignored when there are more targets than parameters.
+    /// in the verdict that uniqueness is not checked. With one or two free parameters it also switches the
+    /// scan of the bounds, which seeds restarts for any number of targets (docs/inverse.md §Every root).
     pub restarts: usize,
+    /// User geometries (loaded from geometry files) that targets may name besides the shipped ones; a
+    /// target's geometry id is looked up here first.
+    pub geometries: Vec<StandardGeometry>,
 }
 
 /// Restarts of an exactly determined fit by default.
@@ -92,6 +96,7 @@ impl Default for FitOptions {
             default_uncertainty: DEFAULT_UNCERTAINTY,
             max_iterations: 200,
             restarts: DEFAULT_RESTARTS,
+            geometries: Vec::new(),
         }
     }
 }
@@ -255,7 +260,18 @@ pub fn fit(
     }
     let geometries: Vec<StandardGeometry> = ids
         .iter()
-        .map(|id| planner.geometry(id).map_err(|e| Error::argument("target", format!(" {id:?}: {e}"))))
+        .map(|id| match options.geometries.iter().find(|g| g.geometry.id == *id) {
+            Some(g) => Ok(g.clone()),
+            None => planner.geometry(id).map_err(|e| {
+                let user: Vec<&str> = options.geometries.iter().map(|g| g.geometry.id.as_str()).collect();
+                let also = if user.is_empty() {
+                    String::new()
+                } else {
+                    format!("; the user geometries given are {}", user.join(", "))
+                };
+                Error::argument("target", format!(" {id:?}: {e}{also}"))
+            }),
+        })
         .collect::<Result<_>>()?;
     let plan_options = PlanOptions { rtol: options.rtol, ..PlanOptions::default() };
     // Match every target to a reading of the plan.
