@@ -344,6 +344,9 @@ pub fn fit(
         return Err(Error::Numeric(format!("the start does not evaluate: {e}")));
     }
     let patience = options.max_iterations.div_ceil(n + 1).max(1);
+    // A restart only has to show where its start leads (back here, to another solution, a plateau or a worse
+    // minimum), not to polish it: a quarter of the budget (docs/inverse.md §Every root, docs/performance.md).
+    let restart_patience = patience.div_ceil(RESTART_BUDGET_DIVISOR);
     let main = solve(first, patience);
     let runs_before_restarts = fwd.runs.get();
 
@@ -394,7 +397,7 @@ pub fn fit(
             failed += 1;
             continue;
         }
-        ends.push(solve(p_k, patience));
+        ends.push(solve(p_k, restart_patience));
     }
     let runs_after_restarts = fwd.runs.get();
     // The fit reported is the solver's from the recipe's start, unless a restart reached a clearly lower χ²
@@ -657,7 +660,10 @@ pub fn fit(
             ));
         }
         if worse > 0 {
-            line.push_str(&format!(", {worse} stopped at a worse local minimum"));
+            line.push_str(&format!(
+                ", {worse} stopped at a worse χ² (a local minimum, or the end of a restart's budget, a quarter of the \
+                 fit's)"
+            ));
         }
         if failed > 0 {
             line.push_str(&format!(", {failed} started outside the model's constraints"));
@@ -712,21 +718,33 @@ pub fn fit(
         let log_note =
             if involved.iter().any(|&k| free[k].log) { ", in the logarithm for log: parameters" } else { "" };
         match measured {
-            Some(d) if d >= 1.0 => {
+            // With one parameter a direction seen at the ends of the bounds is an extremum (or a plateau's
+            // edge); with several it may also be a curved valley of equally good fits, which is what it is
+            // taken for when the restarts found another solution.
+            Some(d) if d >= 1.0 && !(n >= 2 && second_solution) => {
                 stationary = true;
                 weak_lines.push(format!(
                     "the readings are stationary at the fit along {} (each Δ in units of its bound width{log_note}): \
                      their local slope times the bound width is {s:.3} of their uncertainty, yet at the ends of the \
                      bounds that way they differ from the fit's by {d:.4} uncertainties; so the targets do see {}, \
-                     and this point is an extremum, a saddle or a plateau of the readings, where the linear error \
+                     and this point is an extremum, a saddle or a plateau of the readings{}, where the linear error \
                      analysis gives no standard error",
                     combo.join(" "),
                     involved.iter().map(|&k| free[k].pointer.as_str()).collect::<Vec<_>>().join(" and "),
+                    if n >= 2 {
+                        ", or lies in a curved valley along which other parameter sets fit as well"
+                    } else {
+                        ""
+                    },
                 ));
             }
             _ => {
                 identifiable = false;
                 let change = match measured {
+                    Some(d) if d >= 1.0 => format!(
+                        "by {s:.3} of their uncertainty to first order (the valley is curved: at the ends of the \
+                         bounds that way they differ by {d:.4}, and the restarts found other solutions along it)"
+                    ),
                     Some(d) => format!("by at most {d:.3} of their uncertainty (at the ends of the bounds)"),
                     None => format!("by {s:.3} of their uncertainty (the local slope times the bound width)"),
                 };
@@ -881,6 +899,9 @@ const SCAN_RTOL: f64 = 1e-3;
 
 /// Points of the scan per fitted variable: 24 for one free parameter, 8 × 8 for two.
 const SCAN_POINTS: [usize; 2] = [24, 8];
+
+/// A restart's evaluation budget is the fit's divided by this.
+const RESTART_BUDGET_DIVISOR: usize = 4;
 
 /// The plateau probe's step, as a fraction of each bound width.
 const PLATEAU_STEP: f64 = 0.05;
