@@ -702,6 +702,22 @@ fn starts_at_the_transforms_fixed_points_and_near_the_bounds_move() {
         assert!((a - want).abs() < 1e-3, "{bounds}: α = {a}");
         assert!(r.targets[0].weighted_residual.abs() < 1e-3, "{bounds}: {r:#?}");
     }
+    // The spectral metallic's pigment concentration, start 1 = √(0.1·10) in log:0.1..10, to L* = 50 at E2194
+    // 45°: the fit moves to ≈ 3.19 (it used to stay at 1 with χ² ≈ 1033).
+    let t = vec![TargetReading {
+        geometry: "astm-e2194-45".into(),
+        name: "L*".into(),
+        value: 50.0,
+        uncertainty: Some(0.2),
+    }];
+    let r = fit_with(
+        &cerulean("blue-metallic-spectral"),
+        &[free("/pigmented_layer/pigments/0/concentration=log:0.1..10")],
+        &t,
+        no_restarts,
+    );
+    assert!(r.ok() && r.targets[0].weighted_residual.abs() < 1e-3, "{r:#?}");
+    assert!((r.parameters[0].value - 3.19).abs() < 0.05, "{}", r.parameters[0].value);
 }
 
 /// cook-torrance-lobes requires Kd + Σ Ks ≤ 1. Bounds on one lobe's Ks that reach past it (0.01..0.9 with
