@@ -188,7 +188,8 @@ pub struct FitReport {
     /// Data Group's scale factor), else 1.
     pub error_scale: f64,
     /// Forward-model runs (each a full set of readings): the solver's points, the Jacobians' displaced
-    /// points, the final Jacobian, the linearity check's and the restarts' (all of them).
+    /// points, the final Jacobian, the linearity check's, the scan's and the restarts' (with their plateau
+    /// probes), and the identifiability probes at the ends of the box (all of them).
     pub evaluations: usize,
     /// Of `evaluations`, the runs of the linearity check (one standard error each way along every
     /// determined direction).
