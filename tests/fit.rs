@@ -75,7 +75,13 @@ fn one_roughness_from_one_gloss() {
     // One target for one parameter: the verdict says so, and the restarts (gloss falls monotonically with the
     // roughness, so there is one solution) all return to it.
     let line = r.verdict.iter().find(|v| v.contains("exactly determined")).expect("an m = n verdict line");
-    assert!(line.contains("2 restart(s)") && line.contains("2 returned to this solution"), "{line}");
+    let restarts: usize = line.split(" restart(s)").next().unwrap().rsplit(' ').next().unwrap().parse().unwrap();
+    assert!(restarts >= 2 && line.contains(&format!("{restarts} returned to this solution")), "{line}");
+    // The scan of the bounds seeded them (its local minima of χ²), topped up by Halton points to 2.
+    assert!(line.contains("of χ² on a scan of the bounds (24 points"), "{line}");
+    assert!(!line.contains("another solution"), "{line}");
+    assert_eq!(r.scan_evaluations, 24, "{r:#?}");
+    assert!(r.reproduces && r.p_value.is_none() && r.dof == 0, "{r:#?}");
     // Without restarts the verdict says uniqueness is not checked, and nothing else changes.
     let r0 = fit(
         &glass("beckmann", 0.12, 1.5),
@@ -317,6 +323,12 @@ fn cli_fits_writes_json_and_never_overwrites() {
             "targets",
             "converged",
             "identifiable",
+            "stationary",
+            "chi2",
+            "dof",
+            "p_value",
+            "reproduces",
+            "error_scale",
             "singular_values",
             "correlation",
             "verdict",
@@ -392,6 +404,91 @@ fn cli_fits_writes_json_and_never_overwrites() {
     ]);
     assert_eq!(code, 1, "{stdout}");
     assert!(stdout.contains("identifiable: NO"), "{stdout}");
+    assert_eq!(v["dof"], 0);
+    assert_eq!(v["p_value"], Value::Null);
+    assert_eq!(v["reproduces"], true);
+}
+
+/// A two-lobe fit whose Ks bounds reach past Kd + Σ Ks ≤ 1 (this one steps outside it) writes its JSON
+/// document and exits 0; readings the model cannot reproduce exit 1 with "cannot reproduce" and the
+/// residuals, the document still written; a recipe that breaks the constraint itself is bad input (exit 2,
+/// naming the file).
+#[test]
+fn cli_constraints_and_goodness_of_fit() {
+    let ct = "fixtures/recipes/cook-torrance-lobes.json";
+    let (code, stdout, stderr) = glossmeter(&[
+        "fit",
+        ct,
+        "--free",
+        "/lobes/1/ks=0.01..0.9",
+        "--target",
+        "astm-d523-60/gloss=40±0.2",
+        "--format",
+        "json",
+        "--rtol",
+        "1e-5",
+    ]);
+    assert_eq!(code, 0, "{stdout}{stderr}");
+    let v: Value = serde_json::from_str(&stdout).unwrap();
+    assert!((v["targets"][0]["predicted"].as_f64().unwrap() - 40.0).abs() < 0.01, "{v}");
+    let (code, stdout, stderr) = glossmeter(&[
+        "fit",
+        ct,
+        "--free",
+        "/lobes/1/ks=0.01..0.9",
+        "--target",
+        "astm-d523-60/gloss=2000±0.2",
+        "--format",
+        "json",
+        "--rtol",
+        "1e-5",
+    ]);
+    assert_eq!(code, 1, "{stdout}{stderr}");
+    let v: Value = serde_json::from_str(&stdout).unwrap();
+    assert_eq!(v["reproduces"], false);
+    assert!(stderr.contains("the model cannot reproduce these readings"), "{stderr}");
+    // Three gloss readings that no roughness reads together (the 60° raised by 15 GU): exit 1, the table
+    // says so with χ², its degrees of freedom and p, and names the largest residual.
+    let recipe = tmp("ggx-goodness.json");
+    std::fs::write(&recipe, glass("ggx", 0.12, 1.5).to_string()).unwrap();
+    let mut g = readings(&glass("ggx", 0.1, 1.5), D523);
+    g[1] += 15.0;
+    let (code, stdout, stderr) = glossmeter(&[
+        "fit",
+        recipe.to_str().unwrap(),
+        "--free",
+        "/roughness=log:1e-3..0.5",
+        "--target",
+        &format!("astm-d523-20/gloss={}±0.2", g[0]),
+        "--target",
+        &format!("astm-d523-60/gloss={}±0.2", g[1]),
+        "--target",
+        &format!("astm-d523-85/gloss={}±0.2", g[2]),
+        "--rtol",
+        "1e-5",
+    ]);
+    assert_eq!(code, 1, "{stdout}{stderr}");
+    assert!(stdout.contains("for 2 degree(s) of freedom, p = "), "{stdout}");
+    assert!(
+        stdout.contains("the model cannot reproduce these readings") && stdout.contains("largest residuals"),
+        "{stdout}"
+    );
+    assert!(stdout.contains("error scale factor S"), "{stdout}");
+    // Kd + Σ Ks = 0.3 + 0.1 + 0.7 > 1 in the recipe itself.
+    let bad = tmp("ct-bad.json");
+    let mut rec: Value = serde_json::from_str(&std::fs::read_to_string(root().join(ct)).unwrap()).unwrap();
+    rec["lobes"][1]["ks"] = json!(0.7);
+    std::fs::write(&bad, rec.to_string()).unwrap();
+    let (code, stdout, stderr) = glossmeter(&[
+        "fit",
+        bad.to_str().unwrap(),
+        "--free",
+        "/lobes/1/ks=0.01..0.9",
+        "--target",
+        "astm-d523-60/gloss=40",
+    ]);
+    assert_eq!(code, 2, "{stdout}{stderr}");
+    assert!(stderr.contains("ct-bad.json") && !stderr.contains("panicked"), "{stderr}");
 }
 
 #[test]
@@ -472,4 +569,297 @@ fn cli_target_errors_escape_the_users_text_and_exit_2() {
         assert!(stderr.contains(want), "{target:?}: {stderr}");
         assert_eq!(stderr.trim_end().lines().count(), 1, "{target:?}: the message spans lines: {stderr}");
     }
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// Goodness of fit, reach, dead starts, constraints, every root (docs/inverse.md §Goodness of fit, §Reach,
+// §Constraints, §Every root)
+// ---------------------------------------------------------------------------------------------------------
+
+/// The chi-square survival function against closed forms: ν = 2, Q = e^{−x/2}; ν = 4, Q = (1 + x/2)e^{−x/2};
+/// ν = 1, Q = erfc(√(x/2)); ν = 3, Q = erfc(√(x/2)) + √(2x/π) e^{−x/2} (Abramowitz & Stegun 26.4.4, 26.4.5);
+/// no degrees of freedom, no p-value.
+#[test]
+fn chi_square_survival_matches_closed_forms() {
+    use glossmeter::fit::chi2_survival;
+    for &x in &[1e-6, 0.01, 0.3, 1.0, 2.0, 4.9, 5.1, 10.0, 40.0, 200.0, 1400.0] {
+        let rel = |got: f64, want: f64| ((got - want) / want).abs();
+        let e = (-x / 2.0f64).exp();
+        let erfc = libm::erfc((x / 2.0f64).sqrt());
+        let q2 = chi2_survival(x, 2).unwrap();
+        assert!(rel(q2, e) < 1e-12, "ν=2, χ²={x}: {q2} vs {e}");
+        let q4 = chi2_survival(x, 4).unwrap();
+        assert!(rel(q4, (1.0 + x / 2.0) * e) < 1e-12, "ν=4, χ²={x}: {q4}");
+        let q1 = chi2_survival(x, 1).unwrap();
+        assert!(rel(q1, erfc) < 1e-11, "ν=1, χ²={x}: {q1} vs {erfc}");
+        let q3 = chi2_survival(x, 3).unwrap();
+        let w3 = erfc + (2.0 * x / std::f64::consts::PI).sqrt() * e;
+        assert!(rel(q3, w3) < 1e-11, "ν=3, χ²={x}: {q3} vs {w3}");
+    }
+    assert_eq!(chi2_survival(0.0, 3), Some(1.0));
+    assert_eq!(chi2_survival(1.0, 0), None);
+    assert!(glossmeter::fit::gamma_q(-1.0, 1.0).is_nan());
+}
+
+/// Against scipy 1.17.1 (`fixtures/reference/chi2-survival.json`, written by `tools/ref_chi2_survival.py`),
+/// from ν = 1 to 200 and into tails of 1e-200, where 1 − P would cancel.
+#[test]
+fn chi_square_survival_matches_scipy() {
+    let v: Value =
+        serde_json::from_str(&std::fs::read_to_string(root().join("fixtures/reference/chi2-survival.json")).unwrap())
+            .unwrap();
+    let cases = v["cases"].as_array().unwrap();
+    assert!(cases.len() > 100);
+    for c in cases {
+        let (dof, x, p) = (c["dof"].as_u64().unwrap() as usize, c["chi2"].as_f64().unwrap(), c["p"].as_f64().unwrap());
+        let got = glossmeter::fit::chi2_survival(x, dof).unwrap();
+        assert!(((got - p) / p).abs() < 1e-10, "ν={dof}, χ²={x}: {got} vs scipy {p}");
+    }
+}
+
+fn fit_with(start: &Value, free_: &[FreeParameter], t: &[TargetReading], options: FitOptions) -> FitReport {
+    fit(start, "start.json", free_, t, &options).unwrap()
+}
+
+fn loose(rtol: f64) -> FitOptions {
+    FitOptions { rtol, ..FitOptions::default() }
+}
+
+/// Readings no roughness can make together (a GGX α = 0.1 surface's 20/60/85° gloss with the 60° raised by
+/// 15 GU, ± 0.2): the fit ends at its best compromise, but χ² is improbable for its 2 degrees of freedom, so
+/// the verdict says the model cannot reproduce the readings, names the target with the largest residual,
+/// and the fit is not one to trust. The error scale factor is stated.
+#[test]
+fn a_fit_the_model_cannot_reproduce_says_so() {
+    let mut v = readings(&glass("ggx", 0.1, 1.5), D523);
+    v[1] += 15.0;
+    let r =
+        fit_with(&glass("ggx", 0.12, 1.5), &[free("/roughness=log:1e-3..0.5")], &targets(D523, &v, 0.2), loose(1e-5));
+    assert!(r.converged, "{r:#?}");
+    assert_eq!(r.dof, 2);
+    let p = r.p_value.unwrap();
+    assert!(p < glossmeter::fit::P_THRESHOLD, "{r:#?}");
+    // ν = 2: the closed form.
+    assert!((p - (-r.chi2 / 2.0).exp()).abs() <= 1e-12 * p.max(1e-300), "{p} {}", r.chi2);
+    assert!(!r.reproduces && !r.ok(), "{r:#?}");
+    let line = r.verdict.iter().find(|l| l.contains("the model cannot reproduce these readings")).expect("verdict");
+    assert!(
+        line.contains("2 degree(s) of freedom") && line.contains("largest residuals: astm-d523-60/gloss"),
+        "{line}"
+    );
+    assert!((r.error_scale - (r.chi2 / 2.0).sqrt()).abs() < 1e-12 * r.error_scale, "{}", r.error_scale);
+    // The same readings, unshifted: the model reproduces them, p is probable and nothing is scaled.
+    let v = readings(&glass("ggx", 0.1, 1.5), D523);
+    let r =
+        fit_with(&glass("ggx", 0.12, 1.5), &[free("/roughness=log:1e-3..0.5")], &targets(D523, &v, 0.2), loose(1e-5));
+    assert!(r.reproduces && r.ok() && r.p_value.unwrap() > 0.5 && r.error_scale == 1.0, "{r:#?}");
+}
+
+/// ISO 13803 haze 8 HU on a Beckmann dielectric, whose haze peaks at ≈ 5.09 HU: the solver parks at the
+/// maximum. The exactly determined fit misses its target by ~58 uncertainties, so it does not reproduce the
+/// readings; the target is said to be beyond the model's reach, with the largest reading found and where;
+/// the roughness is not called "not determined" (the readings are stationary there, and change by ~100
+/// uncertainties across the bounds).
+#[test]
+fn a_target_beyond_reach_is_reported_as_such_not_as_undetermined() {
+    let start = cerulean("rough-dielectric-beckmann");
+    let t = vec![TargetReading {
+        geometry: "iso-13803-20".into(),
+        name: "haze".into(),
+        value: 8.0,
+        uncertainty: Some(0.05),
+    }];
+    let r = fit_with(&start, &[free("/roughness=log:0.001..0.5")], &t, loose(1e-5));
+    assert!(!r.reproduces && !r.ok(), "{r:#?}");
+    assert!(r.stationary, "{r:#?}");
+    assert!(!r.verdict.iter().any(|l| l.contains("not determined")), "{:?}", r.verdict);
+    let reach = r.verdict.iter().find(|l| l.contains("beyond the model's reach")).expect("a reach line");
+    assert!(reach.contains("iso-13803-20/haze = 8") && reach.contains("largest reading"), "{reach}");
+    // The maximum of the haze over the roughness, 5.0–5.1 HU near m = 0.0215, is where the fit stops.
+    let m = r.parameters[0].value;
+    assert!((0.018..0.026).contains(&m), "{m}");
+    assert!((5.0..5.15).contains(&r.targets[0].predicted), "{r:#?}");
+    assert!(r.targets[0].weighted_residual < -50.0);
+}
+
+/// A start at the midpoint of the bounds (the sine transform's u = 0), at the geometric mean of `log:`
+/// bounds (the same point in ln x) and next to either bound: each fit moves and converges to the exact
+/// solution, restarts off. GGX α ≈ 0.2474 reads 3 GU at 60° (below the start α = 0.3); for the start next to
+/// the lower bound the target is the reading of α = 0.5 (above it).
+#[test]
+fn starts_at_the_transforms_fixed_points_and_near_the_bounds_move() {
+    let g05 = readings(&glass("ggx", 0.5, 1.5), G60)[0];
+    let no_restarts = FitOptions { rtol: 1e-5, restarts: 0, ..FitOptions::default() };
+    for (bounds, target, want) in [
+        ("/roughness=0.1..0.5", 3.0, 0.2474),
+        ("/roughness=log:0.09..1", 3.0, 0.2474),
+        ("/roughness=0.05..0.30001", 3.0, 0.2474),
+        ("/roughness=0.29999..0.9", g05, 0.5),
+    ] {
+        let r = fit_with(&glass("ggx", 0.3, 1.5), &[free(bounds)], &targets(G60, &[target], 0.2), no_restarts.clone());
+        assert!(r.ok(), "{bounds}: {r:#?}");
+        let a = r.parameters[0].value;
+        assert!((a - want).abs() < 1e-3, "{bounds}: α = {a}");
+        assert!(r.targets[0].weighted_residual.abs() < 1e-3, "{bounds}: {r:#?}");
+    }
+    // The spectral metallic's pigment concentration, start 1 = √(0.1·10) in log:0.1..10, to L* = 50 at E2194
+    // 45°: the fit moves to ≈ 3.19 (it used to stay at 1 with χ² ≈ 1033).
+    let t = vec![TargetReading {
+        geometry: "astm-e2194-45".into(),
+        name: "L*".into(),
+        value: 50.0,
+        uncertainty: Some(0.2),
+    }];
+    let r = fit_with(
+        &cerulean("blue-metallic-spectral"),
+        &[free("/pigmented_layer/pigments/0/concentration=log:0.1..10")],
+        &t,
+        no_restarts,
+    );
+    assert!(r.ok() && r.targets[0].weighted_residual.abs() < 1e-3, "{r:#?}");
+    assert!((r.parameters[0].value - 3.19).abs() < 0.05, "{}", r.parameters[0].value);
+}
+
+/// cook-torrance-lobes requires Kd + Σ Ks ≤ 1. Bounds on one lobe's Ks that reach past it (0.01..0.9 with
+/// Kd = 0.3 and the other lobe 0.1) no longer abort the fit: a trial point outside the constraint is
+/// refused and the search stays inside. A reachable target is fitted; an unreachable one (more gloss than
+/// any allowed Ks gives) ends inside the constraint with its report, not reproducing the readings.
+#[test]
+fn constraints_between_parameters_never_abort_the_fit() {
+    let start = cerulean("cook-torrance-lobes");
+    let f = [free("/lobes/1/ks=0.01..0.9")];
+    let r = fit_with(&start, &f, &targets(G60, &[40.0], 0.2), loose(1e-5));
+    assert!(r.ok(), "{r:#?}");
+    assert!(r.targets[0].weighted_residual.abs() < 1e-3);
+    let r = fit_with(&start, &f, &targets(G60, &[2000.0], 0.2), loose(1e-5));
+    assert!(!r.reproduces && !r.ok(), "{r:#?}");
+    let ks = r.parameters[0].value;
+    let kd_max = 0.3;
+    assert!(ks + 0.1 + kd_max <= 1.0 + 1e-12, "the final point leaves the constraint: ks = {ks}");
+    assert!(r.verdict.iter().any(|l| l.contains("outside the model's constraints")), "{:?}", r.verdict);
+}
+
+/// E430 haze-narrow = 0.6 HU on a Beckmann dielectric has two roots either side of its ≈ 0.96 HU maximum at
+/// m ≈ 0.017 (0.0119 and 0.0324). With the default options the scan of the bounds seeds a restart in each
+/// basin, so the fit finds both and says the targets do not single out one recipe.
+#[test]
+fn the_scan_finds_both_roots_of_haze_narrow() {
+    let start = cerulean("rough-dielectric-beckmann");
+    let t = vec![TargetReading {
+        geometry: "astm-e430-30".into(),
+        name: "haze-narrow".into(),
+        value: 0.6,
+        uncertainty: Some(0.02),
+    }];
+    let r = fit_with(&start, &[free("/roughness=log:0.001..0.5")], &t, loose(1e-5));
+    assert!(r.reproduces && !r.identifiable && !r.ok(), "{r:#?}");
+    let m = r.parameters[0].value;
+    let line = r.verdict.iter().find(|l| l.contains("another solution")).expect("a second solution");
+    let other: f64 = line.split("/roughness = ").nth(1).unwrap().split(' ').next().unwrap().parse().unwrap();
+    let (lo, hi) = if m < other { (m, other) } else { (other, m) };
+    assert!((lo - 0.01186).abs() < 3e-4 && (hi - 0.03241).abs() < 6e-4, "roots {lo}, {hi}: {line}");
+    // Both reproduce the target (checked by an independent forward run at each).
+    for root in [lo, hi] {
+        let mut rec = start.clone();
+        rec["roughness"] = json!(root);
+        let h = readings(&rec, &[("astm-e430-30", "haze-narrow")])[0];
+        assert!((h - 0.6).abs() < 0.02, "haze-narrow {h} at m = {root}");
+    }
+}
+
+/// A conductor's reflectance at 60° has a minimum in n near 1.7 (k = 1), so a 60° gloss is read by two n.
+/// From a start on one side the scan's restarts find the root on the other.
+#[test]
+fn the_scan_finds_both_roots_of_a_conductors_index() {
+    let truth = json!({"model": "conductor", "ior": [2.5, 1.0]});
+    let v = readings(&truth, G60);
+    let start = json!({"model": "conductor", "ior": [3.5, 1.0]});
+    let r = fit_with(&start, &[free("/ior/0=0.5..4")], &targets(G60, &v, 0.2), loose(1e-6));
+    assert!(r.reproduces && !r.identifiable, "{r:#?}");
+    let line = r.verdict.iter().find(|l| l.contains("another solution")).expect("a second solution");
+    let other: f64 = line.split("/ior/0 = ").nth(1).unwrap().split(' ').next().unwrap().parse().unwrap();
+    let n = r.parameters[0].value;
+    let (lo, hi) = if n < other { (n, other) } else { (other, n) };
+    assert!((hi - 2.5).abs() < 0.01 && lo < 1.7, "roots {lo}, {hi}");
+    let mut rec = start.clone();
+    rec["ior"][0] = json!(lo);
+    assert!((readings(&rec, G60)[0] - v[0]).abs() < 0.2, "the other root does not read the target");
+}
+
+/// The smooth limit of GGX reads ≈ 89.1 GU at 60°: a 99.9 GU target is out of reach, the fit stops on the
+/// plateau of tiny roughness, and restarts that stop on that plateau are called plateaus, not solutions
+/// that fit as well.
+#[test]
+fn plateau_stops_are_reported_as_plateaus() {
+    let r = fit_with(
+        &glass("ggx", 0.3, 1.5),
+        &[free("/roughness=log:1e-9..0.5")],
+        &targets(G60, &[99.9], 0.2),
+        FitOptions { rtol: 1e-5, restarts: 3, ..FitOptions::default() },
+    );
+    assert!(!r.reproduces && !r.ok(), "{r:#?}");
+    assert!(!r.verdict.iter().any(|l| l.contains("another solution")), "{:?}", r.verdict);
+    assert!(r.verdict.iter().any(|l| l.contains("plateau")), "{:?}", r.verdict);
+    assert!(r.verdict.iter().any(|l| l.contains("beyond the model's reach")), "{:?}", r.verdict);
+}
+
+/// A user geometry (`--geometry-file`) is a fit target like a shipped one, from `--target` and from a sheet:
+/// readings of GGX α = 0.01 on two user geometries are fitted back from α = 0.03. A geometry file that is
+/// invalid, or a reading the user geometry lacks, is bad input (exit 2, naming the file and field, or the
+/// argument).
+#[test]
+fn cli_user_geometries_are_targets() {
+    let files = ["fixtures/geometry/user-e430-like.json", "fixtures/geometry/user-grazing-89.json"];
+    let truth = recipe::parse_str(&glass("ggx", 0.01, 1.5).to_string(), "truth.json").unwrap();
+    let geos = resolve_geometries(&[] as &[&str], &files.map(|f| root().join(f))).unwrap();
+    let r = measure(&truth, &geos, &PlanOptions { rtol: 1e-10, ..PlanOptions::default() }).unwrap();
+    let value = |g: &str, n: &str| r.iter().find(|x| x.geometry == g && x.name == n).unwrap().value.unwrap();
+    let (doi, gloss) = (value("user-doi-45", "doi-0.5"), value("user-grazing-89", "gloss"));
+    let recipe = tmp("user-geo.json");
+    std::fs::write(&recipe, glass("ggx", 0.03, 1.5).to_string()).unwrap();
+    let base = ["fit", recipe.to_str().unwrap(), "--geometry-file", files[0], "--geometry-file", files[1]];
+    let with = |extra: &[&str]| -> (i32, String, String) {
+        let mut a: Vec<&str> = base.to_vec();
+        a.extend_from_slice(&["--free", "/roughness=log:1e-3..0.5", "--rtol", "1e-6", "--format", "json"]);
+        a.extend_from_slice(extra);
+        glossmeter(&a)
+    };
+    let (t1, t2) = (format!("user-doi-45/doi-0.5={doi}±0.2"), format!("user-grazing-89/gloss={gloss}±0.2"));
+    let (code, stdout, stderr) = with(&["--target", &t1, "--target", &t2]);
+    assert_eq!(code, 0, "{stdout}{stderr}");
+    let v: Value = serde_json::from_str(&stdout).unwrap();
+    assert!((v["parameters"][0]["value"].as_f64().unwrap() - 0.01).abs() < 1e-4, "{v}");
+    assert_eq!(v["targets"][0]["geometry"], "user-doi-45");
+    // The same targets from a sheet in the long layout.
+    let sheet = tmp("user-geo.csv");
+    std::fs::write(
+        &sheet,
+        format!(
+            "geometry,quantity,value,uncertainty\nuser-doi-45,doi-0.5,{doi},0.2\nuser-grazing-89,gloss,{gloss},0.2\n"
+        ),
+    )
+    .unwrap();
+    let (code, stdout, stderr) = with(&["--sheet", sheet.to_str().unwrap()]);
+    assert_eq!(code, 0, "{stdout}{stderr}");
+    let w: Value = serde_json::from_str(&stdout).unwrap();
+    assert_eq!(w["parameters"][0]["value"], v["parameters"][0]["value"], "{w}");
+    // Bad input.
+    let (code, _, stderr) = with(&["--target", "user-doi-45/gloss-20=3"]);
+    assert_eq!(code, 2, "{stderr}");
+    assert!(stderr.contains("--target") && stderr.contains("no reading \"gloss-20\""), "{stderr}");
+    let (code, _, stderr) = with(&["--target", "user-doi-46/gloss=3"]);
+    assert_eq!(code, 2, "{stderr}");
+    assert!(stderr.contains("user-doi-46") && stderr.contains("the user geometries given are user-doi-45"), "{stderr}");
+    let (code, _, stderr) = glossmeter(&[
+        "fit",
+        recipe.to_str().unwrap(),
+        "--geometry-file",
+        "fixtures/geometry/bad-missing-angle.json",
+        "--free",
+        "/roughness=log:1e-3..0.5",
+        "--target",
+        "user-doi-45/gloss=3",
+    ]);
+    assert_eq!(code, 2, "{stderr}");
+    assert!(stderr.contains("bad-missing-angle.json") && stderr.contains("/angle_deg"), "{stderr}");
 }

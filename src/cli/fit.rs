@@ -33,6 +33,10 @@ pub struct FitArgs {
     /// A sheet column to skip (repeatable), as in `compare`.
     #[arg(long = "ignore-column", value_name = "HEADER", requires = "sheet")]
     pub ignore_columns: Vec<String>,
+    /// A user geometry file (JSON, the format of `measure --geometry-file`) whose readings may be targets,
+    /// named by its id (repeatable).
+    #[arg(long = "geometry-file", value_name = "FILE")]
+    pub geometry_files: Vec<PathBuf>,
     /// Uncertainty of a target given without one, in the reading's unit.
     #[arg(long, default_value_t = fit::DEFAULT_UNCERTAINTY)]
     pub uncertainty: f64,
@@ -80,8 +84,14 @@ pub fn run(a: FitArgs) -> Result<()> {
         None => a.targets.iter().map(|t| TargetReading::parse(t)).collect::<Result<_>>()?,
     };
     let material = recipe::load_file(&a.recipe)?;
-    let options =
-        FitOptions { rtol: a.rtol, default_uncertainty: a.uncertainty, restarts: a.restarts, ..FitOptions::default() };
+    let geometries = crate::resolve_geometries_or::<&str, _>(&[], &a.geometry_files, &[])?;
+    let options = FitOptions {
+        rtol: a.rtol,
+        default_uncertainty: a.uncertainty,
+        restarts: a.restarts,
+        geometries,
+        ..FitOptions::default()
+    };
     let report = fit::fit(&material.json, &material.file, &free, &targets, &options)?;
     let text = match a.format {
         Format::Json => {
@@ -99,6 +109,9 @@ pub fn run(a: FitArgs) -> Result<()> {
     }
     if !report.ok() {
         let mut why = Vec::new();
+        if !report.reproduces {
+            why.push("the model cannot reproduce these readings");
+        }
         if !report.converged {
             why.push("it did not converge");
         }
@@ -107,6 +120,9 @@ pub fn run(a: FitArgs) -> Result<()> {
         }
         if !report.identifiable {
             why.push("the targets do not determine every parameter");
+        }
+        if report.stationary {
+            why.push("the readings are stationary at the fit");
         }
         return Err(Error::Check(format!("the fit is not to be trusted: {}", why.join("; "))));
     }
@@ -128,7 +144,14 @@ fn table(name: &str, r: &FitReport, timing: bool) -> String {
         parts.push(format!("{} for the linearity check", r.linearity_evaluations));
     }
     if r.restart_evaluations > 0 {
-        parts.push(format!("{} for the restarts", r.restart_evaluations));
+        parts.push(if r.scan_evaluations > 0 {
+            format!(
+                "{} for the scan of the bounds and the restarts ({} for the scan)",
+                r.restart_evaluations, r.scan_evaluations
+            )
+        } else {
+            format!("{} for the restarts", r.restart_evaluations)
+        });
     }
     if !parts.is_empty() {
         s.push_str(&format!(" (of which {})", parts.join(", ")));
@@ -169,7 +192,22 @@ fn table(name: &str, r: &FitReport, timing: bool) -> String {
             t.weighted_residual
         ));
     }
-    s.push_str(&format!("\nχ² = {:.4}\n", r.chi2));
+    s.push_str(&format!("\nχ² = {:.4} for {} degree(s) of freedom", r.chi2, r.dof));
+    match r.p_value {
+        Some(p) => s.push_str(&format!(", p = {p:.3e}")),
+        None => s.push_str(" (exactly determined: every target must be reached within its uncertainty)"),
+    }
+    s.push_str(&format!(
+        "; reproduces the readings: {}\n",
+        if r.reproduces { "yes" } else { "NO: the model cannot reproduce these readings" }
+    ));
+    if r.error_scale > 1.0 {
+        s.push_str(&format!(
+            "standard errors scaled by the error scale factor S = √(χ²/dof) = {:.4} (the residuals scatter more \
+             than the uncertainties say)\n",
+            r.error_scale
+        ));
+    }
     s.push_str(&format!(
         "singular values of the weighted Jacobian (columns × bound width): {}\n",
         r.singular_values.iter().map(|v| format!("{v:.4e}")).collect::<Vec<_>>().join(", ")
@@ -184,7 +222,11 @@ fn table(name: &str, r: &FitReport, timing: bool) -> String {
     }
     s.push_str(&format!(
         "identifiable: {}\n",
-        if r.identifiable { "yes: the targets determine every parameter" } else { "NO" }
+        match (r.identifiable, r.stationary) {
+            (true, false) => "yes: the targets determine every parameter",
+            (true, true) => "NO: the targets see every parameter, but the readings are stationary at the fit",
+            (false, _) => "NO",
+        }
     ));
     for v in &r.verdict {
         s.push_str(&format!("  - {v}\n"));

@@ -21,6 +21,8 @@ pub(super) struct Forward<'a> {
     pub(super) planner: Planner,
     pub(super) geometries: Vec<StandardGeometry>,
     pub(super) options: PlanOptions,
+    /// The options of the scan's runs ([`Mode::Scan`]): the fit's, at a looser tolerance.
+    pub(super) scan_options: PlanOptions,
     /// Index of each target in the plan's readings.
     pub(super) index: Vec<usize>,
     pub(super) runs: std::cell::Cell<usize>,
@@ -34,6 +36,9 @@ pub(super) enum Mode<'p> {
     /// material at the displaced point has another shape than the centre's (another kind of term), so the
     /// frozen methods do not apply to it.
     Frozen(&'p Plan),
+    /// Adaptively at the scan's loose tolerance (`Forward::scan_options`), keeping nothing: the coarse scan of
+    /// the bounds that seeds the restarts (docs/inverse.md §Every root).
+    Scan,
 }
 
 /// Predictions (value, error estimate) of the targets, and the frozen plan of a `Mode::Freeze` run.
@@ -70,6 +75,9 @@ impl Forward<'_> {
                 Ok(p) => (p.execute(), None),
                 Err(_) => return Ok(None),
             },
+            Mode::Scan => {
+                (self.planner.compile(brdf, self.geometries.clone(), self.scan_options.clone())?.execute(), None)
+            }
         };
         let mut out = Vec::with_capacity(self.index.len());
         for &i in &self.index {
@@ -110,9 +118,49 @@ pub(super) struct Problem<'a> {
     /// The current point (computed in `set_params`), or the error that prevented it.
     pub(super) current: std::result::Result<Current, String>,
     pub(super) last_error: std::cell::RefCell<Option<String>>,
+    /// Trial points refused because the recipe does not evaluate there (outside the model's constraints).
+    pub(super) refused: std::cell::Cell<usize>,
 }
 
+/// The origin of the solver's variable u: t = a + (b − a)(1 + sin u)/2 maps u = U_ORIGIN + asin(2(t − a)/(b − a)
+/// − 1) to t. MINPACK's first trust region and its xtol test are relative to the scaled norm ‖D u‖, which is
+/// zero at u = 0; with the sine's own origin the midpoint of every bound (u = 0) would be a start that never
+/// moves. Shifting u by a whole period, 2π, changes no t and keeps ‖D u‖ ≥ (3π/2)·‖D‖ for every start
+/// (docs/inverse.md §Method, "Variables").
+pub(super) const U_ORIGIN: f64 = 2.0 * std::f64::consts::PI;
+
+/// The solver's variable u of a fitted value t in the bounds [a, b] of t.
+pub(super) fn u_of_t(t: f64, (a, b): (f64, f64)) -> f64 {
+    U_ORIGIN + (2.0 * (t - a) / (b - a) - 1.0).clamp(-1.0, 1.0).asin()
+}
+
+/// A residual of this size (in uncertainties) stands for a trial point outside the model's constraints: a
+/// barrier. It is finite, and ten times any residual norm a point inside could have is below it, so the
+/// Levenberg–Marquardt step is refused (its actual reduction is −1) and the trust region shrinks, which keeps
+/// the search inside the constraints without ever ending it (docs/inverse.md §Constraints).
+const BARRIER: f64 = 1e100;
+
 impl Problem<'_> {
+    /// The problem at the start u0 (its point evaluated; see `current`).
+    pub(super) fn new<'a>(
+        fwd: &'a Forward<'a>,
+        targets: &'a [TargetReading],
+        u_sigma: &[f64],
+        u0: &DVector<f64>,
+    ) -> Problem<'a> {
+        let mut p = Problem {
+            fwd,
+            targets,
+            u_sigma: u_sigma.to_vec(),
+            u: u0.clone(),
+            current: Err(String::new()),
+            last_error: std::cell::RefCell::new(None),
+            refused: std::cell::Cell::new(0),
+        };
+        p.set_params(u0);
+        p
+    }
+
     pub(super) fn t_of_u(&self, u: &DVector<f64>) -> Vec<f64> {
         self.fwd
             .free
@@ -146,37 +194,36 @@ impl Problem<'_> {
     /// The step balances the O(h²) truncation of a central difference against the O(ε/h) error of the
     /// readings, ε their largest relative error estimate: h = ε^{1/3}·scale. A displaced point outside the
     /// bounds, or whose material has another shape (the frozen methods do not apply), is replaced by the
-    /// centre (a one-sided difference); a parameter with neither side usable is an error.
-    pub(super) fn jacobian_t(&self, t: &[f64], centre: &[(f64, f64)], frozen: &Plan) -> Result<DMatrix<f64>> {
+    /// centre (a one-sided difference), and so is one that does not evaluate (outside the model's constraints,
+    /// Kd + ΣKs ≤ 1 and the like); a parameter with neither side usable gets a zero column and is listed in the
+    /// second value (docs/inverse.md §Method, "Jacobian").
+    pub(super) fn jacobian_t(&self, t: &[f64], centre: &[(f64, f64)], frozen: &Plan) -> (DMatrix<f64>, Vec<usize>) {
         let m = centre.len();
         let n = t.len();
         let eps = centre.iter().map(|&(v, e)| e / v.abs().max(1e-300)).fold(1e-13, f64::max).min(1e-2);
         let mut j = DMatrix::zeros(m, n);
+        let mut dead = Vec::new();
         for k in 0..n {
             let p = &self.fwd.free[k];
             let (a, b) = p.t_bounds();
             let scale = if p.log { 1.0 } else { t[k].abs().max(1e-3 * (b - a)) };
             let h = (eps.cbrt() * scale).clamp(1e-9 * (b - a), 0.05 * (b - a));
-            let eval = |tk: f64| -> Result<Option<Vec<(f64, f64)>>> {
+            let eval = |tk: f64| -> Option<Vec<(f64, f64)>> {
                 if !(a..=b).contains(&tk) {
-                    return Ok(None);
+                    return None;
                 }
                 let mut tt = t.to_vec();
                 tt[k] = tk;
-                Ok(self.fwd.run(&self.x_of_t(&tt), Mode::Frozen(frozen))?.map(|r| r.0))
+                self.fwd.run(&self.x_of_t(&tt), Mode::Frozen(frozen)).ok().flatten().map(|r| r.0)
             };
-            let (lo, hi) = (eval(t[k] - h)?, eval(t[k] + h)?);
+            let (lo, hi) = (eval(t[k] - h), eval(t[k] + h));
             let (f_lo, t_lo, f_hi, t_hi) = match (lo, hi) {
                 (Some(l), Some(u)) => (l, t[k] - h, u, t[k] + h),
                 (Some(l), None) => (l, t[k] - h, centre.to_vec(), t[k]),
                 (None, Some(u)) => (centre.to_vec(), t[k], u, t[k] + h),
                 (None, None) => {
-                    return Err(Error::Numeric(format!(
-                        "{}: the Jacobian has no usable point on either side of {} (step {h:e} in the fitted \
-                         variable): the material changes kind there",
-                        p.pointer,
-                        p.x_of(t[k])
-                    )))
+                    dead.push(k);
+                    continue;
                 }
             };
             for i in 0..m {
@@ -184,7 +231,7 @@ impl Problem<'_> {
                 j[(i, k)] = (f_hi[i].0 - f_lo[i].0) / (t_hi - t_lo) / s;
             }
         }
-        Ok(j)
+        (j, dead)
     }
 }
 
@@ -211,8 +258,11 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_> {
         match &self.current {
             Ok(c) => Some(self.weighted(&c.predictions)),
             Err(e) => {
+                // A trial point that does not evaluate: the barrier, so the step is refused (see BARRIER).
                 *self.last_error.borrow_mut() = Some(e.clone());
-                None
+                self.refused.set(self.refused.get() + 1);
+                let m = self.targets.len();
+                Some(DVector::from_element(m, BARRIER / (m as f64).sqrt()))
             }
         }
     }
@@ -220,21 +270,13 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_> {
     fn jacobian(&self) -> Option<DMatrix<f64>> {
         let c = self.current.as_ref().ok()?;
         let t = self.t_of_u(&self.u);
-        match self.jacobian_t(&t, &c.predictions, &c.frozen) {
-            Ok(jt) => {
-                // Chain rule: dt/du = (b − a)/2 · cos u.
-                let mut ju = jt;
-                for (k, p) in self.fwd.free.iter().enumerate() {
-                    let (a, b) = p.t_bounds();
-                    let d = 0.5 * (b - a) * self.u[k].cos();
-                    ju.column_mut(k).scale_mut(d);
-                }
-                Some(ju)
-            }
-            Err(e) => {
-                *self.last_error.borrow_mut() = Some(e.to_string());
-                None
-            }
+        let (mut ju, _) = self.jacobian_t(&t, &c.predictions, &c.frozen);
+        // Chain rule: dt/du = (b − a)/2 · cos u.
+        for (k, p) in self.fwd.free.iter().enumerate() {
+            let (a, b) = p.t_bounds();
+            let d = 0.5 * (b - a) * self.u[k].cos();
+            ju.column_mut(k).scale_mut(d);
         }
+        Some(ju)
     }
 }

@@ -182,13 +182,14 @@ pub fn sweep() -> Value {
 pub fn fit() -> Value {
     let num = json!({"type": "number"});
     let stderr = json!({"type": ["number", "null"], "minimum": 0,
-                        "description": "null when the targets do not determine the parameter"});
+                        "description": "null when the linear error analysis gives none (the targets do not determine the parameter, or the readings are stationary there)"});
     json!({
         "$schema": DRAFT,
         "title": "glossmeter fit --format json",
         "type": "object",
-        "required": ["parameters", "targets", "converged", "identifiable", "singular_values", "correlation",
-                     "verdict", "evaluations", "seconds", "recipe"],
+        "required": ["parameters", "targets", "converged", "identifiable", "stationary", "chi2", "dof", "p_value",
+                     "reproduces", "error_scale", "singular_values", "correlation", "verdict", "evaluations",
+                     "seconds", "recipe"],
         "additionalProperties": false,
         "properties": {
             "parameters": {"type": "array", "minItems": 1, "items": {"type": "object", "additionalProperties": false,
@@ -203,6 +204,16 @@ pub fn fit() -> Value {
                 "residual": {"type": ["number", "null"], "description": "predicted − measured"}}}},
             "converged": {"type": "boolean"},
             "identifiable": {"type": "boolean"},
+            "stationary": {"type": "boolean",
+              "description": "the readings are stationary at the fit in a direction the targets see (an extremum or a saddle): no standard error there"},
+            "chi2": {"type": ["number", "null"], "minimum": 0, "description": "Σ of the weighted residuals squared"},
+            "dof": {"type": "integer", "minimum": 0, "description": "degrees of freedom: targets − free parameters"},
+            "p_value": {"type": ["number", "null"], "minimum": 0, "maximum": 1,
+              "description": "chi-square survival function Q(dof/2, χ²/2); null when dof = 0"},
+            "reproduces": {"type": "boolean",
+              "description": "goodness of fit: p ≥ 0.001, or with dof = 0 every target within its uncertainty"},
+            "error_scale": {"type": ["number", "null"], "minimum": 1,
+              "description": "the factor on the standard errors, √(χ²/dof) when above 1 (PDG scale factor), else 1"},
             "singular_values": {"type": "array", "items": {"type": ["number", "null"], "minimum": 0},
               "description": "of the weighted Jacobian, columns scaled by the bound widths, largest first"},
             "correlation": {"type": "array", "items": {"type": "array", "items": num_or_null()}},
