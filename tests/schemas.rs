@@ -166,7 +166,8 @@ fn outputs_follow_their_schemas() {
         assert_valid(&s, &serde_json::from_str(line).unwrap(), line);
     }
     // fit: one roughness to one gloss (exactly determined), with and without timing; two parameters of which
-    // the targets see one (an undetermined standard error, a null); a fit that hits a bound.
+    // the targets see one (an undetermined standard error, a null); a fit that hits a bound; a fit that
+    // cannot run.
     let f = schema("fit");
     let rough = "fixtures/recipes/rough-dielectric-beckmann.json";
     for args in [
@@ -208,6 +209,17 @@ fn outputs_follow_their_schemas() {
             "json",
         ],
         &["fit", rough, "--free", "/roughness=0.05..0.5", "--target", "astm-d523-60/gloss=99±0.2", "--format", "json"],
+        // A fit that cannot run (the hue of a grey has no value): the failure document, exit 1.
+        &[
+            "fit",
+            "fixtures/recipes/grey-lambert.json",
+            "--free",
+            "/albedo=0.1..0.9",
+            "--target",
+            "astm-e2539-15/h=30±1",
+            "--format",
+            "json",
+        ],
     ] {
         let (code, out) = gm(args);
         assert!(code == 0 || code == 1, "{args:?}: exit {code}");

@@ -92,7 +92,16 @@ pub fn run(a: FitArgs) -> Result<()> {
         geometries,
         ..FitOptions::default()
     };
-    let report = fit::fit(&material.json, &material.file, &free, &targets, &options)?;
+    let report = match fit::fit(&material.json, &material.file, &free, &targets, &options) {
+        Ok(report) => report,
+        // A fit that cannot run still writes its document, with the failure in it (then exits 1).
+        Err(Error::Numeric(why)) if a.format == Format::Json => {
+            let doc = crate::report::fit::failure_json(&free, &targets, &why);
+            print(&(serde_json::to_string_pretty(&doc).unwrap_or_default() + "\n"))?;
+            return Err(Error::Numeric(why));
+        }
+        Err(e) => return Err(e),
+    };
     let text = match a.format {
         Format::Json => {
             serde_json::to_string_pretty(&crate::report::fit::json(&report, !a.no_timing))

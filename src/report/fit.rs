@@ -2,7 +2,7 @@
 //! recipe as JSON. The table for people is the command line's.
 use serde_json::{json, Value};
 
-use crate::fit::FitReport;
+use crate::fit::{FitReport, FreeParameter, TargetReading};
 
 /// A finite number, or null.
 fn num(x: f64) -> Value {
@@ -39,5 +39,20 @@ pub fn json(r: &FitReport, timing: bool) -> Value {
         "evaluations": r.evaluations,
         "seconds": if timing { num(r.seconds) } else { Value::Null },
         "recipe": r.recipe,
+    })
+}
+
+/// The document of a fit that could not run to a report (its start or its final point has no finite
+/// readings): the failure, and what was asked, so that `fit --format json` always writes a document
+/// (docs/inverse.md §Verdicts and exit statuses; the schema is the second form of [`super::schema::fit`]).
+pub fn failure_json(free: &[FreeParameter], targets: &[TargetReading], failure: &str) -> Value {
+    json!({
+        "converged": false,
+        "failure": failure,
+        "parameters": free.iter().map(|p| json!({"path": p.pointer, "lower": p.lower, "upper": p.upper}))
+            .collect::<Vec<_>>(),
+        "targets": targets.iter().map(|t| json!({
+            "geometry": t.geometry, "name": t.name, "measured": t.value, "uncertainty": t.uncertainty,
+        })).collect::<Vec<_>>(),
     })
 }

@@ -183,9 +183,7 @@ pub fn fit() -> Value {
     let num = json!({"type": "number"});
     let stderr = json!({"type": ["number", "null"], "minimum": 0,
                         "description": "null when the linear error analysis gives none (the targets do not determine the parameter, or the readings are stationary there)"});
-    json!({
-        "$schema": DRAFT,
-        "title": "glossmeter fit --format json",
+    let report = json!({
         "type": "object",
         "required": ["parameters", "targets", "converged", "identifiable", "stationary", "chi2", "dof", "p_value",
                      "reproduces", "error_scale", "singular_values", "correlation", "verdict", "evaluations",
@@ -223,5 +221,23 @@ pub fn fit() -> Value {
             "seconds": {"type": ["number", "null"], "minimum": 0, "description": "null with --no-timing"},
             "recipe": {"type": "object", "description": "the recipe with the fitted values"},
         },
-    })
+    });
+    // A fit that could not run to a report (its start or final point has no finite readings; exit 1).
+    let failure = json!({
+        "type": "object",
+        "required": ["converged", "failure", "parameters", "targets"],
+        "additionalProperties": false,
+        "properties": {
+            "converged": {"enum": [false]},
+            "failure": {"type": "string", "description": "why the fit could not run"},
+            "parameters": {"type": "array", "items": {"type": "object", "additionalProperties": false,
+              "required": ["path", "lower", "upper"],
+              "properties": {"path": {"type": "string"}, "lower": num, "upper": num}}},
+            "targets": {"type": "array", "items": {"type": "object", "additionalProperties": false,
+              "required": ["geometry", "name", "measured", "uncertainty"],
+              "properties": {"geometry": {"type": "string"}, "name": {"type": "string"}, "measured": num,
+                "uncertainty": {"type": ["number", "null"], "minimum": 0}}}},
+        },
+    });
+    json!({"$schema": DRAFT, "title": "glossmeter fit --format json", "oneOf": [report, failure]})
 }
