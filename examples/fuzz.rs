@@ -48,6 +48,9 @@ struct Tally {
     slowest_case: f64,
 }
 
+/// A case slower than this is named on stderr (not a failure).
+const SLOW_S: f64 = 20.0;
+
 /// A measurement slower than this is reported as a hang. The default options bound every integral by its
 /// evaluation budget (deterministic), not by time: a measured table whose integrals all run to 2·10⁶ evaluations
 /// takes tens of seconds on a loaded machine (49 s seen at a load of ≈ 4 on 2 cores), so the bound is that of a
@@ -162,6 +165,10 @@ fn main() {
             }
         }
         let dt = t0.elapsed().as_secs_f64();
+        if dt > SLOW_S {
+            let shown: String = text.chars().take(400).collect();
+            eprintln!("SLOW case {k} ({}): {dt:.1} s: {shown}", cat.name());
+        }
         t.seconds += dt;
         t.slowest_case = t.slowest_case.max(dt);
         if (k + 1) % 10_000 == 0 {

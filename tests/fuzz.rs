@@ -273,3 +273,56 @@ fn an_empty_sweep_shard_is_no_lost_file() {
     let n = "18446744073709551615";
     assert!(!fuzz_cases::sweep_shard_is_empty(&args(&["sweep", "t.json", "--lhs", n, "--shard", &format!("{n}/{n}")])));
 }
+
+/// Run the binary on `args` (in the crate root), killed after `secs`: the exit code, or None if it was still
+/// running.
+fn run_for(args: &[&str], secs: f64) -> Option<i32> {
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_glossmeter"))
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let t0 = std::time::Instant::now();
+    loop {
+        if let Some(s) = child.try_wait().unwrap() {
+            return s.code();
+        }
+        if t0.elapsed().as_secs_f64() > secs {
+            let _ = child.kill();
+            let _ = child.wait();
+            return None;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+}
+
+/// Found by the extended campaign's tables on the command line: `plot --kind section` of a table whose largest
+/// value is subnormal (1e-320: the log axis' floor, 10⁻⁶ of it, is 0) or near the top of f64 (1e308: the axis'
+/// top, 3× it, is infinite) never ended. The axis is now kept within the normal finite numbers.
+#[test]
+fn a_section_plot_of_an_extreme_table_ends() {
+    for (name, value) in [("subnormal", "1e-320"), ("huge", "1e308"), ("zero", "0")] {
+        let table = fuzz_cases::scratch(&format!("section-{name}.csv"));
+        let mut text = String::from("theta_i,theta_o,brdf\n");
+        for ti in [20, 60] {
+            for to in -89..90 {
+                text.push_str(&format!("{ti},{to},{value}\n"));
+            }
+        }
+        std::fs::write(&table, text).unwrap();
+        let recipe = fuzz_cases::scratch(&format!("section-{name}.json"));
+        let json = serde_json::json!({"model": "inplane-csv", "file": table.to_string_lossy()});
+        std::fs::write(&recipe, json.to_string()).unwrap();
+        let svg = fuzz_cases::scratch(&format!("section-{name}.svg"));
+        let _ = std::fs::remove_file(&svg);
+        let args =
+            ["plot", recipe.to_str().unwrap(), "--kind", "section", "-g", "astm-d523-60", "-o", svg.to_str().unwrap()];
+        assert_eq!(run_for(&args, 60.0), Some(0), "{name}: {args:?}");
+        assert!(std::fs::metadata(&svg).unwrap().len() > 0, "{name}");
+        for f in [table, recipe, svg] {
+            let _ = std::fs::remove_file(f);
+        }
+    }
+}

@@ -209,8 +209,10 @@ fn draw_sections<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, name: &str, p
     let areas = root.split_evenly((panels.len(), 1));
     for (area, p) in areas.iter().zip(panels) {
         let max = p.curve.iter().map(|c| c.1).fold(0.0f64, f64::max);
-        let floor = if max > 0.0 { max * 1e-6 } else { 1e-6 };
-        let top = if max > 0.0 { max * 3.0 } else { 1.0 };
+        // The log axis within the normal finite numbers: a floor of 0 (10⁻⁶ of a subnormal maximum) or an
+        // infinite top (3× a maximum near f64::MAX) made plotters' log scale loop for ever.
+        let floor = if max > 0.0 { (max * 1e-6).max(f64::MIN_POSITIVE) } else { 1e-6 };
+        let top = if max > 0.0 { (max * 3.0).min(f64::MAX).max(floor * 10.0) } else { 1.0 };
         let (x0, x1) = (p.curve[0].0, p.curve[p.curve.len() - 1].0);
         let mut chart = ChartBuilder::on(area)
             .caption(format!("{name}: in-plane section, {} (θi = {}°)", p.id, p.angle), ("sans-serif", 18))

@@ -742,6 +742,12 @@ pub fn generate_registry_recipe(rng: &mut Rng) -> String {
 /// A random MERL `.binary` (small or nonsense dimensions; exact, short or long bodies; values finite,
 /// negative, NaN or infinite) written to a scratch file, and a recipe that reads it.
 pub fn generate_merl(rng: &mut Rng) -> String {
+    let bytes = merl_bytes(rng);
+    table_recipe("merl", &bytes, "binary", rng)
+}
+
+/// The bytes of a random MERL `.binary` ([`generate_merl`]).
+pub fn merl_bytes(rng: &mut Rng) -> Vec<u8> {
     let dim = |rng: &mut Rng| -> i32 {
         match rng.below(20) {
             0 => 0,
@@ -772,10 +778,7 @@ pub fn generate_merl(rng: &mut Rng) -> String {
     if rng.chance(0.05) {
         bytes.truncate(rng.below(12));
     }
-    let path = scratch(&format!("merl-{:016x}.binary", rng.next()));
-    std::fs::write(&path, &bytes).unwrap();
-    let interpolation = rng.pick(&["nearest", "trilinear", "nearest", "cubic"]);
-    serde_json::json!({"model": "merl", "file": path.to_string_lossy(), "interpolation": interpolation}).to_string()
+    bytes
 }
 
 // ---------------------------------------------------------------------------------------------------------
@@ -1061,7 +1064,9 @@ fn inplane_rows(rng: &mut Rng) -> Vec<(String, String, String)> {
     let mut rows = Vec::new();
     // Two tables in five have bad cells.
     let bad = rng.chance(0.4);
+    // A constant: a Lambertian level, or one at the ends of f64 (0, subnormal, near the largest).
     let flat = rng.chance(0.2);
+    let level = *rng.pick(&[0.3, 0.3, 0.3, 0.0, 1e-320, 1e-300, 1e300, 1e308]);
     let width = *rng.pick(&[0.5, 2.0, 5.0, 20.0]);
     for _ in 0..1 + rng.below(3) {
         let ti: f64 = *rng.pick(&[0.0, 10.0, 15.0, 20.0, 30.0, 45.0, 60.0, 75.0, 80.0, 85.0, 89.9, 90.0, -1.0]);
@@ -1070,7 +1075,7 @@ fn inplane_rows(rng: &mut Rng) -> Vec<(String, String, String)> {
             *rng.pick(&[(-89.0, 89.0), (-89.0, 89.0), (0.0, 89.0), (-60.0, 60.0), (-90.0, 90.0), (10.0, 30.0)]);
         for j in 0..k {
             let to = if k == 1 { lo } else { lo + (hi - lo) * j as f64 / (k - 1) as f64 };
-            let v = if flat { 0.3 } else { 0.05 + 50.0 * (-((to - ti) / width).powi(2)).exp() };
+            let v = if flat { level } else { 0.05 + 50.0 * (-((to - ti) / width).powi(2)).exp() };
             rows.push((table_cell(rng, ti, bad), table_cell(rng, to, bad), table_cell(rng, v, bad)));
         }
         if rng.chance(0.05) && !rows.is_empty() {
@@ -1445,7 +1450,8 @@ fn cli_value(opt: &str, rng: &mut Rng) -> String {
 
 /// One random argument vector (without the program name), as a JSON array of strings. Paths are relative to
 /// the crate root (the process runs there); `@NEW` stands for a fresh scratch path (`@NEW.svg` with that
-/// extension), `@FILE:TEXT` for a scratch file holding TEXT. `cheap`: the readings get a small budget first
+/// extension), `@FILE:TEXT` for a scratch file holding TEXT, `@TABLE:MODEL:HEX` for a recipe of MODEL reading a
+/// scratch table of those bytes. `cheap`: the readings get a small budget first
 /// (`--max-seconds 1` for `measure`, `--rtol 1e-3` for `compare`, `--rtol 1e-2 --max-evals 20000` and at most
 /// 3 values per axis for `sweep`, `--rtol 1e-2 --restarts 0` for `fit`, `--rtol 1e-2 --points 2` for `plot`,
 /// `--rtol 1e-2` for `profile`; a second budget given at random is then a usage error, exit 2), so that 10⁴
@@ -1588,6 +1594,20 @@ pub fn generate_cli(rng: &mut Rng, cheap: bool) -> String {
                 } else {
                     rng.pick(ranges).to_string()
                 }
+            };
+            // Now and then `measure`, `plot` and `profile` read a generated table (written with its recipe
+            // when the case runs: `@TABLE:MODEL:HEX`).
+            let recipe = if matches!(sub, "measure" | "plot" | "profile") && rng.chance(0.15) {
+                let (model, bytes) = match rng.below(4) {
+                    0 => ("inplane-csv", generate_inplane(rng).into_bytes()),
+                    1 => ("e1392", generate_e1392(rng).into_bytes()),
+                    2 => ("rgl", generate_rgl(rng)),
+                    _ => ("merl", merl_bytes(rng)),
+                };
+                let hex: String = bytes.iter().map(|b| format!("{b:02x}")).collect();
+                format!("@TABLE:{model}:{hex}")
+            } else {
+                recipe
             };
             a.push(recipe);
             if tame && slow {
@@ -1780,6 +1800,23 @@ pub fn run_cli(text: &str) -> Result<Outcome, String> {
                 let _ = std::fs::remove_file(&p);
                 new_files.push(p.clone());
                 p.to_string_lossy().into_owned()
+            } else if let Some((model, hex)) = a.strip_prefix("@TABLE:").and_then(|t| t.split_once(':')) {
+                let ext = match model {
+                    "inplane-csv" => "csv",
+                    "e1392" => "txt",
+                    "rgl" => "bsdf",
+                    _ => "binary",
+                };
+                let bytes: Vec<u8> =
+                    (0..hex.len() / 2).map(|i| u8::from_str_radix(&hex[2 * i..2 * i + 2], 16).unwrap()).collect();
+                let table = scratch(&format!("cli-{n}-table.{ext}"));
+                std::fs::write(&table, bytes).unwrap();
+                let recipe = scratch(&format!("cli-{n}-table.json"));
+                let json = serde_json::json!({"model": model, "file": table.to_string_lossy()});
+                std::fs::write(&recipe, json.to_string()).unwrap();
+                written.push(table);
+                written.push(recipe.clone());
+                recipe.to_string_lossy().into_owned()
             } else if let Some(text) = a.strip_prefix("@FILE:") {
                 let p = scratch(&format!("cli-{n}-in-{}.json", written.len()));
                 std::fs::write(&p, text).unwrap();
