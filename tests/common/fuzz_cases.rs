@@ -1595,9 +1595,10 @@ pub fn generate_cli(rng: &mut Rng, cheap: bool) -> String {
                     rng.pick(ranges).to_string()
                 }
             };
-            // Now and then `measure`, `plot` and `profile` read a generated table (written with its recipe
-            // when the case runs: `@TABLE:MODEL:HEX`).
-            let recipe = if matches!(sub, "measure" | "plot" | "profile") && rng.chance(0.15) {
+            // Now and then `measure` and `plot` read a generated table (written with its recipe when the case
+            // runs: `@TABLE:MODEL:HEX`). Not `profile`: it has no evaluation budget of its own (`--max-evals`),
+            // and 512 pixels of a table that does not converge run for minutes (80 s seen), docs/reliability.md.
+            let recipe = if matches!(sub, "measure" | "plot") && rng.chance(0.15) {
                 let (model, bytes) = match rng.below(4) {
                     0 => ("inplane-csv", generate_inplane(rng).into_bytes()),
                     1 => ("e1392", generate_e1392(rng).into_bytes()),
