@@ -300,12 +300,20 @@ fn run_for(args: &[&str], secs: f64) -> Option<i32> {
 
 /// Found by the extended campaign's tables on the command line: `plot --kind section` of a table whose largest
 /// value is subnormal (1e-320: the log axis' floor, 10⁻⁶ of it, is 0) or near the top of f64 (1e308: the axis'
-/// top, 3× it, is infinite) never ended. The axis is now kept within the normal finite numbers.
+/// top, 3× it, is infinite) never ended, and one with an infinite value ran out of memory. The axis is now kept
+/// within the normal finite numbers.
 #[test]
 fn a_section_plot_of_an_extreme_table_ends() {
-    for (name, value) in [("subnormal", "1e-320"), ("huge", "1e308"), ("zero", "0")] {
+    // brdf_cos of 1e308 is an infinite f_r near grazing (f_r = value / cos θo): the 10⁶-case run's case 200999,
+    // an RGL table with an infinite value, made plotters' log scale push key points until memory ran out.
+    for (name, value, column) in [
+        ("subnormal", "1e-320", "brdf"),
+        ("huge", "1e308", "brdf"),
+        ("zero", "0", "brdf"),
+        ("infinite", "1e308", "brdf_cos"),
+    ] {
         let table = fuzz_cases::scratch(&format!("section-{name}.csv"));
-        let mut text = String::from("theta_i,theta_o,brdf\n");
+        let mut text = format!("theta_i,theta_o,{column}\n");
         for ti in [20, 60] {
             for to in -89..90 {
                 text.push_str(&format!("{ti},{to},{value}\n"));
@@ -322,6 +330,37 @@ fn a_section_plot_of_an_extreme_table_ends() {
         assert_eq!(run_for(&args, 60.0), Some(0), "{name}: {args:?}");
         assert!(std::fs::metadata(&svg).unwrap().len() > 0, "{name}");
         for f in [table, recipe, svg] {
+            let _ = std::fs::remove_file(f);
+        }
+    }
+}
+
+/// Found beside the campaign (the same log/linear axis pattern as the section plot): `compare --plot` of a
+/// sheet reading 1e308 ± 1e308 never ended (the axis' top, value + uncertainty + 5 % padding, is infinite).
+#[test]
+fn a_comparison_plot_of_extreme_values_ends() {
+    for (name, rows) in [
+        ("top", "s,astm-d523-60,gloss,1e308,1e308\n"),
+        ("both", "s,astm-d523-60,gloss,-1e308,1\ns,astm-d523-20,gloss,1e308,1\n"),
+        ("above", "s,astm-d523-60,gloss,1e308,1\n"),
+    ] {
+        let sheet = fuzz_cases::scratch(&format!("cmp-{name}.csv"));
+        std::fs::write(&sheet, format!("sample,geometry,quantity,value,uncertainty\n{rows}")).unwrap();
+        let svg = fuzz_cases::scratch(&format!("cmp-{name}.svg"));
+        let _ = std::fs::remove_file(&svg);
+        let args = [
+            "compare",
+            "fixtures/recipes/grey-lambert.json",
+            sheet.to_str().unwrap(),
+            "--rtol",
+            "1e-3",
+            "--plot",
+            svg.to_str().unwrap(),
+        ];
+        let code = run_for(&args, 60.0);
+        assert!(matches!(code, Some(0 | 1)), "{name}: {code:?} {args:?}");
+        assert!(std::fs::metadata(&svg).unwrap().len() > 0, "{name}");
+        for f in [sheet, svg] {
             let _ = std::fs::remove_file(f);
         }
     }
