@@ -37,7 +37,18 @@ pub type Result<T> = std::result::Result<T, Error>;
 /// checker, tests/common/fuzz_cases.rs) can tell an echoed input from a computed NaN (`docs/reliability.md` §The
 /// checks).
 pub fn given(x: f64) -> String {
-    format!("`{x}`")
+    format!("`{}`", number(x))
+}
+
+/// A number for a message or a description: its shortest round-trip digits, plain in the everyday range
+/// [10⁻⁶, 10¹⁵) and in scientific notation outside it, so that 1e300 is not printed with all its 301 digits
+/// nor 1e-300 with 300 zeros (`docs/instrument.md` §Numbers in text).
+pub fn number(x: f64) -> String {
+    if x.is_finite() && x != 0.0 && !(1e-6..1e15).contains(&x.abs()) {
+        format!("{x:e}")
+    } else {
+        format!("{x}")
+    }
 }
 
 /// The words of a message that names arguments of a call (a sweep's `vary`, a fit's `target`, a comparison's

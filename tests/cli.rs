@@ -273,3 +273,42 @@ fn a_baseline_that_checks_nothing_never_passes() {
     assert_eq!(code, Some(2), "{err}");
     assert!(err.contains("check nothing"), "{err}");
 }
+
+/// Numbers past 10¹⁵ (and tiny ones) are written in scientific notation in tables, CSV, descriptions and
+/// messages, never as 300 digits (`docs/instrument.md` §Numbers in text).
+#[test]
+fn huge_and_tiny_numbers_are_printed_in_scientific_notation() {
+    let tiny = write("tiny-albedo.json", r#"{"model":"lambert","albedo":1e-300}"#);
+    let (code, out, _) = stderr_of(&["measure", &tiny, "-g", "astm-d523-60", "--no-timing"]);
+    assert_eq!(code, Some(0));
+    assert!(out.contains("Lambert (albedo 1e-300)"), "{out}");
+    let (code, _, err) = stderr_of(&["measure", &tiny, "-g", "astm-d523-60", "--rtol", "1e-300"]);
+    assert_eq!(code, Some(2));
+    assert!(err.contains("`1e-300`") && err.len() < 400, "{err}");
+    // A table whose one cell is 1e300, inside the 60° receptor: a reading of order 1e298 GU.
+    let mut rows = String::from("QUANTITY: BRDF\ntheta_i phi_i theta_s phi_s BRDF\n");
+    for ts in (0..90).step_by(2) {
+        let v = if ts == 60 { 1e300 } else { 0.02 };
+        rows.push_str(&format!("60 0 {ts} 180 {v:e}\n"));
+    }
+    write("huge-cell.txt", &rows);
+    let recipe = write("huge-cell.json", r#"{"model":"e1392","file":"huge-cell.txt"}"#);
+    for format in ["table", "csv"] {
+        let (code, out, _) = stderr_of(&[
+            "measure",
+            &recipe,
+            "-g",
+            "astm-d523-60",
+            "--max-evals",
+            "20000",
+            "--format",
+            format,
+            "--no-timing",
+        ]);
+        assert!(matches!(code, Some(0 | 1)), "{format}: {out}");
+        let rows = out.lines().filter(|l| l.starts_with("astm-d523-60"));
+        let longest = rows.flat_map(|l| l.split([',', ' '])).map(str::len).max().unwrap();
+        assert!(longest < 40, "{format}: a field of {longest} characters:\n{out}");
+        assert!(out.contains("e29") || out.contains("e30"), "{format}: {out}");
+    }
+}

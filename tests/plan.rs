@@ -263,3 +263,23 @@ fn the_planner_names_the_shaped_rule_it_chooses_and_freezes_it() {
     let paint = Plan::compile(fixture("cerulean-blue-c-literal.json"), g, PlanOptions::default()).unwrap();
     assert!(!paint.explain().contains("Gauss–Hermite"), "a lobe over a diffuse body keeps the adaptive rule");
 }
+
+/// Why a reading did not converge is named truly (docs/instrument.md §Bounded work): a frozen plan run on a
+/// material far from the one it was frozen on misses its tolerance with no budget involved, and says so; a
+/// plan that runs out of evaluations says that.
+#[test]
+fn an_unconverged_reading_names_its_true_cause() {
+    let geometry = vec![standards::find("astm-d523-60").unwrap()];
+    let options = PlanOptions { rtol: 1e-6, max_seconds: None, ..PlanOptions::default() };
+    let wide: Arc<dyn Brdf> = Arc::new(TestBeckmann { m: 0.5, n: 1.5, s: Sampling::grey() });
+    let narrow: Arc<dyn Brdf> = Arc::new(TestBeckmann { m: 0.01, n: 1.5, s: Sampling::grey() });
+    let (_, frozen) = Plan::compile(wide, geometry.clone(), options.clone()).unwrap().freeze();
+    let far = frozen.with_material(narrow.clone()).unwrap().execute();
+    assert!(!far[0].converged, "{:?}", far[0]);
+    let why = far[0].problem.as_deref().unwrap();
+    assert!(why.contains("frozen method") && !why.contains("budget exhausted"), "{why}");
+    let starved = PlanOptions { max_evals: 2_000, ..options };
+    let short = Plan::compile(narrow, geometry, starved).unwrap().execute();
+    assert!(!short[0].converged);
+    assert!(short[0].problem.as_deref().unwrap().contains("evaluation budget exhausted"), "{:?}", short[0]);
+}

@@ -72,7 +72,7 @@ fn the_planner_chooses_the_tensor_rule_for_b4_and_names_it() {
     assert!(text.contains("smooth integrand: tensor Gauss–Legendre in (p_s, p_r, v, t_q)"), "{text}");
     assert!(text.contains("fallback: Genz–Malik 7/5"), "{text}");
     let r = &plan.execute()[0];
-    assert!(r.converged && r.evaluations < 2_639, "{r:?}");
+    assert!(r.converged, "{r:?}");
     // An independent value: the Genz–Malik engine forced on the same integral, far tighter.
     let geo = &g85.geometry;
     let rec = *geo.receptor("gloss").unwrap();
@@ -86,6 +86,16 @@ fn the_planner_chooses_the_tensor_rule_for_b4_and_names_it() {
     let actual = (ours.value[0] - tight.value[0]).abs();
     assert!(actual <= ours.error[0] + tight.error[0], "actual {actual:e}, estimate {:e}", ours.error[0]);
     assert!(ours.error[0] <= 1e-6 * ours.value[0]);
+    // Cheaper than the Genz–Malik partition it replaces, at the same tolerance.
+    let mut plain = Method::for_material(b4.as_ref(), geo.theta, geo.source, rec, (1e-6, 0.0), 10_000_000).unwrap();
+    plain.regular.as_mut().unwrap().rule = Rule::GenzMalik75;
+    let plain = plain.execute(b4.as_ref());
+    assert!(
+        ours.evaluations < plain.evaluations,
+        "tensor {} against Genz–Malik {}",
+        ours.evaluations,
+        plain.evaluations
+    );
     // Frozen, and thread counts.
     let (first, frozen) = plan.freeze();
     let again = frozen.execute();

@@ -162,8 +162,8 @@ impl MicrofacetSurface {
 /// "Beckmann m = 0.1" / "GGX α = 0.1".
 pub(crate) fn describe_facets(f: &Microfacet) -> String {
     match f.distribution {
-        Distribution::Beckmann => format!("Beckmann m = {}", f.alpha),
-        Distribution::Ggx => format!("GGX α = {}", f.alpha),
+        Distribution::Beckmann => format!("Beckmann m = {}", crate::error::number(f.alpha)),
+        Distribution::Ggx => format!("GGX α = {}", crate::error::number(f.alpha)),
     }
 }
 

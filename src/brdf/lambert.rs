@@ -52,8 +52,8 @@ impl Brdf for Lambert {
 /// Format per-sample values compactly: one number, or `[a, b, c]`.
 pub(crate) fn fmt_values(v: &[f64]) -> String {
     if v.len() == 1 {
-        format!("{}", v[0])
+        crate::error::number(v[0])
     } else {
-        format!("[{}]", v.iter().map(|x| format!("{x}")).collect::<Vec<_>>().join(", "))
+        format!("[{}]", v.iter().map(|&x| crate::error::number(x)).collect::<Vec<_>>().join(", "))
     }
 }

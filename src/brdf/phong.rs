@@ -111,7 +111,7 @@ impl Brdf for Phong {
         if self.kd.iter().any(|&k| k > 0.0) {
             t.push(Term { label: "Lambertian".into(), kind: TermKind::Diffuse });
         }
-        let label = format!("{} lobe (n = {})", self.name(), self.exponent);
+        let label = format!("{} lobe (n = {})", self.name(), crate::error::number(self.exponent));
         t.push(Term {
             label: label.clone(),
             kind: TermKind::Lobe(Lobe {

@@ -76,7 +76,7 @@ impl Brdf for Ward {
         if self.rho_d.iter().any(|&k| k > 0.0) {
             t.push(Term { label: "Lambertian".into(), kind: TermKind::Diffuse });
         }
-        let label = format!("Ward lobe (α = {})", self.alpha);
+        let label = format!("Ward lobe (α = {})", crate::error::number(self.alpha));
         t.push(Term {
             label: label.clone(),
             kind: TermKind::Lobe(Lobe { slope_width: self.alpha, medium_eta: 1.0, label, tail: super::Tail::Gaussian }),

@@ -20,7 +20,7 @@ pub fn table(materials: &[Material], readings: &[Vec<Reading>], timing: bool) ->
             let mut row = vec![m.name.clone(), r.geometry.clone(), r.name.clone()];
             match r.value {
                 Some(v) => {
-                    row.push(format!("{:.*}", report::decimals(r.error_estimate), v));
+                    row.push(report::shown(v, report::decimals(r.error_estimate)));
                     row.push(r.unit.clone());
                     row.push(format!("{:.1e}", r.error_estimate));
                 }

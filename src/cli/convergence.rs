@@ -139,7 +139,7 @@ pub fn table(material: &Material, sweep: &Sweep) -> String {
     let mut notes = Vec::new();
     for r in &sweep.rows {
         let value = match r.value {
-            Some(v) => format!("{:.*}", decimals(r.error_estimate.map(|e| e.min(r.actual_error.unwrap_or(e)))), v),
+            Some(v) => crate::report::shown(v, decimals(r.error_estimate.map(|e| e.min(r.actual_error.unwrap_or(e))))),
             None => "—".into(),
         };
         let mark = if r.converged { "" } else { " *" };

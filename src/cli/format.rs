@@ -5,7 +5,7 @@ use crate::cli::common::pad_table;
 use crate::instrument::envelope::Envelope;
 use crate::instrument::plan::Reading;
 use crate::recipe::Material;
-use crate::report::decimals;
+use crate::report::{decimals, shown};
 
 /// A duration for people: µs, ms or s.
 pub fn secs(s: f64) -> String {
@@ -31,7 +31,7 @@ pub fn table(material: &Material, readings: &[Reading], timing: bool) -> String 
         match r.value {
             Some(v) => {
                 // A value that rounds to zero is shown as 0.0, never "-0.0" (a compensated haze of −1e-15).
-                let shown = format!("{:.*}", decimals(r.error_estimate), v);
+                let shown = shown(v, decimals(r.error_estimate));
                 let shown = if shown.trim_start_matches('-').chars().all(|c| c == '0' || c == '.') {
                     shown.trim_start_matches('-').to_string()
                 } else {

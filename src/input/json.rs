@@ -136,14 +136,9 @@ pub fn number_in(file: &str, path: &str, v: &Value, range: Range, what: &str) ->
     }
 }
 
-/// A number for a message: plain digits in the everyday range, scientific notation outside it, so that
-/// 1e300 is not printed with all its 301 digits.
+/// A number for a message ([`crate::error::number`]).
 pub fn show(x: f64) -> String {
-    if x != 0.0 && !(1e-6..1e15).contains(&x.abs()) {
-        format!("{x:e}")
-    } else {
-        format!("{x}")
-    }
+    crate::error::number(x)
 }
 
 /// A short description of a JSON value's kind for error messages.

@@ -152,6 +152,10 @@ pub struct Cell<const D: usize> {
     /// of an initial partition or of an unchecked run), kept with a frozen partition so that a re-run gives
     /// the same estimate bits.
     pub scale: f64,
+    /// Whether the cell is half of a bisected one. Only such a cell's calibrated estimate may shrink below
+    /// N₁: the null rules of a box the refinement has never split were fooled on a smooth tail
+    /// ([`calibrated`], `docs/accuracy.md` §5.2).
+    pub split: bool,
 }
 
 impl<const D: usize> Cell<D> {
@@ -166,7 +170,7 @@ impl<const D: usize> Cell<D> {
                 return None;
             }
         }
-        Some(Cell { center: c, half: h, scale: 1.0 })
+        Some(Cell { center: c, half: h, scale: 1.0, split: false })
     }
 
     /// The cells of a list of boxes, degenerate ones dropped.
@@ -315,6 +319,10 @@ pub const CALIBRATION: f64 = 3.0;
 pub const MAX_SHRINK: f64 = 8.0;
 /// The shrink limit on the lobe chart of a smooth material (`Options::max_shrink`, `docs/accuracy.md` §5).
 pub const MAX_SHRINK_LOBE: f64 = 16.0;
+/// The shrink limit on the plain chart (no lobe narrower than the stops: a diffuse body or a lobe's tail seen
+/// off the specular direction): there the null rules of a once-split box were fooled by up to 2.6× on heavy
+/// GGX tails (E2539 −15°, `docs/accuracy.md` §5.2).
+pub const MAX_SHRINK_PLAIN: f64 = 2.0;
 
 /// The calibrated error of one region from three successive null rules, N₁ = |I₇ − I₅|, N₂ = |I₅ − I₃| and
 /// N₃ = |I₃ − I₁| (I₃ on the centre and the ±λ4 axial points, I₁ the centre alone), in the manner of DCUHRE
@@ -344,7 +352,7 @@ pub const CHECK_MARGIN: f64 = 4.0;
 /// The most one check shrinks the children's estimates (a factor on their calibrated estimates).
 pub const CHECK_SHRINK: f64 = 8.0;
 /// The most a checked box's estimate may shrink below N₁ in all.
-pub const CHECKED_MAX_SHRINK: f64 = 64.0;
+pub const CHECKED_MAX_SHRINK: f64 = 32.0;
 
 /// A cell's estimate from its calibrated one and its scale: base·scale, kept within
 /// [N₁/[`CHECKED_MAX_SHRINK`], N₁] (and exactly the calibrated estimate at scale 1).
@@ -445,7 +453,8 @@ fn summarise<const D: usize>(
         let n1 = ((*v - *e) * vol).abs();
         n1s[c] = n1;
         base[c] = if small {
-            calibrated(n1, ((*e - s3[c]) * vol).abs(), ((s3[c] - s1[c]) * vol).abs(), abs7[c] * vol, max_shrink)
+            let shrink = if cell.split { max_shrink } else { 1.0 };
+            calibrated(n1, ((*e - s3[c]) * vol).abs(), ((s3[c] - s1[c]) * vol).abs(), abs7[c] * vol, shrink)
         } else {
             n1
         };
@@ -547,7 +556,8 @@ pub fn integrate_partition<const D: usize, F: FnMut(&[[f64; D]], &mut [f64])>(
         let mut c2 = r.cell.center;
         c1[ax] -= half[ax];
         c2[ax] += half[ax];
-        let children = [Cell { center: c1, half, scale: 1.0 }, Cell { center: c2, half, scale: 1.0 }];
+        let children =
+            [Cell { center: c1, half, scale: 1.0, split: true }, Cell { center: c2, half, scale: 1.0, split: true }];
         apply(&rule, &mut f, &children, ncomp, &mut batch, next_id, &mut fresh);
         next_id += 2;
         evals += 2 * npts;

@@ -23,7 +23,7 @@
 //! The folder (the items of its private files are re-exported here):
 //! * `genz_malik.rs`: the cubature: [`integrate`] over boxes, [`integrate_partition`] over a caller's partition
 //!   of [`Cell`]s, adaptive or frozen ([`Refine`]), [`pointwise`], its [`Options`] and [`Estimate`], the rule's
-//!   points and weights ([`GenzMalikRule`]) and the calibration's limits ([`MAX_SHRINK`], [`MAX_SHRINK_LOBE`]);
+//!   points and weights ([`GenzMalikRule`]) and the calibration's limits ([`MAX_SHRINK`], [`MAX_SHRINK_LOBE`], [`MAX_SHRINK_PLAIN`]);
 //! * `gauss.rs`: the crate's one Gauss–Legendre rule ([`gauss_legendre`], per-process tables up to
 //!   [`TABLE_MAX_ORDER`]: [`gauss_legendre_table`]) and the adaptive Gauss–Kronrod G7/K15
 //!   ([`gauss_kronrod_adaptive`]);
@@ -48,5 +48,5 @@ pub use polar::{
 
 pub use genz_malik::{
     integrate, integrate_partition, pointwise, Cell, Estimate, GenzMalikRule, Options, Refine, MAX_SHRINK,
-    MAX_SHRINK_LOBE,
+    MAX_SHRINK_LOBE, MAX_SHRINK_PLAIN,
 };

@@ -121,19 +121,25 @@ fn tensor_sum<const D: usize, F: FnMut(&[[f64; D]], &mut [f64])>(
 /// The calibration of an axis's term from its last two differences (DCUHRE's scheme, as
 /// `genz_malik::calibrated`, with the same constants): when the differences fall by r = d/d_prev with
 /// 3·r < 1 the orders are in their asymptotic range and the error of the reported (higher) rule is taken as
-/// 3·r·d, but never below d/8; otherwise d itself.
-pub fn calibrate(d: f64, d_prev: f64) -> f64 {
-    use super::genz_malik::{CALIBRATION, MAX_SHRINK};
+/// 3·r·d, but never below d/`max_shrink`; otherwise d itself.
+pub fn calibrate(d: f64, d_prev: f64, max_shrink: f64) -> f64 {
+    use super::genz_malik::CALIBRATION;
     if !(d_prev > 0.0) {
         return d;
     }
     let r = d / d_prev;
     if CALIBRATION * r < 1.0 {
-        (CALIBRATION * r * d).max(d / MAX_SHRINK)
+        (CALIBRATION * r * d).max(d / max_shrink)
     } else {
         d
     }
 }
+
+/// The most a term summed with its sign over several boxes of shared orders may shrink ([`calibrate`]) when
+/// the boxes' differences cancel in the sum (|Σ d_b| < ½ Σ |d_b|): the ratios of such a sum are not those of
+/// one rule's asymptotics (a critical-angle conductor at D523 85° has the differences of three boxes cancel
+/// to 1 % and an actual error of d/2.9; `docs/accuracy.md` §5.2). Otherwise `genz_malik::MAX_SHRINK`.
+pub const SIGNED_MAX_SHRINK: f64 = 2.0;
 
 /// The most raises a run may make ([`Path`]).
 pub const MAX_STEPS: usize = 64;
@@ -263,7 +269,9 @@ pub fn integrate<const D: usize, F: FnMut(&[[f64; D]], &mut [f64])>(
         let d = ss.iter().map(|s| s.terms[k][c]).sum::<f64>().abs();
         if ss.iter().all(|s| s.previous[k].is_some()) {
             let p = ss.iter().map(|s| s.previous[k].as_ref().map_or(0.0, |p| p[c])).sum::<f64>().abs();
-            calibrate(d, p)
+            let unsigned = ss.iter().map(|s| s.terms[k][c].abs()).sum::<f64>();
+            let max_shrink = if d < 0.5 * unsigned { SIGNED_MAX_SHRINK } else { super::genz_malik::MAX_SHRINK };
+            calibrate(d, p, max_shrink)
         } else {
             d
         }

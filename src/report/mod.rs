@@ -36,9 +36,25 @@ pub fn decimals(error: f64) -> usize {
     }
 }
 
-/// A number for CSV: plain decimal digits, the shortest that read back to the same double (never `1e2`).
+/// A number for CSV: the shortest digits that read back to the same double, plain decimals in
+/// [10⁻¹⁵, 10¹⁵) (never `1e2`) and scientific notation outside it (`1e300`, not 301 digits; every CSV reader
+/// takes both; `docs/instrument.md` §Numbers in text).
 pub fn plain(v: f64) -> String {
-    format!("{v}")
+    if v.is_finite() && v != 0.0 && !(1e-15..1e15).contains(&v.abs()) {
+        format!("{v:e}")
+    } else {
+        format!("{v}")
+    }
+}
+
+/// A reading's value for a table: `decimals` places, or three significant digits in scientific notation
+/// from 10¹⁵ on (a 1e300-class reading is not a 300-character column).
+pub fn shown(v: f64, decimals: usize) -> String {
+    if v.is_finite() && v.abs() >= 1e15 {
+        format!("{v:.3e}")
+    } else {
+        format!("{v:.decimals$}")
+    }
 }
 
 /// One reading as `measure --format json` writes it (the schema is [`schema::measure`]).

@@ -12,7 +12,9 @@ use crate::colorimetry::weighting::Weighting;
 use crate::instrument::aperture::{half_angle_kink_point, incidence_kink_point, kinked_position, AxisMap, Chart};
 use crate::instrument::geometry::{solid_angle_density, Axes, Integral, Stop};
 use crate::instrument::sphere;
-use crate::quadrature::{integrate_partition, Estimate, Options, Refine, MAX_SHRINK, MAX_SHRINK_LOBE};
+use crate::quadrature::{
+    integrate_partition, Estimate, Options, Refine, MAX_SHRINK, MAX_SHRINK_LOBE, MAX_SHRINK_PLAIN,
+};
 use crate::Vec3;
 use std::time::Instant;
 
@@ -182,6 +184,7 @@ impl Method {
             flux.value = flux.regular.clone();
             flux.evaluations = r.evaluations;
             flux.converged = r.converged;
+            flux.budget_spent = !r.converged;
             flux.seconds = start.elapsed().as_secs_f64();
             return (flux, frozen);
         }
@@ -250,6 +253,7 @@ impl Method {
             flux.regions += est.regions;
             flux.converged &= est.converged;
             flux.out_of_time |= est.out_of_time;
+            flux.budget_spent |= !est.converged && !est.out_of_time && part.refine == Refine::Adaptive;
             if let Some(m) = frozen.as_mut() {
                 let p = m.delta.as_mut().expect("the same parts");
                 p.cells = cells;
@@ -267,8 +271,12 @@ impl Method {
             let mut integrand = self.regular_integrand(brdf, part, (src, rec), (ncomp, in_material), &vars);
             // A smooth material's region estimates are trusted further (`docs/accuracy.md` §5): checked
             // children, and on the lobe chart (whose boxes are cut to the lobe's widths and kinks) a deeper
-            // shrink.
-            let max_shrink = if smooth && part.chart == Chart::Lobe { MAX_SHRINK_LOBE } else { MAX_SHRINK };
+            // shrink; the plain chart's boxes are not cut to anything, and shrink least.
+            let max_shrink = match part.chart {
+                Chart::Plain => MAX_SHRINK_PLAIN,
+                Chart::Lobe if smooth => MAX_SHRINK_LOBE,
+                _ => MAX_SHRINK,
+            };
             let opts =
                 Options { rtol: part.rtol, atol, max_evals: self.max_evals, deadline, max_shrink, checked: smooth };
             // A shaped rule first (when the planner chose one), the Genz–Malik partition if it does not agree.
@@ -327,6 +335,7 @@ impl Method {
             flux.regions += est.regions;
             flux.converged &= est.converged;
             flux.out_of_time |= est.out_of_time;
+            flux.budget_spent |= !est.converged && !est.out_of_time && part.refine == Refine::Adaptive;
             flux.chart = Some(match rule {
                 Rule::TensorGauss { chart: TensorChart::Plain, .. } => Chart::Plain,
                 Rule::TensorGauss { .. } => Chart::Lobe,

@@ -264,6 +264,10 @@ pub struct Flux {
     pub converged: bool,
     /// Whether a part stopped at the wall-clock budget (`Method::max_seconds`).
     pub out_of_time: bool,
+    /// Whether a part ended unconverged because it reached the evaluation budget (an adaptive part's only
+    /// way to end short of its tolerance besides the clock); false for a frozen part that does not meet its
+    /// tolerance, which no budget would help (docs/instrument.md §Bounded work).
+    pub budget_spent: bool,
     /// Wall time of the integral.
     pub seconds: f64,
     /// The chart the regular part was integrated in (None: there was no regular part).
@@ -282,6 +286,7 @@ impl Flux {
             regions: 0,
             converged: true,
             out_of_time: false,
+            budget_spent: false,
             seconds: 0.0,
             chart: None,
         }

@@ -239,7 +239,13 @@ fn compute_reading(
     match value {
         Ok((v, e)) if v.is_finite() && e.is_finite() => Reading {
             problem: (!converged).then(|| {
-                "evaluation budget exhausted before the tolerance was met (the value is the best estimate)".into()
+                if used.iter().any(|f| f.budget_spent) {
+                    "evaluation budget exhausted before the tolerance was met (the value is the best estimate)".into()
+                } else {
+                    "the frozen method (a kept partition, applied without refinement) does not meet the tolerance \
+                     here; no larger evaluation budget changes it (the value is its estimate)"
+                        .into()
+                }
             }),
             ..valued_reading(r, (v, e), evaluations, seconds, converged)
         },
