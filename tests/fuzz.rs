@@ -1,5 +1,5 @@
 //! The fuzz campaign in `cargo test` (`docs/reliability.md`): property tests over generated and mutated recipes,
-//! geometry files and sheets, in bounded time (a few hundred cases per category, a few seconds). Every case is either
+//! geometry files and sheets, and tables (MERL, RGL, in-plane CSV, E1392), baselines and command lines, in bounded time (a few hundred cases per category). Every case is either
 //! accepted or refused with an error naming the file and a field or line; nothing panics; a recipe that is
 //! accepted is measured (cheap tolerance, small budget) and no reading is NaN or infinite, in the library and
 //! through the command line (exit 0, 1 or 2; no "NaN"/"inf" in the output). The 10⁶-case run by hand is
@@ -91,9 +91,57 @@ proptest! {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 40, failure_persistence: None, ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: 400, failure_persistence: None, ..ProptestConfig::default() })]
 
-    /// Command lines run as a process: exit 0, 1 or 2, no panic, no NaN/inf printed, no file lost or left.
+    /// Generated and mutated RGL `.bsdf` files, read through an `rgl` recipe.
+    #[test]
+    fn rgl_tables(seed in any::<u64>()) {
+        prop_assert!(one(Category::RglTable, seed).is_ok(), "{:?}", one(Category::RglTable, seed));
+    }
+
+    /// Generated and mutated in-plane CSV tables, read through an `inplane-csv` recipe.
+    #[test]
+    fn inplane_tables(seed in any::<u64>()) {
+        prop_assert!(one(Category::InplaneTable, seed).is_ok(), "{:?}", one(Category::InplaneTable, seed));
+    }
+
+    /// Generated and mutated ASTM E1392 tables, read through an `e1392` recipe.
+    #[test]
+    fn e1392_tables(seed in any::<u64>()) {
+        prop_assert!(one(Category::E1392Table, seed).is_ok(), "{:?}", one(Category::E1392Table, seed));
+    }
+
+    /// Generated and mutated baselines, read as `--baseline` reads them and checked against real readings.
+    #[test]
+    fn baselines(seed in any::<u64>()) {
+        prop_assert!(one(Category::Baseline, seed).is_ok(), "{:?}", one(Category::Baseline, seed));
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 24, failure_persistence: None, ..ProptestConfig::default() })]
+
+    /// Accepted tables (MERL, RGL, in-plane CSV, E1392; generated or mutated) are measured (one geometry, rtol
+    /// 1e-2, 20 000 evaluations per integral): every reading finite or absent with a reason.
+    #[test]
+    fn accepted_tables_measure_without_nan(seed in any::<u64>()) {
+        let mut rng = Rng::new(seed);
+        let cat = *rng.pick(&[Category::MerlTable, Category::RglTable, Category::InplaneTable, Category::E1392Table]);
+        let text = case_text(cat, seeds(), &mut rng);
+        if let Ok(Outcome::Accepted(Some(m))) = run_case(cat, &text) {
+            let g = resolve_geometries(&["astm-d523-60"], &[] as &[&str]).unwrap();
+            let opts = PlanOptions { rtol: 1e-2, max_evals: 20_000, ..PlanOptions::default() };
+            let readings = measure(&m, &g, &opts).unwrap();
+            prop_assert!(check_readings(&readings).is_ok(), "{:?}\n{text}", check_readings(&readings));
+        }
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 100, failure_persistence: None, ..ProptestConfig::default() })]
+
+    /// Command lines run as a process (`measure`, `compare`, `convergence`, `sweep`, `fit`, `plot`, `profile`,
+    /// with `--baseline` files, and the rest): exit 0, 1 or 2, no panic, no NaN/inf printed, no file lost or left.
     #[test]
     fn command_lines(seed in any::<u64>()) {
         fuzz_cases::BINARY.get_or_init(|| env!("CARGO_BIN_EXE_glossmeter").into());
@@ -195,4 +243,125 @@ fn the_cli_check_ignores_the_arguments_echoed_back() {
     assert!(!fuzz_cases::prints_non_finite(&fuzz_cases::without_args(shown, &args)));
     // glossmeter's own text still counts.
     assert!(fuzz_cases::prints_non_finite(&fuzz_cases::without_args("fixtures/x.json: value NaN", &args)));
+}
+
+/// Found by the extended campaign (seed 11, cases 744, 1348, …): a `sweep` shard that holds no point (one point
+/// in three shards) rightly writes an empty `-o` file (the shards' outputs concatenated are the whole run),
+/// which the checker took for a lost file. It now computes the shard's range; a shard with points, or shard 1 of
+/// a CSV (the header), must still write something.
+#[test]
+fn an_empty_sweep_shard_is_no_lost_file() {
+    fuzz_cases::BINARY.get_or_init(|| env!("CARGO_BIN_EXE_glossmeter").into());
+    let args = |v: &[&str]| v.iter().map(|s| s.to_string()).collect::<Vec<_>>();
+    let case = r#"["sweep", "fixtures/recipes/glass-n1.5.json", "--vary", "/ior=1.3..1.8:1", "--shard", "2/3",
+        "-o", "@NEW", "--rtol", "1e-2", "--max-evals", "20000"]"#;
+    assert!(matches!(fuzz_cases::run_cli(case), Ok(Outcome::Accepted(_))), "{:?}", fuzz_cases::run_cli(case));
+    assert!(fuzz_cases::sweep_shard_is_empty(&args(&["sweep", "t.json", "--vary", "/a=0..1:1", "--shard", "2/3"])));
+    // Shard 1 of a CSV writes the header; shard 3 of 3 holds the point; jsonl shard 1 of 3 holds none.
+    assert!(!fuzz_cases::sweep_shard_is_empty(&args(&["sweep", "t.json", "--vary", "/a=0..1:1", "--shard", "1/3"])));
+    assert!(!fuzz_cases::sweep_shard_is_empty(&args(&["sweep", "t.json", "--vary", "/a=0..1:1", "--shard", "3/3"])));
+    assert!(fuzz_cases::sweep_shard_is_empty(&args(&[
+        "sweep",
+        "t.json",
+        "--vary",
+        "/a=0..1:1",
+        "--shard",
+        "1/3",
+        "--format",
+        "jsonl"
+    ])));
+    let n = "18446744073709551615";
+    assert!(!fuzz_cases::sweep_shard_is_empty(&args(&["sweep", "t.json", "--lhs", n, "--shard", &format!("{n}/{n}")])));
+}
+
+/// Run the binary on `args` (in the crate root), killed after `secs`: the exit code, or None if it was still
+/// running.
+fn run_for(args: &[&str], secs: f64) -> Option<i32> {
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_glossmeter"))
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let t0 = std::time::Instant::now();
+    loop {
+        if let Some(s) = child.try_wait().unwrap() {
+            return s.code();
+        }
+        if t0.elapsed().as_secs_f64() > secs {
+            let _ = child.kill();
+            let _ = child.wait();
+            return None;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+}
+
+/// Found by the extended campaign's tables on the command line: `plot --kind section` of a table whose largest
+/// value is subnormal (1e-320: the log axis' floor, 10⁻⁶ of it, is 0) or near the top of f64 (1e308: the axis'
+/// top, 3× it, is infinite) never ended, and one with an infinite value ran out of memory. The axis is now kept
+/// within the normal finite numbers.
+#[test]
+fn a_section_plot_of_an_extreme_table_ends() {
+    // brdf_cos of 1e308 is an infinite f_r near grazing (f_r = value / cos θo): the 10⁶-case run's case 200999,
+    // an RGL table with an infinite value, made plotters' log scale push key points until memory ran out.
+    for (name, value, column) in [
+        ("subnormal", "1e-320", "brdf"),
+        ("huge", "1e308", "brdf"),
+        ("zero", "0", "brdf"),
+        ("infinite", "1e308", "brdf_cos"),
+    ] {
+        let table = fuzz_cases::scratch(&format!("section-{name}.csv"));
+        let mut text = format!("theta_i,theta_o,{column}\n");
+        for ti in [20, 60] {
+            for to in -89..90 {
+                text.push_str(&format!("{ti},{to},{value}\n"));
+            }
+        }
+        std::fs::write(&table, text).unwrap();
+        let recipe = fuzz_cases::scratch(&format!("section-{name}.json"));
+        let json = serde_json::json!({"model": "inplane-csv", "file": table.to_string_lossy()});
+        std::fs::write(&recipe, json.to_string()).unwrap();
+        let svg = fuzz_cases::scratch(&format!("section-{name}.svg"));
+        let _ = std::fs::remove_file(&svg);
+        let args =
+            ["plot", recipe.to_str().unwrap(), "--kind", "section", "-g", "astm-d523-60", "-o", svg.to_str().unwrap()];
+        assert_eq!(run_for(&args, 60.0), Some(0), "{name}: {args:?}");
+        assert!(std::fs::metadata(&svg).unwrap().len() > 0, "{name}");
+        for f in [table, recipe, svg] {
+            let _ = std::fs::remove_file(f);
+        }
+    }
+}
+
+/// Found beside the campaign (the same log/linear axis pattern as the section plot): `compare --plot` of a
+/// sheet reading 1e308 ± 1e308 never ended (the axis' top, value + uncertainty + 5 % padding, is infinite).
+#[test]
+fn a_comparison_plot_of_extreme_values_ends() {
+    for (name, rows) in [
+        ("top", "s,astm-d523-60,gloss,1e308,1e308\n"),
+        ("both", "s,astm-d523-60,gloss,-1e308,1\ns,astm-d523-20,gloss,1e308,1\n"),
+        ("above", "s,astm-d523-60,gloss,1e308,1\n"),
+    ] {
+        let sheet = fuzz_cases::scratch(&format!("cmp-{name}.csv"));
+        std::fs::write(&sheet, format!("sample,geometry,quantity,value,uncertainty\n{rows}")).unwrap();
+        let svg = fuzz_cases::scratch(&format!("cmp-{name}.svg"));
+        let _ = std::fs::remove_file(&svg);
+        let args = [
+            "compare",
+            "fixtures/recipes/grey-lambert.json",
+            sheet.to_str().unwrap(),
+            "--rtol",
+            "1e-3",
+            "--plot",
+            svg.to_str().unwrap(),
+        ];
+        let code = run_for(&args, 60.0);
+        assert!(matches!(code, Some(0 | 1)), "{name}: {code:?} {args:?}");
+        assert!(std::fs::metadata(&svg).unwrap().len() > 0, "{name}");
+        for f in [sheet, svg] {
+            let _ = std::fs::remove_file(f);
+        }
+    }
 }

@@ -208,9 +208,11 @@ fn draw_sections<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, name: &str, p
     root.fill(&WHITE).map_err(plot_err)?;
     let areas = root.split_evenly((panels.len(), 1));
     for (area, p) in areas.iter().zip(panels) {
-        let max = p.curve.iter().map(|c| c.1).fold(0.0f64, f64::max);
-        let floor = if max > 0.0 { max * 1e-6 } else { 1e-6 };
-        let top = if max > 0.0 { max * 3.0 } else { 1.0 };
+        // The log axis within the normal finite numbers: a floor of 0 (10⁻⁶ of a subnormal maximum) or an
+        // infinite top (3× a maximum near f64::MAX, or an infinite f_r) made plotters' log scale loop for ever.
+        let max = p.curve.iter().map(|c| c.1).fold(0.0f64, f64::max).min(f64::MAX);
+        let floor = if max > 0.0 { (max * 1e-6).max(f64::MIN_POSITIVE) } else { 1e-6 };
+        let top = if max > 0.0 { (max * 3.0).min(f64::MAX).max(floor * 10.0) } else { 1.0 };
         let (x0, x1) = (p.curve[0].0, p.curve[p.curve.len() - 1].0);
         let mut chart = ChartBuilder::on(area)
             .caption(format!("{name}: in-plane section, {} (θi = {}°)", p.id, p.angle), ("sans-serif", 18))
@@ -242,7 +244,7 @@ fn draw_sections<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, name: &str, p
             .map_err(plot_err)?
             .label(format!("mirror image of the source: {a:.2}° … {b:.2}°"))
             .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 16, y + 5)], orange.mix(0.55).filled()));
-        let pts: Vec<(f64, f64)> = p.curve.iter().map(|&(x, y)| (x, y.max(floor))).collect();
+        let pts: Vec<(f64, f64)> = p.curve.iter().map(|&(x, y)| (x, y.max(floor).min(top))).collect();
         chart
             .draw_series(LineSeries::new(pts, blue.stroke_width(2)))
             .map_err(plot_err)?
@@ -337,6 +339,9 @@ fn draw_comparison<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, name: &str,
             hi = hi.max(m + um).max(p + up);
         }
     }
+    // Within ±1e307 (a value of 1e308 ± 1e308 made the axis infinite, and plotters' key points looped); what
+    // lies beyond is clipped.
+    let (lo, hi) = (lo.clamp(-1e307, 1e307), hi.clamp(-1e307, 1e307));
     let pad = 0.05 * (hi - lo).abs().max(1e-9);
     let (lo, hi) = (lo - pad, hi + pad);
     let mut chart = ChartBuilder::on(&root)

@@ -44,17 +44,37 @@ pub enum Category {
     MutatedGeometry,
     Sheet,
     MerlTable,
+    RglTable,
+    InplaneTable,
+    E1392Table,
+    Baseline,
     CommandLine,
 }
 
 impl Category {
-    pub const ALL: [Category; 6] = [
+    pub const ALL: [Category; 10] = [
         Category::GeneratedRecipe,
         Category::MutatedRecipe,
         Category::MutatedGeometry,
         Category::Sheet,
         Category::MerlTable,
+        Category::RglTable,
+        Category::InplaneTable,
+        Category::E1392Table,
+        Category::Baseline,
         Category::CommandLine,
+    ];
+    /// The categories checked in the library (all but the command lines).
+    pub const IN_LIBRARY: [Category; 9] = [
+        Category::GeneratedRecipe,
+        Category::MutatedRecipe,
+        Category::MutatedGeometry,
+        Category::Sheet,
+        Category::MerlTable,
+        Category::RglTable,
+        Category::InplaneTable,
+        Category::E1392Table,
+        Category::Baseline,
     ];
     pub fn name(self) -> &'static str {
         match self {
@@ -62,7 +82,11 @@ impl Category {
             Category::MutatedRecipe => "mutated recipes",
             Category::MutatedGeometry => "mutated geometry files",
             Category::Sheet => "generated and mutated sheets",
-            Category::MerlTable => "generated MERL tables",
+            Category::MerlTable => "generated and mutated MERL tables",
+            Category::RglTable => "generated and mutated RGL tables",
+            Category::InplaneTable => "generated and mutated in-plane CSV tables",
+            Category::E1392Table => "generated and mutated E1392 tables",
+            Category::Baseline => "generated and mutated baselines",
             Category::CommandLine => "command lines",
         }
     }
@@ -88,6 +112,43 @@ pub struct Seeds {
     pub recipes: Vec<String>,
     pub geometries: Vec<String>,
     pub sheets: Vec<String>,
+    /// MERL `.binary` and RGL `.bsdf` files, as bytes.
+    pub merl: Vec<Vec<u8>>,
+    pub rgl: Vec<Vec<u8>>,
+    /// In-plane CSV and E1392 text tables: each shipped file whole, and (three times as often) thinned to every
+    /// 10th data line (the same format, a tenth of the parsing time per case).
+    pub inplane: Vec<String>,
+    pub e1392: Vec<String>,
+    /// Baselines: `measure` and `compare` JSON documents of real readings ([`baseline_sources`]).
+    pub baselines: Vec<String>,
+}
+
+fn binaries(dir: &str, ext: &str) -> Vec<Vec<u8>> {
+    let mut files: Vec<PathBuf> = std::fs::read_dir(root().join(dir))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == ext))
+        .collect();
+    files.sort();
+    files.iter().map(|p| std::fs::read(p).unwrap()).collect()
+}
+
+/// A table's text with only every 10th line below its column line (comments and the header kept).
+fn thinned(text: &str) -> String {
+    let mut data = 0usize;
+    let mut out = String::new();
+    for l in text.lines() {
+        let is_data = l.trim_start().starts_with(|c: char| c.is_ascii_digit() || c == '-');
+        if is_data {
+            data += 1;
+            if data % 10 != 1 {
+                continue;
+            }
+        }
+        out.push_str(l);
+        out.push('\n');
+    }
+    out
 }
 
 impl Seeds {
@@ -102,7 +163,26 @@ impl Seeds {
                 g.insert_str(i + 7, "user-");
             }
         }
-        Seeds { recipes, geometries, sheets: texts("fixtures/sheets", "csv") }
+        // The thinned tables three times as often as the whole ones (which take ten times as long to read).
+        let mut inplane = texts("fixtures/materials/inplane", "csv");
+        let mut e1392 = texts("fixtures/materials/inplane", "txt");
+        for t in [&mut inplane, &mut e1392] {
+            let thin: Vec<String> = t.iter().map(|x| thinned(x)).collect();
+            for _ in 0..3 {
+                t.extend(thin.iter().cloned());
+            }
+        }
+        let baselines = baseline_sources().iter().flat_map(|b| [b.measure.clone(), b.compare.clone()]).collect();
+        Seeds {
+            recipes,
+            geometries,
+            sheets: texts("fixtures/sheets", "csv"),
+            merl: binaries("fixtures/materials/merl", "binary"),
+            rgl: binaries("fixtures/materials/rgl", "bsdf"),
+            inplane,
+            e1392,
+            baselines,
+        }
     }
 }
 
@@ -351,7 +431,12 @@ pub fn check_error(e: &Error, file: &str) -> Result<(), String> {
                 return Err(format!("error names {f}, not {file}: {shown}"));
             }
             if field.is_empty()
-                && !(message.contains("line") || message.contains("JSON object") || message.contains("no readings"))
+                && !(message.contains("line")
+                    || message.contains("JSON object")
+                    || message.contains("no readings")
+                    // A baseline's reasons about the whole document.
+                    || message.contains("neither a `measure` JSON")
+                    || message.contains("holds no reading"))
             {
                 return Err(format!("an input error with neither field nor line: {shown}"));
             }
@@ -369,7 +454,7 @@ pub fn run_case(cat: Category, text: &str) -> Result<Outcome, String> {
             Ok(m) => Ok(Outcome::Accepted(Some(m))),
             Err(e) => check_error(&e, "fuzz.json").map(|_| Outcome::Refused),
         },
-        Category::MerlTable => {
+        Category::MerlTable | Category::RglTable | Category::InplaneTable | Category::E1392Table => {
             let r = match recipe::parse_str(text, "fuzz.json") {
                 Ok(m) => Ok(Outcome::Accepted(Some(m))),
                 Err(e) => check_error(&e, "fuzz.json").map(|_| Outcome::Refused),
@@ -382,6 +467,7 @@ pub fn run_case(cat: Category, text: &str) -> Result<Outcome, String> {
             }
             r
         }
+        Category::Baseline => run_baseline(text),
         Category::CommandLine => run_cli(text),
         Category::MutatedGeometry => {
             let r = standards::parse(text, "fuzz-geometry.json")
@@ -410,7 +496,27 @@ pub fn case_text(cat: Category, seeds: &Seeds, rng: &mut Rng) -> String {
         // Three in four from the parameter registry (mostly valid), one in four from random fields.
         Category::GeneratedRecipe if rng.chance(0.75) => generate_registry_recipe(rng),
         Category::GeneratedRecipe => generate_recipe(rng),
-        Category::MerlTable => generate_merl(rng),
+        Category::MerlTable if rng.chance(0.5) => generate_merl(rng),
+        Category::MerlTable => {
+            let merl = mutate_bytes(rng.pick::<Vec<u8>>(&seeds.merl), rng);
+            table_recipe("merl", &merl, "binary", rng)
+        }
+        Category::RglTable => {
+            let rgl =
+                if rng.chance(0.5) { generate_rgl(rng) } else { mutate_bytes(rng.pick::<Vec<u8>>(&seeds.rgl), rng) };
+            table_recipe("rgl", &rgl, "bsdf", rng)
+        }
+        Category::InplaneTable => {
+            let t =
+                if rng.chance(0.5) { generate_inplane(rng) } else { mutate(rng.pick::<String>(&seeds.inplane), rng) };
+            table_recipe("inplane-csv", t.as_bytes(), "csv", rng)
+        }
+        Category::E1392Table => {
+            let t = if rng.chance(0.5) { generate_e1392(rng) } else { mutate(rng.pick::<String>(&seeds.e1392), rng) };
+            table_recipe("e1392", t.as_bytes(), "txt", rng)
+        }
+        Category::Baseline if rng.chance(0.5) => generate_baseline(rng),
+        Category::Baseline => mutate(rng.pick::<String>(&seeds.baselines), rng),
         Category::CommandLine => generate_cli(rng, true),
         Category::MutatedRecipe => {
             let base: &String = rng.pick(&seeds.recipes);
@@ -636,6 +742,12 @@ pub fn generate_registry_recipe(rng: &mut Rng) -> String {
 /// A random MERL `.binary` (small or nonsense dimensions; exact, short or long bodies; values finite,
 /// negative, NaN or infinite) written to a scratch file, and a recipe that reads it.
 pub fn generate_merl(rng: &mut Rng) -> String {
+    let bytes = merl_bytes(rng);
+    table_recipe("merl", &bytes, "binary", rng)
+}
+
+/// The bytes of a random MERL `.binary` ([`generate_merl`]).
+pub fn merl_bytes(rng: &mut Rng) -> Vec<u8> {
     let dim = |rng: &mut Rng| -> i32 {
         match rng.below(20) {
             0 => 0,
@@ -666,10 +778,535 @@ pub fn generate_merl(rng: &mut Rng) -> String {
     if rng.chance(0.05) {
         bytes.truncate(rng.below(12));
     }
-    let path = scratch(&format!("merl-{:016x}.binary", rng.next()));
-    std::fs::write(&path, &bytes).unwrap();
-    let interpolation = rng.pick(&["nearest", "trilinear", "nearest", "cubic"]);
-    serde_json::json!({"model": "merl", "file": path.to_string_lossy(), "interpolation": interpolation}).to_string()
+    bytes
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// Binary tables: byte-level mutations of the shipped MERL and RGL files, and generated RGL tensor files.
+// ---------------------------------------------------------------------------------------------------------
+
+/// 1–4 random byte-level edits: a flipped bit, a header-sized integer (u16, u32, u64) or a float (f32, f64)
+/// overwritten by an edge value, a truncation, a deleted or duplicated span. Half of the edits fall in the
+/// first 512 bytes, where the headers (dimensions, ranks, types, offsets, shapes) are.
+pub fn mutate_bytes(bytes: &[u8], rng: &mut Rng) -> Vec<u8> {
+    let mut b = bytes.to_vec();
+    for _ in 0..1 + rng.below(4) {
+        let n = b.len().max(1);
+        let at = if rng.chance(0.5) { rng.below(n.min(512)) } else { rng.below(n) };
+        let put = |b: &mut Vec<u8>, at: usize, v: &[u8]| {
+            for (k, x) in v.iter().enumerate() {
+                if let Some(y) = b.get_mut(at + k) {
+                    *y = *x;
+                }
+            }
+        };
+        match rng.below(10) {
+            0 | 1 => {
+                if let Some(y) = b.get_mut(at) {
+                    *y ^= 1 << rng.below(8);
+                }
+            }
+            2 => {
+                let v = *rng.pick(&[0u64, 1, 2, 3, u32::MAX as u64, u64::MAX, 1 << 31, 1 << 40, n as u64, 100_000]);
+                put(&mut b, at, &v.to_le_bytes());
+            }
+            3 => {
+                let v = *rng.pick(&[0u32, 1, 2, 12, 16, 1024, 1025, u32::MAX, 0x8000_0000, n as u32]);
+                put(&mut b, at, &v.to_le_bytes());
+            }
+            4 => {
+                let v = *rng.pick(&[0u16, 1, 2, 3, 10, 11, 12, 17, u16::MAX]);
+                put(&mut b, at, &v.to_le_bytes());
+            }
+            5 => {
+                let v = *rng.pick(&[f32::NAN, f32::INFINITY, f32::NEG_INFINITY, -1.0, 0.0, 3.0e38, 1e-45, 1.6]);
+                put(&mut b, at & !3, &v.to_le_bytes());
+            }
+            6 => {
+                let v = *rng.pick(&[f64::NAN, f64::INFINITY, -1.0, 0.0, 1e300, 5e-324, -0.0]);
+                put(&mut b, at & !7, &v.to_le_bytes());
+            }
+            7 => b.truncate(rng.below(n)),
+            8 => {
+                let e = (at + 1 + rng.below(16)).min(b.len());
+                if at < e {
+                    b.drain(at..e);
+                }
+            }
+            _ => {
+                let e = (at + 1 + rng.below(16)).min(b.len());
+                if at < e {
+                    let dup = b[at..e].to_vec();
+                    b.splice(e..e, dup);
+                }
+            }
+        }
+    }
+    b
+}
+
+/// Write `bytes` to a fresh scratch file and return a recipe of `model` that reads it, with a random
+/// interpolation (MERL) or off-plane assumption (in-plane tables), now and then a wrong one or an unknown
+/// field.
+pub fn table_recipe(model: &str, bytes: &[u8], ext: &str, rng: &mut Rng) -> String {
+    let path = scratch(&format!("{model}-{:016x}.{ext}", rng.next()));
+    std::fs::write(&path, bytes).unwrap();
+    let mut obj = serde_json::json!({"model": model, "file": path.to_string_lossy()});
+    match model {
+        "merl" => obj["interpolation"] = serde_json::json!(rng.pick(&["nearest", "trilinear", "nearest", "cubic"])),
+        "inplane-csv" | "e1392" if rng.chance(0.7) => {
+            obj["off_plane"] = serde_json::json!(rng.pick(&[
+                "f",
+                "f",
+                "f-cos-cos",
+                "f-cos-cos",
+                "microfacet",
+                "microfacet",
+                "microfacet",
+                "x"
+            ]))
+        }
+        _ => {}
+    }
+    if rng.chance(0.03) {
+        obj["bogus"] = serde_json::json!(1);
+    }
+    obj.to_string()
+}
+
+/// One field of a tensor file to write: name, type code, shape and its data (little-endian).
+struct TensorField {
+    name: String,
+    dtype: u8,
+    shape: Vec<u64>,
+    data: Vec<u8>,
+}
+
+/// A tensor file (`measured/rgl.rs` describes the container) from its fields; `bad_offset` moves one
+/// field's data offset.
+fn tensor_file(fields: &[TensorField], bad_offset: Option<(usize, u64)>) -> Vec<u8> {
+    let header: usize = 18 + fields.iter().map(|f| 2 + f.name.len() + 2 + 1 + 8 + 8 * f.shape.len()).sum::<usize>();
+    let mut out = b"tensor_file\0".to_vec();
+    out.extend([1u8, 0]);
+    out.extend((fields.len() as u32).to_le_bytes());
+    let mut offset = header as u64;
+    for (k, f) in fields.iter().enumerate() {
+        out.extend((f.name.len() as u16).to_le_bytes());
+        out.extend(f.name.as_bytes());
+        out.extend((f.shape.len() as u16).to_le_bytes());
+        out.push(f.dtype);
+        let o = match bad_offset {
+            Some((j, o)) if j == k => o,
+            _ => offset,
+        };
+        out.extend(o.to_le_bytes());
+        for d in &f.shape {
+            out.extend(d.to_le_bytes());
+        }
+        offset += f.data.len() as u64;
+    }
+    for f in fields {
+        out.extend(&f.data);
+    }
+    out
+}
+
+/// A random value of a table: mostly a positive number of the lobe's scale, now and then 0, negative, NaN,
+/// infinite or huge.
+fn table_value(rng: &mut Rng, scale: f64) -> f64 {
+    let u = (rng.next() >> 11) as f64 / (1u64 << 53) as f64;
+    match rng.below(200) {
+        0 => f64::NAN,
+        1 => f64::INFINITY,
+        2 => -1.0,
+        3 => 1e300,
+        4 => 1e-300,
+        5..=9 => 0.0,
+        _ => scale * u,
+    }
+}
+
+/// A random RGL `.bsdf`: small grids (2–5 per axis, 1–4 incident angles, isotropic or a full anisotropic
+/// circle), spectral or RGB; with probability ~1/3 one thing wrong: a dimension off by one, a field missing
+/// or of another type or rank, axes not increasing or out of range, a data offset past the end; values as
+/// [`table_value`].
+pub fn generate_rgl(rng: &mut Rng) -> Vec<u8> {
+    let f32s = |v: &[f64]| v.iter().flat_map(|x| (*x as f32).to_le_bytes()).collect::<Vec<u8>>();
+    let nt = 1 + rng.below(4);
+    let np = *rng.pick(&[1usize, 1, 2, 4]);
+    let n = 2 + rng.below(4);
+    let (ny, nx) = (2 + rng.below(4), 2 + rng.below(4));
+    let spectral = rng.chance(0.5);
+    let nl = if spectral { 1 + rng.below(4) } else { 3 };
+    // One of a few defects, or none (values only).
+    let defect = if rng.chance(0.35) { 1 + rng.below(8) } else { 0 };
+    let mut thetas: Vec<f64> = (0..nt).map(|i| 1.5 * i as f64 / nt.max(2) as f64).collect();
+    let mut phis: Vec<f64> = if np <= 2 {
+        (0..np).map(|i| i as f64).collect()
+    } else {
+        (0..np).map(|i| -std::f64::consts::PI + 2.0 * std::f64::consts::PI * i as f64 / (np - 1) as f64).collect()
+    };
+    let mut lambdas: Vec<f64> = (0..nl).map(|i| 400.0 + 100.0 * i as f64).collect();
+    match defect {
+        1 if nt > 1 => thetas.swap(0, 1),
+        1 => thetas[0] = 2.0,
+        2 if np > 2 => phis[np - 1] = 0.0,
+        2 => lambdas[0] = *rng.pick(&[f64::NAN, 100.0, 900.0]),
+        _ => {}
+    }
+    let mut vals = |k: usize, scale: f64| -> Vec<f64> { (0..k).map(|_| table_value(rng, scale)).collect() };
+    let mut fields = vec![
+        TensorField { name: "theta_i".into(), dtype: 10, shape: vec![nt as u64], data: f32s(&thetas) },
+        TensorField { name: "phi_i".into(), dtype: 10, shape: vec![np as u64], data: f32s(&phis) },
+        TensorField {
+            name: "ndf".into(),
+            dtype: 10,
+            shape: vec![ny as u64, nx as u64],
+            data: f32s(&vals(ny * nx, 10.0)),
+        },
+        TensorField {
+            name: "sigma".into(),
+            dtype: 10,
+            shape: vec![ny as u64, nx as u64],
+            data: f32s(&vals(ny * nx, 1.0)),
+        },
+        TensorField {
+            name: "vndf".into(),
+            dtype: 10,
+            shape: vec![np as u64, nt as u64, ny as u64, nx as u64],
+            data: f32s(&vals(np * nt * ny * nx, 5.0)),
+        },
+        TensorField {
+            name: "luminance".into(),
+            dtype: 10,
+            shape: vec![np as u64, nt as u64, n as u64, n as u64],
+            data: f32s(&vals(np * nt * n * n, 1.0)),
+        },
+        TensorField {
+            name: if spectral { "spectra" } else { "rgb" }.into(),
+            dtype: 10,
+            shape: vec![np as u64, nt as u64, nl as u64, n as u64, n as u64],
+            data: f32s(&vals(np * nt * nl * n * n, 1.0)),
+        },
+        TensorField { name: "description".into(), dtype: 1, shape: vec![4], data: b"fuzz".to_vec() },
+        TensorField { name: "jacobian".into(), dtype: 1, shape: vec![1], data: vec![rng.below(2) as u8] },
+    ];
+    if spectral {
+        fields.push(TensorField {
+            name: "wavelengths".into(),
+            dtype: 10,
+            shape: vec![nl as u64],
+            data: f32s(&lambdas),
+        });
+    }
+    let k = rng.below(fields.len());
+    let mut bad_offset = None;
+    match defect {
+        3 => {
+            let f = &mut fields[k];
+            let j = rng.below(f.shape.len());
+            f.shape[j] = if rng.chance(0.5) { f.shape[j] + 1 } else { f.shape[j].saturating_sub(1) };
+        }
+        4 => {
+            fields.remove(k);
+        }
+        5 => fields[k].dtype = *rng.pick(&[0u8, 1, 9, 11, 12, 255]),
+        6 => {
+            let f = &mut fields[k];
+            f.shape.push(1);
+        }
+        7 => bad_offset = Some((k, *rng.pick(&[0u64, 1, u64::MAX, 1 << 40]))),
+        8 => {
+            let dup = TensorField {
+                name: fields[k].name.clone(),
+                dtype: fields[k].dtype,
+                shape: fields[k].shape.clone(),
+                data: fields[k].data.clone(),
+            };
+            fields.push(dup);
+        }
+        _ => {}
+    }
+    if rng.chance(0.2) {
+        let len = fields.len();
+        fields.swap(rng.below(len), rng.below(len));
+    }
+    tensor_file(&fields, bad_offset)
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// In-plane text tables: generated in-plane CSV and ASTM E1392 files.
+// ---------------------------------------------------------------------------------------------------------
+
+/// A cell of a text table: a number; in a table with `bad` cells, now and then a non-number or an edge value.
+fn table_cell(rng: &mut Rng, x: f64, bad: bool) -> String {
+    if !bad {
+        return format!("{x:.6e}");
+    }
+    match rng.below(40) {
+        0 => "NaN".into(),
+        1 => "inf".into(),
+        2 => "x".into(),
+        3 => String::new(),
+        4 => "1e400".into(),
+        5 => "1e300".into(),
+        6 => "-1".into(),
+        7 => "1e-320".into(),
+        8 => "\"1\"".into(),
+        _ => format!("{x:.6e}"),
+    }
+}
+
+/// The rows of a generated in-plane table: (θi, θo signed, value), θi from 1–3 incidences (now and then 0°,
+/// 89.9°, 90° or negative), θo on a grid of 2–40 points (now and then repeated or out of range), values a
+/// Beckmann-like lobe about the specular direction on a diffuse floor, or a constant.
+fn inplane_rows(rng: &mut Rng) -> Vec<(String, String, String)> {
+    let mut rows = Vec::new();
+    // Two tables in five have bad cells.
+    let bad = rng.chance(0.4);
+    // A constant: a Lambertian level, or one at the ends of f64 (0, subnormal, near the largest).
+    let flat = rng.chance(0.2);
+    let level = *rng.pick(&[0.3, 0.3, 0.3, 0.0, 1e-320, 1e-300, 1e300, 1e308]);
+    let width = *rng.pick(&[0.5, 2.0, 5.0, 20.0]);
+    for _ in 0..1 + rng.below(3) {
+        let ti: f64 = *rng.pick(&[0.0, 10.0, 15.0, 20.0, 30.0, 45.0, 60.0, 75.0, 80.0, 85.0, 89.9, 90.0, -1.0]);
+        let k = *rng.pick(&[1usize, 2, 3, 5, 10, 20, 40]);
+        let (lo, hi): (f64, f64) =
+            *rng.pick(&[(-89.0, 89.0), (-89.0, 89.0), (0.0, 89.0), (-60.0, 60.0), (-90.0, 90.0), (10.0, 30.0)]);
+        for j in 0..k {
+            let to = if k == 1 { lo } else { lo + (hi - lo) * j as f64 / (k - 1) as f64 };
+            let v = if flat { level } else { 0.05 + 50.0 * (-((to - ti) / width).powi(2)).exp() };
+            rows.push((table_cell(rng, ti, bad), table_cell(rng, to, bad), table_cell(rng, v, bad)));
+        }
+        if rng.chance(0.05) && !rows.is_empty() {
+            let r = rows[rows.len() - 1].clone();
+            rows.push(r);
+        }
+    }
+    rows
+}
+
+/// A generated in-plane CSV table (`theta_i,theta_o,brdf` or `brdf_cos`, in any order; BOM, comments,
+/// blank lines; now and then an unknown or missing column or a short row).
+pub fn generate_inplane(rng: &mut Rng) -> String {
+    let mut s = String::new();
+    if rng.chance(0.1) {
+        s.push('\u{feff}');
+    }
+    if rng.chance(0.5) {
+        s.push_str("# generated\n");
+    }
+    let value = *rng.pick(&["brdf", "brdf", "brdf_cos", "brdf_cos", "BRDF", "Brdf_Cos", "x", ""]);
+    let order = rng.below(3);
+    let header = match order {
+        0 => format!("theta_i,theta_o,{value}"),
+        1 => format!("theta_o,theta_i,{value}"),
+        _ => format!("{value},theta_i,theta_o"),
+    };
+    s.push_str(&header);
+    if rng.chance(0.03) {
+        s.push_str(",brdf_cos");
+    }
+    s.push('\n');
+    for (ti, to, v) in inplane_rows(rng) {
+        if rng.chance(0.02) {
+            s.push('\n');
+        }
+        let line = match order {
+            0 => format!("{ti},{to},{v}"),
+            1 => format!("{to},{ti},{v}"),
+            _ => format!("{v},{ti},{to}"),
+        };
+        s.push_str(&line);
+        if rng.chance(0.01) {
+            s.push_str(",1");
+        }
+        s.push('\n');
+    }
+    s
+}
+
+/// A generated ASTM E1392-style table (keyword lines, a column line naming θi, φi, θs, φs and BRDF or
+/// CCBRDF, space- or comma-separated rows in and out of the plane).
+pub fn generate_e1392(rng: &mut Rng) -> String {
+    let mut s = String::new();
+    if rng.chance(0.1) {
+        s.push('\u{feff}');
+    }
+    if rng.chance(0.7) {
+        s.push_str("SAMPLE: generated\nWAVELENGTH: 550 nm\n");
+    }
+    let value = *rng.pick(&["BRDF", "BRDF", "CCBRDF", "CCBRDF", "brdf", "x", "BRDF CCBRDF"]);
+    let sep = if rng.chance(0.8) { " " } else { "," };
+    let cols =
+        if rng.chance(0.95) { ["theta_i", "phi_i", "theta_s", "phi_s"].join(sep) } else { "theta_i phi_i".into() };
+    s.push_str(&format!("{cols}{sep}{value}\n"));
+    for (ti, to, v) in inplane_rows(rng) {
+        // θo signed: + on the specular side (φs = φi + 180°), − on the source's side (φs = φi).
+        let (ts, ps) = match to.parse::<f64>() {
+            Ok(x) if x < 0.0 => (format!("{}", -x), "0".to_string()),
+            _ => (to.clone(), "180".to_string()),
+        };
+        let ps = match rng.below(30) {
+            0 => "90".to_string(),
+            1 => "540".to_string(),
+            2 => "-180".to_string(),
+            _ => ps,
+        };
+        s.push_str(&[ti, "0".into(), ts, ps, v].join(sep));
+        s.push('\n');
+    }
+    s
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// Baselines: real `measure` and `compare` documents, mutated, and generated ones.
+// ---------------------------------------------------------------------------------------------------------
+
+/// A recipe, the sheet that goes with it (if any), and baselines of its readings.
+pub struct BaselineSource {
+    pub recipe: &'static str,
+    pub sheet: Option<&'static str>,
+    /// `measure --format json` of the recipe (rtol 1e-2, 20 000 evaluations per integral, no timing).
+    pub measure: String,
+    /// A `compare` document of the same readings (its `comparisons` only, which is what a baseline reads).
+    pub compare: String,
+    /// The material's name and its readings.
+    pub material: String,
+    pub readings: Vec<glossmeter::Reading>,
+}
+
+/// The baseline sources, measured once per process on the default panel.
+pub fn baseline_sources() -> &'static [BaselineSource] {
+    static S: std::sync::OnceLock<Vec<BaselineSource>> = std::sync::OnceLock::new();
+    S.get_or_init(|| {
+        let panel = glossmeter::resolve_geometries(glossmeter::DEFAULT_PANEL, &[] as &[&str]).unwrap();
+        let opts = glossmeter::PlanOptions { rtol: 1e-2, max_evals: 20_000, ..Default::default() };
+        [
+            ("fixtures/recipes/black-glass.json", Some("fixtures/sheets/black-glass-check.csv")),
+            ("fixtures/recipes/glass-n1.5.json", Some("fixtures/sheets/glass-n1.5-trigloss.csv")),
+            ("fixtures/recipes/grey-lambert.json", None),
+        ]
+        .into_iter()
+        .map(|(recipe, sheet)| {
+            // The name as the command line derives it from the relative path (the recipe's or its stem).
+            let text = std::fs::read_to_string(root().join(recipe)).unwrap();
+            let m = recipe::parse_str(&text, recipe).unwrap();
+            let readings = glossmeter::measure(&m, &panel, &opts).unwrap();
+            let measure = glossmeter::report::pretty(&glossmeter::report::measure::json_doc(&m, &readings, false));
+            let comparisons: Vec<serde_json::Value> = readings
+                .iter()
+                .map(|r| {
+                    serde_json::json!({"sample": m.name, "material": m.name, "geometry": r.geometry,
+                        "predicted_reading": r.name, "predicted": r.value,
+                        "error_estimate": r.value.map(|_| r.error_estimate)})
+                })
+                .collect();
+            let compare = glossmeter::report::pretty(&serde_json::json!({"comparisons": comparisons}));
+            BaselineSource { recipe, sheet, measure, compare, material: m.name.clone(), readings }
+        })
+        .collect()
+    })
+}
+
+const BASELINE_VALUES: &[&str] = &[
+    "0", "1", "89.1", "-1", "1e308", "-1e308", "1e-320", "null", "\"NaN\"", "\"89\"", "[]", "1e400", "true", "1e15",
+    "1e16", "-0",
+];
+
+/// A generated baseline: a `measure` document (one material, or a `material` per reading) or a `compare`
+/// one, 0–6 readings with real or unknown materials, geometries and readings, values and estimates from
+/// [`BASELINE_VALUES`]; now and then not an object at all.
+pub fn generate_baseline(rng: &mut Rng) -> String {
+    let src = rng.pick(baseline_sources());
+    let materials = [src.material.as_str(), "black-glass", "glass-1.50", "nope", ""];
+    let geometries = ["astm-d523-20", "astm-d523-60", "astm-d523-85", "astm-e430-30", "iso-13803-20", "nope"];
+    let names = ["gloss", "haze", "doi", "haze-narrow", "log-haze", "haze-index", "x"];
+    let mut entries = Vec::new();
+    for _ in 0..rng.below(7) {
+        let real = (!src.readings.is_empty() && rng.chance(0.6)).then(|| rng.pick(&src.readings).clone());
+        let geometry = real.as_ref().map_or_else(|| rng.pick(&geometries).to_string(), |r| r.geometry.clone());
+        let name = real.as_ref().map_or_else(|| rng.pick(&names).to_string(), |r| r.name.clone());
+        let value = match &real {
+            Some(r) if rng.chance(0.5) => format!("{}", r.value.unwrap_or(0.0)),
+            _ => rng.pick(BASELINE_VALUES).to_string(),
+        };
+        let e = if rng.chance(0.5) { "0.001".to_string() } else { rng.pick(BASELINE_VALUES).to_string() };
+        let material = if rng.chance(0.8) { src.material.clone() } else { rng.pick(&materials).to_string() };
+        entries.push((material, geometry, name, value, e));
+    }
+    let json_str = |s: &str| serde_json::to_string(s).unwrap();
+    match rng.below(10) {
+        0 => rng.pick(&["[]", "\"x\"", "{}", "null", "{\"readings\": 1}", "{\"comparisons\": {}}"]).to_string(),
+        1..=5 => {
+            let per_reading = rng.chance(0.3);
+            let rs: Vec<String> = entries
+                .iter()
+                .map(|(m, g, n, v, e)| {
+                    let mat = if per_reading { format!("\"material\": {}, ", json_str(m)) } else { String::new() };
+                    format!(
+                        "{{{mat}\"geometry\": {}, \"name\": {}, \"value\": {v}, \"error_estimate\": {e}}}",
+                        json_str(g),
+                        json_str(n)
+                    )
+                })
+                .collect();
+            let top = if per_reading {
+                String::new()
+            } else {
+                format!("\"material\": {{\"name\": {}}}, ", json_str(&src.material))
+            };
+            format!("{{{top}\"readings\": [{}]}}", rs.join(", "))
+        }
+        _ => {
+            let cs: Vec<String> = entries
+                .iter()
+                .map(|(m, g, n, v, e)| {
+                    format!(
+                        "{{\"material\": {}, \"geometry\": {}, \"predicted_reading\": {}, \"predicted\": {v}, \
+                         \"error_estimate\": {e}}}",
+                        json_str(m),
+                        json_str(g),
+                        json_str(n)
+                    )
+                })
+                .collect();
+            format!("{{\"comparisons\": [{}]}}", cs.join(", "))
+        }
+    }
+}
+
+/// A baseline case: the text written to a scratch file and read as `--baseline` reads it; accepted, or refused
+/// with an input error naming that file. An accepted one is checked against the readings of every baseline
+/// source: every baseline entry and every check (now, then, allowed) finite, its JSON without a non-finite
+/// number.
+pub fn run_baseline(text: &str) -> Result<Outcome, String> {
+    static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let n = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let path = scratch(&format!("baseline-{n}.json"));
+    std::fs::write(&path, text).unwrap();
+    let r = glossmeter::comparison::load_baseline(&path);
+    let _ = std::fs::remove_file(&path);
+    let entries = match r {
+        Err(e) => return check_error(&e, &path.display().to_string()).map(|_| Outcome::Refused),
+        Ok(b) => b,
+    };
+    if let Some(b) =
+        entries.iter().find(|b| !(b.value.is_finite() && b.error_estimate.is_finite() && b.error_estimate >= 0.0))
+    {
+        return Err(format!("a baseline entry accepted with a non-finite value or estimate: {b:?}"));
+    }
+    for src in baseline_sources() {
+        let drift =
+            glossmeter::comparison::check_baseline(src.readings.iter().map(|r| (src.material.as_str(), r)), &entries);
+        for d in &drift {
+            let shown = glossmeter::report::drift_json(d).to_string();
+            if !(d.now.is_finite() && d.then.is_finite() && d.allowed.is_finite()) || prints_non_finite(&shown) {
+                return Err(format!("a baseline check with a non-finite number: {d:?}"));
+            }
+        }
+    }
+    Ok(Outcome::Accepted(None))
 }
 
 // ---------------------------------------------------------------------------------------------------------
@@ -692,12 +1329,51 @@ fn files(dir: &str, ext: &str) -> Vec<String> {
     v
 }
 
+/// Recipes cheap enough for the slow subcommands (`sweep`, `fit`, `plot`, `profile`): the analytic single-lobe
+/// models and the tiny MERL table (the paints and the spectral fixtures are fuzzed in the library and by
+/// `measure`), each with ranges of numbers it has, for the cases that should get past the parser.
+const CHEAP_RECIPES: &[(&str, &[&str])] = &[
+    ("fixtures/recipes/grey-lambert.json", &["/albedo=0.1..0.9"]),
+    ("fixtures/recipes/rgb-lambert.json", &["/albedo/0=0.1..0.9", "/albedo/2=0.05..0.5"]),
+    ("fixtures/recipes/glass-n1.5.json", &["/ior=1.3..1.8"]),
+    ("fixtures/recipes/black-glass.json", &["/ior=1.3..1.8"]),
+    ("fixtures/recipes/bench-b2-beckmann-0.1.json", &["/roughness=0.05..0.3", "/ior=1.3..1.8"]),
+    ("fixtures/recipes/bench-b4-ggx-0.3.json", &["/roughness=0.05..0.5", "/ior=1.3..1.8"]),
+    ("fixtures/recipes/rough-dielectric-beckmann.json", &["/roughness=0.01..0.3", "/ior=1.2..2"]),
+    ("fixtures/recipes/rough-conductor-ggx.json", &["/roughness=0.05..0.4", "/ior/0=0.5..2"]),
+    ("fixtures/recipes/phong.json", &["/exponent=10..500", "/ks=0.01..0.1"]),
+    ("fixtures/recipes/ward.json", &["/alpha=0.02..0.3", "/rho_s=0.01..0.1"]),
+    ("fixtures/recipes/merl-lambert-tiny.json", &[]),
+    ("fixtures/materials/rgl/beckmann-iso-32.json", &[]),
+];
+
+/// JSON Pointer ranges for `sweep --vary`, `fit --free` and `plot --vary`: valid for some recipes, unknown,
+/// reversed, empty, non-finite or malformed for others.
+const POINTER_RANGES: &[&str] = &[
+    "/roughness=0.05..0.3",
+    "/albedo=0.1..0.9",
+    "/ior=1.3..1.8",
+    "/roughness=0.3..0.05",
+    "/nope=0..1",
+    "/roughness=0..0",
+    "/roughness=NaN..1",
+    "/roughness=1e-300..1e999",
+    "/albedo/0=0.1..0.9",
+    "/ior/0=1.2..1.9",
+    "roughness=0.1..0.2",
+    "/roughness",
+    "x",
+    "",
+];
+
 /// The value of option `opt` in a generated command line.
 fn cli_value(opt: &str, rng: &mut Rng) -> String {
     let paths = ["@NEW", "@NEW", "@NEW", "Cargo.toml", "fixtures", "/dev/full", "/nonexistent/dir/x.txt", ""];
+    let pictures =
+        ["@NEW.svg", "@NEW.svg", "@NEW.png", "@NEW", "@NEW.txt", "Cargo.toml", "/dev/full", "/nonexistent/dir/x.svg"];
     match opt {
         "-g" => rng.pick(CLI_IDS).to_string(),
-        "--rtol" | "--max-seconds" | "-k" | "--tolerance" | "--max-de00" | "--min-time-ms" => {
+        "--rtol" | "--max-seconds" | "-k" | "--tolerance" | "--max-de00" | "--min-time-ms" | "--uncertainty" => {
             rng.pick(CLI_NUMBERS).to_string()
         }
         "--tolerances" => {
@@ -706,29 +1382,87 @@ fn cli_value(opt: &str, rng: &mut Rng) -> String {
         "--max-evals" | "--max-repetitions" => {
             rng.pick(&["0", "1", "100", "20000", "-1", "x", "NaN", "99999999999999999999"]).to_string()
         }
-        "--format" => rng.pick(&["table", "json", "csv", "junit", "xml", ""]).to_string(),
+        "--restarts" | "--points" | "--lhs" => rng.pick(&["0", "1", "2", "3", "-1", "x", "NaN", ""]).to_string(),
+        "--seed" => rng.pick(&["0", "1", "18446744073709551615", "-1", "x"]).to_string(),
+        "--shard" => rng
+            .pick(&["1/1", "1/2", "2/2", "2/3", "0/1", "4/3", "1/0", "x", "18446744073709551615/18446744073709551615"])
+            .to_string(),
+        "--format" => rng.pick(&["table", "json", "csv", "junit", "jsonl", "xml", ""]).to_string(),
         "--illuminant" => rng.pick(&["D65", "D50", "A", "C", "F2", ""]).to_string(),
         "--observer" => rng.pick(&["10", "2", "5", ""]).to_string(),
-        "--delimiter" => rng.pick(&[",", ";", "\\t", "ab", ""]).to_string(),
-        "-o" | "--plot" => rng.pick(&paths).to_string(),
+        "--delimiter" => rng.pick(&[",", ";", "\\t", "tab", "ab", ""]).to_string(),
+        "-o" | "--output" => rng.pick(&paths).to_string(),
+        "--plot" => rng.pick(&pictures).to_string(),
+        "--kind" => rng.pick(&["section", "gloss-vs-parameter", "x", ""]).to_string(),
+        "--vary" => {
+            let n = rng.pick(&[":2", ":2", ":3", ":1", ":0", ":-1", ":x", ""]);
+            format!("{}{n}", rng.pick(POINTER_RANGES))
+        }
+        "--log" => rng.pick(&["/roughness", "/albedo", "/nope", "x"]).to_string(),
+        "--free" => {
+            let r = rng.pick(POINTER_RANGES);
+            match r.split_once('=') {
+                Some((p, range)) if rng.chance(0.3) => format!("{p}=log:{range}"),
+                _ => r.to_string(),
+            }
+        }
+        "--target" => rng
+            .pick(&[
+                "astm-d523-60/gloss=50±1",
+                "astm-d523-20/gloss=20+-0.5",
+                "astm-d523-85/gloss=90",
+                "astm-e430-30/haze=2±0.1",
+                "astm-d523-60/gloss=NaN",
+                "astm-d523-60/gloss=1e999",
+                "astm-d523-60/gloss=50±-1",
+                "astm-d523-60/gloss=50±0",
+                "nope/gloss=1",
+                "astm-d523-60/nope=1",
+                "x",
+                "",
+            ])
+            .to_string(),
+        "--sample" => rng.pick(&["glass-1.50", "black-glass", "x", ""]).to_string(),
         "--geometry-file" => {
             let mut g = files("fixtures/geometry", "json");
+            g.push("standards/rspec-20.json".into());
             g.push("nope.json".into());
             rng.pick(&g).clone()
+        }
+        "--baseline" => {
+            // A baseline written for the case (the source's own readings, mutated or generated), or a file that
+            // is no baseline.
+            let src = rng.pick(baseline_sources());
+            let doc = if rng.chance(0.5) { src.measure.clone() } else { src.compare.clone() };
+            let doc = match rng.below(4) {
+                0 | 1 => doc,
+                2 => mutate(&doc, rng),
+                _ => generate_baseline(rng),
+            };
+            match rng.below(10) {
+                0 => rng.pick(&["Cargo.toml", "fixtures", "nope.json", "/dev/null", ""]).to_string(),
+                _ => format!("@FILE:{doc}"),
+            }
         }
         _ => String::new(),
     }
 }
 
 /// One random argument vector (without the program name), as a JSON array of strings. Paths are relative to
-/// the crate root (the process runs there); `@NEW` stands for a fresh scratch path. `cheap`: the readings
-/// get a small budget first (`--max-seconds 1` for `measure`, `--rtol 1e-3` for `compare`; a second
-/// budget given at random is then a usage error, exit 2), so that 10⁴ command lines fit in minutes.
+/// the crate root (the process runs there); `@NEW` stands for a fresh scratch path (`@NEW.svg` with that
+/// extension), `@FILE:TEXT` for a scratch file holding TEXT, `@TABLE:MODEL:HEX` for a recipe of MODEL reading a
+/// scratch table of those bytes. `cheap`: the readings get a small budget first
+/// (`--max-seconds 1` for `measure`, `--rtol 1e-3` for `compare`, `--rtol 1e-2 --max-evals 20000` and at most
+/// 3 values per axis for `sweep`, `--rtol 1e-2 --restarts 0` for `fit`, `--rtol 1e-2 --points 2` for `plot`,
+/// `--rtol 1e-2` for `profile`; a second budget given at random is then a usage error, exit 2), so that 10⁴
+/// command lines fit in minutes.
 pub fn generate_cli(rng: &mut Rng, cheap: bool) -> String {
     let mut recipes = files("fixtures/recipes", "json");
     recipes.retain(|r| !r.contains("bench-b3")); // keep the run fast; the panel is fuzzed in the library
-    recipes.extend(files("fixtures/bad", "json"));
-    recipes.extend(["nope.json", "fixtures", "/dev/null", "", "-"].map(String::from));
+    let cheap_recipes: Vec<String> = CHEAP_RECIPES.iter().map(|(r, _)| r.to_string()).collect();
+    // One recipe in four is refused: a bad fixture, a missing file, a directory, empty, stdin.
+    let mut bad_recipes = files("fixtures/bad", "json");
+    bad_recipes.extend(["nope.json", "fixtures", "/dev/null", "", "-"].map(String::from));
     let mut sheets = files("fixtures/sheets", "csv");
     sheets.extend(files("fixtures/sheets/bad", "csv"));
     let mut a: Vec<String> = Vec::new();
@@ -739,6 +1473,14 @@ pub fn generate_cli(rng: &mut Rng, cheap: bool) -> String {
         "compare",
         "compare",
         "convergence",
+        "sweep",
+        "sweep",
+        "fit",
+        "fit",
+        "plot",
+        "plot",
+        "profile",
+        "profile",
         "standards",
         "schema",
         "help",
@@ -763,6 +1505,7 @@ pub fn generate_cli(rng: &mut Rng, cheap: bool) -> String {
             "--illuminant",
             "--observer",
             "--envelope",
+            "--baseline",
             "--bogus",
         ],
         "compare" => &[
@@ -776,29 +1519,194 @@ pub fn generate_cli(rng: &mut Rng, cheap: bool) -> String {
             "--max-de00",
             "--delimiter",
             "--illuminant",
+            "--baseline",
             "--bogus",
         ],
         "convergence" => &["-g", "--format", "--plot", "-o", "--min-time-ms", "--max-repetitions", "--bogus"],
+        "sweep" => &[
+            "--vary",
+            "--log",
+            "--lhs",
+            "--seed",
+            "-g",
+            "--shard",
+            "--format",
+            "--rtol",
+            "--no-timing",
+            "--max-evals",
+            "-o",
+            "--bogus",
+        ],
+        "fit" => &[
+            "--free",
+            "--target",
+            "--target",
+            "--sheet",
+            "--sample",
+            "--delimiter",
+            "--uncertainty",
+            "--restarts",
+            "--rtol",
+            "--format",
+            "-o",
+            "--no-timing",
+            "--bogus",
+        ],
+        "plot" => &["--kind", "-g", "--vary", "--points", "--rtol", "-o", "--output", "--bogus"],
+        "profile" => &["-g", "--geometry-file", "--format", "--plot", "-o", "--rtol", "--allow-unconverged", "--bogus"],
         _ => &[],
     };
     match sub {
-        "measure" | "compare" | "convergence" => {
-            a.push(rng.pick(&recipes).clone());
+        "measure" | "compare" | "convergence" | "sweep" | "fit" | "plot" | "profile" => {
+            let slow = matches!(sub, "sweep" | "fit" | "plot" | "profile");
+            let pool = if rng.chance(0.25) {
+                &bad_recipes
+            } else if slow {
+                &cheap_recipes
+            } else {
+                &recipes
+            };
+            // compare with a baseline: the recipe and sheet of a baseline source, most of the time.
+            // Two in five cases are tame: for `compare`, a baseline source's recipe and sheet; for the newer
+            // subcommands, a cheap recipe, ranges it has, valid targets and pictures; for all, no random
+            // options, so that they reach the computation.
+            let tame = rng.chance(0.4);
+            let src = match sub {
+                "compare" if tame || rng.chance(0.3) => {
+                    Some(rng.pick(baseline_sources())).filter(|s| s.sheet.is_some())
+                }
+                "measure" if rng.chance(0.2) => Some(rng.pick(baseline_sources())),
+                _ => None,
+            };
+            let recipe = match src {
+                Some(s) => s.recipe.to_string(),
+                None => rng.pick(pool).clone(),
+            };
+            let (recipe, ranges): (String, &[&str]) = if tame && slow {
+                let (r, ranges) = rng.pick(CHEAP_RECIPES);
+                (r.to_string(), ranges)
+            } else {
+                (recipe, &[])
+            };
+            let range = |rng: &mut Rng| -> String {
+                if ranges.is_empty() {
+                    rng.pick(POINTER_RANGES).to_string()
+                } else {
+                    rng.pick(ranges).to_string()
+                }
+            };
+            // Now and then `measure` and `plot` read a generated table (written with its recipe when the case
+            // runs: `@TABLE:MODEL:HEX`). Not `profile`: it has no evaluation budget of its own (`--max-evals`),
+            // and 512 pixels of a table that does not converge run for minutes (80 s seen), docs/reliability.md.
+            let recipe = if matches!(sub, "measure" | "plot") && rng.chance(0.15) {
+                let (model, bytes) = match rng.below(4) {
+                    0 => ("inplane-csv", generate_inplane(rng).into_bytes()),
+                    1 => ("e1392", generate_e1392(rng).into_bytes()),
+                    2 => ("rgl", generate_rgl(rng)),
+                    _ => ("merl", merl_bytes(rng)),
+                };
+                let hex: String = bytes.iter().map(|b| format!("{b:02x}")).collect();
+                format!("@TABLE:{model}:{hex}")
+            } else {
+                recipe
+            };
+            a.push(recipe);
+            if tame && slow {
+                a.extend(match sub {
+                    "sweep" => {
+                        let mut v = vec!["--vary".to_string(), format!("{}:{}", range(rng), 1 + rng.below(3))];
+                        if rng.chance(0.3) {
+                            v.extend(["--format".into(), "jsonl".into()]);
+                        }
+                        if rng.chance(0.3) {
+                            v.extend(["--shard".into(), rng.pick(&["1/2", "2/2", "2/3"]).to_string()]);
+                        }
+                        v
+                    }
+                    "fit" => {
+                        let t = *rng.pick(&[
+                            "astm-d523-60/gloss=50±1",
+                            "astm-d523-20/gloss=20+-0.5",
+                            "astm-d523-85/gloss=90",
+                            "astm-d523-60/gloss=0.5±0.1",
+                        ]);
+                        vec!["--free".into(), range(rng), "--target".into(), t.into()]
+                    }
+                    "plot" if rng.chance(0.5) => vec!["--kind".into(), "section".into()],
+                    "plot" => vec!["--kind".into(), "gloss-vs-parameter".into(), "--vary".into(), range(rng)],
+                    _ => vec![],
+                });
+                if sub == "plot" {
+                    a.extend(["-o".into(), rng.pick(&["@NEW.svg", "@NEW.png"]).to_string()]);
+                }
+                if sub != "plot" && rng.chance(0.5) {
+                    a.extend(["-o".into(), "@NEW".into()]);
+                }
+                if sub == "profile" && rng.chance(0.5) {
+                    a.extend(["--plot".into(), rng.pick(&["@NEW.svg", "@NEW.png"]).to_string()]);
+                }
+            }
             if sub == "compare" {
-                a.push(if rng.chance(0.9) { rng.pick(&sheets).clone() } else { "nope.csv".into() });
+                a.push(match src {
+                    Some(s) => s.sheet.unwrap().to_string(),
+                    None if rng.chance(0.9) => rng.pick(&sheets).clone(),
+                    None => "nope.csv".into(),
+                });
             }
-            if cheap && sub == "measure" {
-                a.extend(["--max-seconds".into(), "1".into()]);
+            if src.is_some() && (!tame || rng.chance(0.6)) {
+                a.push("--baseline".into());
+                a.push(cli_value("--baseline", rng));
             }
-            if cheap && sub == "compare" {
-                a.extend(["--rtol".into(), "1e-3".into()]);
+            if cheap {
+                let budget: &[&str] = match sub {
+                    "measure" => &["--max-seconds", "1"],
+                    "compare" => &["--rtol", "1e-3"],
+                    "sweep" => &["--rtol", "1e-2", "--max-evals", "20000"],
+                    "fit" => &["--rtol", "1e-2", "--restarts", "0"],
+                    "plot" => &["--rtol", "1e-2", "--points", "2"],
+                    "profile" => &["--rtol", "1e-2"],
+                    _ => &[],
+                };
+                a.extend(budget.iter().map(|s| s.to_string()));
             }
-            if sub == "convergence" {
-                let t = cli_value("--tolerances", rng);
-                a.extend(["--tolerances".into(), t, "--max-repetitions".into(), "1".into()]);
-                a.extend(["--min-time-ms".into(), "0".into(), "-g".into(), "astm-d523-60".into()]);
+            match sub {
+                _ if tame && slow => {}
+                "convergence" => {
+                    let t = if tame { "1e-2,1e-3".to_string() } else { cli_value("--tolerances", rng) };
+                    a.extend(["--tolerances".into(), t, "--max-repetitions".into(), "1".into()]);
+                    a.extend(["--min-time-ms".into(), "0".into(), "-g".into(), "astm-d523-60".into()]);
+                }
+                // What each needs (most of the time): a varied path, a free parameter and a target, a kind and
+                // a picture.
+                "sweep" if rng.chance(0.9) => {
+                    if rng.chance(0.05) {
+                        // The shard of one point of a hypercube of 2⁶⁴ − 1 points.
+                        let n = "18446744073709551615";
+                        a.extend(["--vary".into(), "/roughness=0.05..0.3".into(), "--lhs".into(), n.into()]);
+                        a.extend(["--shard".into(), format!("{}/{n}", rng.pick(&["1", "2", n]))]);
+                    } else {
+                        a.extend(["--vary".into(), cli_value("--vary", rng)]);
+                    }
+                }
+                "fit" if rng.chance(0.9) => {
+                    a.extend(["--free".into(), cli_value("--free", rng)]);
+                    if rng.chance(0.8) {
+                        a.extend(["--target".into(), cli_value("--target", rng)]);
+                    } else {
+                        a.extend(["--sheet".into(), rng.pick(&sheets).clone()]);
+                    }
+                }
+                "plot" if rng.chance(0.9) => {
+                    let kind = if rng.chance(0.5) { "section" } else { "gloss-vs-parameter" };
+                    a.extend(["--kind".into(), kind.into(), "-o".into(), cli_value("--plot", rng)]);
+                    if kind == "gloss-vs-parameter" && rng.chance(0.8) {
+                        a.extend(["--vary".into(), rng.pick(POINTER_RANGES).to_string()]);
+                    }
+                }
+                _ => {}
             }
-            for _ in 0..rng.below(5) {
+            // Fewer random options for the newer subcommands, so that more of them get past the parser.
+            for _ in 0..if tame { 0 } else { rng.below(if slow { 3 } else { 5 }) } {
                 let opt = *rng.pick(options);
                 a.push(opt.into());
                 if rng.chance(0.05) {
@@ -841,6 +1749,32 @@ pub fn without_args(out: &str, args: &[String]) -> String {
     s
 }
 
+/// Whether a `sweep` command line asks for a shard that holds no point and so rightly writes nothing: its
+/// range `[⌊(K−1)·P/M⌋, ⌊K·P/M⌋)` of the P points (the product of the grid's N, or the hypercube's N) is empty,
+/// and it is not shard 1 of a CSV (which writes the header). False when any of it does not parse.
+pub fn sweep_shard_is_empty(args: &[String]) -> bool {
+    if args.first().map(String::as_str) != Some("sweep") {
+        return false;
+    }
+    let value = |opt: &str| args.windows(2).filter(|w| w[0] == opt).map(|w| w[1].as_str()).next_back();
+    let Some((k, m)) = value("--shard").and_then(|s| s.split_once('/')) else { return false };
+    let (Ok(k), Ok(m)) = (k.parse::<u128>(), m.parse::<u128>()) else { return false };
+    let points = match value("--lhs") {
+        Some(n) => n.parse::<u128>().ok(),
+        None => args
+            .windows(2)
+            .filter(|w| w[0] == "--vary")
+            .map(|w| w[1].rsplit_once(':').and_then(|(_, n)| n.parse::<u128>().ok()))
+            .try_fold(1u128, |p, n| n.map(|n| p.saturating_mul(n))),
+    };
+    let Some(p) = points else { return false };
+    if !(1..=m).contains(&k) {
+        return false;
+    }
+    let empty = (k - 1) * p / m == k * p / m;
+    empty && (k > 1 || value("--format") == Some("jsonl"))
+}
+
 /// The binary that CLI cases run (set by the test or the driver before the first case).
 pub static BINARY: std::sync::OnceLock<PathBuf> = std::sync::OnceLock::new();
 
@@ -857,13 +1791,37 @@ pub fn run_cli(text: &str) -> Result<Outcome, String> {
     static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
     let n = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
     let mut new_files = Vec::new();
+    let mut written = Vec::new();
     let args: Vec<String> = args
         .into_iter()
         .map(|a| {
-            if a == "@NEW" {
-                let p = scratch(&format!("cli-{n}-{}.out", new_files.len()));
+            if let Some(ext) = a.strip_prefix("@NEW") {
+                let ext = ext.strip_prefix('.').unwrap_or("out");
+                let p = scratch(&format!("cli-{n}-{}.{ext}", new_files.len()));
                 let _ = std::fs::remove_file(&p);
                 new_files.push(p.clone());
+                p.to_string_lossy().into_owned()
+            } else if let Some((model, hex)) = a.strip_prefix("@TABLE:").and_then(|t| t.split_once(':')) {
+                let ext = match model {
+                    "inplane-csv" => "csv",
+                    "e1392" => "txt",
+                    "rgl" => "bsdf",
+                    _ => "binary",
+                };
+                let bytes: Vec<u8> =
+                    (0..hex.len() / 2).map(|i| u8::from_str_radix(&hex[2 * i..2 * i + 2], 16).unwrap()).collect();
+                let table = scratch(&format!("cli-{n}-table.{ext}"));
+                std::fs::write(&table, bytes).unwrap();
+                let recipe = scratch(&format!("cli-{n}-table.json"));
+                let json = serde_json::json!({"model": model, "file": table.to_string_lossy()});
+                std::fs::write(&recipe, json.to_string()).unwrap();
+                written.push(table);
+                written.push(recipe.clone());
+                recipe.to_string_lossy().into_owned()
+            } else if let Some(text) = a.strip_prefix("@FILE:") {
+                let p = scratch(&format!("cli-{n}-in-{}.json", written.len()));
+                std::fs::write(&p, text).unwrap();
+                written.push(p.clone());
                 p.to_string_lossy().into_owned()
             } else {
                 a
@@ -910,21 +1868,23 @@ pub fn run_cli(text: &str) -> Result<Outcome, String> {
         let mut v = Ok(if code == Some(2) { Outcome::Refused } else { Outcome::Accepted(None) });
         for f in &new_files {
             // Only the files that the command line names as -o or --plot targets.
-            let named = args.windows(2).any(|w| (w[0] == "-o" || w[0] == "--plot") && w[1] == f.to_string_lossy());
+            let named = args
+                .windows(2)
+                .any(|w| matches!(w[0].as_str(), "-o" | "--output" | "--plot") && w[1] == f.to_string_lossy());
             if !named {
                 continue;
             }
             let len = std::fs::metadata(f).map(|m| m.len());
             match (code, len) {
                 (Some(2), Ok(_)) => v = fail("a file left behind by a refused run"),
-                (Some(0 | 1), Ok(0)) => v = fail("an empty output file"),
+                (Some(0 | 1), Ok(0)) if !sweep_shard_is_empty(&args) => v = fail("an empty output file"),
                 (Some(0 | 1), Err(_)) => v = fail("an output file missing after success"),
                 _ => {}
             }
         }
         v
     };
-    for f in new_files.iter().chain([&out_path, &err_path]) {
+    for f in new_files.iter().chain(&written).chain([&out_path, &err_path]) {
         let _ = std::fs::remove_file(f);
     }
     verdict
