@@ -453,13 +453,16 @@ fn check_path(template: &Value, file: &str, model: &str, path: &str) -> Result<(
             .take(6)
             .map(|p| p.pointer.to_string())
             .collect();
+        let which = if examples.is_empty() {
+            "it has no numeric parameter to vary".to_string()
+        } else {
+            format!("its numeric parameters include {}", examples.join(", "))
+        };
         return Err(Error::input(
             file,
             path,
             Words::argument("vary").and(format!(
-                ": not a parameter of a `{model}` recipe (its numeric parameters include {}; the full list is in \
-                 docs/recipe-format.md)",
-                examples.join(", ")
+                ": not a parameter of a `{model}` recipe ({which}; the full list is in docs/recipe-format.md)"
             )),
         ));
     };

@@ -309,3 +309,12 @@ fn the_last_shard_of_a_two_to_the_64_hypercube_ends() {
     assert_eq!(text.lines().count(), 1, "{text}");
     assert!(text.starts_with(&format!("{},", u64::MAX - 1)), "{text}");
 }
+
+/// A table recipe has no numeric parameter: the refusal says so instead of listing nothing.
+#[test]
+fn a_table_recipe_has_nothing_to_vary_and_says_so() {
+    let (code, _, err) =
+        gm(&["sweep", "fixtures/materials/rgl/beckmann-iso-32.json", "-g", "astm-d523-60", "--vary", "/x=0..1:2"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("has no numeric parameter to vary") && !err.contains("include ;"), "{err}");
+}
