@@ -87,9 +87,10 @@ pub fn reading_value(
             let (h, he) = compensated_haze(mean(receptors), specimen(compensation), *factor, standard(specular))?;
             if !(h > -20.0) {
                 return Err(format!(
-                    "the compensated linear haze {h} is at or below −20, where K·log10(H/20 + 1) has no value (the \
+                    "the compensated linear haze {} is at or below −20, where K·log10(H/20 + 1) has no value (the \
                      compensation receptor sees more diffuse light than the haze receptors, relative to a \
-                     Lambertian body)"
+                     Lambertian body)",
+                    crate::error::number(h)
                 ));
             }
             Ok((k * (h / 20.0 + 1.0).log10(), k * he / (std::f64::consts::LN_10 * (h + 20.0))))
@@ -251,7 +252,11 @@ fn compute_reading(
         },
         Ok((v, e)) => problem_reading(
             r,
-            format!("the reading's arithmetic overflowed (value {v}, error estimate {e}); the fluxes are out of range"),
+            format!(
+                "the reading's arithmetic overflowed (value {}, error estimate {}); the fluxes are out of range",
+                crate::error::number(v),
+                crate::error::number(e)
+            ),
         ),
         // The hue of a neutral colour has no value by definition, not by failure: null, with the reason as
         // its note, converged as its fluxes are (it changes no exit status).
