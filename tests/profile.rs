@@ -92,8 +92,13 @@ fn a_smooth_dielectric_profile_is_each_pixels_share_of_the_mirror_image() {
     let geo = &g.geometry;
     let reference = Stop::from_angles(spec.pixel, spec.perpendicular, 0.0);
     let standard = mirror_flux(geo.theta, geo.source, reference, 1.567);
-    let prof =
-        profile::measure(brdf(r#"{"model": "smooth-dielectric", "ior": 1.5}"#), &g, PlanOptions::default()).unwrap();
+    let prof = profile::measure(
+        brdf(r#"{"model": "smooth-dielectric", "ior": 1.5}"#),
+        &g,
+        PlanOptions::default(),
+        profile::Budget::default(),
+    )
+    .unwrap();
     let (mut lit, mut dark) = (0, 0);
     for r in &prof.rows {
         let expected = 100.0 * mirror_flux(geo.theta, geo.source, spec.stop(r.pixel), 1.5) / standard;
@@ -128,7 +133,13 @@ fn a_lambertian_profile_is_its_closed_form_pixel_by_pixel() {
     let standard = mirror_flux(geo.theta, geo.source, reference, 1.567);
     let p_source = geo.source.projected_solid_angle(-geo.theta);
     let rho = 0.5;
-    let prof = profile::measure(brdf(r#"{"model": "lambert", "albedo": 0.5}"#), &g, PlanOptions::default()).unwrap();
+    let prof = profile::measure(
+        brdf(r#"{"model": "lambert", "albedo": 0.5}"#),
+        &g,
+        PlanOptions::default(),
+        profile::Budget::default(),
+    )
+    .unwrap();
     for r in &prof.rows {
         let flux = rho / std::f64::consts::PI * spec.stop(r.pixel).projected_solid_angle(geo.theta) * p_source;
         let expected = 100.0 * flux / standard;
@@ -254,4 +265,61 @@ fn bad_profiles_are_refused_with_the_file_and_the_field() {
     assert_eq!(code, 2, "{err}");
     let (code, _, _) = gm(&["profile", "no/such/recipe.json"]);
     assert_eq!(code, 2);
+}
+
+/// A profile that cannot converge (a constant 10³⁰⁸ table: every pixel's integral refines to its budget, and
+/// with the measurement's 2·10⁶ per part 512 pixels ran 8 minutes) ends within its deterministic evaluation
+/// budget (docs/instrument.md §1.8): each part of each pixel gets min(--max-evals, --max-total-evals /
+/// (2·pixels)), every pixel that reached it says so and is not converged, the command exits 1 (0 with
+/// --allow-unconverged), and a second run gives the same bytes.
+#[test]
+fn a_profile_that_cannot_converge_ends_within_its_evaluation_budget() {
+    let table = tmp("constant-1e308.csv");
+    let mut csv = String::from("theta_i,theta_o,brdf_cos\n");
+    for ti in (0..=85).step_by(5) {
+        for to in -89..=89 {
+            csv.push_str(&format!("{ti},{to},1e308\n"));
+        }
+    }
+    std::fs::write(&table, csv).unwrap();
+    let recipe = tmp("constant-1e308.json");
+    std::fs::write(&recipe, format!(r#"{{"model": "inplane-csv", "file": "{}"}}"#, table.display())).unwrap();
+    let r = recipe.to_str().unwrap();
+    let args = &["profile", r, "--format", "json", "--max-total-evals", "200000"];
+    let (code, out, err) = gm(args);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("converge"), "{err}");
+    let doc: Value = serde_json::from_str(&out).unwrap();
+    // 200 000 / (2 · 512) = 195 per part.
+    assert_eq!(doc["budget"]["per_part"], 195, "{}", doc["budget"]);
+    assert_eq!(doc["budget"]["max_total_evals"], 200_000);
+    assert_eq!(doc["budget"]["max_evals"], profile::DEFAULT_PIXEL_EVALS);
+    let rows = doc["rows"].as_array().unwrap();
+    let unconverged: Vec<&Value> = rows.iter().filter(|r| r["converged"] == false).collect();
+    assert!(!unconverged.is_empty());
+    for row in &unconverged {
+        let problem = row["problem"].as_str().unwrap_or_default();
+        assert!(problem.contains("budget") || row["value"].is_null(), "pixel {}: {problem}", row["pixel"]);
+    }
+    // Deterministic: the same budget, the same bytes.
+    let (code2, out2, _) = gm(args);
+    assert_eq!((code2, &out2), (1, &out));
+    // A budget of 0 is a usage error.
+    let (code, _, err) = gm(&["profile", r, "--max-evals", "0"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("--max-evals"), "{err}");
+    let (code, _, _) = gm(&["profile", r, "--max-total-evals", "0"]);
+    assert_eq!(code, 2);
+    let _ = std::fs::remove_file(&table);
+    let _ = std::fs::remove_file(&recipe);
+}
+
+/// The budget's share per part is the counts' alone: min(per part, total / (2·pixels)), at least 1.
+#[test]
+fn the_profile_budget_is_shared_equally_by_the_pixels() {
+    let b = profile::Budget { per_part: 1000, total: 1_000_000 };
+    assert_eq!(b.part_budget(512), 976);
+    assert_eq!(b.part_budget(100), 1000);
+    assert_eq!(profile::Budget { per_part: 1000, total: 10 }.part_budget(512), 1);
+    assert_eq!(profile::Budget::default().part_budget(512), 19_531);
 }

@@ -51,10 +51,21 @@ pub struct ProfileArgs {
     /// Exit 0 even if a pixel did not converge within its budget (it is still marked in the output).
     #[arg(long)]
     pub allow_unconverged: bool,
+    /// Evaluation budget of each part of one pixel's integral (deterministic: a pixel that reaches it is
+    /// marked not converged, the same bits on every machine).
+    #[arg(long, default_value_t = profile::DEFAULT_PIXEL_EVALS)]
+    pub max_evals: usize,
+    /// Evaluation budget of the whole profile, shared equally by the pixels: each part of each pixel's
+    /// integral gets at most MAX_TOTAL_EVALS / (2 × pixels), and at most --max-evals.
+    #[arg(long, default_value_t = profile::DEFAULT_TOTAL_EVALS)]
+    pub max_total_evals: usize,
 }
 
 pub fn run(args: ProfileArgs) -> Result<()> {
     check_rtol(args.rtol)?;
+    if args.max_evals == 0 || args.max_total_evals == 0 {
+        return Err(Error::Usage("--max-evals and --max-total-evals must be at least 1".into()));
+    }
     let target = OutputTarget::new(args.output.as_deref(), "--output")?;
     if let Some(p) = &args.plot {
         super::plot::check_plot_path(p, "--plot")?;
@@ -70,7 +81,8 @@ pub fn run(args: ProfileArgs) -> Result<()> {
     // Checked before any work: the geometry must have a profile array.
     crate::instrument::standards::profile::of(&g)?;
     let options = PlanOptions { rtol: args.rtol, ..PlanOptions::default() };
-    let prof = profile::measure(material.brdf.clone(), &g, options)?;
+    let budget = profile::Budget { per_part: args.max_evals, total: args.max_total_evals };
+    let prof = profile::measure(material.brdf.clone(), &g, options, budget)?;
     let text = match args.format {
         ProfileFormat::Csv => csv(&prof)?,
         ProfileFormat::Json => json(&material, &prof),
@@ -135,6 +147,13 @@ pub fn json(material: &Material, p: &Profile) -> String {
         "normalisation": "100·Φ(specimen, pixel) / Φ(gloss standard, a pixel-sized window centred on the specular \
                           direction): the standard reads 100 inside its source image (docs/instrument.md §1.8)",
         "evaluations": p.rows.iter().map(|r| r.reading.evaluations).sum::<usize>(),
+        "budget": {
+            "max_evals": p.budget.per_part,
+            "max_total_evals": p.budget.total,
+            "per_part": p.part_budget,
+            "rule": "each part of each pixel's integral gets min(max_evals, max_total_evals / (2 · pixels)) \
+                     evaluations; a pixel that reaches it is not converged",
+        },
         "rows": rows,
     });
     let mut s = serde_json::to_string_pretty(&doc).expect("finite values serialise");

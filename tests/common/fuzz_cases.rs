@@ -1379,7 +1379,7 @@ fn cli_value(opt: &str, rng: &mut Rng) -> String {
         "--tolerances" => {
             rng.pick(&["1e-2,1e-3", "1e-2", "0.5,1e-3", "NaN", "x", "", "1e-2,,1e-3", "1e-20"]).to_string()
         }
-        "--max-evals" | "--max-repetitions" => {
+        "--max-evals" | "--max-total-evals" | "--max-repetitions" => {
             rng.pick(&["0", "1", "100", "20000", "-1", "x", "NaN", "99999999999999999999"]).to_string()
         }
         "--restarts" | "--points" | "--lhs" => rng.pick(&["0", "1", "2", "3", "-1", "x", "NaN", ""]).to_string(),
@@ -1454,7 +1454,7 @@ fn cli_value(opt: &str, rng: &mut Rng) -> String {
 /// scratch table of those bytes. `cheap`: the readings get a small budget first
 /// (`--max-seconds 1` for `measure`, `--rtol 1e-3` for `compare`, `--rtol 1e-2 --max-evals 20000` and at most
 /// 3 values per axis for `sweep`, `--rtol 1e-2 --restarts 0` for `fit`, `--rtol 1e-2 --points 2` for `plot`,
-/// `--rtol 1e-2` for `profile`; a second budget given at random is then a usage error, exit 2), so that 10⁴
+/// `--rtol 1e-2 --max-total-evals 2000000` for `profile`; a second budget given at random is then a usage error, exit 2), so that 10⁴
 /// command lines fit in minutes.
 pub fn generate_cli(rng: &mut Rng, cheap: bool) -> String {
     let mut recipes = files("fixtures/recipes", "json");
@@ -1553,7 +1553,18 @@ pub fn generate_cli(rng: &mut Rng, cheap: bool) -> String {
             "--bogus",
         ],
         "plot" => &["--kind", "-g", "--vary", "--points", "--rtol", "-o", "--output", "--bogus"],
-        "profile" => &["-g", "--geometry-file", "--format", "--plot", "-o", "--rtol", "--allow-unconverged", "--bogus"],
+        "profile" => &[
+            "-g",
+            "--geometry-file",
+            "--format",
+            "--plot",
+            "-o",
+            "--rtol",
+            "--allow-unconverged",
+            "--max-evals",
+            "--max-total-evals",
+            "--bogus",
+        ],
         _ => &[],
     };
     match sub {
@@ -1595,10 +1606,10 @@ pub fn generate_cli(rng: &mut Rng, cheap: bool) -> String {
                     rng.pick(ranges).to_string()
                 }
             };
-            // Now and then `measure` and `plot` read a generated table (written with its recipe when the case
-            // runs: `@TABLE:MODEL:HEX`). Not `profile`: it has no evaluation budget of its own (`--max-evals`),
-            // and 512 pixels of a table that does not converge run for minutes (80 s seen), docs/reliability.md.
-            let recipe = if matches!(sub, "measure" | "plot") && rng.chance(0.15) {
+            // Now and then `measure`, `plot` and `profile` read a generated table (written with its recipe when
+            // the case runs: `@TABLE:MODEL:HEX`); `profile` under its evaluation budget (`--max-total-evals`),
+            // since 512 pixels of a table that does not converge ran for minutes without one (docs/reliability.md).
+            let recipe = if matches!(sub, "measure" | "plot" | "profile") && rng.chance(0.15) {
                 let (model, bytes) = match rng.below(4) {
                     0 => ("inplane-csv", generate_inplane(rng).into_bytes()),
                     1 => ("e1392", generate_e1392(rng).into_bytes()),
@@ -1664,7 +1675,7 @@ pub fn generate_cli(rng: &mut Rng, cheap: bool) -> String {
                     "sweep" => &["--rtol", "1e-2", "--max-evals", "20000"],
                     "fit" => &["--rtol", "1e-2", "--restarts", "0"],
                     "plot" => &["--rtol", "1e-2", "--points", "2"],
-                    "profile" => &["--rtol", "1e-2"],
+                    "profile" => &["--rtol", "1e-2", "--max-total-evals", "2000000"],
                     _ => &[],
                 };
                 a.extend(budget.iter().map(|s| s.to_string()));
