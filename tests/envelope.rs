@@ -57,8 +57,9 @@ fn envelope_extremes_are_those_of_the_corner_geometries() {
     let g = standards::find("astm-d523-20").unwrap();
     let options = PlanOptions { rtol: 1e-5, ..Default::default() };
     let nominal = Plan::compile(m.brdf.clone(), vec![g.clone()], options.clone()).unwrap().execute();
-    let env = envelope::read(m.brdf.clone(), std::slice::from_ref(&g), &nominal, options.clone()).unwrap();
-    let e = env[0].clone().unwrap();
+    let env = envelope::read(m.brdf.clone(), std::slice::from_ref(&g), &nominal, options.clone(), None).unwrap();
+    assert!(env.cut.is_empty());
+    let e = env.of[0].clone().unwrap();
     // The same 2^k corner geometries read one by one, each in its own plan: the envelope is their extremes
     // together with the nominal reading, and a lobe wider than the receptor makes them differ.
     let (vars, corners) = envelope::variants(&g).unwrap();
@@ -71,4 +72,42 @@ fn envelope_extremes_are_those_of_the_corner_geometries() {
     let hi = values.iter().copied().fold(f64::NEG_INFINITY, f64::max).max(nominal[0].value.unwrap());
     assert_eq!((e.min, e.max), (lo, hi));
     assert!(e.max > e.min);
+}
+
+/// `--max-seconds` with `--envelope` is a limit for the whole command, counted from its start, not one per
+/// variant (97 s were seen for `--max-seconds 1`: each of the 32 variants had the whole limit). With a limit
+/// far below any run, the command ends with exit 1 and says the envelope was cut; no envelope is reported
+/// (null, `"envelope_cut": true`), and every reading that has a value is the unlimited run's, bit for bit:
+/// nothing in the output depends on the machine's speed (docs/instrument.md §Bounded work). No timing is
+/// asserted.
+#[test]
+fn the_wall_clock_limit_is_the_whole_command_s_and_cuts_the_envelope_honestly() {
+    let recipe = "fixtures/recipes/rough-dielectric-beckmann.json";
+    let read = |limit: Option<&str>, name: &str| -> (i32, serde_json::Value) {
+        let out = tmp(name);
+        let _ = std::fs::remove_file(&out);
+        let mut args = vec!["glossmeter", "measure", recipe, "-g", "astm-d523-60", "-g", "astm-d523-85"];
+        args.extend(["--rtol", "1e-5", "--envelope", "--format", "json", "--no-timing", "-o", out.to_str().unwrap()]);
+        if let Some(s) = limit {
+            args.extend(["--max-seconds", s]);
+        }
+        let code = run(args);
+        let doc = serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
+        let _ = std::fs::remove_file(&out);
+        (code, doc)
+    };
+    let (code, free) = read(None, "free.json");
+    assert_eq!(code, 0);
+    let (code, cut) = read(Some("1e-9"), "cut.json");
+    assert_eq!(code, 1, "a cut envelope is no complete result");
+    let (free, cut) = (free["readings"].as_array().unwrap(), cut["readings"].as_array().unwrap());
+    assert_eq!(free.len(), cut.len());
+    for (f, c) in free.iter().zip(cut) {
+        assert!(f["envelope_min"].is_f64() && f.get("envelope_cut").is_none(), "{f}");
+        assert!(c["envelope_min"].is_null() && c["envelope_max"].is_null(), "{c}");
+        assert_eq!(c["envelope_cut"], true, "{c}");
+        if let Some(v) = c["value"].as_f64() {
+            assert_eq!(v.to_bits(), f["value"].as_f64().unwrap().to_bits(), "{c}");
+        }
+    }
 }

@@ -2,7 +2,7 @@
 //! readings, the tolerance envelope, durations. A reading without a finite value is printed as "—", with the
 //! reason: never as NaN or inf.
 use crate::cli::common::pad_table;
-use crate::instrument::envelope::Envelope;
+use crate::instrument::envelope::Envelopes;
 use crate::instrument::plan::Reading;
 use crate::recipe::Material;
 use crate::report::{decimals, shown};
@@ -80,13 +80,13 @@ pub fn table(material: &Material, readings: &[Reading], timing: bool) -> String 
 }
 
 /// The envelope as a table after the readings.
-pub fn envelope_table(readings: &[Reading], envelopes: &[Option<Envelope>]) -> String {
+pub fn envelope_table(readings: &[Reading], envelopes: &Envelopes) -> String {
     let mut out = String::from("\ntolerance envelope (the standard's tolerances and the plausible ranges of assumed numbers; docs/instrument.md §Tolerance envelope)\n");
     out += &format!(
         "{:<13} {:<11} {:>12} {:>12} {:>12}  {}\n",
         "geometry", "reading", "min", "nominal", "max", "variants"
     );
-    for (r, e) in readings.iter().zip(envelopes) {
+    for (r, e) in readings.iter().zip(&envelopes.of) {
         let nominal = r.value.map(|v| format!("{v:.6}")).unwrap_or_else(|| "—".into());
         match e {
             Some(e) => {
@@ -103,10 +103,12 @@ pub fn envelope_table(readings: &[Reading], envelopes: &[Option<Envelope>]) -> S
                 )
             }
             None => {
-                out += &format!(
-                    "{:<13} {:<11} {:>12} {:>12} {:>12}  no tolerances in the standard data\n",
-                    r.geometry, r.name, "—", nominal, "—"
-                )
+                let why = if envelopes.cut.contains(&r.geometry) {
+                    "cut by the wall-clock limit"
+                } else {
+                    "no tolerances in the standard data"
+                };
+                out += &format!("{:<13} {:<11} {:>12} {:>12} {:>12}  {why}\n", r.geometry, r.name, "—", nominal, "—")
             }
         }
     }

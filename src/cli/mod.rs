@@ -115,6 +115,10 @@ fn dispatch(cli: Cli) -> Result<()> {
                 )));
             }
             let max_seconds = (max_seconds > 0.0).then_some(max_seconds);
+            // The limit is the whole command's, counted from here: the nominal readings and every envelope
+            // variant share it (docs/instrument.md §Bounded work).
+            let deadline =
+                max_seconds.and_then(|s| crate::instrument::method::deadline_after(std::time::Instant::now(), s));
             if envelope && format == Format::Csv {
                 return Err(Error::Usage(
                     "--envelope is reported in the table and JSON formats; use --format table or json".into(),
@@ -148,11 +152,11 @@ fn dispatch(cli: Cli) -> Result<()> {
                     _ => eprint!("{e}"),
                 }
             }
-            let run = plan.run();
+            let run = plan.run_until(deadline);
             let evaluations = run.evaluations();
             let readings = run.readings;
             let envelopes = if envelope {
-                Some(crate::instrument::envelope::read(material.brdf.clone(), &geos, &readings, options)?)
+                Some(crate::instrument::envelope::read(material.brdf.clone(), &geos, &readings, options, deadline)?)
             } else {
                 None
             };
@@ -180,6 +184,14 @@ fn dispatch(cli: Cli) -> Result<()> {
             }
             target.write(&text)?;
             check_drift(drift.as_deref())?;
+            if let Some(cut) = envelopes.as_ref().map(|e| &e.cut).filter(|c| !c.is_empty()) {
+                return Err(Error::Numeric(format!(
+                    "the wall-clock limit (--max-seconds, for the whole command) was reached before the tolerance \
+                     envelope of {} was read: it is left out (null), since a partial one would depend on the \
+                     machine's speed and load",
+                    cut.join(", ")
+                )));
+            }
             readings_status(&readings, allow_unconverged)
         }
         Command::Standards { id } => {

@@ -174,16 +174,32 @@ pub struct Envelope {
     pub variations: Vec<Variation>,
 }
 
+/// The envelopes of a set of readings ([`read`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Envelopes {
+    /// One per reading of the nominal set, in its order ([`read`]).
+    pub of: Vec<Option<Envelope>>,
+    /// The geometries (ids) whose envelope the wall-clock limit cut: a variant not started before the deadline,
+    /// or one with a reading the limit left without a value. Their envelopes are `None`: an extreme over the
+    /// variants read in time would depend on the machine's speed (docs/instrument.md §Bounded work).
+    pub cut: Vec<String>,
+}
+
 /// Read `brdf` through every variant of every geometry; one envelope per reading of `nominal` (in its
-/// order) that has a value, `None` for a reading without a value, of a composite geometry, or of a geometry
-/// without variations.
+/// order) that has a value, `None` for a reading without a value, of a composite geometry, of a geometry
+/// without variations, or of one the limit cut. `deadline` is the command's own wall-clock limit
+/// (`PlanOptions::max_seconds` counted from the start of the command, not of each variant; None: none): every
+/// variant plan runs under it ([`Plan::run_until`](super::plan::Plan::run_until)), and a variant that would
+/// start after it is not read.
 pub fn read(
     brdf: std::sync::Arc<dyn crate::brdf::Brdf>,
     geometries: &[StandardGeometry],
     nominal: &[super::plan::Reading],
     options: super::plan::PlanOptions,
-) -> Result<Vec<Option<Envelope>>> {
+    deadline: Option<std::time::Instant>,
+) -> Result<Envelopes> {
     let mut out: Vec<Option<Envelope>> = vec![None; nominal.len()];
+    let mut cut = Vec::new();
     for g in geometries {
         if g.geometry.is_composite() {
             continue;
@@ -194,9 +210,20 @@ pub fn read(
         }
         let n = geos.len();
         let mut readings = Vec::with_capacity(n);
+        let mut late = false;
         for v in geos {
+            if deadline.is_some_and(|d| std::time::Instant::now() >= d) {
+                late = true;
+                break;
+            }
             let plan = super::plan::Plan::compile(brdf.clone(), vec![v], options.clone())?;
-            readings.push(plan.execute());
+            let run = plan.run_until(deadline);
+            late |= run.fluxes.iter().any(|f| f.out_of_time);
+            readings.push(run.readings);
+        }
+        if late {
+            cut.push(g.geometry.id.clone());
+            continue;
         }
         for (i, r) in nominal.iter().enumerate() {
             let (true, Some(value)) = (r.geometry == g.geometry.id, r.value) else { continue };
@@ -224,5 +251,5 @@ pub fn read(
             }
         }
     }
-    Ok(out)
+    Ok(Envelopes { of: out, cut })
 }

@@ -5,7 +5,7 @@ use serde_json::{json, Value};
 
 use super::{csv_text, drift_json, plain, pretty, reading_json};
 use crate::comparison::Drift;
-use crate::instrument::envelope::Envelope;
+use crate::instrument::envelope::Envelopes;
 use crate::instrument::plan::Reading;
 use crate::recipe::Material;
 use crate::{Error, Result};
@@ -24,10 +24,14 @@ pub fn json(material: &Material, readings: &[Reading], timing: bool) -> String {
 }
 
 /// Add `"envelope_min"`, `"envelope_max"` and the variations to each reading of a `json` document (null where
-/// the standard data give no tolerance), and the envelope's method at the top.
-pub fn json_with_envelope(mut doc: serde_json::Value, envelopes: &[Option<Envelope>]) -> serde_json::Value {
+/// the standard data give no tolerance, or where the wall-clock limit cut the envelope: then
+/// `"envelope_cut": true`), and the envelope's method at the top.
+pub fn json_with_envelope(mut doc: serde_json::Value, envelopes: &Envelopes) -> serde_json::Value {
     if let Some(rs) = doc["readings"].as_array_mut() {
-        for (r, e) in rs.iter_mut().zip(envelopes) {
+        for (r, e) in rs.iter_mut().zip(&envelopes.of) {
+            if envelopes.cut.iter().any(|g| r["geometry"] == g.as_str()) {
+                r["envelope_cut"] = json!(true);
+            }
             r["envelope_min"] = json!(e.as_ref().map(|e| e.min));
             r["envelope_max"] = json!(e.as_ref().map(|e| e.max));
             if let Some(e) = e {

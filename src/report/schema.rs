@@ -28,6 +28,7 @@ fn reading(batch: bool) -> Value {
         "envelope_min": {"type": ["number", "null"], "description": "with --envelope: the least reading within the tolerances"},
         "envelope_max": {"type": ["number", "null"], "description": "with --envelope: the greatest reading within the tolerances"},
         "envelope": {"type": "object", "description": "with --envelope: how the envelope was read (variants, method, numbers varied)"},
+        "envelope_cut": {"const": true, "description": "with --envelope and --max-seconds: the limit (the whole command's) was reached before this geometry's envelope was read, so it is null (exit 1)"},
     });
     let mut required =
         vec!["geometry", "name", "quantity", "value", "unit", "error_estimate", "evaluations", "converged"];

@@ -295,7 +295,14 @@ impl Plan {
     /// [`Plan::execute`], keeping the flux of every integral with the readings: what the whole plan cost
     /// ([`Execution::evaluations`], each distinct integral counted once).
     pub fn run(&self) -> Execution {
-        let deadline = self.deadline();
+        self.run_until(self.deadline())
+    }
+
+    /// [`Plan::run`] under a deadline of the caller's (None: none) instead of the plan's own (the start + its
+    /// wall-clock budget): a command that runs several plans (`measure --envelope`, its nominal plan and
+    /// every variant's) holds them all to one limit counted from its start. The integrals still take their
+    /// budget from [`PlanOptions::max_seconds`] ([`Method::execute_until`]).
+    pub fn run_until(&self, deadline: Option<std::time::Instant>) -> Execution {
         let todo = self.specimen_jobs();
         let computed: Vec<Flux> =
             todo.par_iter().map(|&j| self.jobs[j].method.execute_until(self.material.as_ref(), deadline)).collect();
