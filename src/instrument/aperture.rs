@@ -199,6 +199,13 @@ pub fn delta_kinks(kinks: &[Kink], theta: f64, src: Stop) -> Vec<f64> {
 /// radii) (the triangle inequality on the sphere: the angle between ωi and ωo differs from the axes' 2θ by
 /// at most the two directions' angles from their axes), in increasing order.
 pub fn regular_kinks(kinks: &[Kink], theta: f64, src: Stop, rec: Stop) -> Vec<f64> {
+    regular_kinks_between(kinks, 2.0 * theta, src, rec)
+}
+
+/// [`regular_kinks`] for stops whose axes are `axes_angle` apart (2θ on the mirror axis; θ + the viewing
+/// angle for a receptor off it, in the plane on the other side of the normal).
+pub fn regular_kinks_between(kinks: &[Kink], axes_angle: f64, src: Stop, rec: Stop) -> Vec<f64> {
+    let theta = 0.5 * axes_angle.abs();
     let a = stop_radius(src) + stop_radius(rec);
     let mut c: Vec<f64> = kinks
         .iter()
@@ -301,6 +308,33 @@ pub fn half_angle_kink_point(axes: &Axes, dot: f64, u: f64, qs: f64, qr: f64, lo
             let ab = a * b;
             let r = ab.sqrt();
             (n / r - dot, dn / r - 0.5 * n * (2.0 * ps * b - 2.0 * pr * a) / (ab * r))
+        },
+        lo,
+        hi,
+    )
+}
+
+/// The position p_s of the source-stop point on the half-angle kink ωi·ωo = `dot` in the plain chart, at fixed
+/// q_s and receptor direction `wo` (a receptor off the mirror axis), within [lo, hi]: ωi·ωo = S·ωo/|S| with
+/// S = (−sin θ + p cos θ, q, cos θ + p sin θ) (`Axes::source_dir`), at the rate (dS/dp·ωo)/|S| − (S·ωo)·p/|S|³.
+/// It increases with p_s for a receptor across the normal (the source direction turns towards it) and
+/// decreases for one on the source's side; the root is found on the increasing one of ±(ωi·ωo − dot). The end
+/// on the kink's side when the kink does not cross.
+pub fn plain_kink_point(axes: &Axes, dot: f64, qs: f64, wo: crate::Vec3, lo: f64, hi: f64) -> f64 {
+    let (c, s) = (axes.theta.cos(), axes.theta.sin());
+    let g = |p: f64| {
+        let sv = crate::Vec3::new(-s + p * c, qs, c + p * s);
+        let n2 = 1.0 + p * p + qs * qs;
+        let n = n2.sqrt();
+        let d = sv.dot(wo);
+        let dd = c * wo.x + s * wo.z;
+        (d / n - dot, dd / n - d * p / (n2 * n))
+    };
+    let sign = if g(hi).0 >= g(lo).0 { 1.0 } else { -1.0 };
+    increasing_root(
+        |p| {
+            let (v, dv) = g(p);
+            (sign * v, sign * dv)
         },
         lo,
         hi,
@@ -488,6 +522,25 @@ mod tests {
         let root = half_angle_kink_point(&axes, k, 0.003, 0.01, -0.02, 0.0, 0.0);
         assert_eq!(root, 0.0, "an empty bracket returns its end");
         assert!(numeric > 0.0, "ωi·ωo increases with p_s at constant u");
+    }
+
+    /// The plain chart's kink point lies on ωi·ωo = dot for a receptor off the mirror axis.
+    #[test]
+    fn the_plain_kink_point_lies_on_its_kink() {
+        let (src, rec) = (Axes::new(45f64.to_radians()), Axes::new(30f64.to_radians()));
+        let c = (1.0f64 - 0.599 * 0.599).sqrt();
+        let dot = 2.0 * c * c - 1.0;
+        for (qs, pr, qr) in [(0.0, 0.0, 0.0), (0.01, -0.02, 0.015), (-0.03, 0.03, -0.01)] {
+            let wo = rec.receptor_dir(pr, qr);
+            let p = plain_kink_point(&src, dot, qs, wo, -0.1, 0.1);
+            assert!((src.source_dir(p, qs).dot(wo) - dot).abs() < 1e-14, "p = {p}");
+        }
+        // A receptor on the source's side (E2194 110°: viewing 45° − 110°): ωi·ωo decreases with p_s.
+        let back = Axes::new(-65f64.to_radians());
+        let wo = back.receptor_dir(0.01, -0.02);
+        let d = src.source_dir(0.0, 0.01).dot(wo);
+        let p = plain_kink_point(&src, d, 0.01, wo, -0.1, 0.1);
+        assert!(p.abs() < 1e-12, "p = {p}");
     }
 
     /// The kinked position tiles [lo, hi]: each piece runs from one breakpoint to the next, ∫ dx/dt dt = hi − lo,

@@ -11,8 +11,8 @@ use super::{DeltaPart, Design, Method, Projection, RegularPart, Rule, Target, Te
 use crate::brdf::{Brdf, Lobe, Tail, TermKind};
 use crate::colorimetry::weighting::Weighting;
 use crate::instrument::aperture::{
-    choose_chart, clip, delta_kinks, lobe_boxes, lobe_splits, lobe_widths_uv, mirror_overlap, regular_kinks, AxisMap,
-    Chart, DELTA_SHARE,
+    choose_chart, clip, delta_kinks, lobe_boxes, lobe_splits, lobe_widths_uv, mirror_overlap, regular_kinks,
+    regular_kinks_between, AxisMap, Chart, DELTA_SHARE,
 };
 use crate::instrument::geometry::{Integral, Stop};
 use crate::quadrature::{tensor, Cell, Refine};
@@ -80,9 +80,13 @@ impl Method {
         };
         let regular = match (d.has_regular, clipped) {
             (true, Some((src, rec))) => {
-                // Off the mirror axis no lobe is centred in the stops: the plain variables (and no kink cuts:
-                // the cut's chart is the lobe chart, whose variables assume the mirror axis).
-                let kinks = if on_mirror_axis { regular_kinks(d.kinks, d.theta, src, rec) } else { Vec::new() };
+                // Off the mirror axis no lobe is centred in the stops: the plain variables, with p_s cut at the
+                // kinks there (`RegularPart::kinks`).
+                let kinks = if on_mirror_axis {
+                    regular_kinks(d.kinks, d.theta, src, rec)
+                } else {
+                    regular_kinks_between(d.kinks, d.theta + d.viewing, src, rec)
+                };
                 let chart = if !on_mirror_axis {
                     Chart::Plain
                 } else if kinks.is_empty() {
@@ -96,10 +100,23 @@ impl Method {
                         let boxes = kinked_boxes(lobe_boxes(&splits), kinks.len());
                         (splits, boxes)
                     }
-                    Chart::Plain => (
+                    Chart::Plain if kinks.is_empty() => (
                         [vec![], vec![]],
                         vec![([src.p[0], src.q[0], rec.p[0], rec.q[0]], [src.p[1], src.q[1], rec.p[1], rec.q[1]])],
                     ),
+                    // The first axis is the kinked position t ∈ [0, 1] of p_s (`aperture::kinked_position`).
+                    Chart::Plain => {
+                        let m = (kinks.len() + 1) as f64;
+                        let boxes = (0..=kinks.len())
+                            .map(|j| {
+                                (
+                                    [j as f64 / m, src.q[0], rec.p[0], rec.q[0]],
+                                    [(j + 1) as f64 / m, src.q[1], rec.p[1], rec.q[1]],
+                                )
+                            })
+                            .collect();
+                        ([vec![], vec![]], boxes)
+                    }
                 };
                 let share = 1.0 - DELTA_SHARE;
                 let rule = match chart {

@@ -9,7 +9,9 @@ use super::polar::lobe_polar;
 use super::{Flux, Method, Projection, RegularPart, Rule, TensorChart};
 use crate::brdf::Brdf;
 use crate::colorimetry::weighting::Weighting;
-use crate::instrument::aperture::{half_angle_kink_point, incidence_kink_point, kinked_position, AxisMap, Chart};
+use crate::instrument::aperture::{
+    half_angle_kink_point, incidence_kink_point, kinked_position, plain_kink_point, AxisMap, Chart,
+};
 use crate::instrument::geometry::{solid_angle_density, Axes, Integral, Stop};
 use crate::instrument::sphere;
 use crate::quadrature::{
@@ -82,11 +84,20 @@ impl Method {
         let aq = AxisMap { s: src.q, r: rec.q };
         let (weighting, projection) = (&self.weighting, self.projection);
         let n = brdf.sampling().len();
+        let plain_kinked = part.chart == Chart::Plain && !part.kinks.is_empty();
         let mut batch = PairBatch::default();
         move |pts: &[[f64; 4]], out: &mut [f64]| {
             batch.clear(pts.len());
             for (i, x) in pts.iter().enumerate() {
-                let (ps, qs, pr, qr, jac) = if vars.get() == TensorChart::Plain {
+                let (ps, qs, pr, qr, jac) = if vars.get() == TensorChart::Plain && plain_kinked {
+                    // The plain chart cut at the kinks: x[0] is the kinked position t of p_s.
+                    let wo = rec_axes.receptor_dir(x[2], x[3]);
+                    let (ps, jp) = kinked_position(x[0], src.p[0], src.p[1], part.kinks.len(), |k| {
+                        let c = part.kinks[k];
+                        plain_kink_point(&axes, 2.0 * c * c - 1.0, x[1], wo, src.p[0], src.p[1])
+                    });
+                    (ps, x[1], x[2], x[3], jp)
+                } else if vars.get() == TensorChart::Plain {
                     (x[0], x[1], x[2], x[3], 1.0)
                 } else if vars.get() == TensorChart::PlainPLobeQ {
                     let (qs, qr, jq) = aq.at(x[2], x[3]);

@@ -169,9 +169,11 @@ pub struct RegularPart {
     /// The split points of the lobe chart on u and v (empty for the plain chart).
     pub splits: [Vec<f64>; 2],
     /// The cosines c of the half-angle kinks (`Kink::HalfAngle`, ωi·h = c) whose surface may cross the
-    /// domain, in increasing order; non-empty only in the lobe chart (a kink forces it). For each (u, q_s,
-    /// q_r) the overlap position t_p runs over p_s in m + 1 pieces cut where ωi·ωo = 2c² − 1
-    /// (`aperture::half_angle_kink_point`), so every kink lies on a boundary of the initial boxes.
+    /// domain, in increasing order. On the mirror axis a kink forces the lobe chart: for each (u, q_s, q_r)
+    /// the overlap position t_p runs over p_s in m + 1 pieces cut where ωi·ωo = 2c² − 1
+    /// (`aperture::half_angle_kink_point`). Off it (the plain chart) the first variable is the kinked position
+    /// t of p_s for each (q_s, p_r, q_r) (`aperture::plain_kink_point`). Either way every kink lies on a
+    /// boundary of the initial boxes.
     pub kinks: Vec<f64>,
     /// The partition: the initial boxes at design time, the final partition of a frozen method.
     pub cells: Vec<Cell<4>>,

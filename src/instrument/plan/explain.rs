@@ -210,7 +210,10 @@ fn describe_method(m: &Method, terms: &[Term]) -> String {
     };
     let regular = m.regular.as_ref().map(|p| {
         let chart = match p.chart {
-            Chart::Plain => "plain variables (no lobe narrower than the stops)".to_string(),
+            Chart::Plain => format!(
+                "plain variables (no lobe narrower than the stops){}",
+                describe_kinks(&p.kinks, "p_s cut along ωi·h = cos θc")
+            ),
             Chart::Lobe => format!(
                 "lobe variables, {} × {} split points{}",
                 p.splits[0].len(),
