@@ -12,7 +12,8 @@
 //! * `aperture.rs`: questions about one aperture integral: [`aperture::clip`], [`aperture::mirror_overlap`],
 //!   the [`aperture::Chart`] ([`aperture::choose_chart`]), [`aperture::lobe_widths_uv`],
 //!   [`aperture::lobe_splits`], [`aperture::lobe_boxes`], the kinks that cross the stops
-//!   ([`aperture::delta_kinks`], [`aperture::regular_kinks`], [`aperture::kinked_position`]) and
+//!   ([`aperture::delta_kinks`], [`aperture::regular_kinks`], [`aperture::regular_kinks_between`],
+//!   [`aperture::kinked_position`]) and
 //!   [`aperture::DELTA_SHARE`];
 //! * `reference.rs`: independent references that share no code with the quadrature
 //!   ([`reference::projected_solid_angle`], [`reference::lambertian_flux_reference`],
