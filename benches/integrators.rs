@@ -3,8 +3,8 @@
 //! has taken ≥ 100 ms in total and reported as the median time per run.
 //!
 //! Run: `cargo bench --bench integrators` (release). `BENCH_QUICK=1` shrinks the baselines for a smoke
-//! test. `BENCH_CASES=B1,B3,NARROW,B5,BATCH` runs only the sections named (the cases B1–B4, the narrow-GGX
-//! rows, the B5 panel with its side-by-side rule table, the batch throughput); unset, all of them. The Markdown tables go to stdout and to `bench/results/latest.md`; see `bench/README.md` and
+//! test. `BENCH_CASES=B1,B3,NARROW,B5,BATCH,WIDE` runs only the sections named (the cases B1–B4, the narrow-GGX
+//! rows, the B5 panel with its side-by-side rule table, the batch throughput, the lobes as wide as the stops); unset, all of them. The Markdown tables go to stdout and to `bench/results/latest.md`; see `bench/README.md` and
 //! `docs/performance.md`.
 //!
 //! Cases (the specimen flux Φ = ∫_source ∫_receptor f cos θi cos θo dωi dωo through the gloss receptor):
@@ -844,6 +844,9 @@ fn main() {
     if wants("BATCH") {
         batch(&mut md, quick);
     }
+    if wants("WIDE") {
+        wide_lobes(&mut md);
+    }
 
     print!("{md}");
     let out = Path::new(env!("CARGO_MANIFEST_DIR")).join("bench/results/latest.md");
@@ -1305,4 +1308,117 @@ fn batch(md: &mut String, quick: bool) {
         }
         let _ = writeln!(md, "| {k} | {} | {:.0} | {:.2}× | {runs} |", fmt_time(secs), n as f64 / secs, base / secs);
     }
+}
+
+/// Lobes about as wide as the stops (`docs/performance.md` §"Lobes as wide as the stops"): Beckmann and GGX m = 0.003,
+/// 0.01, 0.03 (n = 1.5) at D523 20°/60°/85° and E430 30°, the Günther presets
+/// (fixtures/materials/guenther-2005) and `cook-torrance-lobes` over the default panel, rtol 1e-6. Per recipe, the
+/// specimen integrals' exact evaluation counts with the planner's methods (today: the Genz–Malik partition for all of
+/// them), beside two alternatives forced on the same methods in the same run: Genz–Malik on the overlap-kink partition
+/// alone (no lobe splits) and the tensor Gauss–Legendre rule with orders shared by the kink partition's boxes
+/// (`TensorChart::Lobe`, falling back to the Genz–Malik partition). For each, the largest actual / estimate over the
+/// recipe's integrals against a Genz–Malik run at 10⁻³ of the integral's tolerances (skipping integrals whose flux is
+/// below the absolute floor). The limit a rule can reach is measured by independent code (`tools/limit_wide_lobes.py`).
+fn wide_lobes(md: &mut String) {
+    use glossmeter::instrument::aperture::{lobe_boxes, AxisMap, Chart};
+    use glossmeter::quadrature::Cell;
+    let _ = writeln!(md, "\n## Lobes as wide as the stops (one run; load average at the start {})\n", loadavg());
+    let _ = writeln!(md, "| recipe | geometries | specimen integrals | planner: evaluations | time (1 thread) | worst actual/est. | Genz–Malik, kink partition: evaluations | worst actual/est. | tensor GL shared orders, kink partition: evaluations | worst actual/est. |");
+    let _ = writeln!(md, "|---|---|---|---|---|---|---|---|---|---|");
+    let set = ["astm-d523-20", "astm-d523-60", "astm-d523-85", "astm-e430-30"];
+    let mut cases: Vec<(String, Arc<dyn Brdf>, Vec<&str>)> = vec![];
+    for d in ["beckmann", "ggx"] {
+        for m in [0.003, 0.01, 0.03] {
+            let text = format!(r#"{{"model":"microfacet","distribution":"{d}","roughness":{m},"ior":1.5}}"#);
+            match glossmeter::recipe::parse_str(&text, "wide.json") {
+                Ok(r) => cases.push((format!("{d} m = {m}"), r.brdf, set.to_vec())),
+                Err(e) => eprintln!("[bench] {d} {m}: {e}"),
+            }
+        }
+    }
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut presets: Vec<_> = std::fs::read_dir(root.join("fixtures/materials/guenther-2005"))
+        .map(|d| d.filter_map(|e| e.ok().map(|e| e.path())).collect())
+        .unwrap_or_default();
+    presets.sort();
+    presets.push(root.join("fixtures/recipes/cook-torrance-lobes.json"));
+    for p in presets {
+        match glossmeter::recipe::load_file(&p) {
+            Ok(r) => cases.push((
+                p.file_stem().map_or_else(String::new, |s| s.to_string_lossy().into_owned()),
+                r.brdf,
+                PANEL.to_vec(),
+            )),
+            Err(e) => eprintln!("[bench] {}: {e}", p.display()),
+        }
+    }
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build().expect("pool");
+    let opts = PlanOptions { rtol: 1e-6, ..Default::default() };
+    let mut totals = [0usize; 3];
+    for (name, brdf, geoms) in cases {
+        let geo: Vec<StandardGeometry> = geoms.iter().filter_map(|g| standards::find(g).ok()).collect();
+        let Ok(plan) = Plan::compile(brdf.clone(), geo, opts.clone()) else { continue };
+        let (_, secs, _) = pool.install(|| timed(|| plan.execute()));
+        let mut evals = [0usize; 3];
+        let mut worst = [0.0f64; 3];
+        let mut n = 0;
+        for job in plan.jobs.iter().filter(|j| j.method.target == Target::Specimen) {
+            n += 1;
+            let mut tight = job.method.clone();
+            if let Some(p) = tight.regular.as_mut() {
+                (p.rule, p.rtol, p.atol) = (Rule::GenzMalik75, 1e-3 * p.rtol, 1e-3 * p.atol);
+            }
+            if let Some(p) = tight.delta.as_mut() {
+                (p.rtol, p.atol) = (1e-3 * p.rtol, 1e-3 * p.atol);
+            }
+            let r = tight.execute(brdf.as_ref()).value[0];
+            let floor = job.method.regular.as_ref().map_or(0.0, |p| p.atol);
+            for (v, slot) in [0usize, 1, 2].into_iter().zip(evals.iter_mut()) {
+                let mut m = job.method.clone();
+                let clipped = m.clipped;
+                if let (Some(p), Some((src, rec))) = (m.regular.as_mut(), clipped) {
+                    let eligible = p.chart == Chart::Lobe && p.kinks.is_empty() && p.rule == Rule::GenzMalik75;
+                    if eligible && v == 1 {
+                        let kinks = |a: AxisMap| {
+                            let [lo, hi] = a.range();
+                            let mut x = vec![lo, hi, a.s[1] + a.r[0], a.s[0] + a.r[1]];
+                            x.retain(|x| *x >= lo && *x <= hi);
+                            x.sort_by(f64::total_cmp);
+                            x.dedup_by(|a, b| (*a - *b).abs() <= 1e-14 * (hi - lo));
+                            x
+                        };
+                        let sp = [kinks(AxisMap { s: src.p, r: rec.p }), kinks(AxisMap { s: src.q, r: rec.q })];
+                        p.cells = Cell::from_boxes(&lobe_boxes(&sp));
+                    }
+                    if eligible && v == 2 {
+                        p.rule =
+                            Rule::TensorGauss { chart: TensorChart::Lobe, levels: [1; 4], path: Default::default() };
+                    }
+                }
+                let f = m.execute(brdf.as_ref());
+                *slot += f.evaluations;
+                let actual = (f.value[0] - r).abs();
+                if r.abs() > floor && f.error[0] > 0.0 {
+                    worst[v] = worst[v].max(actual / f.error[0]);
+                }
+            }
+        }
+        for k in 0..3 {
+            totals[k] += evals[k];
+        }
+        let _ = writeln!(
+            md,
+            "| {name} | {} | {n} | {} | {} | {:.3} | {} | {:.3} | {} | {:.3} |",
+            geoms.len(),
+            evals[0],
+            fmt_time(secs),
+            worst[0],
+            evals[1],
+            worst[1],
+            evals[2],
+            worst[2]
+        );
+    }
+    let _ = writeln!(md, "| **total** | | | {} | | | {} | | {} | |", totals[0], totals[1], totals[2]);
+    let _ = writeln!(md, "\nLoad average at the end of this section {}.", loadavg());
 }

@@ -7,7 +7,8 @@
 //!
 //! Plain `main` (harness = false), `std::time::Instant`: each case is built repeatedly for ≥ 200 ms and the
 //! median of the per-build times is reported. Run at normal priority: `cargo bench --bench paint_build`; the
-//! table goes to stdout (copy it to docs/performance.md with the load average).
+//! table goes to stdout (copy it to docs/performance.md with the load average). `PAINT_BUILD=sweep` runs only
+//! the sweep-point rows (`sweep_points`).
 use std::time::Instant;
 
 use glossmeter::optics::coat_albedo::CoatAlbedo;
@@ -18,7 +19,89 @@ fn median(mut v: Vec<f64>) -> f64 {
     v[v.len() / 2]
 }
 
+/// Sets one field of a recipe.
+type Setter = Box<dyn Fn(&mut serde_json::Value, f64)>;
+
+/// What one sweep point rebuilds (`docs/performance.md` §"Paint rebuilds in sweeps"): the recipe of a point is
+/// parsed and its paint built anew (`Sweep::plan_point` → `recipe::parse_str` → `Paint::new`), so the median time of
+/// building a paint fixture whose one field alternates between two values is what a sweep over that field pays per
+/// point before its integrals. Rows: the coat index (every flake table depends on it: a metal flake's relative index
+/// (n + ik)/η, the pearl stack's surrounding resin η) and the flake area ratio (no table depends on it).
+fn sweep_points() {
+    println!("### What a sweep point rebuilds: building a paint whose one field alternates between two values\n");
+    println!("| fixture | field | values | without the table memo (before) | with it | builds timed each |");
+    println!("|---|---|---|---|---|---|");
+    let fixtures = [
+        "cerulean-blue-c",
+        "cerulean-blue-c-literal",
+        "white-pearl",
+        "white-pearl-spectral",
+        "blue-metallic-spectral",
+        "silver-metallic",
+    ];
+    for f in fixtures {
+        let Ok(text) = std::fs::read_to_string(format!("fixtures/recipes/{f}.json")) else { continue };
+        let Ok(base) = serde_json::from_str::<serde_json::Value>(&text) else { continue };
+        let area = ["metallic_flakes", "pearlescent_flakes"].into_iter().find(|k| base.get(*k).is_some());
+        let mut fields: Vec<(String, [f64; 2], Setter)> =
+            vec![("/clear_coat/index".into(), [1.5, 1.52], Box::new(|v, x| v["clear_coat"]["index"] = x.into()))];
+        if let Some(k) = area {
+            let a0 = base[k]["area_ratio"].as_f64().unwrap_or(0.3);
+            fields.push((
+                format!("/{k}/area_ratio"),
+                [a0, 0.9 * a0],
+                Box::new(move |v, x| v[k]["area_ratio"] = x.into()),
+            ));
+        }
+        for (name, values, set) in fields {
+            let texts: Vec<String> = values
+                .iter()
+                .map(|&x| {
+                    let mut v = base.clone();
+                    set(&mut v, x);
+                    serde_json::to_string(&v).expect("json")
+                })
+                .collect();
+            // Interleaved: a build without the memo (forgotten first: every table computed, the engine before it),
+            // then one with it, alternating the two values.
+            let (mut cold, mut warm) = (vec![], vec![]);
+            let start = Instant::now();
+            let mut i = 0;
+            while start.elapsed().as_secs_f64() < 0.6 || warm.len() < 6 {
+                for forget in [true, false] {
+                    if forget {
+                        glossmeter::brdf::paint::forget_tables();
+                    }
+                    let t = Instant::now();
+                    let m = glossmeter::recipe::parse_str(&texts[i % 2], "bench.json").expect("recipe");
+                    let dt = t.elapsed().as_secs_f64();
+                    std::hint::black_box(m);
+                    if forget {
+                        cold.push(dt)
+                    } else {
+                        warm.push(dt)
+                    }
+                    i += 1;
+                }
+            }
+            let n = warm.len();
+            println!(
+                "| {f} | `{name}` | {} / {} | {:.3} ms | {:.3} ms | {n} |",
+                values[0],
+                values[1],
+                median(cold) * 1e3,
+                median(warm) * 1e3
+            );
+        }
+    }
+    println!();
+}
+
 fn main() {
+    if std::env::var("PAINT_BUILD").is_ok_and(|v| v == "sweep") {
+        sweep_points();
+        return;
+    }
     let base: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string("fixtures/recipes/solid-white.json").expect("fixture"))
             .expect("json");

@@ -4,6 +4,7 @@
 //! Chebyshev tables, and the split flake light's unscattered transmission τ and diffuse weight
 //! (`docs/model.md` §Metallic flakes, §Pearlescent flakes, §Flake light through the pigment).
 use super::hemisphere::{hemispherical_mean, DIFFUSE_FRESNEL_NODES};
+use super::memo::Memo;
 use crate::optics::fresnel::{critical_cosine_complex, fr_conductor};
 use crate::optics::kubelka_munk::Layer;
 use crate::optics::microfacet::Microfacet;
@@ -41,6 +42,10 @@ pub(super) struct FlakeTerm {
     /// verified Chebyshev table over the local cosine ∈ [0, 1] (max deviation from the direct evaluation ≤
     /// `TABLE_TOLERANCE` at check points), or None when no table met it.
     pub(super) table: Option<Vec<ChebTable>>,
+    /// The same tables on one grid (each at the largest piece count among them: a table that met the tolerance
+    /// with fewer pieces is fitted again at that count), what the folded evaluation sums coefficients over
+    /// (`folded.rs`); None when `table` is None or a refit missed the tolerance.
+    pub(super) grid: Option<Vec<ChebTable>>,
     /// Split flake light: per sample, the optical depth ε·X' of the cover for collimated light, ε = (K + S)/2.
     pub(super) depth: Vec<f64>,
     /// Split flake light: per sample, the diffuse part's weight R_d/(π(1 − τ̄)): R_d = KM cover over the
@@ -132,7 +137,7 @@ impl FlakeTerm {
     }
 
     /// Precompute the split flake light's per-sample constants (`depth`, `diffuse`).
-    pub(super) fn split_constants(&mut self, k_mix: &[f64], s_mix: &[f64], depth_mm: f64, wavelengths_nm: &[f64]) {
+    fn split_constants(&mut self, k_mix: &[f64], s_mix: &[f64], depth_mm: f64, wavelengths_nm: &[f64]) {
         let (x, w) = gauss_legendre(DIFFUSE_FRESNEL_NODES);
         let n = self.cover.len();
         self.depth = (0..n).map(|j| 0.5 * (k_mix[j] + s_mix[j]) * depth_mm).collect();
@@ -156,10 +161,94 @@ impl FlakeTerm {
     }
 
     /// Build the per-sample tables; all or none.
-    pub(super) fn tabulate(&mut self, wavelengths_nm: &[f64]) {
+    fn tabulate(&mut self, wavelengths_nm: &[f64]) {
         let tables: Option<Vec<ChebTable>> = (0..self.cover.len())
             .map(|k| ChebTable::fit(|c| self.reflectance_direct(k, c, wavelengths_nm[k]), 0.0, 1.0, TABLE_TOLERANCE))
             .collect();
         self.table = tables;
     }
+
+    /// The tables on one grid ([`FlakeTerm::grid`]).
+    fn on_one_grid(&self, wavelengths_nm: &[f64]) -> Option<Vec<ChebTable>> {
+        let t = self.table.as_ref()?;
+        let pieces = t.iter().map(ChebTable::pieces).max()?;
+        t.iter()
+            .enumerate()
+            .map(|(k, tk)| match tk.pieces() == pieces {
+                true => Some(tk.clone()),
+                false => ChebTable::fit_with_pieces(
+                    |c| self.reflectance_direct(k, c, wavelengths_nm[k]),
+                    0.0,
+                    1.0,
+                    pieces,
+                    TABLE_TOLERANCE,
+                ),
+            })
+            .collect()
+    }
+
+    /// Everything the term computes from its optics, its cover and the samples: the tables ([`FlakeTerm::table`],
+    /// [`FlakeTerm::grid`]) and, for the split flake light, its constants ([`FlakeTerm::split_constants`]) —
+    /// taken from the process's [`Memo`] when a build before had the same inputs to the bit (what a sweep point
+    /// that varies an area ratio, a spread, the primer or the coat's roughness meets), else computed and kept.
+    pub(super) fn prepare(&mut self, k_mix: &[f64], s_mix: &[f64], depth_mm: f64, wavelengths_nm: &[f64]) {
+        let key = self.key(k_mix, s_mix, depth_mm, wavelengths_nm);
+        let made = TABLES.get_or_make(key, || {
+            let mut t = self.clone();
+            t.tabulate(wavelengths_nm);
+            t.grid = t.on_one_grid(wavelengths_nm);
+            if t.split {
+                t.split_constants(k_mix, s_mix, depth_mm, wavelengths_nm);
+            }
+            Prepared { table: t.table, grid: t.grid, depth: t.depth, diffuse: t.diffuse }
+        });
+        self.table = made.table.clone();
+        self.grid = made.grid.clone();
+        self.depth = made.depth.clone();
+        self.diffuse = made.diffuse.clone();
+    }
+
+    /// The bits of every input [`FlakeTerm::prepare`] reads: the optics, the cover per sample, whether the light
+    /// is split, the wavelengths, the table tolerance, and for the split light the pigment mix and the depth.
+    fn key(&self, k_mix: &[f64], s_mix: &[f64], depth_mm: f64, wavelengths_nm: &[f64]) -> Vec<u64> {
+        let mut key = vec![TABLE_TOLERANCE.to_bits(), self.split as u64];
+        match &self.optics {
+            FlakeOptics::Metal(eta) => {
+                key.push(1);
+                key.extend(eta.iter().flat_map(|e| [e.re.to_bits(), e.im.to_bits()]));
+            }
+            FlakeOptics::Pearl { layers, medium } => {
+                key.push(2);
+                for l in layers {
+                    key.extend([l.n.re.to_bits(), l.n.im.to_bits(), l.thickness_nm.to_bits(), l.coherent as u64]);
+                }
+                key.push(medium.to_bits());
+            }
+        }
+        key.extend(self.cover.iter().flat_map(|c| [c.r0.to_bits(), c.t.to_bits()]));
+        key.extend(wavelengths_nm.iter().map(|w| w.to_bits()));
+        if self.split {
+            key.push(depth_mm.to_bits());
+            key.extend(k_mix.iter().chain(s_mix).map(|x| x.to_bits()));
+        }
+        key
+    }
+}
+
+/// The flake terms' tables kept between paint builds ([`FlakeTerm::prepare`]).
+static TABLES: Memo<Prepared> = Memo::new();
+
+/// Forget every kept flake table, so that the next paint build computes its tables as if it were the first of
+/// the process (what `benches/paint_build.rs` times as the build without the memo; readings are the same bits
+/// either way).
+pub fn forget_tables() {
+    TABLES.clear();
+}
+
+/// What [`FlakeTerm::prepare`] computes and the memo keeps.
+struct Prepared {
+    table: Option<Vec<ChebTable>>,
+    grid: Option<Vec<ChebTable>>,
+    depth: Vec<f64>,
+    diffuse: Vec<f64>,
 }

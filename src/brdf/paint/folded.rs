@@ -1,7 +1,7 @@
 //! The paint's flake tables and direction-independent sums folded for one weighted sum of its samples
 //! ([`Folded`], [`FoldedFlake`]): what the luminous row's evaluation `Paint::eval_folded` reads
 //! (`docs/model.md` §Folded evaluation).
-use super::flake::{FlakeTerm, TABLE_TOLERANCE};
+use super::flake::FlakeTerm;
 use crate::optics::tabulated::ChebTable;
 
 /// The paint prepared for one weighted sum of its samples, Σ_j w_j f_j (the luminous row of its sampling:
@@ -40,12 +40,11 @@ pub(super) struct FoldedFlake {
 
 impl Folded {
     /// Prepare a paint for the row `w` (n weights): its flake terms (`metallic`, `pearlescent`), its body term
-    /// per sample and its wavelengths.
+    /// per sample.
     pub(super) fn new(
         metallic: Option<&FlakeTerm>,
         pearlescent: Option<&FlakeTerm>,
         body: &[f64],
-        lambdas: &[f64],
         w: &[f64],
     ) -> Folded {
         let flakes = metallic
@@ -53,22 +52,8 @@ impl Folded {
             .chain(pearlescent)
             .map(|fl| {
                 let grey_cover = fl.depth.iter().all(|d| d.to_bits() == fl.depth[0].to_bits());
-                let grid = fl.table.as_ref().and_then(|t| {
-                    let pieces = t.iter().map(ChebTable::pieces).max().expect("one table per sample");
-                    t.iter()
-                        .enumerate()
-                        .map(|(k, tk)| match tk.pieces() == pieces {
-                            true => Some(tk.clone()),
-                            false => ChebTable::fit_with_pieces(
-                                |c| fl.reflectance_direct(k, c, lambdas[k]),
-                                0.0,
-                                1.0,
-                                pieces,
-                                TABLE_TOLERANCE,
-                            ),
-                        })
-                        .collect::<Option<Vec<_>>>()
-                });
+                // The tables on one grid were made with the flake term (`FlakeTerm::grid`).
+                let grid = fl.grid.clone();
                 let constant = !fl.split || grey_cover;
                 let table = grid.as_ref().filter(|_| constant).and_then(|g| ChebTable::combine(g, w));
                 FoldedFlake {

@@ -22,7 +22,7 @@
 //! as printed, for comparison only.
 //!
 //! The folder, one idea per file (no file imports `mod.rs`; `folded.rs` imports `flake.rs`, which imports
-//! `hemisphere.rs`; `spec.rs` imports none of them):
+//! `hemisphere.rs` and `memo.rs`; `spec.rs` imports none of them):
 //! - `mod.rs`: the model, [`Paint`]: [`Paint::new`] (the checks and everything that does not depend on
 //!   direction), the folded evaluation `Paint::eval_folded`, the [`Brdf`] impl (`eval`, `delta_reflectance`,
 //!   `terms`, `smooth`, `seams`, `describe`) and [`MAX_SAMPLES`];
@@ -34,6 +34,8 @@
 //!   diffuse weight;
 //! - `folded.rs`: the flake tables and direction-independent sums folded for one weighted sum of the samples
 //!   (`Folded`, `FoldedFlake`);
+//! - `memo.rs`: [`MEMO_ENTRIES`] and the bounded process-wide memo in which `flake.rs` keeps its tables between
+//!   builds, keyed by the bits of their inputs (a sweep point that changes no input of a table reuses it);
 //! - `hemisphere.rs`: hemispherical means by Gauss–Legendre in the cosine ([`DIFFUSE_FRESNEL_NODES`]): the
 //!   coat's [`diffuse_fresnel_reflectance`] r_e and [`internal_diffuse_reflectance`] r_i, and
 //!   [`hemispherical_mean`], the rule cut at total-internal-reflection kinks.
@@ -48,12 +50,14 @@
 mod flake;
 mod folded;
 mod hemisphere;
+mod memo;
 mod spec;
 
-pub use flake::TABLE_TOLERANCE;
+pub use flake::{forget_tables, TABLE_TOLERANCE};
 pub use hemisphere::{
     diffuse_fresnel_reflectance, hemispherical_mean, internal_diffuse_reflectance, DIFFUSE_FRESNEL_NODES,
 };
+pub use memo::MEMO_ENTRIES;
 pub use spec::{
     spread_to_slope, ClearCoat, FlakeLight, Form, MetallicFlakes, PaintSpec, PearlescentFlakes, Pigment,
     PigmentedLayer, Spread,
@@ -208,14 +212,12 @@ impl Paint {
                 cover: cover(depth),
                 optics,
                 table: None,
+                grid: None,
                 depth: vec![0.0; n],
                 diffuse: vec![0.0; n],
                 split,
             };
-            term.tabulate(&spec.sampling.wavelengths_nm);
-            if split {
-                term.split_constants(&k_mix, &s_mix, depth, &spec.sampling.wavelengths_nm);
-            }
+            term.prepare(&k_mix, &s_mix, depth, &spec.sampling.wavelengths_nm);
             term
         };
         let metallic = spec.metallic.as_ref().filter(|m| m.area_ratio > 0.0).map(|m| {
@@ -244,15 +246,8 @@ impl Paint {
             folded: None,
         };
         let luminous = Weighting::luminous(&paint.spec.sampling).ok().and_then(|w| w.rows.into_iter().next());
-        paint.folded = luminous.map(|w| {
-            Folded::new(
-                paint.metallic.as_ref(),
-                paint.pearlescent.as_ref(),
-                &paint.body,
-                &paint.spec.sampling.wavelengths_nm,
-                &w,
-            )
-        });
+        paint.folded =
+            luminous.map(|w| Folded::new(paint.metallic.as_ref(), paint.pearlescent.as_ref(), &paint.body, &w));
         Ok(paint)
     }
 
