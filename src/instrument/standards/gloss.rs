@@ -31,6 +31,7 @@ pub const BUILTIN: &[(&str, &str)] = &[
     ("astm-d2457-45.json", include_str!("../../../standards/astm-d2457-45.json")),
     ("tappi-t480-75.json", include_str!("../../../standards/tappi-t480-75.json")),
     ("rspec-20.json", include_str!("../../../standards/rspec-20.json")),
+    ("rhopoint-iq-20.json", include_str!("../../../standards/rhopoint-iq-20.json")),
 ];
 
 const TOP_FIELDS: &[&str] = &[
@@ -144,9 +145,10 @@ pub fn parse(text: &str, origin: &str) -> Result<StandardGeometry> {
             ));
         }
         let source = Stop::from_angles(s_in.to_radians(), s_perp.to_radians(), 0.0);
-        if let Some(p) = o.opt_obj("profile")? {
-            crate::instrument::standards::profile::parse_spec(&p, angle)?;
-        }
+        let array = match o.opt_obj("profile")? {
+            Some(p) => Some(crate::instrument::standards::profile::parse_spec(&p, angle)?),
+            None => None,
+        };
         let rec_v = o.array("receptors")?;
         if rec_v.is_empty() {
             return Err(o.err("receptors", "at least one receptor is required"));
@@ -157,6 +159,11 @@ pub fn parse(text: &str, origin: &str) -> Result<StandardGeometry> {
             let name = nonempty_str(&r, "name")?;
             if receptors.iter().any(|(n, _)| *n == name) {
                 return Err(r.err("name", format!("duplicate receptor name {name:?}")));
+            }
+            if r.get("shape").and_then(Value::as_str) == Some("pixels") {
+                let stop = crate::instrument::standards::profile::pixel_window(&r, array.as_ref())?;
+                receptors.push((name, stop));
+                continue;
             }
             let (r_in, r_perp) = aperture(&r, &["name", "shape", "in_plane_deg", "perpendicular_deg", "offset_deg"])?;
             let off = sourced(
@@ -398,6 +405,17 @@ pub fn describe(g: &StandardGeometry) -> String {
                 r.get("shape").and_then(Value::as_str).unwrap_or("?"),
                 stop.solid_angle()
             );
+            if r.get("shape").and_then(Value::as_str) == Some("pixels") {
+                out += &format!(
+                    "    pixels of the profile array, {:.4}° to {:.4}° from specular in plane (pixel edges), as tall as the \
+                     pixels\n",
+                    stop.p[0].atan().to_degrees(),
+                    stop.p[1].atan().to_degrees()
+                );
+                out += &format!("    first pixel: {}\n", sourced_text(r.get("pixel_first"), ""));
+                out += &format!("    last pixel: {}\n", sourced_text(r.get("pixel_last"), ""));
+                continue;
+            }
             out += &format!("    in plane: {}\n", sourced_text(r.get("in_plane_deg"), "°"));
             out += &format!("    perpendicular: {}\n", sourced_text(r.get("perpendicular_deg"), "°"));
             out += &format!("    offset from specular: {}\n", sourced_text(r.get("offset_deg"), "°"));
@@ -471,6 +489,9 @@ pub fn list_line(g: &StandardGeometry) -> String {
         .iter()
         .map(|r| {
             let name = r.get("name").and_then(Value::as_str).unwrap_or("?");
+            if r.get("shape").and_then(Value::as_str) == Some("pixels") {
+                return format!("{name} pixels {}–{}", val(r, "pixel_first"), val(r, "pixel_last"));
+            }
             let off = val(r, "offset_deg");
             let off = if off == "0" || off == "0.0" { String::new() } else { format!("@{off}°") };
             format!("{name} {}°×{}°{off}", val(r, "in_plane_deg"), val(r, "perpendicular_deg"))
