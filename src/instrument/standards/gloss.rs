@@ -444,6 +444,65 @@ pub fn describe(g: &StandardGeometry) -> String {
     out
 }
 
+/// For a geometry whose receptors include windows of its profile array (`"shape": "pixels"`,
+/// `docs/instrument.md` §1.9), the lines `--explain` adds: each window's pixels and angles, each reading's
+/// definition, and every number of the file whose status is `assumed` (JSON Pointer, value, the start of its
+/// reason). None for any other geometry.
+pub fn pixel_array_text(g: &StandardGeometry) -> Option<String> {
+    let recs = g.spec.get("receptors").and_then(Value::as_array)?;
+    let is_pixels = |r: &Value| r.get("shape").and_then(Value::as_str) == Some("pixels");
+    if !recs.iter().any(is_pixels) {
+        return None;
+    }
+    let mut out = String::from("  pixel-array readings (docs/instrument.md §1.9):\n");
+    for (r, (name, stop)) in recs.iter().zip(&g.geometry.receptors) {
+        if is_pixels(r) {
+            let px = |k: &str| r.get(k).and_then(|x| x.get("value")).map(|x| x.to_string()).unwrap_or_default();
+            out += &format!(
+                "    window {name}: pixels {}–{}, {:+.4}° to {:+.4}° from specular in plane\n",
+                px("pixel_first"),
+                px("pixel_last"),
+                stop.p[0].atan().to_degrees(),
+                stop.p[1].atan().to_degrees()
+            );
+        }
+    }
+    for (spec, name) in g.geometry.readings.iter().zip(&g.reading_names) {
+        out += &format!("    {name} ({}) = {}\n", spec.unit(), reading_summary(spec));
+    }
+    let mut assumed = Vec::new();
+    assumed_numbers(&g.spec, String::new(), &mut assumed);
+    out += &format!("  assumed numbers of {} ({}; `glossmeter standards {}` gives each reason in full):\n", g.geometry.id, assumed.len(), g.geometry.id);
+    for (pointer, value, why) in assumed {
+        let short: String = why.chars().take(110).collect();
+        let more = if why.chars().count() > 110 { "…" } else { "" };
+        out += &format!("    {pointer} = {value}: {short}{more}\n");
+    }
+    Some(out)
+}
+
+/// Every sourced number of a geometry specification whose status is `assumed`: (JSON Pointer, value, source).
+fn assumed_numbers(v: &Value, pointer: String, out: &mut Vec<(String, String, String)>) {
+    match v {
+        Value::Object(m) => {
+            if let (Some(value), Some("assumed")) = (m.get("value"), m.get("status").and_then(Value::as_str)) {
+                let source = m.get("source").and_then(Value::as_str).unwrap_or("").to_string();
+                out.push((pointer, value.to_string(), source));
+                return;
+            }
+            for (k, x) in m {
+                assumed_numbers(x, format!("{pointer}/{}", k.replace('~', "~0").replace('/', "~1")), out);
+            }
+        }
+        Value::Array(a) => {
+            for (i, x) in a.iter().enumerate() {
+                assumed_numbers(x, format!("{pointer}/{i}"), out);
+            }
+        }
+        _ => {}
+    }
+}
+
 fn reading_summary(r: &ReadingSpec) -> String {
     match r {
         ReadingSpec::Gloss { receptor } => format!("100·Φ({receptor}) / Φ_standard({receptor})"),
