@@ -19,7 +19,8 @@
 //!   `dielectric.rs` (the smooth dielectric [`dielectric::SmoothDielectric`] and the rough interface of a
 //!   dielectric or a conductor [`dielectric::MicrofacetSurface`], with its [`dielectric::Ior`]), `conductor.rs`
 //!   ([`conductor::SmoothConductor`]), `phong.rs` ([`phong::Phong`]), `ward.rs` ([`ward::Ward`]),
-//!   `multilobe.rs` ([`multilobe::CookTorranceLobes`]) and `paint`, the paint model of Ďurikovič & Ágošton
+//!   `multilobe.rs` ([`multilobe::CookTorranceLobes`]), `halo.rs` (a Rayleigh–Rice scatter halo on a model's
+//!   mirror, [`halo::WithHalo`] over [`halo::Halo`]) and `paint`, the paint model of Ďurikovič & Ágošton
 //!   (2007) ([`paint::Paint`] built from a [`paint::PaintSpec`]);
 //! * `albedo.rs`: the directional albedo that resolves narrow lobes
 //!   ([`albedo::directional_albedo`], [`albedo::directional_albedo_to`]): a d/8 sphere's hemisphere
@@ -33,6 +34,7 @@ use crate::{Error, Result, Vec3};
 pub mod albedo;
 pub mod conductor;
 pub mod dielectric;
+pub mod halo;
 pub mod lambert;
 pub mod multilobe;
 pub mod paint;
