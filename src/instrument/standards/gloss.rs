@@ -472,7 +472,12 @@ pub fn pixel_array_text(g: &StandardGeometry) -> Option<String> {
     }
     let mut assumed = Vec::new();
     assumed_numbers(&g.spec, String::new(), &mut assumed);
-    out += &format!("  assumed numbers of {} ({}; `glossmeter standards {}` gives each reason in full):\n", g.geometry.id, assumed.len(), g.geometry.id);
+    out += &format!(
+        "  assumed numbers of {} ({}; `glossmeter standards {}` gives each reason in full):\n",
+        g.geometry.id,
+        assumed.len(),
+        g.geometry.id
+    );
     for (pointer, value, why) in assumed {
         let short: String = why.chars().take(110).collect();
         let more = if why.chars().count() > 110 { "…" } else { "" };

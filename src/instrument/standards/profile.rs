@@ -117,7 +117,9 @@ pub fn pixel_window(o: &Obj, array: Option<&ProfileSpec>) -> Result<Stop> {
     if first > last {
         return Err(o.obj("pixel_last")?.err(
             "value",
-            format!("the window's last pixel {last} lies before its first pixel {first}: give pixel_first ≤ pixel_last"),
+            format!(
+                "the window's last pixel {last} lies before its first pixel {first}: give pixel_first ≤ pixel_last"
+            ),
         ));
     }
     Ok(p.window(first, last))
