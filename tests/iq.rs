@@ -48,10 +48,7 @@ fn value(rs: &[Reading], geometry: &str, name: &str) -> f64 {
 fn window(first: usize, last: usize, height_deg: f64) -> Stop {
     let lo = ((first as f64 - 255.5) * W - 0.5 * W).to_radians();
     let hi = ((last as f64 - 255.5) * W + 0.5 * W).to_radians();
-    Stop {
-        p: [lo.tan(), hi.tan()],
-        q: [-(0.5 * height_deg).to_radians().tan(), (0.5 * height_deg).to_radians().tan()],
-    }
+    Stop { p: [lo.tan(), hi.tan()], q: [-(0.5 * height_deg).to_radians().tan(), (0.5 * height_deg).to_radians().tan()] }
 }
 
 #[test]
@@ -135,10 +132,13 @@ fn a_lambertian_body_reads_the_closed_forms_of_its_windows() {
     let flux = |s: Stop| rho / std::f64::consts::PI * s.projected_solid_angle(theta) * p_source;
     let standard = mirror_flux(theta, geo.source, window(224, 287, 3.6), 1.567);
     let haze = 100.0 * 0.5 * (flux(window(182, 195, 3.6)) + flux(window(316, 329, 3.6))) / standard;
-    let doi = 100.0 * (1.0 - 0.5 * (flux(window(241, 247, 3.6)) + flux(window(263, 269, 3.6))) / flux(window(252, 258, 3.6)));
+    let doi =
+        100.0 * (1.0 - 0.5 * (flux(window(241, 247, 3.6)) + flux(window(263, 269, 3.6))) / flux(window(252, 258, 3.6)));
     let gloss = 100.0 * flux(window(224, 287, 3.6)) / standard;
     let rs = read(r#"{"model": "lambert", "albedo": 0.5}"#, &["rhopoint-iq-20"]);
-    for (name, want) in [("gloss", gloss), ("haze", haze), ("doi", doi), ("log-haze", 1285.1 * (haze / 20.0 + 1.0).log10())] {
+    for (name, want) in
+        [("gloss", gloss), ("haze", haze), ("doi", doi), ("log-haze", 1285.1 * (haze / 20.0 + 1.0).log10())]
+    {
         let got = value(&rs, "rhopoint-iq-20", name);
         assert!((got - want).abs() <= 1e-6 * want.abs().max(1e-3), "{name}: {got} vs {want}");
     }
@@ -169,9 +169,21 @@ fn windows_outside_the_array_are_refused_naming_file_and_field() {
     std::fs::write(&recipe, r#"{"model": "smooth-dielectric", "ior": 1.5}"#).unwrap();
     let recipe = recipe.to_str().unwrap();
     let cases: Vec<(Box<dyn Fn(&mut Value)>, &str, &str)> = vec![
-        (Box::new(|g: &mut Value| g["receptors"][5]["pixel_last"]["value"] = 512.into()), "/receptors/5/pixel_last", "511"),
-        (Box::new(|g: &mut Value| g["receptors"][4]["pixel_first"]["value"] = (-1).into()), "/receptors/4/pixel_first", "511"),
-        (Box::new(|g: &mut Value| g["receptors"][1]["pixel_first"]["value"] = 2.5.into()), "/receptors/1/pixel_first", "whole"),
+        (
+            Box::new(|g: &mut Value| g["receptors"][5]["pixel_last"]["value"] = 512.into()),
+            "/receptors/5/pixel_last",
+            "511",
+        ),
+        (
+            Box::new(|g: &mut Value| g["receptors"][4]["pixel_first"]["value"] = (-1).into()),
+            "/receptors/4/pixel_first",
+            "511",
+        ),
+        (
+            Box::new(|g: &mut Value| g["receptors"][1]["pixel_first"]["value"] = 2.5.into()),
+            "/receptors/1/pixel_first",
+            "whole",
+        ),
         (
             Box::new(|g: &mut Value| g["receptors"][0]["pixel_first"]["value"] = 300.into()),
             "/receptors/0/pixel_last",
@@ -185,7 +197,9 @@ fn windows_outside_the_array_are_refused_naming_file_and_field() {
             "profile",
         ),
         (
-            Box::new(|g: &mut Value| g["receptors"][2]["offset_deg"] = serde_json::json!({"value": 1, "source": "x", "status": "assumed"})),
+            Box::new(|g: &mut Value| {
+                g["receptors"][2]["offset_deg"] = serde_json::json!({"value": 1, "source": "x", "status": "assumed"})
+            }),
             "/receptors/2",
             "offset_deg",
         ),
@@ -212,7 +226,13 @@ fn standards_and_explain_show_the_pixel_readings_and_what_is_assumed() {
     let (code, out, err) = gm(&["measure", recipe.to_str().unwrap(), "-g", "rhopoint-iq-20", "--explain"]);
     assert_eq!(code, 0, "{err}");
     let all = format!("{out}{err}");
-    for needle in ["pixel-array readings", "window rspec: pixels 252–258", "/source/in_plane_deg = 0.1", "assumed numbers", "doi (DOI) = 100·(Φ(rspec)"] {
+    for needle in [
+        "pixel-array readings",
+        "window rspec: pixels 252–258",
+        "/source/in_plane_deg = 0.1",
+        "assumed numbers",
+        "doi (DOI) = 100·(Φ(rspec)",
+    ] {
         assert!(all.contains(needle), "{needle}: {all}");
     }
 }

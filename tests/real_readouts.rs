@@ -59,3 +59,44 @@ fn the_konica_rspec_panels_are_lacquers_with_orange_peel() {
         assert!(n_range.0 < n && n < n_range.1, "{sample}: n = {n}");
     }
 }
+
+#[test]
+fn the_orange_peel_panel_is_not_reproduced_and_the_85_degree_gloss_is_why() {
+    // The full readout (20°, 60°, 85° gloss, haze read as log haze, DOI, Rspec) against the best two-scale
+    // lacquer (GGX facet slopes with a Rayleigh–Rice halo at the smooth-surface bound, σ = 22 nm), started at
+    // its best fit (docs/instrument.md §1.10). It reproduces 20° gloss and haze within about 2u; no lacquer of
+    // this family reads 85° gloss below ~98 while reading 60° gloss near 88: the fit must say it cannot
+    // reproduce the readings (exit 1) and name 85° gloss as the largest residual.
+    let (code, doc, err) = fit(&[
+        "fixtures/real/models/panel-two-scale.json",
+        "--target",
+        "astm-d523-20/gloss=66.3",
+        "--target",
+        "astm-d523-60/gloss=88.3",
+        "--target",
+        "astm-d523-85/gloss=94.0",
+        "--target",
+        "rhopoint-iq-20/log-haze=14.2",
+        "--target",
+        "rhopoint-iq-20/doi=77.5",
+        "--target",
+        "rhopoint-iq-20/rspec=26.1",
+        "--free",
+        "/roughness=log:1e-4..0.02",
+        "--free",
+        "/ior=1.3..1.8",
+        "--free",
+        "/scatter/correlation_length_um=log:0.3..100",
+    ]);
+    assert_eq!(code, 1, "{err}");
+    assert_eq!(doc["reproduces"], false);
+    let targets = doc["targets"].as_array().unwrap();
+    let weighted = |t: &Value| (t["residual"].as_f64().unwrap() / t["uncertainty"].as_f64().unwrap()).abs();
+    let worst = targets.iter().max_by(|a, b| weighted(a).total_cmp(&weighted(b))).unwrap();
+    assert_eq!((worst["geometry"].as_str(), worst["name"].as_str()), (Some("astm-d523-85"), Some("gloss")));
+    assert!(worst["residual"].as_f64().unwrap() > 3.0, "{worst}");
+    for (g, n) in [("astm-d523-20", "gloss"), ("rhopoint-iq-20", "log-haze")] {
+        let t = targets.iter().find(|t| t["geometry"] == g && t["name"] == n).unwrap();
+        assert!(weighted(t) < 2.5, "{g}/{n}: {t}");
+    }
+}
