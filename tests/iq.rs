@@ -147,6 +147,9 @@ fn a_lambertian_body_reads_the_closed_forms_of_its_windows() {
     assert!(doi.abs() < 1.0, "{doi}");
 }
 
+/// An edit of the shipped geometry's JSON.
+type Edit = Box<dyn Fn(&mut Value)>;
+
 fn iq_with(edit: impl Fn(&mut Value)) -> std::path::PathBuf {
     let mut g: Value = serde_json::from_str(include_str!("../standards/rhopoint-iq-20.json")).unwrap();
     g["id"] = "my-iq".into();
@@ -168,7 +171,7 @@ fn windows_outside_the_array_are_refused_naming_file_and_field() {
     let recipe = tmp("glass.json");
     std::fs::write(&recipe, r#"{"model": "smooth-dielectric", "ior": 1.5}"#).unwrap();
     let recipe = recipe.to_str().unwrap();
-    let cases: Vec<(Box<dyn Fn(&mut Value)>, &str, &str)> = vec![
+    let cases: Vec<(Edit, &str, &str)> = vec![
         (
             Box::new(|g: &mut Value| g["receptors"][5]["pixel_last"]["value"] = 512.into()),
             "/receptors/5/pixel_last",
