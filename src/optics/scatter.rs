@@ -7,7 +7,7 @@
 //! isotropic 2-D PSD S₂(f) in nm²·µm² (so ∫∫ S₂ d²f = σ² in nm²).
 //!
 //! * f_r(ωi, ωo) = (16π²/λ⁴)·cos θi·cos θs·Q(ωi, ωo)·S₂(f), f = (ωo,xy + ωi,xy)/λ (the distance of the
-//!   scattered direction cosines from the specular ones, over λ; Stover Eq. 5.17 with our ωi pointing to the
+//!   scattered direction cosines from the specular ones, over λ; Stover Ch. 5, with our ωi pointing to the
 //!   source);
 //! * Q the polarisation (Fresnel) factor of a surface of relative permittivity ε, unpolarised:
 //!   Q = (Q_ss + Q_sp + Q_ps + Q_pp)/2, which is the Fresnel reflectance R(θi) at the specular direction;
@@ -121,7 +121,7 @@ fn gamma_ratio(x: f64, y: f64) -> f64 {
 }
 
 /// The unpolarised Rayleigh–Rice polarisation factor Q = (Q_ss + Q_sp + Q_ps + Q_pp)/2 of a surface of
-/// relative permittivity ε (Stover 2012, Eqs. 5.18–5.21; Church, Jenkinson & Zavada 1979), at incidence
+/// relative permittivity ε (Stover 2012, Ch. 5; Elson & Bennett 1979; Church, Jenkinson & Zavada 1979), at incidence
 /// θi, scatter θs and scatter azimuth φs from the plane of incidence (φs = 0 forward, the specular side).
 /// At the specular direction (θs = θi, φs = 0) Q is the Fresnel reflectance (R_s + R_p)/2.
 pub fn polarisation_factor(eps: Complex64, cos_i: f64, cos_s: f64, cos_phi: f64, sin_phi: f64) -> f64 {
