@@ -4,7 +4,6 @@
 //! mirror with a halo), reciprocity, the σ → 0 limit, and readings: the haze of a coat with a halo grows as σ².
 use glossmeter::brdf::albedo::directional_albedo_to;
 use glossmeter::brdf::halo::Halo;
-use glossmeter::brdf::Brdf;
 use glossmeter::instrument::plan::{PlanOptions, Reading};
 use glossmeter::instrument::standards;
 use glossmeter::optics::fresnel::fr_dielectric;
