@@ -253,10 +253,11 @@ fn batches_and_folded_sums_include_the_halo() {
     let m = recipe::load_file(&path).unwrap();
     let b = m.brdf.as_ref();
     let n = b.sampling().len();
-    let pairs: Vec<(Vec3, Vec3)> = [(20.0, 180.0, 21.5, 2.0), (60.0, 180.0, 60.0, 0.0), (45.0, 30.0, 10.0, 250.0), (85.0, 180.0, 84.0, 1.0)]
-        .iter()
-        .map(|&(a, p, c, q)| (dir(a, p), dir(c, q)))
-        .collect();
+    let pairs: Vec<(Vec3, Vec3)> =
+        [(20.0, 180.0, 21.5, 2.0), (60.0, 180.0, 60.0, 0.0), (45.0, 30.0, 10.0, 250.0), (85.0, 180.0, 84.0, 1.0)]
+            .iter()
+            .map(|&(a, p, c, q)| (dir(a, p), dir(c, q)))
+            .collect();
     let (wi, wo): (Vec<Vec3>, Vec<Vec3>) = pairs.iter().copied().unzip();
     let mut batch = vec![f64::NAN; n * wi.len()];
     b.eval_batch(&wi, &wo, &mut batch);

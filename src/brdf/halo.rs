@@ -43,7 +43,7 @@ impl Halo {
         if !(sigma > 0.0 && sigma <= sigma_max) {
             return Err(Error::Usage(format!(
                 "the rms roughness σ = {} nm is outside the smooth-surface (Rayleigh–Rice) theory at λ = {} nm; \
-                 allowed: σ in (0, {}] nm (4πσ/λ ≤ {}, docs/optics.md §Validity)",
+                 allowed: σ in (0, {}] nm (4πσ/λ ≤ {}, docs/optics.md §8, Validity)",
                 crate::error::number(sigma),
                 sampling.wavelengths_nm.iter().copied().fold(f64::INFINITY, f64::min),
                 crate::error::number(sigma_max),
