@@ -146,11 +146,26 @@ pub fn rayleigh_rice(psd: &Psd, eps: Complex64, lambda_nm: f64, wi: [f64; 3], wo
     if !(wi[2] > 0.0 && wo[2] > 0.0) {
         return 0.0;
     }
+    rayleigh_rice_with_q(psd, polarisation(eps, wi, wo), lambda_nm, wi, wo)
+}
+
+/// Q of [`polarisation_factor`] for the directions `wi`, `wo` (components x, y, z): the one factor of
+/// [`rayleigh_rice`] that depends on ε and not on λ, so a model whose ε is the same at every sample computes
+/// it once per direction pair.
+pub fn polarisation(eps: Complex64, wi: [f64; 3], wo: [f64; 3]) -> f64 {
+    let (cos_phi, sin_phi) = scatter_azimuth(wi, wo);
+    polarisation_factor(eps, wi[2], wo[2], cos_phi, sin_phi)
+}
+
+/// [`rayleigh_rice`] given its polarisation factor `q` (the same bits as [`rayleigh_rice`] with
+/// `q = polarisation(eps, wi, wo)`); zero below the horizon.
+pub fn rayleigh_rice_with_q(psd: &Psd, q: f64, lambda_nm: f64, wi: [f64; 3], wo: [f64; 3]) -> f64 {
+    if !(wi[2] > 0.0 && wo[2] > 0.0) {
+        return 0.0;
+    }
     let lambda_um = lambda_nm * 1e-3;
     let (fx, fy) = ((wo[0] + wi[0]) / lambda_um, (wo[1] + wi[1]) / lambda_um);
     let f = fx.hypot(fy);
-    let (cos_phi, sin_phi) = scatter_azimuth(wi, wo);
-    let q = polarisation_factor(eps, wi[2], wo[2], cos_phi, sin_phi);
     16.0 * PI * PI * wi[2].min(1.0) * wo[2].min(1.0) * q * psd.s2(f) / (lambda_nm * lambda_nm * lambda_um * lambda_um)
 }
 
