@@ -947,7 +947,7 @@ macro_rules! scatter_params {
                 "",
                 Some(SCATTER_C_RANGE),
                 Opt("2 (exponential autocovariance)"),
-                "K-correlation exponent C: profile PSD ∝ (1 + (B f)²)^(−C/2); k-correlation only",
+                "K-correlation exponent C: profile PSD ∝ (1 + (B f)²)^(−C/2), σ² diverges at C ≤ 1; k-correlation only",
             ),
             a: p(
                 concat!($base, "/a_nm2_um"),

@@ -12,7 +12,7 @@ Route (deliberately different from the Rust code in src/optics/scatter.rs):
   S2(f) = K/(1 + (B f)^2)^((C+1)/2); K is fixed by requiring that the one-sided profile PSD at fx = 0,
   2 * integral over all fy of S2(0, fy), equals A (scipy.integrate.quad), and A for a given rms roughness by
   sigma^2 = integral_0^inf A/(1 + (B fx)^2)^(C/2) dfx (quad). The Gaussian PSD is pi l^2 sigma^2 exp(-(pi l f)^2).
-* The polarisation factor Q from the published component formulas (Stover 2012 Eqs. 5.18-5.21) written in
+* The polarisation factor Q from the published component formulas (Stover 2012 Ch. 5; Elson & Bennett 1979) written in
   the angles (theta_i, theta_s, phi_s) with numpy's complex square root; checked against the textbook Fresnel
   reflectances at the specular direction.
 * The BRDF at chosen (theta_i, theta_s, phi_s) from spherical angles (the Rust code works in vectors).

@@ -10,7 +10,7 @@
 //! over the halo; `tests/scatter.rs` measures the difference), so the mirror, the halo and what the inner
 //! model puts under the interface (T = 1 − R, unchanged) conserve energy to that order.
 use super::{Brdf, Kink, Lobe, Tail, Term, TermKind};
-use crate::optics::scatter::{polarisation_factor, rayleigh_rice, Psd};
+use crate::optics::scatter::{polarisation, polarisation_factor, rayleigh_rice, rayleigh_rice_with_q, Psd};
 use crate::spectrum::Sampling;
 use crate::{Error, Result, Vec3};
 use num_complex::Complex64;
@@ -43,7 +43,7 @@ impl Halo {
         if !(sigma > 0.0 && sigma <= sigma_max) {
             return Err(Error::Usage(format!(
                 "the rms roughness σ = {} nm is outside the smooth-surface (Rayleigh–Rice) theory at λ = {} nm; \
-                 allowed: σ in (0, {}] nm (4πσ/λ ≤ {}, docs/optics.md §Validity)",
+                 allowed: σ in (0, {}] nm (4πσ/λ ≤ {}, docs/optics.md §8, Validity)",
                 crate::error::number(sigma),
                 sampling.wavelengths_nm.iter().copied().fold(f64::INFINITY, f64::min),
                 crate::error::number(sigma_max),
@@ -62,6 +62,14 @@ impl Halo {
     /// The halo's value per sample, added to `out`.
     pub fn add(&self, wi: Vec3, wo: Vec3, out: &mut [f64]) {
         let (a, b) = ([wi.x, wi.y, wi.z], [wo.x, wo.y, wo.z]);
+        if self.eps.windows(2).all(|w| w[0] == w[1]) {
+            // One ε (a coat's real index): Q once per pair, the same bits as per sample.
+            let q = self.eps.first().map_or(0.0, |e| polarisation(*e, a, b));
+            for (o, lam) in out.iter_mut().zip(&self.lambda_nm) {
+                *o += rayleigh_rice_with_q(&self.psd, q, *lam, a, b);
+            }
+            return;
+        }
         for ((o, eps), lam) in out.iter_mut().zip(&self.eps).zip(&self.lambda_nm) {
             *o += rayleigh_rice(&self.psd, *eps, *lam, a, b);
         }

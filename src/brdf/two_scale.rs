@@ -2,7 +2,7 @@
 //! (orange peel, a microfacet slope distribution in geometric optics) carry a small-scale micro-roughness
 //! that scatters by Rayleigh–Rice (`brdf::halo`, `optics::scatter`). It exists because a real panel's
 //! 20° profile shows both at once: the specular peak spread over tenths of a degree (Rspec far below 20°
-//! gloss) and a halo reaching the haze windows near 2° (docs/optics.md §Near-specular scatter, the two-scale
+//! gloss) and a halo reaching the haze windows near 2° (docs/optics.md §9, the two-scale
 //! form; docs/instrument.md §1.10):
 //!
 //!   f = (1 − g(θ̄))·f_facets(ωi, ωo) + f_RR(ωi, ωo),     cos θ̄ = (cos θi + cos θo)/2,

@@ -7,7 +7,7 @@
 //! isotropic 2-D PSD S₂(f) in nm²·µm² (so ∫∫ S₂ d²f = σ² in nm²).
 //!
 //! * f_r(ωi, ωo) = (16π²/λ⁴)·cos θi·cos θs·Q(ωi, ωo)·S₂(f), f = (ωo,xy + ωi,xy)/λ (the distance of the
-//!   scattered direction cosines from the specular ones, over λ; Stover Eq. 5.17 with our ωi pointing to the
+//!   scattered direction cosines from the specular ones, over λ; Stover Ch. 5, with our ωi pointing to the
 //!   source);
 //! * Q the polarisation (Fresnel) factor of a surface of relative permittivity ε, unpolarised:
 //!   Q = (Q_ss + Q_sp + Q_ps + Q_pp)/2, which is the Fresnel reflectance R(θi) at the specular direction;
@@ -121,7 +121,7 @@ fn gamma_ratio(x: f64, y: f64) -> f64 {
 }
 
 /// The unpolarised Rayleigh–Rice polarisation factor Q = (Q_ss + Q_sp + Q_ps + Q_pp)/2 of a surface of
-/// relative permittivity ε (Stover 2012, Eqs. 5.18–5.21; Church, Jenkinson & Zavada 1979), at incidence
+/// relative permittivity ε (Stover 2012, Ch. 5; Elson & Bennett 1979; Church, Jenkinson & Zavada 1979), at incidence
 /// θi, scatter θs and scatter azimuth φs from the plane of incidence (φs = 0 forward, the specular side).
 /// At the specular direction (θs = θi, φs = 0) Q is the Fresnel reflectance (R_s + R_p)/2.
 pub fn polarisation_factor(eps: Complex64, cos_i: f64, cos_s: f64, cos_phi: f64, sin_phi: f64) -> f64 {
@@ -146,11 +146,26 @@ pub fn rayleigh_rice(psd: &Psd, eps: Complex64, lambda_nm: f64, wi: [f64; 3], wo
     if !(wi[2] > 0.0 && wo[2] > 0.0) {
         return 0.0;
     }
+    rayleigh_rice_with_q(psd, polarisation(eps, wi, wo), lambda_nm, wi, wo)
+}
+
+/// Q of [`polarisation_factor`] for the directions `wi`, `wo` (components x, y, z): the one factor of
+/// [`rayleigh_rice`] that depends on ε and not on λ, so a model whose ε is the same at every sample computes
+/// it once per direction pair.
+pub fn polarisation(eps: Complex64, wi: [f64; 3], wo: [f64; 3]) -> f64 {
+    let (cos_phi, sin_phi) = scatter_azimuth(wi, wo);
+    polarisation_factor(eps, wi[2], wo[2], cos_phi, sin_phi)
+}
+
+/// [`rayleigh_rice`] given its polarisation factor `q` (the same bits as [`rayleigh_rice`] with
+/// `q = polarisation(eps, wi, wo)`); zero below the horizon.
+pub fn rayleigh_rice_with_q(psd: &Psd, q: f64, lambda_nm: f64, wi: [f64; 3], wo: [f64; 3]) -> f64 {
+    if !(wi[2] > 0.0 && wo[2] > 0.0) {
+        return 0.0;
+    }
     let lambda_um = lambda_nm * 1e-3;
     let (fx, fy) = ((wo[0] + wi[0]) / lambda_um, (wo[1] + wi[1]) / lambda_um);
     let f = fx.hypot(fy);
-    let (cos_phi, sin_phi) = scatter_azimuth(wi, wo);
-    let q = polarisation_factor(eps, wi[2], wo[2], cos_phi, sin_phi);
     16.0 * PI * PI * wi[2].min(1.0) * wo[2].min(1.0) * q * psd.s2(f) / (lambda_nm * lambda_nm * lambda_um * lambda_um)
 }
 

@@ -16,6 +16,8 @@
 //! * `paint.rs`: `"model": "paint"` recipes ([`paint::parse_paint`], [`paint::parse_paint_spec`]);
 //! * `measured.rs`: the measured tables' recipes, a path resolved against the recipe's directory
 //!   ([`measured::resolve`], [`measured::parse_merl`], [`measured::parse_rgl`], [`measured::parse_inplane`]);
+//! * `scatter.rs`: the `scatter` object (a Rayleigh–Rice halo on a smooth interface's mirror) of `paint`,
+//!   `cook-torrance-lobes` and `microfacet` recipes ([`scatter::parse_scatter`]);
 //! * `schema.rs`: the JSON Schema of the format, generated from the registry ([`schema::schema`]).
 use crate::brdf::conductor::SmoothConductor;
 use crate::brdf::dielectric::{Ior, MicrofacetSurface, SmoothDielectric};

@@ -102,7 +102,7 @@ pub fn parse_scatter(
             sigma_field,
             format!(
                 "{what}: the smooth-surface (Rayleigh–Rice) theory needs 4πσ/λ ≤ {MAX_PHASE} at the shortest \
-                 sampled wavelength, {lambda_min} nm (docs/optics.md §Validity)"
+                 sampled wavelength, {lambda_min} nm (docs/optics.md §8, Validity)"
             ),
         ));
     }
