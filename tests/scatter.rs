@@ -309,3 +309,38 @@ fn halo_readings_are_within_their_error_estimates() {
         }
     }
 }
+
+/// A halo's σ and ℓ are recovered by `fit` from the 20° gloss, the ISO 13803 log haze and the E430 DOI of a
+/// hazy clear coat (what a coatings engineer's readout gives), within 3 standard errors.
+#[test]
+fn fit_recovers_a_halo_from_gloss_haze_and_doi() {
+    use glossmeter::fit::{fit, FitOptions, FreeParameter, TargetReading};
+    let truth: Value =
+        serde_json::from_str(&std::fs::read_to_string(root().join("fixtures/recipes/clear-coat-haze.json")).unwrap())
+            .unwrap();
+    let wanted = [("astm-d523-20", "gloss"), ("iso-13803-20", "log-haze"), ("astm-e430-30", "doi")];
+    let ids: Vec<&str> = wanted.iter().map(|w| w.0).collect();
+    let exact = read(&truth.to_string(), &ids);
+    let targets: Vec<TargetReading> = wanted
+        .iter()
+        .map(|(g, n)| TargetReading {
+            geometry: g.to_string(),
+            name: n.to_string(),
+            value: value(&exact, g, n).0,
+            uncertainty: Some(0.05),
+        })
+        .collect();
+    let mut start = truth.clone();
+    start["clear_coat"]["scatter"]["rms_roughness_nm"] = serde_json::json!(8.0);
+    start["clear_coat"]["scatter"]["correlation_length_um"] = serde_json::json!(10.0);
+    let free = [
+        FreeParameter::parse("/clear_coat/scatter/rms_roughness_nm=1..17").unwrap(),
+        FreeParameter::parse("/clear_coat/scatter/correlation_length_um=log:0.5..100").unwrap(),
+    ];
+    let r = fit(&start, "start.json", &free, &targets, &FitOptions { rtol: 1e-8, ..FitOptions::default() }).unwrap();
+    assert!(r.ok(), "{r:#?}");
+    for (p, t) in r.parameters.iter().zip([15.0, 4.0]) {
+        let se = p.std_error.unwrap();
+        assert!((p.value - t).abs() <= 3.0 * se && se < 0.1 * t, "{}: {} ± {se}, true {t}", p.pointer, p.value);
+    }
+}

@@ -70,8 +70,10 @@ pub enum Tail {
     /// The GGX (Trowbridge–Reitz) tail, D ∝ α²/(α² + tan²θh)² (Walter et al. 2007, Eq. 33): ∝ u⁻⁴, and exactly
     /// 1/(1 + ρ²)² in the scaled polar radius ρ, which the polar rule (`Rule::LobePolar`) maps to a polynomial.
     InverseQuartic,
-    /// Heavier than a Gaussian in a way the model does not state (a user's function probed from Python):
-    /// split geometrically out to the ends of the range, integrated by the adaptive partition.
+    /// Heavier than a Gaussian in a way the model does not state (a user's function probed from Python), or
+    /// a shape no shaped rule fits (a Rayleigh–Rice halo, `halo.rs`: a power law in spatial frequency, not a
+    /// Gaussian or a GGX tail in the lobe variables): split geometrically out to the ends of the range,
+    /// integrated by the adaptive partition.
     Unknown,
     /// A measured table's lobe: it falls off however the table's values do, and the table's interpolation
     /// kinks at every cell boundary (rings of θh around the specular direction, steps of θd, θi and φd), so
