@@ -867,6 +867,120 @@ pub const INPLANE_OFF_PLANE: Param = p(
     "the isotropy assumption off the plane: f: f_r depends on (θh, θd) only (exact for a Lambertian); f-cos-cos: f_r·cos θi·cos θo does (exact for a microfacet lobe up to masking); microfacet: f_r·cos θi·cos θo/G2 does, G2 the Smith term of the table's own distribution (exact for an isotropic microfacet lobe with Smith masking)",
 );
 
+// ---------------------------------------------------------------------------------------------------------
+// Near-specular scatter: a Rayleigh–Rice halo from a surface PSD (docs/optics.md §Near-specular scatter), at
+// three places: the paint's clear coat, a Cook–Torrance model's clear coat, a smooth microfacet interface.
+// ---------------------------------------------------------------------------------------------------------
+
+/// The rms roughness σ of a scatter PSD, nm: the range the parser accepts as a number; the smooth-surface
+/// bound 4πσ/λ ≤ `optics::scatter::MAX_PHASE` (22.3 nm at 560 nm) is checked against the sampling after.
+pub const SCATTER_SIGMA_RANGE: Range = Range { lo: 0.0, lo_closed: false, hi: 100.0, hi_closed: true };
+/// The correlation length ℓ, µm: from well below a wavelength (the halo all evanescent) to 5 mm (a halo far
+/// narrower than any instrument's aperture).
+pub const SCATTER_ELL_RANGE: Range = Range::closed(0.01, 5000.0);
+/// The K-correlation exponent C: above 1 (σ² diverges at C ≤ 1: Church & Takacs) up to 10 (a PSD that falls
+/// as f^-11, past any measured surface).
+pub const SCATTER_C_RANGE: Range = Range { lo: 1.0, lo_closed: false, hi: 10.0, hi_closed: true };
+/// The K-correlation B, µm (2π times the correlation length).
+pub const SCATTER_B_RANGE: Range = Range::closed(0.06, 31500.0);
+
+/// The registry entries of one scatter object (its pointer prefix and models).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ScatterParams {
+    pub object: Param,
+    pub psd: Param,
+    pub sigma: Param,
+    pub ell: Param,
+    pub c: Param,
+    pub a: Param,
+    pub b: Param,
+    pub notes: Param,
+}
+
+macro_rules! scatter_params {
+    ($base:literal, $models:expr, $what:literal) => {
+        ScatterParams {
+            object: p(
+                $base,
+                $models,
+                Type::Object,
+                "",
+                NONE,
+                Opt("no halo"),
+                concat!(
+                    "a Rayleigh–Rice scatter halo from the topography of ",
+                    $what,
+                    " (docs/optics.md §Near-specular scatter)"
+                ),
+            ),
+            psd: p(
+                concat!($base, "/psd"),
+                $models,
+                Type::Choice(&["k-correlation", "gaussian"]),
+                "",
+                NONE,
+                Req,
+                "the surface PSD: Church–Takacs K-correlation (ABC) or Gaussian",
+            ),
+            sigma: p(
+                concat!($base, "/rms_roughness_nm"),
+                $models,
+                Type::Number,
+                "nm",
+                Some(SCATTER_SIGMA_RANGE),
+                Opt("give this with correlation_length_um, or a_nm2_um with b_um"),
+                "rms roughness σ (all frequencies); also 4πσ/λ ≤ 0.5 at the shortest sampled wavelength",
+            ),
+            ell: p(
+                concat!($base, "/correlation_length_um"),
+                $models,
+                Type::Number,
+                "µm",
+                Some(SCATTER_ELL_RANGE),
+                Opt("with rms_roughness_nm"),
+                "correlation length ℓ: B = 2πℓ (K-correlation), exp(−r²/ℓ²) autocovariance (Gaussian)",
+            ),
+            c: p(
+                concat!($base, "/c"),
+                $models,
+                Type::Number,
+                "",
+                Some(SCATTER_C_RANGE),
+                Opt("2 (exponential autocovariance)"),
+                "K-correlation exponent C: profile PSD ∝ (1 + (B f)²)^(−C/2), σ² diverges at C ≤ 1; k-correlation only",
+            ),
+            a: p(
+                concat!($base, "/a_nm2_um"),
+                $models,
+                Type::Number,
+                "nm²·µm",
+                Some(Range::above(0.0)),
+                Opt("give this with b_um, or rms_roughness_nm"),
+                "K-correlation A: the one-sided profile PSD at f = 0; k-correlation only",
+            ),
+            b: p(
+                concat!($base, "/b_um"),
+                $models,
+                Type::Number,
+                "µm",
+                Some(SCATTER_B_RANGE),
+                Opt("with a_nm2_um"),
+                "K-correlation B (the knee at f = 1/B); k-correlation only",
+            ),
+            notes: p(concat!($base, "/notes"), $models, Type::Notes, "", NONE, Opt("none"), "free text"),
+        }
+    };
+}
+
+pub const PAINT_SCATTER: ScatterParams =
+    scatter_params!("/clear_coat/scatter", PAINT, "the clear coat's surface (a smooth coat only)");
+pub const CT_SCATTER: ScatterParams = scatter_params!("/clear_coat/scatter", CT, "the clear coat's surface");
+pub const MICROFACET_SCATTER: ScatterParams = scatter_params!(
+    "/scatter",
+    &["microfacet"],
+    "the interface (smooth: on its mirror; rough: the two-scale surface of slopes and halo, brdf/two_scale.rs)"
+);
+
 /// Every entry, in the order of the docs table (descriptive fields first, then model by model).
 pub static PARAMS: &[&Param] = &[
     &MODEL,
@@ -889,6 +1003,14 @@ pub static PARAMS: &[&Param] = &[
     &MICROFACET_DISTRIBUTION,
     &MICROFACET_ROUGHNESS,
     &SHADOWING,
+    &MICROFACET_SCATTER.object,
+    &MICROFACET_SCATTER.psd,
+    &MICROFACET_SCATTER.sigma,
+    &MICROFACET_SCATTER.ell,
+    &MICROFACET_SCATTER.c,
+    &MICROFACET_SCATTER.a,
+    &MICROFACET_SCATTER.b,
+    &MICROFACET_SCATTER.notes,
     // phong, blinn-phong
     &PHONG_EXPONENT,
     &PHONG_KS,
@@ -907,6 +1029,14 @@ pub static PARAMS: &[&Param] = &[
     &CT_COAT,
     &CT_COAT_INDEX,
     &CT_COAT_NOTES,
+    &CT_SCATTER.object,
+    &CT_SCATTER.psd,
+    &CT_SCATTER.sigma,
+    &CT_SCATTER.ell,
+    &CT_SCATTER.c,
+    &CT_SCATTER.a,
+    &CT_SCATTER.b,
+    &CT_SCATTER.notes,
     // paint
     &PAINT_FORM,
     &PAINT_FLAKE_LIGHT,
@@ -918,6 +1048,14 @@ pub static PARAMS: &[&Param] = &[
     &COAT_ROUGHNESS,
     &COAT_DISTRIBUTION,
     &COAT_NOTES,
+    &PAINT_SCATTER.object,
+    &PAINT_SCATTER.psd,
+    &PAINT_SCATTER.sigma,
+    &PAINT_SCATTER.ell,
+    &PAINT_SCATTER.c,
+    &PAINT_SCATTER.a,
+    &PAINT_SCATTER.b,
+    &PAINT_SCATTER.notes,
     &LAYER,
     &LAYER_THICKNESS,
     &LAYER_PRIMER,

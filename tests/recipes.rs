@@ -113,6 +113,14 @@ const BAD: &[(&str, &str, &[&str])] = &[
     ("phong-exponent-negative.json", "/exponent", &["-5 is out of range"]),
     ("not-an-object.json", "", &["expected a JSON object"]),
     ("name-not-string.json", "/name", &["expected a string"]),
+    ("scatter-c-diverges.json", "/scatter/c", &["1 is out of range", "(1, 10]", "σ² diverges at C ≤ 1"]),
+    (
+        "scatter-sigma-not-smooth.json",
+        "/clear_coat/scatter/rms_roughness_nm",
+        &["σ = 40 nm", "allowed: σ ≤ 22.28", "4πσ/λ ≤ 0.5"],
+    ),
+    ("scatter-a-nonpositive.json", "/scatter/a_nm2_um", &["0 is out of range", "> 0"]),
+    ("scatter-correlation-length-range.json", "/scatter/correlation_length_um", &["out of range", "[0.01, 5000]"]),
 ];
 
 #[test]

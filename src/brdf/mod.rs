@@ -19,7 +19,9 @@
 //!   `dielectric.rs` (the smooth dielectric [`dielectric::SmoothDielectric`] and the rough interface of a
 //!   dielectric or a conductor [`dielectric::MicrofacetSurface`], with its [`dielectric::Ior`]), `conductor.rs`
 //!   ([`conductor::SmoothConductor`]), `phong.rs` ([`phong::Phong`]), `ward.rs` ([`ward::Ward`]),
-//!   `multilobe.rs` ([`multilobe::CookTorranceLobes`]) and `paint`, the paint model of Ďurikovič & Ágošton
+//!   `multilobe.rs` ([`multilobe::CookTorranceLobes`]), `halo.rs` (a Rayleigh–Rice scatter halo on a model's
+//!   mirror, [`halo::WithHalo`] over [`halo::Halo`]), `two_scale.rs` (a rough interface with that halo,
+//!   [`two_scale::RoughWithHalo`]) and `paint`, the paint model of Ďurikovič & Ágošton
 //!   (2007) ([`paint::Paint`] built from a [`paint::PaintSpec`]);
 //! * `albedo.rs`: the directional albedo that resolves narrow lobes
 //!   ([`albedo::directional_albedo`], [`albedo::directional_albedo_to`]): a d/8 sphere's hemisphere
@@ -33,10 +35,12 @@ use crate::{Error, Result, Vec3};
 pub mod albedo;
 pub mod conductor;
 pub mod dielectric;
+pub mod halo;
 pub mod lambert;
 pub mod multilobe;
 pub mod paint;
 pub mod phong;
+pub mod two_scale;
 pub mod ward;
 
 /// A glossy lobe centred on the specular direction (half vector along the normal, or, for a lobe formed
@@ -66,8 +70,10 @@ pub enum Tail {
     /// The GGX (Trowbridge–Reitz) tail, D ∝ α²/(α² + tan²θh)² (Walter et al. 2007, Eq. 33): ∝ u⁻⁴, and exactly
     /// 1/(1 + ρ²)² in the scaled polar radius ρ, which the polar rule (`Rule::LobePolar`) maps to a polynomial.
     InverseQuartic,
-    /// Heavier than a Gaussian in a way the model does not state (a user's function probed from Python):
-    /// split geometrically out to the ends of the range, integrated by the adaptive partition.
+    /// Heavier than a Gaussian in a way the model does not state (a user's function probed from Python), or
+    /// a shape no shaped rule fits (a Rayleigh–Rice halo, `halo.rs`: a power law in spatial frequency, not a
+    /// Gaussian or a GGX tail in the lobe variables): split geometrically out to the ends of the range,
+    /// integrated by the adaptive partition.
     Unknown,
     /// A measured table's lobe: it falls off however the table's values do, and the table's interpolation
     /// kinks at every cell boundary (rings of θh around the specular direction, steps of θd, θi and φd), so

@@ -15,6 +15,8 @@
 //!   [`thin_film::FilmLayer`], [`thin_film::StackResult`]);
 //! * `microfacet.rs`: Beckmann and GGX distributions with Smith and V-cavity masking
 //!   ([`microfacet::Microfacet`], [`microfacet::Distribution`], [`microfacet::Shadowing`]);
+//! * `scatter.rs`: smooth-surface (Rayleigh–Rice) scatter from a surface PSD, K-correlation or Gaussian
+//!   ([`scatter::Psd`], [`scatter::rayleigh_rice`], [`scatter::polarisation_factor`]);
 //! * `tabulated.rs`: piecewise Chebyshev tables of smooth functions of one variable, accepted only with their
 //!   error verified when built ([`tabulated::ChebTable`]; the node and basis helpers the coat-albedo table uses);
 //! * `coat_albedo.rs`: the directional albedo E(μ) of a rough coat's lobe and its mean Ē
@@ -24,5 +26,6 @@ pub mod coat_albedo;
 pub mod fresnel;
 pub mod kubelka_munk;
 pub mod microfacet;
+pub mod scatter;
 pub mod tabulated;
 pub mod thin_film;

@@ -16,12 +16,16 @@
 //! * `paint.rs`: `"model": "paint"` recipes ([`paint::parse_paint`], [`paint::parse_paint_spec`]);
 //! * `measured.rs`: the measured tables' recipes, a path resolved against the recipe's directory
 //!   ([`measured::resolve`], [`measured::parse_merl`], [`measured::parse_rgl`], [`measured::parse_inplane`]);
+//! * `scatter.rs`: the `scatter` object (a Rayleigh–Rice halo on a smooth interface's mirror) of `paint`,
+//!   `cook-torrance-lobes` and `microfacet` recipes ([`scatter::parse_scatter`]);
 //! * `schema.rs`: the JSON Schema of the format, generated from the registry ([`schema::schema`]).
 use crate::brdf::conductor::SmoothConductor;
 use crate::brdf::dielectric::{Ior, MicrofacetSurface, SmoothDielectric};
+use crate::brdf::halo::WithHalo;
 use crate::brdf::lambert::Lambert;
 use crate::brdf::multilobe::{CookTorranceLobes, CtLobe};
 use crate::brdf::phong::{Phong, PhongVariant};
+use crate::brdf::two_scale::RoughWithHalo;
 use crate::brdf::ward::Ward;
 use crate::brdf::Brdf;
 use crate::input::json::{kind, parse_json, Obj};
@@ -37,6 +41,7 @@ use std::sync::Arc;
 pub mod fields;
 pub mod measured;
 pub mod paint;
+pub mod scatter;
 pub mod schema;
 
 pub use crate::registry::{MAX_LOBES, MODELS};
@@ -141,7 +146,28 @@ pub fn parse_brdf(obj: &Obj) -> Result<Arc<dyn Brdf>> {
             let shadowing = shadowing(obj)?;
             let ior = parse_ior(obj, &reg::MICROFACET_IOR)?;
             let sampling = if ior.len() == 3 { Sampling::rgb() } else { Sampling::grey() };
-            Arc::new(MicrofacetSurface::new(Microfacet::new(distribution, alpha), shadowing, ior, sampling)?)
+            let index: Vec<Complex64> = ior
+                .iter()
+                .map(|i| match i {
+                    Ior::Conductor(c) => *c,
+                    Ior::Dielectric(n) => Complex64::new(*n, 0.0),
+                })
+                .collect();
+            let facets = Microfacet::new(distribution, alpha);
+            let surface: Arc<dyn Brdf> = Arc::new(MicrofacetSurface::new(facets, shadowing, ior, sampling.clone())?);
+            match obj.opt_obj("scatter")? {
+                None => surface,
+                Some(s) => {
+                    let halo = scatter::parse_scatter(&s, &reg::MICROFACET_SCATTER, model, &index, &sampling)?;
+                    if facets.effectively_smooth() {
+                        Arc::new(WithHalo::new(surface, halo)?)
+                    } else {
+                        // A rough interface: the two-scale surface (facets' slopes and the micro-roughness's
+                        // halo, brdf/two_scale.rs).
+                        Arc::new(RoughWithHalo::new(surface, halo)?)
+                    }
+                }
+            }
         }
         "phong" | "blinn-phong" => {
             let variant = if model == "phong" { PhongVariant::Phong } else { PhongVariant::BlinnPhong };
@@ -323,10 +349,12 @@ fn shadowing(obj: &Obj) -> Result<Shadowing> {
 
 /// `cook-torrance-lobes`: kd, lobes[{ks, r, m}], optional distribution and shadowing.
 fn parse_lobes(obj: &Obj) -> Result<Arc<dyn Brdf>> {
+    let mut coat_scatter = None;
     let clear_coat = match obj.opt_obj("clear_coat")? {
         None => None,
         Some(c) => {
             c.deny_unknown_in("cook-torrance-lobes")?;
+            coat_scatter = c.opt_obj("scatter")?;
             Some(c.param(&reg::CT_COAT_INDEX)?)
         }
     };
@@ -357,9 +385,17 @@ fn parse_lobes(obj: &Obj) -> Result<Arc<dyn Brdf>> {
         .collect();
     let ks: Vec<&Vec<f64>> = lobes.iter().map(|l| &l.ks).collect();
     energy_check(obj, "lobes", &kd, &ks, "Kd + Σ Ks")?;
-    let model = CookTorranceLobes::new(kd, lobes, shadowing, sampling)?;
-    Ok(Arc::new(match clear_coat {
+    let model = CookTorranceLobes::new(kd, lobes, shadowing, sampling.clone())?;
+    let model: Arc<dyn Brdf> = Arc::new(match clear_coat {
         Some(n) => model.with_clear_coat(n),
         None => model,
-    }))
+    });
+    match (coat_scatter, clear_coat) {
+        (Some(s), Some(n)) => {
+            let index = vec![Complex64::new(n, 0.0); sampling.len()];
+            let halo = scatter::parse_scatter(&s, &reg::CT_SCATTER, "cook-torrance-lobes", &index, &sampling)?;
+            Ok(Arc::new(WithHalo::new(model, halo)?))
+        }
+        _ => Ok(model),
+    }
 }

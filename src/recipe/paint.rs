@@ -2,6 +2,7 @@
 //! model in `docs/model.md`. Every value is checked here with the field path, so a bad recipe is refused with
 //! the file, the field and what is allowed; [`Paint::new`] re-checks the same constraints for callers that
 //! build a [`PaintSpec`] in code.
+use crate::brdf::halo::WithHalo;
 use crate::brdf::paint::{
     ClearCoat, FlakeLight, Form, MetallicFlakes, Paint, PaintSpec, PearlescentFlakes, Pigment, PigmentedLayer, Spread,
     MAX_SAMPLES,
@@ -9,7 +10,7 @@ use crate::brdf::paint::{
 use crate::brdf::Brdf;
 use crate::input::json::{kind, Obj};
 use crate::optics::kubelka_munk::invert_white_black;
-use crate::optics::microfacet::Distribution;
+use crate::optics::microfacet::{Distribution, Microfacet};
 use crate::recipe::fields::param_number;
 use crate::registry::{self as reg, Param};
 use crate::spectrum::Sampling;
@@ -28,8 +29,30 @@ const PAINT: &str = "paint";
 /// Parse a paint recipe (the root object of the file) into a validated BRDF.
 pub fn parse_paint(obj: &Obj) -> Result<Arc<dyn Brdf>> {
     let spec = parse_paint_spec(obj)?;
-    let paint = Paint::new(spec).map_err(|e| Error::input(obj.file, obj.path.clone(), e.to_string()))?;
-    Ok(Arc::new(paint))
+    let coat = obj.obj("clear_coat")?;
+    let scatter = coat.opt_obj("scatter")?;
+    if scatter.is_some() && spec.coat.roughness >= Microfacet::SMOOTH_THRESHOLD {
+        return Err(coat.err(
+            "scatter",
+            format!(
+                "a scatter halo sits on a smooth coat's mirror; roughness = {} is not smooth (allowed with scatter: \
+                 roughness 0, below {:e})",
+                spec.coat.roughness,
+                Microfacet::SMOOTH_THRESHOLD
+            ),
+        ));
+    }
+    let (index, sampling) = (spec.coat.index, spec.sampling.clone());
+    let paint: Arc<dyn Brdf> =
+        Arc::new(Paint::new(spec).map_err(|e| Error::input(obj.file, obj.path.clone(), e.to_string()))?);
+    match scatter {
+        None => Ok(paint),
+        Some(s) => {
+            let n = vec![num_complex::Complex64::new(index, 0.0); sampling.len()];
+            let halo = crate::recipe::scatter::parse_scatter(&s, &reg::PAINT_SCATTER, PAINT, &n, &sampling)?;
+            Ok(Arc::new(WithHalo::new(paint, halo)?))
+        }
+    }
 }
 
 /// Parse a paint recipe into its [`PaintSpec`] (validated field by field).
