@@ -450,7 +450,9 @@ impl Plan {
                 .map(|k| {
                     let diff = twins.iter().map(|c| (c.value[k] - f.value[k]).abs()).fold(0.0, f64::max);
                     let err = twins.iter().map(|c| c.error[k]).fold(0.0, f64::max) + f.error[k];
-                    resolved &= err <= DATA_RESOLVED * diff;
+                    // Twins that read exactly the table's value (a constant table) settle it at once.
+                    let same = twins.iter().all(|c| c.value[k].to_bits() == f.value[k].to_bits());
+                    resolved &= same || err <= DATA_RESOLVED * diff;
                     twins.iter().map(|c| (c.value[k] - f.value[k]).abs() + c.error[k]).fold(0.0, f64::max) + f.error[k]
                 })
                 .collect();
