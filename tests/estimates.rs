@@ -191,7 +191,7 @@ fn every_default_reading_s_estimate_covers_its_actual_error() {
     let all = standards::builtin_all().unwrap();
     let default = PlanOptions::default();
     // Without a wall-clock budget: what is checked must not depend on the machine's load.
-    let tight = PlanOptions { rtol: 1e-10, max_seconds: None, ..PlanOptions::default() };
+    let tight = PlanOptions { rtol: 1e-10, max_seconds: None, rtol_from_data: false, ..PlanOptions::default() };
     let mut rng = Rng(0x0005_EED0_FE57);
     let (mut checked, mut unchecked, mut exact) = (0usize, 0usize, 0usize);
     let mut ratios: Vec<f64> = Vec::new();

@@ -405,8 +405,12 @@ fn tables_state_their_half_width_and_a_flat_table_is_diffuse() {
     assert!(text.contains("every value the same") && text.contains("plain variables"), "{text}");
     let lambert = gloss(recipe::parse_str(r#"{"model": "lambert", "albedo": 0.5}"#, "l").unwrap().brdf);
     for (r, l) in plan.execute().iter().zip(&lambert) {
-        // 57 on the specimen, 17 on the gloss standard.
-        assert_eq!(r.evaluations, 74, "{}", r.geometry);
+        // 17 on the gloss standard and 57 on each of the table and its two coarse twins at each of the three
+        // pilot tolerances (docs/accuracy.md §Data uncertainty of measured tables): the file's values differ
+        // from a constant in the last digits, so the twins differ from the table by rounding and no pilot
+        // resolves the difference; the last pilot is the flux.
+        assert_eq!(r.evaluations, 17 + 3 * 3 * 57, "{}", r.geometry);
+        assert!(r.data_uncertainty.is_some_and(|u| u <= 1e-3 * r.value.unwrap()), "{r:?}");
         let v = r.value.unwrap();
         assert!((v - l.0).abs() <= r.error_estimate + l.1 + 1e-12 * v, "{}: {v} vs {l:?}", r.geometry);
     }

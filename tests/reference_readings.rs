@@ -127,7 +127,8 @@ fn compare(options: &PlanOptions) -> Vec<String> {
 #[test]
 fn every_default_reading_agrees_with_the_rtol_1e_10_reference_within_its_estimate() {
     if std::env::var_os("GLOSSMETER_REGENERATE_REFERENCE").is_some() {
-        let options = PlanOptions { rtol: REFERENCE_RTOL, max_seconds: None, ..PlanOptions::default() };
+        let options =
+            PlanOptions { rtol: REFERENCE_RTOL, max_seconds: None, rtol_from_data: false, ..PlanOptions::default() };
         let start = std::time::Instant::now();
         let now = readings(&options);
         let mut map = serde_json::Map::new();
@@ -168,7 +169,7 @@ fn every_reading_at_rtol_1e_4_1e_7_and_1e_8_agrees_with_the_reference_within_its
         return;
     }
     for rtol in [1e-4, 1e-7, 1e-8] {
-        let fails = compare(&PlanOptions { rtol, ..PlanOptions::default() });
+        let fails = compare(&PlanOptions { rtol, rtol_from_data: false, ..PlanOptions::default() });
         assert!(
             fails.is_empty(),
             "rtol {rtol:e}: {} reading(s) outside their estimate:\n{}",

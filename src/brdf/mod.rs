@@ -244,6 +244,15 @@ pub trait Brdf: Send + Sync + std::fmt::Debug {
         false
     }
 
+    /// The same measured table read on about every second sample along each of its axes (its two *coarse
+    /// twins*, on the even samples and on the odd ones), from which the planner estimates a reading's data
+    /// (resolution) uncertainty: the larger difference of the readings through a twin and through the table
+    /// (`docs/accuracy.md` §Data uncertainty of measured tables). Empty for a model that is not a table (the
+    /// default) and for a twin itself.
+    fn coarser(&self) -> Vec<std::sync::Arc<dyn Brdf>> {
+        Vec::new()
+    }
+
     /// A one-line human description, e.g. "microfacet (GGX α = 0.1, n = 1.5, Smith height-correlated)".
     fn describe(&self) -> String;
 }

@@ -47,9 +47,11 @@ pub enum Command {
         /// A user geometry file in the standards format (repeatable).
         #[arg(long = "geometry-file")]
         geometry_files: Vec<PathBuf>,
-        /// Relative tolerance of every reading.
-        #[arg(long, default_value_t = 1e-6)]
-        rtol: f64,
+        /// Relative tolerance of every reading (default 1e-6; for a measured table, by default a quarter of
+        /// each integral's data uncertainty, never tighter than 1e-6 nor looser than 1e-2: given here, it is
+        /// used as given, for tables too).
+        #[arg(long)]
+        rtol: Option<f64>,
         #[arg(long, value_enum, default_value_t = Format::Table)]
         format: Format,
         /// Print the measurement plan before measuring.

@@ -50,9 +50,10 @@ pub struct CompareArgs {
     /// A previous `measure` or `compare` JSON: fail any prediction that moved by more than both error estimates.
     #[arg(long, value_name = "PREVIOUS.json")]
     pub baseline: Option<PathBuf>,
-    /// Relative tolerance of the predictions.
-    #[arg(long, default_value_t = 1e-6)]
-    pub rtol: f64,
+    /// Relative tolerance of the predictions (default 1e-6; for a measured table, by default a quarter of each
+    /// integral's data uncertainty, never tighter than 1e-6: given here, it is used as given, tables too).
+    #[arg(long)]
+    pub rtol: Option<f64>,
     #[arg(long, value_enum, default_value_t = CompareFormat::Table)]
     pub format: CompareFormat,
     /// Write to this new file instead of stdout (an existing file is refused before any work).
@@ -85,7 +86,9 @@ pub fn parse_delimiter(s: &str) -> Result<u8> {
 pub fn run(a: CompareArgs) -> Result<()> {
     let rule = VerdictRule { k: a.k, tolerance: a.tolerance };
     rule.check()?;
-    check_rtol(a.rtol)?;
+    let rtol_from_data = a.rtol.is_none();
+    let rtol = a.rtol.unwrap_or(PlanOptions::default().rtol);
+    check_rtol(rtol)?;
     if let Some(p) = &a.plot {
         crate::cli::plot::check_plot_path(p, "--plot")?;
     }
@@ -130,7 +133,7 @@ pub fn run(a: CompareArgs) -> Result<()> {
     };
     let baseline = a.baseline.as_deref().map(comparison::load_baseline).transpose()?;
     let sheet = sheet::load(&sheet_path, &options)?;
-    let plan_options = PlanOptions { rtol: a.rtol, colour, ..PlanOptions::default() };
+    let plan_options = PlanOptions { rtol, colour, rtol_from_data, ..PlanOptions::default() };
     let mut cmp = comparison::compare_sheet(&sheet, &recipes, &rule, &plan_options)?;
     let des = comparison::colour_differences(&mut cmp, a.max_de00);
     let drift = match &baseline {

@@ -20,7 +20,13 @@ pub fn secs(s: f64) -> String {
 
 pub fn table(material: &Material, readings: &[Reading], timing: bool) -> String {
     let mut rows: Vec<Vec<String>> = vec![];
-    let mut head = vec!["geometry", "reading", "value", "unit", "numerical error", "evaluations"];
+    // A measured table's readings carry a data uncertainty beside the numerical error: a column of its own.
+    let data = readings.iter().any(|r| r.data_uncertainty.is_some());
+    let mut head = vec!["geometry", "reading", "value", "unit", "numerical error"];
+    if data {
+        head.push("data uncertainty");
+    }
+    head.push("evaluations");
     if timing {
         head.push("time");
     }
@@ -40,11 +46,17 @@ pub fn table(material: &Material, readings: &[Reading], timing: bool) -> String 
                 row.push(shown);
                 row.push(r.unit.clone());
                 row.push(format!("{:.1e}", r.error_estimate));
+                if data {
+                    row.push(r.data_uncertainty.map_or("—".into(), |u| format!("{u:.1e}")));
+                }
             }
             None => {
                 row.push("—".into());
                 row.push(r.unit.clone());
                 row.push("—".into());
+                if data {
+                    row.push("—".into());
+                }
             }
         }
         // The mark (and its footnote) only on a printed value: a reading without one says why in its note.
@@ -66,12 +78,18 @@ pub fn table(material: &Material, readings: &[Reading], timing: bool) -> String 
     }
     let mut s = format!("{} ({})\n{}\n\n", material.name, material.file, material.brdf.describe());
     // numbers right-aligned, words left-aligned
-    s.push_str(&pad_table(&rows, &[2, 4, 5, 6]));
+    s.push_str(&pad_table(&rows, if data { &[2, 4, 5, 6, 7] } else { &[2, 4, 5, 6] }));
     if readings.iter().any(|r| !r.converged && r.value.is_some()) {
         s.push_str("* not converged: a budget (evaluations or wall-clock time, see the notes) ran out before the tolerance was met\n");
     }
     if readings.iter().any(|r| r.value.is_some()) {
         s.push_str("numerical error: the integration's error estimate, not the uncertainty of the prediction\n");
+    }
+    if data {
+        s.push_str(
+            "data uncertainty: how far the table's resolution may put the reading from that of the surface it \
+             samples (the reading through the table on every second sample, docs/accuracy.md)\n",
+        );
     }
     for n in notes {
         s.push_str(&format!("note: {n}\n"));

@@ -103,6 +103,8 @@ fn dispatch(cli: Cli) -> Result<()> {
             max_seconds,
             envelope,
         } => {
+            let rtol_from_data = rtol.is_none();
+            let rtol = rtol.unwrap_or(PlanOptions::default().rtol);
             check_rtol(rtol)?;
             let colour = colour.conditions()?;
             if max_evals == 0 {
@@ -127,7 +129,8 @@ fn dispatch(cli: Cli) -> Result<()> {
             let target = OutputTarget::new(output.as_deref(), "--output")?;
             let baseline_file = baseline.as_ref().map(|p| p.display().to_string());
             let baseline = baseline.as_deref().map(crate::comparison::load_baseline).transpose()?;
-            let options = PlanOptions { rtol, max_evals, max_seconds, colour, ..PlanOptions::default() };
+            let options =
+                PlanOptions { rtol, max_evals, max_seconds, colour, rtol_from_data, ..PlanOptions::default() };
             if recipes.len() > 1 || recipes[0].is_dir() {
                 if explain {
                     return Err(Error::Usage("--explain takes one recipe".into()));

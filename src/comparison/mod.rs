@@ -165,7 +165,9 @@ pub struct Allowance {
     pub statistical: f64,
     /// The stated uncertainty (or the tolerance).
     pub stated: f64,
-    /// The prediction's error estimate.
+    /// The prediction's error estimate, plus its data uncertainty when the material is a measured table (the
+    /// table's resolution is as much a limit of the prediction as the integration; docs/accuracy.md §Data
+    /// uncertainty of measured tables).
     pub prediction: f64,
 }
 
@@ -268,7 +270,7 @@ pub fn judge(group: Group, material: &Material, readings: &[Reading], rule: &Ver
     let a = Allowance {
         statistical: rule.k * s.std / (s.n as f64).sqrt(),
         stated: stated.unwrap_or(0.0),
-        prediction: p.error_estimate,
+        prediction: p.error_estimate + p.data_uncertainty.unwrap_or(0.0),
     };
     let verdict = if (v - s.mean).abs() <= a.total() { Verdict::Inside } else { Verdict::Outside };
     mk(Some(p), Some(a), verdict)
@@ -568,6 +570,7 @@ mod tests {
             converged: true,
             problem: value.is_none().then(|| "zero flux".into()),
             note: None,
+            data_uncertainty: None,
         }
     }
 

@@ -319,8 +319,14 @@ pub fn sweep(
     tols.sort_by(|a, b| b.total_cmp(a));
     tols.dedup();
     let tightest = *tols.last().expect("validated non-empty");
-    let plan_options =
-        |rtol: f64| PlanOptions { rtol, max_evals: options.max_evals, max_seconds: None, ..PlanOptions::default() };
+    let plan_options = |rtol: f64| PlanOptions {
+        rtol,
+        max_evals: options.max_evals,
+        max_seconds: None,
+        // The study is of the numerical error against the tolerance: each rtol is used as given, tables too.
+        rtol_from_data: false,
+        ..PlanOptions::default()
+    };
 
     // The reference.
     let probe = Plan::compile(material.clone(), geometries.clone(), plan_options(tightest))?;

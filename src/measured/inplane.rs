@@ -38,7 +38,7 @@
 //! Q(θh, θd*)·Q(0, θd)/Q(0, θd*), θd* the largest difference angle at which (θh, θd*) is measured — exact
 //! when Q is a product of a function of θh and one of θd (a constant; F(θd)·D(θh)), and the specular row
 //! Q(0, ·) carrying the θd dependence.
-use super::table::{file_name, reflection_half_diff, Nodes, Table, TableAxis};
+use super::table::{file_name, reflection_half_diff, Nodes, Resolution, Table, TableAxis};
 use crate::brdf::{Brdf, Lobe, Term, TermKind};
 use crate::spectrum::Sampling;
 use crate::{Error, Result, Vec3};
@@ -276,6 +276,9 @@ pub struct InPlaneBrdf {
     /// The lobe's half width at half maximum as a slope, measured from the table (with its extension) when
     /// it is built ([`super::table::specular_half_width`]).
     half_width: f64,
+    /// The samples the lookups read: the file's own, or every second θo of each row and every second row (the
+    /// coarse twin, [`Brdf::coarser`]); the measured domain and Smith's Λ stay the table's own.
+    resolution: Resolution,
 }
 
 impl InPlaneBrdf {
@@ -362,6 +365,7 @@ impl InPlaneBrdf {
             sampling: Sampling::grey(),
             flat,
             half_width: f64::INFINITY,
+            resolution: Resolution::Own,
         };
         brdf.half_width = brdf.measure_half_width();
         Ok(brdf)
@@ -422,7 +426,8 @@ impl InPlaneBrdf {
     }
 
     fn interpolate(&self, theta_i: f64, theta_o: f64, row: Row) -> f64 {
-        let (i0, i1, t) = self.theta_i.linear(theta_i);
+        let res = self.resolution;
+        let (i0, i1, t) = self.theta_i.linear_at(theta_i, res);
         let row_theta = |i: usize| match &self.theta_i.nodes {
             Nodes::Values(v) => v[i],
             Nodes::Index(_) => i as f64,
@@ -430,7 +435,7 @@ impl InPlaneBrdf {
         let at = |i: usize| {
             let (ti, to) = (row_theta(i), theta_o - theta_i + row_theta(i));
             let mut v = [0.0];
-            self.rows[i].linear(&[to], &mut v);
+            self.rows[i].linear_at(&[to], res, &mut v);
             let to = to.clamp(-FRAC_PI_2, FRAC_PI_2);
             match row {
                 Row::F => v[0],
@@ -575,12 +580,22 @@ impl Brdf for InPlaneBrdf {
         }]
     }
 
+    fn coarser(&self) -> Vec<std::sync::Arc<dyn Brdf>> {
+        if self.resolution != Resolution::Own {
+            return Vec::new();
+        }
+        Resolution::TWINS
+            .iter()
+            .map(|&resolution| std::sync::Arc::new(InPlaneBrdf { resolution, ..self.clone() }) as _)
+            .collect()
+    }
+
     fn describe(&self) -> String {
         let name = file_name(&self.file);
         let unused =
             if self.unused > 0 { format!(", {} out-of-plane points not used", self.unused) } else { String::new() };
         format!(
-            "measured in-plane table {name} ({}, {} points, {} angles of incidence, θo {:.1}° to {:.1}°, clamped outside; isotropic, {} off the plane{unused})",
+            "measured in-plane table {name} ({}, {} points, {} angles of incidence, θo {:.1}° to {:.1}°, clamped outside; isotropic, {} off the plane{unused}{})",
             self.format,
             self.points,
             self.rows.len(),
@@ -590,7 +605,8 @@ impl Brdf for InPlaneBrdf {
                 OffPlane::Brdf => "f = f(θh, θd)",
                 OffPlane::BrdfCosCos => "f·cos θi·cos θo = g(θh, θd)",
                 OffPlane::Microfacet => "f·cos θi·cos θo/G2 = g(θh, θd), Smith G2 of the table's own D",
-            }
+            },
+            if self.resolution != Resolution::Own { "; a coarse twin, read on about every second sample" } else { "" }
         )
     }
 }

@@ -19,7 +19,7 @@
 //! This file only decodes the bytes and chooses those coordinates; the table and its interpolation are the
 //! shared layer in `table.rs`. `docs/model.md` §Measured tables (MERL) gives the details and the known limits
 //! of the data.
-use super::table::{file_name, floor_index, reflection_half_diff, Edge, Table, TableAxis};
+use super::table::{file_name, floor_index, reflection_half_diff, Edge, Resolution, Table, TableAxis};
 pub use super::table::{fold_phi_d, half_diff, HalfDiff};
 use crate::brdf::{Brdf, Lobe, Term, TermKind};
 use crate::spectrum::Sampling;
@@ -75,6 +75,8 @@ pub struct MerlBrdf {
     /// The lobe's half width at half maximum as a slope, measured from the table at load
     /// ([`super::table::specular_half_width`]).
     half_width: f64,
+    /// The samples the lookup reads: the table's own, or every second one (the coarse twin, [`Brdf::coarser`]).
+    resolution: Resolution,
 }
 
 impl MerlBrdf {
@@ -150,6 +152,7 @@ impl MerlBrdf {
             sampling: Sampling::rgb(),
             flat,
             half_width: f64::INFINITY,
+            resolution: Resolution::Own,
         };
         m.half_width = super::table::specular_half_width(|wi, wo, out| m.eval(wi, wo, out), 3);
         m
@@ -211,7 +214,8 @@ impl MerlBrdf {
 
     fn nearest(&self, hd: &HalfDiff) -> [f64; 3] {
         let (ih, id, ip) = self.bin(hd.theta_h, hd.theta_d, hd.phi_d);
-        let c = self.table.cell(&[ih, id, ip]);
+        let r = self.resolution;
+        let c = self.table.cell(&[r.floor(ih), r.floor(id), r.floor(ip)]);
         [c[0], c[1], c[2]]
     }
 
@@ -221,7 +225,7 @@ impl MerlBrdf {
         let ud = hd.theta_d.max(0.0) / FRAC_PI_2 * nd as f64;
         let up = fold_phi_d(hd.phi_d) / PI * np as f64;
         let mut out = [0.0; 3];
-        self.table.linear(&[uh, ud, up], &mut out);
+        self.table.linear_at(&[uh, ud, up], self.resolution, &mut out);
         out
     }
 }
@@ -296,13 +300,24 @@ impl Brdf for MerlBrdf {
         }]
     }
 
+    fn coarser(&self) -> Vec<std::sync::Arc<dyn Brdf>> {
+        if self.resolution != Resolution::Own {
+            return Vec::new();
+        }
+        Resolution::TWINS
+            .iter()
+            .map(|&resolution| std::sync::Arc::new(MerlBrdf { resolution, ..self.clone() }) as _)
+            .collect()
+    }
+
     fn describe(&self) -> String {
         let name = file_name(&self.file);
         let [nh, nd, np] = self.dims;
         format!(
-            "measured MERL table {name} ({nh} × {nd} × {np} θh × θd × φd, {} lookup, {} invalid entries read as 0)",
+            "measured MERL table {name} ({nh} × {nd} × {np} θh × θd × φd, {} lookup, {} invalid entries read as 0{})",
             self.interpolation.name(),
-            self.invalid
+            self.invalid,
+            if self.resolution != Resolution::Own { "; a coarse twin, read on about every second sample" } else { "" }
         )
     }
 }

@@ -26,7 +26,7 @@
 //! f·cos θ' itself (Mitsuba 3's `measured` plugin): f = spectra / cos θ'. Every 2-D table is bilinear on its
 //! grid, every parameter linear between its values (clamped), exactly as `PiecewiseLinear2D`; the
 //! arithmetic here is f64 on the files' f32 values.
-use super::table::{elevation, TableAxis};
+use super::table::{elevation, Edge, Resolution, TableAxis};
 use crate::brdf::{Brdf, Lobe, Term, TermKind};
 use crate::spectrum::Sampling;
 use crate::{Error, Result, Vec3};
@@ -311,11 +311,13 @@ impl Warp2D {
         Warp2D { nx, ny, params, strides, data: out, marginal, conditional }
     }
 
-    /// The slices and weights of a parameter point (2^D corners, D ≤ 3; pbrt's `lookup`).
-    fn corners(&self, param: &[f64]) -> Corners {
+    /// The slices and weights of a parameter point (2^D corners, D ≤ 3; pbrt's `lookup`). At
+    /// `Resolution::Coarse` the incident directions' parameters (φi, θi: the first two) are read on every
+    /// second node; a third parameter (the spectral axis) never is.
+    fn corners(&self, param: &[f64], res: Resolution) -> Corners {
         let mut c = Corners { n: 1, at: [(0, 1.0); 8] };
         for (k, a) in self.params.iter().enumerate() {
-            let (i0, i1, t) = a.linear(param[k]);
+            let (i0, i1, t) = a.linear_at(param[k], if k < 2 { res } else { Resolution::Own });
             let n = c.n;
             for j in (0..n).rev() {
                 let (s, w) = c.at[j];
@@ -340,20 +342,32 @@ impl Warp2D {
         (px, py, sx - px as f64, sy - py as f64)
     }
 
-    /// The bilinear value at p (pbrt `Evaluate`, for an unnormalised table: the stored values themselves).
-    fn eval(&self, p: [f64; 2], param: &[f64]) -> f64 {
-        let corners = self.corners(param);
-        let (px, py, fx, fy) = self.cell(p);
+    /// The bilinear value at p (pbrt `Evaluate`, for an unnormalised table: the stored values themselves). At
+    /// `Resolution::Coarse` on every second node of the grid and of the incident directions' parameters.
+    fn eval(&self, p: [f64; 2], param: &[f64], res: Resolution) -> f64 {
+        let corners = self.corners(param, res);
         let (nx, size) = (self.nx, self.nx * self.ny);
-        let i = px + py * nx;
-        let v = |j: usize| Self::lookup(&corners, &self.data, j, size);
-        let (v00, v10, v01, v11) = (v(i), v(i + 1), v(i + nx), v(i + nx + 1));
+        let ((x0, x1, fx), (y0, y1, fy)) = match res {
+            Resolution::Own => {
+                let (px, py, fx, fy) = self.cell(p);
+                ((px, px + 1, fx), (py, py + 1, fy))
+            }
+            Resolution::Coarse | Resolution::Shifted => {
+                let at =
+                    |u: f64, n: usize| TableAxis::index(n, Edge::Clamp).linear_at(u.max(0.0) * (n - 1) as f64, res);
+                (at(p[0], self.nx), at(p[1], self.ny))
+            }
+        };
+        let v = |x: usize, y: usize| Self::lookup(&corners, &self.data, x + y * nx, size);
+        let (v00, v10, v01, v11) = (v(x0, y0), v(x1, y0), v(x0, y1), v(x1, y1));
         (1.0 - fy) * ((1.0 - fx) * v00 + fx * v10) + fy * ((1.0 - fx) * v01 + fx * v11)
     }
 
-    /// The inverse of the warp (pbrt `Invert`): the sample of the unit square that the warp maps to p.
-    fn invert(&self, p: [f64; 2], param: &[f64]) -> [f64; 2] {
-        let corners = self.corners(param);
+    /// The inverse of the warp (pbrt `Invert`): the sample of the unit square that the warp maps to p. The warp
+    /// is the tables' parameterisation, not a measured value: its grid is read in full at either resolution,
+    /// its parameters (φi, θi) at `res`, as the spectra's are.
+    fn invert(&self, p: [f64; 2], param: &[f64], res: Resolution) -> [f64; 2] {
+        let corners = self.corners(param, res);
         let (px, py, fx, fy) = self.cell(p);
         let (nx, ny, size) = (self.nx, self.ny, self.nx * self.ny);
         let off = px + py * nx;
@@ -411,6 +425,9 @@ pub struct RglBrdf {
     /// The lobe's half width at half maximum as a slope, measured from the table at load
     /// ([`super::table::specular_half_width`]).
     half_width: f64,
+    /// The samples the lookups read: the file's own, or every second one of the NDF, σ and spectral grids and
+    /// of the incident directions (the coarse twin, [`Brdf::coarser`]).
+    resolution: Resolution,
 }
 
 fn shape_err(file: &str, f: &Field, what: String) -> Error {
@@ -560,6 +577,7 @@ impl RglBrdf {
             dropped,
             sampling,
             half_width: f64::INFINITY,
+            resolution: Resolution::Own,
         };
         let n = brdf.sampling.len();
         brdf.half_width = super::table::specular_half_width(|wi, wo, out| brdf.eval(wi, wo, out), n);
@@ -610,14 +628,18 @@ impl Brdf for RglBrdf {
         let mut u_m = [theta2u(theta_m), phi2u(if self.isotropic { phi_m - phi_p } else { phi_m })];
         u_m[1] -= u_m[1].floor();
         let params = [phi_p, theta_p];
-        let s = self.vndf.invert(u_m, &params);
-        let scale =
-            if self.jacobian { self.ndf.eval(u_m, &[]) / (4.0 * self.sigma.eval(u_p, &[]) * wo.z) } else { 1.0 / wo.z };
+        let res = self.resolution;
+        let s = self.vndf.invert(u_m, &params, res);
+        let scale = if self.jacobian {
+            self.ndf.eval(u_m, &[], res) / (4.0 * self.sigma.eval(u_p, &[], res) * wo.z)
+        } else {
+            1.0 / wo.z
+        };
         if !scale.is_finite() {
             return;
         }
         for (o, &ch) in out.iter_mut().zip(&self.channels) {
-            *o = self.spectra.eval(s, &[phi_p, theta_p, ch]).max(0.0) * scale;
+            *o = self.spectra.eval(s, &[phi_p, theta_p, ch], res).max(0.0) * scale;
         }
     }
 
@@ -638,6 +660,16 @@ impl Brdf for RglBrdf {
         false
     }
 
+    fn coarser(&self) -> Vec<std::sync::Arc<dyn Brdf>> {
+        if self.resolution != Resolution::Own {
+            return Vec::new();
+        }
+        Resolution::TWINS
+            .iter()
+            .map(|&resolution| std::sync::Arc::new(RglBrdf { resolution, ..self.clone() }) as _)
+            .collect()
+    }
+
     fn describe(&self) -> String {
         let name = super::table::file_name(&self.file);
         let [np, nt, n, ny, nx] = self.shape;
@@ -647,10 +679,11 @@ impl Brdf for RglBrdf {
             String::new()
         };
         format!(
-            "measured RGL table {name} {:?} ({}, {np} × {nt} incident directions, {n} × {n} spectral grid, NDF {ny} × {nx}, {}{dropped})",
+            "measured RGL table {name} {:?} ({}, {np} × {nt} incident directions, {n} × {n} spectral grid, NDF {ny} × {nx}, {}{dropped}{})",
             self.description,
             if self.isotropic { "isotropic" } else { "anisotropic" },
-            self.sampling.describe()
+            self.sampling.describe(),
+            if self.resolution != Resolution::Own { "; a coarse twin, read on about every second sample" } else { "" }
         )
     }
 }
@@ -663,7 +696,7 @@ mod tests {
     fn uniform_warp_inverts_to_the_identity() {
         let w = Warp2D::new(&[2.0; 12], 4, 3, vec![], true);
         for p in [[0.1, 0.2], [0.5, 0.5], [0.97, 0.03]] {
-            let s = w.invert(p, &[]);
+            let s = w.invert(p, &[], Resolution::Own);
             assert!((s[0] - p[0]).abs() < 1e-14 && (s[1] - p[1]).abs() < 1e-14, "{s:?} vs {p:?}");
         }
     }
@@ -673,12 +706,12 @@ mod tests {
         // A sloped density: the inverse is monotone and maps the corners to the corners.
         let data: Vec<f64> = (0..20).map(|i| 1.0 + (i % 5) as f64 + 0.5 * (i / 5) as f64).collect();
         let w = Warp2D::new(&data, 5, 4, vec![], true);
-        assert!(w.invert([0.0, 0.0], &[]).iter().all(|v| v.abs() < 1e-14));
-        let top = w.invert([1.0, 1.0], &[]);
+        assert!(w.invert([0.0, 0.0], &[], Resolution::Own).iter().all(|v| v.abs() < 1e-14));
+        let top = w.invert([1.0, 1.0], &[], Resolution::Own);
         assert!((top[0] - 1.0).abs() < 1e-12 && (top[1] - 1.0).abs() < 1e-12, "{top:?}");
         let mut last = -1.0;
         for k in 0..50 {
-            let s = w.invert([k as f64 / 49.0, 0.3], &[]);
+            let s = w.invert([k as f64 / 49.0, 0.3], &[], Resolution::Own);
             assert!(s[0] >= last);
             last = s[0];
         }

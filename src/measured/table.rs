@@ -7,6 +7,41 @@
 //! BRDF representation"), used by the MERL lookup and by the in-plane tables' isotropic extension.
 use crate::Vec3;
 use std::f64::consts::PI;
+use std::sync::Arc;
+
+/// Which samples of a table a lookup reads: all of them (the table as given), or about every second one along
+/// each axis (its two coarse twins, from which a reading's data uncertainty is estimated: `docs/accuracy.md`
+/// §Data uncertainty of measured tables). Both twins keep a clamped axis' ends (and so its range) and make
+/// every interval wider than the table's: `Coarse` reads the samples 0, 2, 4, … and the last, its last
+/// interval spanning three of the table's when their number is odd; `Shifted` the samples 0, 3, 5, 7, … and
+/// the last, its first interval spanning three and its last two or three. A periodic axis (n even) keeps
+/// 0, 2, … or 1, 3, … and wraps.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Resolution {
+    /// Every sample: the table as given.
+    #[default]
+    Own,
+    /// The even samples and the last: the first coarse twin.
+    Coarse,
+    /// The first sample, the odd samples from the third on, and the last: the second coarse twin, whose nodes
+    /// are the table's samples that the first twin leaves out.
+    Shifted,
+}
+
+impl Resolution {
+    /// The two coarse twins.
+    pub const TWINS: [Resolution; 2] = [Resolution::Coarse, Resolution::Shifted];
+
+    /// The sample of a twin at or below sample `i` of the table (for a piecewise constant lookup).
+    pub fn floor(self, i: usize) -> usize {
+        match self {
+            Resolution::Own => i,
+            Resolution::Coarse => i - i % 2,
+            Resolution::Shifted if i < 3 => 0,
+            Resolution::Shifted => i - (i + 1) % 2,
+        }
+    }
+}
 
 /// Where the samples of an axis sit, in the axis' coordinate.
 #[derive(Clone, Debug, PartialEq)]
@@ -61,6 +96,71 @@ impl TableAxis {
             (Nodes::Index(n), Edge::Periodic) => periodic_index_pair(u, *n),
             (Nodes::Values(v), _) => value_pair(v, u),
         }
+    }
+
+    /// [`TableAxis::linear`] at a [`Resolution`]: for a twin, the two neighbouring nodes of the twin and the
+    /// weight of the second, in the same coordinate `u`.
+    pub fn linear_at(&self, u: f64, res: Resolution) -> (usize, usize, f64) {
+        if res == Resolution::Own {
+            return self.linear(u);
+        }
+        let n = self.len();
+        if n < 2 {
+            return self.linear(u);
+        }
+        let pos = |k: usize| match &self.nodes {
+            Nodes::Index(_) => k as f64,
+            Nodes::Values(v) => v[k],
+        };
+        if let (Nodes::Index(_), Edge::Periodic) = (&self.nodes, self.edge) {
+            if !(u > 0.0) && res == Resolution::Coarse {
+                return (0, 0, 0.0);
+            }
+            // Nodes every 2 from `first` (0 or 1), period n.
+            let first = if res == Resolution::Coarse { 0.0 } else { 1.0 };
+            let g = (u - first).rem_euclid(n as f64);
+            let g = if g.is_finite() { g } else { 0.0 };
+            let a = (g / 2.0).floor() * 2.0;
+            let t = ((g - a) / 2.0).clamp(0.0, 1.0);
+            let ai = (a as usize + first as usize) % n;
+            return (ai, (ai + 2) % n, t);
+        }
+        // Nodes c_0 = 0, …, c_{m−1} = n − 1 (see the type's documentation).
+        let shifted = res == Resolution::Shifted;
+        let m = if !shifted {
+            ((n - 1) / 2 + 1).max(2)
+        } else if n >= 4 {
+            (n - 4) / 2 + 2
+        } else {
+            2
+        };
+        let node = |j: usize| {
+            if j + 1 == m {
+                n - 1
+            } else if !shifted {
+                2 * j
+            } else if j == 0 {
+                0
+            } else {
+                2 * j + 1
+            }
+        };
+        let interval = |i: usize| {
+            if !shifted {
+                i / 2
+            } else if i < 3 {
+                0
+            } else {
+                (i - 1) / 2
+            }
+        };
+        if !(u > pos(0)) {
+            return (0, node(1), 0.0);
+        }
+        let (i, _, _) = self.linear(u);
+        let j = interval(i).min(m - 2);
+        let (a, b) = (node(j), node(j + 1));
+        (a, b, ((u - pos(a)) / (pos(b) - pos(a))).clamp(0.0, 1.0))
     }
 
     /// The sample at or below `u` (the cell that contains it), clamped to the axis; NaN → 0.
@@ -135,7 +235,8 @@ pub struct Table {
     axes: Vec<TableAxis>,
     strides: Vec<usize>,
     channels: usize,
-    data: Vec<f64>,
+    /// Shared, so that a table's coarse twin (`Resolution::Coarse`) costs no copy of its data.
+    data: Arc<Vec<f64>>,
 }
 
 impl Table {
@@ -148,7 +249,7 @@ impl Table {
             s *= a.len();
         }
         assert_eq!(s, data.len(), "table size does not match its axes");
-        Table { axes, strides, channels, data }
+        Table { axes, strides, channels, data: Arc::new(data) }
     }
 
     pub fn axes(&self) -> &[TableAxis] {
@@ -167,9 +268,15 @@ impl Table {
 
     /// The cell that contains the point (each axis' `floor`): piecewise constant lookup.
     pub fn nearest(&self, coords: &[f64], out: &mut [f64]) {
+        self.nearest_at(coords, Resolution::Own, out)
+    }
+
+    /// [`Table::nearest`] at a [`Resolution`] (a twin: its sample at or below each axis' floor).
+    pub fn nearest_at(&self, coords: &[f64], res: Resolution, out: &mut [f64]) {
         let mut o = 0;
         for (k, a) in self.axes.iter().enumerate() {
-            o += a.floor(coords[k]) * self.strides[k];
+            let i = res.floor(a.floor(coords[k]));
+            o += i * self.strides[k];
         }
         out.copy_from_slice(&self.data[o..o + self.channels]);
     }
@@ -177,8 +284,13 @@ impl Table {
     /// Multilinear interpolation: the 2^N corners in order (first axis outermost), each weighted by the
     /// product of its axes' weights taken in axis order; corners of weight 0 are skipped.
     pub fn linear(&self, coords: &[f64], out: &mut [f64]) {
+        self.linear_at(coords, Resolution::Own, out)
+    }
+
+    /// [`Table::linear`] at a [`Resolution`] (`Coarse`: on every second sample of each axis).
+    pub fn linear_at(&self, coords: &[f64], res: Resolution, out: &mut [f64]) {
         out.fill(0.0);
-        let pairs: Vec<(usize, usize, f64)> = self.axes.iter().zip(coords).map(|(a, &u)| a.linear(u)).collect();
+        let pairs: Vec<(usize, usize, f64)> = self.axes.iter().zip(coords).map(|(a, &u)| a.linear_at(u, res)).collect();
         self.accumulate(&pairs, 0, 0, None, out);
     }
 
@@ -374,6 +486,44 @@ mod tests {
         let p = TableAxis::index(4, Edge::Periodic);
         assert_eq!(p.linear(3.5), (3, 0, 0.5));
         assert_eq!(c.floor(3.9), 3);
+    }
+
+    #[test]
+    fn coarse_axes_use_every_second_sample_and_the_last() {
+        let v = TableAxis::values(vec![0.0, 1.0, 3.0, 4.0, 6.0]);
+        // Four intervals: coarse nodes 0, 3 (index 2) and 6 (index 4).
+        assert_eq!(v.linear_at(1.5, Resolution::Coarse), (0, 2, 0.5));
+        assert_eq!(v.linear_at(4.5, Resolution::Coarse), (2, 4, 0.5));
+        assert_eq!(v.linear_at(-1.0, Resolution::Coarse), (0, 2, 0.0));
+        assert_eq!(v.linear_at(9.0, Resolution::Coarse), (2, 4, 1.0));
+        // Three intervals: the coarse nodes are the ends, the one coarse interval spans all three.
+        let v = TableAxis::values(vec![0.0, 1.0, 3.0, 4.0]);
+        assert_eq!(v.linear_at(3.5, Resolution::Coarse), (0, 3, 0.875));
+        // The shifted twin of 8 samples: 0, 3, 5, 7.
+        let s = TableAxis::index(8, Edge::Clamp);
+        assert_eq!(s.linear_at(1.5, Resolution::Shifted), (0, 3, 0.5));
+        assert_eq!(s.linear_at(4.0, Resolution::Shifted), (3, 5, 0.5));
+        assert_eq!(s.linear_at(6.5, Resolution::Shifted), (5, 7, 0.75));
+        // Of 7 samples: 0, 3, 6.
+        assert_eq!(TableAxis::index(7, Edge::Clamp).linear_at(5.0, Resolution::Shifted), (3, 6, 2.0 / 3.0));
+        assert_eq!(TableAxis::index(6, Edge::Periodic).linear_at(0.5, Resolution::Shifted), (5, 1, 0.75));
+        assert_eq!(Resolution::Shifted.floor(4), 3);
+        assert_eq!(Resolution::Shifted.floor(2), 0);
+        let c = TableAxis::index(5, Edge::Clamp);
+        assert_eq!(c.linear_at(3.0, Resolution::Coarse), (2, 4, 0.5));
+        assert_eq!(c.linear_at(7.0, Resolution::Coarse), (2, 4, 1.0));
+        let p = TableAxis::index(6, Edge::Periodic);
+        assert_eq!(p.linear_at(5.0, Resolution::Coarse), (4, 0, 0.5));
+        assert_eq!(p.linear_at(1.0, Resolution::Coarse), (0, 2, 0.5));
+        // A linear function is read exactly at either resolution.
+        let t = Table::new(vec![TableAxis::values(vec![0.0, 1.0, 3.0, 4.0, 6.0])], 1, vec![1.0, 3.0, 7.0, 9.0, 13.0]);
+        let mut out = [0.0];
+        for x in [0.3, 2.2, 3.9, 5.5] {
+            for res in Resolution::TWINS {
+                t.linear_at(&[x], res, &mut out);
+                assert!((out[0] - (1.0 + 2.0 * x)).abs() < 1e-12, "{x} {res:?}: {out:?}");
+            }
+        }
     }
 
     #[test]

@@ -50,7 +50,17 @@ pub fn json_with_envelope(mut doc: serde_json::Value, envelopes: &Envelopes) -> 
 
 /// The CSV of `measure`: a header, then one record per reading (the fields of [`reading_json`]).
 pub fn csv(readings: &[Reading], timing: bool) -> Result<String> {
-    let mut head = vec!["geometry", "name", "quantity", "value", "unit", "error_estimate", "evaluations", "converged"];
+    let mut head = vec![
+        "geometry",
+        "name",
+        "quantity",
+        "value",
+        "unit",
+        "error_estimate",
+        "data_uncertainty",
+        "evaluations",
+        "converged",
+    ];
     if timing {
         head.push("seconds");
     }
@@ -64,6 +74,7 @@ pub fn csv(readings: &[Reading], timing: bool) -> Result<String> {
             r.value.map(plain).unwrap_or_default(),
             r.unit.clone(),
             r.value.map(|_| plain(r.error_estimate)).unwrap_or_default(),
+            r.value.and(r.data_uncertainty).map(plain).unwrap_or_default(),
             r.evaluations.to_string(),
             r.converged.to_string(),
         ];

@@ -69,6 +69,9 @@ pub fn reading_json(r: &Reading, timing: bool) -> serde_json::Value {
         "evaluations": r.evaluations,
         "converged": r.converged,
     });
+    if let (Some(_), Some(u)) = (r.value, r.data_uncertainty) {
+        o["data_uncertainty"] = json!(u);
+    }
     if timing {
         o["seconds"] = json!(r.seconds);
     }

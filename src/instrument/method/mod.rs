@@ -274,6 +274,10 @@ pub struct Flux {
     pub seconds: f64,
     /// The chart the regular part was integrated in (None: there was no regular part).
     pub chart: Option<Chart>,
+    /// The data (resolution) uncertainty per component, absolute, for a measured table read through the
+    /// plan (`Plan::run`; `docs/accuracy.md` §Data uncertainty of measured tables); None for a model, and for
+    /// an integral run on its own ([`Method::execute`]). Not part of `error`, which stays the numerical error.
+    pub data_uncertainty: Option<Vec<f64>>,
 }
 
 impl Flux {
@@ -291,11 +295,29 @@ impl Flux {
             budget_spent: false,
             seconds: 0.0,
             chart: None,
+            data_uncertainty: None,
         }
     }
 }
 
 impl Method {
+    /// The same method at another relative tolerance: the flux's and each part's tolerance and absolute floor
+    /// scaled by rtol / self.rtol (the shares and floors of `Plan::compile` are proportional to the rtol).
+    pub fn with_rtol(&self, rtol: f64) -> Method {
+        let s = rtol / self.rtol;
+        let mut m = self.clone();
+        m.rtol = rtol;
+        if let Some(d) = &mut m.delta {
+            d.rtol *= s;
+            d.atol *= s;
+        }
+        if let Some(r) = &mut m.regular {
+            r.rtol *= s;
+            r.atol *= s;
+        }
+        m
+    }
+
     /// Whether the method was frozen (its parts re-run a kept partition without refinement).
     pub fn is_frozen(&self) -> bool {
         self.delta.iter().all(|p| p.refine == Refine::Frozen) && self.regular.iter().all(|p| p.refine == Refine::Frozen)

@@ -297,6 +297,7 @@ impl Planner {
         };
         Ok(Plan {
             white_point,
+            twins: material.coarser(),
             material,
             options,
             geometries: queue.into_iter().map(|(g, _)| g).collect(),

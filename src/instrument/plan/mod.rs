@@ -80,6 +80,27 @@ pub const MIN_RTOL: f64 = 1e-12;
 /// There is no default wall-clock budget: [`PlanOptions::max_seconds`] is opt-in, and an integral that meets it gives no value.
 pub const DEFAULT_MAX_EVALS: usize = 2_000_000;
 
+/// The fraction of a measured table's data uncertainty that its specimen integrals are asked for by default
+/// ([`PlanOptions::rtol_from_data`]): the numerical error then adds at most a quarter of the data uncertainty
+/// to a reading, and the integral is not driven to a precision its data does not have (docs/accuracy.md
+/// §Data uncertainty of measured tables).
+pub const DATA_FRACTION: f64 = 0.25;
+
+/// The loosest relative tolerance the data uncertainty may set (a table so coarse that a quarter of its
+/// uncertainty exceeds 1 % is still integrated to 1 %).
+pub const DATA_MAX_RTOL: f64 = 1e-2;
+
+/// The tolerances at which a table and its coarse twins are integrated to estimate the data uncertainty, in
+/// turn until the sum of their numerical errors is at most [`DATA_RESOLVED`] times the difference of the two
+/// fluxes (so that the difference, not the integration, is most of what is measured), and never tighter
+/// than the plan's rtol. (Looser first tolerances cost the same: the initial partition at the table's
+/// resolution already meets 10⁻², measured on `beckmann-iso-32`.)
+pub const DATA_PILOT_RTOL: [f64; 3] = [1e-2, 1e-3, 1e-4];
+
+/// When the pilots stop: e_coarse + e_table ≤ DATA_RESOLVED·|Φ_coarse − Φ_table| (then the data
+/// uncertainty u = |Φ_coarse − Φ_table| + e_coarse + e_table is at most 3 × the difference).
+pub const DATA_RESOLVED: f64 = 2.0;
+
 /// Knobs of the planner. The defaults are what `measure` uses; the others exist to measure what each
 /// optimisation saves (`docs/performance.md`).
 #[derive(Clone, Debug, PartialEq)]
@@ -106,6 +127,11 @@ pub struct PlanOptions {
     /// Illuminant and observer of colour readings (default D65 and the CIE 1964 10° observer, as colour QC
     /// uses; gloss readings are luminous whatever this says).
     pub colour: Conditions,
+    /// For a measured table (a material with coarse twins, `Brdf::coarser`): let each specimen integral's
+    /// tolerance default to [`DATA_FRACTION`] of its data uncertainty, relative, within [`DATA_MAX_RTOL`]
+    /// and never tighter than `rtol` (docs/accuracy.md §Data uncertainty of measured tables). False: `rtol`
+    /// is used as given (the command line's `--rtol` sets this false). No effect on other materials.
+    pub rtol_from_data: bool,
 }
 
 impl Default for PlanOptions {
@@ -118,6 +144,7 @@ impl Default for PlanOptions {
             max_evals: DEFAULT_MAX_EVALS,
             max_seconds: None,
             colour: Conditions::default(),
+            rtol_from_data: true,
         }
     }
 }
@@ -168,6 +195,11 @@ pub struct Reading {
     pub problem: Option<String>,
     /// A caveat on a valid value (e.g. a specimen outside the scope of the standard's formula).
     pub note: Option<String>,
+    /// The data (resolution) uncertainty of a reading of a measured table, in the reading's unit: how far
+    /// the table's interpolant may put the reading from that of the surface it samples (docs/accuracy.md
+    /// §Data uncertainty of measured tables). None for a model (no data) and when there is no value.
+    /// Separate from `error_estimate`, the numerical error of the integration.
+    pub data_uncertainty: Option<f64>,
 }
 
 /// One execution of a plan ([`Plan::run`]): the readings, and the flux of every integral of the plan.
@@ -224,6 +256,9 @@ pub struct Plan {
     shape: Shape,
     /// The standards' fluxes, computed at compile time (None for specimen jobs).
     standard_flux: Vec<Option<Flux>>,
+    /// The material's coarse twins (`Brdf::coarser`: a measured table on about every second sample), from
+    /// which each specimen flux's data uncertainty is estimated; empty for a model.
+    twins: Vec<Arc<dyn Brdf>>,
     /// X, Y, Z of the perfect reflecting diffuser under the colour conditions, from the material's own grid
     /// (the row sums of its weights, so a white diffuser reads L* = 100 exactly); None without colour readings.
     white_point: Option<(Conditions, [f64; 3])>,
@@ -247,6 +282,7 @@ impl Plan {
             )));
         }
         let mut p = self.clone();
+        p.twins = material.coarser();
         p.material = material;
         Ok(p)
     }
@@ -268,7 +304,10 @@ impl Plan {
         let todo = self.specimen_jobs();
         let results: Vec<(Flux, Method)> = todo
             .par_iter()
-            .map(|&j| self.jobs[j].method.execute_and_freeze_until(self.material.as_ref(), deadline))
+            .map(|&j| {
+                let (f, m) = self.run_job(j, deadline, true);
+                (f, m.expect("kept"))
+            })
             .collect();
         let mut frozen = self.clone();
         let mut flux = self.known_fluxes();
@@ -304,8 +343,7 @@ impl Plan {
     /// budget from [`PlanOptions::max_seconds`] ([`Method::execute_until`]).
     pub fn run_until(&self, deadline: Option<std::time::Instant>) -> Execution {
         let todo = self.specimen_jobs();
-        let computed: Vec<Flux> =
-            todo.par_iter().map(|&j| self.jobs[j].method.execute_until(self.material.as_ref(), deadline)).collect();
+        let computed: Vec<Flux> = todo.par_iter().map(|&j| self.run_job(j, deadline, false).0).collect();
         let mut flux = self.known_fluxes();
         for (&j, f) in todo.iter().zip(computed) {
             flux[j] = Some(f);
@@ -354,7 +392,7 @@ impl Plan {
                 let (p, j) = tasks[t];
                 let plan = &plans[p];
                 let deadline = *deadlines[p].get_or_init(|| plan.deadline());
-                let f = plan.jobs[j].method.execute_until(plan.material.as_ref(), deadline);
+                let f = plan.run_job(j, deadline, false).0;
                 let complete = {
                     let mut slot = pending[p].lock().unwrap_or_else(PoisonError::into_inner);
                     slot.1[j] = Some(f);
@@ -383,6 +421,112 @@ impl Plan {
                     .unwrap_or_else(|| plan.execution(pend.into_inner().unwrap_or_else(PoisonError::into_inner).1))
             })
             .collect()
+    }
+
+    /// One specimen integral of the plan on its material (with `freeze`, also the frozen method). For a
+    /// measured table (a plan with coarse twins) the integral is first run on the table and on each twin at
+    /// the pilot tolerances ([`DATA_PILOT_RTOL`], each no tighter than the plan's rtol) until the summed
+    /// numerical errors are at most [`DATA_RESOLVED`] times the larger difference; the data uncertainty of
+    /// each component is
+    ///
+    ///     u = max over the twins t of (|Φ_t − Φ_table| + e_t) + e_table
+    ///
+    /// (docs/accuracy.md §Data uncertainty of measured tables). With [`PlanOptions::rtol_from_data`] the
+    /// integral's tolerance is then max(rtol, min(DATA_FRACTION·u/|Φ|, DATA_MAX_RTOL)) over its components
+    /// (the smallest); if the last pilot on the table already met that tolerance (as its tolerance or by its
+    /// own error estimate), it is the flux, otherwise the table is integrated again at it. Every evaluation of
+    /// the pilots is counted in the flux's. A frozen method runs as frozen on all of them, once.
+    fn run_job(&self, j: usize, deadline: Option<std::time::Instant>, freeze: bool) -> (Flux, Option<Method>) {
+        let method = &self.jobs[j].method;
+        let material = self.material.as_ref();
+        let exec = |m: &Method, b: &dyn Brdf| -> (Flux, Option<Method>) {
+            if freeze {
+                let (f, m) = m.execute_and_freeze_until(b, deadline);
+                (f, Some(m))
+            } else {
+                (m.execute_until(b, deadline), None)
+            }
+        };
+        if self.twins.is_empty() {
+            return exec(method, material);
+        }
+        // (u, whether the summed numerical errors are within DATA_RESOLVED × the larger difference)
+        let uncertainty = |f: &Flux, twins: &[Flux]| -> (Vec<f64>, bool) {
+            let mut resolved = true;
+            let u = (0..f.value.len())
+                .map(|k| {
+                    let diff = twins.iter().map(|c| (c.value[k] - f.value[k]).abs()).fold(0.0, f64::max);
+                    let err = twins.iter().map(|c| c.error[k]).fold(0.0, f64::max) + f.error[k];
+                    // Twins that read exactly the table's value (a constant table) settle it at once.
+                    let same = twins.iter().all(|c| c.value[k].to_bits() == f.value[k].to_bits());
+                    resolved &= same || err <= DATA_RESOLVED * diff;
+                    twins.iter().map(|c| (c.value[k] - f.value[k]).abs() + c.error[k]).fold(0.0, f64::max) + f.error[k]
+                })
+                .collect();
+            (u, resolved)
+        };
+        let run_twins =
+            |m: &Method| -> Vec<Flux> { self.twins.iter().map(|t| m.execute_until(t.as_ref(), deadline)).collect() };
+        let cost =
+            |fs: &[Flux]| (fs.iter().map(|f| f.evaluations).sum::<usize>(), fs.iter().map(|f| f.seconds).sum::<f64>());
+        if method.is_frozen() {
+            let (mut f, m) = exec(method, material);
+            let c = run_twins(method);
+            f.data_uncertainty = Some(uncertainty(&f, &c).0);
+            let (e, s) = cost(&c);
+            f.evaluations += e;
+            f.seconds += s;
+            return (f, m);
+        }
+        let rtol = self.options.rtol;
+        let mut spent = (0usize, 0.0f64);
+        let mut pilot: Option<(Flux, Option<Method>, f64)> = None;
+        for rp in DATA_PILOT_RTOL.iter().map(|&r| r.max(rtol)) {
+            if pilot.as_ref().is_some_and(|p| p.2 <= rp) {
+                break;
+            }
+            let m = method.with_rtol(rp);
+            let (f, fm) = exec(&m, material);
+            let c = run_twins(&m);
+            if let Some((p, _, _)) = &pilot {
+                spent.0 += p.evaluations;
+                spent.1 += p.seconds;
+            }
+            let (e, s) = cost(&c);
+            spent.0 += e;
+            spent.1 += s;
+            let (u, resolved) = uncertainty(&f, &c);
+            let late = f.out_of_time || c.iter().any(|c| c.out_of_time);
+            pilot = Some((Flux { data_uncertainty: Some(u), ..f }, fm, rp));
+            if resolved || late {
+                break;
+            }
+        }
+        let (pf, pm, rp) = pilot.expect("at least one pilot ran");
+        let u = pf.data_uncertainty.clone().expect("set");
+        let target = if self.options.rtol_from_data {
+            let rel = (0..u.len())
+                .filter(|&k| pf.value[k].abs() > 0.0)
+                .map(|k| DATA_FRACTION * u[k] / pf.value[k].abs())
+                .fold(DATA_MAX_RTOL, f64::min);
+            rtol.max(rel)
+        } else {
+            rtol
+        };
+        // The last pilot is the flux when it ran at the target tolerance or tighter, or when its own error
+        // estimate already meets the target (adaptive cubature often ends well inside its tolerance).
+        let meets = pf.converged && (0..u.len()).all(|k| pf.error[k] <= target * pf.value[k].abs());
+        let (mut f, m) = if rp <= target || meets {
+            (pf, pm)
+        } else {
+            spent.0 += pf.evaluations;
+            spent.1 += pf.seconds;
+            let (f, m) = exec(&method.with_rtol(target), material);
+            (Flux { data_uncertainty: Some(u), ..f }, m)
+        };
+        f.evaluations += spent.0;
+        f.seconds += spent.1;
+        (f, m)
     }
 
     /// The execution from the flux of every job (the standards' and the computed ones).

@@ -27,6 +27,7 @@ fn valued_reading(
         converged,
         problem: None,
         note: None,
+        data_uncertainty: None,
     }
 }
 
@@ -43,6 +44,7 @@ fn problem_reading(r: &PlannedReading, why: String) -> Reading {
         converged: false,
         problem: Some(why),
         note: None,
+        data_uncertainty: None,
     }
 }
 
@@ -194,6 +196,40 @@ pub fn neutral_chroma(chroma_error: f64) -> f64 {
     (3.0 * chroma_error).max(NEUTRAL_CHROMA_FLOOR)
 }
 
+/// The value of a direct reading and the first-order propagation of what `spread(flux, component, is
+/// standard)` gives each flux component: its numerical error, or its data uncertainty.
+fn direct_value(
+    r: &PlannedReading,
+    flux: &[Flux],
+    jobs: &[Job],
+    white_point: Option<(Conditions, [f64; 3])>,
+    spread: &dyn Fn(&Flux, usize, bool) -> f64,
+) -> std::result::Result<(f64, f64), String> {
+    let specimen = |rx: &str| {
+        let j = r.specimen_jobs[rx];
+        let c = component_of(r, jobs, j);
+        (flux[j].value[c], spread(&flux[j], c, false))
+    };
+    let standard = |rx: &str| {
+        let f = &flux[r.standard_jobs[rx]];
+        (f.value[0], spread(f, 0, true))
+    };
+    match (&r.spec, r.kind) {
+        (ReadingSpec::Colour { quantity, terms, white }, WeightingKind::Xyz(cond)) => {
+            let (xyz, err) = colour_xyz(terms, *white, &|rx, k| {
+                let j = r.specimen_jobs[rx];
+                let c = component_of(r, jobs, j) + k;
+                (flux[j].value[c], spread(&flux[j], c, false))
+            });
+            match white_point {
+                Some((c, w)) if c == cond => colour_value(*quantity, xyz, err, w),
+                _ => Err("no white point for these colour conditions".into()),
+            }
+        }
+        _ => reading_value(&r.spec, &specimen, &standard),
+    }
+}
+
 /// Combine fluxes into a direct reading, with first-order error propagation.
 fn compute_reading(
     r: &PlannedReading,
@@ -201,15 +237,6 @@ fn compute_reading(
     jobs: &[Job],
     white_point: Option<(Conditions, [f64; 3])>,
 ) -> Reading {
-    let specimen = |rx: &str| {
-        let j = r.specimen_jobs[rx];
-        let c = component_of(r, jobs, j);
-        (flux[j].value[c], flux[j].error[c])
-    };
-    let standard = |rx: &str| {
-        let f = &flux[r.standard_jobs[rx]];
-        (f.value[0], f.error[0])
-    };
     let used: Vec<&Flux> = r.specimen_jobs.values().chain(r.standard_jobs.values()).map(|&j| &flux[j]).collect();
     let evaluations = used.iter().map(|f| f.evaluations).sum();
     let seconds = used.iter().map(|f| f.seconds).sum();
@@ -223,22 +250,22 @@ fn compute_reading(
         // The work done is reported as it was: only the value is withheld.
         return Reading { evaluations, seconds, ..problem_reading(r, why.into()) };
     }
-    let value = match (&r.spec, r.kind) {
-        (ReadingSpec::Colour { quantity, terms, white }, WeightingKind::Xyz(cond)) => {
-            let (xyz, err) = colour_xyz(terms, *white, &|rx, k| {
-                let j = r.specimen_jobs[rx];
-                let c = component_of(r, jobs, j) + k;
-                (flux[j].value[c], flux[j].error[c])
-            });
-            match white_point {
-                Some((c, w)) if c == cond => colour_value(*quantity, xyz, err, w),
-                _ => Err("no white point for these colour conditions".into()),
-            }
-        }
-        _ => reading_value(&r.spec, &specimen, &standard),
+    let value = direct_value(r, flux, jobs, white_point, &|f, c, _| f.error[c]);
+    // The data uncertainty: the same first-order propagation with each specimen flux's data uncertainty in
+    // place of its error, and none on the standards' (analytic) fluxes.
+    let data = r.specimen_jobs.values().any(|&j| flux[j].data_uncertainty.is_some()).then(|| {
+        direct_value(r, flux, jobs, white_point, &|f, c, standard| match (&f.data_uncertainty, standard) {
+            (Some(u), false) => u[c],
+            _ => 0.0,
+        })
+    });
+    let data_uncertainty = match data {
+        Some(Ok((_, u))) if u.is_finite() => Some(u),
+        _ => None,
     };
     match value {
         Ok((v, e)) if v.is_finite() && e.is_finite() => Reading {
+            data_uncertainty,
             problem: (!converged).then(|| {
                 if used.iter().any(|f| f.budget_spent) {
                     "evaluation budget exhausted before the tolerance was met (the value is the best estimate)".into()
@@ -283,7 +310,12 @@ fn compose_reading(r: &PlannedReading, done: &[Option<Reading>]) -> Reading {
     if !(v.is_finite() && e.is_finite()) {
         return problem_reading(r, "non-finite result".into());
     }
+    let data_uncertainty = match (a.data_uncertainty, b.data_uncertainty) {
+        (None, None) => None,
+        (ua, ub) => Some(haze_index_value((x, ua.unwrap_or(0.0)), (y, ub.unwrap_or(0.0))).1),
+    };
     Reading {
+        data_uncertainty,
         note: (x <= 70.0 || v < 0.0).then(|| {
             "outside the scope of ASTM D4039, which is defined for non-metallic specimens with G60 > 70 (a negative \
              index means the 20° receptor gathers relatively more than the 60° one, as for near-mirror flakes)"
