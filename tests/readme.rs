@@ -89,3 +89,22 @@ fn readme_fit_example_is_the_actual_output() {
     assert_eq!(runs(&quoted, "error analysis, "), restarts, "for the scan and restarts: {quoted}");
     assert_eq!(runs(&quoted, "of the bounds at "), scan, "points of the scan: {quoted}");
 }
+
+/// The README's literal reading of the flakes: "read 665 GU at 20°", what the binary prints to the nearest GU.
+#[test]
+fn readme_literal_flakes_reading_is_the_actual_output() {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let readme = std::fs::read_to_string(root.join("README.md")).unwrap();
+    let text = readme.split_whitespace().collect::<Vec<_>>().join(" ");
+    let quoted = number_after(&text, "second mirror under the coat and read ");
+    assert!(text.contains("GU at 20°: `fixtures/recipes/cerulean-blue-c-literal.json`"), "README changed");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_glossmeter"))
+        .current_dir(&root)
+        .args(["measure", "fixtures/recipes/cerulean-blue-c-literal.json", "-g", "astm-d523-20", "--format", "json"])
+        .output()
+        .unwrap();
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let value = doc["readings"][0]["value"].as_f64().unwrap();
+    assert_eq!(quoted.1, 0);
+    assert!((quoted.0 - value).abs() <= 0.5, "README {} GU, binary {value}", quoted.0);
+}

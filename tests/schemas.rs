@@ -48,6 +48,27 @@ fn outputs_follow_their_schemas() {
         &["measure", "fixtures/recipes/glass-n1.5.json", "--format", "json", "--no-timing"],
         &["measure", "fixtures/recipes/glass-n1.5.json", "fixtures/recipes/black-glass.json", "--format", "json"],
         &["measure", "fixtures/recipes/glass-n1.5.json", "-g", "astm-d523-60", "--format", "json", "--baseline", base],
+        // the tolerance envelope on each reading (null where a standard gives no tolerance)
+        &[
+            "measure",
+            "fixtures/recipes/glass-n1.5.json",
+            "-g",
+            "astm-d523-60",
+            "-g",
+            "iso-13803-20",
+            "--envelope",
+            "--format",
+            "json",
+        ],
+        &[
+            "measure",
+            "fixtures/recipes/glass-n1.5.json",
+            "fixtures/recipes/black-glass.json",
+            "--format",
+            "json",
+            "--baseline",
+            base,
+        ],
     ] {
         let (_, out) = gm(args);
         assert_valid(&m, &serde_json::from_str(&out).unwrap(), &format!("{args:?}"));
