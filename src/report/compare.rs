@@ -32,7 +32,7 @@ pub struct AllowanceDoc {
 /// One compared (sample, reading): the sheet's values and statistics, the prediction, the allowance and the
 /// verdict.
 #[derive(Clone, Debug, Serialize, JsonSchema)]
-#[schemars(transform = super::nullable_but_written(&["predicted_reading", "uncertainty", "predicted", "error_estimate", "difference", "allowance", "inside", "reason", "unchecked"]))]
+#[schemars(transform = comparison_doc_nullable)]
 #[serde(deny_unknown_fields)]
 pub struct ComparisonDoc {
     pub sample: String,
@@ -130,7 +130,7 @@ pub struct SheetDoc {
 
 /// The verdict rule: k standard errors of the mean, and the uncertainty of rows that state none.
 #[derive(Clone, Debug, Serialize, JsonSchema)]
-#[schemars(transform = super::nullable_but_written(&["tolerance"]))]
+#[schemars(transform = rule_doc_nullable)]
 #[serde(deny_unknown_fields)]
 pub struct RuleDoc {
     #[schemars(range(min = 0))]
@@ -152,7 +152,7 @@ pub struct SummaryDoc {
 
 /// CIEDE2000 of a (sample, geometry) with L*, a*, b* on the sheet.
 #[derive(Clone, Debug, Serialize, JsonSchema)]
-#[schemars(transform = super::nullable_but_written(&["inside"]))]
+#[schemars(transform = colour_difference_doc_nullable)]
 #[serde(deny_unknown_fields)]
 pub struct ColourDifferenceDoc {
     pub sample: String,
@@ -289,4 +289,29 @@ pub fn csv(cmp: &[Comparison]) -> Result<String> {
         ]
     });
     csv_text(&head, rows)
+}
+
+fn comparison_doc_nullable(schema: &mut schemars::Schema) {
+    super::nullable_but_written(
+        schema,
+        &[
+            "predicted_reading",
+            "uncertainty",
+            "predicted",
+            "error_estimate",
+            "difference",
+            "allowance",
+            "inside",
+            "reason",
+            "unchecked",
+        ],
+    );
+}
+
+fn rule_doc_nullable(schema: &mut schemars::Schema) {
+    super::nullable_but_written(schema, &["tolerance"]);
+}
+
+fn colour_difference_doc_nullable(schema: &mut schemars::Schema) {
+    super::nullable_but_written(schema, &["inside"]);
 }

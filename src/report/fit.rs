@@ -13,7 +13,7 @@ fn finite(x: f64) -> Option<f64> {
 
 /// A fitted parameter: its value, standard error and bounds.
 #[derive(Clone, Debug, Serialize, JsonSchema)]
-#[schemars(transform = super::nullable_but_written(&["value", "std_error"]))]
+#[schemars(transform = parameter_doc_nullable)]
 #[serde(deny_unknown_fields)]
 pub struct ParameterDoc {
     /// JSON Pointer into the recipe.
@@ -30,7 +30,7 @@ pub struct ParameterDoc {
 
 /// A target reading with the fit's prediction and residual.
 #[derive(Clone, Debug, Serialize, JsonSchema)]
-#[schemars(transform = super::nullable_but_written(&["predicted", "residual"]))]
+#[schemars(transform = target_doc_nullable)]
 #[serde(deny_unknown_fields)]
 pub struct TargetDoc {
     pub geometry: String,
@@ -47,7 +47,7 @@ pub struct TargetDoc {
 /// `fit --format json` of a fit that ran to a report: the JSON contract of docs/inverse.md §Output, and
 /// `verdict` (the same words as the table's).
 #[derive(Clone, Debug, Serialize, JsonSchema)]
-#[schemars(transform = super::nullable_but_written(&["chi2", "p_value", "error_scale", "seconds"]))]
+#[schemars(transform = fit_doc_nullable)]
 #[serde(deny_unknown_fields)]
 pub struct FitDoc {
     #[schemars(length(min = 1))]
@@ -99,7 +99,7 @@ pub struct FreeParameterDoc {
 
 /// A target as asked for, in the failure document.
 #[derive(Clone, Debug, Serialize, JsonSchema)]
-#[schemars(transform = super::nullable_but_written(&["uncertainty"]))]
+#[schemars(transform = target_asked_doc_nullable)]
 #[serde(deny_unknown_fields)]
 pub struct TargetAskedDoc {
     pub geometry: String,
@@ -197,4 +197,20 @@ pub fn failure_json(free: &[FreeParameter], targets: &[TargetReading], failure: 
             })
             .collect(),
     })
+}
+
+fn parameter_doc_nullable(schema: &mut schemars::Schema) {
+    super::nullable_but_written(schema, &["value", "std_error"]);
+}
+
+fn target_doc_nullable(schema: &mut schemars::Schema) {
+    super::nullable_but_written(schema, &["predicted", "residual"]);
+}
+
+fn fit_doc_nullable(schema: &mut schemars::Schema) {
+    super::nullable_but_written(schema, &["chi2", "p_value", "error_scale", "seconds"]);
+}
+
+fn target_asked_doc_nullable(schema: &mut schemars::Schema) {
+    super::nullable_but_written(schema, &["uncertainty"]);
 }

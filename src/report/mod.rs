@@ -67,17 +67,17 @@ pub fn to_json<T: Serialize>(doc: &T) -> serde_json::Value {
     serde_json::to_value(doc).expect("a report document serialises (string keys, no custom serialisers)")
 }
 
-/// A schemars transform for a document type: these nullable fields (`Option` without
-/// `skip_serializing_if`) are always written, as null when there is nothing, so they are required. (schemars
-/// leaves an `Option` field out of `required`, and its `required` attribute forbids null.)
-pub(crate) fn nullable_but_written(fields: &'static [&'static str]) -> impl Fn(&mut schemars::Schema) {
-    move |schema: &mut schemars::Schema| {
-        let required = schema.ensure_object().entry("required").or_insert_with(|| serde_json::Value::Array(vec![]));
-        if let Some(required) = required.as_array_mut() {
-            for f in fields {
-                if !required.iter().any(|r| r == f) {
-                    required.push((*f).into());
-                }
+/// For a document type's schemars `transform`: these nullable fields (`Option` without `skip_serializing_if`)
+/// are always written, as null when there is nothing, so they are required. (schemars leaves an `Option` field
+/// out of `required`, and its `required` attribute forbids null.) A transform is named by a function path, not
+/// an expression: the derive parses it with syn's default features (the library alone builds without syn's
+/// `full`).
+pub(crate) fn nullable_but_written(schema: &mut schemars::Schema, fields: &[&str]) {
+    let required = schema.ensure_object().entry("required").or_insert_with(|| serde_json::Value::Array(vec![]));
+    if let Some(required) = required.as_array_mut() {
+        for f in fields {
+            if !required.iter().any(|r| r == f) {
+                required.push((*f).into());
             }
         }
     }
@@ -108,7 +108,7 @@ fn quantity_enum(schema: &mut schemars::Schema) {
 
 /// One reading of `measure --format json` (docs/instrument.md §Output; the Python bindings' dicts).
 #[derive(Clone, Debug, Serialize, JsonSchema)]
-#[schemars(transform = nullable_but_written(&["value", "error_estimate"]))]
+#[schemars(transform = reading_doc_nullable)]
 #[serde(deny_unknown_fields)]
 pub struct ReadingDoc {
     /// The geometry id.
@@ -296,7 +296,7 @@ pub fn pretty(doc: &serde_json::Value) -> String {
 /// One reading of a `sweep --format jsonl` line: the fields of [`ReadingDoc`] without the quantity, the
 /// evaluation count, the note and the time.
 #[derive(Clone, Debug, Serialize, JsonSchema)]
-#[schemars(transform = nullable_but_written(&["value", "error_estimate"]))]
+#[schemars(transform = sweep_reading_doc_nullable)]
 #[serde(deny_unknown_fields)]
 pub struct SweepReadingDoc {
     pub geometry: String,
@@ -361,4 +361,12 @@ pub fn csv_text<R: IntoIterator<Item = String>>(header: &[&str], rows: impl Into
     let bytes =
         w.into_inner().map_err(|e| Error::Io { file: "<csv>".into(), source: std::io::Error::other(e.to_string()) })?;
     Ok(String::from_utf8(bytes).expect("csv is utf-8"))
+}
+
+fn reading_doc_nullable(schema: &mut schemars::Schema) {
+    nullable_but_written(schema, &["value", "error_estimate"]);
+}
+
+fn sweep_reading_doc_nullable(schema: &mut schemars::Schema) {
+    nullable_but_written(schema, &["value", "error_estimate"]);
 }
