@@ -170,7 +170,8 @@ pub struct ColourDifferenceDoc {
     pub inside: Option<bool>,
 }
 
-/// `compare --format json` (the schema is [`super::schema::compare`]).
+/// `compare --format json`: the sheet, the rule, one entry per compared (sample, reading), the summary, the
+/// colour differences and the baseline checks.
 #[derive(Clone, Debug, Serialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 #[schemars(title = "glossmeter compare --format json")]

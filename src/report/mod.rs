@@ -293,7 +293,7 @@ pub fn pretty(doc: &serde_json::Value) -> String {
     s
 }
 
-/// One reading of a `sweep --format jsonl` line: the fields of [`ReadingDoc`] without the quantity, the
+/// One reading of a `sweep --format jsonl` line: the fields of a `measure` reading without the quantity, the
 /// evaluation count, the note and the time.
 #[derive(Clone, Debug, Serialize, JsonSchema)]
 #[schemars(transform = sweep_reading_doc_nullable)]
@@ -327,8 +327,8 @@ impl SweepReadingDoc {
     }
 }
 
-/// One line of `sweep --format jsonl` (the lines are written by `crate::sweep`; the schema is
-/// [`schema::sweep`]).
+/// One line of `sweep --format jsonl`: the point's index and parameter values, and its readings or why there
+/// are none (the lines are written by `crate::sweep`).
 #[derive(Clone, Debug, Serialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 #[schemars(title = "glossmeter sweep --format jsonl (one object per line)")]
