@@ -402,21 +402,16 @@ impl Sweep {
         csv_line(&row)
     }
 
-    /// One JSON line (each reading's object is the report's, [`report::sweep_reading_json`]).
+    /// One JSON line (the report's [`report::SweepLineDoc`], each reading a [`report::SweepReadingDoc`]).
     pub fn jsonl_row(&self, r: &PointResult, timing: bool) -> String {
-        let params: serde_json::Map<String, Value> =
-            self.axes.iter().zip(&r.values).map(|(a, v)| (a.path.clone(), json!(v))).collect();
-        let mut o = json!({"index": r.index, "parameters": params});
-        match &r.outcome {
-            Ok(readings) => {
-                o["readings"] = readings.iter().map(report::sweep_reading_json).collect();
-            }
-            Err(e) => o["problem"] = json!(e),
-        }
-        if timing {
-            o["seconds"] = json!(r.seconds);
-        }
-        o.to_string() + "\n"
+        let line = report::SweepLineDoc {
+            index: r.index,
+            parameters: self.axes.iter().zip(&r.values).map(|(a, v)| (a.path.clone(), *v)).collect(),
+            readings: r.outcome.as_ref().ok().map(|rs| rs.iter().map(report::SweepReadingDoc::new).collect()),
+            problem: r.outcome.as_ref().err().cloned(),
+            seconds: timing.then_some(r.seconds),
+        };
+        report::to_json(&line).to_string() + "\n"
     }
 
     fn cells(&self, r: &PointResult, cols: &[(String, String, String)]) -> (Vec<Option<(f64, f64)>>, String) {

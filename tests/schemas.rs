@@ -1,6 +1,6 @@
-//! The output schemas (`glossmeter schema --output-format ...`) against real outputs: a small validator of
-//! the keywords the schemas use (type, properties, required, additionalProperties, items, enum, minimum,
-//! oneOf), so a field added to an output without its schema fails here.
+//! The output schemas (`glossmeter schema --output-format ...`) against real outputs, validated with the
+//! `jsonschema` crate (draft 2020-12), so a field added to an output without its schema fails here, and so does
+//! a schema that is not a valid JSON Schema.
 use std::process::Command;
 
 use serde_json::Value;
@@ -10,89 +10,25 @@ fn gm(args: &[&str]) -> (i32, String) {
     (out.status.code().unwrap_or(-1), String::from_utf8_lossy(&out.stdout).into_owned())
 }
 
-fn type_ok(t: &str, v: &Value) -> bool {
-    match t {
-        "object" => v.is_object(),
-        "array" => v.is_array(),
-        "string" => v.is_string(),
-        "number" => v.is_number(),
-        "integer" => v.is_u64() || v.is_i64(),
-        "boolean" => v.is_boolean(),
-        "null" => v.is_null(),
-        _ => panic!("unknown type {t}"),
-    }
-}
-
 /// Every violation, as "pointer: what".
-fn validate(s: &Value, v: &Value, at: &str, out: &mut Vec<String>) {
-    if let Some(t) = s.get("type") {
-        let ok = match t {
-            Value::String(t) => type_ok(t, v),
-            Value::Array(ts) => ts.iter().any(|t| type_ok(t.as_str().unwrap(), v)),
-            _ => panic!("bad type"),
-        };
-        if !ok {
-            out.push(format!("{at}: {v} is not {t}"));
-            return;
-        }
-    }
-    if let Some(e) = s.get("enum").and_then(|e| e.as_array()) {
-        if !e.contains(v) {
-            out.push(format!("{at}: {v} not in {e:?}"));
-        }
-    }
-    if let (Some(m), Some(x)) = (s.get("minimum").and_then(|m| m.as_f64()), v.as_f64()) {
-        if x < m {
-            out.push(format!("{at}: {x} < {m}"));
-        }
-    }
-    if let Some(alts) = s.get("oneOf").and_then(|a| a.as_array()) {
-        let passing = alts
-            .iter()
-            .filter(|a| {
-                let mut e = vec![];
-                validate(a, v, at, &mut e);
-                e.is_empty()
-            })
-            .count();
-        if passing != 1 {
-            out.push(format!("{at}: {passing} of the oneOf alternatives match"));
-        }
-    }
-    if let Some(o) = v.as_object() {
-        for r in s.get("required").and_then(|r| r.as_array()).into_iter().flatten() {
-            if !o.contains_key(r.as_str().unwrap()) {
-                out.push(format!("{at}: missing {r}"));
-            }
-        }
-        let props = s.get("properties").and_then(|p| p.as_object());
-        for (k, x) in o {
-            match props.and_then(|p| p.get(k)) {
-                Some(ps) => validate(ps, x, &format!("{at}/{k}"), out),
-                None => match s.get("additionalProperties") {
-                    Some(Value::Bool(false)) => out.push(format!("{at}: unexpected {k}")),
-                    Some(a @ Value::Object(_)) => validate(a, x, &format!("{at}/{k}"), out),
-                    _ => {}
-                },
-            }
-        }
-    }
-    if let (Some(items), Some(a)) = (s.get("items"), v.as_array()) {
-        for (i, x) in a.iter().enumerate() {
-            validate(items, x, &format!("{at}/{i}"), out);
-        }
-    }
+fn violations(s: &Value, v: &Value) -> Vec<String> {
+    let validator = jsonschema::validator_for(s).unwrap_or_else(|e| panic!("not a valid schema: {e}"));
+    validator.iter_errors(v).map(|e| format!("{}: {e}", e.instance_path())).collect()
 }
 
 fn schema(kind: &str) -> Value {
     let (code, text) = gm(&["schema", "--output-format", kind]);
     assert_eq!(code, 0);
-    serde_json::from_str(&text).unwrap()
+    let s: Value = serde_json::from_str(&text).unwrap();
+    assert_eq!(s["$schema"], "https://json-schema.org/draft/2020-12/schema", "{kind}");
+    if let Err(e) = jsonschema::meta::validate(&s) {
+        panic!("the {kind} schema is not a valid JSON Schema: {e}");
+    }
+    s
 }
 
 fn assert_valid(s: &Value, v: &Value, what: &str) {
-    let mut e = vec![];
-    validate(s, v, "", &mut e);
+    let e = violations(s, v);
     assert!(e.is_empty(), "{what}: {e:#?}");
 }
 
@@ -112,6 +48,27 @@ fn outputs_follow_their_schemas() {
         &["measure", "fixtures/recipes/glass-n1.5.json", "--format", "json", "--no-timing"],
         &["measure", "fixtures/recipes/glass-n1.5.json", "fixtures/recipes/black-glass.json", "--format", "json"],
         &["measure", "fixtures/recipes/glass-n1.5.json", "-g", "astm-d523-60", "--format", "json", "--baseline", base],
+        // the tolerance envelope on each reading (null where a standard gives no tolerance)
+        &[
+            "measure",
+            "fixtures/recipes/glass-n1.5.json",
+            "-g",
+            "astm-d523-60",
+            "-g",
+            "iso-13803-20",
+            "--envelope",
+            "--format",
+            "json",
+        ],
+        &[
+            "measure",
+            "fixtures/recipes/glass-n1.5.json",
+            "fixtures/recipes/black-glass.json",
+            "--format",
+            "json",
+            "--baseline",
+            base,
+        ],
     ] {
         let (_, out) = gm(args);
         assert_valid(&m, &serde_json::from_str(&out).unwrap(), &format!("{args:?}"));
@@ -226,8 +183,42 @@ fn outputs_follow_their_schemas() {
         let doc: Value = serde_json::from_str(&out).unwrap_or_else(|e| panic!("{args:?}: {e}: {out}"));
         assert_valid(&f, &doc, &format!("{args:?}"));
     }
-    // The validator itself rejects what it should.
-    let mut e = vec![];
-    validate(&m, &serde_json::json!({"material": {"name": "x"}, "readings": [], "extra": 1}), "", &mut e);
-    assert!(!e.is_empty());
+}
+
+/// The schemas are strict where the outputs are: a document with a field unknown to its type, a missing
+/// field, a wrong type or a number out of range is refused (so the validation above can fail).
+#[test]
+fn the_schemas_refuse_what_no_output_holds() {
+    let m = schema("measure");
+    let (_, out) = gm(&["measure", "fixtures/recipes/glass-n1.5.json", "-g", "astm-d523-60", "--format", "json"]);
+    let good: Value = serde_json::from_str(&out).unwrap();
+    assert!(violations(&m, &good).is_empty());
+    let bad = |f: &dyn Fn(&mut Value)| {
+        let mut d = good.clone();
+        f(&mut d);
+        violations(&m, &d)
+    };
+    assert!(!bad(&|d| d["extra"] = 1.into()).is_empty(), "an unknown top-level field");
+    assert!(!bad(&|d| d["readings"][0]["colour"] = "red".into()).is_empty(), "an unknown reading field");
+    assert!(!bad(&|d| d["readings"][0]["material"] = "x".into()).is_empty(), "a batch field in one recipe");
+    assert!(!bad(&|d| {
+        d["readings"][0].as_object_mut().unwrap().remove("value");
+    })
+    .is_empty());
+    assert!(!bad(&|d| d["readings"][0]["value"] = "40".into()).is_empty(), "a string value");
+    assert!(!bad(&|d| d["readings"][0]["error_estimate"] = (-1.0).into()).is_empty(), "a negative estimate");
+    assert!(!bad(&|d| d["readings"][0]["quantity"] = "shine".into()).is_empty(), "an unknown quantity");
+    assert!(!bad(&|d| d["evaluations"] = (-3).into()).is_empty(), "a negative count");
+    // null where the output writes null (a reading without a value) is allowed
+    assert!(bad(&|d| {
+        d["readings"][0]["value"] = Value::Null;
+        d["readings"][0]["error_estimate"] = Value::Null;
+    })
+    .is_empty());
+    let f = schema("fit");
+    let failure = serde_json::json!({"converged": true, "failure": "x", "parameters": [], "targets": []});
+    assert!(!violations(&f, &failure).is_empty(), "a failure document says converged: false");
+    let s = schema("sweep");
+    assert!(violations(&s, &serde_json::json!({"index": 0, "parameters": {"/a": 0.5}})).is_empty());
+    assert!(!violations(&s, &serde_json::json!({"index": 0, "parameters": {"/a": "0.5"}})).is_empty());
 }

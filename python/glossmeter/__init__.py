@@ -5,28 +5,61 @@
 
 Every function is a thin layer over the library (see docs/python.md):
 
-* ``measure(recipe, geometries=None, rtol=1e-6)``: readings of a recipe (dict, JSON string or path), one
-  dict per reading with the fields of ``glossmeter measure --format json``.
-* ``measure_brdf(f, geometries=None, rtol=1e-6, lobes=None, delta=None)``: readings of a Python BRDF
-  ``f(wi, wo)`` evaluated in batches of (N, 3) NumPy arrays.
+* ``measure(recipe, geometries=None, rtol=1e-6, timing=True, *, as_frame=False, as_arrays=False)``: readings
+  of a recipe (dict, JSON string or path), one dict per reading with the fields of
+  ``glossmeter measure --format json``; or a pandas DataFrame (``as_frame=True``), or a dict of NumPy arrays,
+  one per field (``as_arrays=True``).
+* ``measure_brdf(f, geometries=None, rtol=1e-6, lobes=None, delta=None, wavelengths=None, timing=True, *,
+  as_frame=False, as_arrays=False)``: readings of a Python BRDF ``f(wi, wo)`` evaluated in batches of (N, 3)
+  NumPy arrays.
 * ``standards()``, ``geometry(id)``, ``describe_geometry(id)``, ``schema()``, ``describe(recipe)``.
 
-Bad input raises ``ValueError`` with the message the CLI prints; an unreadable file raises ``OSError``.
+Bad input raises ``ValueError`` with the message the CLI prints; an argument of the wrong type raises
+``TypeError`` naming the argument and what it allows; an unreadable file raises ``OSError``.
 """
-from ._glossmeter import (  # noqa: F401
+from typing import TYPE_CHECKING, Any, Dict, Literal, Optional, Sequence, Union, overload
+
+import numpy as np
+import numpy.typing as npt
+
+from . import _glossmeter
+from ._glossmeter import (
     DEFAULT_GEOMETRIES,
     __version__,
     describe,
     describe_geometry,
     geometry,
-    measure,
-    measure_brdf,
     schema,
     standards,
 )
+from ._types import (
+    BrdfFunction,
+    Delta,
+    Geometries,
+    Geometry,
+    LobeHint,
+    Lobes,
+    Reading,
+    Readings,
+    Recipe,
+)
+
+if TYPE_CHECKING:
+    import pandas
 
 __all__ = [
     "DEFAULT_GEOMETRIES",
+    "Arrays",
+    "BrdfFunction",
+    "Delta",
+    "Geometries",
+    "Geometry",
+    "LobeHint",
+    "Lobes",
+    "Reading",
+    "Readings",
+    "Recipe",
+    "__version__",
     "describe",
     "describe_geometry",
     "geometry",
@@ -34,4 +67,118 @@ __all__ = [
     "measure_brdf",
     "schema",
     "standards",
+    "to_arrays",
+    "to_frame",
 ]
+
+#: A table of readings as NumPy arrays, one per field.
+Arrays = Dict[str, npt.NDArray[Any]]
+
+
+def _flag(name: str, value: object) -> bool:
+    if isinstance(value, (bool, np.bool_)):
+        return bool(value)
+    raise TypeError(f"{name}: expected True or False, got {type(value).__name__}")
+
+
+def to_arrays(readings: Sequence[Reading]) -> Arrays:
+    """Readings as NumPy arrays, one per field: ``value``, ``error_estimate`` and ``seconds`` float64 (NaN
+    where a reading has no finite value: its ``problem`` says why), ``evaluations`` int64, ``converged``
+    bool, ``geometry``, ``name``, ``quantity`` and ``unit`` str, ``problem`` and ``note`` object (None where
+    absent). ``seconds`` is there only if every reading has it."""
+    rows = list(readings)
+    out: Arrays = {}
+    for key in ("geometry", "name", "quantity"):
+        out[key] = np.array([r[key] for r in rows], dtype=str)
+    out["value"] = np.array([np.nan if r["value"] is None else r["value"] for r in rows], dtype=np.float64)
+    out["unit"] = np.array([r["unit"] for r in rows], dtype=str)
+    out["error_estimate"] = np.array(
+        [np.nan if r["error_estimate"] is None else r["error_estimate"] for r in rows], dtype=np.float64)
+    out["evaluations"] = np.array([r["evaluations"] for r in rows], dtype=np.int64)
+    out["converged"] = np.array([r["converged"] for r in rows], dtype=bool)
+    if rows and all("seconds" in r for r in rows):
+        out["seconds"] = np.array([r.get("seconds", np.nan) for r in rows], dtype=np.float64)
+    out["problem"] = np.array([r.get("problem") for r in rows], dtype=object)
+    out["note"] = np.array([r.get("note") for r in rows], dtype=object)
+    return out
+
+
+def to_frame(readings: Sequence[Reading]) -> "pandas.DataFrame":
+    """Readings as a pandas DataFrame, one row per reading, the columns of :func:`to_arrays`. Needs pandas
+    (``pip install pandas``), which glossmeter does not require otherwise."""
+    try:
+        import pandas as pd
+    except ImportError as e:
+        raise ImportError(
+            "as_frame=True (a pandas DataFrame) needs pandas, which is not installed: pip install pandas "
+            "(or pip install 'glossmeter[pandas]'); as_arrays=True gives the same columns as NumPy arrays "
+            "without it"
+        ) from e
+    return pd.DataFrame(to_arrays(readings))
+
+
+def _shaped(readings: Readings, as_frame: bool, as_arrays: bool) -> Union[Readings, Arrays, "pandas.DataFrame"]:
+    if as_frame:
+        return to_frame(readings)
+    if as_arrays:
+        return to_arrays(readings)
+    return readings
+
+
+def _check_shape_flags(as_frame: object, as_arrays: object) -> None:
+    """Refuse bad ``as_frame``/``as_arrays`` before any work (and pandas missing, before a long measurement)."""
+    frame, arrays = _flag("as_frame", as_frame), _flag("as_arrays", as_arrays)
+    if frame and arrays:
+        raise ValueError("as_frame and as_arrays: give at most one (a DataFrame, or a dict of NumPy arrays)")
+    if frame:
+        try:
+            import pandas  # noqa: F401
+        except ImportError:
+            to_frame([])
+
+
+@overload
+def measure(recipe: Recipe, geometries: Geometries = ..., rtol: float = ..., timing: bool = ..., *,
+            as_frame: Literal[False] = ..., as_arrays: Literal[False] = ...) -> Readings: ...
+@overload
+def measure(recipe: Recipe, geometries: Geometries = ..., rtol: float = ..., timing: bool = ..., *,
+            as_frame: Literal[True], as_arrays: Literal[False] = ...) -> "pandas.DataFrame": ...
+@overload
+def measure(recipe: Recipe, geometries: Geometries = ..., rtol: float = ..., timing: bool = ..., *,
+            as_frame: Literal[False] = ..., as_arrays: Literal[True]) -> Arrays: ...
+def measure(recipe: Recipe, geometries: Geometries = None, rtol: float = 1e-6, timing: bool = True, *,
+            as_frame: bool = False, as_arrays: bool = False) -> Union[Readings, Arrays, "pandas.DataFrame"]:
+    """Read a recipe (a dict, a JSON string or a path) through instrument geometries (None: the default panel
+    of ``glossmeter measure``; or one or a list of builtin ids, geometry files or geometry dicts).
+
+    Returns one dict per reading with the fields of ``glossmeter measure --format json``; with
+    ``as_frame=True`` a pandas DataFrame, with ``as_arrays=True`` a dict of NumPy arrays (:func:`to_arrays`).
+    Bad input raises ValueError with the message the CLI prints; a reading without a finite value has value
+    None (NaN in a frame or array) and a "problem"."""
+    _check_shape_flags(as_frame, as_arrays)
+    return _shaped(_glossmeter.measure(recipe, geometries, rtol, timing), as_frame, as_arrays)
+
+
+@overload
+def measure_brdf(f: BrdfFunction, geometries: Geometries = ..., rtol: float = ..., lobes: Optional[Lobes] = ...,
+                 delta: Optional[Delta] = ..., wavelengths: Optional[Sequence[float]] = ..., timing: bool = ..., *,
+                 as_frame: Literal[False] = ..., as_arrays: Literal[False] = ...) -> Readings: ...
+@overload
+def measure_brdf(f: BrdfFunction, geometries: Geometries = ..., rtol: float = ..., lobes: Optional[Lobes] = ...,
+                 delta: Optional[Delta] = ..., wavelengths: Optional[Sequence[float]] = ..., timing: bool = ..., *,
+                 as_frame: Literal[True], as_arrays: Literal[False] = ...) -> "pandas.DataFrame": ...
+@overload
+def measure_brdf(f: BrdfFunction, geometries: Geometries = ..., rtol: float = ..., lobes: Optional[Lobes] = ...,
+                 delta: Optional[Delta] = ..., wavelengths: Optional[Sequence[float]] = ..., timing: bool = ..., *,
+                 as_frame: Literal[False] = ..., as_arrays: Literal[True]) -> Arrays: ...
+def measure_brdf(f: BrdfFunction, geometries: Geometries = None, rtol: float = 1e-6, lobes: Optional[Lobes] = None,
+                 delta: Optional[Delta] = None, wavelengths: Optional[Sequence[float]] = None, timing: bool = True,
+                 *, as_frame: bool = False, as_arrays: bool = False) -> Union[Readings, Arrays, "pandas.DataFrame"]:
+    """Read a Python BRDF ``f(wi, wo)`` through instrument geometries: f takes two (N, 3) float64 arrays of
+    unit directions (local frame, z the normal) and returns f_r in sr⁻¹ as (N,) or (N, S). ``lobes`` hints the
+    lobe widths (None: probe f; []: f is smooth), ``delta`` is a mirror component, ``wavelengths`` (nm) name
+    S spectral samples other than 1 (grey) or 3 (linear RGB). Returns what :func:`measure` returns; an
+    exception raised in f propagates as itself. See docs/python.md."""
+    _check_shape_flags(as_frame, as_arrays)
+    readings = _glossmeter.measure_brdf(f, geometries, rtol, lobes, delta, wavelengths, timing)
+    return _shaped(readings, as_frame, as_arrays)

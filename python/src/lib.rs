@@ -15,10 +15,11 @@ use glossmeter::instrument::plan::{PlanOptions, Reading};
 use glossmeter::instrument::standards::{self as stds, StandardGeometry};
 use glossmeter::recipe::{self, Material};
 use glossmeter::{report, Error};
-use pyo3::exceptions::{PyFileNotFoundError, PyOSError, PyRuntimeError, PyValueError};
+use pyo3::exceptions::{PyFileNotFoundError, PyOSError, PyRuntimeError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyString};
 
+mod args;
 mod probe;
 mod pybrdf;
 
@@ -56,7 +57,7 @@ pub(crate) fn guarded<T>(f: impl FnOnce() -> PyResult<T>) -> PyResult<T> {
 /// A Python object as JSON text: a `str` as is, anything else through `json.dumps`.
 fn json_text(py: Python<'_>, obj: &Bound<'_, PyAny>) -> PyResult<String> {
     if let Ok(s) = obj.cast::<PyString>() {
-        return Ok(s.to_str()?.to_string());
+        return Ok(s.to_cow()?.into_owned());
     }
     let json = py.import("json")?;
     json.call_method1("dumps", (obj,))?.extract()
@@ -98,12 +99,12 @@ fn from_json<'py>(py: Python<'py>, v: &serde_json::Value) -> PyResult<Bound<'py,
 /// A recipe given as a dict, a JSON string or a path (str or os.PathLike).
 fn load_recipe(py: Python<'_>, recipe: &Bound<'_, PyAny>) -> PyResult<Material> {
     if let Ok(s) = recipe.cast::<PyString>() {
-        let s = s.to_str()?;
+        let s = s.to_cow()?;
         let t = s.trim_start();
         if t.starts_with('{') {
-            return recipe::parse_str(s, "<string>").map_err(to_py_err);
+            return recipe::parse_str(&s, "<string>").map_err(to_py_err);
         }
-        return recipe::load_file(std::path::Path::new(s)).map_err(to_py_err);
+        return recipe::load_file(std::path::Path::new(&*s)).map_err(to_py_err);
     }
     if recipe.is_instance_of::<PyDict>() {
         let text = json_text(py, recipe)?;
@@ -115,9 +116,9 @@ fn load_recipe(py: Python<'_>, recipe: &Bound<'_, PyAny>) -> PyResult<Material> 
             let p: PathBuf = p.extract()?;
             recipe::load_file(&p).map_err(to_py_err)
         }
-        Err(_) => Err(PyValueError::new_err(format!(
-            "recipe: expected a dict, a JSON string or a path, got {}",
-            recipe.get_type().name()?
+        Err(_) => Err(PyTypeError::new_err(format!(
+            "recipe: expected a dict, a JSON string or a path (str or os.PathLike), got {}",
+            args::type_name(recipe)
         ))),
     }
 }
@@ -142,14 +143,14 @@ fn find_builtin(id: &str) -> PyResult<StandardGeometry> {
 }
 
 /// One geometry: a builtin id, a path to a geometry file (str ending in ".json" or os.PathLike), or a dict in
-/// the standards format.
-fn load_geometry(py: Python<'_>, g: &Bound<'_, PyAny>) -> PyResult<StandardGeometry> {
+/// the standards format. `name` is how a refusal names the argument (`id`, `geometries`, `geometries[2]`).
+fn load_geometry(py: Python<'_>, g: &Bound<'_, PyAny>, name: &str) -> PyResult<StandardGeometry> {
     if let Ok(s) = g.cast::<PyString>() {
-        let s = s.to_str()?;
+        let s = s.to_cow()?;
         if s.ends_with(".json") || s.contains(std::path::MAIN_SEPARATOR) {
-            return stds::load_file(std::path::Path::new(s)).map_err(to_py_err);
+            return stds::load_file(std::path::Path::new(&*s)).map_err(to_py_err);
         }
-        return find_builtin(s);
+        return find_builtin(&s);
     }
     if g.is_instance_of::<PyDict>() {
         let text = json_text(py, g)?;
@@ -161,9 +162,10 @@ fn load_geometry(py: Python<'_>, g: &Bound<'_, PyAny>) -> PyResult<StandardGeome
             let p: PathBuf = p.extract()?;
             stds::load_file(&p).map_err(to_py_err)
         }
-        Err(_) => Err(PyValueError::new_err(format!(
-            "geometries: expected a geometry id, a path or a dict, got {}",
-            g.get_type().name()?
+        Err(_) => Err(PyTypeError::new_err(format!(
+            "{name}: expected a geometry id (str, e.g. \"astm-d523-60\"), the path of a geometry file (str ending \
+             in .json, or os.PathLike) or a geometry dict, got {}",
+            args::type_name(g)
         ))),
     }
 }
@@ -175,11 +177,26 @@ pub(crate) fn load_geometries(
 ) -> PyResult<Vec<StandardGeometry>> {
     match geometries {
         None => glossmeter::api::DEFAULT_PANEL.iter().map(|id| find_builtin(id)).collect(),
-        Some(g) if g.is_instance_of::<PyString>() || g.is_instance_of::<PyDict>() => Ok(vec![load_geometry(py, g)?]),
+        Some(g) if g.is_none() => load_geometries(py, None),
+        Some(g) if g.is_instance_of::<PyString>() || g.is_instance_of::<PyDict>() => {
+            Ok(vec![load_geometry(py, g, "geometries")?])
+        }
         Some(g) => {
+            let items = match g.try_iter() {
+                Ok(items) => items,
+                // os.PathLike: one geometry file.
+                Err(_) if g.hasattr("__fspath__")? => return Ok(vec![load_geometry(py, g, "geometries")?]),
+                Err(_) => {
+                    return Err(PyTypeError::new_err(format!(
+                        "geometries: expected None (the default panel), a geometry id, a path, a geometry dict, or a \
+                         list of these, got {}",
+                        args::type_name(g)
+                    )))
+                }
+            };
             let mut out = Vec::new();
-            for item in g.try_iter()? {
-                out.push(load_geometry(py, &item?)?);
+            for (i, item) in items.enumerate() {
+                out.push(load_geometry(py, &item?, &format!("geometries[{i}]"))?);
             }
             if out.is_empty() {
                 return Err(PyValueError::new_err("geometries: an empty list; give None for the default panel"));
@@ -237,14 +254,17 @@ pub(crate) fn run_plan(
 /// reading with the fields of `glossmeter measure --format json`. Bad input raises ValueError with the
 /// message the CLI prints; a reading without a finite value has value None and a "problem".
 #[pyfunction]
-#[pyo3(signature = (recipe, geometries=None, rtol=1e-6, timing=true))]
+#[pyo3(signature = (recipe, geometries=None, rtol=None, timing=None))]
+#[pyo3(text_signature = "(recipe, geometries=None, rtol=1e-6, timing=True)")]
 fn measure<'py>(
     py: Python<'py>,
     recipe: &Bound<'py, PyAny>,
     geometries: Option<&Bound<'py, PyAny>>,
-    rtol: f64,
-    timing: bool,
+    rtol: Option<&Bound<'py, PyAny>>,
+    timing: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyList>> {
+    let rtol = args::rtol(rtol)?;
+    let timing = args::flag("timing", timing, true)?;
     let material = guarded(|| load_recipe(py, recipe))?;
     let geos = guarded(|| load_geometries(py, geometries))?;
     let readings = run_plan(py, material.brdf.clone(), geos, rtol, false)?;
@@ -269,7 +289,7 @@ fn standards(py: Python<'_>) -> PyResult<Bound<'_, PyList>> {
 #[pyfunction]
 fn geometry<'py>(py: Python<'py>, id: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
     guarded(|| {
-        let g = load_geometry(py, id)?;
+        let g = load_geometry(py, id, "id")?;
         from_json(py, &g.spec)
     })
 }
@@ -277,7 +297,7 @@ fn geometry<'py>(py: Python<'py>, id: &Bound<'py, PyAny>) -> PyResult<Bound<'py,
 /// describe_geometry(id) -> str: the text of `glossmeter standards ID`.
 #[pyfunction]
 fn describe_geometry(py: Python<'_>, id: &Bound<'_, PyAny>) -> PyResult<String> {
-    guarded(|| Ok(stds::describe(&load_geometry(py, id)?)))
+    guarded(|| Ok(stds::describe(&load_geometry(py, id, "id")?)))
 }
 
 /// schema() -> dict: the JSON Schema of the recipe format (`glossmeter schema`).

@@ -20,6 +20,7 @@ use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
+use crate::args::{self, type_name};
 use crate::probe;
 use crate::{guarded, load_geometries, readings_to_py, run_plan, to_py_err};
 
@@ -64,18 +65,31 @@ fn copy_values(
     s: Option<usize>,
     out: &mut Vec<f64>,
 ) -> PyResult<usize> {
-    let arr = asarray.call1((result, "float64"))?;
-    let arr: PyReadonlyArrayDyn<f64> = arr.extract().map_err(|_| {
-        PyTypeError::new_err(format!("{what} must return a float array of shape (N,) or (N, S), with N = {n}"))
-    })?;
+    let expected = format!(
+        "expected f_r as an array of numbers of shape ({n},) or ({n}, S): one value (or S spectral samples) per \
+         point of the batch of N = {n}"
+    );
+    if result.is_none() {
+        return Err(PyTypeError::new_err(format!("{what} returned None (a missing `return`?); {expected}")));
+    }
+    let arr = asarray
+        .call1((result, "float64"))
+        .map_err(|_| PyTypeError::new_err(format!("{what} returned {}; {expected}", type_name(result))))?;
+    let arr: PyReadonlyArrayDyn<f64> = arr
+        .extract()
+        .map_err(|_| PyTypeError::new_err(format!("{what} returned {}; {expected}", type_name(result))))?;
     let shape = arr.shape().to_vec();
     let got_s = match shape.as_slice() {
         [m] if *m == n => 1,
         [m, k] if *m == n && *k >= 1 => *k,
         _ => {
+            let shown = shape.iter().map(|d| d.to_string()).collect::<Vec<_>>().join(", ");
+            let comma = if shape.len() == 1 { "," } else { "" };
             return Err(PyValueError::new_err(format!(
-                "{what} returned an array of shape {shape:?} for N = {n} points; expected ({n},) or ({n}, S)"
-            )))
+                "{what} returned {} of shape ({shown}{comma}); {expected} (a single number is not broadcast: \
+                 return e.g. numpy.full(len(wi), x))",
+                type_name(result)
+            )));
         }
     };
     if let Some(s) = s {
@@ -260,8 +274,20 @@ fn specimen_angles(geos: &[glossmeter::instrument::standards::StandardGeometry])
 fn parse_lobes(lobes: &Bound<'_, PyAny>) -> PyResult<Vec<Lobe>> {
     let mut out = Vec::new();
     let bad = |i: usize, m: String| PyValueError::new_err(format!("lobes[{i}]: {m}"));
-    for (i, item) in lobes.try_iter()?.enumerate() {
+    let items = match lobes.try_iter() {
+        Ok(items) if !lobes.is_instance_of::<pyo3::types::PyString>() && !lobes.is_instance_of::<PyDict>() => items,
+        _ => {
+            return Err(PyTypeError::new_err(format!(
+                "lobes: expected None (probe f), [] (f is smooth) or a list of slope widths or dicts {{\"slope\": m, \
+                 \"tail\": \"heavy\" | \"gaussian\", \"eta\": 1.0, \"label\": str}}, got {}",
+                type_name(lobes)
+            )))
+        }
+    };
+    for (i, item) in items.enumerate() {
         let item = item?;
+        let number =
+            |key: &str, v: &Bound<'_, PyAny>, allowed: &str| args::real(&format!("lobes[{i}][\"{key}\"]"), v, allowed);
         let (slope, heavy, eta, label) = if let Ok(d) = item.cast::<PyDict>() {
             for k in d.keys() {
                 let k: String = k.extract()?;
@@ -273,30 +299,42 @@ fn parse_lobes(lobes: &Bound<'_, PyAny>) -> PyResult<Vec<Lobe>> {
                 }
             }
             let slope: f64 = match d.get_item("slope")? {
-                Some(v) => v.extract().map_err(|_| bad(i, "\"slope\" must be a number".into()))?,
+                Some(v) => number("slope", &v, "the facet slope width, Beckmann m or GGX α, in (0, 10]")?,
                 None => return Err(bad(i, "missing \"slope\" (the facet slope width, Beckmann m or GGX α)".into())),
             };
             let heavy = match d.get_item("tail")? {
                 None => true,
-                Some(v) => match v.extract::<String>()?.as_str() {
-                    "heavy" => true,
-                    "gaussian" => false,
-                    other => return Err(bad(i, format!("\"tail\" is \"{other}\"; allowed: \"heavy\", \"gaussian\""))),
+                Some(v) => match v.extract::<String>().as_deref() {
+                    Ok("heavy") => true,
+                    Ok("gaussian") => false,
+                    Ok(other) => {
+                        return Err(bad(i, format!("\"tail\" is \"{other}\"; allowed: \"heavy\", \"gaussian\"")))
+                    }
+                    Err(_) => {
+                        return Err(PyTypeError::new_err(format!(
+                            "lobes[{i}][\"tail\"]: expected \"heavy\" or \"gaussian\", got {}",
+                            type_name(&v)
+                        )))
+                    }
                 },
             };
             let eta: f64 = match d.get_item("eta")? {
-                Some(v) => v.extract().map_err(|_| bad(i, "\"eta\" must be a number".into()))?,
+                Some(v) => number("eta", &v, "the index of the medium the lobe forms in, in [1, 4]")?,
                 None => 1.0,
             };
             let label: String = match d.get_item("label")? {
-                Some(v) => v.extract()?,
+                Some(v) => v.extract().map_err(|_| {
+                    PyTypeError::new_err(format!("lobes[{i}][\"label\"]: expected a str, got {}", type_name(&v)))
+                })?,
                 None => format!("lobe {i} of f (hinted)"),
             };
             (slope, heavy, eta, label)
         } else {
-            let slope: f64 = item
-                .extract()
-                .map_err(|_| bad(i, "expected a slope width (number) or a dict {\"slope\": m, ...}".into()))?;
+            let slope = args::real(
+                &format!("lobes[{i}]"),
+                &item,
+                "a slope width in (0, 10], or a dict {\"slope\": m, \"tail\": ..., \"eta\": ..., \"label\": ...}",
+            )?;
             (slope, true, 1.0, format!("lobe {i} of f (hinted)"))
         };
         if !(slope.is_finite() && slope > 0.0 && slope <= 10.0) {
@@ -322,21 +360,33 @@ fn parse_lobes(lobes: &Bound<'_, PyAny>) -> PyResult<Vec<Lobe>> {
 /// smooth. `delta`: a mirror component, R as a number, a list of S numbers, or a callable R(wi) → (N,) or
 /// (N, S). An exception raised in f propagates as itself.
 #[pyfunction]
-#[pyo3(signature = (f, geometries=None, rtol=1e-6, lobes=None, delta=None, wavelengths=None, timing=true))]
+#[pyo3(signature = (f, geometries=None, rtol=None, lobes=None, delta=None, wavelengths=None, timing=None))]
+#[pyo3(text_signature = "(f, geometries=None, rtol=1e-6, lobes=None, delta=None, wavelengths=None, timing=True)")]
 #[allow(clippy::too_many_arguments)]
 pub fn measure_brdf<'py>(
     py: Python<'py>,
     f: &Bound<'py, PyAny>,
     geometries: Option<&Bound<'py, PyAny>>,
-    rtol: f64,
+    rtol: Option<&Bound<'py, PyAny>>,
     lobes: Option<&Bound<'py, PyAny>>,
     delta: Option<&Bound<'py, PyAny>>,
-    wavelengths: Option<Vec<f64>>,
-    timing: bool,
+    wavelengths: Option<&Bound<'py, PyAny>>,
+    timing: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyList>> {
     if !f.is_callable() {
-        return Err(PyTypeError::new_err("f must be callable as f(wi, wo) with two (N, 3) arrays"));
+        return Err(PyTypeError::new_err(format!(
+            "f: expected a callable f(wi, wo) taking two (N, 3) float64 arrays and returning f_r as (N,) or (N, S), \
+             got {}",
+            type_name(f)
+        )));
     }
+    let rtol = args::rtol(rtol)?;
+    let timing = args::flag("timing", timing, true)?;
+    let wavelengths = match wavelengths {
+        None => None,
+        Some(w) if w.is_none() => None,
+        Some(w) => Some(args::reals("wavelengths", w, "the wavelength of each spectral sample of f, in nm")?),
+    };
     let geos = guarded(|| load_geometries(py, geometries))?;
     let hinted = match lobes {
         None => None,
@@ -355,7 +405,8 @@ pub fn measure_brdf<'py>(
     let sampling = match (&wavelengths, s) {
         (Some(w), _) if w.len() != s => {
             return Err(PyValueError::new_err(format!(
-                "wavelengths has {} entries but f returns {s} spectral sample(s) per point",
+                "wavelengths: {} entries, but f returns {s} spectral sample(s) per point (one wavelength in nm per \
+                 sample)",
                 w.len()
             )))
         }
@@ -364,8 +415,8 @@ pub fn measure_brdf<'py>(
         (None, 3) => Sampling::rgb(),
         (None, _) => {
             return Err(PyValueError::new_err(format!(
-                "f returns {s} spectral samples per point: give their wavelengths (nm) as wavelengths=[...] \
-                 (1 sample is grey, 3 are linear RGB)"
+                "wavelengths: f returns {s} spectral samples per point: give their wavelengths (nm) as \
+                 wavelengths=[...] (1 sample is grey, 3 are linear RGB)"
             )))
         }
     };
@@ -393,15 +444,17 @@ pub fn measure_brdf<'py>(
         None => None,
         Some(d) if d.is_callable() => Some(Delta::Callable(d.clone().unbind())),
         Some(d) => {
-            let r: Vec<f64> = if let Ok(x) = d.extract::<f64>() {
-                vec![x; s]
-            } else {
-                d.extract::<Vec<f64>>().map_err(|_| {
-                    PyValueError::new_err("delta: expected a number, a list of S numbers or a callable R(wi)")
-                })?
+            let allowed = "the mirror reflectance R in [0, 1]: a number, a list of S numbers, or a callable R(wi)";
+            let r: Vec<f64> = match args::real("delta", d, allowed) {
+                Ok(x) => vec![x; s],
+                Err(_) => args::reals("delta", d, allowed)
+                    .map_err(|_| PyTypeError::new_err(format!("delta: expected {allowed}, got {}", type_name(d))))?,
             };
             if r.len() != s {
-                return Err(PyValueError::new_err(format!("delta has {} values, f returns {s} per point", r.len())));
+                return Err(PyValueError::new_err(format!(
+                    "delta: {} values, but f returns {s} spectral sample(s) per point (one R per sample)",
+                    r.len()
+                )));
             }
             if let Some(x) = r.iter().find(|x| !(x.is_finite() && **x >= 0.0 && **x <= 1.0)) {
                 return Err(PyValueError::new_err(format!("delta: reflectance {x} is outside [0, 1]")));

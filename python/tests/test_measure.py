@@ -99,7 +99,7 @@ def test_unknown_geometry_bad_rtol_and_missing_file():
         glossmeter.measure(lam, rtol=float("nan"))
     with pytest.raises(FileNotFoundError, match="no-such-recipe.json"):
         glossmeter.measure("no-such-recipe.json")
-    with pytest.raises(ValueError, match="expected a dict"):
+    with pytest.raises(TypeError, match="recipe: expected a dict"):
         glossmeter.measure(42)
 
 

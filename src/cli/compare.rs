@@ -146,7 +146,7 @@ pub fn run(a: CompareArgs) -> Result<()> {
     let text = match a.format {
         CompareFormat::Table => table(&sheet, &cmp, &rule, &drift, baseline.is_some()) + &de_table(&des),
         CompareFormat::Json => {
-            report::pretty(&report::compare::json_doc(&sheet, &cmp, &rule, &drift, a.baseline.as_deref(), &des))
+            report::compare::json_doc(&sheet, &cmp, &rule, &drift, a.baseline.as_deref(), &des).text()
         }
         CompareFormat::Csv => report::compare::csv(&cmp)?,
         CompareFormat::Junit => junit::compare(&sheet, &cmp, &drift)?,

@@ -172,13 +172,13 @@ fn dispatch(cli: Cli) -> Result<()> {
                     format::table(&material, &readings, !no_timing) + &format::envelope_table(&readings, e)
                 }
                 (Format::Json, e) => {
-                    let mut doc = report::measure::json_doc(&material, &readings, !no_timing);
-                    doc["evaluations"] = serde_json::json!(evaluations);
-                    let doc = report::measure::with_baseline(doc, drift.as_deref(), baseline_file.clone());
-                    report::pretty(&match e {
+                    let doc = report::measure::json_doc(&material, &readings, !no_timing, evaluations)
+                        .with_baseline(drift.as_deref(), baseline_file.clone());
+                    match e {
                         None => doc,
-                        Some(e) => report::measure::json_with_envelope(doc, e),
-                    })
+                        Some(e) => doc.with_envelope(e),
+                    }
+                    .text()
                 }
                 (Format::Csv, _) => report::measure::csv(&readings, !no_timing)?,
             });
@@ -280,14 +280,9 @@ fn measure_batch(
             }
             t
         }
-        Format::Json => report::pretty(&report::measure::with_baseline(
-            report::measure::with_evaluations(
-                report::measure::batch_json_doc(&materials, &readings, how.timing),
-                &evaluations,
-            ),
-            drift.as_deref(),
-            how.baseline.as_ref().map(|(_, f)| f.clone()),
-        )),
+        Format::Json => report::measure::batch_json_doc(&materials, &readings, how.timing, &evaluations)
+            .with_baseline(drift.as_deref(), how.baseline.as_ref().map(|(_, f)| f.clone()))
+            .text(),
         Format::Csv => report::measure::batch_csv(&materials, &readings, how.timing)?,
     };
     target.write(&text)?;

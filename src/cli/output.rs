@@ -2,14 +2,15 @@
 //! result file is evidence: a failed write (a full disk) must never leave a truncated or empty file behind,
 //! and an existing file must never be overwritten.
 //!
-//! A file is written to a temporary file in the same directory, flushed and synced, then hard-linked to its
-//! name (`link(2)` fails if the name exists, so nothing is ever clobbered, even by a file that appeared during
-//! the run), and the temporary name is removed. The target is checked before any work is done
+//! A file is written to a temporary file in the same directory (`tempfile::NamedTempFile`, a new name opened
+//! with `O_EXCL`), flushed and synced, then given its name with `persist_noclobber`, which fails if the name
+//! exists (`renameat2` with `RENAME_NOREPLACE`, or `link(2)` and `unlink(2)` where the file system has no such
+//! rename), so nothing is ever clobbered, even by a file that appeared during the run. On any failure the
+//! temporary file is removed when it is dropped. The target is checked before any work is done
 //! ([`OutputTarget::new`]), so a long computation is not wasted on a name that would be refused.
-use std::fs::{File, OpenOptions};
+use std::fs::File;
 use std::io::Write;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicUsize, Ordering};
 
 use crate::{Error, Result};
 
@@ -114,34 +115,30 @@ pub fn write_new_file_with(
 /// Create the new file `path` atomically with the contents `body` writes (see the module documentation):
 /// on any error of `body`, of the flush or of the link, no file is left behind.
 pub fn write_new_file_by(path: &Path, body: impl FnOnce(&mut File) -> Result<()>) -> Result<()> {
-    static COUNTER: AtomicUsize = AtomicUsize::new(0);
     let io = |source| Error::Io { file: path.display().to_string(), source };
     let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| "output".into());
-    let (tmp, mut file) = loop {
-        let n = COUNTER.fetch_add(1, Ordering::Relaxed);
-        let tmp = parent(path).join(format!(".{name}.glossmeter-{}-{n}.tmp", std::process::id()));
-        match OpenOptions::new().write(true).create_new(true).open(&tmp) {
-            Ok(f) => break (tmp, f),
-            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
-            Err(e) => return Err(io(e)),
+    let prefix = format!(".{name}.glossmeter-");
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(&prefix).suffix(".tmp");
+    // A result file is made as `File::create` makes one (0666 less the umask), not private as a temporary
+    // file is by default (0600).
+    #[cfg(unix)]
+    builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
+    let mut tmp = builder.tempfile_in(parent(path)).map_err(io)?;
+    // On an error here `tmp` is dropped, which removes the temporary file.
+    body(tmp.as_file_mut())?;
+    tmp.as_file_mut().flush().and_then(|_| tmp.as_file().sync_all()).map_err(io)?;
+    tmp.persist_noclobber(path).map(drop).map_err(|e| {
+        // `e.file` (the temporary file) is dropped with `e`, which removes it.
+        if e.error.kind() == std::io::ErrorKind::AlreadyExists {
+            Error::Usage(format!(
+                "{}: already exists; glossmeter never overwrites a file (choose another name)",
+                path.display()
+            ))
+        } else {
+            io(e.error)
         }
-    };
-    let result = body(&mut file).and_then(|_| file.flush().and_then(|_| file.sync_all()).map_err(io));
-    drop(file);
-    let result = result.and_then(|_| {
-        std::fs::hard_link(&tmp, path).map_err(|e| {
-            if e.kind() == std::io::ErrorKind::AlreadyExists {
-                Error::Usage(format!(
-                    "{}: already exists; glossmeter never overwrites a file (choose another name)",
-                    path.display()
-                ))
-            } else {
-                io(e)
-            }
-        })
-    });
-    let _ = std::fs::remove_file(&tmp);
-    result
+    })
 }
 
 #[cfg(test)]
@@ -189,6 +186,17 @@ mod tests {
         assert_eq!(entries(&d), vec!["out.txt".to_string()]);
         write_new_file(&d.join("fresh.txt"), b"whole").unwrap();
         assert_eq!(std::fs::read_to_string(d.join("fresh.txt")).unwrap(), "whole");
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_written_file_has_the_permissions_of_a_created_one() {
+        use std::os::unix::fs::PermissionsExt;
+        let d = dir("mode");
+        write_new_file(&d.join("ours.txt"), b"x").unwrap();
+        std::fs::File::create(d.join("plain.txt")).unwrap();
+        let mode = |n: &str| std::fs::metadata(d.join(n)).unwrap().permissions().mode() & 0o777;
+        assert_eq!(mode("ours.txt"), mode("plain.txt"));
     }
 
     #[test]

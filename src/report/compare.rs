@@ -4,39 +4,196 @@
 //! (sample, reading). The JUnit XML and the table for people are the command line's.
 use std::path::Path;
 
-use serde_json::{json, Value};
+use schemars::JsonSchema;
+use serde::Serialize;
 
-use super::{csv_text, drift_json, plain};
+use super::{csv_text, plain, pretty, to_json, BaselineDoc};
 use crate::comparison::sheet::{self, Sheet};
 use crate::comparison::{ColourDifference, Comparison, Drift, Verdict, VerdictRule};
 use crate::Result;
 
-/// One comparison (a sample's reading against its prediction) as the `comparisons` entry of [`json_doc`].
-pub fn comparison_json(c: &Comparison) -> Value {
-    let p = c.predicted.as_ref();
-    let s = c.group.stats;
-    json!({
-        "sample": c.group.sample, "material": c.material, "recipe": c.recipe,
-        "geometry": c.group.geometry, "reading": c.group.reading,
-        "predicted_reading": p.map(|p| p.name.clone()),
-        "lines": c.group.lines, "columns": c.group.columns,
-        "values": c.group.values,
-        "n": s.n, "mean": s.mean, "std": s.std, "min": s.min, "max": s.max,
-        "uncertainty": c.group.uncertainty,
-        "predicted": p.and_then(|p| p.value),
-        "error_estimate": p.filter(|p| p.value.is_some()).map(|p| p.error_estimate),
-        "difference": c.difference(),
-        "allowance": c.allowance.map(|a| json!({
-            "statistical": a.statistical, "stated": a.stated, "prediction": a.prediction, "total": a.total()
-        })),
-        "verdict": c.verdict.label(),
-        "inside": match c.verdict { Verdict::Inside => Some(true), Verdict::Outside => Some(false), _ => None },
-        "reason": match &c.verdict { Verdict::NotPredicted(w) | Verdict::NoValue(w) => Some(w.clone()), _ => None },
-        "unchecked": c.verdict.why_unchecked(),
-    })
+/// The allowed difference of a comparison: its parts and their total.
+#[derive(Clone, Debug, Serialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct AllowanceDoc {
+    /// k·s/√n.
+    #[schemars(range(min = 0))]
+    pub statistical: f64,
+    /// The stated uncertainty (or the tolerance).
+    #[schemars(range(min = 0))]
+    pub stated: f64,
+    /// The prediction's error estimate.
+    #[schemars(range(min = 0))]
+    pub prediction: f64,
+    #[schemars(range(min = 0))]
+    pub total: f64,
 }
 
-/// The JSON document of `compare` (printed pretty, [`super::pretty`]).
+/// One compared (sample, reading): the sheet's values and statistics, the prediction, the allowance and the
+/// verdict.
+#[derive(Clone, Debug, Serialize, JsonSchema)]
+#[schemars(transform = comparison_doc_nullable)]
+#[serde(deny_unknown_fields)]
+pub struct ComparisonDoc {
+    pub sample: String,
+    pub material: String,
+    pub recipe: String,
+    pub geometry: String,
+    pub reading: String,
+    pub predicted_reading: Option<String>,
+    /// The sheet's lines the values came from.
+    #[schemars(inner(range(min = 1)))]
+    pub lines: Vec<usize>,
+    pub columns: Vec<String>,
+    pub values: Vec<f64>,
+    #[schemars(range(min = 1))]
+    pub n: usize,
+    pub mean: f64,
+    #[schemars(range(min = 0))]
+    pub std: f64,
+    pub min: f64,
+    pub max: f64,
+    pub uncertainty: Option<f64>,
+    pub predicted: Option<f64>,
+    pub error_estimate: Option<f64>,
+    /// predicted − measured mean.
+    pub difference: Option<f64>,
+    pub allowance: Option<AllowanceDoc>,
+    /// unchecked (no value, or no allowance) and OUTSIDE fail the check (exit 1).
+    #[schemars(extend("enum" = ["ok", "OUTSIDE", "unchecked", "not predicted"]))]
+    pub verdict: String,
+    pub inside: Option<bool>,
+    /// Why not predicted, or why the prediction has no value.
+    pub reason: Option<String>,
+    /// Why the row could not be checked.
+    pub unchecked: Option<String>,
+}
+
+impl ComparisonDoc {
+    pub fn new(c: &Comparison) -> ComparisonDoc {
+        let p = c.predicted.as_ref();
+        let s = c.group.stats;
+        ComparisonDoc {
+            sample: c.group.sample.clone(),
+            material: c.material.clone(),
+            recipe: c.recipe.clone(),
+            geometry: c.group.geometry.clone(),
+            reading: c.group.reading.clone(),
+            predicted_reading: p.map(|p| p.name.clone()),
+            lines: c.group.lines.clone(),
+            columns: c.group.columns.clone(),
+            values: c.group.values.clone(),
+            n: s.n,
+            mean: s.mean,
+            std: s.std,
+            min: s.min,
+            max: s.max,
+            uncertainty: c.group.uncertainty,
+            predicted: p.and_then(|p| p.value),
+            error_estimate: p.filter(|p| p.value.is_some()).map(|p| p.error_estimate),
+            difference: c.difference(),
+            allowance: c.allowance.map(|a| AllowanceDoc {
+                statistical: a.statistical,
+                stated: a.stated,
+                prediction: a.prediction,
+                total: a.total(),
+            }),
+            verdict: c.verdict.label().into(),
+            inside: match c.verdict {
+                Verdict::Inside => Some(true),
+                Verdict::Outside => Some(false),
+                _ => None,
+            },
+            reason: match &c.verdict {
+                Verdict::NotPredicted(w) | Verdict::NoValue(w) => Some(w.clone()),
+                _ => None,
+            },
+            unchecked: c.verdict.why_unchecked(),
+        }
+    }
+}
+
+/// The sheet read: its file, encoding, delimiter, layout, `# key: value` lines and ignored columns.
+#[derive(Clone, Debug, Serialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct SheetDoc {
+    pub file: String,
+    pub encoding: String,
+    pub delimiter: String,
+    #[schemars(extend("enum" = ["long", "wide", "colour"]))]
+    pub layout: String,
+    /// The sheet's `# key: value` lines.
+    #[schemars(with = "std::collections::BTreeMap<String, String>")]
+    pub metadata: serde_json::Value,
+    pub ignored_columns: Vec<String>,
+}
+
+/// The verdict rule: k standard errors of the mean, and the uncertainty of rows that state none.
+#[derive(Clone, Debug, Serialize, JsonSchema)]
+#[schemars(transform = rule_doc_nullable)]
+#[serde(deny_unknown_fields)]
+pub struct RuleDoc {
+    #[schemars(range(min = 0))]
+    pub k: f64,
+    pub tolerance: Option<f64>,
+}
+
+/// How many comparisons ended in each verdict.
+#[derive(Clone, Debug, Serialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct SummaryDoc {
+    pub readings: usize,
+    pub inside: usize,
+    pub outside: usize,
+    pub no_value: usize,
+    pub no_allowance: usize,
+    pub not_predicted: usize,
+}
+
+/// CIEDE2000 of a (sample, geometry) with L*, a*, b* on the sheet.
+#[derive(Clone, Debug, Serialize, JsonSchema)]
+#[schemars(transform = colour_difference_doc_nullable)]
+#[serde(deny_unknown_fields)]
+pub struct ColourDifferenceDoc {
+    pub sample: String,
+    pub geometry: String,
+    /// The first line of the sheet's L* rows.
+    #[schemars(range(min = 1))]
+    pub line: usize,
+    /// L*, a*, b*.
+    pub measured: [f64; 3],
+    /// L*, a*, b*.
+    pub predicted: [f64; 3],
+    #[schemars(range(min = 0))]
+    pub de00: f64,
+    /// ΔE00 within the maximum, when a maximum is given.
+    pub inside: Option<bool>,
+}
+
+/// `compare --format json`: the sheet, the rule, one entry per compared (sample, reading), the summary, the
+/// colour differences and the baseline checks.
+#[derive(Clone, Debug, Serialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+#[schemars(title = "glossmeter compare --format json")]
+pub struct CompareDoc {
+    pub sheet: SheetDoc,
+    pub rule: RuleDoc,
+    pub comparisons: Vec<ComparisonDoc>,
+    pub summary: SummaryDoc,
+    pub colour_differences: Vec<ColourDifferenceDoc>,
+    /// With --baseline: the checks against it.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub baseline: Option<BaselineDoc>,
+}
+
+impl CompareDoc {
+    /// The document printed as the CLI prints it ([`pretty`]).
+    pub fn text(&self) -> String {
+        pretty(&to_json(self))
+    }
+}
+
+/// The JSON document of `compare`.
 pub fn json_doc(
     sheet: &Sheet,
     cmp: &[Comparison],
@@ -44,45 +201,46 @@ pub fn json_doc(
     drift: &[Drift],
     baseline: Option<&Path>,
     des: &[ColourDifference],
-) -> Value {
-    let mut doc = json!({
-        "sheet": {
-            "file": sheet.file, "encoding": sheet.encoding, "delimiter": (sheet.delimiter as char).to_string(),
-            "layout": match sheet.layout {
+) -> CompareDoc {
+    let count = |f: &dyn Fn(&Verdict) -> bool| cmp.iter().filter(|c| f(&c.verdict)).count();
+    CompareDoc {
+        sheet: SheetDoc {
+            file: sheet.file.clone(),
+            encoding: sheet.encoding.clone(),
+            delimiter: (sheet.delimiter as char).to_string(),
+            layout: match sheet.layout {
                 sheet::Layout::Long => "long",
                 sheet::Layout::Wide => "wide",
                 sheet::Layout::Colour => "colour",
-            },
-            "metadata": sheet.metadata_json(), "ignored_columns": sheet.ignored_columns,
+            }
+            .into(),
+            metadata: sheet.metadata_json(),
+            ignored_columns: sheet.ignored_columns.clone(),
         },
-        "rule": {"k": rule.k, "tolerance": rule.tolerance},
-        "comparisons": cmp.iter().map(comparison_json).collect::<Vec<_>>(),
-        "summary": {
-            "readings": cmp.len(),
-            "inside": cmp.iter().filter(|c| c.verdict == Verdict::Inside).count(),
-            "outside": cmp.iter().filter(|c| c.verdict == Verdict::Outside).count(),
-            "no_value": cmp.iter().filter(|c| matches!(c.verdict, Verdict::NoValue(_))).count(),
-            "no_allowance": cmp.iter().filter(|c| c.verdict == Verdict::NoAllowance).count(),
-            "not_predicted": cmp.iter().filter(|c| matches!(c.verdict, Verdict::NotPredicted(_))).count(),
+        rule: RuleDoc { k: rule.k, tolerance: rule.tolerance },
+        comparisons: cmp.iter().map(ComparisonDoc::new).collect(),
+        summary: SummaryDoc {
+            readings: cmp.len(),
+            inside: count(&|v| *v == Verdict::Inside),
+            outside: count(&|v| *v == Verdict::Outside),
+            no_value: count(&|v| matches!(v, Verdict::NoValue(_))),
+            no_allowance: count(&|v| *v == Verdict::NoAllowance),
+            not_predicted: count(&|v| matches!(v, Verdict::NotPredicted(_))),
         },
-    });
-    doc["colour_differences"] = des
-        .iter()
-        .map(|d| {
-            json!({
-                "sample": d.sample, "geometry": d.geometry, "line": d.line,
-                "measured": [d.measured.l, d.measured.a, d.measured.b],
-                "predicted": [d.predicted.l, d.predicted.a, d.predicted.b],
-                "de00": d.de00, "inside": d.inside,
+        colour_differences: des
+            .iter()
+            .map(|d| ColourDifferenceDoc {
+                sample: d.sample.clone(),
+                geometry: d.geometry.clone(),
+                line: d.line,
+                measured: [d.measured.l, d.measured.a, d.measured.b],
+                predicted: [d.predicted.l, d.predicted.a, d.predicted.b],
+                de00: d.de00,
+                inside: d.inside,
             })
-        })
-        .collect::<Vec<_>>()
-        .into();
-    if let Some(b) = baseline {
-        doc["baseline"] = json!({"file": b.display().to_string(), "checks": drift.iter().map(drift_json).collect::<Vec<_>>(),
-                                 "moved": drift.iter().filter(|d| d.moved).count()});
+            .collect(),
+        baseline: baseline.map(|b| BaselineDoc::new(b.display().to_string(), drift)),
     }
-    doc
 }
 
 /// The CSV of `compare`: a header, then one record per comparison.
@@ -132,4 +290,29 @@ pub fn csv(cmp: &[Comparison]) -> Result<String> {
         ]
     });
     csv_text(&head, rows)
+}
+
+fn comparison_doc_nullable(schema: &mut schemars::Schema) {
+    super::nullable_but_written(
+        schema,
+        &[
+            "predicted_reading",
+            "uncertainty",
+            "predicted",
+            "error_estimate",
+            "difference",
+            "allowance",
+            "inside",
+            "reason",
+            "unchecked",
+        ],
+    );
+}
+
+fn rule_doc_nullable(schema: &mut schemars::Schema) {
+    super::nullable_but_written(schema, &["tolerance"]);
+}
+
+fn colour_difference_doc_nullable(schema: &mut schemars::Schema) {
+    super::nullable_but_written(schema, &["inside"]);
 }

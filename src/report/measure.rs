@@ -1,51 +1,86 @@
 //! The documents of `measure`: one recipe's readings as JSON (with the tolerance envelope and the baseline
 //! checks when asked for) and as CSV, and the same for many recipes in one process (`crate::batch`), each
 //! reading with its material and file (the schema of both JSON forms is [`super::schema::measure`]).
-use serde_json::{json, Value};
+use schemars::JsonSchema;
+use serde::Serialize;
 
-use super::{csv_text, drift_json, plain, pretty, reading_json};
+use super::{csv_text, plain, pretty, to_json, BaselineDoc, ReadingDoc};
 use crate::comparison::Drift;
 use crate::instrument::envelope::Envelopes;
 use crate::instrument::plan::Reading;
 use crate::recipe::Material;
 use crate::{Error, Result};
 
-/// The JSON document of one material's readings (built as a value, never re-parsed: serde_json's default
-/// float parser is not exact to the last bit).
-pub fn json_doc(material: &Material, readings: &[Reading], timing: bool) -> serde_json::Value {
-    json!({
-        "material": {"name": material.name, "file": material.file, "model": material.brdf.describe()},
-        "readings": readings.iter().map(|r| reading_json(r, timing)).collect::<Vec<_>>(),
-    })
+/// A material measured: its name, recipe file and the model its recipe builds.
+#[derive(Clone, Debug, Serialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct MaterialDoc {
+    pub name: String,
+    /// The recipe file.
+    pub file: String,
+    /// The one-line description of the model.
+    pub model: String,
 }
 
-pub fn json(material: &Material, readings: &[Reading], timing: bool) -> String {
-    pretty(&json_doc(material, readings, timing))
-}
-
-/// Add `"envelope_min"`, `"envelope_max"` and the variations to each reading of a `json` document (null where
-/// the standard data give no tolerance, or where the wall-clock limit cut the envelope: then
-/// `"envelope_cut": true`), and the envelope's method at the top.
-pub fn json_with_envelope(mut doc: serde_json::Value, envelopes: &Envelopes) -> serde_json::Value {
-    if let Some(rs) = doc["readings"].as_array_mut() {
-        for (r, e) in rs.iter_mut().zip(&envelopes.of) {
-            if envelopes.cut.iter().any(|g| r["geometry"] == g.as_str()) {
-                r["envelope_cut"] = json!(true);
-            }
-            r["envelope_min"] = json!(e.as_ref().map(|e| e.min));
-            r["envelope_max"] = json!(e.as_ref().map(|e| e.max));
-            if let Some(e) = e {
-                r["envelope"] = json!({
-                    "variants": e.variants,
-                    "method": if e.corners { "all corners" } else { "one number at a time" },
-                    "varied": e.variations.iter().map(|v| json!({
-                        "pointer": v.pointer, "kind": v.kind, "nominal": v.nominal, "low": v.low, "high": v.high, "status": v.status
-                    })).collect::<Vec<_>>(),
-                });
-            }
-        }
+impl MaterialDoc {
+    pub fn new(m: &Material) -> MaterialDoc {
+        MaterialDoc { name: m.name.clone(), file: m.file.clone(), model: m.brdf.describe() }
     }
-    doc
+}
+
+/// `measure --format json` of one recipe.
+#[derive(Clone, Debug, Serialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct MeasureDoc {
+    pub material: MaterialDoc,
+    pub readings: Vec<ReadingDoc>,
+    /// BRDF evaluations of the whole plan: every distinct aperture integral (the gloss standards' included)
+    /// counted once; a reading's own evaluations count every integral it uses, so shared integrals appear in
+    /// several readings.
+    pub evaluations: usize,
+    /// With --baseline: the checks against it.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub baseline: Option<BaselineDoc>,
+}
+
+/// The JSON document of one material's readings, with the plan's `evaluations`.
+pub fn json_doc(material: &Material, readings: &[Reading], timing: bool, evaluations: usize) -> MeasureDoc {
+    MeasureDoc {
+        material: MaterialDoc::new(material),
+        readings: readings.iter().map(|r| ReadingDoc::new(r, timing)).collect(),
+        evaluations,
+        baseline: None,
+    }
+}
+
+impl MeasureDoc {
+    /// Add the tolerance envelope to each reading (`None` where the standard data give no tolerance, or where
+    /// the wall-clock limit cut the envelope: then `"envelope_cut": true`).
+    pub fn with_envelope(mut self, envelopes: &Envelopes) -> MeasureDoc {
+        self.readings = self
+            .readings
+            .into_iter()
+            .zip(&envelopes.of)
+            .map(|(r, e)| {
+                let cut = envelopes.cut.iter().any(|g| *g == r.geometry);
+                r.with_envelope(e.as_ref(), cut)
+            })
+            .collect();
+        self
+    }
+
+    /// Add the baseline checks (when a baseline was given).
+    pub fn with_baseline(mut self, drift: Option<&[Drift]>, file: Option<String>) -> MeasureDoc {
+        if let (Some(d), Some(file)) = (drift, file) {
+            self.baseline = Some(BaselineDoc::new(file, d));
+        }
+        self
+    }
+
+    /// The document printed as the CLI prints it ([`pretty`]).
+    pub fn text(&self) -> String {
+        pretty(&to_json(self))
+    }
 }
 
 /// The CSV of `measure`: a header, then one record per reading (the fields of [`reading_json`]).
@@ -88,46 +123,101 @@ pub fn csv(readings: &[Reading], timing: bool) -> Result<String> {
     csv_text(&head, rows)
 }
 
-/// Add the baseline checks to a JSON document (when a baseline was given).
-pub fn with_baseline(mut doc: serde_json::Value, drift: Option<&[Drift]>, file: Option<String>) -> serde_json::Value {
-    if let (Some(d), Some(file)) = (drift, file) {
-        doc["baseline"] = serde_json::json!({
-            "file": file,
-            "checks": d.iter().map(drift_json).collect::<Vec<_>>(),
-            "moved": d.iter().filter(|x| x.moved).count(),
-        });
-    }
-    doc
+/// A material of a batch, with the BRDF evaluations of its plan.
+#[derive(Clone, Debug, Serialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct BatchMaterialDoc {
+    pub name: String,
+    pub file: String,
+    pub model: String,
+    /// BRDF evaluations of this material's plan: every distinct aperture integral counted once.
+    pub evaluations: usize,
 }
 
-/// The JSON of `measure` for many recipes: `materials` and `readings`, each reading with its `material` and
-/// `file` (the per-reading fields are those of the one-recipe JSON).
-pub fn batch_json_doc(materials: &[Material], readings: &[Vec<Reading>], timing: bool) -> Value {
+/// One reading of a batch: the fields of the one-recipe reading, and its material and recipe file.
+#[derive(Clone, Debug, Serialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct BatchReadingDoc {
+    /// The material's name.
+    pub material: String,
+    /// The material's recipe file.
+    pub file: String,
+    #[serde(flatten)]
+    pub reading: ReadingDoc,
+}
+
+/// `measure --format json` of many recipes in one process (`crate::batch`).
+#[derive(Clone, Debug, Serialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct BatchDoc {
+    pub materials: Vec<BatchMaterialDoc>,
+    pub readings: Vec<BatchReadingDoc>,
+    /// BRDF evaluations of all the materials' plans together.
+    pub evaluations: usize,
+    /// With --baseline: the checks against it.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub baseline: Option<BaselineDoc>,
+}
+
+/// `measure --format json`: the document of one recipe, or of many (its schema is `schema::measure`).
+#[derive(Clone, Debug, Serialize, JsonSchema)]
+#[serde(untagged)]
+#[schemars(title = "glossmeter measure --format json")]
+pub enum MeasureOutput {
+    /// One recipe.
+    One(MeasureDoc),
+    /// Many recipes.
+    Many(BatchDoc),
+}
+
+/// The JSON of `measure` for many recipes: `materials` (each with its plan's `evaluations`) and `readings`,
+/// each reading with its `material` and `file`, and the sum of the evaluations.
+pub fn batch_json_doc(
+    materials: &[Material],
+    readings: &[Vec<Reading>],
+    timing: bool,
+    evaluations: &[usize],
+) -> BatchDoc {
     let mut all = vec![];
     for (m, rs) in materials.iter().zip(readings) {
         for r in rs {
-            let mut r = reading_json(r, timing);
-            r["material"] = json!(m.name);
-            r["file"] = json!(m.file);
-            all.push(r);
+            all.push(BatchReadingDoc {
+                material: m.name.clone(),
+                file: m.file.clone(),
+                reading: ReadingDoc::new(r, timing),
+            });
         }
     }
-    json!({
-        "materials": materials.iter().map(|m| json!({"name": m.name, "file": m.file, "model": m.brdf.describe()})).collect::<Vec<_>>(),
-        "readings": all,
-    })
+    BatchDoc {
+        materials: materials
+            .iter()
+            .zip(evaluations)
+            .map(|(m, e)| BatchMaterialDoc {
+                name: m.name.clone(),
+                file: m.file.clone(),
+                model: m.brdf.describe(),
+                evaluations: *e,
+            })
+            .collect(),
+        readings: all,
+        evaluations: evaluations.iter().sum(),
+        baseline: None,
+    }
 }
 
-/// Add each material's plan cost (`"evaluations"` in its `materials` entry: the BRDF evaluations of its
-/// plan, each distinct integral counted once) and their sum at the top of a [`batch_json_doc`] document.
-pub fn with_evaluations(mut doc: Value, evaluations: &[usize]) -> Value {
-    if let Some(ms) = doc["materials"].as_array_mut() {
-        for (m, e) in ms.iter_mut().zip(evaluations) {
-            m["evaluations"] = json!(e);
+impl BatchDoc {
+    /// Add the baseline checks (when a baseline was given).
+    pub fn with_baseline(mut self, drift: Option<&[Drift]>, file: Option<String>) -> BatchDoc {
+        if let (Some(d), Some(file)) = (drift, file) {
+            self.baseline = Some(BaselineDoc::new(file, d));
         }
+        self
     }
-    doc["evaluations"] = json!(evaluations.iter().sum::<usize>());
-    doc
+
+    /// The document printed as the CLI prints it ([`pretty`]).
+    pub fn text(&self) -> String {
+        pretty(&to_json(self))
+    }
 }
 
 /// The CSV of `measure` with `material` and `file` columns in front.

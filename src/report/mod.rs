@@ -7,23 +7,27 @@
 //!
 //! The folder, a file per family of documents:
 //! * `mod.rs`: what the documents share: the numbers ([`decimals`], [`plain`]), one reading as JSON
-//!   ([`reading_json`]) and as a sweep writes it ([`sweep_reading_json`]; the sweep's lines are
-//!   `crate::sweep`'s), one baseline check ([`drift_json`]), JSON printed ([`pretty`]) and CSV text
-//!   ([`csv_text`]);
+//!   ([`ReadingDoc`], [`reading_json`]) and as a sweep's line holds it ([`SweepReadingDoc`], in a
+//!   [`SweepLineDoc`] that `crate::sweep` writes), the baseline checks ([`BaselineDoc`], [`drift_json`]), JSON
+//!   printed ([`pretty`]) and CSV text ([`csv_text`]);
 //! * [`measure`]: one recipe's readings as JSON and CSV, with the envelope, the baseline and, for many
 //!   recipes, each reading's material;
 //! * [`compare`]: the predictions beside a sheet, as JSON and CSV;
 //! * [`fit`]: the fit's report as JSON;
-//! * [`schema`]: the JSON Schemas of the outputs.
+//! * [`schema`]: the JSON Schemas of the outputs, derived (`schemars`) from the document types: the structs
+//!   that the writers serialise ([`ReadingDoc`], [`measure::MeasureDoc`], [`compare::CompareDoc`],
+//!   [`fit::FitDoc`], ...), so a field cannot be written without being in its schema.
 pub mod compare;
 pub mod fit;
 pub mod measure;
 pub mod schema;
 
 use crate::comparison::Drift;
+use crate::instrument::envelope::Envelope;
 use crate::instrument::plan::Reading;
 use crate::{Error, Result};
-use serde_json::json;
+use schemars::JsonSchema;
+use serde::Serialize;
 
 /// Decimal places of a reading in the table: one, i.e. 0.1 of the instrument's unit (GU, HU, DOI), as a
 /// glossmeter displays it (ASTM D523 reports gloss to 0.1 GU); none if the numerical error is larger than
@@ -57,37 +61,243 @@ pub fn shown(v: f64, decimals: usize) -> String {
     }
 }
 
+/// A document as a JSON value. Built from the document's struct, never re-parsed from text (serde_json's
+/// default float parser is not exact to the last bit); a non-finite number would be null (the writers put none).
+pub fn to_json<T: Serialize>(doc: &T) -> serde_json::Value {
+    serde_json::to_value(doc).expect("a report document serialises (string keys, no custom serialisers)")
+}
+
+/// For a document type's schemars `transform`: these nullable fields (`Option` without `skip_serializing_if`)
+/// are always written, as null when there is nothing, so they are required. (schemars leaves an `Option` field
+/// out of `required`, and its `required` attribute forbids null.) A transform is named by a function path, not
+/// an expression: the derive parses it with syn's default features (the library alone builds without syn's
+/// `full`).
+pub(crate) fn nullable_but_written(schema: &mut schemars::Schema, fields: &[&str]) {
+    let required = schema.ensure_object().entry("required").or_insert_with(|| serde_json::Value::Array(vec![]));
+    if let Some(required) = required.as_array_mut() {
+        for f in fields {
+            if !required.iter().any(|r| r == f) {
+                required.push((*f).into());
+            }
+        }
+    }
+}
+
+/// The quantities a reading can be of (`Reading::quantity`).
+const QUANTITIES: [&str; 15] = [
+    "gloss",
+    "haze",
+    "log-haze",
+    "haze-compensated",
+    "log-haze-compensated",
+    "doi",
+    "haze-index",
+    "X",
+    "Y",
+    "Z",
+    "L*",
+    "a*",
+    "b*",
+    "C*",
+    "h",
+];
+
+fn quantity_enum(schema: &mut schemars::Schema) {
+    schema.insert("enum".into(), QUANTITIES.into());
+}
+
+/// One reading of `measure --format json` (docs/instrument.md §Output; the Python bindings' dicts).
+#[derive(Clone, Debug, Serialize, JsonSchema)]
+#[schemars(transform = reading_doc_nullable)]
+#[serde(deny_unknown_fields)]
+pub struct ReadingDoc {
+    /// The geometry id.
+    pub geometry: String,
+    /// The reading's name (e.g. haze-narrow).
+    pub name: String,
+    /// What the reading is.
+    #[schemars(transform = quantity_enum)]
+    pub quantity: String,
+    /// The reading; null when there is no finite value (see problem).
+    pub value: Option<f64>,
+    pub unit: String,
+    /// The numerical error estimate (of the integration); null when there is no value.
+    #[schemars(range(min = 0))]
+    pub error_estimate: Option<f64>,
+    /// A measured table's data (resolution) uncertainty, in the reading's unit: the reading through the table on
+    /// every second sample against the reading through the table (docs/accuracy.md); absent for models and
+    /// readings without a value.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    #[schemars(range(min = 0))]
+    pub data_uncertainty: Option<f64>,
+    /// BRDF evaluations of the integrals this reading uses.
+    pub evaluations: usize,
+    /// Whether every integral met the tolerance within the budgets.
+    pub converged: bool,
+    /// Wall time in seconds; absent with --no-timing.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    #[schemars(range(min = 0))]
+    pub seconds: Option<f64>,
+    /// Why there is no value, or what limits it.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub problem: Option<String>,
+    /// What the reader should know (e.g. a standard's scope).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub note: Option<String>,
+    /// With --envelope: the least reading within the tolerances (null where the data give none).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub envelope_min: Option<Option<f64>>,
+    /// With --envelope: the greatest reading within the tolerances (null where the data give none).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub envelope_max: Option<Option<f64>>,
+    /// With --envelope: how the envelope was read.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub envelope: Option<EnvelopeDoc>,
+    /// With --envelope and --max-seconds: the limit (the whole command's) was reached before this geometry's
+    /// envelope was read, so it is null (exit 1).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    #[schemars(extend("const" = true))]
+    pub envelope_cut: Option<bool>,
+}
+
+impl ReadingDoc {
+    pub fn new(r: &Reading, timing: bool) -> ReadingDoc {
+        ReadingDoc {
+            geometry: r.geometry.clone(),
+            name: r.name.clone(),
+            quantity: r.quantity.clone(),
+            value: r.value,
+            unit: r.unit.clone(),
+            error_estimate: r.value.map(|_| r.error_estimate),
+            data_uncertainty: r.value.and(r.data_uncertainty),
+            evaluations: r.evaluations,
+            converged: r.converged,
+            seconds: timing.then_some(r.seconds),
+            problem: r.problem.clone(),
+            note: r.note.clone(),
+            envelope_min: None,
+            envelope_max: None,
+            envelope: None,
+            envelope_cut: None,
+        }
+    }
+
+    /// With the tolerance envelope of `measure --envelope` (`None`: the standard data give no tolerance).
+    pub fn with_envelope(mut self, e: Option<&Envelope>, cut: bool) -> ReadingDoc {
+        self.envelope_cut = cut.then_some(true);
+        self.envelope_min = Some(e.map(|e| e.min));
+        self.envelope_max = Some(e.map(|e| e.max));
+        self.envelope = e.map(EnvelopeDoc::new);
+        self
+    }
+}
+
+/// How a reading's envelope was read: the variant geometries, the method and the numbers varied.
+#[derive(Clone, Debug, Serialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct EnvelopeDoc {
+    /// How many variant geometries were read.
+    pub variants: usize,
+    /// "all corners" or "one number at a time".
+    #[schemars(extend("enum" = ["all corners", "one number at a time"]))]
+    pub method: String,
+    pub varied: Vec<VariationDoc>,
+}
+
+/// One number of a geometry varied within its tolerance (`envelope::Variation`).
+#[derive(Clone, Debug, Serialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct VariationDoc {
+    /// JSON Pointer of the number in the geometry file.
+    pub pointer: String,
+    /// "tolerance" or "plausible".
+    pub kind: String,
+    pub nominal: f64,
+    pub low: f64,
+    pub high: f64,
+    /// The variation's own status (verified, secondary, assumed).
+    pub status: String,
+}
+
+impl EnvelopeDoc {
+    fn new(e: &Envelope) -> EnvelopeDoc {
+        EnvelopeDoc {
+            variants: e.variants,
+            method: if e.corners { "all corners" } else { "one number at a time" }.into(),
+            varied: e
+                .variations
+                .iter()
+                .map(|v| VariationDoc {
+                    pointer: v.pointer.clone(),
+                    kind: v.kind.into(),
+                    nominal: v.nominal,
+                    low: v.low,
+                    high: v.high,
+                    status: v.status.clone(),
+                })
+                .collect(),
+        }
+    }
+}
+
 /// One reading as `measure --format json` writes it (the schema is [`schema::measure`]).
 pub fn reading_json(r: &Reading, timing: bool) -> serde_json::Value {
-    let mut o = json!({
-        "geometry": r.geometry,
-        "name": r.name,
-        "quantity": r.quantity,
-        "value": r.value,
-        "unit": r.unit,
-        "error_estimate": if r.value.is_some() { Some(r.error_estimate) } else { None },
-        "evaluations": r.evaluations,
-        "converged": r.converged,
-    });
-    if let (Some(_), Some(u)) = (r.value, r.data_uncertainty) {
-        o["data_uncertainty"] = json!(u);
+    to_json(&ReadingDoc::new(r, timing))
+}
+
+/// One baseline check: a reading then and now, and whether it moved.
+#[derive(Clone, Debug, Serialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct DriftDoc {
+    pub material: String,
+    pub geometry: String,
+    pub reading: String,
+    pub now: f64,
+    pub then: f64,
+    /// The difference allowed.
+    #[schemars(range(min = 0))]
+    pub allowed: f64,
+    pub moved: bool,
+}
+
+impl From<&Drift> for DriftDoc {
+    fn from(d: &Drift) -> DriftDoc {
+        DriftDoc {
+            material: d.material.clone(),
+            geometry: d.geometry.clone(),
+            reading: d.reading.clone(),
+            now: d.now,
+            then: d.then,
+            allowed: d.allowed,
+            moved: d.moved,
+        }
     }
-    if timing {
-        o["seconds"] = json!(r.seconds);
+}
+
+/// The baseline checks of `measure --baseline` and `compare --baseline`.
+#[derive(Clone, Debug, Serialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct BaselineDoc {
+    /// The baseline file.
+    pub file: String,
+    pub checks: Vec<DriftDoc>,
+    /// How many readings moved by more than allowed.
+    pub moved: usize,
+}
+
+impl BaselineDoc {
+    pub fn new(file: String, drift: &[Drift]) -> BaselineDoc {
+        BaselineDoc {
+            file,
+            checks: drift.iter().map(DriftDoc::from).collect(),
+            moved: drift.iter().filter(|d| d.moved).count(),
+        }
     }
-    if let Some(p) = &r.problem {
-        o["problem"] = json!(p);
-    }
-    if let Some(n) = &r.note {
-        o["note"] = json!(n);
-    }
-    o
 }
 
 /// One baseline check (a reading then and now, and whether it moved), as `measure` and `compare` list them.
 pub fn drift_json(d: &Drift) -> serde_json::Value {
-    json!({"material": d.material, "geometry": d.geometry, "reading": d.reading,
-           "now": d.now, "then": d.then, "allowed": d.allowed, "moved": d.moved})
+    to_json(&DriftDoc::from(d))
 }
 
 /// A JSON value as the CLI prints it: pretty, with a final newline.
@@ -97,17 +307,60 @@ pub fn pretty(doc: &serde_json::Value) -> String {
     s
 }
 
-/// The fields [`sweep_reading_json`] keeps.
-const SWEEP_READING_FIELDS: [&str; 7] = ["geometry", "name", "unit", "value", "error_estimate", "converged", "problem"];
+/// One reading of a `sweep --format jsonl` line: the fields of a `measure` reading without the quantity, the
+/// evaluation count, the note and the time.
+#[derive(Clone, Debug, Serialize, JsonSchema)]
+#[schemars(transform = sweep_reading_doc_nullable)]
+#[serde(deny_unknown_fields)]
+pub struct SweepReadingDoc {
+    pub geometry: String,
+    pub name: String,
+    pub unit: String,
+    /// null when there is no finite value (see problem).
+    pub value: Option<f64>,
+    /// The numerical error estimate; null when there is no value.
+    #[schemars(range(min = 0))]
+    pub error_estimate: Option<f64>,
+    pub converged: bool,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub problem: Option<String>,
+}
 
-/// One reading as a line of `sweep --format jsonl` writes it (the schema is [`schema::sweep`]): the object of
-/// [`reading_json`] without the quantity, the evaluation count, the note and the time.
-pub fn sweep_reading_json(r: &Reading) -> serde_json::Value {
-    let mut o = reading_json(r, false);
-    if let Some(fields) = o.as_object_mut() {
-        fields.retain(|k, _| SWEEP_READING_FIELDS.contains(&k.as_str()));
+impl SweepReadingDoc {
+    pub fn new(r: &Reading) -> SweepReadingDoc {
+        let d = ReadingDoc::new(r, false);
+        SweepReadingDoc {
+            geometry: d.geometry,
+            name: d.name,
+            unit: d.unit,
+            value: d.value,
+            error_estimate: d.error_estimate,
+            converged: d.converged,
+            problem: d.problem,
+        }
     }
-    o
+}
+
+/// One line of `sweep --format jsonl`: the point's index and parameter values, and its readings or why there
+/// are none (the lines are written by `crate::sweep`).
+#[derive(Clone, Debug, Serialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+#[schemars(title = "glossmeter sweep --format jsonl (one object per line)")]
+pub struct SweepLineDoc {
+    /// The point's index in the grid or design.
+    pub index: u64,
+    /// The varied values, by JSON Pointer.
+    pub parameters: std::collections::BTreeMap<String, f64>,
+    /// The readings at this point (absent when the recipe at this point is invalid).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub readings: Option<Vec<SweepReadingDoc>>,
+    /// Why the recipe at this point is invalid (then no readings).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub problem: Option<String>,
+    /// Wall time in seconds; absent with --no-timing.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    #[schemars(range(min = 0))]
+    pub seconds: Option<f64>,
 }
 
 /// CSV text in memory: the header, then one record per row (quoted where the csv crate must). Every CSV that
@@ -122,4 +375,12 @@ pub fn csv_text<R: IntoIterator<Item = String>>(header: &[&str], rows: impl Into
     let bytes =
         w.into_inner().map_err(|e| Error::Io { file: "<csv>".into(), source: std::io::Error::other(e.to_string()) })?;
     Ok(String::from_utf8(bytes).expect("csv is utf-8"))
+}
+
+fn reading_doc_nullable(schema: &mut schemars::Schema) {
+    nullable_but_written(schema, &["value", "error_estimate"]);
+}
+
+fn sweep_reading_doc_nullable(schema: &mut schemars::Schema) {
+    nullable_but_written(schema, &["value", "error_estimate"]);
 }

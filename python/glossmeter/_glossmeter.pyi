@@ -1,0 +1,30 @@
+"""Stubs of the compiled module ``glossmeter._glossmeter`` (python/src/lib.rs, python/src/pybrdf.rs). The
+public API is ``glossmeter`` (``__init__.py``), which re-exports these with ``as_frame``/``as_arrays`` added."""
+from typing import Any, Dict, List, Optional, Sequence
+
+from ._types import BrdfFunction, Delta, Geometries, Geometry, Lobes, Reading, Recipe
+
+__version__: str
+DEFAULT_GEOMETRIES: List[str]
+
+def measure(
+    recipe: Recipe,
+    geometries: Geometries = None,
+    rtol: float = 1e-6,
+    timing: bool = True,
+) -> List[Reading]: ...
+def measure_brdf(
+    f: BrdfFunction,
+    geometries: Geometries = None,
+    rtol: float = 1e-6,
+    lobes: Optional[Lobes] = None,
+    delta: Optional[Delta] = None,
+    wavelengths: Optional[Sequence[float]] = None,
+    timing: bool = True,
+) -> List[Reading]: ...
+def standards() -> List[Dict[str, Any]]: ...
+def geometry(id: Geometry) -> Dict[str, Any]: ...
+def describe_geometry(id: Geometry) -> str: ...
+def schema() -> Dict[str, Any]: ...
+def describe(recipe: Recipe) -> str: ...
+def _panic() -> None: ...

@@ -1,0 +1,59 @@
+//! Arguments from Python, converted with refusals that name the argument and what it allows
+//! (docs/python.md §Errors): a value of the wrong type is a `TypeError`, a value out of range a `ValueError`,
+//! each saying `name: expected ..., got ...` instead of PyO3's generic conversion messages.
+use glossmeter::instrument::plan::rtol_refusal;
+use pyo3::exceptions::{PyTypeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::{PyBool, PyString};
+
+/// The Python type name of a value, for messages (`int`, `str`, `NoneType`).
+pub fn type_name(v: &Bound<'_, PyAny>) -> String {
+    v.get_type().name().map(|n| n.to_string()).unwrap_or_else(|_| "an unknown type".into())
+}
+
+/// A real number (int, float, or anything with `__float__`, e.g. a NumPy scalar); a bool or a str is refused.
+pub fn real(name: &str, v: &Bound<'_, PyAny>, allowed: &str) -> PyResult<f64> {
+    let refuse = || PyTypeError::new_err(format!("{name}: expected a number ({allowed}), got {}", type_name(v)));
+    if v.is_instance_of::<PyBool>() || v.is_instance_of::<PyString>() {
+        return Err(refuse());
+    }
+    v.extract::<f64>().map_err(|_| refuse())
+}
+
+/// `rtol`: None is the default 10⁻⁶; otherwise a number in (0, 1) (the planner's check, `plan::rtol_refusal`).
+pub fn rtol(v: Option<&Bound<'_, PyAny>>) -> PyResult<f64> {
+    let x = match v {
+        None => return Ok(1e-6),
+        Some(v) => real("rtol", v, "the relative tolerance of the integrals, in (0, 1), e.g. 1e-6")?,
+    };
+    match rtol_refusal(x) {
+        Some(why) => Err(PyValueError::new_err(format!("rtol {why} (the relative tolerance of the integrals)"))),
+        None => Ok(x),
+    }
+}
+
+/// A flag: True or False (a NumPy bool too); None is `default`. An int is refused (0 and 1 are not flags).
+pub fn flag(name: &str, v: Option<&Bound<'_, PyAny>>, default: bool) -> PyResult<bool> {
+    match v {
+        None => Ok(default),
+        Some(v) if v.is_none() => Ok(default),
+        Some(v) => v
+            .extract::<bool>()
+            .map_err(|_| PyTypeError::new_err(format!("{name}: expected True or False, got {}", type_name(v)))),
+    }
+}
+
+/// A list of numbers (any iterable of numbers but a str); `name[i]` names a bad element.
+pub fn reals(name: &str, v: &Bound<'_, PyAny>, allowed: &str) -> PyResult<Vec<f64>> {
+    let refuse =
+        || PyTypeError::new_err(format!("{name}: expected a list of numbers ({allowed}), got {}", type_name(v)));
+    if v.is_instance_of::<PyString>() {
+        return Err(refuse());
+    }
+    let items = v.try_iter().map_err(|_| refuse())?;
+    let mut out = Vec::new();
+    for (i, x) in items.enumerate() {
+        out.push(real(&format!("{name}[{i}]"), &x?, allowed)?);
+    }
+    Ok(out)
+}

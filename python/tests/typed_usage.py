@@ -1,0 +1,43 @@
+"""Checked by `mypy --strict` in .ci/run (not run by pytest): the package's stubs and annotations are real.
+
+Each `# type: ignore[...]` marks a call the types must refuse; with --strict (warn_unused_ignores), an ignore
+that nothing needed fails the check, so stubs that had gone `Any` would fail here."""
+import pathlib
+from typing import Any, Dict, List
+
+import numpy as np
+import numpy.typing as npt
+import pandas as pd
+
+import glossmeter
+from glossmeter import LobeHint, Reading
+
+
+def grey(wi: npt.NDArray[np.float64], wo: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
+    return np.full(len(wi), 0.1)
+
+
+def usage() -> None:
+    readings: List[Reading] = glossmeter.measure(pathlib.Path("fixtures/recipes/black-glass.json"))
+    value = readings[0]["value"]
+    if value is not None:
+        print(value + 1.0)
+    print(readings[0]["geometry"].upper(), readings[0]["evaluations"] + 1, readings[0].get("note"))
+    frame: pd.DataFrame = glossmeter.measure({"model": "lambert", "albedo": 0.5}, as_frame=True)
+    arrays: Dict[str, npt.NDArray[Any]] = glossmeter.measure("{}", ["astm-d523-60"], 1e-6, False, as_arrays=True)
+    hint: LobeHint = {"slope": 0.05, "tail": "gaussian"}
+    brdf: List[Reading] = glossmeter.measure_brdf(grey, geometries="astm-d523-60", lobes=[0.1, hint], delta=0.04)
+    print(frame.shape, arrays["value"].mean(), brdf[0]["converged"])
+    ids: List[str] = glossmeter.DEFAULT_GEOMETRIES
+    spec: Dict[str, Any] = glossmeter.geometry(ids[0])
+    text: str = glossmeter.describe_geometry(spec) + glossmeter.describe({"model": "lambert", "albedo": 0.5})
+    print(text, glossmeter.schema()["title"], len(glossmeter.standards()), glossmeter.__version__)
+
+    # What the types refuse (each ignore is needed, or mypy --strict fails on an unused one):
+    glossmeter.measure(42)  # type: ignore[call-overload]
+    glossmeter.measure("r.json", rtol="x")  # type: ignore[call-overload]
+    glossmeter.measure_brdf(42)  # type: ignore[call-overload]
+    bad_hint: LobeHint = {"slope": 0.05, "tail": "fat"}  # type: ignore[typeddict-item]
+    wrong: List[Reading] = glossmeter.measure("r.json", as_frame=True)  # type: ignore[assignment]
+    not_a_str: int = glossmeter.describe("r.json")  # type: ignore[assignment]
+    print(bad_hint, wrong, not_a_str)
