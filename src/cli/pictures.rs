@@ -79,8 +79,8 @@ pub fn run(a: PlotArgs) -> Result<()> {
             if !(2..=200).contains(&a.points) {
                 return Err(Error::Usage(format!("--points must be 2 to 200, got {}", a.points)));
             }
-            let file = a.recipe.display().to_string();
-            let text = std::fs::read_to_string(&a.recipe).map_err(|source| Error::Io { file: file.clone(), source })?;
+            let file = crate::input::name(&a.recipe);
+            let text = crate::input::read_text(&a.recipe, "recipe")?;
             let json: Value = crate::input::json::parse_json(&text, &file)?;
             match json.pointer(&pointer) {
                 Some(Value::Number(_)) => {}

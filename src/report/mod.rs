@@ -47,6 +47,69 @@ pub fn plain(v: f64) -> String {
     }
 }
 
+/// A measured number (a sheet's mean, std, min, max; a difference or an allowance built from them) for CSV and
+/// JUnit text: rounded to ten significant digits, then its shortest decimals, plain or scientific as [`plain`].
+/// A sheet's 99.99 averaged in binary is `99.99000000000001`; no instrument reads to 10⁻¹⁴ GU, so it prints
+/// `99.99` (docs/instrument.md §Numbers in text). JSON keeps the full double.
+pub fn measured(v: f64) -> String {
+    if !v.is_finite() || v == 0.0 {
+        return plain(v);
+    }
+    plain(format!("{v:.9e}").parse::<f64>().unwrap_or(v))
+}
+
+/// An error estimate alone for CSV and JUnit text: two significant digits, rounded up (a printed estimate is
+/// never below the computed one), as [`with_error`] prints it.
+pub fn error_text(e: f64) -> String {
+    if !(e.is_finite() && e > 0.0) {
+        return plain(e);
+    }
+    two_digits_up(e)
+}
+
+/// A value and its error estimate for CSV and JUnit text, each to the precision the estimate gives it
+/// (docs/instrument.md §Numbers in text): the value rounded at the estimate's third significant digit (at most
+/// 17 significant digits), the estimate to two significant digits rounded up after adding the value's rounding
+/// (half a unit of its last printed digit), so that the printed estimate still covers the printed value's error.
+/// `89.14 ± 3.5763209946461607e-11` prints `89.1400000000000` and `3.6e-11`. A zero or non-finite estimate
+/// leaves the value at [`measured`].
+pub fn with_error(v: f64, e: f64) -> (String, String) {
+    if !(v.is_finite() && e.is_finite() && e > 0.0) {
+        return (measured(v), if e.is_finite() { plain(e) } else { String::new() });
+    }
+    // The place of the estimate's third significant digit, and the value's decimals (negative: tens, ...).
+    let place = e.log10().floor() as i32 - 2;
+    let magnitude = if v == 0.0 { place } else { v.abs().log10().floor() as i32 };
+    let place = place.max(magnitude - 16);
+    let half_unit = 0.5 * 10f64.powi(place);
+    let value = if (1e-6..1e15).contains(&v.abs()) || v == 0.0 {
+        if place < 0 {
+            format!("{v:.*}", (-place) as usize)
+        } else {
+            let unit = 10f64.powi(place);
+            format!("{:.0}", (v / unit).round() * unit)
+        }
+    } else {
+        format!("{v:.*e}", (magnitude - place).clamp(0, 16) as usize)
+    };
+    (value, two_digits_up(e + half_unit))
+}
+
+/// `x` > 0 rounded up to two significant digits: plain in [10⁻³, 10⁶), else `3.6e-11`.
+fn two_digits_up(x: f64) -> String {
+    let q = x.log10().floor() as i32;
+    let unit = 10f64.powi(q - 1);
+    // The quotient carries the division's rounding; a hair above a whole number is that number.
+    let m = x / unit;
+    let m = if m - m.floor() < 1e-12 { m.floor() } else { m.ceil() };
+    let r = m * unit;
+    if (1e-3..1e6).contains(&r) {
+        format!("{r:.*}", (1 - q).max(0) as usize)
+    } else {
+        format!("{r:.1e}")
+    }
+}
+
 /// A reading's value for a table: `decimals` places, or three significant digits in scientific notation
 /// from 10¹⁵ on (a 1e300-class reading is not a 300-character column).
 pub fn shown(v: f64, decimals: usize) -> String {
@@ -119,4 +182,32 @@ pub fn csv_text<R: IntoIterator<Item = String>>(header: &[&str], rows: impl Into
     let bytes =
         w.into_inner().map_err(|e| Error::Io { file: "<csv>".into(), source: std::io::Error::other(e.to_string()) })?;
     Ok(String::from_utf8(bytes).expect("csv is utf-8"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn numbers_in_text_are_rounded_to_their_precision() {
+        assert_eq!(measured(99.99000000000001), "99.99");
+        assert_eq!(measured(0.1 + 0.2), "0.3");
+        assert_eq!(measured(-2.5e-20), "-2.5e-20");
+        assert_eq!(error_text(0.000000000035763209946461607), "3.6e-11");
+        assert_eq!(error_text(0.0123), "0.013");
+        assert_eq!(error_text(0.012), "0.012");
+        assert_eq!(error_text(250.0), "250");
+        assert_eq!(
+            with_error(89.13999999999999, 3.5763209946461607e-11),
+            ("89.1400000000000".into(), "3.6e-11".into())
+        );
+        assert_eq!(with_error(12.345, 0.21), ("12.345".into(), "0.22".into()));
+        assert_eq!(with_error(12345.4, 250.0), ("12345".into(), "260".into()));
+        // The printed estimate covers the printed value's error, whatever the digits.
+        for (v, e) in [(1.23456789, 3.3e-4), (0.7, 0.0101), (-4.4, 0.0999), (5e20, 1e12), (1.5e-9, 2e-13)] {
+            let (vs, es) = with_error(v, e);
+            let (pv, pe): (f64, f64) = (vs.parse().unwrap(), es.parse().unwrap());
+            assert!(pe >= e && (pv - v).abs() <= pe - e + 1e-15 * v.abs(), "{v} {e}: {vs} {es}");
+        }
+    }
 }
