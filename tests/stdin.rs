@@ -82,7 +82,9 @@ fn sheets_workbooks_geometry_files_baselines_and_templates_from_stdin() {
 
 #[test]
 fn standard_input_is_read_once() {
-    let (code, _, err) = piped(&["compare", "-", "-"], &read(GLASS));
-    assert_eq!(code, 2);
-    assert!(err.contains("`-` (standard input) is given for a second input"), "{err}");
+    for args in [&["compare", "-", "-"][..], &["measure", "-", "--baseline", "-"], &["measure", GLASS, "-", "-"]] {
+        let (code, _, err) = piped(args, &read(GLASS));
+        assert_eq!(code, 2, "{args:?}");
+        assert!(err.contains("`-` (standard input) is given for a second input"), "{args:?}: {err}");
+    }
 }

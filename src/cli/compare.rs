@@ -128,6 +128,9 @@ pub fn run(a: CompareArgs) -> Result<()> {
             return Err(Error::Usage(format!("--recipe-dir {}: not a directory", d.display())));
         }
     }
+    crate::input::at_most_one_stdin(
+        a.paths.iter().chain(&a.baseline).map(PathBuf::as_path).chain(per_sample.iter().map(|(_, f)| f.as_path())),
+    )?;
     let recipes = Recipes { default, dir: a.recipe_dir.clone(), per_sample };
     let options = SheetOptions {
         delimiter: a.delimiter.as_deref().map(parse_delimiter).transpose()?,

@@ -72,6 +72,9 @@ pub fn run(a: FitArgs) -> Result<()> {
     }
     // Refused before any work if it exists (or its directory does not); written whole or not at all.
     let output = OutputTarget::new(a.output.as_deref(), "-o")?;
+    crate::input::at_most_one_stdin(
+        std::iter::once(&a.recipe).chain(&a.sheet).chain(&a.geometry_files).map(PathBuf::as_path),
+    )?;
     let free: Vec<FreeParameter> = a.free.iter().map(|f| FreeParameter::parse(f)).collect::<Result<_>>()?;
     let targets: Vec<TargetReading> = match &a.sheet {
         Some(s) => {

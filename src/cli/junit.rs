@@ -50,13 +50,14 @@ pub fn classname(sheet: &Sheet, sample: &str) -> String {
     parts.join(".")
 }
 
-/// The message of a comparison case: every number to its precision (`report::measured`, `report::with_error`).
+/// The message of a comparison case: every number to its precision (`report::measured`,
+/// `report::with_error_text`).
 pub fn message(c: &Comparison) -> String {
     let s = c.group.stats;
     let p = c.predicted.as_ref();
     let predicted = match p.and_then(|p| p.value.map(|v| (v, p.error_estimate))) {
         Some((v, e)) => {
-            let (v, e) = report::with_error(v, e);
+            let (v, e) = report::with_error_text(v, e);
             format!("{v} ± {e}")
         }
         None => "none".into(),

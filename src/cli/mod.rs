@@ -122,6 +122,9 @@ fn dispatch(cli: Cli) -> Result<()> {
                     "--envelope is reported in the table and JSON formats; use --format table or json".into(),
                 ));
             }
+            crate::input::at_most_one_stdin(
+                recipes.iter().chain(&baseline).chain(&geometry_files).map(PathBuf::as_path),
+            )?;
             let target = OutputTarget::new(output.as_deref(), "--output")?;
             let baseline_file = baseline.as_deref().map(crate::input::name);
             let baseline = baseline.as_deref().map(crate::comparison::load_baseline).transpose()?;

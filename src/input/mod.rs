@@ -44,6 +44,18 @@ pub fn name(path: &Path) -> String {
     }
 }
 
+/// Refuse, before any reading, a run that names `-` for two inputs (standard input can be read once).
+pub fn at_most_one_stdin<'a>(paths: impl IntoIterator<Item = &'a Path>) -> Result<()> {
+    if paths.into_iter().filter(|p| is_stdin(p)).count() > 1 {
+        return Err(Error::Usage(
+            "`-` (standard input) is given for a second input: standard input can be read once, so at most one \
+             input may be `-`"
+                .into(),
+        ));
+    }
+    Ok(())
+}
+
 /// Set when standard input has been read: it can be read once, so a second `-` is an error, not an empty file.
 static STDIN_READ: AtomicBool = AtomicBool::new(false);
 

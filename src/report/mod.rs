@@ -58,8 +58,8 @@ pub fn measured(v: f64) -> String {
     plain(format!("{v:.9e}").parse::<f64>().unwrap_or(v))
 }
 
-/// An error estimate alone for CSV and JUnit text: two significant digits, rounded up (a printed estimate is
-/// never below the computed one), as [`with_error`] prints it.
+/// An error estimate alone for text (JUnit messages): two significant digits, rounded up (a printed estimate is
+/// never below the computed one); plain in [10⁻³, 10⁶), else `3.6e-11`.
 pub fn error_text(e: f64) -> String {
     if !(e.is_finite() && e > 0.0) {
         return plain(e);
@@ -67,22 +67,39 @@ pub fn error_text(e: f64) -> String {
     two_digits_up(e)
 }
 
-/// A value and its error estimate for CSV and JUnit text, each to the precision the estimate gives it
-/// (docs/instrument.md §Numbers in text): the value rounded at the estimate's third significant digit (at most
-/// 17 significant digits), the estimate to two significant digits rounded up after adding the value's rounding
-/// (half a unit of its last printed digit), so that the printed estimate still covers the printed value's error.
-/// `89.14 ± 3.5763209946461607e-11` prints `89.1400000000000` and `3.6e-11`. A zero or non-finite estimate
-/// leaves the value at [`measured`].
+/// A value and its error estimate for CSV, each to the precision the estimate gives it (docs/instrument.md
+/// §Numbers in text): the value rounded at the estimate's third significant digit (at most 17 significant
+/// digits), the estimate to two significant digits rounded up after adding the value's rounding (half a unit of
+/// its last printed digit), so that the printed estimate still covers the printed value's error. Both are plain
+/// decimals in [10⁻¹⁵, 10¹⁵) as [`plain`]: `89.14 ± 3.5763209946461607e-11` prints `89.1400000000000` and
+/// `0.000000000036`. A zero or non-finite estimate leaves the value at [`measured`].
 pub fn with_error(v: f64, e: f64) -> (String, String) {
+    match rounded(v, e) {
+        Some((value, up)) => (value, plain_two_digits(up)),
+        None => (measured(v), if e.is_finite() { plain(e) } else { String::new() }),
+    }
+}
+
+/// [`with_error`] for text (JUnit messages): the estimate as [`error_text`] writes it (`3.6e-11`).
+pub fn with_error_text(v: f64, e: f64) -> (String, String) {
+    match rounded(v, e) {
+        Some((value, up)) => (value, two_digits_up(up)),
+        None => (measured(v), if e.is_finite() { plain(e) } else { String::new() }),
+    }
+}
+
+/// The value rounded to its estimate's precision, and the estimate plus that rounding (None without a positive
+/// finite estimate).
+fn rounded(v: f64, e: f64) -> Option<(String, f64)> {
     if !(v.is_finite() && e.is_finite() && e > 0.0) {
-        return (measured(v), if e.is_finite() { plain(e) } else { String::new() });
+        return None;
     }
     // The place of the estimate's third significant digit, and the value's decimals (negative: tens, ...).
     let place = e.log10().floor() as i32 - 2;
     let magnitude = if v == 0.0 { place } else { v.abs().log10().floor() as i32 };
     let place = place.max(magnitude - 16);
     let half_unit = 0.5 * 10f64.powi(place);
-    let value = if (1e-6..1e15).contains(&v.abs()) || v == 0.0 {
+    let value = if (1e-15..1e15).contains(&v.abs()) || v == 0.0 {
         if place < 0 {
             format!("{v:.*}", (-place) as usize)
         } else {
@@ -92,17 +109,32 @@ pub fn with_error(v: f64, e: f64) -> (String, String) {
     } else {
         format!("{v:.*e}", (magnitude - place).clamp(0, 16) as usize)
     };
-    (value, two_digits_up(e + half_unit))
+    Some((value, e + half_unit))
 }
 
-/// `x` > 0 rounded up to two significant digits: plain in [10⁻³, 10⁶), else `3.6e-11`.
-fn two_digits_up(x: f64) -> String {
+/// `x` > 0 rounded up to two significant digits, as [`plain`] writes numbers (plain in [10⁻¹⁵, 10¹⁵)).
+fn plain_two_digits(x: f64) -> String {
+    let (r, q) = up_two_digits(x);
+    if (1e-15..1e15).contains(&r) {
+        format!("{r:.*}", (1 - q).max(0) as usize)
+    } else {
+        format!("{r:.1e}")
+    }
+}
+
+/// `x` > 0 rounded up to two significant digits, and the power of ten of its first digit.
+fn up_two_digits(x: f64) -> (f64, i32) {
     let q = x.log10().floor() as i32;
     let unit = 10f64.powi(q - 1);
     // The quotient carries the division's rounding; a hair above a whole number is that number.
     let m = x / unit;
     let m = if m - m.floor() < 1e-12 { m.floor() } else { m.ceil() };
-    let r = m * unit;
+    (m * unit, q)
+}
+
+/// `x` > 0 rounded up to two significant digits: plain in [10⁻³, 10⁶), else `3.6e-11`.
+fn two_digits_up(x: f64) -> String {
+    let (r, q) = up_two_digits(x);
     if (1e-3..1e6).contains(&r) {
         format!("{r:.*}", (1 - q).max(0) as usize)
     } else {
