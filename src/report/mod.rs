@@ -230,9 +230,11 @@ mod tests {
         assert_eq!(error_text(0.012), "0.012");
         assert_eq!(error_text(250.0), "250");
         assert_eq!(
-            with_error(89.13999999999999, 3.5763209946461607e-11),
+            with_error_text(89.13999999999999, 3.5763209946461607e-11),
             ("89.1400000000000".into(), "3.6e-11".into())
         );
+        // CSV keeps plain decimals.
+        assert_eq!(with_error(89.14, 3.5763209946461607e-11).1, "0.000000000036");
         assert_eq!(with_error(12.345, 0.21), ("12.345".into(), "0.22".into()));
         assert_eq!(with_error(12345.4, 250.0), ("12345".into(), "260".into()));
         // The printed estimate covers the printed value's error, whatever the digits.
