@@ -69,9 +69,12 @@ fn has_noise(text: &str) -> bool {
     })
 }
 
+/// A report to check: label, arguments, exit status, tests, failures, skipped.
+type Run<'a> = (&'a str, &'a [&'a str], i32, usize, usize, usize);
+
 #[test]
 fn reports_validate_against_the_xsd_and_read_back_in_junitparser() {
-    let runs: [(&str, &[&str], i32, usize, usize, usize); 4] = [
+    let runs: [Run; 4] = [
         (
             "pass",
             &["compare", "fixtures/recipes/glass-n1.5.json", "fixtures/sheets/byk-semicolon-decimal-comma.csv"],
