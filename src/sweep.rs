@@ -627,6 +627,41 @@ mod tests {
         Sweep::new(t, "t.json", axes, design, vec![], PlanOptions::default())
     }
 
+    /// Progress comes from the work done: within a chunk, after every integral, never decreasing, and whole
+    /// at the end; the rows are the same bits as without it.
+    #[test]
+    fn progress_is_reported_per_integral() {
+        let geos =
+            crate::resolve_geometries(&["astm-d523-20", "astm-d523-60", "astm-e430-30"], &[] as &[&str]).unwrap();
+        let t: Value = serde_json::from_str(r#"{"model": "lambert", "albedo": 0.5}"#).unwrap();
+        let axes = vec![parse_vary("/albedo=0.1..0.9:6").unwrap()];
+        let s = Sweep::new(t, "t.json", axes, SweepDesign::Grid, geos, PlanOptions::default()).unwrap();
+        let seen = std::sync::Mutex::new(Vec::<f64>::new());
+        let mut rows = String::new();
+        s.run_reporting(
+            0..6,
+            |r| {
+                rows.push_str(&s.csv_row(&r, false));
+                Ok(())
+            },
+            &|done| seen.lock().unwrap().push(done),
+        )
+        .unwrap();
+        let seen = seen.into_inner().unwrap();
+        // Six points in one chunk, several integrals each: many reports before the chunk's rows come.
+        assert!(seen.len() > 12, "{} reports", seen.len());
+        assert!(seen.windows(2).all(|w| w[1] >= w[0]), "{seen:?}");
+        assert!(seen[0] < 1.0 && seen.iter().filter(|&&d| d < 6.0).count() > 6, "{seen:?}");
+        assert_eq!(*seen.last().unwrap(), 6.0);
+        let mut plain = String::new();
+        s.run(0..6, |r| {
+            plain.push_str(&s.csv_row(&r, false));
+            Ok(())
+        })
+        .unwrap();
+        assert_eq!(rows, plain);
+    }
+
     #[test]
     fn grid_and_hypercube_points() {
         let a = parse_vary("/albedo=0.1..0.9:5").unwrap();
