@@ -173,13 +173,11 @@ pub fn draw_side_legend<DB: DrawingBackend>(
             Mark::Dot(col) => area.draw(&Circle::new((17, c), 5, col.filled())),
         }
         .map_err(plot_err)?;
-        for (k, l) in wrap(text, chars).iter().enumerate() {
-            area.draw(&Text::new(l.clone(), (32, y + k as i32 * line), font.clone())).map_err(plot_err)?;
-            if k > 0 {
-                y += line;
-            }
+        for l in wrap(text, chars) {
+            area.draw(&Text::new(l, (32, y), font.clone())).map_err(plot_err)?;
+            y += line;
         }
-        y += line + 3;
+        y += 3;
     }
     Ok(())
 }
