@@ -69,6 +69,33 @@ pub fn parse_vary(s: &str) -> Result<SweepAxis> {
     Ok(SweepAxis { path: path.to_string(), lo, hi, n, log: false })
 }
 
+/// The decimals of a step or a bound: the fewest (at most 12) that write it to within 10⁻⁶ of their last
+/// place, so 0.049999999999999996, the double nearest (0.3 − 0.05)/5, has 2 and 1/3 has 12.
+fn decimals_of(x: f64) -> i32 {
+    (0..12)
+        .find(|&d| {
+            let scaled = x.abs() * 10f64.powi(d);
+            (scaled - scaled.round()).abs() <= 1e-6
+        })
+        .unwrap_or(12)
+}
+
+/// Grid value j of n on a linear axis (docs/instrument.md §Sweeps): LO + j·step, step = (HI − LO)/(n − 1),
+/// rounded to the decimals of the step and of LO, so that the values are the decimals the user meant
+/// (0.05..0.3:6 gives 0.15, not 0.15000000000000002). A value whose scaled form is beyond 2⁵² is left as
+/// computed (it has no fractional decimals to clean).
+fn grid_value(lo: f64, hi: f64, j: u64, n: u64) -> f64 {
+    let step = (hi - lo) / (n - 1) as f64;
+    let x = lo + step * j as f64;
+    let d = decimals_of(step).max(decimals_of(lo));
+    let scale = 10f64.powi(d);
+    if (x * scale).abs() < 4.5e15 {
+        (x * scale).round() / scale
+    } else {
+        x
+    }
+}
+
 /// `K/M` with 1 ≤ K ≤ M.
 pub fn parse_shard(s: &str) -> Result<(u64, u64)> {
     let bad = |m: &str| Error::argument("shard", format!(" `{s}`: {m} (expected K/M with 1 ≤ K ≤ M)"));
@@ -252,7 +279,11 @@ impl Sweep {
                     let n = a.n.expect("grid");
                     let j = rest % n;
                     rest /= n;
-                    out[d] = if n == 1 { a.lo } else { map(a, j as f64 / (n - 1) as f64) };
+                    out[d] = match n {
+                        1 => a.lo,
+                        _ if a.log || j == 0 || j == n - 1 => map(a, j as f64 / (n - 1) as f64),
+                        _ => grid_value(a.lo, a.hi, j, n),
+                    };
                 }
                 out
             }
@@ -309,8 +340,28 @@ impl Sweep {
     /// largest expected first ([`Plan::run_all`]): the threads balance integrals, not points, and a chunk
     /// ends with small integrals on every thread. A point's `seconds` is its parsing and planning time plus the wall time of
     /// its integrals.
-    pub fn run(&self, range: Range<u64>, mut sink: impl FnMut(PointResult) -> Result<()>) -> Result<()> {
+    pub fn run(&self, range: Range<u64>, sink: impl FnMut(PointResult) -> Result<()>) -> Result<()> {
+        self.run_reporting(range, sink, &|_| {})
+    }
+
+    /// [`Sweep::run`], reporting the work done as it is done (docs/instrument.md §Sweeps, progress):
+    /// `progress(points)` gets the points of the range completed so far, fractional and non-decreasing, after
+    /// every integral: each integral completes the share of its point that its expected evaluation count is of
+    /// the point's (a point whose recipe is invalid counts whole once planned). The rows still come in index
+    /// order at the end of each chunk; only the count moves within it. The results are the same bits.
+    pub fn run_reporting(
+        &self,
+        range: Range<u64>,
+        mut sink: impl FnMut(PointResult) -> Result<()>,
+        progress: &(dyn Fn(f64) + Sync),
+    ) -> Result<()> {
         let planner = Planner::new()?;
+        let completed = std::sync::Mutex::new(0.0f64);
+        let add = |x: f64| {
+            let mut c = completed.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+            *c += x;
+            progress(*c);
+        };
         let chunk = CHUNK_PER_THREAD * rayon::current_num_threads().max(1) as u64;
         let mut start = range.start;
         while start < range.end {
@@ -336,7 +387,28 @@ impl Sweep {
                 };
                 rows.push((values, planned_ok, planning));
             }
-            let mut runs: Vec<Option<Execution>> = Plan::run_all(&plans).into_iter().map(Some).collect();
+            // The share of its point each integral completes; points with nothing to integrate count now.
+            let shares: Vec<Vec<f64>> = plans
+                .iter()
+                .map(|p| {
+                    let w: Vec<f64> = p.jobs.iter().map(|j| j.method.expected_evaluations().max(1.0)).collect();
+                    let total: f64 = p.specimen_jobs().iter().map(|&j| w[j]).sum();
+                    w.iter().map(|x| x / total).collect()
+                })
+                .collect();
+            let immediate =
+                (end - start) as usize - plans.len() + plans.iter().filter(|p| p.specimen_jobs().is_empty()).count();
+            if immediate > 0 {
+                add(immediate as f64);
+            }
+            let mut runs: Vec<Option<Execution>> =
+                Plan::run_all_reporting(&plans, &|p, j| add(shares[p][j])).into_iter().map(Some).collect();
+            // Whole at the chunk's end (the shares' sum has rounding in its last bits).
+            {
+                let mut c = completed.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+                *c = (end - range.start) as f64;
+                progress(*c);
+            }
             for ((values, planned_ok, planning), i) in rows.into_iter().zip(start..end) {
                 let (outcome, seconds) = match planned_ok {
                     Ok(k) => {
@@ -377,7 +449,8 @@ impl Sweep {
         csv_line(&h)
     }
 
-    /// One CSV row (numbers as Rust's shortest round-trip decimals; empty where there is no value).
+    /// One CSV row: the point's values as Rust's shortest round-trip decimals, each reading and its error
+    /// estimate to their precision (`report::with_error`); empty where there is no value.
     pub fn csv_row(&self, r: &PointResult, timing: bool) -> String {
         let mut row: Vec<String> = vec![r.index.to_string()];
         row.extend(r.values.iter().map(|v| v.to_string()));
@@ -386,8 +459,9 @@ impl Sweep {
         for c in cells {
             match c {
                 Some((v, e)) => {
-                    row.push(report::plain(v));
-                    row.push(report::plain(e));
+                    let (v, e) = report::with_error(v, e);
+                    row.push(v);
+                    row.push(e);
                 }
                 None => {
                     row.push(String::new());
@@ -548,12 +622,54 @@ mod tests {
         Sweep::new(t, "t.json", axes, design, vec![], PlanOptions::default())
     }
 
+    /// Progress comes from the work done: within a chunk, after every integral, never decreasing, and whole
+    /// at the end; the rows are the same bits as without it.
+    #[test]
+    fn progress_is_reported_per_integral() {
+        let geos =
+            crate::resolve_geometries(&["astm-d523-20", "astm-d523-60", "astm-e430-30"], &[] as &[&str]).unwrap();
+        let t: Value = serde_json::from_str(r#"{"model": "lambert", "albedo": 0.5}"#).unwrap();
+        let axes = vec![parse_vary("/albedo=0.1..0.9:6").unwrap()];
+        let s = Sweep::new(t, "t.json", axes, SweepDesign::Grid, geos, PlanOptions::default()).unwrap();
+        let seen = std::sync::Mutex::new(Vec::<f64>::new());
+        let mut rows = String::new();
+        s.run_reporting(
+            0..6,
+            |r| {
+                rows.push_str(&s.csv_row(&r, false));
+                Ok(())
+            },
+            &|done| seen.lock().unwrap().push(done),
+        )
+        .unwrap();
+        let seen = seen.into_inner().unwrap();
+        // Six points in one chunk, several integrals each: many reports before the chunk's rows come.
+        assert!(seen.len() > 12, "{} reports", seen.len());
+        assert!(seen.windows(2).all(|w| w[1] >= w[0]), "{seen:?}");
+        assert!(seen[0] < 1.0 && seen.iter().filter(|&&d| d < 6.0).count() > 6, "{seen:?}");
+        assert_eq!(*seen.last().unwrap(), 6.0);
+        let mut plain = String::new();
+        s.run(0..6, |r| {
+            plain.push_str(&s.csv_row(&r, false));
+            Ok(())
+        })
+        .unwrap();
+        assert_eq!(rows, plain);
+    }
+
     #[test]
     fn grid_and_hypercube_points() {
         let a = parse_vary("/albedo=0.1..0.9:5").unwrap();
         let s = sweep(vec![a.clone()], SweepDesign::Grid).unwrap();
         let v: Vec<f64> = (0..5).map(|i| s.point(i)[0]).collect();
-        assert_eq!(v, [0.1, 0.30000000000000004, 0.5, 0.7000000000000001, 0.9]);
+        // The user's decimals (LO + j·step rounded to the step's decimals), not 0.30000000000000004.
+        assert_eq!(v, [0.1, 0.3, 0.5, 0.7, 0.9]);
+        let s = sweep(vec![parse_vary("/albedo=0.05..0.3:6").unwrap()], SweepDesign::Grid).unwrap();
+        let v: Vec<String> = (0..6).map(|i| s.point(i)[0].to_string()).collect();
+        assert_eq!(v, ["0.05", "0.1", "0.15", "0.2", "0.25", "0.3"]);
+        // A step with no short decimal form keeps 12 decimals.
+        let s = sweep(vec![parse_vary("/albedo=0..1:4").unwrap()], SweepDesign::Grid).unwrap();
+        assert_eq!(s.point(1)[0].to_string(), "0.333333333333");
         let mut l = a.clone();
         l.log = true;
         let s = sweep(vec![l], SweepDesign::Grid).unwrap();

@@ -25,8 +25,9 @@ pub enum CompareFormat {
 
 #[derive(clap::Args, Debug)]
 pub struct CompareArgs {
-    /// `[RECIPE] SHEET`: the recipe (JSON) for every sample, then the sheet (CSV; see docs/instrument.md
-    /// §Sheets). Without RECIPE, samples take theirs from --recipe-dir / --recipe.
+    /// `[RECIPE] SHEET`: the recipe (JSON) for every sample, then the sheet (CSV, or an .xlsx/.xls/.ods
+    /// workbook; see docs/instrument.md §Sheets). Without RECIPE, samples take theirs from --recipe-dir /
+    /// --recipe. Either may be `-`, standard input.
     #[arg(num_args = 1..=2, required = true, value_name = "[RECIPE] SHEET")]
     pub paths: Vec<PathBuf>,
     /// Take each sample's recipe from DIR/<sample>.json.
@@ -35,9 +36,12 @@ pub struct CompareArgs {
     /// The recipe of one sample (repeatable); takes precedence over --recipe-dir.
     #[arg(long = "recipe", value_name = "SAMPLE=FILE")]
     pub recipes: Vec<String>,
-    /// The separator: `,`, `;` or `tab` (default: detected from the header line).
+    /// The separator of a text sheet: `,`, `;` or `tab` (default: detected from the header line).
     #[arg(long)]
     pub delimiter: Option<String>,
+    /// The sheet of a workbook (.xlsx, .xls, .ods) to read; default: its first sheet.
+    #[arg(long, value_name = "NAME")]
+    pub sheet_name: Option<String>,
     /// Skip a column the reader does not know (repeatable; case and spaces do not matter).
     #[arg(long = "ignore-column", value_name = "HEADER")]
     pub ignore_columns: Vec<String>,
@@ -56,7 +60,7 @@ pub struct CompareArgs {
     pub rtol: Option<f64>,
     #[arg(long, value_enum, default_value_t = CompareFormat::Table)]
     pub format: CompareFormat,
-    /// Write to this new file instead of stdout (an existing file is refused before any work).
+    /// Write to this new file instead of stdout (`-`: stdout; an existing file is refused before any work).
     #[arg(long, short = 'o')]
     pub output: Option<PathBuf>,
     /// Exit 0 even if a prediction did not converge within its budget (the comparison is still made).
@@ -68,7 +72,8 @@ pub struct CompareArgs {
     pub max_de00: Option<f64>,
     #[command(flatten)]
     pub colour: ColourArgs,
-    /// Also draw measured against predicted with error bars (FILE.png or FILE.svg, never overwritten).
+    /// Also draw the residuals (predicted − measured) with the allowance and the verdict per reading (FILE.png
+    /// or FILE.svg, never overwritten).
     #[arg(long)]
     pub plot: Option<PathBuf>,
 }
@@ -126,10 +131,14 @@ pub fn run(a: CompareArgs) -> Result<()> {
             return Err(Error::Usage(format!("--recipe-dir {}: not a directory", d.display())));
         }
     }
+    crate::input::at_most_one_stdin(
+        a.paths.iter().chain(&a.baseline).map(PathBuf::as_path).chain(per_sample.iter().map(|(_, f)| f.as_path())),
+    )?;
     let recipes = Recipes { default, dir: a.recipe_dir.clone(), per_sample };
     let options = SheetOptions {
         delimiter: a.delimiter.as_deref().map(parse_delimiter).transpose()?,
         ignore_columns: a.ignore_columns.clone(),
+        sheet_name: a.sheet_name.clone(),
     };
     let baseline = a.baseline.as_deref().map(comparison::load_baseline).transpose()?;
     let sheet = sheet::load(&sheet_path, &options)?;
@@ -254,7 +263,10 @@ fn table(sheet: &Sheet, cmp: &[Comparison], rule: &VerdictRule, drift: &[Drift],
             ));
         }
     }
-    let mut s = format!("{}: predictions against the sheet\n", sheet.file);
+    let mut s = match &sheet.workbook_sheet {
+        Some(w) => format!("{} (sheet \"{w}\"): predictions against the sheet\n", sheet.file),
+        None => format!("{}: predictions against the sheet\n", sheet.file),
+    };
     for (k, v) in &sheet.metadata {
         s.push_str(&format!("# {k}: {v}\n"));
     }
@@ -265,6 +277,12 @@ fn table(sheet: &Sheet, cmp: &[Comparison], rule: &VerdictRule, drift: &[Drift],
         rule.k,
         summary(cmp)
     ));
+    if sheet.statistics_checked > 0 {
+        s.push_str(&format!(
+            "statistics: {} stated value(s) (mean, std, min, max, range columns) agree with the readings\n",
+            sheet.statistics_checked
+        ));
+    }
     for n in notes {
         s.push_str(&format!("note: {n}\n"));
     }

@@ -21,7 +21,8 @@ pub struct FitArgs {
     /// A target reading, GEOMETRY/READING=VALUE[±U] (or +-U), e.g. astm-d523-60/gloss=85±0.2. Repeatable.
     #[arg(long = "target")]
     pub targets: Vec<String>,
-    /// Targets from a glossmeter sheet (CSV, the layouts `compare` reads).
+    /// Targets from a glossmeter sheet (CSV or an .xlsx/.xls/.ods workbook, the layouts `compare` reads; `-`:
+    /// standard input).
     #[arg(long, conflicts_with = "targets")]
     pub sheet: Option<PathBuf>,
     /// The sample of the sheet to fit (needed when the sheet has several).
@@ -30,6 +31,9 @@ pub struct FitArgs {
     /// The sheet's separator (`,`, `;` or `tab`); detected from the header line by default.
     #[arg(long, requires = "sheet")]
     pub delimiter: Option<String>,
+    /// The sheet of a workbook to read (default: its first sheet), as in `compare`.
+    #[arg(long, value_name = "NAME", requires = "sheet")]
+    pub sheet_name: Option<String>,
     /// A sheet column to skip (repeatable), as in `compare`.
     #[arg(long = "ignore-column", value_name = "HEADER", requires = "sheet")]
     pub ignore_columns: Vec<String>,
@@ -68,12 +72,16 @@ pub fn run(a: FitArgs) -> Result<()> {
     }
     // Refused before any work if it exists (or its directory does not); written whole or not at all.
     let output = OutputTarget::new(a.output.as_deref(), "-o")?;
+    crate::input::at_most_one_stdin(
+        std::iter::once(&a.recipe).chain(&a.sheet).chain(&a.geometry_files).map(PathBuf::as_path),
+    )?;
     let free: Vec<FreeParameter> = a.free.iter().map(|f| FreeParameter::parse(f)).collect::<Result<_>>()?;
     let targets: Vec<TargetReading> = match &a.sheet {
         Some(s) => {
             let options = SheetOptions {
                 delimiter: a.delimiter.as_deref().map(parse_delimiter).transpose()?,
                 ignore_columns: a.ignore_columns.clone(),
+                sheet_name: a.sheet_name.clone(),
             };
             let (targets, notes) = fit::targets_from_sheet(&sheet::load(s, &options)?, a.sample.as_deref())?;
             for n in notes {

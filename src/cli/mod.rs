@@ -13,7 +13,8 @@
 //! * the writers: [`format`](mod@format) the text tables of `measure` ([`format::table`],
 //!   [`format::envelope_table`]), [`output`] the files ([`output::OutputTarget`]: a new file whole or not at
 //!   all, never overwriting, or standard output), [`plot`] the pictures (PNG or SVG with an embedded font),
-//!   [`junit`] the JUnit XML of `compare`.
+//!   [`junit`] the JUnit XML of `compare`, [`progress`] the progress bar of `sweep` (rate and time left from the
+//!   work done).
 use std::io::Write;
 use std::path::PathBuf;
 
@@ -35,6 +36,7 @@ pub mod output;
 pub mod pictures;
 pub mod plot;
 pub mod profile;
+pub mod progress;
 pub mod sweep;
 
 use args::{Cli, Command, OutputSchema};
@@ -126,8 +128,11 @@ fn dispatch(cli: Cli) -> Result<()> {
                     "--envelope is reported in the table and JSON formats; use --format table or json".into(),
                 ));
             }
+            crate::input::at_most_one_stdin(
+                recipes.iter().chain(&baseline).chain(&geometry_files).map(PathBuf::as_path),
+            )?;
             let target = OutputTarget::new(output.as_deref(), "--output")?;
-            let baseline_file = baseline.as_ref().map(|p| p.display().to_string());
+            let baseline_file = baseline.as_deref().map(crate::input::name);
             let baseline = baseline.as_deref().map(crate::comparison::load_baseline).transpose()?;
             let options =
                 PlanOptions { rtol, max_evals, max_seconds, colour, rtol_from_data, ..PlanOptions::default() };

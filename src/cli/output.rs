@@ -24,8 +24,9 @@ pub struct OutputTarget {
 }
 
 impl OutputTarget {
-    /// `None` is standard output. A path is refused now if it exists or its directory does not.
+    /// `None` and `-` are standard output. A path is refused now if it exists or its directory does not.
     pub fn new(path: Option<&Path>, option: &str) -> Result<OutputTarget> {
+        let path = path.filter(|p| p.as_os_str() != "-");
         if let Some(p) = path {
             check_new_file(p, option)?;
         }

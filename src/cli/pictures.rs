@@ -9,7 +9,7 @@ use plotters::prelude::*;
 use serde_json::Value;
 
 use super::common::check_rtol;
-use super::plot::plot_err;
+use super::plot::{plot_err, Mark};
 use crate::brdf::{mirror, Brdf};
 use crate::colorimetry::weighting::Weighting;
 use crate::comparison::Comparison;
@@ -38,9 +38,13 @@ pub struct PlotArgs {
     /// `/roughness=0.02..0.3`.
     #[arg(long)]
     pub vary: Option<String>,
-    /// For gloss-vs-parameter: how many values, evenly spaced.
+    /// For gloss-vs-parameter: how many values.
     #[arg(long, default_value_t = 9)]
     pub points: usize,
+    /// For gloss-vs-parameter: how the values are spaced. `auto`: logarithmically when the range spans a
+    /// decade or more (LO > 0 and HI ≥ 10·LO, as a roughness range does), else evenly.
+    #[arg(long, value_enum, default_value_t = Spacing::Auto)]
+    pub spacing: Spacing,
     /// Relative tolerance of the readings (gloss-vs-parameter).
     #[arg(long, default_value_t = 1e-5)]
     pub rtol: f64,
@@ -49,7 +53,36 @@ pub struct PlotArgs {
     pub output: PathBuf,
 }
 
+/// The spacing of the values of gloss-vs-parameter.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Spacing {
+    Auto,
+    Linear,
+    Log,
+}
+
 const DEFAULT: &[&str] = &["astm-d523-20", "astm-d523-60", "astm-d523-85"];
+
+/// The axis name of a recipe number (docs/instrument.md §Pictures): the registry's words for it, the
+/// alternative that names the recipe's own choice where the words offer several (`GGX α` out of `Beckmann rms
+/// slope m or GGX α` for a GGX recipe), its unit, and the pointer: `GGX α (slope), /roughness`.
+pub fn parameter_label(recipe: &Value, pointer: &str) -> String {
+    let model = recipe.get("model").and_then(Value::as_str).unwrap_or("");
+    let Some(p) = crate::registry::lookup(model, pointer) else { return format!("recipe {pointer}") };
+    let first = p.description.split(';').next().unwrap_or("").trim();
+    let parent = pointer.rsplit_once('/').map_or("", |(a, _)| a);
+    let choices: Vec<String> = recipe
+        .pointer(parent)
+        .and_then(Value::as_object)
+        .map(|o| o.values().filter_map(Value::as_str).map(str::to_lowercase).collect())
+        .unwrap_or_default();
+    let words = first
+        .split(" or ")
+        .find(|alt| choices.iter().any(|c| !c.is_empty() && alt.to_lowercase().contains(c.as_str())))
+        .unwrap_or(first);
+    let unit = if p.unit.is_empty() { String::new() } else { format!(" ({})", p.unit) };
+    format!("{words}{unit}, {pointer}")
+}
 
 pub fn run(a: PlotArgs) -> Result<()> {
     super::plot::check_plot_path(&a.output, "--output")?;
@@ -79,8 +112,8 @@ pub fn run(a: PlotArgs) -> Result<()> {
             if !(2..=200).contains(&a.points) {
                 return Err(Error::Usage(format!("--points must be 2 to 200, got {}", a.points)));
             }
-            let file = a.recipe.display().to_string();
-            let text = std::fs::read_to_string(&a.recipe).map_err(|source| Error::Io { file: file.clone(), source })?;
+            let file = crate::input::name(&a.recipe);
+            let text = crate::input::read_text(&a.recipe, "recipe")?;
             let json: Value = crate::input::json::parse_json(&text, &file)?;
             match json.pointer(&pointer) {
                 Some(Value::Number(_)) => {}
@@ -94,9 +127,24 @@ pub fn run(a: PlotArgs) -> Result<()> {
                 None => return Err(Error::input(&file, &pointer, "--vary: no such field in the recipe")),
             }
             let name = recipe::parse_str(&text, &file)?.name;
+            let log = match a.spacing {
+                Spacing::Log if !(lo > 0.0) => {
+                    return Err(Error::Usage(format!("--spacing log needs LO > 0, got {}", crate::error::given(lo))))
+                }
+                Spacing::Log => true,
+                Spacing::Linear => false,
+                Spacing::Auto => lo > 0.0 && hi >= 10.0 * lo,
+            };
+            let label = parameter_label(&json, &pointer);
             let mut series: Vec<(String, Vec<(f64, f64)>)> = Vec::new();
             for k in 0..a.points {
-                let x = lo + (hi - lo) * k as f64 / (a.points - 1) as f64;
+                let t = k as f64 / (a.points - 1) as f64;
+                let x = match k {
+                    0 => lo,
+                    k if k == a.points - 1 => hi,
+                    _ if log => (lo.ln() + (hi.ln() - lo.ln()) * t).exp(),
+                    _ => lo + (hi - lo) * t,
+                };
                 let mut j = json.clone();
                 *j.pointer_mut(&pointer).expect("checked above") = serde_json::json!(x);
                 let m = recipe::parse_str(&j.to_string(), &file)
@@ -119,7 +167,7 @@ pub fn run(a: PlotArgs) -> Result<()> {
                 return Err(Error::Numeric("no reading has a value over the range".into()));
             }
             crate::render_plot!(&a.output, "--output", (1000, 640), |root| draw_vs_parameter(
-                root, &name, &pointer, &series
+                root, &name, &label, log, &series
             ))?;
         }
     }
@@ -210,18 +258,32 @@ fn section(brdf: &dyn Brdf, g: &StandardGeometry) -> Option<Section> {
     })
 }
 
+/// The log axis of a section panel (docs/instrument.md §Pictures): from half the smallest positive f_r of the
+/// curve (but not below 10⁻⁸ of its largest, so a lobe's far tail does not spread the axis over 20 decades) to
+/// twice the largest (10⁻³ to 1 when the regular part is 0 everywhere, a mirror). Values below the floor are
+/// drawn at it. Within the normal finite numbers: a floor of 0 or an infinite top made
+/// plotters' log scale loop for ever.
+fn section_axis(p: &Section) -> (f64, f64) {
+    let positive = p.curve.iter().map(|c| c.1).filter(|v| v.is_finite() && *v > 0.0);
+    let (min, max) = positive.fold((f64::INFINITY, 0.0f64), |(a, b), v| (a.min(v), b.max(v)));
+    let (lo, hi) = if max > 0.0 { ((min * 0.5).max(max * 1e-8), max * 2.0) } else { (f64::INFINITY, 0.0) };
+    if !(lo.is_finite() && hi > 0.0) {
+        return (1e-3, 1.0);
+    }
+    let lo = lo.clamp(f64::MIN_POSITIVE, 1e300);
+    let hi = hi.min(f64::MAX / 4.0).max(lo * 10.0);
+    (lo, hi)
+}
+
 fn draw_sections<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, name: &str, panels: &[Section]) -> Result<()> {
     root.fill(&WHITE).map_err(plot_err)?;
     let areas = root.split_evenly((panels.len(), 1));
     for (area, p) in areas.iter().zip(panels) {
-        // The log axis within the normal finite numbers: a floor of 0 (10⁻⁶ of a subnormal maximum) or an
-        // infinite top (3× a maximum near f64::MAX, or an infinite f_r) made plotters' log scale loop for ever.
-        let max = p.curve.iter().map(|c| c.1).fold(0.0f64, f64::max).min(f64::MAX);
-        let floor = if max > 0.0 { (max * 1e-6).max(f64::MIN_POSITIVE) } else { 1e-6 };
-        let top = if max > 0.0 { (max * 3.0).min(f64::MAX).max(floor * 10.0) } else { 1.0 };
+        let (floor, top) = section_axis(p);
+        let (chart_area, legend_area) = area.split_horizontally(680);
         let (x0, x1) = (p.curve[0].0, p.curve[p.curve.len() - 1].0);
-        let mut chart = ChartBuilder::on(area)
-            .caption(format!("{name}: in-plane section, {} (θi = {}°)", p.id, p.angle), ("sans-serif", 18))
+        let mut chart = ChartBuilder::on(&chart_area)
+            .caption(format!("in-plane section, {} (θi = {}°)", p.id, p.angle), ("sans-serif", 17))
             .margin(10)
             .x_label_area_size(40)
             .y_label_area_size(70)
@@ -231,165 +293,233 @@ fn draw_sections<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, name: &str, p
             .configure_mesh()
             .x_desc("θo in the plane of incidence (°, + on the specular side)")
             .y_desc("f_r (1/sr, luminous)")
-            .y_label_formatter(&|y| format!("{y:.0e}"))
+            .y_label_formatter(&|y| super::plot::tick(*y))
             .draw()
             .map_err(plot_err)?;
         let blue = RGBColor(40, 90, 200);
         let orange = RGBColor(230, 140, 20);
+        let mut legend: Vec<(Mark, String)> = vec![];
         for (i, (rname, a, b)) in p.receptors.iter().enumerate() {
             let c = Palette99::pick(i + 2).mix(0.22);
             chart
                 .draw_series(std::iter::once(Rectangle::new([(*a, floor), (*b, top)], c.filled())))
-                .map_err(plot_err)?
-                .label(format!("receptor {rname}: {a:.2}° … {b:.2}°"))
-                .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 16, y + 5)], c.filled()));
+                .map_err(plot_err)?;
+            legend.push((Mark::Box(c), format!("receptor {rname}: {a:.2}° … {b:.2}°")));
         }
         let (a, b) = p.source_image;
         chart
             .draw_series(std::iter::once(Rectangle::new([(a, floor), (b, top)], orange.mix(0.55).filled())))
-            .map_err(plot_err)?
-            .label(format!("mirror image of the source: {a:.2}° … {b:.2}°"))
-            .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 16, y + 5)], orange.mix(0.55).filled()));
+            .map_err(plot_err)?;
+        legend.push((Mark::Box(orange.mix(0.55)), format!("mirror image of the source: {a:.2}° … {b:.2}°")));
+        let clamped = p.curve.iter().filter(|c| c.1 < floor).count();
         let pts: Vec<(f64, f64)> = p.curve.iter().map(|&(x, y)| (x, y.max(floor).min(top))).collect();
-        chart
-            .draw_series(LineSeries::new(pts, blue.stroke_width(2)))
-            .map_err(plot_err)?
-            .label("regular part of f_r (values below the floor drawn at it)")
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], blue.stroke_width(2)));
+        if p.curve.iter().any(|c| c.1 > 0.0) {
+            chart.draw_series(LineSeries::new(pts, blue.stroke_width(2))).map_err(plot_err)?;
+            legend.push((
+                Mark::Line(blue.to_rgba()),
+                if clamped > 0 {
+                    format!("regular part of f_r ({clamped} of {} values below the axis drawn at it)", p.curve.len())
+                } else {
+                    "regular part of f_r".into()
+                },
+            ));
+        } else {
+            legend.push((Mark::Line(blue.to_rgba()), "regular part of f_r: 0 everywhere (not drawn)".into()));
+        }
         if let Some(r) = p.delta {
             chart
                 .draw_series(std::iter::once(PathElement::new(
                     vec![(p.angle, floor), (p.angle, top)],
                     BLACK.stroke_width(2),
                 )))
-                .map_err(plot_err)?
-                .label(format!("mirror (delta) component, R = {r:.4}"))
-                .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], BLACK.stroke_width(2)));
+                .map_err(plot_err)?;
+            legend.push((
+                Mark::Line(BLACK.to_rgba()),
+                format!("mirror (delta) component at the specular angle, reflectance R = {r:.4} (not on the f_r axis)"),
+            ));
         }
-        super::plot::draw_legend(&mut chart, SeriesLabelPosition::UpperRight, 12)?;
+        super::plot::draw_side_legend(&legend_area, name, &legend, 13)?;
     }
     root.present().map_err(plot_err)?;
     Ok(())
 }
 
+/// Readings against the parameter: x on a log axis when the values are log-spaced (drawn as log10 x with the
+/// ticks labelled in x), the legend beside the chart.
 fn draw_vs_parameter<DB: DrawingBackend>(
     root: DrawingArea<DB, Shift>,
     name: &str,
-    pointer: &str,
+    label: &str,
+    log: bool,
     series: &[(String, Vec<(f64, f64)>)],
 ) -> Result<()> {
     root.fill(&WHITE).map_err(plot_err)?;
-    let xs = series.iter().flat_map(|s| s.1.iter().map(|p| p.0));
+    let fx = |x: f64| if log { x.log10() } else { x };
+    let xs = series.iter().flat_map(|s| s.1.iter().map(|p| fx(p.0)));
     let (x0, x1) = xs.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| (a.min(x), b.max(x)));
     let ys = series.iter().flat_map(|s| s.1.iter().map(|p| p.1));
     let (y0, y1) = ys.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), y| (a.min(y), b.max(y)));
     let pad = 0.05 * (y1 - y0).abs().max(1e-9);
-    let mut chart = ChartBuilder::on(&root)
-        .caption(format!("{name}: readings against {pointer}"), ("sans-serif", 20))
+    let xpad = 0.02 * (x1 - x0).abs().max(1e-12);
+    let (chart_area, legend_area) = root.split_horizontally(720);
+    let mut units: Vec<&str> =
+        series.iter().filter_map(|s| s.0.rsplit_once('(').map(|(_, u)| u.trim_end_matches(')'))).collect();
+    units.dedup();
+    let y_desc =
+        if units.len() == 1 { format!("reading ({})", units[0]) } else { "reading (unit in the legend)".into() };
+    let mut chart = ChartBuilder::on(&chart_area)
+        .caption(format!("{name}: readings against {}", label.split(',').next().unwrap_or(label)), ("sans-serif", 18))
         .margin(12)
         .x_label_area_size(45)
         .y_label_area_size(70)
-        .build_cartesian_2d(x0..x1, (y0 - pad)..(y1 + pad))
+        .build_cartesian_2d((x0 - xpad)..(x1 + xpad), (y0 - pad)..(y1 + pad))
         .map_err(plot_err)?;
-    chart.configure_mesh().x_desc(format!("recipe {pointer}")).y_desc("reading").draw().map_err(plot_err)?;
+    let x_desc = if log { format!("{label} (log scale)") } else { label.to_string() };
+    chart
+        .configure_mesh()
+        .x_desc(x_desc)
+        .y_desc(y_desc)
+        .x_label_formatter(&|x| super::plot::tick(if log { 10f64.powf(*x) } else { *x }))
+        .draw()
+        .map_err(plot_err)?;
+    let mut legend = vec![];
     for (i, (label, pts)) in series.iter().enumerate() {
         let c = Palette99::pick(i).to_rgba();
-        chart
-            .draw_series(LineSeries::new(pts.clone(), c.stroke_width(2)))
-            .map_err(plot_err)?
-            .label(label.clone())
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], c.stroke_width(2)));
+        let pts: Vec<(f64, f64)> = pts.iter().map(|&(x, y)| (fx(x), y)).collect();
+        chart.draw_series(LineSeries::new(pts.clone(), c.stroke_width(2))).map_err(plot_err)?;
         chart.draw_series(pts.iter().map(|&p| Circle::new(p, 3, c.filled()))).map_err(plot_err)?;
+        legend.push((Mark::Line(c), label.clone()));
     }
-    super::plot::draw_legend(&mut chart, SeriesLabelPosition::UpperRight, 13)?;
+    let spacing = if log { "values spaced logarithmically" } else { "values spaced evenly" };
+    legend.push((Mark::Dot(BLACK.to_rgba()), format!("a computed reading ({spacing})")));
+    super::plot::draw_side_legend(&legend_area, "readings", &legend, 13)?;
     root.present().map_err(plot_err)?;
     Ok(())
 }
 
-/// `compare --plot`: measured (x: the mean of the sheet's repeats, with the measurement's allowance — k·s/√n
-/// plus the stated uncertainty — as a horizontal bar) against predicted (y, with the prediction's error
-/// estimate as a vertical bar), one colour per geometry and reading, and y = x.
+/// `compare --plot` (docs/instrument.md §Pictures): the residual predicted − measured of every reading with a
+/// prediction, in the reading's unit, against its row in the comparison; the allowance (k·s/√n + stated
+/// uncertainty + the prediction's error estimate, the verdict's threshold) as a band ±A about 0; each point
+/// coloured by its verdict (ok green, outside red, unchecked grey) and the verdict written beside it. The legend,
+/// beside the chart, names every row.
 pub fn write_comparison(path: &Path, cmp: &[Comparison]) -> Result<()> {
-    let mut groups: Vec<Group> = Vec::new();
+    let mut rows: Vec<Residual> = Vec::new();
     let mut names: Vec<&str> = Vec::new();
     for c in cmp {
-        let Some(p) = c.predicted.as_ref() else { continue };
-        let Some(v) = p.value else { continue };
+        let Some(d) = c.difference() else { continue };
         if !names.contains(&c.material.as_str()) {
             names.push(&c.material);
         }
-        let label = format!("{} {}", c.group.geometry, c.group.reading);
-        let bar = c.allowance.map(|a| a.statistical + a.stated).or(c.group.uncertainty).unwrap_or(0.0);
-        let pt = (c.group.stats.mean, v, bar, p.error_estimate);
-        match groups.iter_mut().find(|g| g.0 == label) {
-            Some(g) => g.1.push(pt),
-            None => groups.push((label, vec![pt])),
-        }
+        let unit = c.predicted.as_ref().map(|p| p.unit.clone()).unwrap_or_default();
+        rows.push(Residual {
+            label: format!("{} {} {}", c.group.sample, c.group.geometry, c.group.reading),
+            unit,
+            residual: d,
+            allowance: c.allowance.map(|a| a.total()),
+            verdict: c.verdict.label(),
+        });
     }
-    if groups.is_empty() {
+    if rows.is_empty() {
         return Err(Error::Numeric("nothing to plot: no row has a prediction with a value".into()));
     }
-    let name = if names.len() <= 3 { names.join(", ") } else { format!("{} samples", names.len()) };
-    crate::render_plot!(path, "--plot", (900, 800), |root| draw_comparison(root, &name, &groups))
+    let name = if names.len() == 1 { names[0].to_string() } else { format!("{} materials", names.len()) };
+    let h = 640.max(120 + 42 * rows.len().min(40) as u32);
+    crate::render_plot!(path, "--plot", (1100, h), |root| draw_comparison(root, &name, &rows))
 }
 
-/// A series label and its points (measured, predicted, measured's bar, predicted's bar).
-type Group = (String, Vec<(f64, f64, f64, f64)>);
+/// One row of the residual chart.
+struct Residual {
+    label: String,
+    unit: String,
+    residual: f64,
+    /// The verdict's threshold A (None: the row has no allowance and is unchecked).
+    allowance: Option<f64>,
+    verdict: &'static str,
+}
 
-fn draw_comparison<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, name: &str, groups: &[Group]) -> Result<()> {
-    root.fill(&WHITE).map_err(plot_err)?;
-    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-    for (_, pts) in groups {
-        for &(m, p, um, up) in pts {
-            lo = lo.min(m - um).min(p - up);
-            hi = hi.max(m + um).max(p + up);
-        }
+fn verdict_colour(v: &str) -> RGBAColor {
+    match v {
+        "ok" => RGBColor(30, 150, 60).to_rgba(),
+        "OUTSIDE" => RGBColor(210, 40, 40).to_rgba(),
+        _ => RGBColor(130, 130, 130).to_rgba(),
     }
-    // Within ±1e307 (a value of 1e308 ± 1e308 made the axis infinite, and plotters' key points looped); what
-    // lies beyond is clipped.
-    let (lo, hi) = (lo.clamp(-1e307, 1e307), hi.clamp(-1e307, 1e307));
-    let pad = 0.05 * (hi - lo).abs().max(1e-9);
-    let (lo, hi) = (lo - pad, hi + pad);
-    let mut chart = ChartBuilder::on(&root)
-        .caption(format!("{name}: predicted against measured"), ("sans-serif", 20))
+}
+
+fn draw_comparison<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, name: &str, rows: &[Residual]) -> Result<()> {
+    root.fill(&WHITE).map_err(plot_err)?;
+    // Symmetric about 0, wide enough for every residual and every band; within ±1e307 (a residual of 1e308
+    // made the axis infinite and plotters' key points loop); what lies beyond is clipped.
+    let span = rows
+        .iter()
+        .map(|r| r.residual.abs().max(r.allowance.unwrap_or(0.0)))
+        .filter(|v| v.is_finite())
+        .fold(0.0f64, f64::max)
+        .clamp(1e-12, 1e307)
+        * 1.25;
+    let n = rows.len();
+    let (chart_area, legend_area) = root.split_horizontally(760);
+    let mut units: Vec<&str> = rows.iter().map(|r| r.unit.as_str()).collect();
+    units.sort();
+    units.dedup();
+    let mut chart = ChartBuilder::on(&chart_area)
+        .caption(format!("{name}: predicted − measured, with the allowance"), ("sans-serif", 18))
         .margin(12)
         .x_label_area_size(45)
-        .y_label_area_size(70)
-        .build_cartesian_2d(lo..hi, lo..hi)
+        .y_label_area_size(80)
+        .build_cartesian_2d(0.4..(n as f64 + 0.6), -span..span)
         .map_err(plot_err)?;
     chart
         .configure_mesh()
-        .x_desc("measured (sheet), bar: the row's uncertainty")
-        .y_desc("predicted, bar: error estimate")
+        .x_desc("row of the comparison (named in the legend)")
+        .y_desc(format!("predicted − measured ({})", units.join(", ")))
+        .x_labels(n.min(20) + 1)
+        .x_label_formatter(&|x| {
+            let k = x.round();
+            if (x - k).abs() < 1e-6 && k >= 1.0 && k <= n as f64 {
+                format!("{k}")
+            } else {
+                String::new()
+            }
+        })
+        // The tick at 0 computed as 1.7e-18 is 0.
+        .y_label_formatter(&|y| super::plot::tick(if y.abs() < span * 1e-9 { 0.0 } else { *y }))
         .draw()
         .map_err(plot_err)?;
     chart
-        .draw_series(std::iter::once(PathElement::new(
-            vec![(lo, lo), (hi, hi)],
-            RGBColor(120, 120, 120).stroke_width(1),
-        )))
-        .map_err(plot_err)?
-        .label("predicted = measured")
-        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], RGBColor(120, 120, 120).stroke_width(1)));
-    for (i, (label, pts)) in groups.iter().enumerate() {
-        let c = Palette99::pick(i).to_rgba();
+        .draw_series(std::iter::once(PathElement::new(vec![(0.4, 0.0), (n as f64 + 0.6, 0.0)], BLACK.stroke_width(1))))
+        .map_err(plot_err)?;
+    let band = RGBColor(60, 120, 220).mix(0.22);
+    let mut legend = vec![(Mark::Box(band), "allowance ±A: inside ⇔ |predicted − measured| ≤ A".to_string())];
+    for (i, r) in rows.iter().enumerate() {
+        let x = i as f64 + 1.0;
+        if let Some(a) = r.allowance.filter(|a| a.is_finite()) {
+            let a = a.min(span);
+            chart
+                .draw_series(std::iter::once(Rectangle::new([(x - 0.3, -a), (x + 0.3, a)], band.filled())))
+                .map_err(plot_err)?;
+        }
+        let c = verdict_colour(r.verdict);
+        let y = r.residual.clamp(-span, span);
+        chart.draw_series(std::iter::once(Circle::new((x, y), 5, c.filled()))).map_err(plot_err)?;
         chart
-            .draw_series(
-                pts.iter().map(|&(m, p, _, up)| ErrorBar::new_vertical(m, p - up, p, p + up, c.stroke_width(2), 8)),
-            )
+            .draw_series(std::iter::once(Text::new(
+                r.verdict.to_string(),
+                (x + 0.08, y),
+                ("sans-serif", 13).into_font().color(&c),
+            )))
             .map_err(plot_err)?;
-        chart
-            .draw_series(
-                pts.iter().map(|&(m, p, um, _)| ErrorBar::new_horizontal(p, m - um, m, m + um, c.stroke_width(2), 8)),
-            )
-            .map_err(plot_err)?;
-        chart
-            .draw_series(pts.iter().map(|&(m, p, _, _)| Circle::new((m, p), 4, c.filled())))
-            .map_err(plot_err)?
-            .label(label.clone())
-            .legend(move |(x, y)| Circle::new((x + 8, y), 4, c.filled()));
+        if i < 40 {
+            let a = r.allowance.map(super::plot::tick).unwrap_or_else(|| "none".into());
+            legend.push((
+                Mark::Dot(c),
+                format!("{}: {}: {} (A = {a}) {}", i + 1, r.label, super::plot::tick(r.residual), r.verdict),
+            ));
+        }
     }
-    super::plot::draw_legend(&mut chart, SeriesLabelPosition::UpperLeft, 13)?;
+    if n > 40 {
+        legend.push((Mark::Dot(BLACK.to_rgba()), format!("… and {} more rows (in the table)", n - 40)));
+    }
+    super::plot::draw_side_legend(&legend_area, "rows and verdicts", &legend, 12)?;
     root.present().map_err(plot_err)?;
     Ok(())
 }

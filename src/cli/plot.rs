@@ -139,6 +139,81 @@ pub fn draw_legend<'a, DB: DrawingBackend + 'a, CT: plotters::coord::CoordTransl
         .map_err(plot_err)
 }
 
+/// The mark of a legend entry drawn beside a chart ([`draw_side_legend`]).
+#[derive(Clone, Copy, Debug)]
+pub enum Mark {
+    Line(RGBAColor),
+    Box(RGBAColor),
+    Dot(RGBAColor),
+}
+
+/// A legend beside the chart, in its own drawing area, so that it never covers the data: one entry per line
+/// (long texts wrapped at words), a mark then the text, in a sans-serif font of `size` px.
+pub fn draw_side_legend<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    title: &str,
+    entries: &[(Mark, String)],
+    size: u32,
+) -> Result<()> {
+    let (w, _) = area.dim_in_pixel();
+    let chars = ((w as f64 - 40.0) / (0.55 * size as f64)).max(10.0) as usize;
+    let font = ("sans-serif", size).into_font();
+    let line = size as i32 + 5;
+    let mut y = 30;
+    for l in wrap(title, chars + 3) {
+        area.draw(&Text::new(l, (8, y), font.clone().style(FontStyle::Bold))).map_err(plot_err)?;
+        y += line;
+    }
+    y += 4;
+    for (mark, text) in entries {
+        let c = y + size as i32 / 2;
+        match *mark {
+            Mark::Line(col) => area.draw(&PathElement::new(vec![(8, c), (26, c)], col.stroke_width(3))),
+            Mark::Box(col) => area.draw(&Rectangle::new([(8, c - 6), (26, c + 6)], col.filled())),
+            Mark::Dot(col) => area.draw(&Circle::new((17, c), 5, col.filled())),
+        }
+        .map_err(plot_err)?;
+        for l in wrap(text, chars) {
+            area.draw(&Text::new(l, (32, y), font.clone())).map_err(plot_err)?;
+            y += line;
+        }
+        y += 3;
+    }
+    Ok(())
+}
+
+/// Words wrapped into lines of at most `width` characters (a longer word stands alone).
+fn wrap(text: &str, width: usize) -> Vec<String> {
+    let mut lines: Vec<String> = vec![];
+    let mut cur = String::new();
+    for word in text.split_whitespace() {
+        if !cur.is_empty() && cur.chars().count() + 1 + word.chars().count() > width {
+            lines.push(std::mem::take(&mut cur));
+        }
+        if !cur.is_empty() {
+            cur.push(' ');
+        }
+        cur.push_str(word);
+    }
+    if !cur.is_empty() || lines.is_empty() {
+        lines.push(cur);
+    }
+    lines
+}
+
+/// A tick label with two significant digits: plain from 10⁻³ to 10⁴, else `3.2e-5`.
+pub fn tick(y: f64) -> String {
+    if y == 0.0 || !y.is_finite() {
+        return "0".into();
+    }
+    let r: f64 = format!("{y:.1e}").parse().unwrap_or(y);
+    if (1e-3..1e4).contains(&r.abs()) {
+        format!("{r}")
+    } else {
+        format!("{r:.1e}").replace(".0e", "e")
+    }
+}
+
 /// One series: (time, actual error, estimated error) per tolerance, loose to tight.
 struct Series {
     label: String,

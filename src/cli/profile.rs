@@ -101,15 +101,18 @@ pub fn run(args: ProfileArgs) -> Result<()> {
 pub const COLUMNS: &[&str] =
     &["pixel", "angle_deg", "angle_half_width_deg", "value", "error_estimate", "unit", "converged", "evaluations"];
 
-/// CSV: one line per pixel, every number in full precision; an empty value where there is none.
+/// CSV: one line per pixel, the angles in full precision, each value and its error estimate to their precision
+/// (`report::with_error`); an empty value where there is none.
 pub fn csv(p: &Profile) -> Result<String> {
     let rows = p.rows.iter().map(|r| {
+        let (value, error) =
+            r.reading.value.map(|v| crate::report::with_error(v, r.reading.error_estimate)).unwrap_or_default();
         [
             r.pixel.to_string(),
             plain(r.angle_deg),
             plain(r.half_width_deg),
-            r.reading.value.map(plain).unwrap_or_default(),
-            if r.reading.value.is_some() { plain(r.reading.error_estimate) } else { String::new() },
+            value,
+            error,
             r.reading.unit.clone(),
             r.reading.converged.to_string(),
             r.reading.evaluations.to_string(),

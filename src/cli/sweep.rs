@@ -1,6 +1,6 @@
 //! `glossmeter sweep`: a template recipe measured over a grid or a Latin hypercube of JSON Pointer paths,
 //! streamed as CSV or JSON lines. The points, shards and rows are the library's (`crate::sweep`); this module
-//! parses the arguments, draws the progress bar (only when stderr is a terminal) and writes.
+//! parses the arguments, draws the progress bar (only when stderr is a terminal; `cli::progress`) and writes.
 use std::io::IsTerminal;
 use std::path::PathBuf;
 
@@ -73,7 +73,7 @@ pub fn run(a: SweepArgs) -> Result<()> {
         return Err(Error::Usage("--max-evals must be at least 1".into()));
     }
     let target = OutputTarget::new(a.output.as_deref(), "--output")?;
-    let file = a.template.display().to_string();
+    let file = crate::input::name(&a.template);
     let text = crate::input::read_text(&a.template, "recipe")?;
     let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
     let template: serde_json::Value = serde_json::from_str(text).map_err(|e| {
@@ -84,31 +84,25 @@ pub fn run(a: SweepArgs) -> Result<()> {
     let s = Sweep::new(template, &file, axes, design, geos, options)?;
     let range = s.shard(k, m);
     let timing = !a.no_timing;
-    let bar = if std::io::stderr().is_terminal() {
-        let b = indicatif::ProgressBar::new(range.end - range.start);
-        b.set_style(
-            indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} points, {per_sec}, eta {eta}")
-                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-        );
-        b
-    } else {
-        indicatif::ProgressBar::hidden()
-    };
+    let bar = crate::cli::progress::Bar::new(range.end - range.start, std::io::stderr().is_terminal());
     let name = target.name();
     let io = |source: std::io::Error| Error::Io { file: name.clone(), source };
     target.stream(|out| {
         if a.format == SweepFormat::Csv && k == 1 {
             out.write_all(s.csv_header(timing).as_bytes()).map_err(io)?;
         }
-        s.run(range, |r| {
-            let line = match a.format {
-                SweepFormat::Csv => s.csv_row(&r, timing),
-                SweepFormat::Jsonl => s.jsonl_row(&r, timing),
-            };
-            bar.inc(1);
-            out.write_all(line.as_bytes()).map_err(io)
-        })
+        s.run_reporting(
+            range,
+            |r| {
+                let line = match a.format {
+                    SweepFormat::Csv => s.csv_row(&r, timing),
+                    SweepFormat::Jsonl => s.jsonl_row(&r, timing),
+                };
+                out.write_all(line.as_bytes()).map_err(io)
+            },
+            &|done| bar.report(done),
+        )
     })?;
-    bar.finish_and_clear();
+    bar.finish();
     Ok(())
 }

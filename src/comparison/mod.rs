@@ -24,8 +24,14 @@
 //! * [`sheet`]: the input format, instrument sheets as instruments and spreadsheets write them (encodings,
 //!   separators, decimal commas, header aliases, metadata, repeats: [`sheet::load`], [`sheet::parse`] →
 //!   [`sheet::Sheet`] of [`sheet::SheetRow`]s, [`sheet::READING_COLUMNS`]), with errors naming file, line and
-//!   column. It imports nothing of the crate but `input` and `error`.
+//!   column (or the workbook's sheet, row and cell). It imports nothing of the crate but `input`, `error` and its
+//!   two helpers:
+//! * [`workbook`]: one sheet of an `.xlsx`/`.xls`/`.ods` workbook (calamine) as the text the sheet reader reads;
+//! * [`series`]: the makers' statistics columns (`Mean 20°`, `Std 20°`, min, max, range) and their check
+//!   against the repeated readings.
+pub mod series;
 pub mod sheet;
+pub mod workbook;
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -428,7 +434,7 @@ pub struct BaselineEntry {
 
 /// Read a baseline file: the JSON of `measure` (one or many recipes) or of `compare`.
 pub fn load_baseline(path: &Path) -> Result<Vec<BaselineEntry>> {
-    let file = path.display().to_string();
+    let file = crate::input::name(path);
     // Read as every JSON input is: the size limit, a BOM, duplicate keys refused.
     let text = crate::input::read_text(path, "baseline")?;
     let doc = crate::input::json::parse_json(&text, &file)?;

@@ -16,10 +16,18 @@
 //! * repeated readings: several rows for the same sample, or columns with a repeat suffix (`60° #2`,
 //!   `60° (2)`, `60° [2]`).
 //!
+//! * the makers' statistics columns (`Mean 20°`, `Std 20°`, `Min`, `Max`, `Range`; [`super::series`]): each
+//!   value is checked against the series of readings it summarises;
+//! * workbooks (`.xlsx`, `.xls`, `.ods`, …; [`super::workbook`]): one sheet, by name or the first, read by the
+//!   same rules, positions named as cells (`sheet "Readings", row 5, cell C5`).
+//!
 //! A column the reader does not recognise is an error (unless the caller ignores it by name), so that no reading
-//! is silently dropped. Every error names the file, the line and the column.
+//! is silently dropped. Every error names the file, the line (or the workbook's sheet, row and cell) and the column.
+use std::collections::HashMap;
 use std::path::Path;
 
+use super::series::{self, Series, Statistic};
+use super::workbook;
 use crate::error::Words;
 use crate::{Error, Result};
 
@@ -185,6 +193,8 @@ pub struct SheetOptions {
     pub delimiter: Option<u8>,
     /// Column headers to skip (matched like aliases: case, spaces and punctuation do not matter).
     pub ignore_columns: Vec<String>,
+    /// The sheet of a workbook to read (the first when None); refused for a text sheet.
+    pub sheet_name: Option<String>,
 }
 
 /// One measured value.
@@ -231,6 +241,12 @@ pub struct Sheet {
     pub geometry_column: Option<usize>,
     pub quantity_column: Option<usize>,
     pub rows: Vec<SheetRow>,
+    /// The sheet read, when the file is a workbook (then `encoding` is `xlsx workbook` etc., lines are its rows,
+    /// and positions are named as its cells, counting columns from `first_column`, 0-based).
+    pub workbook_sheet: Option<String>,
+    pub first_column: u32,
+    /// The statistics cells (`Mean 20°`, …) checked against their series.
+    pub statistics_checked: usize,
 }
 
 impl Sheet {
@@ -251,11 +267,20 @@ impl Sheet {
         serde_json::Value::Object(m)
     }
 
-    /// `line L, column C (header)` of a row's sample or geometry cell.
+    /// `line L, column C (header)` of a row's sample or geometry cell (`sheet "S", row L, cell B7 (header)` in
+    /// a workbook).
     pub fn cell(&self, line: usize, column: Option<usize>, what: &str) -> String {
+        let place = self.place();
         match column {
-            Some(c) => at(line, c, &self.headers[c]),
-            None => format!("line {line} (no {what} column)"),
+            Some(c) => at(&place, line, c, &self.headers[c]),
+            None => format!("{} (no {what} column)", place.line(line)),
+        }
+    }
+
+    fn place(&self) -> Place {
+        match &self.workbook_sheet {
+            Some(sheet) => Place::Cells { sheet: sheet.clone(), first_column: self.first_column },
+            None => Place::Lines,
         }
     }
 
@@ -271,10 +296,41 @@ impl Sheet {
     }
 }
 
+/// Read a sheet file (or `-`, standard input): a workbook if its bytes are one ([`workbook::is_workbook`]),
+/// else text.
 pub fn load(path: &Path, options: &SheetOptions) -> Result<Sheet> {
-    let file = path.display().to_string();
+    let file = crate::input::name(path);
     let bytes = crate::input::read_bytes(path, "sheet")?;
+    if workbook::is_workbook(&bytes) {
+        return parse_workbook(&bytes, &file, options);
+    }
+    if options.sheet_name.is_some() {
+        return Err(Error::Argument(
+            Words::from(format!("{file} is a text sheet, not a workbook: "))
+                .and_argument("sheet_name")
+                .and(" names a sheet of an .xlsx, .xls or .ods workbook"),
+        ));
+    }
     parse_bytes(&bytes, &file, options)
+}
+
+/// A workbook's sheet (`options.sheet_name`, or the first) read by the rules of a text sheet.
+pub fn parse_workbook(bytes: &[u8], file: &str, options: &SheetOptions) -> Result<Sheet> {
+    if options.delimiter.is_some() {
+        return Err(Error::Argument(
+            Words::from(format!("{file} is a workbook, which has cells, not separators: "))
+                .and_argument("delimiter")
+                .and(" applies to text sheets"),
+        ));
+    }
+    let w = workbook::read(bytes, file, options.sheet_name.as_deref())?;
+    let place = Place::Cells { sheet: w.sheet.clone(), first_column: w.first_column };
+    let text_options = SheetOptions { delimiter: Some(b','), ..options.clone() };
+    let mut sheet = parse_at(&w.text, file, &text_options, &place)?;
+    sheet.encoding = format!("{} workbook", w.format);
+    sheet.workbook_sheet = Some(w.sheet);
+    sheet.first_column = w.first_column;
+    Ok(sheet)
 }
 
 /// Decode a sheet's bytes: a BOM decides; else UTF-8 if it is valid UTF-8; else Windows-1252.
@@ -382,6 +438,11 @@ enum Role {
     Uncertainty,
     /// An L*, a*, b* column of the colour layout (0, 1, 2).
     Lab(usize),
+    /// A maker's statistics column, of a named reading (geometry, reading) or of the row's reading.
+    Statistic {
+        stat: Statistic,
+        of: Option<(&'static str, &'static str)>,
+    },
     /// A reading column of the wide layout: geometry, reading, repeat index, not-predicted reason.
     Reading {
         geometry: &'static str,
@@ -424,12 +485,24 @@ fn role(header: &str, ignore: &[String]) -> Option<Role> {
     if let Some(g) = gloss_angle(&b) {
         return Some(Role::Reading { geometry: g, reading: "gloss", repeat, not_predicted: None });
     }
-    READING_COLUMNS.iter().find(|c| c.names.contains(&b.as_str())).map(|c| Role::Reading {
-        geometry: c.geometry,
-        reading: c.reading,
-        repeat,
-        not_predicted: c.not_predicted,
-    })
+    if let Some(c) = READING_COLUMNS.iter().find(|c| c.names.contains(&b.as_str())) {
+        return Some(Role::Reading {
+            geometry: c.geometry,
+            reading: c.reading,
+            repeat,
+            not_predicted: c.not_predicted,
+        });
+    }
+    // A statistics column: `Mean 20°`, `20° Std`, `Range Haze`, or a bare `Mean` (of the row's reading).
+    let (stat, rest) = series::split(&n)?;
+    if rest.is_empty() {
+        return Some(Role::Statistic { stat, of: None });
+    }
+    let of = match gloss_angle(rest) {
+        Some(g) => (g, "gloss"),
+        None => READING_COLUMNS.iter().find(|c| c.names.contains(&rest)).map(|c| (c.geometry, c.reading))?,
+    };
+    Some(Role::Statistic { stat, of: Some(of) })
 }
 
 /// The separator of the header line: the most frequent of `;`, `,` and tab outside quotes (`,` on a tie).
@@ -492,11 +565,56 @@ fn metadata_line(line: &str) -> Option<(String, String)> {
     ok.then(|| (k.to_lowercase(), v.trim().to_string()))
 }
 
-fn at(line: usize, col: usize, header: &str) -> String {
-    format!("line {line}, column {} ({header})", col + 1)
+/// How positions in a sheet are named: lines and columns of a text file, or a workbook sheet's rows and cells.
+#[derive(Clone, Debug, PartialEq)]
+enum Place {
+    Lines,
+    Cells { sheet: String, first_column: u32 },
 }
 
+impl Place {
+    /// `line 7`, or `sheet "Readings", row 7`.
+    fn line(&self, line: usize) -> String {
+        match self {
+            Place::Lines => format!("line {line}"),
+            Place::Cells { sheet, .. } => format!("sheet \"{sheet}\", row {line}"),
+        }
+    }
+
+    /// `line 7, column 3`, or `sheet "Readings", row 7, cell C7`.
+    fn column(&self, line: usize, col: usize) -> String {
+        match self {
+            Place::Lines => format!("line {line}, column {}", col + 1),
+            Place::Cells { sheet, first_column } => {
+                format!("sheet \"{sheet}\", row {line}, cell {}", workbook::cell_name(line, first_column + col as u32))
+            }
+        }
+    }
+}
+
+fn at(place: &Place, line: usize, col: usize, header: &str) -> String {
+    format!("{} ({header})", place.column(line, col))
+}
+
+/// A statistics cell of a row, checked once the whole sheet is read.
+struct StatCell {
+    line: usize,
+    column: usize,
+    stat: Statistic,
+    sample: String,
+    geometry: String,
+    reading: String,
+    value: f64,
+    /// The cell as written (its decimals are the statistic's precision).
+    text: String,
+}
+
+/// Parse a text sheet (`file` names it in messages).
 pub fn parse(text: &str, file: &str, options: &SheetOptions) -> Result<Sheet> {
+    parse_at(text, file, options, &Place::Lines)
+}
+
+fn parse_at(text: &str, file: &str, options: &SheetOptions, place: &Place) -> Result<Sheet> {
     let metadata: Vec<(String, String)> = text.lines().filter_map(metadata_line).collect();
     let header_line = text.lines().find(|l| !l.trim().is_empty() && !l.trim_start().starts_with('#'));
     let Some(header_line) = header_line else {
@@ -529,14 +647,14 @@ pub fn parse(text: &str, file: &str, options: &SheetOptions) -> Result<Sheet> {
     let mut roles = Vec::new();
     for (j, h) in headers.iter().enumerate() {
         if h.is_empty() {
-            return Err(Error::input(file, at(hline, j, "empty"), "empty column header"));
+            return Err(Error::input(file, at(place, hline, j, "empty"), "empty column header"));
         }
         match role(h, &options.ignore_columns) {
             Some(r) => roles.push(r),
             None => {
                 return Err(Error::input(
                     file,
-                    at(hline, j, h),
+                    at(place, hline, j, h),
                     Words::from(format!(
                         "unrecognised column `{h}` (the columns glossmeter reads are listed in docs/instrument.md \
                          §Sheets; pass "
@@ -553,7 +671,7 @@ pub fn parse(text: &str, file: &str, options: &SheetOptions) -> Result<Sheet> {
             if roles[i] == roles[j] && !matches!(roles[j], Role::Info | Role::Ignored) {
                 return Err(Error::input(
                     file,
-                    at(hline, j, &headers[j]),
+                    at(place, hline, j, &headers[j]),
                     format!(
                         "duplicate column: `{}` means the same as column {} (`{}`); number repeated readings \
                          as `60° #1`, `60° #2`",
@@ -573,15 +691,23 @@ pub fn parse(text: &str, file: &str, options: &SheetOptions) -> Result<Sheet> {
         (Some(_), None) if lab_cols.iter().all(Option::is_some) => Layout::Colour,
         (Some(_), Some(_)) => Layout::Long,
         (Some(_), None) => {
-            return Err(Error::input(file, format!("line {hline} (header)"), "the long layout needs a `value` column"))
+            return Err(Error::input(
+                file,
+                format!("{} (header)", place.line(hline)),
+                "the long layout needs a `value` column",
+            ))
         }
         (None, Some(v)) => {
-            return Err(Error::input(file, at(hline, v, &headers[v]), "the long layout needs a `geometry` column"))
+            return Err(Error::input(
+                file,
+                at(place, hline, v, &headers[v]),
+                "the long layout needs a `geometry` column",
+            ))
         }
         (None, None) if reading_cols.is_empty() => {
             return Err(Error::input(
                 file,
-                format!("line {hline} (header)"),
+                format!("{} (header)", place.line(hline)),
                 "no reading columns: expected `geometry` and `value` (long layout) or reading columns such as \
                  20°, 60°, 85°, Haze, DOI (wide layout)",
             ))
@@ -592,37 +718,65 @@ pub fn parse(text: &str, file: &str, options: &SheetOptions) -> Result<Sheet> {
         if let Some(j) = roles.iter().position(|r| matches!(r, Role::Lab(_))) {
             return Err(Error::input(
                 file,
-                at(hline, j, &headers[j]),
+                at(place, hline, j, &headers[j]),
                 "an L*, a* or b* column belongs to the colour layout: a `geometry` column with all three of `L*`, \
                  `a*`, `b*` and no `value` column",
             ));
         }
     }
     if layout == Layout::Colour {
-        if let Some(j) =
-            roles.iter().position(|r| matches!(r, Role::Quantity | Role::Uncertainty | Role::Reading { .. }))
-        {
+        if let Some(j) = roles.iter().position(|r| {
+            matches!(r, Role::Quantity | Role::Uncertainty | Role::Reading { .. } | Role::Statistic { .. })
+        }) {
             return Err(Error::input(
                 file,
-                at(hline, j, &headers[j]),
-                "a colour-layout sheet (`geometry` with `L*`, `a*`, `b*`) has no other reading, quantity or uncertainty columns",
+                at(place, hline, j, &headers[j]),
+                "a colour-layout sheet (`geometry` with `L*`, `a*`, `b*`) has no other reading, quantity, \
+                 uncertainty or statistics columns",
             ));
         }
     } else if layout == Layout::Long {
         if let Some(&j) = reading_cols.first() {
             return Err(Error::input(
                 file,
-                at(hline, j, &headers[j]),
+                at(place, hline, j, &headers[j]),
                 "a reading column in a long-layout sheet (one with `geometry` and `value`): use one layout",
             ));
         }
     } else if let Some(j) = roles.iter().position(|r| matches!(r, Role::Quantity | Role::Uncertainty)) {
         return Err(Error::input(
             file,
-            at(hline, j, &headers[j]),
+            at(place, hline, j, &headers[j]),
             "`quantity` and `uncertainty` belong to the long layout (with `geometry` and `value`)",
         ));
     }
+    // A statistics column without a reading in its name (`Mean`) is of the row's reading: in the wide layout
+    // there must be just one.
+    let mut wide_reading: Option<(&'static str, &'static str)> = None;
+    if layout == Layout::Wide {
+        for &c in &reading_cols {
+            if let Role::Reading { geometry, reading, .. } = roles[c] {
+                match wide_reading {
+                    Some(r) if r != (geometry, reading) => {
+                        if let Some(j) = roles.iter().position(|r| matches!(r, Role::Statistic { of: None, .. })) {
+                            return Err(Error::input(
+                                file,
+                                at(place, hline, j, &headers[j]),
+                                format!(
+                                    "a statistics column without a reading in its name is of the sheet's one reading, \
+                                     but this sheet has several (`{}`, `{}`): name it, e.g. `{} {}`",
+                                    headers[reading_cols[0]], headers[c], headers[j], headers[reading_cols[0]]
+                                ),
+                            ));
+                        }
+                    }
+                    _ => wide_reading = Some((geometry, reading)),
+                }
+            }
+        }
+    }
+    let stat_cols: Vec<usize> = (0..roles.len()).filter(|&j| matches!(roles[j], Role::Statistic { .. })).collect();
+    let mut stat_cells: Vec<StatCell> = vec![];
     let sample_c = find(&Role::Sample);
     let ignored_columns = (0..roles.len()).filter(|&j| roles[j] == Role::Ignored).map(|j| headers[j].clone()).collect();
     let mut rows = Vec::new();
@@ -636,16 +790,20 @@ pub fn parse(text: &str, file: &str, options: &SheetOptions) -> Result<Sheet> {
             let j = rec.len().min(headers.len());
             return Err(Error::input(
                 file,
-                format!("line {line}, column {}", j + 1),
+                place.column(line, j),
                 format!("{} fields, but the header (line {hline}) has {}", rec.len(), headers.len()),
             ));
         }
         let get = |c: Option<usize>| c.and_then(|c| rec.get(c)).unwrap_or("").to_string();
         let num = |c: usize, what: &str, nonneg: bool| -> Result<f64> {
             let v = parse_number(&rec[c])
-                .map_err(|m| Error::input(file, at(line, c, &headers[c]), format!("{what}: {m}")))?;
+                .map_err(|m| Error::input(file, at(place, line, c, &headers[c]), format!("{what}: {m}")))?;
             if nonneg && v < 0.0 {
-                return Err(Error::input(file, at(line, c, &headers[c]), format!("{what} must be ≥ 0, got {v}")));
+                return Err(Error::input(
+                    file,
+                    at(place, line, c, &headers[c]),
+                    format!("{what} must be ≥ 0, got {v}"),
+                ));
             }
             Ok(v)
         };
@@ -655,7 +813,7 @@ pub fn parse(text: &str, file: &str, options: &SheetOptions) -> Result<Sheet> {
                 let (g, v) = (geo_c.expect("long"), val_c.expect("long"));
                 let geometry = get(Some(g));
                 if geometry.is_empty() {
-                    return Err(Error::input(file, at(line, g, &headers[g]), "empty geometry id"));
+                    return Err(Error::input(file, at(place, line, g, &headers[g]), "empty geometry id"));
                 }
                 let reading = match get(find(&Role::Quantity)) {
                     q if q.is_empty() => "gloss".to_string(),
@@ -679,7 +837,7 @@ pub fn parse(text: &str, file: &str, options: &SheetOptions) -> Result<Sheet> {
                 rows.push(SheetRow {
                     line,
                     column: headers[v].clone(),
-                    sample,
+                    sample: sample.clone(),
                     geometry,
                     reading,
                     value,
@@ -691,7 +849,7 @@ pub fn parse(text: &str, file: &str, options: &SheetOptions) -> Result<Sheet> {
                 let g = geo_c.expect("colour");
                 let geometry = get(Some(g));
                 if geometry.is_empty() {
-                    return Err(Error::input(file, at(line, g, &headers[g]), "empty geometry id"));
+                    return Err(Error::input(file, at(place, line, g, &headers[g]), "empty geometry id"));
                 }
                 for (i, c) in lab_cols.iter().enumerate() {
                     let c = c.expect("colour layout has all three");
@@ -729,9 +887,65 @@ pub fn parse(text: &str, file: &str, options: &SheetOptions) -> Result<Sheet> {
                 }
             }
         }
+        for &c in &stat_cols {
+            if rec[c].is_empty() {
+                continue;
+            }
+            let Role::Statistic { stat, of } = roles[c] else { unreachable!() };
+            let value = num(c, &format!("the stated {}", stat.name()), false)?;
+            let (geometry, reading) = match (of, layout) {
+                (Some((g, r)), _) => (g.to_string(), r.to_string()),
+                (None, Layout::Wide) => {
+                    let (g, r) = wide_reading.expect("a wide sheet has a reading column");
+                    (g.to_string(), r.to_string())
+                }
+                // The long layout: the row's own reading.
+                (None, _) => match rows.last().filter(|r| r.line == line) {
+                    Some(r) => (r.geometry.clone(), r.reading.clone()),
+                    None => continue,
+                },
+            };
+            stat_cells.push(StatCell {
+                line,
+                column: c,
+                stat,
+                sample: sample.clone(),
+                geometry,
+                reading,
+                value,
+                text: rec[c].to_string(),
+            });
+        }
+    }
+    // Each stated statistic against its series: the sample's readings of that reading in the whole sheet.
+    let mut series_of: HashMap<(&str, &str, &str), Vec<f64>> = HashMap::new();
+    for r in &rows {
+        series_of.entry((r.sample.as_str(), r.geometry.as_str(), r.reading.as_str())).or_default().push(r.value);
+    }
+    for sc in &stat_cells {
+        let (c, text) = (sc.column, &headers[sc.column]);
+        let sample = if sc.sample.is_empty() { String::new() } else { format!(" of sample `{}`", sc.sample) };
+        let Some(values) = series_of.get(&(sc.sample.as_str(), sc.geometry.as_str(), sc.reading.as_str())) else {
+            return Err(Error::input(
+                file,
+                at(place, sc.line, c, text),
+                format!(
+                    "a stated {}{sample}, but the sheet has no {} {} readings{sample} to check it against",
+                    sc.stat.name(),
+                    sc.geometry,
+                    sc.reading
+                ),
+            ));
+        };
+        series::check(sc.stat, sc.value, &sc.text, &Series::of(values))
+            .map_err(|m| Error::input(file, at(place, sc.line, c, text), format!("{m}{sample}")))?;
     }
     if rows.is_empty() {
-        return Err(Error::input(file, format!("line {hline} (header)"), "the sheet has a header but no readings"));
+        return Err(Error::input(
+            file,
+            format!("{} (header)", place.line(hline)),
+            "the sheet has a header but no readings",
+        ));
     }
     Ok(Sheet {
         file: file.to_string(),
@@ -746,6 +960,9 @@ pub fn parse(text: &str, file: &str, options: &SheetOptions) -> Result<Sheet> {
         geometry_column: geo_c,
         quantity_column: find(&Role::Quantity),
         rows,
+        workbook_sheet: None,
+        first_column: 0,
+        statistics_checked: stat_cells.len(),
     })
 }
 

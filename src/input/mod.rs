@@ -6,12 +6,14 @@
 //! The folder:
 //! * `mod.rs` (this): [`read_text`] and [`read_bytes`] with the text limit [`MAX_TEXT_BYTES`], and their
 //!   `_limited` forms ([`read_text_limited`], [`read_bytes_limited`]) that the measured tables use with
-//!   [`MAX_TABLE_BYTES`];
+//!   [`MAX_TABLE_BYTES`]; the path `-` is standard input ([`is_stdin`], named [`STDIN`] in messages), which
+//!   one input of a run may be (docs/instrument.md §Standard input and output);
 //! * `json.rs`: a JSON document read with errors that name the file and the field's JSON Pointer
 //!   ([`json::parse_json`], which refuses duplicate keys, [`json::Obj`] and its typed accessors, [`json::kind`],
 //!   [`json::show`]); every recipe and geometry-file parser reads through it.
 use std::io::Read;
 use std::path::Path;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use crate::{Error, Result};
 
@@ -24,6 +26,38 @@ pub const MAX_TEXT_BYTES: u64 = 16 * 1024 * 1024;
 /// The largest measured table (RGL `.bsdf`, in-plane CSV, ASTM E1392 text): 256 MiB. A MERL-resolution
 /// isotropic table is 34 MB (90 × 90 × 180 × 3 doubles); RGL files of measured materials are 1–60 MB.
 pub const MAX_TABLE_BYTES: u64 = 256 * 1024 * 1024;
+
+/// How standard input is named in messages (the path `-`).
+pub const STDIN: &str = "<stdin>";
+
+/// Whether a path is `-`, standard input (a file named `-` is still reachable as `./-`).
+pub fn is_stdin(path: &Path) -> bool {
+    path.as_os_str() == "-"
+}
+
+/// A path as messages name it: the path as given, or [`STDIN`] for `-`.
+pub fn name(path: &Path) -> String {
+    if is_stdin(path) {
+        STDIN.into()
+    } else {
+        path.display().to_string()
+    }
+}
+
+/// Refuse, before any reading, a run that names `-` for two inputs (standard input can be read once).
+pub fn at_most_one_stdin<'a>(paths: impl IntoIterator<Item = &'a Path>) -> Result<()> {
+    if paths.into_iter().filter(|p| is_stdin(p)).count() > 1 {
+        return Err(Error::Usage(
+            "`-` (standard input) is given for a second input: standard input can be read once, so at most one \
+             input may be `-`"
+                .into(),
+        ));
+    }
+    Ok(())
+}
+
+/// Set when standard input has been read: it can be read once, so a second `-` is an error, not an empty file.
+static STDIN_READ: AtomicBool = AtomicBool::new(false);
 
 /// Read a UTF-8 text file of at most [`MAX_TEXT_BYTES`]; `what` names the kind of file in messages.
 pub fn read_text(path: &Path, what: &str) -> Result<String> {
@@ -38,11 +72,21 @@ pub fn read_bytes(path: &Path, what: &str) -> Result<Vec<u8>> {
 /// The bytes of a file of at most `limit` bytes; a larger one (or an endless one, `/dev/zero`) is refused
 /// after reading `limit` + 1 bytes, naming the file and the limit.
 pub fn read_bytes_limited(path: &Path, what: &str, limit: u64) -> Result<Vec<u8>> {
-    let file = path.display().to_string();
+    let file = name(path);
     let io = |source| Error::Io { file: file.clone(), source };
-    let f = std::fs::File::open(path).map_err(io)?;
     let mut bytes = Vec::new();
-    f.take(limit + 1).read_to_end(&mut bytes).map_err(io)?;
+    if is_stdin(path) {
+        if STDIN_READ.swap(true, Ordering::SeqCst) {
+            return Err(Error::Usage(format!(
+                "`-` (standard input) is given for a second input (a {what}): standard input can be read once, so \
+                 at most one input may be `-`"
+            )));
+        }
+        std::io::stdin().lock().take(limit + 1).read_to_end(&mut bytes).map_err(io)?;
+    } else {
+        let f = std::fs::File::open(path).map_err(io)?;
+        f.take(limit + 1).read_to_end(&mut bytes).map_err(io)?;
+    }
     if bytes.len() as u64 > limit {
         return Err(Error::input(
             &file,
@@ -55,7 +99,7 @@ pub fn read_bytes_limited(path: &Path, what: &str, limit: u64) -> Result<Vec<u8>
 
 /// [`read_text`] with the limit given.
 pub fn read_text_limited(path: &Path, what: &str, limit: u64) -> Result<String> {
-    let file = path.display().to_string();
+    let file = name(path);
     let bytes = read_bytes_limited(path, what, limit)?;
     String::from_utf8(bytes).map_err(|e| {
         Error::input(

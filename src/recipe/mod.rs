@@ -67,7 +67,7 @@ pub struct Material {
 
 /// Read and validate a recipe file. I/O errors name the file.
 pub fn load_file(path: &std::path::Path) -> Result<Material> {
-    let file = path.display().to_string();
+    let file = crate::input::name(path);
     let text = crate::input::read_text(path, "recipe")?;
     parse_str(&text, &file)
 }

@@ -7,7 +7,7 @@ use std::path::Path;
 use schemars::JsonSchema;
 use serde::Serialize;
 
-use super::{csv_text, plain, pretty, to_json, BaselineDoc};
+use super::{csv_text, pretty, to_json, BaselineDoc};
 use crate::comparison::sheet::{self, Sheet};
 use crate::comparison::{ColourDifference, Comparison, Drift, Verdict, VerdictRule};
 use crate::Result;
@@ -263,10 +263,13 @@ pub fn csv(cmp: &[Comparison]) -> Result<String> {
         "verdict",
         "note",
     ];
-    let e = |v: Option<f64>| v.map(plain).unwrap_or_default();
+    // Numbers to their precision (docs/instrument.md §Numbers in text); the JSON keeps every digit.
+    let e = |v: Option<f64>| v.map(super::measured).unwrap_or_default();
     let rows = cmp.iter().map(|c| {
         let p = c.predicted.as_ref();
         let s = c.group.stats;
+        let (predicted, error) =
+            p.and_then(|p| p.value.map(|v| super::with_error(v, p.error_estimate))).unwrap_or_default();
         [
             c.group.lines[0].to_string(),
             c.group.sample.clone(),
@@ -278,8 +281,8 @@ pub fn csv(cmp: &[Comparison]) -> Result<String> {
             e(Some(s.std)),
             e(Some(s.min)),
             e(Some(s.max)),
-            e(p.and_then(|p| p.value)),
-            e(p.filter(|p| p.value.is_some()).map(|p| p.error_estimate)),
+            predicted,
+            error,
             e(c.difference()),
             e(c.allowance.map(|a| a.total())),
             c.verdict.label().to_string(),

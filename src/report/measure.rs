@@ -102,14 +102,16 @@ pub fn csv(readings: &[Reading], timing: bool) -> Result<String> {
     head.push("problem");
     head.push("note");
     let rows = readings.iter().map(|r| {
+        // The value and its error estimate to their precision (docs/instrument.md §Numbers in text).
+        let (value, error) = r.value.map(|v| super::with_error(v, r.error_estimate)).unwrap_or_default();
         let mut rec = vec![
             r.geometry.clone(),
             r.name.clone(),
             r.quantity.clone(),
-            r.value.map(plain).unwrap_or_default(),
+            value.clone(),
             r.unit.clone(),
-            r.value.map(|_| plain(r.error_estimate)).unwrap_or_default(),
-            r.value.and(r.data_uncertainty).map(plain).unwrap_or_default(),
+            error.clone(),
+            r.value.and(r.data_uncertainty).map(super::plain_two_digits).unwrap_or_default(),
             r.evaluations.to_string(),
             r.converged.to_string(),
         ];

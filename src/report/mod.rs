@@ -51,6 +51,102 @@ pub fn plain(v: f64) -> String {
     }
 }
 
+/// A measured number (a sheet's mean, std, min, max; a difference or an allowance built from them) for CSV and
+/// JUnit text: rounded to ten significant digits, then its shortest decimals, plain or scientific as [`plain`].
+/// A sheet's 99.99 averaged in binary is `99.99000000000001`; no instrument reads to 10⁻¹⁴ GU, so it prints
+/// `99.99` (docs/instrument.md §Numbers in text). JSON keeps the full double.
+pub fn measured(v: f64) -> String {
+    if !v.is_finite() || v == 0.0 {
+        return plain(v);
+    }
+    plain(format!("{v:.9e}").parse::<f64>().unwrap_or(v))
+}
+
+/// An error estimate alone for text (JUnit messages): two significant digits, rounded up (a printed estimate is
+/// never below the computed one); plain in [10⁻³, 10⁶), else `3.6e-11`.
+pub fn error_text(e: f64) -> String {
+    if !(e.is_finite() && e > 0.0) {
+        return plain(e);
+    }
+    two_digits_up(e)
+}
+
+/// A value and its error estimate for CSV, each to the precision the estimate gives it (docs/instrument.md
+/// §Numbers in text): the value rounded at the estimate's third significant digit (at most 17 significant
+/// digits), the estimate to two significant digits rounded up after adding the value's rounding (half a unit of
+/// its last printed digit), so that the printed estimate still covers the printed value's error. Both are plain
+/// decimals in [10⁻¹⁵, 10¹⁵) as [`plain`]: `89.14 ± 3.5763209946461607e-11` prints `89.1400000000000` and
+/// `0.000000000036`. A zero or non-finite estimate leaves the value at [`measured`].
+pub fn with_error(v: f64, e: f64) -> (String, String) {
+    match rounded(v, e) {
+        Some((value, up)) => (value, plain_two_digits(up)),
+        None => (measured(v), if e.is_finite() { plain(e) } else { String::new() }),
+    }
+}
+
+/// [`with_error`] for text (JUnit messages): the estimate as [`error_text`] writes it (`3.6e-11`).
+pub fn with_error_text(v: f64, e: f64) -> (String, String) {
+    match rounded(v, e) {
+        Some((value, up)) => (value, two_digits_up(up)),
+        None => (measured(v), if e.is_finite() { plain(e) } else { String::new() }),
+    }
+}
+
+/// The value rounded to its estimate's precision, and the estimate plus that rounding (None without a positive
+/// finite estimate).
+fn rounded(v: f64, e: f64) -> Option<(String, f64)> {
+    if !(v.is_finite() && e.is_finite() && e > 0.0) {
+        return None;
+    }
+    // The place of the estimate's third significant digit, and the value's decimals (negative: tens, ...).
+    let place = e.log10().floor() as i32 - 2;
+    let magnitude = if v == 0.0 { place } else { v.abs().log10().floor() as i32 };
+    let place = place.max(magnitude - 16);
+    let half_unit = 0.5 * 10f64.powi(place);
+    let value = if (1e-15..1e15).contains(&v.abs()) || v == 0.0 {
+        if place < 0 {
+            format!("{v:.*}", (-place) as usize)
+        } else {
+            let unit = 10f64.powi(place);
+            format!("{:.0}", (v / unit).round() * unit)
+        }
+    } else {
+        format!("{v:.*e}", (magnitude - place).clamp(0, 16) as usize)
+    };
+    Some((value, e + half_unit))
+}
+
+/// `x` > 0 rounded up to two significant digits, as [`plain`] writes numbers (plain in [10⁻¹⁵, 10¹⁵)).
+/// An uncertainty in CSV: two significant digits, rounded up, as plain decimals from 10⁻¹⁵ to 10¹⁵.
+pub(crate) fn plain_two_digits(x: f64) -> String {
+    let (r, q) = up_two_digits(x);
+    if (1e-15..1e15).contains(&r) {
+        format!("{r:.*}", (1 - q).max(0) as usize)
+    } else {
+        format!("{r:.1e}")
+    }
+}
+
+/// `x` > 0 rounded up to two significant digits, and the power of ten of its first digit.
+fn up_two_digits(x: f64) -> (f64, i32) {
+    let q = x.log10().floor() as i32;
+    let unit = 10f64.powi(q - 1);
+    // The quotient carries the division's rounding; a hair above a whole number is that number.
+    let m = x / unit;
+    let m = if m - m.floor() < 1e-12 { m.floor() } else { m.ceil() };
+    (m * unit, q)
+}
+
+/// `x` > 0 rounded up to two significant digits: plain in [10⁻³, 10⁶), else `3.6e-11`.
+fn two_digits_up(x: f64) -> String {
+    let (r, q) = up_two_digits(x);
+    if (1e-3..1e6).contains(&r) {
+        format!("{r:.*}", (1 - q).max(0) as usize)
+    } else {
+        format!("{r:.1e}")
+    }
+}
+
 /// A reading's value for a table: `decimals` places, or three significant digits in scientific notation
 /// from 10¹⁵ on (a 1e300-class reading is not a 300-character column).
 pub fn shown(v: f64, decimals: usize) -> String {
@@ -383,4 +479,34 @@ fn reading_doc_nullable(schema: &mut schemars::Schema) {
 
 fn sweep_reading_doc_nullable(schema: &mut schemars::Schema) {
     nullable_but_written(schema, &["value", "error_estimate"]);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn numbers_in_text_are_rounded_to_their_precision() {
+        assert_eq!(measured(99.99000000000001), "99.99");
+        assert_eq!(measured(0.1 + 0.2), "0.3");
+        assert_eq!(measured(-2.5e-20), "-2.5e-20");
+        assert_eq!(error_text(0.000000000035763209946461607), "3.6e-11");
+        assert_eq!(error_text(0.0123), "0.013");
+        assert_eq!(error_text(0.012), "0.012");
+        assert_eq!(error_text(250.0), "250");
+        assert_eq!(
+            with_error_text(89.13999999999999, 3.5763209946461607e-11),
+            ("89.1400000000000".into(), "3.6e-11".into())
+        );
+        // CSV keeps plain decimals.
+        assert_eq!(with_error(89.14, 3.5763209946461607e-11).1, "0.000000000036");
+        assert_eq!(with_error(12.345, 0.21), ("12.345".into(), "0.22".into()));
+        assert_eq!(with_error(12345.4, 250.0), ("12345".into(), "260".into()));
+        // The printed estimate covers the printed value's error, whatever the digits.
+        for (v, e) in [(1.23456789, 3.3e-4), (0.7, 0.0101), (-4.4, 0.0999), (5e20, 1e12), (1.5e-9, 2e-13)] {
+            let (vs, es) = with_error(v, e);
+            let (pv, pe): (f64, f64) = (vs.parse().unwrap(), es.parse().unwrap());
+            assert!(pe >= e && (pv - v).abs() <= pe - e + 1e-15 * v.abs(), "{v} {e}: {vs} {es}");
+        }
+    }
 }

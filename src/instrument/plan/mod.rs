@@ -368,6 +368,12 @@ impl Plan {
     /// integral is the same method on the same material, on one thread; the order only decides when);
     /// each plan's wall-clock budget starts when its first integral does.
     pub fn run_all(plans: &[Plan]) -> Vec<Execution> {
+        Plan::run_all_reporting(plans, &|_, _| {})
+    }
+
+    /// [`Plan::run_all`], calling `done(plan, job)` on the worker thread as each specimen integral ends (for
+    /// progress: the weights of the integrals are their `expected_evaluations`). The results are the same bits.
+    pub fn run_all_reporting(plans: &[Plan], done_integral: &(dyn Fn(usize, usize) + Sync)) -> Vec<Execution> {
         let tasks: Vec<(usize, usize)> = plans
             .iter()
             .enumerate()
@@ -402,6 +408,7 @@ impl Plan {
                 if let Some(flux) = complete {
                     let _ = done[p].set(plan.execution(flux));
                 }
+                done_integral(p, j);
             }
         };
         let threads = rayon::current_num_threads().min(tasks.len()).max(1);
@@ -538,7 +545,7 @@ impl Plan {
     /// The jobs to run on the material, in plan order. Only these go to the thread pool: a plan with one
     /// specimen integral runs it on the calling thread (rayon runs a one-item parallel iterator in place),
     /// which spares a one-off small plan the hand-over to the pool and back (tens of µs).
-    fn specimen_jobs(&self) -> Vec<usize> {
+    pub fn specimen_jobs(&self) -> Vec<usize> {
         (0..self.jobs.len()).filter(|&j| self.standard_flux[j].is_none()).collect()
     }
 

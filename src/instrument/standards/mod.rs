@@ -146,7 +146,7 @@ pub fn builtin_all() -> Result<Vec<StandardGeometry>> {
 /// Load a user geometry file (same format as the builtin ones: a gloss geometry, or a colour geometry when it
 /// has a `kind`, `docs/colour.md`).
 pub fn load_file(path: &Path) -> Result<StandardGeometry> {
-    let name = path.display().to_string();
+    let name = crate::input::name(path);
     let text = crate::input::read_text(path, "geometry file")?;
     let is_colour = parse_json(&text, &name).map(|v| colour::is_colour_spec(&v)).unwrap_or(false);
     let g = if is_colour { colour::parse(&text, &name)? } else { parse(&text, &name)? };
