@@ -289,6 +289,9 @@ function markStale(text) {
 const measureSoon = debounce(measure, 300);
 
 function recipeChanged() {
+  // Whatever is under way describes an older recipe: it will never be shown as current.
+  state.measureSeq += 1;
+  if (state.measureAbort) state.measureAbort.abort();
   markStale("computing…");
   measureSoon();
   if ($("picture-live").checked && !$("panel-pictures").hidden) pictureSoon();
