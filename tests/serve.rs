@@ -61,9 +61,8 @@ fn parse(raw: &[u8]) -> Answer {
     let head = String::from_utf8_lossy(&raw[..split]).to_string();
     let mut lines = head.split("\r\n");
     let status: u16 = lines.next().unwrap().split(' ').nth(1).unwrap().parse().unwrap();
-    let headers: Vec<(String, String)> = lines
-        .filter_map(|l| l.split_once(':').map(|(k, v)| (k.trim().to_string(), v.trim().to_string())))
-        .collect();
+    let headers: Vec<(String, String)> =
+        lines.filter_map(|l| l.split_once(':').map(|(k, v)| (k.trim().to_string(), v.trim().to_string()))).collect();
     let mut body = raw[split + 4..].to_vec();
     if headers.iter().any(|(k, v)| k.eq_ignore_ascii_case("transfer-encoding") && v.contains("chunked")) {
         body = dechunk(&body);
@@ -152,28 +151,58 @@ fn the_endpoints_answer_on_the_command_lines_documents() {
     assert_eq!(a.status, 200, "{}", a.body);
     assert!(a.json()["plan"].as_str().unwrap().contains("astm-d523-60"));
     // plot: SVG from the command line's drawing code.
-    for kind in [json!({"kind": "section"}), json!({"kind": "profile"}), json!({"kind": "gloss-vs-parameter", "vary": "/ior=1.4..1.6", "points": 3})] {
+    for kind in [
+        json!({"kind": "section"}),
+        json!({"kind": "profile"}),
+        json!({"kind": "gloss-vs-parameter", "vary": "/ior=1.4..1.6", "points": 3}),
+    ] {
         let a = request(addr, "POST", "/api/plot", &with_recipe(&glass, kind.clone()), &[]);
         assert_eq!(a.status, 200, "{kind}: {}", a.body);
         assert_eq!(a.header("content-type"), Some("image/svg+xml"));
         assert!(a.body.starts_with("<svg"), "{kind}");
     }
     // sweep: the JSON lines of `sweep --format jsonl --no-timing`, streamed, with the count in X-Points.
-    let a = request(addr, "POST", "/api/sweep", &with_recipe(&glass, json!({"vary": ["/ior=1.4..1.6:3"], "geometries": ["astm-d523-60"]})), &[]);
+    let a = request(
+        addr,
+        "POST",
+        "/api/sweep",
+        &with_recipe(&glass, json!({"vary": ["/ior=1.4..1.6:3"], "geometries": ["astm-d523-60"]})),
+        &[],
+    );
     assert_eq!(a.status, 200, "{}", a.body);
     assert_eq!(a.header("x-points"), Some("3"));
     let rows: Vec<Value> = a.body.lines().map(|l| serde_json::from_str(l).unwrap()).collect();
     assert_eq!(rows.len(), 3);
     let cli = std::process::Command::new(env!("CARGO_BIN_EXE_glossmeter"))
-        .args(["sweep", "fixtures/recipes/black-glass.json", "--vary", "/ior=1.4..1.6:3", "-g", "astm-d523-60", "--format", "jsonl", "--no-timing"])
+        .args([
+            "sweep",
+            "fixtures/recipes/black-glass.json",
+            "--vary",
+            "/ior=1.4..1.6:3",
+            "-g",
+            "astm-d523-60",
+            "--format",
+            "jsonl",
+            "--no-timing",
+        ])
         .output()
         .unwrap();
-    let cli_rows: Vec<Value> = String::from_utf8(cli.stdout).unwrap().lines().map(|l| serde_json::from_str(l).unwrap()).collect();
-    assert_eq!(rows.iter().map(|r| &r["readings"]).collect::<Vec<_>>(), cli_rows.iter().map(|r| &r["readings"]).collect::<Vec<_>>());
+    let cli_rows: Vec<Value> =
+        String::from_utf8(cli.stdout).unwrap().lines().map(|l| serde_json::from_str(l).unwrap()).collect();
+    assert_eq!(
+        rows.iter().map(|r| &r["readings"]).collect::<Vec<_>>(),
+        cli_rows.iter().map(|r| &r["readings"]).collect::<Vec<_>>()
+    );
     // compare: the verdicts of a shipped sheet, in JSON, CSV and JUnit.
     let sheet = std::fs::read_to_string("fixtures/sheets/black-glass-check.csv").unwrap();
     for format in ["json", "csv", "junit"] {
-        let a = request(addr, "POST", "/api/compare", &with_recipe(&glass, json!({"sheet": {"name": "black-glass-check.csv", "text": sheet}, "format": format})), &[]);
+        let a = request(
+            addr,
+            "POST",
+            "/api/compare",
+            &with_recipe(&glass, json!({"sheet": {"name": "black-glass-check.csv", "text": sheet}, "format": format})),
+            &[],
+        );
         assert_eq!(a.status, 200, "{format}: {}", a.body);
         match format {
             "json" => {
@@ -187,7 +216,16 @@ fn the_endpoints_answer_on_the_command_lines_documents() {
         }
     }
     // fit: one free parameter to one target.
-    let a = request(addr, "POST", "/api/fit", &with_recipe(&glass, json!({"free": ["/ior=1.3..1.8"], "target": ["astm-d523-60/gloss=90±0.1"], "restarts": 0})), &[]);
+    let a = request(
+        addr,
+        "POST",
+        "/api/fit",
+        &with_recipe(
+            &glass,
+            json!({"free": ["/ior=1.3..1.8"], "target": ["astm-d523-60/gloss=90±0.1"], "restarts": 0}),
+        ),
+        &[],
+    );
     assert_eq!(a.status, 200, "{}", a.body);
     let doc = a.json();
     assert_eq!(doc["converged"], true, "{doc}");
@@ -207,7 +245,11 @@ fn bad_requests_get_the_librarys_message_as_json_400() {
         ("/api/measure", br#"{"recipe": {"model": "lambert", "albedo": 0.5}, "max_evals": 1e12}"#, "/max_evals"),
         ("/api/measure", br#"{"recipe": {"model": "lambert", "albedo": 0.5}, "bogus": 1}"#, "unknown field"),
         ("/api/plot", br#"{"recipe": {"model": "lambert", "albedo": 0.5}, "kind": "pie"}"#, "/kind"),
-        ("/api/sweep", br#"{"recipe": {"model": "lambert", "albedo": 0.5}, "vary": ["/albedo=0..1:100000"]}"#, "at most"),
+        (
+            "/api/sweep",
+            br#"{"recipe": {"model": "lambert", "albedo": 0.5}, "vary": ["/albedo=0..1:100000"]}"#,
+            "at most",
+        ),
         ("/api/compare", br#"{"recipe": {"model": "lambert", "albedo": 0.5}, "sheet": {"base64": "!!"}}"#, "base64"),
         ("/api/fit", br#"{"recipe": {"model": "lambert", "albedo": 0.5}, "free": [], "target": []}"#, "target"),
     ];
@@ -249,15 +291,19 @@ fn foreign_host_and_origin_are_refused() {
 
 #[test]
 fn oversize_bodies_are_refused_with_413() {
-    let addr = start(ServeOptions { limits: Limits { body_bytes: 4096, ..Limits::default() }, ..ServeOptions::default() });
-    let big = format!(r#"{{"recipe": {{"model": "lambert", "albedo": 0.5, "description": "{}"}}}}"#, "x".repeat(10_000));
+    let addr =
+        start(ServeOptions { limits: Limits { body_bytes: 4096, ..Limits::default() }, ..ServeOptions::default() });
+    let big =
+        format!(r#"{{"recipe": {{"model": "lambert", "albedo": 0.5, "description": "{}"}}}}"#, "x".repeat(10_000));
     let a = request(addr, "POST", "/api/measure", big.as_bytes(), &[]);
     assert_eq!(a.status, 413, "{}", a.body);
     assert!(a.json()["error"].as_str().unwrap().contains("4096"));
     // A body that says it is small and is not: read up to the cap, then refused.
     let mut s = TcpStream::connect(addr).unwrap();
     s.set_read_timeout(Some(Duration::from_secs(60))).unwrap();
-    let head = format!("POST /api/measure HTTP/1.1\r\nHost: {addr}\r\nConnection: close\r\nTransfer-Encoding: chunked\r\n\r\n");
+    let head = format!(
+        "POST /api/measure HTTP/1.1\r\nHost: {addr}\r\nConnection: close\r\nTransfer-Encoding: chunked\r\n\r\n"
+    );
     s.write_all(head.as_bytes()).unwrap();
     let chunk = "y".repeat(3000);
     for _ in 0..3 {
@@ -268,7 +314,11 @@ fn oversize_bodies_are_refused_with_413() {
     let _ = s.read_to_end(&mut raw);
     assert_eq!(parse(&raw).status, 413);
     // The server still answers.
-    let a = post(addr, "/api/measure", &json!({"recipe": {"model": "lambert", "albedo": 0.5}, "geometries": ["astm-d523-60"]}));
+    let a = post(
+        addr,
+        "/api/measure",
+        &json!({"recipe": {"model": "lambert", "albedo": 0.5}, "geometries": ["astm-d523-60"]}),
+    );
     assert_eq!(a.status, 200, "{}", a.body);
 }
 
@@ -294,7 +344,8 @@ fn tables_are_read_only_inside_the_data_directory() {
     assert_eq!(a.status, 200, "{}", a.body);
     assert!(a.json()["readings"][0]["value"].is_number());
     let outside = root.join("outside.binary").display().to_string();
-    let mut refused = vec!["../outside.binary", "merl/../../outside.binary", outside.as_str(), "missing.binary", "merl"];
+    let mut refused =
+        vec!["../outside.binary", "merl/../../outside.binary", outside.as_str(), "missing.binary", "merl"];
     if cfg!(unix) {
         refused.push("link.binary");
     }
@@ -344,7 +395,12 @@ fn a_flood_of_200_concurrent_requests_is_bounded_and_nothing_is_lost() {
     let elapsed = clock.elapsed();
     let ok: Vec<&Answer> = answers.iter().filter(|a| a.status == 200).collect();
     let busy = answers.iter().filter(|a| a.status == 503).count();
-    assert_eq!(ok.len() + busy, 200, "every answer is 200 or 503: {:?}", answers.iter().map(|a| a.status).collect::<Vec<_>>());
+    assert_eq!(
+        ok.len() + busy,
+        200,
+        "every answer is 200 or 503: {:?}",
+        answers.iter().map(|a| a.status).collect::<Vec<_>>()
+    );
     assert!(!ok.is_empty(), "some requests were served");
     assert!(busy > 0, "the concurrency cap answered the excess 503");
     for a in &ok {
