@@ -274,16 +274,24 @@ fn busy(s: &Shared) -> Response {
     r
 }
 
+/// A request's body (capped) and a permit to compute (or at once the 413 or 503 answer). The body is read
+/// before the permit is taken, so that a slow upload holds no permit.
+async fn admit(
+    s: &Shared,
+    req: Request,
+) -> std::result::Result<(axum::body::Bytes, tokio::sync::OwnedSemaphorePermit), Response> {
+    let bytes = body(s, req).await?;
+    let permit = s.permits.clone().try_acquire_owned().map_err(|_| busy(s))?;
+    Ok((bytes, permit))
+}
+
 type Endpoint = fn(&api::Request, Context) -> Result<Reply>;
 
 /// Run an endpoint on the blocking pool, if a permit is free (else 503 at once).
 async fn work(s: Arc<Shared>, req: Request, f: Endpoint) -> Response {
-    let bytes = match body(&s, req).await {
-        Ok(b) => b,
+    let (bytes, permit) = match admit(&s, req).await {
+        Ok(a) => a,
         Err(r) => return r,
-    };
-    let Ok(permit) = s.permits.clone().try_acquire_owned() else {
-        return busy(&s);
     };
     let shared = s.clone();
     let out = tokio::task::spawn_blocking(move || {
@@ -306,12 +314,9 @@ async fn work(s: Arc<Shared>, req: Request, f: Endpoint) -> Response {
 /// the `X-Points` header, so that a client can show progress). A failure after the first line ends the
 /// stream with a line `{"error": …}`.
 async fn sweep(State(s): State<Arc<Shared>>, req: Request) -> Response {
-    let bytes = match body(&s, req).await {
-        Ok(b) => b,
+    let (bytes, permit) = match admit(&s, req).await {
+        Ok(a) => a,
         Err(r) => return r,
-    };
-    let Ok(permit) = s.permits.clone().try_acquire_owned() else {
-        return busy(&s);
     };
     let shared = s.clone();
     let checked = tokio::task::spawn_blocking(move || {

@@ -137,3 +137,42 @@ def test_the_picture_and_the_screenshot(browser, tmp_path):
     assert d.save_screenshot(path)
     assert os.path.getsize(path) > 10_000
     assert console_errors(d) == []
+
+
+def test_a_sweep_streams_its_points_and_draws_its_curve(browser):
+    d = browser
+    wait_current(d)
+    choose_fixture(d, "black-glass")
+    d.find_element(By.ID, "tab-sweep").click()
+    Select(d.find_element(By.ID, "sweep-path")).select_by_value("/ior")
+    n = d.find_element(By.ID, "sweep-n")
+    n.clear()
+    n.send_keys("3")
+    d.find_element(By.ID, "sweep-go").click()
+    WebDriverWait(d, WAIT).until(lambda d: d.find_element(By.ID, "sweep-count").text == "3 / 3 points")
+    assert len(d.find_elements(By.CSS_SELECTOR, "#sweep-rows tbody tr")) == 3
+    WebDriverWait(d, WAIT).until(lambda d: (d.find_element(By.ID, "sweep-picture").get_attribute("src") or "").startswith("blob:"))
+    assert d.find_element(By.ID, "sweep-error").text == ""
+    assert console_errors(d) == []
+
+
+def test_a_fit_reaches_its_target(browser):
+    d = browser
+    wait_current(d)
+    choose_fixture(d, "black-glass")
+    d.find_element(By.ID, "tab-fit").click()
+    box = d.find_element(By.CSS_SELECTOR, "#fit-free input[value='/ior']")
+    box.click()
+    row = box.find_element(By.XPATH, "..")
+    for cls, v in (("lo", "1.3"), ("hi", "1.8")):
+        e = row.find_element(By.CLASS_NAME, cls)
+        e.clear()
+        e.send_keys(v)
+    t = d.find_element(By.ID, "fit-targets")
+    t.clear()
+    t.send_keys("astm-d523-60/gloss=90±0.1")
+    d.find_element(By.ID, "fit-go").click()
+    WebDriverWait(d, WAIT).until(lambda d: d.find_element(By.ID, "fit-verdict").text or d.find_element(By.ID, "fit-error").text)
+    assert d.find_element(By.ID, "fit-error").text == ""
+    assert d.find_element(By.ID, "fit-verdict").text.startswith("The fit is to be trusted"), d.find_element(By.ID, "fit-verdict").text
+    assert console_errors(d) == []
