@@ -398,6 +398,7 @@ fn a_flood_of_200_concurrent_requests_is_bounded_and_nothing_is_lost() {
     let elapsed = clock.elapsed();
     let ok: Vec<&Answer> = answers.iter().filter(|a| a.status == 200).collect();
     let busy = answers.iter().filter(|a| a.status == 503).count();
+    eprintln!("flood: {} served, {busy} answered busy, in {elapsed:?}", ok.len());
     assert_eq!(
         ok.len() + busy,
         200,
