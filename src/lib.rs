@@ -40,6 +40,8 @@ pub mod quadrature;
 pub mod recipe;
 pub mod registry;
 pub mod report;
+#[cfg(feature = "serve")]
+pub mod serve;
 pub mod spectrum;
 pub mod sweep;
 

@@ -106,4 +106,30 @@ pub enum Command {
     /// The goniophotometric profile about the 20° specular direction (Rhopoint IQ-class 512-pixel array):
     /// one row per pixel, angle and normalised reading with their error estimates (CSV or JSON).
     Profile(profile::ProfileArgs),
+    /// Serve the virtual meter as a local web page and an HTTP API (docs/serve.md); prints the address and
+    /// serves until stopped.
+    #[cfg(feature = "serve")]
+    Serve(ServeArgs),
+}
+
+/// The arguments of `glossmeter serve` (the server is `glossmeter::serve`, wired in by the binary).
+#[derive(clap::Args, Debug, Clone)]
+pub struct ServeArgs {
+    /// The port to listen on (0: any free port; the address printed says which).
+    #[arg(long, default_value_t = 8080)]
+    pub port: u16,
+    /// The address to listen on. Anything but loopback lets other machines reach the server (it warns).
+    #[arg(long, default_value = "127.0.0.1")]
+    pub host: String,
+    /// The directory recipes may name table files in (relative paths, no `..`, no symbolic links out);
+    /// without it no table file is read.
+    #[arg(long, value_name = "DIR")]
+    pub data_dir: Option<PathBuf>,
+    /// Another name the server answers to in the Host header (repeatable), e.g. the machine's name when
+    /// --host is not loopback.
+    #[arg(long = "allow-host", value_name = "NAME")]
+    pub allow_hosts: Vec<String>,
+    /// Computations running at once; further requests are answered 503 (busy) at once.
+    #[arg(long, default_value_t = 2)]
+    pub jobs: usize,
 }

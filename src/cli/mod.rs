@@ -43,8 +43,21 @@ use args::{Cli, Command, OutputSchema};
 use common::{check_rtol, readings_status, Format};
 use output::{print, OutputTarget, STDOUT};
 
-/// Run the CLI; returns the process exit status.
+/// Run the CLI; returns the process exit status. `glossmeter serve` needs the server, which stands above
+/// the command line: the binary passes it in through [`run_with`]; here it is refused.
 pub fn run<I, T>(args: I) -> i32
+where
+    I: IntoIterator<Item = T>,
+    T: Into<std::ffi::OsString> + Clone,
+{
+    run_with(args, &|_| Err(Error::Usage("this program has no server: run the glossmeter binary".into())))
+}
+
+/// The server of `glossmeter serve`, given by the caller ([`run_with`]).
+pub type Serve<'a> = &'a dyn Fn(&args::ServeArgs) -> Result<()>;
+
+/// Run the CLI with `serve` as the server of `glossmeter serve`; returns the process exit status.
+pub fn run_with<I, T>(args: I, serve: Serve) -> i32
 where
     I: IntoIterator<Item = T>,
     T: Into<std::ffi::OsString> + Clone,
@@ -65,7 +78,7 @@ where
             };
         }
     };
-    match dispatch(cli) {
+    match dispatch(cli, serve) {
         Ok(()) => 0,
         // A reader that went away (`glossmeter standards | head -1`) is not an error: end quietly, as
         // ripgrep does. Only standard output is treated so; a file that cannot be written is an error.
@@ -87,7 +100,7 @@ pub fn exit_status(e: &Error) -> i32 {
     }
 }
 
-fn dispatch(cli: Cli) -> Result<()> {
+fn dispatch(cli: Cli, #[allow(unused_variables)] serve: Serve) -> Result<()> {
     match cli.command {
         Command::Measure {
             recipes,
@@ -215,6 +228,8 @@ fn dispatch(cli: Cli) -> Result<()> {
         Command::Plot(args) => pictures::run(args),
         Command::Profile(args) => profile::run(args),
         Command::Sweep(args) => sweep::run(args),
+        #[cfg(feature = "serve")]
+        Command::Serve(args) => serve(&args),
         Command::Schema { output_format } => {
             let schema = match output_format {
                 None => recipe::schema::schema(),

@@ -523,3 +523,24 @@ fn draw_comparison<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, name: &str,
     root.present().map_err(plot_err)?;
     Ok(())
 }
+
+/// The in-plane section picture of `material` through `geometries` as an SVG document in memory (what
+/// `plot --kind section` writes to a file; the server's `/api/plot`).
+pub fn section_svg(material: &recipe::Material, geometries: &[StandardGeometry]) -> Result<String> {
+    let panels: Vec<Section> = geometries.iter().filter_map(|g| section(material.brdf.as_ref(), g)).collect();
+    if panels.is_empty() {
+        return Err(Error::Usage("none of the geometries has a receptor in the plane of incidence to draw".into()));
+    }
+    let h = 420 * panels.len() as u32;
+    super::plot::to_svg((1000, h), |root| draw_sections(root, &material.name, &panels))
+}
+
+/// Readings against one recipe number (`pointer`) as an SVG document in memory: `series` holds a label
+/// (geometry, reading, unit) and its (value of the number, reading) points, as `plot --kind
+/// gloss-vs-parameter` draws them.
+pub fn vs_parameter_svg(name: &str, pointer: &str, series: &[(String, Vec<(f64, f64)>)]) -> Result<String> {
+    if series.iter().all(|s| s.1.is_empty()) {
+        return Err(Error::Numeric("no reading has a value over the range".into()));
+    }
+    super::plot::to_svg((1000, 640), |root| draw_vs_parameter(root, name, pointer, series))
+}

@@ -362,3 +362,18 @@ fn tolerance_span(t: &[f64]) -> String {
 pub fn write_plot(sweep: &Sweep, title: &str, path: &Path) -> Result<PlotSummary> {
     crate::render_plot!(path, "--plot", (1000, 720), |root| draw_sweep(root, sweep, title))
 }
+
+/// Draw with `draw` into an SVG document of `size` pixels held in memory (the server's pictures,
+/// docs/serve.md): the same drawing code and embedded font as the files `render_plot!` writes.
+pub fn to_svg<T>(
+    size: (u32, u32),
+    draw: impl FnOnce(DrawingArea<SVGBackend<'_>, Shift>) -> Result<T>,
+) -> Result<String> {
+    register_font();
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
+        draw(root)?;
+    }
+    Ok(svg)
+}

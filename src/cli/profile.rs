@@ -195,3 +195,8 @@ fn draw<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, p: &Profile, title: &s
     root.present().map_err(plot_err)?;
     Ok(())
 }
+
+/// The profile's picture as an SVG document in memory (the server's `/api/plot`).
+pub fn svg(p: &Profile, title: &str) -> Result<String> {
+    super::plot::to_svg((1000, 640), |root| draw(root, p, title))
+}

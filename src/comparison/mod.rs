@@ -325,27 +325,7 @@ pub fn compare_sheet(
 ) -> Result<Vec<Comparison>> {
     rule.check()?;
     let groups = group_rows(&sheet.rows);
-    // Geometries: a shipped id, else "not predicted" for a recognised column, else an error at its row.
-    let mut geometries: HashMap<String, StandardGeometry> = HashMap::new();
-    let mut missing: HashMap<String, String> = HashMap::new();
-    for id in sheet.geometry_ids() {
-        match standards::find(&id) {
-            Ok(g) => {
-                geometries.insert(id, g);
-            }
-            Err(e) => {
-                let row = sheet.rows.iter().find(|r| r.geometry == id).expect("id from rows");
-                if sheet.layout == Layout::Long {
-                    return Err(Error::input(
-                        &sheet.file,
-                        sheet.cell(row.line, sheet.geometry_column, "geometry"),
-                        e.to_string(),
-                    ));
-                }
-                missing.insert(id.clone(), format!("geometry `{id}` is not shipped in this version"));
-            }
-        }
-    }
+    let geometries = sheet_geometries(sheet)?;
     // Recipes per sample, in order of first appearance.
     let mut samples: Vec<(String, PathBuf)> = Vec::new();
     for g in &groups {
@@ -372,22 +352,86 @@ pub fn compare_sheet(
     paths.sort();
     paths.dedup();
     let materials: Vec<Material> = paths.iter().map(|p| recipe::load_file(p)).collect::<Result<_>>()?;
+    let of_sample: Vec<(String, usize)> =
+        samples.iter().map(|(s, p)| (s.clone(), paths.binary_search(p).expect("path listed"))).collect();
+    judge_all(sheet, groups, geometries, &materials, &of_sample, rule, options)
+}
+
+/// Compare a sheet with the predictions of one material for every sample (a recipe held in memory, as the
+/// server's `/api/compare` has it; [`compare_sheet`] finds recipes by file).
+pub fn compare_sheet_with(
+    sheet: &Sheet,
+    material: &Material,
+    rule: &VerdictRule,
+    options: &PlanOptions,
+) -> Result<Vec<Comparison>> {
+    rule.check()?;
+    let groups = group_rows(&sheet.rows);
+    let geometries = sheet_geometries(sheet)?;
+    let mut of_sample: Vec<(String, usize)> = Vec::new();
+    for g in &groups {
+        if !of_sample.iter().any(|(s, _)| *s == g.sample) {
+            of_sample.push((g.sample.clone(), 0));
+        }
+    }
+    judge_all(sheet, groups, geometries, std::slice::from_ref(material), &of_sample, rule, options)
+}
+
+/// The sheet's geometries: a shipped id, else "not predicted" for a recognised column (the second map, with
+/// why), else an error at its row.
+type SheetGeometries = (HashMap<String, StandardGeometry>, HashMap<String, String>);
+
+fn sheet_geometries(sheet: &Sheet) -> Result<SheetGeometries> {
+    let mut geometries: HashMap<String, StandardGeometry> = HashMap::new();
+    let mut missing: HashMap<String, String> = HashMap::new();
+    for id in sheet.geometry_ids() {
+        match standards::find(&id) {
+            Ok(g) => {
+                geometries.insert(id, g);
+            }
+            Err(e) => {
+                let row = sheet.rows.iter().find(|r| r.geometry == id).expect("id from rows");
+                if sheet.layout == Layout::Long {
+                    return Err(Error::input(
+                        &sheet.file,
+                        sheet.cell(row.line, sheet.geometry_column, "geometry"),
+                        e.to_string(),
+                    ));
+                }
+                missing.insert(id.clone(), format!("geometry `{id}` is not shipped in this version"));
+            }
+        }
+    }
+    Ok((geometries, missing))
+}
+
+/// Measure each material once (in parallel) through the geometries of its samples' rows and judge every
+/// group; `of_sample` names each sample's material (an index into `materials`).
+fn judge_all(
+    sheet: &Sheet,
+    groups: Vec<Group>,
+    (geometries, missing): SheetGeometries,
+    materials: &[Material],
+    of_sample: &[(String, usize)],
+    rule: &VerdictRule,
+    options: &PlanOptions,
+) -> Result<Vec<Comparison>> {
+    let material_of = |sample: &str| of_sample.iter().find(|(s, _)| s == sample).map(|(_, i)| *i);
     // Each recipe through the geometries of all the rows of its samples.
-    let geometry_ids_of = |path: &Path| -> Vec<String> {
+    let geometry_ids_of = |i: usize| -> Vec<String> {
         let mut ids: Vec<String> = Vec::new();
         for g in &groups {
-            let p = samples.iter().find(|(s, _)| *s == g.sample).map(|(_, p)| p.as_path());
-            if p == Some(path) && geometries.contains_key(&g.geometry) && !ids.contains(&g.geometry) {
+            if material_of(&g.sample) == Some(i) && geometries.contains_key(&g.geometry) && !ids.contains(&g.geometry) {
                 ids.push(g.geometry.clone());
             }
         }
         ids
     };
-    let readings: Vec<Vec<Reading>> = paths
+    let readings: Vec<Vec<Reading>> = materials
         .par_iter()
-        .zip(materials.par_iter())
-        .map(|(p, m)| {
-            let geos: Vec<StandardGeometry> = geometry_ids_of(p).iter().map(|id| geometries[id].clone()).collect();
+        .enumerate()
+        .map(|(i, m)| {
+            let geos: Vec<StandardGeometry> = geometry_ids_of(i).iter().map(|id| geometries[id].clone()).collect();
             if geos.is_empty() {
                 return Ok(vec![]);
             }
@@ -396,8 +440,7 @@ pub fn compare_sheet(
         .collect::<Result<_>>()?;
     let mut out = Vec::with_capacity(groups.len());
     for mut g in groups {
-        let path = &samples.iter().find(|(s, _)| *s == g.sample).expect("every sample has a recipe").1;
-        let i = paths.binary_search(path).expect("path listed");
+        let i = material_of(&g.sample).expect("every sample has a recipe");
         if let Some(why) = missing.get(&g.geometry) {
             g.not_predicted.get_or_insert_with(|| why.clone());
         }

@@ -1,0 +1,549 @@
+//! The server's API (docs/serve.md §API): one function per endpoint, synchronous (the server runs it on its
+//! blocking pool), JSON in and the command line's documents out, written by the same code (`crate::report`,
+//! the pictures of `cli::pictures` and `cli::profile`, the JUnit of `cli::junit`). A request is one JSON
+//! object: the recipe (the JSON of a recipe file, under `recipe`) and the options, named as the command
+//! line's flags are (`rtol`, `geometries`, `vary`, `free`, `target`, `k`, `tolerance`, …). The recipe's text
+//! is read as sent, as `measure` reads a file, so that a reading is the same bits as `measure`'s.
+use std::borrow::Cow;
+use std::path::Path;
+
+use serde_json::{json, Value};
+
+use super::security::{table_path, Limits};
+use crate::colorimetry::{Conditions, Illuminant, Observer};
+use crate::comparison::sheet::{self, Sheet, SheetOptions};
+use crate::comparison::{self, VerdictRule};
+use crate::fit::{self, FitOptions, FreeParameter, TargetReading};
+use crate::input::json::{kind, parse_json, Obj};
+use crate::instrument::plan::{rtol_refusal, Plan, PlanOptions};
+use crate::instrument::standards::{self, StandardGeometry};
+use crate::recipe::{self, Material};
+use crate::registry::{self, Type};
+use crate::sweep::{Sweep, SweepAxis, SweepDesign};
+use crate::{report, Error, Result};
+
+/// How a request body is named in messages.
+pub const REQUEST: &str = "request";
+/// How the request's recipe is named in messages (and in the documents' `material.file`).
+pub const RECIPE: &str = "recipe";
+
+/// What every endpoint knows of the server.
+#[derive(Clone, Copy, Debug)]
+pub struct Context<'a> {
+    pub limits: &'a Limits,
+    /// Where recipes may name table files (None: nowhere).
+    pub data_dir: Option<&'a Path>,
+}
+
+/// An answer: its media type and its body.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Reply {
+    pub content_type: &'static str,
+    pub body: String,
+}
+
+impl Reply {
+    fn json(doc: &Value) -> Reply {
+        Reply { content_type: "application/json", body: report::pretty(doc) }
+    }
+}
+
+/// A request: its JSON object, and the text of its `recipe` member as sent.
+pub struct Request {
+    pub value: Value,
+    pub recipe: Option<String>,
+}
+
+impl Request {
+    /// Parse a body (UTF-8 JSON, an object; a key given twice is refused, as in recipe files).
+    pub fn parse(bytes: &[u8]) -> Result<Request> {
+        let text = std::str::from_utf8(bytes).map_err(|e| Error::input(REQUEST, "", format!("not UTF-8 text: {e}")))?;
+        let value = parse_json(text, REQUEST)?;
+        Obj::new(REQUEST, "", &value)?;
+        #[derive(serde::Deserialize)]
+        struct Raw<'a> {
+            #[serde(borrow)]
+            recipe: Option<&'a serde_json::value::RawValue>,
+        }
+        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+        let raw: Raw =
+            serde_json::from_str(text).map_err(|e| Error::input(REQUEST, "/recipe", format!("cannot be read: {e}")))?;
+        Ok(Request { value, recipe: raw.recipe.map(|r| r.get().to_string()) })
+    }
+
+    fn obj(&self) -> Obj<'_> {
+        Obj::new(REQUEST, "", &self.value).expect("checked by parse")
+    }
+}
+
+/// The recipe's text with every table path (a registry entry `…/file` of the recipe's model) replaced by
+/// the file it names in the data directory ([`table_path`]); the text as sent when it names none.
+fn with_tables<'t>(text: &'t str, ctx: Context) -> Result<Cow<'t, str>> {
+    let mut v = parse_json(text, RECIPE)?;
+    let Some(model) = v.get("model").and_then(Value::as_str).map(str::to_string) else {
+        return Ok(Cow::Borrowed(text));
+    };
+    let mut changed = false;
+    for p in registry::PARAMS.iter().filter(|p| p.applies_to(&model) && p.ty == Type::Text && p.key() == "file") {
+        let Some(Value::String(given)) = v.pointer(p.pointer) else { continue };
+        let found = table_path(ctx.data_dir, given, RECIPE, p.pointer)?;
+        let found = found
+            .to_str()
+            .ok_or_else(|| Error::input(RECIPE, p.pointer, "the table's path in the data directory is not UTF-8"))?
+            .to_string();
+        *v.pointer_mut(p.pointer).expect("found above") = Value::String(found);
+        changed = true;
+    }
+    Ok(if changed { Cow::Owned(v.to_string()) } else { Cow::Borrowed(text) })
+}
+
+fn recipe_text<'r>(req: &'r Request, ctx: Context) -> Result<Cow<'r, str>> {
+    let text = req.recipe.as_deref().ok_or_else(|| {
+        Error::input(REQUEST, "/recipe", "missing required field: the recipe, a JSON object (see `glossmeter schema`)")
+    })?;
+    with_tables(text, ctx)
+}
+
+/// The request's recipe, validated.
+fn material(req: &Request, ctx: Context) -> Result<Material> {
+    recipe::parse_str(&recipe_text(req, ctx)?, RECIPE)
+}
+
+fn strings(o: &Obj, key: &str) -> Result<Vec<String>> {
+    match o.get(key) {
+        None => Ok(vec![]),
+        Some(_) => o
+            .array(key)?
+            .iter()
+            .enumerate()
+            .map(|(i, v)| {
+                v.as_str().map(str::to_string).ok_or_else(|| {
+                    Error::input(REQUEST, o.element(key, i), format!("expected a string, got {}", kind(v)))
+                })
+            })
+            .collect(),
+    }
+}
+
+fn whole(o: &Obj, key: &str, lo: usize, hi: usize, what: &str) -> Result<Option<usize>> {
+    o.opt_num(key, lo as f64, hi as f64, what)?
+        .map(|x| {
+            if x.fract() == 0.0 {
+                Ok(x as usize)
+            } else {
+                Err(o.err(key, format!("{x} is not a whole number ({what})")))
+            }
+        })
+        .transpose()
+}
+
+/// `geometries`: shipped ids (at most `limits.geometries`; files are not read), else `default`.
+fn geometries(o: &Obj, ctx: Context, default: &[&str]) -> Result<Vec<StandardGeometry>> {
+    let ids = strings(o, "geometries")?;
+    if ids.len() > ctx.limits.geometries {
+        return Err(o.err(
+            "geometries",
+            format!("{} geometries; this server takes at most {}", ids.len(), ctx.limits.geometries),
+        ));
+    }
+    crate::resolve_geometries_or(&ids, &[] as &[&str], default)
+        .map_err(|e| o.err("geometries", e.naming(&|a| format!("`{a}`"))))
+}
+
+/// `rtol`, `max_evals` (at most the server's), `illuminant`, `observer`: the plan's options.
+fn plan_options(o: &Obj, ctx: Context, rtol: f64) -> Result<PlanOptions> {
+    let rtol = match o.get("rtol") {
+        None => rtol,
+        Some(v) => {
+            let x = v.as_f64().ok_or_else(|| o.err("rtol", format!("expected a number, got {}", kind(v))))?;
+            if let Some(why) = rtol_refusal(x) {
+                return Err(o.err("rtol", why));
+            }
+            x
+        }
+    };
+    let max_evals = whole(o, "max_evals", 1, ctx.limits.max_evals, "evaluations per aperture integral")?
+        .unwrap_or(ctx.limits.max_evals);
+    let colour = Conditions {
+        illuminant: Illuminant::parse(o.opt_str("illuminant")?.unwrap_or("D65"))
+            .map_err(|e| o.err("illuminant", e.to_string()))?,
+        observer: Observer::parse(o.opt_str("observer")?.unwrap_or("10"))
+            .map_err(|e| o.err("observer", e.to_string()))?,
+    };
+    Ok(PlanOptions { rtol, max_evals, colour, ..PlanOptions::default() })
+}
+
+fn timing(o: &Obj) -> Result<bool> {
+    match o.get("timing") {
+        None => Ok(false),
+        Some(Value::Bool(b)) => Ok(*b),
+        Some(v) => Err(o.err("timing", format!("expected true or false, got {}", kind(v)))),
+    }
+}
+
+const MEASURE_FIELDS: &[&str] = &["recipe", "geometries", "rtol", "max_evals", "illuminant", "observer", "timing"];
+
+/// `POST /api/measure`: the document of `glossmeter measure --format json` (with `--no-timing` unless
+/// `timing` is true) for the recipe through `geometries` (default: the default panel).
+pub fn measure(req: &Request, ctx: Context) -> Result<Reply> {
+    let o = req.obj();
+    o.deny_unknown(MEASURE_FIELDS)?;
+    let options = plan_options(&o, ctx, 1e-6)?;
+    let geos = geometries(&o, ctx, crate::api::DEFAULT_PANEL)?;
+    let timing = timing(&o)?;
+    let material = material(req, ctx)?;
+    let plan = Plan::compile(material.brdf.clone(), geos, options)?;
+    let run = plan.run();
+    let evaluations = run.evaluations();
+    let mut doc = report::measure::json_doc(&material, &run.readings, timing);
+    doc["evaluations"] = json!(evaluations);
+    Ok(Reply::json(&doc))
+}
+
+/// `POST /api/explain`: the measurement plan of `measure --explain`, as text in `{"plan": …}`.
+pub fn explain(req: &Request, ctx: Context) -> Result<Reply> {
+    let o = req.obj();
+    o.deny_unknown(MEASURE_FIELDS)?;
+    let options = plan_options(&o, ctx, 1e-6)?;
+    let geos = geometries(&o, ctx, crate::api::DEFAULT_PANEL)?;
+    let material = material(req, ctx)?;
+    let plan = Plan::compile(material.brdf.clone(), geos, options)?;
+    Ok(Reply::json(&json!({
+        "material": {"name": material.name, "model": material.brdf.describe()},
+        "plan": plan.explain(),
+    })))
+}
+
+/// The geometries `plot --kind section` draws by default.
+const SECTION_DEFAULT: &[&str] = &["astm-d523-20", "astm-d523-60", "astm-d523-85"];
+
+/// `POST /api/plot`: an SVG picture drawn by the command line's code: `kind` `section` (the in-plane BRDF
+/// section with the apertures, `plot --kind section`), `profile` (the goniophotometric profile of
+/// `geometry`, default rspec-20, `profile --plot`) or `gloss-vs-parameter` (`vary` PATH=LO..HI over `points`
+/// values, `plot --kind gloss-vs-parameter`).
+pub fn plot(req: &Request, ctx: Context) -> Result<Reply> {
+    let o = req.obj();
+    o.deny_unknown(&[
+        "recipe",
+        "kind",
+        "geometries",
+        "geometry",
+        "vary",
+        "points",
+        "rtol",
+        "max_evals",
+        "illuminant",
+        "observer",
+    ])?;
+    let kind = o.str("kind")?;
+    let svg = match kind {
+        "section" => {
+            let geos = geometries(&o, ctx, SECTION_DEFAULT)?;
+            crate::cli::pictures::section_svg(&material(req, ctx)?, &geos)?
+        }
+        "profile" => {
+            let options = plan_options(&o, ctx, 1e-6)?;
+            let id = o.opt_str("geometry")?.unwrap_or(crate::cli::profile::DEFAULT_GEOMETRY);
+            let g = standards::find(id).map_err(|e| o.err("geometry", e.to_string()))?;
+            standards::profile::of(&g).map_err(|e| o.err("geometry", e.to_string()))?;
+            let m = material(req, ctx)?;
+            let prof = crate::instrument::profile::measure(m.brdf.clone(), &g, options)?;
+            crate::cli::profile::svg(&prof, &format!("{}: {} profile", m.name, prof.geometry))?
+        }
+        "gloss-vs-parameter" => {
+            let options = plan_options(&o, ctx, 1e-5)?;
+            let geos = geometries(&o, ctx, SECTION_DEFAULT)?;
+            let points = whole(&o, "points", 2, ctx.limits.plot_points, "values of the varied number")?.unwrap_or(9);
+            let vary = o.str("vary")?;
+            let axis = crate::sweep::parse_vary(&format!("{vary}:{points}"))
+                .map_err(|e| o.err("vary", e.naming(&|a| format!("`{a}`"))))?;
+            let text = recipe_text(req, ctx)?;
+            let name = recipe::parse_str(&text, RECIPE)?.name;
+            let template = parse_json(&text, RECIPE)?;
+            let pointer = axis.path.clone();
+            let s = Sweep::new(template, RECIPE, vec![axis], SweepDesign::Grid, geos, options)?;
+            let mut series: Vec<(String, Vec<(f64, f64)>)> = Vec::new();
+            s.run(0..s.len(), |r| {
+                let readings =
+                    r.outcome.map_err(|why| Error::Usage(format!("`vary` {pointer} = {}: {why}", r.values[0])))?;
+                for reading in readings {
+                    let label = format!("{} {} ({})", reading.geometry, reading.name, reading.unit);
+                    let Some(v) = reading.value else { continue };
+                    match series.iter_mut().find(|s| s.0 == label) {
+                        Some(s) => s.1.push((r.values[0], v)),
+                        None => series.push((label, vec![(r.values[0], v)])),
+                    }
+                }
+                Ok(())
+            })?;
+            crate::cli::pictures::vs_parameter_svg(&name, &pointer, &series)?
+        }
+        other => {
+            return Err(o.err(
+                "kind",
+                format!("unknown kind {other:?}; allowed: \"section\", \"profile\", \"gloss-vs-parameter\""),
+            ))
+        }
+    };
+    Ok(Reply { content_type: "image/svg+xml", body: svg })
+}
+
+/// `POST /api/sweep`, checked before any work: the sweep of `glossmeter sweep --format jsonl --no-timing`
+/// (`vary` PATH=LO..HI:N strings, `log` paths, `lhs` N and `seed`), at most `limits.sweep_points` points.
+pub fn sweep(req: &Request, ctx: Context) -> Result<Sweep> {
+    let o = req.obj();
+    o.deny_unknown(&[
+        "recipe",
+        "vary",
+        "log",
+        "lhs",
+        "seed",
+        "geometries",
+        "rtol",
+        "max_evals",
+        "illuminant",
+        "observer",
+    ])?;
+    let options = plan_options(&o, ctx, 1e-6)?;
+    let geos = geometries(&o, ctx, crate::api::DEFAULT_PANEL)?;
+    let mut axes: Vec<SweepAxis> =
+        strings(&o, "vary")?.iter().map(|v| crate::sweep::parse_vary(v)).collect::<Result<_>>()?;
+    for l in strings(&o, "log")? {
+        match axes.iter_mut().find(|x| x.path == l) {
+            Some(x) => x.log = true,
+            None => return Err(o.err("log", format!("{l}: not a `vary` path"))),
+        }
+    }
+    let design = match whole(&o, "lhs", 1, ctx.limits.sweep_points as usize, "points of the Latin hypercube")? {
+        Some(n) => {
+            SweepDesign::Lhs { n: n as u64, seed: whole(&o, "seed", 0, usize::MAX, "seed")?.unwrap_or(0) as u64 }
+        }
+        None => SweepDesign::Grid,
+    };
+    let template: Value = serde_json::from_str(&recipe_text(req, ctx)?).map_err(|e| {
+        Error::input(RECIPE, "", format!("malformed JSON at line {}, column {}: {e}", e.line(), e.column()))
+    })?;
+    let s = Sweep::new(template, RECIPE, axes, design, geos, options)?;
+    if s.len() > ctx.limits.sweep_points {
+        return Err(o.err(
+            "vary",
+            format!("{} points; this server sweeps at most {} in one request", s.len(), ctx.limits.sweep_points),
+        ));
+    }
+    Ok(s)
+}
+
+/// Run a checked sweep, handing each JSON line (a row of `sweep --format jsonl --no-timing`) to `line` in
+/// index order, a few points at a time (so that the page can show progress).
+pub fn run_sweep(s: &Sweep, mut line: impl FnMut(String) -> Result<()>) -> Result<()> {
+    let step = rayon::current_num_threads().max(1) as u64;
+    let mut start = 0;
+    while start < s.len() {
+        let end = (start + step).min(s.len());
+        s.run(start..end, |r| line(s.jsonl_row(&r, false)))?;
+        start = end;
+    }
+    Ok(())
+}
+
+/// The sheet of a request: `{"name": …, "base64": …}` (any file `compare` reads) or `{"name": …, "text": …}`,
+/// read by the same code as `compare`'s files (`comparison::sheet::parse_bytes`); `name` names it in
+/// messages and nothing is written to disk.
+fn sheet(o: &Obj) -> Result<Sheet> {
+    let s = o.obj("sheet")?;
+    s.deny_unknown(&["name", "base64", "text"])?;
+    let name: String = s.opt_str("name")?.unwrap_or("sheet.csv").chars().take(200).collect();
+    let bytes = match (s.opt_str("base64")?, s.opt_str("text")?) {
+        (Some(b), None) => {
+            use base64::Engine;
+            base64::engine::general_purpose::STANDARD
+                .decode(b.trim())
+                .map_err(|e| s.err("base64", format!("not base64: {e}")))?
+        }
+        (None, Some(t)) => t.as_bytes().to_vec(),
+        _ => return Err(s.err("text", "give the sheet as `base64` (its bytes) or as `text`, one of the two")),
+    };
+    let options = SheetOptions {
+        delimiter: o.opt_str("delimiter")?.map(parse_delimiter).transpose().map_err(|e| o.err("delimiter", e))?,
+        ignore_columns: strings(o, "ignore_columns")?,
+    };
+    sheet::parse_bytes(&bytes, &name, &options)
+}
+
+fn parse_delimiter(s: &str) -> std::result::Result<u8, String> {
+    crate::cli::compare::parse_delimiter(s).map_err(|_| format!("must be \",\", \";\" or \"tab\", got {s:?}"))
+}
+
+/// `POST /api/compare`: the sheet beside the recipe's predictions (the one recipe for every sample), as
+/// `compare --format json|csv|junit` writes them (`format`, default json); verdicts are in the document, the
+/// HTTP status is 200 whatever they are.
+pub fn compare(req: &Request, ctx: Context) -> Result<Reply> {
+    let o = req.obj();
+    o.deny_unknown(&[
+        "recipe",
+        "sheet",
+        "delimiter",
+        "ignore_columns",
+        "k",
+        "tolerance",
+        "max_de00",
+        "rtol",
+        "max_evals",
+        "illuminant",
+        "observer",
+        "format",
+    ])?;
+    let rule = VerdictRule {
+        k: o.opt_num("k", 0.0, f64::INFINITY, "k")?.unwrap_or(2.0),
+        tolerance: o.opt_num("tolerance", 0.0, f64::INFINITY, "tolerance")?,
+    };
+    let max_de00 = o.opt_num("max_de00", 0.0, f64::INFINITY, "largest ΔE00")?;
+    let options = plan_options(&o, ctx, 1e-6)?;
+    let format = o.opt_str("format")?.unwrap_or("json");
+    if !["json", "csv", "junit"].contains(&format) {
+        return Err(o.err("format", format!("unknown format {format:?}; allowed: \"json\", \"csv\", \"junit\"")));
+    }
+    let sheet = sheet(&o)?;
+    let ids = sheet.geometry_ids();
+    if ids.len() > ctx.limits.geometries {
+        return Err(
+            o.err("sheet", format!("{} geometries; this server takes at most {}", ids.len(), ctx.limits.geometries))
+        );
+    }
+    let material = material(req, ctx)?;
+    let mut cmp = comparison::compare_sheet_with(&sheet, &material, &rule, &options)?;
+    let des = comparison::colour_differences(&mut cmp, max_de00);
+    Ok(match format {
+        "csv" => Reply { content_type: "text/csv; charset=utf-8", body: report::compare::csv(&cmp)? },
+        "junit" => Reply { content_type: "application/xml", body: crate::cli::junit::compare(&sheet, &cmp, &[])? },
+        _ => Reply::json(&report::compare::json_doc(&sheet, &cmp, &rule, &[], None, &des)),
+    })
+}
+
+/// `POST /api/fit`: `glossmeter fit --format json --no-timing`: `free` parameters (PATH=LO..HI or
+/// PATH=log:LO..HI) fitted to `target` readings (GEOMETRY/READING=VALUE[±U]) or to a `sheet`'s `sample`.
+pub fn fit(req: &Request, ctx: Context) -> Result<Reply> {
+    let o = req.obj();
+    o.deny_unknown(&[
+        "recipe",
+        "free",
+        "target",
+        "sheet",
+        "sample",
+        "delimiter",
+        "ignore_columns",
+        "uncertainty",
+        "restarts",
+        "rtol",
+    ])?;
+    let l = ctx.limits;
+    let rtol = plan_options(&o, ctx, 1e-6)?.rtol;
+    let free: Vec<FreeParameter> =
+        strings(&o, "free")?.iter().map(|f| FreeParameter::parse(f)).collect::<Result<_>>()?;
+    if free.len() > l.fit_free {
+        return Err(o.err("free", format!("{} free parameters; this server fits at most {}", free.len(), l.fit_free)));
+    }
+    let targets: Vec<TargetReading> = if o.get("sheet").is_some() {
+        if o.get("target").is_some() {
+            return Err(o.err("target", "give `target` readings or a `sheet`, not both"));
+        }
+        fit::targets_from_sheet(&sheet(&o)?, o.opt_str("sample")?)?.0
+    } else {
+        strings(&o, "target")?.iter().map(|t| TargetReading::parse(t)).collect::<Result<_>>()?
+    };
+    if targets.len() > l.fit_targets {
+        return Err(o.err("target", format!("{} targets; this server fits at most {}", targets.len(), l.fit_targets)));
+    }
+    let options = FitOptions {
+        rtol,
+        default_uncertainty: o
+            .opt_num("uncertainty", f64::MIN_POSITIVE, f64::INFINITY, "uncertainty")?
+            .unwrap_or(fit::DEFAULT_UNCERTAINTY),
+        restarts: whole(&o, "restarts", 0, l.fit_restarts, "restarts")?
+            .unwrap_or(fit::DEFAULT_RESTARTS.min(l.fit_restarts)),
+        max_iterations: l.fit_iterations,
+        ..FitOptions::default()
+    };
+    let material = material(req, ctx)?;
+    let report = fit::fit(&material.json, &material.file, &free, &targets, &options)?;
+    Ok(Reply::json(&report::fit::json(&report, false)))
+}
+
+/// `GET /api/registry`: every recipe parameter (JSON Pointer, models, type, unit, range, default, meaning)
+/// and the models, from which the page builds its editor.
+pub fn registry_doc() -> Reply {
+    let params: Vec<Value> = registry::PARAMS
+        .iter()
+        .map(|p| {
+            json!({
+                "pointer": p.pointer,
+                "models": p.models,
+                "type": p.ty.describe(),
+                "numeric": p.ty.is_numeric(),
+                "number": p.ty == Type::Number,
+                "choices": match p.ty { Type::Choice(c) => json!(c), _ => Value::Null },
+                "unit": p.unit,
+                "range": p.range.map(|r| json!({
+                    "lo": finite(r.lo), "hi": finite(r.hi), "lo_closed": r.lo_closed, "hi_closed": r.hi_closed,
+                    "text": r.describe_short(),
+                })),
+                "default": match p.presence { registry::Presence::Required => Value::Null, registry::Presence::Default(d) => json!(d) },
+                "required": p.presence == registry::Presence::Required,
+                "description": p.description,
+            })
+        })
+        .collect();
+    Reply::json(&json!({"models": registry::MODELS, "parameters": params}))
+}
+
+fn finite(x: f64) -> Value {
+    if x.is_finite() {
+        json!(x)
+    } else {
+        Value::Null
+    }
+}
+
+/// `GET /api/geometries`: the shipped geometries (id, the line of `glossmeter standards`, whether it is in
+/// the default panel, whether it has a profile array).
+pub fn geometries_doc() -> Result<Reply> {
+    let all = standards::builtin_all()?;
+    let list: Vec<Value> = all
+        .iter()
+        .map(|g| {
+            json!({
+                "id": g.geometry.id,
+                "line": standards::list_line_any(g),
+                "default": crate::api::DEFAULT_PANEL.contains(&g.geometry.id.as_str()),
+                "profile": standards::profile::of(g).is_ok(),
+            })
+        })
+        .collect();
+    Ok(Reply::json(&json!({"geometries": list})))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_recipe_text_is_kept_as_sent() {
+        let r = Request::parse(br#"{"recipe": {"model": "lambert", "albedo": 0.1000000000000000055511151231257827}}"#)
+            .unwrap();
+        assert_eq!(
+            r.recipe.as_deref(),
+            Some(r#"{"model": "lambert", "albedo": 0.1000000000000000055511151231257827}"#)
+        );
+        assert!(Request::parse(b"[1]").is_err());
+        assert!(Request::parse(br#"{"a": 1, "a": 2}"#).is_err());
+    }
+
+    #[test]
+    fn a_table_needs_the_data_directory() {
+        let l = Limits::default();
+        let ctx = Context { limits: &l, data_dir: None };
+        let r = Request::parse(br#"{"recipe": {"model": "merl", "file": "x.binary"}}"#).unwrap();
+        let e = measure(&r, ctx).unwrap_err().to_string();
+        assert!(e.contains("--data-dir"), "{e}");
+    }
+}

@@ -1,0 +1,424 @@
+//! `glossmeter serve` (docs/serve.md): the API on a server on an ephemeral loopback port, and its safety:
+//! foreign `Host`/`Origin`, oversize bodies, table paths out of the data directory, and a flood of 200
+//! concurrent requests (every one answered, 200 with the right bits or 503, and the server still answering).
+//! The client is a few lines of HTTP/1.1 over a `TcpStream`, so that a test can send any `Host` it likes.
+use std::io::{Read, Write};
+use std::net::{SocketAddr, TcpStream};
+use std::path::PathBuf;
+use std::time::{Duration, Instant};
+
+use glossmeter::serve::{Limits, ServeOptions, Server};
+use serde_json::{json, Value};
+
+fn start(options: ServeOptions) -> SocketAddr {
+    let server = Server::bind(ServeOptions { port: 0, ..options }).expect("binds");
+    let addr = server.addr();
+    std::thread::spawn(move || server.run());
+    addr
+}
+
+fn default_server() -> SocketAddr {
+    start(ServeOptions::default())
+}
+
+struct Answer {
+    status: u16,
+    headers: Vec<(String, String)>,
+    body: String,
+}
+
+impl Answer {
+    fn json(&self) -> Value {
+        serde_json::from_str(&self.body).unwrap_or_else(|e| panic!("not JSON ({e}): {}", self.body))
+    }
+    fn header(&self, name: &str) -> Option<&str> {
+        self.headers.iter().find(|(k, _)| k.eq_ignore_ascii_case(name)).map(|(_, v)| v.as_str())
+    }
+}
+
+/// One request with `Connection: close`; `extra` headers as given (a `Host` among them replaces the right one).
+fn request(addr: SocketAddr, method: &str, path: &str, body: &[u8], extra: &[(&str, &str)]) -> Answer {
+    let mut s = TcpStream::connect(addr).expect("connects");
+    s.set_read_timeout(Some(Duration::from_secs(300))).unwrap();
+    let mut head = format!("{method} {path} HTTP/1.1\r\nConnection: close\r\nContent-Length: {}\r\n", body.len());
+    if !extra.iter().any(|(k, _)| k.eq_ignore_ascii_case("host")) {
+        head.push_str(&format!("Host: {addr}\r\n"));
+    }
+    for (k, v) in extra {
+        head.push_str(&format!("{k}: {v}\r\n"));
+    }
+    head.push_str("Content-Type: application/json\r\n\r\n");
+    s.write_all(head.as_bytes()).unwrap();
+    // The server may answer (413) before reading a large body and close: a failed write is not a failure.
+    let _ = s.write_all(body);
+    let mut raw = Vec::new();
+    let _ = s.read_to_end(&mut raw);
+    parse(&raw)
+}
+
+fn parse(raw: &[u8]) -> Answer {
+    let split = raw.windows(4).position(|w| w == b"\r\n\r\n").expect("a complete head");
+    let head = String::from_utf8_lossy(&raw[..split]).to_string();
+    let mut lines = head.split("\r\n");
+    let status: u16 = lines.next().unwrap().split(' ').nth(1).unwrap().parse().unwrap();
+    let headers: Vec<(String, String)> =
+        lines.filter_map(|l| l.split_once(':').map(|(k, v)| (k.trim().to_string(), v.trim().to_string()))).collect();
+    let mut body = raw[split + 4..].to_vec();
+    if headers.iter().any(|(k, v)| k.eq_ignore_ascii_case("transfer-encoding") && v.contains("chunked")) {
+        body = dechunk(&body);
+    }
+    Answer { status, headers, body: String::from_utf8(body).expect("UTF-8 body") }
+}
+
+fn dechunk(mut b: &[u8]) -> Vec<u8> {
+    let mut out = Vec::new();
+    loop {
+        let end = b.windows(2).position(|w| w == b"\r\n").expect("chunk size line");
+        let n = usize::from_str_radix(std::str::from_utf8(&b[..end]).unwrap().trim(), 16).unwrap();
+        if n == 0 {
+            return out;
+        }
+        out.extend_from_slice(&b[end + 2..end + 2 + n]);
+        b = &b[end + 2 + n + 2..];
+    }
+}
+
+fn post(addr: SocketAddr, path: &str, body: &Value) -> Answer {
+    request(addr, "POST", path, body.to_string().as_bytes(), &[])
+}
+
+fn fixture(name: &str) -> String {
+    std::fs::read_to_string(format!("fixtures/recipes/{name}.json")).unwrap()
+}
+
+/// A request body with the recipe's text spliced in as it is in the file.
+fn with_recipe(recipe_text: &str, rest: Value) -> Vec<u8> {
+    let mut rest = rest.to_string();
+    assert!(rest.ends_with('}'));
+    rest.pop();
+    let sep = if rest == "{" { "" } else { "," };
+    format!("{rest}{sep}\"recipe\":{recipe_text}}}").into_bytes()
+}
+
+fn cli_measure_json(file: &str, geometries: &[&str]) -> Value {
+    let mut cmd = std::process::Command::new(env!("CARGO_BIN_EXE_glossmeter"));
+    cmd.args(["measure", "--format", "json", "--no-timing", file]);
+    for g in geometries {
+        cmd.args(["-g", g]);
+    }
+    let out = cmd.output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+#[test]
+fn measure_gives_the_bits_of_the_command_line() {
+    let addr = default_server();
+    for (name, geos) in [("cerulean-blue-c", vec![]), ("semigloss-white", vec!["astm-d523-60", "astm-e430-30"])] {
+        let body = with_recipe(&fixture(name), json!({"geometries": geos}));
+        let a = request(addr, "POST", "/api/measure", &body, &[]);
+        assert_eq!(a.status, 200, "{}", a.body);
+        assert_eq!(a.header("content-type"), Some("application/json"));
+        let served = a.json();
+        let cli = cli_measure_json(&format!("fixtures/recipes/{name}.json"), &geos);
+        // Everything but the file name the material came from is the same document, bit for bit.
+        assert_eq!(served["readings"], cli["readings"], "{name}");
+        assert_eq!(served["evaluations"], cli["evaluations"]);
+        assert_eq!(served["material"]["name"], cli["material"]["name"]);
+        assert_eq!(served["material"]["file"], "recipe");
+        assert!(!served["readings"].as_array().unwrap().is_empty());
+    }
+}
+
+#[test]
+fn the_endpoints_answer_on_the_command_lines_documents() {
+    let addr = default_server();
+    let glass = fixture("black-glass");
+    // The page and its data.
+    let page = request(addr, "GET", "/", b"", &[]);
+    assert_eq!(page.status, 200);
+    assert!(page.body.contains("<title>glossmeter"));
+    assert!(page.header("content-security-policy").is_some());
+    let reg = request(addr, "GET", "/api/registry", b"", &[]).json();
+    assert!(reg["parameters"].as_array().unwrap().iter().any(|p| p["pointer"] == "/ior" && p["unit"].is_string()));
+    let geos = request(addr, "GET", "/api/geometries", b"", &[]).json();
+    assert!(geos["geometries"].as_array().unwrap().iter().any(|g| g["id"] == "astm-d523-60" && g["default"] == true));
+    let fix = request(addr, "GET", "/api/fixtures", b"", &[]).json();
+    assert!(fix["fixtures"].as_array().unwrap().len() > 10);
+    assert_eq!(request(addr, "GET", "/nothing", b"", &[]).status, 404);
+    // explain: the plan's text.
+    let a = request(addr, "POST", "/api/explain", &with_recipe(&glass, json!({"geometries": ["astm-d523-60"]})), &[]);
+    assert_eq!(a.status, 200, "{}", a.body);
+    assert!(a.json()["plan"].as_str().unwrap().contains("astm-d523-60"));
+    // plot: SVG from the command line's drawing code.
+    for kind in [
+        json!({"kind": "section"}),
+        json!({"kind": "profile"}),
+        json!({"kind": "gloss-vs-parameter", "vary": "/ior=1.4..1.6", "points": 3}),
+    ] {
+        let a = request(addr, "POST", "/api/plot", &with_recipe(&glass, kind.clone()), &[]);
+        assert_eq!(a.status, 200, "{kind}: {}", a.body);
+        assert_eq!(a.header("content-type"), Some("image/svg+xml"));
+        assert!(a.body.starts_with("<svg"), "{kind}");
+    }
+    // sweep: the JSON lines of `sweep --format jsonl --no-timing`, streamed, with the count in X-Points.
+    let a = request(
+        addr,
+        "POST",
+        "/api/sweep",
+        &with_recipe(&glass, json!({"vary": ["/ior=1.4..1.6:3"], "geometries": ["astm-d523-60"]})),
+        &[],
+    );
+    assert_eq!(a.status, 200, "{}", a.body);
+    assert_eq!(a.header("x-points"), Some("3"));
+    let rows: Vec<Value> = a.body.lines().map(|l| serde_json::from_str(l).unwrap()).collect();
+    assert_eq!(rows.len(), 3);
+    let cli = std::process::Command::new(env!("CARGO_BIN_EXE_glossmeter"))
+        .args([
+            "sweep",
+            "fixtures/recipes/black-glass.json",
+            "--vary",
+            "/ior=1.4..1.6:3",
+            "-g",
+            "astm-d523-60",
+            "--format",
+            "jsonl",
+            "--no-timing",
+        ])
+        .output()
+        .unwrap();
+    let cli_rows: Vec<Value> =
+        String::from_utf8(cli.stdout).unwrap().lines().map(|l| serde_json::from_str(l).unwrap()).collect();
+    assert_eq!(
+        rows.iter().map(|r| &r["readings"]).collect::<Vec<_>>(),
+        cli_rows.iter().map(|r| &r["readings"]).collect::<Vec<_>>()
+    );
+    // compare: the verdicts of a shipped sheet, in JSON, CSV and JUnit.
+    let sheet = std::fs::read_to_string("fixtures/sheets/black-glass-check.csv").unwrap();
+    for format in ["json", "csv", "junit"] {
+        let a = request(
+            addr,
+            "POST",
+            "/api/compare",
+            &with_recipe(&glass, json!({"sheet": {"name": "black-glass-check.csv", "text": sheet}, "format": format})),
+            &[],
+        );
+        assert_eq!(a.status, 200, "{format}: {}", a.body);
+        match format {
+            "json" => {
+                let doc = a.json();
+                let cmp = doc["comparisons"].as_array().unwrap();
+                assert!(!cmp.is_empty());
+                assert!(cmp.iter().all(|c| c["verdict"] == "ok"), "{doc}");
+            }
+            "csv" => assert!(a.body.lines().count() > 1),
+            _ => assert!(a.body.contains("<testsuite")),
+        }
+    }
+    // fit: one free parameter to one target.
+    let a = request(
+        addr,
+        "POST",
+        "/api/fit",
+        &with_recipe(
+            &glass,
+            json!({"free": ["/ior=1.3..1.8"], "target": ["astm-d523-60/gloss=90±0.1"], "restarts": 0}),
+        ),
+        &[],
+    );
+    assert_eq!(a.status, 200, "{}", a.body);
+    let doc = a.json();
+    assert_eq!(doc["converged"], true, "{doc}");
+    assert!((doc["targets"][0]["predicted"].as_f64().unwrap() - 90.0).abs() < 0.1);
+}
+
+#[test]
+fn bad_requests_get_the_librarys_message_as_json_400() {
+    let addr = default_server();
+    let cases: &[(&str, &[u8], &str)] = &[
+        ("/api/measure", b"{not json", "malformed JSON"),
+        ("/api/measure", br#"{"recipe": {"model": "lambert", "albedo": 7}}"#, "/albedo"),
+        ("/api/measure", br#"{"recipe": {"model": "nope"}}"#, "unknown model"),
+        ("/api/measure", br#"{"geometries": ["astm-d523-60"]}"#, "/recipe"),
+        ("/api/measure", br#"{"recipe": {"model": "lambert", "albedo": 0.5}, "rtol": 2}"#, "/rtol"),
+        ("/api/measure", br#"{"recipe": {"model": "lambert", "albedo": 0.5}, "geometries": ["no-such"]}"#, "no-such"),
+        ("/api/measure", br#"{"recipe": {"model": "lambert", "albedo": 0.5}, "max_evals": 1e12}"#, "/max_evals"),
+        ("/api/measure", br#"{"recipe": {"model": "lambert", "albedo": 0.5}, "bogus": 1}"#, "unknown field"),
+        ("/api/plot", br#"{"recipe": {"model": "lambert", "albedo": 0.5}, "kind": "pie"}"#, "/kind"),
+        (
+            "/api/sweep",
+            br#"{"recipe": {"model": "lambert", "albedo": 0.5}, "vary": ["/albedo=0..1:100000"]}"#,
+            "at most",
+        ),
+        ("/api/compare", br#"{"recipe": {"model": "lambert", "albedo": 0.5}, "sheet": {"base64": "!!"}}"#, "base64"),
+        ("/api/fit", br#"{"recipe": {"model": "lambert", "albedo": 0.5}, "free": [], "target": []}"#, "target"),
+    ];
+    for (path, body, says) in cases {
+        let a = request(addr, "POST", path, body, &[]);
+        assert_eq!(a.status, 400, "{path} {}: {}", String::from_utf8_lossy(body), a.body);
+        let e = a.json()["error"].as_str().unwrap().to_string();
+        assert!(e.contains(says), "{path}: {e:?} should say {says:?}");
+        assert!(!e.contains("panicked") && !e.contains("src/"), "{e}");
+    }
+}
+
+#[test]
+fn foreign_host_and_origin_are_refused() {
+    let addr = default_server();
+    let port = addr.port();
+    let body = br#"{"recipe": {"model": "lambert", "albedo": 0.5}, "geometries": ["astm-d523-60"]}"#;
+    let own = format!("localhost:{port}");
+    let refused: Vec<Vec<(&str, String)>> = vec![
+        vec![("Host", "evil.example".into())],
+        vec![("Host", format!("evil.example:{port}"))],
+        vec![("Host", "localhost:1".into())],
+        vec![("Host", own.clone()), ("Origin", "http://evil.example".into())],
+        vec![("Host", own.clone()), ("Origin", "null".into())],
+        vec![("Host", own.clone()), ("Sec-Fetch-Site", "cross-site".into())],
+    ];
+    for headers in &refused {
+        let h: Vec<(&str, &str)> = headers.iter().map(|(k, v)| (*k, v.as_str())).collect();
+        for (method, path) in [("POST", "/api/measure"), ("GET", "/")] {
+            let a = request(addr, method, path, if method == "POST" { body } else { b"" }, &h);
+            assert_eq!(a.status, 403, "{h:?} {path}: {}", a.body);
+            assert!(a.json()["error"].is_string());
+        }
+    }
+    let origin = format!("http://localhost:{port}");
+    let a = request(addr, "POST", "/api/measure", body, &[("Host", &own), ("Origin", &origin)]);
+    assert_eq!(a.status, 200, "{}", a.body);
+}
+
+#[test]
+fn oversize_bodies_are_refused_with_413() {
+    let addr =
+        start(ServeOptions { limits: Limits { body_bytes: 4096, ..Limits::default() }, ..ServeOptions::default() });
+    let big =
+        format!(r#"{{"recipe": {{"model": "lambert", "albedo": 0.5, "description": "{}"}}}}"#, "x".repeat(10_000));
+    let a = request(addr, "POST", "/api/measure", big.as_bytes(), &[]);
+    assert_eq!(a.status, 413, "{}", a.body);
+    assert!(a.json()["error"].as_str().unwrap().contains("4096"));
+    // A body that says it is small and is not: read up to the cap, then refused.
+    let mut s = TcpStream::connect(addr).unwrap();
+    s.set_read_timeout(Some(Duration::from_secs(60))).unwrap();
+    let head = format!(
+        "POST /api/measure HTTP/1.1\r\nHost: {addr}\r\nConnection: close\r\nTransfer-Encoding: chunked\r\n\r\n"
+    );
+    s.write_all(head.as_bytes()).unwrap();
+    let chunk = "y".repeat(3000);
+    for _ in 0..3 {
+        let _ = s.write_all(format!("{:x}\r\n{chunk}\r\n", chunk.len()).as_bytes());
+    }
+    let _ = s.write_all(b"0\r\n\r\n");
+    let mut raw = Vec::new();
+    let _ = s.read_to_end(&mut raw);
+    assert_eq!(parse(&raw).status, 413);
+    // The server still answers.
+    let a = post(
+        addr,
+        "/api/measure",
+        &json!({"recipe": {"model": "lambert", "albedo": 0.5}, "geometries": ["astm-d523-60"]}),
+    );
+    assert_eq!(a.status, 200, "{}", a.body);
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("glossmeter-serve-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+#[test]
+fn tables_are_read_only_inside_the_data_directory() {
+    let root = scratch("data");
+    let data = root.join("data");
+    std::fs::create_dir_all(data.join("merl")).unwrap();
+    std::fs::copy("fixtures/materials/merl/lambert-tiny.binary", data.join("merl/lambert-tiny.binary")).unwrap();
+    std::fs::copy("fixtures/materials/merl/lambert-tiny.binary", root.join("outside.binary")).unwrap();
+    #[cfg(unix)]
+    std::os::unix::fs::symlink(root.join("outside.binary"), data.join("link.binary")).unwrap();
+    let addr = start(ServeOptions { data_dir: Some(data.clone()), ..ServeOptions::default() });
+    let body = |file: &str| json!({"recipe": {"model": "merl", "file": file}, "geometries": ["astm-d523-60"]});
+    let a = post(addr, "/api/measure", &body("merl/lambert-tiny.binary"));
+    assert_eq!(a.status, 200, "{}", a.body);
+    assert!(a.json()["readings"][0]["value"].is_number());
+    let outside = root.join("outside.binary").display().to_string();
+    let mut refused =
+        vec!["../outside.binary", "merl/../../outside.binary", outside.as_str(), "missing.binary", "merl"];
+    if cfg!(unix) {
+        refused.push("link.binary");
+    }
+    for f in refused {
+        for path in ["/api/measure", "/api/plot", "/api/sweep", "/api/compare", "/api/fit"] {
+            let mut b = body(f);
+            match path {
+                "/api/plot" => b["kind"] = json!("section"),
+                "/api/sweep" => b["vary"] = json!(["/interpolation=0..1:2"]),
+                "/api/compare" => {
+                    b.as_object_mut().unwrap().remove("geometries");
+                    b["sheet"] = json!({"text": "sample,60°\na,10\n"});
+                }
+                "/api/fit" => {
+                    b = json!({"recipe": b["recipe"], "free": ["/x=0..1"], "target": ["astm-d523-60/gloss=1"]});
+                }
+                _ => {}
+            }
+            let a = post(addr, path, &b);
+            assert_eq!(a.status, 400, "{f} {path}: {}", a.body);
+            let e = a.json()["error"].as_str().unwrap().to_string();
+            assert!(e.contains("/file"), "{f} {path}: {e}");
+            // The message repeats what the client sent and nothing of where the server keeps its files.
+            if !f.starts_with('/') {
+                assert!(!e.contains(&root.display().to_string()), "the message shows no server path: {e}");
+            }
+        }
+    }
+    // Without --data-dir no table is read at all.
+    let bare = default_server();
+    let a = post(bare, "/api/measure", &body("merl/lambert-tiny.binary"));
+    assert_eq!(a.status, 400);
+    assert!(a.body.contains("--data-dir"));
+    std::fs::remove_dir_all(&root).unwrap();
+}
+
+#[test]
+fn a_flood_of_200_concurrent_requests_is_bounded_and_nothing_is_lost() {
+    let addr = start(ServeOptions { limits: Limits { jobs: 2, ..Limits::default() }, ..ServeOptions::default() });
+    let body = with_recipe(&fixture("cerulean-blue-c"), json!({}));
+    let expected = cli_measure_json("fixtures/recipes/cerulean-blue-c.json", &[]);
+    let clock = Instant::now();
+    let handles: Vec<_> = (0..200)
+        .map(|_| {
+            let body = body.clone();
+            std::thread::spawn(move || request(addr, "POST", "/api/measure", &body, &[]))
+        })
+        .collect();
+    let answers: Vec<Answer> = handles.into_iter().map(|h| h.join().expect("every request is answered")).collect();
+    let elapsed = clock.elapsed();
+    let ok: Vec<&Answer> = answers.iter().filter(|a| a.status == 200).collect();
+    let busy = answers.iter().filter(|a| a.status == 503).count();
+    eprintln!("flood: {} served, {busy} answered busy, in {elapsed:?}", ok.len());
+    assert_eq!(
+        ok.len() + busy,
+        200,
+        "every answer is 200 or 503: {:?}",
+        answers.iter().map(|a| a.status).collect::<Vec<_>>()
+    );
+    assert!(!ok.is_empty(), "some requests were served");
+    assert!(busy > 0, "the concurrency cap answered the excess 503");
+    for a in &ok {
+        assert_eq!(a.json()["readings"], expected["readings"], "a served reading is the command line's");
+    }
+    for a in answers.iter().filter(|a| a.status == 503) {
+        assert_eq!(a.header("retry-after"), Some("1"));
+        assert!(a.json()["error"].as_str().unwrap().contains("busy"));
+    }
+    // Bounded in time: the excess is refused at once, so the flood ends in about the time of a few readings
+    // (a generous bound, not a benchmark).
+    assert!(elapsed < Duration::from_secs(120), "the flood took {elapsed:?}");
+    // Still answering, and computing.
+    let a = request(addr, "POST", "/api/measure", &body, &[]);
+    assert_eq!(a.status, 200, "{}", a.body);
+    assert_eq!(a.json()["readings"], expected["readings"]);
+}
