@@ -535,12 +535,13 @@ pub fn section_svg(material: &recipe::Material, geometries: &[StandardGeometry])
     super::plot::to_svg((1000, h), |root| draw_sections(root, &material.name, &panels))
 }
 
-/// Readings against one recipe number (`pointer`) as an SVG document in memory: `series` holds a label
+/// Readings against one recipe number (named `label`, on a log axis when `log`) as an SVG document in memory:
+/// `series` holds a label
 /// (geometry, reading, unit) and its (value of the number, reading) points, as `plot --kind
 /// gloss-vs-parameter` draws them.
-pub fn vs_parameter_svg(name: &str, pointer: &str, series: &[(String, Vec<(f64, f64)>)]) -> Result<String> {
+pub fn vs_parameter_svg(name: &str, label: &str, log: bool, series: &[(String, Vec<(f64, f64)>)]) -> Result<String> {
     if series.iter().all(|s| s.1.is_empty()) {
         return Err(Error::Numeric("no reading has a value over the range".into()));
     }
-    super::plot::to_svg((1000, 640), |root| draw_vs_parameter(root, name, pointer, series))
+    super::plot::to_svg((1000, 640), |root| draw_vs_parameter(root, name, label, log, series))
 }

@@ -62,7 +62,7 @@ impl MeasureDoc {
             .into_iter()
             .zip(&envelopes.of)
             .map(|(r, e)| {
-                let cut = envelopes.cut.iter().any(|g| *g == r.geometry);
+                let cut = envelopes.cut.contains(&r.geometry);
                 r.with_envelope(e.as_ref(), cut)
             })
             .collect();

@@ -183,6 +183,16 @@ fn timing(o: &Obj) -> Result<bool> {
 
 const MEASURE_FIELDS: &[&str] = &["recipe", "geometries", "rtol", "max_evals", "illuminant", "observer", "timing"];
 
+/// A profile's evaluation budget on this server: the command line's, each part held to the server's per-integral
+/// limit and the whole profile to ten times it (docs/serve.md §Limits).
+fn profile_budget(ctx: Context) -> crate::instrument::profile::Budget {
+    let d = crate::instrument::profile::Budget::default();
+    crate::instrument::profile::Budget {
+        per_part: d.per_part.min(ctx.limits.max_evals),
+        total: d.total.min(ctx.limits.max_evals.saturating_mul(10)),
+    }
+}
+
 /// `POST /api/measure`: the document of `glossmeter measure --format json` (with `--no-timing` unless
 /// `timing` is true) for the recipe through `geometries` (default: the default panel).
 pub fn measure(req: &Request, ctx: Context) -> Result<Reply> {
@@ -195,9 +205,8 @@ pub fn measure(req: &Request, ctx: Context) -> Result<Reply> {
     let plan = Plan::compile(material.brdf.clone(), geos, options)?;
     let run = plan.run();
     let evaluations = run.evaluations();
-    let mut doc = report::measure::json_doc(&material, &run.readings, timing);
-    doc["evaluations"] = json!(evaluations);
-    Ok(Reply::json(&doc))
+    let doc = report::measure::json_doc(&material, &run.readings, timing, evaluations);
+    Ok(Reply::json(&report::to_json(&doc)))
 }
 
 /// `POST /api/explain`: the measurement plan of `measure --explain`, as text in `{"plan": …}`.
@@ -247,7 +256,7 @@ pub fn plot(req: &Request, ctx: Context) -> Result<Reply> {
             let g = standards::find(id).map_err(|e| o.err("geometry", e.to_string()))?;
             standards::profile::of(&g).map_err(|e| o.err("geometry", e.to_string()))?;
             let m = material(req, ctx)?;
-            let prof = crate::instrument::profile::measure(m.brdf.clone(), &g, options)?;
+            let prof = crate::instrument::profile::measure(m.brdf.clone(), &g, options, profile_budget(ctx))?;
             crate::cli::profile::svg(&prof, &format!("{}: {} profile", m.name, prof.geometry))?
         }
         "gloss-vs-parameter" => {
@@ -261,6 +270,7 @@ pub fn plot(req: &Request, ctx: Context) -> Result<Reply> {
             let name = recipe::parse_str(&text, RECIPE)?.name;
             let template = parse_json(&text, RECIPE)?;
             let pointer = axis.path.clone();
+            let (log, label) = (axis.log, crate::cli::pictures::parameter_label(&template, &pointer));
             let s = Sweep::new(template, RECIPE, vec![axis], SweepDesign::Grid, geos, options)?;
             let mut series: Vec<(String, Vec<(f64, f64)>)> = Vec::new();
             s.run(0..s.len(), |r| {
@@ -276,7 +286,7 @@ pub fn plot(req: &Request, ctx: Context) -> Result<Reply> {
                 }
                 Ok(())
             })?;
-            crate::cli::pictures::vs_parameter_svg(&name, &pointer, &series)?
+            crate::cli::pictures::vs_parameter_svg(&name, &label, log, &series)?
         }
         other => {
             return Err(o.err(
@@ -366,6 +376,7 @@ fn sheet(o: &Obj) -> Result<Sheet> {
     let options = SheetOptions {
         delimiter: o.opt_str("delimiter")?.map(parse_delimiter).transpose().map_err(|e| o.err("delimiter", e))?,
         ignore_columns: strings(o, "ignore_columns")?,
+        sheet_name: o.opt_str("sheet_name")?.map(str::to_owned),
     };
     sheet::parse_bytes(&bytes, &name, &options)
 }
@@ -416,7 +427,7 @@ pub fn compare(req: &Request, ctx: Context) -> Result<Reply> {
     Ok(match format {
         "csv" => Reply { content_type: "text/csv; charset=utf-8", body: report::compare::csv(&cmp)? },
         "junit" => Reply { content_type: "application/xml", body: crate::cli::junit::compare(&sheet, &cmp, &[])? },
-        _ => Reply::json(&report::compare::json_doc(&sheet, &cmp, &rule, &[], None, &des)),
+        _ => Reply::json(&report::to_json(&report::compare::json_doc(&sheet, &cmp, &rule, &[], None, &des))),
     })
 }
 
