@@ -436,7 +436,9 @@ impl Plan {
     /// numerical errors are at most [`DATA_RESOLVED`] times the larger difference; the data uncertainty of
     /// each component is
     ///
-    ///     u = max over the twins t of (|Φ_t − Φ_table| + e_t) + e_table
+    /// ```text
+    /// u = max over the twins t of (|Φ_t − Φ_table| + e_t) + e_table
+    /// ```
     ///
     /// (docs/accuracy.md §Data uncertainty of measured tables). With [`PlanOptions::rtol_from_data`] the
     /// integral's tolerance is then max(rtol, min(DATA_FRACTION·u/|Φ|, DATA_MAX_RTOL)) over its components
