@@ -1379,14 +1379,8 @@ fn wide_lobes(md: &mut String) {
                 if let (Some(p), Some((src, rec))) = (m.regular.as_mut(), clipped) {
                     let eligible = p.chart == Chart::Lobe && p.kinks.is_empty() && p.rule == Rule::GenzMalik75;
                     if eligible && v == 1 {
-                        let kinks = |a: AxisMap| {
-                            let [lo, hi] = a.range();
-                            let mut x = vec![lo, hi, a.s[1] + a.r[0], a.s[0] + a.r[1]];
-                            x.retain(|x| *x >= lo && *x <= hi);
-                            x.sort_by(f64::total_cmp);
-                            x.dedup_by(|a, b| (*a - *b).abs() <= 1e-14 * (hi - lo));
-                            x
-                        };
+                        // The range ends and the overlap kinks (as `tensor_boxes` splits the lobe chart).
+                        let kinks = |a: AxisMap| a.splits(&[]);
                         let sp = [kinks(AxisMap { s: src.p, r: rec.p }), kinks(AxisMap { s: src.q, r: rec.q })];
                         p.cells = Cell::from_boxes(&lobe_boxes(&sp));
                     }

@@ -581,13 +581,7 @@ impl Brdf for InPlaneBrdf {
     }
 
     fn coarser(&self) -> Vec<std::sync::Arc<dyn Brdf>> {
-        if self.resolution != Resolution::Own {
-            return Vec::new();
-        }
-        Resolution::TWINS
-            .iter()
-            .map(|&resolution| std::sync::Arc::new(InPlaneBrdf { resolution, ..self.clone() }) as _)
-            .collect()
+        self.resolution.twins(|resolution| std::sync::Arc::new(InPlaneBrdf { resolution, ..self.clone() }) as _)
     }
 
     fn describe(&self) -> String {

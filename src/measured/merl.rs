@@ -301,13 +301,7 @@ impl Brdf for MerlBrdf {
     }
 
     fn coarser(&self) -> Vec<std::sync::Arc<dyn Brdf>> {
-        if self.resolution != Resolution::Own {
-            return Vec::new();
-        }
-        Resolution::TWINS
-            .iter()
-            .map(|&resolution| std::sync::Arc::new(MerlBrdf { resolution, ..self.clone() }) as _)
-            .collect()
+        self.resolution.twins(|resolution| std::sync::Arc::new(MerlBrdf { resolution, ..self.clone() }) as _)
     }
 
     fn describe(&self) -> String {

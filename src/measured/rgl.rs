@@ -661,13 +661,7 @@ impl Brdf for RglBrdf {
     }
 
     fn coarser(&self) -> Vec<std::sync::Arc<dyn Brdf>> {
-        if self.resolution != Resolution::Own {
-            return Vec::new();
-        }
-        Resolution::TWINS
-            .iter()
-            .map(|&resolution| std::sync::Arc::new(RglBrdf { resolution, ..self.clone() }) as _)
-            .collect()
+        self.resolution.twins(|resolution| std::sync::Arc::new(RglBrdf { resolution, ..self.clone() }) as _)
     }
 
     fn describe(&self) -> String {

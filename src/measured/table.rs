@@ -32,6 +32,15 @@ impl Resolution {
     /// The two coarse twins.
     pub const TWINS: [Resolution; 2] = [Resolution::Coarse, Resolution::Shifted];
 
+    /// A table's coarse twins, `at(r)` being the table read at resolution r: both [`Resolution::TWINS`] for a
+    /// table at its own resolution, none for a twin (twins have no twins).
+    pub fn twins<T>(self, at: impl Fn(Resolution) -> T) -> Vec<T> {
+        if self != Resolution::Own {
+            return Vec::new();
+        }
+        Resolution::TWINS.iter().map(|&r| at(r)).collect()
+    }
+
     /// The sample of a twin at or below sample `i` of the table (for a piecewise constant lookup).
     pub fn floor(self, i: usize) -> usize {
         match self {

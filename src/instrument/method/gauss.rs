@@ -18,14 +18,8 @@ pub const TENSOR_MAX_LEVEL: usize = 9;
 /// plain chart; in the lobe chart (u, t_p, v, t_q) the products of the intervals between the range ends and
 /// the overlap kinks s₁ + r₀, s₀ + r₁ of u and of v (where the overlap length is linear), t ∈ [0, 1].
 pub fn tensor_boxes(chart: TensorChart, src: Stop, rec: Stop) -> Vec<([f64; 4], [f64; 4])> {
-    let kinks = |a: AxisMap| {
-        let [lo, hi] = a.range();
-        let mut x = vec![lo, hi, a.s[1] + a.r[0], a.s[0] + a.r[1]];
-        x.retain(|x| *x >= lo && *x <= hi);
-        x.sort_by(f64::total_cmp);
-        x.dedup_by(|a, b| (*a - *b).abs() <= 1e-14 * (hi - lo));
-        x
-    };
+    // The range ends and the overlap kinks, no lobe splits.
+    let kinks = |a: AxisMap| a.splits(&[]);
     match chart {
         TensorChart::Plain => {
             vec![([src.p[0], src.q[0], rec.p[0], rec.q[0]], [src.p[1], src.q[1], rec.p[1], rec.q[1]])]
