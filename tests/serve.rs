@@ -422,3 +422,36 @@ fn a_flood_of_200_concurrent_requests_is_bounded_and_nothing_is_lost() {
     assert_eq!(a.status, 200, "{}", a.body);
     assert_eq!(a.json()["readings"], expected["readings"]);
 }
+
+#[test]
+fn a_table_s_tolerance_is_chosen_as_the_command_line_chooses_it() {
+    // Without `rtol` a measured table's tolerance comes from its data; with one it is used as given, as
+    // `measure --rtol` uses it: the two readings differ, and each is the command line's to the bit.
+    const RECIPE: &str = "fixtures/materials/rgl/beckmann-iso-32.json";
+    let addr = start(ServeOptions { data_dir: Some("fixtures/materials/rgl".into()), ..ServeOptions::default() });
+    let cli = |rtol: Option<&str>| {
+        let mut cmd = std::process::Command::new(env!("CARGO_BIN_EXE_glossmeter"));
+        cmd.args(["measure", "--format", "json", "--no-timing", RECIPE, "-g", "astm-d523-60"]);
+        if let Some(r) = rtol {
+            cmd.args(["--rtol", r]);
+        }
+        let out = cmd.output().unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        serde_json::from_slice::<Value>(&out.stdout).unwrap()
+    };
+    let text = std::fs::read_to_string(RECIPE).unwrap();
+    let from_data =
+        request(addr, "POST", "/api/measure", &with_recipe(&text, json!({"geometries": ["astm-d523-60"]})), &[]);
+    let given = request(
+        addr,
+        "POST",
+        "/api/measure",
+        &with_recipe(&text, json!({"geometries": ["astm-d523-60"], "rtol": 1e-4})),
+        &[],
+    );
+    assert_eq!(from_data.status, 200, "{}", from_data.body);
+    assert_eq!(given.status, 200, "{}", given.body);
+    assert_eq!(from_data.json()["readings"], cli(None)["readings"]);
+    assert_eq!(given.json()["readings"], cli(Some("1e-4"))["readings"]);
+    assert_ne!(from_data.json()["readings"], given.json()["readings"]);
+}

@@ -152,6 +152,9 @@ fn geometries(o: &Obj, ctx: Context, default: &[&str]) -> Result<Vec<StandardGeo
 
 /// `rtol`, `max_evals` (at most the server's), `illuminant`, `observer`: the plan's options.
 fn plan_options(o: &Obj, ctx: Context, rtol: f64) -> Result<PlanOptions> {
+    // As `measure --rtol`: a tolerance given is used as given; without one a measured table's tolerance comes
+    // from its data (docs/accuracy.md §Data uncertainty of measured tables).
+    let rtol_from_data = o.get("rtol").is_none();
     let rtol = match o.get("rtol") {
         None => rtol,
         Some(v) => {
@@ -170,7 +173,7 @@ fn plan_options(o: &Obj, ctx: Context, rtol: f64) -> Result<PlanOptions> {
         observer: Observer::parse(o.opt_str("observer")?.unwrap_or("10"))
             .map_err(|e| o.err("observer", e.to_string()))?,
     };
-    Ok(PlanOptions { rtol, max_evals, colour, ..PlanOptions::default() })
+    Ok(PlanOptions { rtol, max_evals, colour, rtol_from_data, ..PlanOptions::default() })
 }
 
 fn timing(o: &Obj) -> Result<bool> {
