@@ -5,11 +5,11 @@
 
 Every function is a thin layer over the library (see docs/python.md):
 
-* ``measure(recipe, geometries=None, rtol=1e-6, timing=True, *, as_frame=False, as_arrays=False)``: readings
+* ``measure(recipe, geometries=None, rtol=None, timing=True, *, as_frame=False, as_arrays=False)``: readings
   of a recipe (dict, JSON string or path), one dict per reading with the fields of
   ``glossmeter measure --format json``; or a pandas DataFrame (``as_frame=True``), or a dict of NumPy arrays,
   one per field (``as_arrays=True``).
-* ``measure_brdf(f, geometries=None, rtol=1e-6, lobes=None, delta=None, wavelengths=None, timing=True, *,
+* ``measure_brdf(f, geometries=None, rtol=None, lobes=None, delta=None, wavelengths=None, timing=True, *,
   as_frame=False, as_arrays=False)``: readings of a Python BRDF ``f(wi, wo)`` evaluated in batches of (N, 3)
   NumPy arrays.
 * ``standards()``, ``geometry(id)``, ``describe_geometry(id)``, ``schema()``, ``describe(recipe)``.
@@ -138,15 +138,15 @@ def _check_shape_flags(as_frame: object, as_arrays: object) -> None:
 
 
 @overload
-def measure(recipe: Recipe, geometries: Geometries = ..., rtol: float = ..., timing: bool = ..., *,
+def measure(recipe: Recipe, geometries: Geometries = ..., rtol: Optional[float] = ..., timing: bool = ..., *,
             as_frame: Literal[False] = ..., as_arrays: Literal[False] = ...) -> Readings: ...
 @overload
-def measure(recipe: Recipe, geometries: Geometries = ..., rtol: float = ..., timing: bool = ..., *,
+def measure(recipe: Recipe, geometries: Geometries = ..., rtol: Optional[float] = ..., timing: bool = ..., *,
             as_frame: Literal[True], as_arrays: Literal[False] = ...) -> "pandas.DataFrame": ...
 @overload
-def measure(recipe: Recipe, geometries: Geometries = ..., rtol: float = ..., timing: bool = ..., *,
+def measure(recipe: Recipe, geometries: Geometries = ..., rtol: Optional[float] = ..., timing: bool = ..., *,
             as_frame: Literal[False] = ..., as_arrays: Literal[True]) -> Arrays: ...
-def measure(recipe: Recipe, geometries: Geometries = None, rtol: float = 1e-6, timing: bool = True, *,
+def measure(recipe: Recipe, geometries: Geometries = None, rtol: Optional[float] = None, timing: bool = True, *,
             as_frame: bool = False, as_arrays: bool = False) -> Union[Readings, Arrays, "pandas.DataFrame"]:
     """Read a recipe (a dict, a JSON string or a path) through instrument geometries (None: the default panel
     of ``glossmeter measure``; or one or a list of builtin ids, geometry files or geometry dicts).
@@ -160,18 +160,18 @@ def measure(recipe: Recipe, geometries: Geometries = None, rtol: float = 1e-6, t
 
 
 @overload
-def measure_brdf(f: BrdfFunction, geometries: Geometries = ..., rtol: float = ..., lobes: Optional[Lobes] = ...,
+def measure_brdf(f: BrdfFunction, geometries: Geometries = ..., rtol: Optional[float] = ..., lobes: Optional[Lobes] = ...,
                  delta: Optional[Delta] = ..., wavelengths: Optional[Sequence[float]] = ..., timing: bool = ..., *,
                  as_frame: Literal[False] = ..., as_arrays: Literal[False] = ...) -> Readings: ...
 @overload
-def measure_brdf(f: BrdfFunction, geometries: Geometries = ..., rtol: float = ..., lobes: Optional[Lobes] = ...,
+def measure_brdf(f: BrdfFunction, geometries: Geometries = ..., rtol: Optional[float] = ..., lobes: Optional[Lobes] = ...,
                  delta: Optional[Delta] = ..., wavelengths: Optional[Sequence[float]] = ..., timing: bool = ..., *,
                  as_frame: Literal[True], as_arrays: Literal[False] = ...) -> "pandas.DataFrame": ...
 @overload
-def measure_brdf(f: BrdfFunction, geometries: Geometries = ..., rtol: float = ..., lobes: Optional[Lobes] = ...,
+def measure_brdf(f: BrdfFunction, geometries: Geometries = ..., rtol: Optional[float] = ..., lobes: Optional[Lobes] = ...,
                  delta: Optional[Delta] = ..., wavelengths: Optional[Sequence[float]] = ..., timing: bool = ..., *,
                  as_frame: Literal[False] = ..., as_arrays: Literal[True]) -> Arrays: ...
-def measure_brdf(f: BrdfFunction, geometries: Geometries = None, rtol: float = 1e-6, lobes: Optional[Lobes] = None,
+def measure_brdf(f: BrdfFunction, geometries: Geometries = None, rtol: Optional[float] = None, lobes: Optional[Lobes] = None,
                  delta: Optional[Delta] = None, wavelengths: Optional[Sequence[float]] = None, timing: bool = True,
                  *, as_frame: bool = False, as_arrays: bool = False) -> Union[Readings, Arrays, "pandas.DataFrame"]:
     """Read a Python BRDF ``f(wi, wo)`` through instrument geometries: f takes two (N, 3) float64 arrays of

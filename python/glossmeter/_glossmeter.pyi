@@ -10,13 +10,13 @@ DEFAULT_GEOMETRIES: List[str]
 def measure(
     recipe: Recipe,
     geometries: Geometries = None,
-    rtol: float = 1e-6,
+    rtol: Optional[float] = None,
     timing: bool = True,
 ) -> List[Reading]: ...
 def measure_brdf(
     f: BrdfFunction,
     geometries: Geometries = None,
-    rtol: float = 1e-6,
+    rtol: Optional[float] = None,
     lobes: Optional[Lobes] = None,
     delta: Optional[Delta] = None,
     wavelengths: Optional[Sequence[float]] = None,

@@ -1,7 +1,7 @@
 //! Arguments from Python, converted with refusals that name the argument and what it allows
 //! (docs/python.md §Errors): a value of the wrong type is a `TypeError`, a value out of range a `ValueError`,
 //! each saying `name: expected ..., got ...` instead of PyO3's generic conversion messages.
-use glossmeter::instrument::plan::rtol_refusal;
+use glossmeter::instrument::plan::{rtol_refusal, PlanOptions};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyString};
@@ -20,15 +20,17 @@ pub fn real(name: &str, v: &Bound<'_, PyAny>, allowed: &str) -> PyResult<f64> {
     v.extract::<f64>().map_err(|_| refuse())
 }
 
-/// `rtol`: None is the default 10⁻⁶; otherwise a number in (0, 1) (the planner's check, `plan::rtol_refusal`).
-pub fn rtol(v: Option<&Bound<'_, PyAny>>) -> PyResult<f64> {
+/// `rtol`: None is the planner's default (10⁻⁶, and for a measured table the tolerance its data uncertainty
+/// allows); a number in (0, 1) (the planner's check, `plan::rtol_refusal`) is used as given, as the command
+/// line's `--rtol` is (docs/accuracy.md §Data uncertainty of measured tables).
+pub fn plan_options(v: Option<&Bound<'_, PyAny>>) -> PyResult<PlanOptions> {
     let x = match v {
-        None => return Ok(1e-6),
+        None => return Ok(PlanOptions::default()),
         Some(v) => real("rtol", v, "the relative tolerance of the integrals, in (0, 1), e.g. 1e-6")?,
     };
     match rtol_refusal(x) {
         Some(why) => Err(PyValueError::new_err(format!("rtol {why} (the relative tolerance of the integrals)"))),
-        None => Ok(x),
+        None => Ok(PlanOptions { rtol: x, rtol_from_data: false, ..PlanOptions::default() }),
     }
 }
 

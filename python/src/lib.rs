@@ -224,14 +224,13 @@ pub(crate) fn run_plan(
     py: Python<'_>,
     brdf: Arc<dyn glossmeter::brdf::Brdf>,
     geos: Vec<StandardGeometry>,
-    rtol: f64,
+    options: PlanOptions,
     one_thread: bool,
 ) -> PyResult<Vec<Reading>> {
     let run = move || {
         guarded(|| {
             let material = Material { name: String::new(), file: String::new(), brdf, json: serde_json::Value::Null };
-            glossmeter::api::measure(&material, &geos, &PlanOptions { rtol, ..PlanOptions::default() })
-                .map_err(to_py_err)
+            glossmeter::api::measure(&material, &geos, &options).map_err(to_py_err)
         })
     };
     py.detach(|| {
@@ -247,7 +246,7 @@ pub(crate) fn run_plan(
     })
 }
 
-/// measure(recipe, geometries=None, rtol=1e-6, timing=True) -> list[dict]
+/// measure(recipe, geometries=None, rtol=None, timing=True) -> list[dict]
 ///
 /// Read a recipe (a dict, a JSON string or a path) through instrument geometries (None: the default panel of
 /// `glossmeter measure`; or a list of builtin ids, geometry files or geometry dicts). Returns one dict per
@@ -255,7 +254,7 @@ pub(crate) fn run_plan(
 /// message the CLI prints; a reading without a finite value has value None and a "problem".
 #[pyfunction]
 #[pyo3(signature = (recipe, geometries=None, rtol=None, timing=None))]
-#[pyo3(text_signature = "(recipe, geometries=None, rtol=1e-6, timing=True)")]
+#[pyo3(text_signature = "(recipe, geometries=None, rtol=None, timing=True)")]
 fn measure<'py>(
     py: Python<'py>,
     recipe: &Bound<'py, PyAny>,
@@ -263,11 +262,11 @@ fn measure<'py>(
     rtol: Option<&Bound<'py, PyAny>>,
     timing: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyList>> {
-    let rtol = args::rtol(rtol)?;
+    let options = args::plan_options(rtol)?;
     let timing = args::flag("timing", timing, true)?;
     let material = guarded(|| load_recipe(py, recipe))?;
     let geos = guarded(|| load_geometries(py, geometries))?;
-    let readings = run_plan(py, material.brdf.clone(), geos, rtol, false)?;
+    let readings = run_plan(py, material.brdf.clone(), geos, options, false)?;
     guarded(|| readings_to_py(py, &readings, timing))
 }
 

@@ -350,7 +350,7 @@ fn parse_lobes(lobes: &Bound<'_, PyAny>) -> PyResult<Vec<Lobe>> {
     Ok(out)
 }
 
-/// measure_brdf(f, geometries=None, rtol=1e-6, lobes=None, delta=None, wavelengths=None, timing=True)
+/// measure_brdf(f, geometries=None, rtol=None, lobes=None, delta=None, wavelengths=None, timing=True)
 ///
 /// Read a Python BRDF through instrument geometries. `f(wi, wo)` takes two (N, 3) float64 arrays (local
 /// frame, z the normal) and returns f_r in sr⁻¹, shape (N,) or (N, S), S spectral samples (1: grey, 3: linear
@@ -361,7 +361,7 @@ fn parse_lobes(lobes: &Bound<'_, PyAny>) -> PyResult<Vec<Lobe>> {
 /// (N, S). An exception raised in f propagates as itself.
 #[pyfunction]
 #[pyo3(signature = (f, geometries=None, rtol=None, lobes=None, delta=None, wavelengths=None, timing=None))]
-#[pyo3(text_signature = "(f, geometries=None, rtol=1e-6, lobes=None, delta=None, wavelengths=None, timing=True)")]
+#[pyo3(text_signature = "(f, geometries=None, rtol=None, lobes=None, delta=None, wavelengths=None, timing=True)")]
 #[allow(clippy::too_many_arguments)]
 pub fn measure_brdf<'py>(
     py: Python<'py>,
@@ -380,7 +380,7 @@ pub fn measure_brdf<'py>(
             type_name(f)
         )));
     }
-    let rtol = args::rtol(rtol)?;
+    let options = args::plan_options(rtol)?;
     let timing = args::flag("timing", timing, true)?;
     let wavelengths = match wavelengths {
         None => None,
@@ -496,7 +496,7 @@ pub fn measure_brdf<'py>(
         asarray: asarray.unbind(),
         error: Mutex::new(None),
     });
-    let readings = run_plan(py, brdf.clone(), geos, rtol, true)?;
+    let readings = run_plan(py, brdf.clone(), geos, options, true)?;
     if let Some(e) = brdf.take_error() {
         return Err(e);
     }

@@ -59,6 +59,21 @@ def test_the_dicts_are_the_cli_json():
     assert json.loads(out.stdout)["readings"] == glossmeter.measure(str(path), timing=False)
 
 
+@pytest.mark.parametrize("rtol", [None, 1e-6])
+def test_a_table_s_tolerance_is_chosen_as_the_command_line_chooses_it(rtol):
+    # Without rtol a measured table is integrated to the tolerance its data uncertainty allows; a given rtol is
+    # used as given, as `measure --rtol` uses it (docs/python.md, docs/accuracy.md §Data uncertainty).
+    exe = cli_binary()
+    if exe is None:
+        pytest.skip("the release CLI is not built (cargo build --release); .ci/run builds it first")
+    path = RECIPES.parent / "materials" / "rgl" / "beckmann-iso-32.json"
+    args = [exe, "measure", str(path), "-g", "astm-d523-60", "--format", "json", "--no-timing"]
+    if rtol is not None:
+        args += ["--rtol", str(rtol)]
+    out = subprocess.run(args, capture_output=True, text=True, check=True)
+    assert json.loads(out.stdout)["readings"] == glossmeter.measure(str(path), "astm-d523-60", rtol, timing=False)
+
+
 def cli_error(args):
     exe = cli_binary()
     if exe is None:
