@@ -328,25 +328,22 @@ pub fn compare_sheet(
     let geometries = sheet_geometries(sheet)?;
     // Recipes per sample, in order of first appearance.
     let mut samples: Vec<(String, PathBuf)> = Vec::new();
-    for g in &groups {
-        if samples.iter().any(|(s, _)| *s == g.sample) {
-            continue;
-        }
-        let Some(p) = recipes.path_of(&g.sample) else {
-            let row = sheet.rows.iter().find(|r| r.sample == g.sample).expect("sample from rows");
+    for sample in distinct_samples(&groups) {
+        let Some(p) = recipes.path_of(sample) else {
+            let row = sheet.rows.iter().find(|r| r.sample == sample).expect("sample from rows");
             let where_ = match &recipes.dir {
-                Some(d) => format!("no {}/{}.json", d.display(), g.sample),
+                Some(d) => format!("no {}/{}.json", d.display(), sample),
                 None => "no recipe given".into(),
             };
             return Err(Error::input(
                 &sheet.file,
                 sheet.cell(row.line, sheet.sample_column, "sample"),
-                Words::from(format!("sample `{}` has no recipe ({where_}; give one with ", g.sample))
+                Words::from(format!("sample `{sample}` has no recipe ({where_}; give one with "))
                     .and_argument("per_sample")
-                    .and(format!(" '{}=FILE')", g.sample)),
+                    .and(format!(" '{sample}=FILE')")),
             ));
         };
-        samples.push((g.sample.clone(), p));
+        samples.push((sample.to_string(), p));
     }
     let mut paths: Vec<PathBuf> = samples.iter().map(|(_, p)| p.clone()).collect();
     paths.sort();
@@ -368,13 +365,17 @@ pub fn compare_sheet_with(
     rule.check()?;
     let groups = group_rows(&sheet.rows);
     let geometries = sheet_geometries(sheet)?;
-    let mut of_sample: Vec<(String, usize)> = Vec::new();
-    for g in &groups {
-        if !of_sample.iter().any(|(s, _)| *s == g.sample) {
-            of_sample.push((g.sample.clone(), 0));
-        }
-    }
+    let of_sample: Vec<(String, usize)> = distinct_samples(&groups).map(|s| (s.to_string(), 0)).collect();
     judge_all(sheet, groups, geometries, std::slice::from_ref(material), &of_sample, rule, options)
+}
+
+/// The samples of the groups, each once, in order of first appearance.
+fn distinct_samples(groups: &[Group]) -> impl Iterator<Item = &str> {
+    groups
+        .iter()
+        .enumerate()
+        .filter(|(i, g)| !groups[..*i].iter().any(|h| h.sample == g.sample))
+        .map(|(_, g)| g.sample.as_str())
 }
 
 /// The sheet's geometries: a shipped id, else "not predicted" for a recognised column (the second map, with
