@@ -975,8 +975,11 @@ macro_rules! scatter_params {
 pub const PAINT_SCATTER: ScatterParams =
     scatter_params!("/clear_coat/scatter", PAINT, "the clear coat's surface (a smooth coat only)");
 pub const CT_SCATTER: ScatterParams = scatter_params!("/clear_coat/scatter", CT, "the clear coat's surface");
-pub const MICROFACET_SCATTER: ScatterParams =
-    scatter_params!("/scatter", &["microfacet"], "the interface (roughness 0 only)");
+pub const MICROFACET_SCATTER: ScatterParams = scatter_params!(
+    "/scatter",
+    &["microfacet"],
+    "the interface (smooth: on its mirror; rough: the two-scale surface of slopes and halo, brdf/two_scale.rs)"
+);
 
 /// Every entry, in the order of the docs table (descriptive fields first, then model by model).
 pub static PARAMS: &[&Param] = &[

@@ -271,3 +271,36 @@ fn a_lobe_about_as_wide_as_the_stops_at_85_degrees_is_covered() {
         assert!(actual <= d.error_estimate, "{json}: actual {actual:e} > estimate {:e}", d.error_estimate);
     }
 }
+
+/// The two readings of the Rhopoint IQ-class pixel-array geometry whose estimates fell below their actual error
+/// (docs/accuracy.md §5.2, "A lobe between half and the whole range wide"): a Phong lobe (n = 5091.6) whose
+/// width in u, 1.98·10⁻², lies between half and the whole u-range of the 0.1° source against the 1.8° gloss
+/// window (3.34·10⁻²), read 2.07× below its error at the default rtol; and the Rayleigh–Rice halo of
+/// `clear-coat-haze` (1.73·10⁻² wide in u), 1.33× below at rtol 10⁻⁸. The lobe chart had no split at the lobe's
+/// centre on u, so one box held the peak. Each must now cover its error against the rtol-10⁻¹⁰ reading.
+#[test]
+fn a_lobe_between_half_and_the_whole_range_wide_is_covered_on_the_pixel_array() {
+    let g = standards::find("rhopoint-iq-20").unwrap();
+    let tight = PlanOptions { rtol: 1e-10, max_seconds: None, rtol_from_data: false, ..PlanOptions::default() };
+    let haze = std::fs::read_to_string("fixtures/recipes/clear-coat-haze.json").unwrap();
+    let cases = [
+        (r#"{"model":"phong","exponent":5091.6,"ks":0.28455,"kd":0.140315}"#.to_string(), "generated.json", 1e-6),
+        (haze, "clear-coat-haze.json", 1e-8),
+    ];
+    for (json, file, rtol) in cases {
+        let m = glossmeter::recipe::parse_str(&json, &format!("fixtures/recipes/{file}")).unwrap();
+        let at = |options: PlanOptions| {
+            let readings = Plan::compile(m.brdf.clone(), vec![g.clone()], options).unwrap().execute();
+            readings.into_iter().find(|r| r.name == "gloss").expect("a gloss reading")
+        };
+        let d = at(PlanOptions { rtol, rtol_from_data: false, ..PlanOptions::default() });
+        let r = at(tight.clone());
+        assert!(d.converged && r.converged, "{file}");
+        let actual = (d.value.unwrap() - r.value.unwrap()).abs();
+        assert!(
+            actual <= d.error_estimate,
+            "{file} at rtol {rtol:e}: actual {actual:e} > estimate {:e}",
+            d.error_estimate
+        );
+    }
+}

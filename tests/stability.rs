@@ -471,8 +471,8 @@ fn every_geometry_lambert_and_smooth_dielectric() {
 
 /// Microfacet surfaces (n = 1.5) from roughness 1e-6 to 1, Beckmann and GGX, on every D523 geometry, against
 /// runs 100× tighter; continuity across the "effectively smooth" switch (roughness 1e-7 × (1 ± 1e-4)) and
-/// across the flux engine's lobe-split switch (splits only where the lobe is narrower than half the range of
-/// the lobe variable; w_u = 2m, w_v = 2m cos θ for a surface lobe, docs/instrument.md §Quadrature).
+/// across the flux engine's lobe-split switch (splits only where the lobe is narrower than the range of the
+/// lobe variable; w_u = 2m, w_v = 2m cos θ for a surface lobe, docs/instrument.md §Quadrature).
 #[test]
 fn microfacet_roughness_sweep_and_switches() {
     let test = "microfacet_roughness_sweep_and_switches";
@@ -495,7 +495,7 @@ fn microfacet_roughness_sweep_and_switches() {
         let rec = g.receptor("gloss").unwrap();
         let range_u = (g.source.p[1] + rec.p[1]) - (g.source.p[0] + rec.p[0]);
         let range_v = (g.source.q[1] + rec.q[1]) - (g.source.q[0] + rec.q[0]);
-        for (axis, m_star) in [("u", range_u / 4.0), ("v", range_v / (4.0 * g.theta.cos()))] {
+        for (axis, m_star) in [("u", range_u / 2.0), ("v", range_v / (2.0 * g.theta.cos()))] {
             let a = run(&mf(dist, m_star * (1.0 - 1e-9)), g60, RTOL);
             let b = run(&mf(dist, m_star * (1.0 + 1e-9)), g60, RTOL);
             // Evidence that the partition changed: the initial boxes differ, so do the evaluation counts.

@@ -21,6 +21,7 @@ const IDS: &[&str] = &[
     "astm-d2457-45",
     "tappi-t480-75",
     "rspec-20",
+    "rhopoint-iq-20",
 ];
 
 fn root() -> PathBuf {

@@ -20,7 +20,8 @@
 //!   dielectric or a conductor [`dielectric::MicrofacetSurface`], with its [`dielectric::Ior`]), `conductor.rs`
 //!   ([`conductor::SmoothConductor`]), `phong.rs` ([`phong::Phong`]), `ward.rs` ([`ward::Ward`]),
 //!   `multilobe.rs` ([`multilobe::CookTorranceLobes`]), `halo.rs` (a Rayleigh–Rice scatter halo on a model's
-//!   mirror, [`halo::WithHalo`] over [`halo::Halo`]) and `paint`, the paint model of Ďurikovič & Ágošton
+//!   mirror, [`halo::WithHalo`] over [`halo::Halo`]), `two_scale.rs` (a rough interface with that halo,
+//!   [`two_scale::RoughWithHalo`]) and `paint`, the paint model of Ďurikovič & Ágošton
 //!   (2007) ([`paint::Paint`] built from a [`paint::PaintSpec`]);
 //! * `albedo.rs`: the directional albedo that resolves narrow lobes
 //!   ([`albedo::directional_albedo`], [`albedo::directional_albedo_to`]): a d/8 sphere's hemisphere
@@ -39,6 +40,7 @@ pub mod lambert;
 pub mod multilobe;
 pub mod paint;
 pub mod phong;
+pub mod two_scale;
 pub mod ward;
 
 /// A glossy lobe centred on the specular direction (half vector along the normal, or, for a lobe formed

@@ -217,7 +217,13 @@ fn section(brdf: &dyn Brdf, g: &StandardGeometry) -> Option<Section> {
         .get("receptors")?
         .as_array()?
         .iter()
-        .filter_map(|r| {
+        .zip(&g.geometry.receptors)
+        .filter_map(|(r, (_, stop))| {
+            if r.get("shape").and_then(Value::as_str) == Some("pixels") {
+                // A window of the profile array: its edges from the compiled stop (p = tan of the angle).
+                let name = r.get("name").and_then(Value::as_str).unwrap_or("receptor").to_string();
+                return Some((name, angle + stop.p[0].atan().to_degrees(), angle + stop.p[1].atan().to_degrees()));
+            }
             let w = r.get("in_plane_deg")?.get("value")?.as_f64()?;
             let off = r.get("offset_deg").and_then(|o| o.get("value")).and_then(Value::as_f64).unwrap_or(0.0);
             let name = r.get("name").and_then(Value::as_str).unwrap_or("receptor").to_string();

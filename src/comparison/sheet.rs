@@ -52,17 +52,32 @@ const NOT_PUBLIC: &str = "the maker's formula is not public";
 pub const READING_COLUMNS: &[ReadingColumn] = &[
     ReadingColumn {
         names: &["haze", "hu", "haze20", "20haze", "hazehu"],
-        geometry: "iso-13803-20",
+        geometry: IQ,
         reading: "haze",
         not_predicted: None,
-        source: "BYK haze-gloss and Rhopoint IQ report haze at 20° (ISO 13803 / ASTM E430)",
+        source: "Rhopoint IQ / Elcometer 408 haze on the 20° pixel array (ASTM E430 windows; `rhopoint-iq-20`, \
+                 docs/instrument.md §1.9)",
     },
     ReadingColumn {
         names: &["loghaze", "hulog", "hazelog", "loghu", "loghaze20", "hazeloghu"],
+        geometry: IQ,
+        reading: "log-haze",
+        not_predicted: None,
+        source: "Rhopoint IQ HU_LOG / Elcometer 408 HULog on the 20° pixel array (`rhopoint-iq-20`, §1.9)",
+    },
+    ReadingColumn {
+        names: &["hazeiso13803", "iso13803haze", "iso13803"],
+        geometry: "iso-13803-20",
+        reading: "haze",
+        not_predicted: None,
+        source: "ISO 13803 20° haze of a gloss-haze meter with fixed haze detectors (BYK haze-gloss class)",
+    },
+    ReadingColumn {
+        names: &["loghazeiso13803", "iso13803loghaze"],
         geometry: "iso-13803-20",
         reading: "log-haze",
         not_predicted: None,
-        source: "log haze of the BYK haze-gloss / Rhopoint IQ (docs/instrument.md §1.6)",
+        source: "ISO 13803 log haze of a gloss-haze meter with fixed haze detectors (docs/instrument.md §1.6)",
     },
     ReadingColumn {
         names: &["hazenarrow", "narrowhaze", "hazen"],
@@ -79,7 +94,14 @@ pub const READING_COLUMNS: &[ReadingColumn] = &[
         source: "ASTM E430 wide-angle haze at 30°",
     },
     ReadingColumn {
-        names: &["doi", "distinctnessofimage", "doi30"],
+        names: &["doi", "distinctnessofimage", "doi20"],
+        geometry: IQ,
+        reading: "doi",
+        not_predicted: None,
+        source: "Rhopoint IQ / Elcometer 408 DOI on the 20° profile (`rhopoint-iq-20`, docs/instrument.md §1.9)",
+    },
+    ReadingColumn {
+        names: &["doi30", "doie430", "e430doi"],
         geometry: "astm-e430-30",
         reading: "doi",
         not_predicted: None,
@@ -94,26 +116,31 @@ pub const READING_COLUMNS: &[ReadingColumn] = &[
     },
     ReadingColumn {
         names: &["rspec", "rspec20"],
-        geometry: "rspec-20",
+        geometry: IQ,
         reading: "rspec",
         not_predicted: None,
-        source: "Rhopoint IQ peak specular reflectance at 20° (the `rspec-20` geometry, docs/instrument.md §1.8)",
+        source: "Rhopoint IQ peak specular reflectance, ±0.0991° of the 20° array (`rhopoint-iq-20`, §1.9)",
     },
     ReadingColumn {
         names: &["riq", "reflectedimagequality"],
-        geometry: "rspec-20",
+        geometry: IQ,
         reading: "riq",
         not_predicted: Some(NOT_PUBLIC),
         source: "Rhopoint IQ reflected image quality",
     },
     ReadingColumn {
         names: &["doic", "doicomp", "doicompensated", "compensateddoi", "doicomp20"],
-        geometry: "astm-e430-30",
+        geometry: IQ,
         reading: "doi-compensated",
         not_predicted: Some(NOT_PUBLIC),
         source: "makers' compensated DOI",
     },
 ];
+
+/// The geometry of a Rhopoint IQ-class meter's 20° pixel-array readings: an IQ sheet's Haze, Log Haze, DOI,
+/// Rspec and RIQ columns are readings of it (its 20°, 60° and 85° gloss columns are the ISO 2813 / D523 gloss
+/// the maker says they follow, [`GLOSS_ANGLES`]).
+pub const IQ: &str = "rhopoint-iq-20";
 
 /// Columns that say which sample a row is.
 pub const SAMPLE_COLUMNS: &[&str] =
@@ -1029,14 +1056,16 @@ mod tests {
             ("G60", "astm-d523-60", "gloss"),
             ("85 deg", "astm-d523-85", "gloss"),
             ("60° (GU)", "astm-d523-60", "gloss"),
-            ("HU", "iso-13803-20", "haze"),
-            ("Haze", "iso-13803-20", "haze"),
-            ("Log Haze", "iso-13803-20", "log-haze"),
-            ("HU_LOG", "iso-13803-20", "log-haze"),
-            ("HULog", "iso-13803-20", "log-haze"),
-            ("DOI", "astm-e430-30", "doi"),
-            ("Rspec", "rspec-20", "rspec"),
-            ("RIQ", "rspec-20", "riq"),
+            ("HU", IQ, "haze"),
+            ("Haze", IQ, "haze"),
+            ("Log Haze", IQ, "log-haze"),
+            ("HU_LOG", IQ, "log-haze"),
+            ("HULog", IQ, "log-haze"),
+            ("Haze ISO 13803", "iso-13803-20", "haze"),
+            ("DOI", IQ, "doi"),
+            ("DOI 30", "astm-e430-30", "doi"),
+            ("Rspec", IQ, "rspec"),
+            ("RIQ", IQ, "riq"),
         ] {
             match role(h, &[]) {
                 Some(Role::Reading { geometry, reading, .. }) => assert_eq!((geometry, reading), (g, r), "{h}"),

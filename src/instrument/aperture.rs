@@ -147,7 +147,11 @@ impl AxisMap {
         // every box. A Gaussian tail is below e⁻¹⁰⁰ of the peak beyond 10w: the splits stop there.
         let range_reach = a.abs().max(b.abs());
         for &(w, heavy) in &kept {
-            if w > 0.0 && w < 0.5 * (b - a) {
+            // Every lobe narrower than the range (the lobe chart's own condition, `choose_chart`) has its centre
+            // as a split, and its widths where they fall inside. A lobe between half and the whole range wide
+            // (a narrow source against a wide window) left without them put its peak inside one box whose
+            // I₇ − I₅ cancelled between the axes, 25× below its error (docs/accuracy.md §5.2).
+            if w > 0.0 && w < b - a {
                 pts.push(0.0);
                 let reach = if heavy { range_reach } else { range_reach.min(10.0 * w * (1.0 + 1e-12)) };
                 let mut k = 1.0;
@@ -490,6 +494,23 @@ mod tests {
         // The boxes tile the product of the split intervals.
         let boxes = lobe_boxes(&[u.clone(), v.clone()]);
         assert_eq!(boxes.len(), (u.len() - 1) * (v.len() - 1));
+    }
+
+    /// A lobe narrower than the range but wider than half of it (the 0.1° source of `rhopoint-iq-20` against
+    /// its 1.8° gloss window) still has its centre as a split: the lobe chart is chosen because of it, and a
+    /// box across its peak was fooled (docs/accuracy.md §5.2). One at least as wide as the range adds none.
+    #[test]
+    fn a_lobe_wider_than_half_the_range_still_splits_at_its_centre() {
+        let m = AxisMap { s: [-8.7e-4, 8.7e-4], r: [-0.0158, 0.0158] };
+        let range = 2.0 * (8.7e-4 + 0.0158);
+        let ends_and_kinks = m.splits(&[]);
+        assert_eq!(ends_and_kinks.len(), 4);
+        for w in [0.55 * range, 0.99 * range] {
+            let s = m.splits(&[(w, false)]);
+            assert!(s.contains(&0.0), "w = {w}: {s:?}");
+            assert_eq!(s.len(), 5, "±w lie outside the range: {s:?}");
+        }
+        assert_eq!(m.splits(&[(1.01 * range, false)]), ends_and_kinks);
     }
 
     /// The kink points lie on their kinks to rounding: ωi·ωo = 2c² − 1 (so ωi·h = c) for the half-angle

@@ -25,6 +25,7 @@ use crate::brdf::halo::WithHalo;
 use crate::brdf::lambert::Lambert;
 use crate::brdf::multilobe::{CookTorranceLobes, CtLobe};
 use crate::brdf::phong::{Phong, PhongVariant};
+use crate::brdf::two_scale::RoughWithHalo;
 use crate::brdf::ward::Ward;
 use crate::brdf::Brdf;
 use crate::input::json::{kind, parse_json, Obj};
@@ -157,19 +158,14 @@ pub fn parse_brdf(obj: &Obj) -> Result<Arc<dyn Brdf>> {
             match obj.opt_obj("scatter")? {
                 None => surface,
                 Some(s) => {
-                    if !facets.effectively_smooth() {
-                        return Err(obj.err(
-                            "scatter",
-                            format!(
-                                "a scatter halo sits on a smooth interface's mirror; roughness = {alpha} is not \
-                                 smooth (allowed with scatter: roughness < {:e}); for a lobe with a halo use \
-                                 cook-torrance-lobes with a clear_coat",
-                                Microfacet::SMOOTH_THRESHOLD
-                            ),
-                        ));
-                    }
                     let halo = scatter::parse_scatter(&s, &reg::MICROFACET_SCATTER, model, &index, &sampling)?;
-                    Arc::new(WithHalo::new(surface, halo)?)
+                    if facets.effectively_smooth() {
+                        Arc::new(WithHalo::new(surface, halo)?)
+                    } else {
+                        // A rough interface: the two-scale surface (facets' slopes and the micro-roughness's
+                        // halo, brdf/two_scale.rs).
+                        Arc::new(RoughWithHalo::new(surface, halo)?)
+                    }
                 }
             }
         }

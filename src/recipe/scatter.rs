@@ -188,9 +188,12 @@ mod tests {
 
     #[test]
     fn a_halo_needs_a_mirror() {
+        // A rough microfacet interface with a halo is the two-scale surface (brdf/two_scale.rs, docs/optics.md
+        // §9): its facets keep 1 − g, the halo is added.
         let t = r#"{"model": "microfacet", "distribution": "ggx", "roughness": 0.1, "ior": 1.5,
                     "scatter": {"psd": "gaussian", "rms_roughness_nm": 2, "correlation_length_um": 5}}"#;
-        assert_eq!(err(t).0, "/scatter");
+        let m = parse_str(t, "r.json").unwrap();
+        assert!(m.brdf.describe().contains("halo") && !m.brdf.has_delta(), "{}", m.brdf.describe());
         let t = r#"{"model": "cook-torrance-lobes", "kd": 0.1, "lobes": [{"ks": 0.1, "r": 0.5, "m": 0.2}],
                     "scatter": {"psd": "gaussian", "rms_roughness_nm": 2, "correlation_length_um": 5}}"#;
         assert_eq!(err(t).0, "/scatter");

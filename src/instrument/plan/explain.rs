@@ -110,6 +110,9 @@ impl Plan {
                 geo.theta.to_degrees(),
                 geo.scale.describe()
             ));
+            if let Some(text) = crate::instrument::standards::gloss::pixel_array_text(g) {
+                s.push_str(&text);
+            }
             for l in &lobes {
                 let w = lobe_widths_uv(l, geo.theta);
                 s.push_str(&format!(

@@ -31,6 +31,7 @@ pub const BUILTIN: &[(&str, &str)] = &[
     ("astm-d2457-45.json", include_str!("../../../standards/astm-d2457-45.json")),
     ("tappi-t480-75.json", include_str!("../../../standards/tappi-t480-75.json")),
     ("rspec-20.json", include_str!("../../../standards/rspec-20.json")),
+    ("rhopoint-iq-20.json", include_str!("../../../standards/rhopoint-iq-20.json")),
 ];
 
 const TOP_FIELDS: &[&str] = &[
@@ -144,9 +145,10 @@ pub fn parse(text: &str, origin: &str) -> Result<StandardGeometry> {
             ));
         }
         let source = Stop::from_angles(s_in.to_radians(), s_perp.to_radians(), 0.0);
-        if let Some(p) = o.opt_obj("profile")? {
-            crate::instrument::standards::profile::parse_spec(&p, angle)?;
-        }
+        let array = match o.opt_obj("profile")? {
+            Some(p) => Some(crate::instrument::standards::profile::parse_spec(&p, angle)?),
+            None => None,
+        };
         let rec_v = o.array("receptors")?;
         if rec_v.is_empty() {
             return Err(o.err("receptors", "at least one receptor is required"));
@@ -157,6 +159,11 @@ pub fn parse(text: &str, origin: &str) -> Result<StandardGeometry> {
             let name = nonempty_str(&r, "name")?;
             if receptors.iter().any(|(n, _)| *n == name) {
                 return Err(r.err("name", format!("duplicate receptor name {name:?}")));
+            }
+            if r.get("shape").and_then(Value::as_str) == Some("pixels") {
+                let stop = crate::instrument::standards::profile::pixel_window(&r, array.as_ref())?;
+                receptors.push((name, stop));
+                continue;
             }
             let (r_in, r_perp) = aperture(&r, &["name", "shape", "in_plane_deg", "perpendicular_deg", "offset_deg"])?;
             let off = sourced(
@@ -398,6 +405,17 @@ pub fn describe(g: &StandardGeometry) -> String {
                 r.get("shape").and_then(Value::as_str).unwrap_or("?"),
                 stop.solid_angle()
             );
+            if r.get("shape").and_then(Value::as_str) == Some("pixels") {
+                out += &format!(
+                    "    pixels of the profile array, {:.4}° to {:.4}° from specular in plane (pixel edges), as tall as the \
+                     pixels\n",
+                    stop.p[0].atan().to_degrees(),
+                    stop.p[1].atan().to_degrees()
+                );
+                out += &format!("    first pixel: {}\n", sourced_text(r.get("pixel_first"), ""));
+                out += &format!("    last pixel: {}\n", sourced_text(r.get("pixel_last"), ""));
+                continue;
+            }
             out += &format!("    in plane: {}\n", sourced_text(r.get("in_plane_deg"), "°"));
             out += &format!("    perpendicular: {}\n", sourced_text(r.get("perpendicular_deg"), "°"));
             out += &format!("    offset from specular: {}\n", sourced_text(r.get("offset_deg"), "°"));
@@ -424,6 +442,70 @@ pub fn describe(g: &StandardGeometry) -> String {
         out += &format!("  notes: {n}\n");
     }
     out
+}
+
+/// For a geometry whose receptors include windows of its profile array (`"shape": "pixels"`,
+/// `docs/instrument.md` §1.9), the lines `--explain` adds: each window's pixels and angles, each reading's
+/// definition, and every number of the file whose status is `assumed` (JSON Pointer, value, the start of its
+/// reason). None for any other geometry.
+pub fn pixel_array_text(g: &StandardGeometry) -> Option<String> {
+    let recs = g.spec.get("receptors").and_then(Value::as_array)?;
+    let is_pixels = |r: &Value| r.get("shape").and_then(Value::as_str) == Some("pixels");
+    if !recs.iter().any(is_pixels) {
+        return None;
+    }
+    let mut out = String::from("  pixel-array readings (docs/instrument.md §1.9):\n");
+    for (r, (name, stop)) in recs.iter().zip(&g.geometry.receptors) {
+        if is_pixels(r) {
+            let px = |k: &str| r.get(k).and_then(|x| x.get("value")).map(|x| x.to_string()).unwrap_or_default();
+            out += &format!(
+                "    window {name}: pixels {}–{}, {:+.4}° to {:+.4}° from specular in plane\n",
+                px("pixel_first"),
+                px("pixel_last"),
+                stop.p[0].atan().to_degrees(),
+                stop.p[1].atan().to_degrees()
+            );
+        }
+    }
+    for (spec, name) in g.geometry.readings.iter().zip(&g.reading_names) {
+        out += &format!("    {name} ({}) = {}\n", spec.unit(), reading_summary(spec));
+    }
+    let mut assumed = Vec::new();
+    assumed_numbers(&g.spec, String::new(), &mut assumed);
+    out += &format!(
+        "  assumed numbers of {} ({}; `glossmeter standards {}` gives each reason in full):\n",
+        g.geometry.id,
+        assumed.len(),
+        g.geometry.id
+    );
+    for (pointer, value, why) in assumed {
+        let short: String = why.chars().take(110).collect();
+        let more = if why.chars().count() > 110 { "…" } else { "" };
+        out += &format!("    {pointer} = {value}: {short}{more}\n");
+    }
+    Some(out)
+}
+
+/// Every sourced number of a geometry specification whose status is `assumed`: (JSON Pointer, value, source).
+fn assumed_numbers(v: &Value, pointer: String, out: &mut Vec<(String, String, String)>) {
+    match v {
+        Value::Object(m) => {
+            if let (Some(value), Some("assumed")) = (m.get("value"), m.get("status").and_then(Value::as_str)) {
+                let source = m.get("source").and_then(Value::as_str).unwrap_or("").to_string();
+                out.push((pointer, value.to_string(), source));
+                return;
+            }
+            for (k, x) in m {
+                assumed_numbers(x, format!("{pointer}/{}", k.replace('~', "~0").replace('/', "~1")), out);
+            }
+        }
+        Value::Array(a) => {
+            for (i, x) in a.iter().enumerate() {
+                assumed_numbers(x, format!("{pointer}/{i}"), out);
+            }
+        }
+        _ => {}
+    }
 }
 
 fn reading_summary(r: &ReadingSpec) -> String {
@@ -471,6 +553,9 @@ pub fn list_line(g: &StandardGeometry) -> String {
         .iter()
         .map(|r| {
             let name = r.get("name").and_then(Value::as_str).unwrap_or("?");
+            if r.get("shape").and_then(Value::as_str) == Some("pixels") {
+                return format!("{name} pixels {}–{}", val(r, "pixel_first"), val(r, "pixel_last"));
+            }
             let off = val(r, "offset_deg");
             let off = if off == "0" || off == "0.0" { String::new() } else { format!("@{off}°") };
             format!("{name} {}°×{}°{off}", val(r, "in_plane_deg"), val(r, "perpendicular_deg"))

@@ -47,6 +47,19 @@ impl ProfileSpec {
         Stop::from_angles(self.pixel, self.perpendicular, self.centre(k))
     }
 
+    /// The stop of pixels `first` ..= `last` side by side: in plane from the left edge of `first` to the right
+    /// edge of `last`, as tall as the pixels.
+    pub fn window(&self, first: usize, last: usize) -> Stop {
+        let lo = (self.centre_deg(first) - 0.5 * self.pixel_deg).to_radians();
+        let hi = (self.centre_deg(last) + 0.5 * self.pixel_deg).to_radians();
+        Stop::from_angles(hi - lo, self.perpendicular, 0.5 * (lo + hi))
+    }
+
+    /// The window's edges from the specular direction, degrees: (left edge of `first`, right edge of `last`).
+    pub fn window_deg(&self, first: usize, last: usize) -> (f64, f64) {
+        (self.centre_deg(first) - 0.5 * self.pixel_deg, self.centre_deg(last) + 0.5 * self.pixel_deg)
+    }
+
     /// The name of pixel k (and of its reading): `pixel-0000` … (four digits at least, sorted as numbers).
     pub fn name(&self, k: usize) -> String {
         format!("pixel-{k:04}")
@@ -75,6 +88,41 @@ pub fn parse_spec(o: &Obj, angle_deg: f64) -> Result<ProfileSpec> {
         ));
     }
     Ok(ProfileSpec { pixels: n as usize, pixel: w.to_radians(), perpendicular: h.to_radians(), pixel_deg: w })
+}
+
+/// A receptor made of pixels of the profile array (`"shape": "pixels"`, `docs/instrument.md` §1.9): `o` is the
+/// receptor's object, with `pixel_first` and `pixel_last` (sourced whole numbers, 0-based, first ≤ last, both
+/// within the array). The stop is the union of those pixels: in plane from the left edge of `pixel_first` to the
+/// right edge of `pixel_last`, as tall as the pixels. A geometry without a `profile` block, a pixel outside the
+/// array or a window whose first pixel lies after its last is refused, naming the file and the field.
+pub fn pixel_window(o: &Obj, array: Option<&ProfileSpec>) -> Result<Stop> {
+    o.deny_unknown(&["name", "shape", "pixel_first", "pixel_last", "notes"])?;
+    let Some(p) = array else {
+        return Err(o.err(
+            "shape",
+            "a receptor of shape \"pixels\" reads pixels of the geometry's profile array, and this geometry has no \
+             `profile` block (pixels, pixel_deg, perpendicular_deg: docs/instrument.md §1.8)",
+        ));
+    };
+    let last_pixel = (p.pixels - 1) as f64;
+    let what = format!("a pixel of the profile array, 0-based: a whole number from 0 to {}", p.pixels - 1);
+    let index = |key: &str| -> Result<usize> {
+        let v = sourced(o, key, Range::closed(0.0, last_pixel), &what)?;
+        if v.fract() != 0.0 {
+            return Err(o.obj(key)?.err("value", format!("{v} is not a whole pixel; {what}")));
+        }
+        Ok(v as usize)
+    };
+    let (first, last) = (index("pixel_first")?, index("pixel_last")?);
+    if first > last {
+        return Err(o.obj("pixel_last")?.err(
+            "value",
+            format!(
+                "the window's last pixel {last} lies before its first pixel {first}: give pixel_first ≤ pixel_last"
+            ),
+        ));
+    }
+    Ok(p.window(first, last))
 }
 
 /// The profile array of a geometry (its `profile` block); a geometry without one is an error naming its file.

@@ -96,7 +96,15 @@ pub(crate) fn aperture(o: &Obj, allowed: &[&str]) -> Result<(f64, f64)> {
                  the inscribed one (side = diameter/√2) or the square of equal solid angle (side ≈ 0.886 × diameter), \
                  and say which in the numbers' \"source\"",
         )),
-        other => return Err(o.err("shape", format!("unknown shape {other:?}; allowed: rectangle"))),
+        other => {
+            return Err(o.err(
+                "shape",
+                format!(
+                    "unknown shape {other:?}; allowed: rectangle (and \"pixels\" for a receptor of a gloss geometry \
+                     with a `profile` array, docs/instrument.md §1.9)"
+                ),
+            ))
+        }
     }
     o.deny_unknown(allowed)?;
     let what = "a full aperture angle in degrees";
