@@ -44,48 +44,14 @@ fn dir(theta: f64, phi: f64) -> Vec3 {
 /// A MERL-format table (90 × 90 × 180, trilinear) of the engine's GGX microfacet model (n = 1.5), sampled at
 /// the bins' lower edges.
 fn merl_ggx(alpha: f64) -> glossmeter::measured::merl::MerlBrdf {
-    use glossmeter::measured::merl::{Interpolation, MerlBrdf, MERL_DIMS, MERL_SCALE};
+    use glossmeter::measured::merl::{Interpolation, MerlBrdf, MERL_DIMS};
     let m = glossmeter::recipe::parse_str(
         &format!(r#"{{"model":"microfacet","distribution":"ggx","roughness":{alpha},"ior":1.5}}"#),
         "ggx",
     )
     .unwrap()
     .brdf;
-    let [nh, nd, np] = MERL_DIMS;
-    let n = nh * nd * np;
-    let mut vals = vec![0.0; n];
-    let mut f = vec![0.0; m.sampling().len()];
-    for ih in 0..nh {
-        let th = std::f64::consts::FRAC_PI_2 * (ih as f64 / nh as f64).powi(2);
-        for id in 0..nd {
-            let td = id as f64 / nd as f64 * std::f64::consts::FRAC_PI_2;
-            for ip in 0..np {
-                let pd = ip as f64 / np as f64 * std::f64::consts::PI;
-                let d = Vec3::new(td.sin() * pd.cos(), td.sin() * pd.sin(), td.cos());
-                let y = Vec3::new(d.x * th.cos() + d.z * th.sin(), d.y, -d.x * th.sin() + d.z * th.cos());
-                let h = Vec3::new(th.sin(), 0.0, th.cos());
-                let wo = 2.0 * y.dot(h) * h - y;
-                let v = if y.z > 1e-9 && wo.z > 1e-9 {
-                    m.eval(y, wo, &mut f);
-                    f[0]
-                } else {
-                    -1.0
-                };
-                vals[ip + id * np + ih * np * nd] = v;
-            }
-        }
-    }
-    let mut bytes = Vec::with_capacity(12 + 24 * n);
-    for d in MERL_DIMS {
-        bytes.extend_from_slice(&(d as i32).to_le_bytes());
-    }
-    for s in MERL_SCALE {
-        for v in &vals {
-            let raw = if *v < 0.0 { -1.0 } else { v / s };
-            bytes.extend_from_slice(&raw.to_le_bytes());
-        }
-    }
-    MerlBrdf::from_bytes(&bytes, "ggx.binary", Interpolation::Trilinear).unwrap()
+    MerlBrdf::tabulate(m.as_ref(), MERL_DIMS, Interpolation::Trilinear).unwrap()
 }
 
 fn main() {

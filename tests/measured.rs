@@ -222,10 +222,12 @@ fn lambertian_table_reads_rho_over_pi_with_both_lookups() {
     assert!(!m.is_flat());
     match &m.terms()[0].kind {
         TermKind::Lobe(l) => {
-            assert!(close(l.slope_width, (FRAC_PI_2 / 8100.0).tan(), 1e-15), "{}", l.slope_width);
             assert_eq!((l.medium_eta, l.label.as_str()), (1.0, "measured (MERL)"));
-            // The bump is far from the specular scan: the lobe never falls to half, its half width is infinite.
-            assert_eq!(l.tail, glossmeter::brdf::Tail::Table { half_width: f64::INFINITY });
+            // The bump is far from the specular scan: the lobe never falls to half, its half width is infinite
+            // (and so the slope width the partition splits at: the plain chart); the resolution is the table's.
+            let glossmeter::brdf::Tail::Table { half_width, resolution } = l.tail else { panic!("{l:?}") };
+            assert_eq!((half_width, l.slope_width), (f64::INFINITY, f64::INFINITY));
+            assert!(close(resolution, (FRAC_PI_2 / 8100.0).tan(), 1e-15), "{resolution}");
         }
         k => panic!("expected a lobe, got {k:?}"),
     }

@@ -206,17 +206,22 @@ fn broken_files_are_refused_with_offset_and_field() {
     let _ = p;
 }
 
-/// The lobe width the integrator is told (`Lobe::slope_width`) is the table's own resolution: for an RGL file
+/// The table's resolution the lobe states (`Tail::Table`'s `resolution`) is its own: for an RGL file
 /// tan((π/2)/(n − 1)²), n the finer of the NDF and VNDF grids (the first u_θ node off the pole); for an
-/// in-plane table tan(Δ/2), Δ its smallest θo step (0.1° in the fixtures).
+/// in-plane table tan(Δ/2), Δ its smallest θo step (0.1° in the fixtures). The lobe's slope width, where the
+/// partition splits, is its half width (`docs/instrument.md` §Quadrature, *Measured tables*).
 #[test]
-fn the_table_resolution_is_the_lobe_width() {
-    use glossmeter::brdf::TermKind;
+fn the_table_resolution_is_stated_with_the_lobe() {
+    use glossmeter::brdf::{Tail, TermKind};
     let width = |m: &recipe::Material| -> f64 {
         let terms = m.brdf.terms();
         assert_eq!(terms.len(), 1);
         match &terms[0].kind {
-            TermKind::Lobe(l) => l.slope_width,
+            TermKind::Lobe(l) => {
+                let Tail::Table { half_width, resolution } = l.tail else { panic!("{l:?}") };
+                assert_eq!(l.slope_width.to_bits(), half_width.to_bits(), "{l:?}");
+                resolution
+            }
             other => panic!("{other:?}"),
         }
     };
@@ -390,11 +395,13 @@ fn tables_state_their_half_width_and_a_flat_table_is_diffuse() {
         inplane(&d, "e1392", "beckmann-e1392.txt"),
         inplane_with(&d, "inplane-csv", "beckmann.csv", "microfacet"),
     ] {
-        let Some(Tail::Table { half_width }) = tail(&m) else { panic!("{}: {:?}", m.file, m.brdf.terms()) };
+        let Some(Tail::Table { half_width, .. }) = tail(&m) else { panic!("{}: {:?}", m.file, m.brdf.terms()) };
         // Measured 0.1217 (RGL 16) and 0.1219 (the others).
         assert!((0.118..0.126).contains(&half_width), "{}: {half_width}", m.file);
     }
-    assert_eq!(tail(&rgl(&d, "lambert-rgb.bsdf")), Some(Tail::Table { half_width: f64::INFINITY }));
+    assert!(
+        matches!(tail(&rgl(&d, "lambert-rgb.bsdf")), Some(Tail::Table { half_width, .. }) if half_width == f64::INFINITY)
+    );
     let flat = inplane(&d, "inplane-csv", "lambert-cos.csv");
     assert_eq!(flat.brdf.terms()[0].kind, TermKind::Diffuse);
     // With the f-cos-cos extension the same file is not a constant BRDF: a lobe again.

@@ -81,9 +81,13 @@ pub enum Tail {
     /// (`docs/instrument.md` §Quadrature, *Measured tables*). `half_width` is the lobe's own half width at half
     /// maximum as a slope (tan of the half-vector tilt), measured from the table when it is loaded
     /// ([`crate::measured::table::specular_half_width`]); infinite when the table does not fall to half its
-    /// specular value within `table::HALF_WIDTH_MAX_TILT_DEG` (40°) of tilt. The lobe's `slope_width` stays
-    /// the table's resolution (where the partition must split).
-    Table { half_width: f64 },
+    /// specular value within `table::HALF_WIDTH_MAX_TILT_DEG` (40°) of tilt. `resolution` is the table's
+    /// angular resolution at the specular direction (tan of its finest step there), kept for `--explain` and for
+    /// the rule that splits at it. The lobe's `slope_width`, where the partition splits, is `half_width`
+    /// (∞ when the table does not halve: the plain chart): at the tolerance a table's data allow, the kinks at
+    /// its cells are below the tolerance and the adaptive partition finds the few that are not
+    /// (`docs/instrument.md` §Quadrature, *Measured tables*, "The partition at the lobe's width").
+    Table { half_width: f64, resolution: f64 },
 }
 
 impl Tail {

@@ -15,7 +15,7 @@
 //! Gaussian tail and to the end of the range for a heavy one, so a lobe of any width is resolved by the
 //! initial partition. An ideal-mirror (delta) component is integrated analytically in u (it sits at
 //! u = v = 0) as a 2-D integral over the stops' mirror overlap.
-use crate::brdf::{Kink, Lobe};
+use crate::brdf::{Kink, Lobe, Tail};
 use crate::instrument::geometry::{Axes, Stop};
 
 /// Fraction of a flux's tolerance given to its delta part. The delta part is a smooth 2-D integral that
@@ -54,7 +54,8 @@ pub fn choose_chart(lobes: &[Lobe], theta: f64, source: Stop, receptor: Stop) ->
     let range_v = (source.q[1] - source.q[0]) + (receptor.q[1] - receptor.q[0]);
     let wide = |l: &Lobe| {
         let w = lobe_widths_uv(l, theta);
-        w[0] >= range_u && w[1] >= range_v
+        let pole = table_pole_widths(l, theta).unwrap_or(w);
+        w[0] >= range_u && w[1] >= range_v && pole[0] >= range_u && pole[1] >= range_v
     };
     if lobes.iter().all(wide) {
         Chart::Plain
@@ -78,9 +79,32 @@ pub fn lobe_splits(lobes: &[Lobe], theta: f64, source: Stop, receptor: Stop) -> 
     let ap = AxisMap { s: source.p, r: receptor.p };
     let aq = AxisMap { s: source.q, r: receptor.q };
     let widths: Vec<[f64; 2]> = lobes.iter().map(|l| lobe_widths_uv(l, theta)).collect();
-    let up = ap.splits(&widths.iter().zip(lobes).map(|(w, l)| (w[0], l.tail.is_heavy())).collect::<Vec<_>>());
-    let uq = aq.splits(&widths.iter().zip(lobes).map(|(w, l)| (w[1], l.tail.is_heavy())).collect::<Vec<_>>());
+    let mut up = ap.splits(&widths.iter().zip(lobes).map(|(w, l)| (w[0], l.tail.is_heavy())).collect::<Vec<_>>());
+    let mut uq = aq.splits(&widths.iter().zip(lobes).map(|(w, l)| (w[1], l.tail.is_heavy())).collect::<Vec<_>>());
+    for pole in lobes.iter().filter_map(|l| table_pole_widths(l, theta)) {
+        for (pts, a, w) in [(&mut up, ap, pole[0]), (&mut uq, aq, pole[1])] {
+            let [lo, hi] = a.range();
+            pts.extend([0.0, -w, w].into_iter().filter(|x| *x > lo && *x < hi));
+            pts.sort_by(f64::total_cmp);
+            let tiny = 1e-14 * (hi - lo).max(1e-300);
+            pts.dedup_by(|x, y| (*x - *y).abs() <= tiny);
+        }
+    }
     [up, uq]
+}
+
+/// The widths in (u, v) of a measured table's first ring around the specular direction (`Tail::Table`'s
+/// `resolution` as the slope width), where its interpolant has a cusp (the grids of MERL and RGL are
+/// sampled in √θh or u_θ = √(2θ/π), so the interpolant is linear in √θh in the first cell; an in-plane table's
+/// is linear in |θh|): the lobe chart splits at 0 and ± these widths, so that the cusp sits in the corners of
+/// boxes a ring wide (`docs/instrument.md` §Quadrature, *Measured tables*). None for a lobe of a model.
+pub fn table_pole_widths(lobe: &Lobe, theta: f64) -> Option<[f64; 2]> {
+    match lobe.tail {
+        Tail::Table { resolution, .. } => {
+            Some(lobe_widths_uv(&Lobe { slope_width: resolution, ..lobe.clone() }, theta))
+        }
+        _ => None,
+    }
 }
 
 /// The initial boxes of the lobe chart in (u, t_p, v, t_q): the product of the split intervals, t ∈ [0, 1].

@@ -519,7 +519,7 @@ impl InPlaneBrdf {
         (d, d_theta)
     }
 
-    /// Slope width reported to the integrator: tan of half the smallest θo step (a step of the receptor by
+    /// The resolution stated with the lobe (`Tail::Table`): tan of half the smallest θo step (a step of the receptor by
     /// Δ turns the half vector by Δ/2).
     pub fn resolution_slope(&self) -> f64 {
         (0.5 * self.min_step).tan()
@@ -572,10 +572,10 @@ impl Brdf for InPlaneBrdf {
         vec![Term {
             label: format!("measured in-plane table ({}, isotropic (θh, θd) extension)", self.format),
             kind: TermKind::Lobe(Lobe {
-                slope_width: self.resolution_slope(),
+                slope_width: self.half_width,
                 medium_eta: 1.0,
                 label: format!("measured ({})", self.format),
-                tail: crate::brdf::Tail::Table { half_width: self.half_width },
+                tail: crate::brdf::Tail::Table { half_width: self.half_width, resolution: self.resolution_slope() },
             }),
         }]
     }

@@ -119,6 +119,48 @@ impl MerlBrdf {
         Ok(Self::from_parts(file.to_string(), dims, &bytes[HEADER_BYTES..], interpolation))
     }
 
+    /// A MERL-format table (dims n_θh × n_θd × n_φd) of a grey model's BRDF (its first sample, in all three
+    /// channels), sampled where this reader places its samples (the bins' lower edges: θh = (π/2)(i/n_θh)²,
+    /// θd = (π/2)(j/n_θd), φd = π(k/n_φd)), written in the MERL byte layout and read back as a file would be;
+    /// directions below the horizon get MERL's invalid marker. For tests and benches of the table path: a
+    /// table whose analytic original is known (docs/accuracy.md §Data uncertainty of measured tables).
+    pub fn tabulate(model: &dyn Brdf, dims: [usize; 3], interpolation: Interpolation) -> Result<Self> {
+        let [nh, nd, np] = dims;
+        let n = nh * nd * np;
+        let mut vals = vec![0.0; n];
+        let mut f = vec![0.0; model.sampling().len()];
+        for ih in 0..nh {
+            let th = FRAC_PI_2 * (ih as f64 / nh as f64).powi(2);
+            let h = Vec3::new(th.sin(), 0.0, th.cos());
+            for id in 0..nd {
+                let td = id as f64 / nd as f64 * FRAC_PI_2;
+                for ip in 0..np {
+                    let pd = ip as f64 / np as f64 * PI;
+                    let d = Vec3::new(td.sin() * pd.cos(), td.sin() * pd.sin(), td.cos());
+                    // ωi: the difference vector rotated from the half-vector frame (φh = 0) to the surface's.
+                    let wi = Vec3::new(d.x * th.cos() + d.z * th.sin(), d.y, -d.x * th.sin() + d.z * th.cos());
+                    let wo = 2.0 * wi.dot(h) * h - wi;
+                    vals[ip + id * np + ih * np * nd] = if wi.z > 1e-9 && wo.z > 1e-9 {
+                        model.eval(wi, wo, &mut f);
+                        f[0]
+                    } else {
+                        -1.0
+                    };
+                }
+            }
+        }
+        let mut bytes = Vec::with_capacity(HEADER_BYTES + 24 * n);
+        for d in dims {
+            bytes.extend_from_slice(&(d as i32).to_le_bytes());
+        }
+        for s in MERL_SCALE {
+            for v in &vals {
+                bytes.extend_from_slice(&(if *v < 0.0 { -1.0 } else { v / s }).to_le_bytes());
+            }
+        }
+        Self::from_bytes(&bytes, "tabulated.binary", interpolation)
+    }
+
     /// `body` holds exactly 3·n·8 bytes (checked by the callers).
     fn from_parts(file: String, dims: [usize; 3], body: &[u8], interpolation: Interpolation) -> Self {
         let n = dims[0] * dims[1] * dims[2];
@@ -205,7 +247,7 @@ impl MerlBrdf {
         (ih, id, ip)
     }
 
-    /// Slope width reported to the integrator: the tangent of the first θh bin edge, (π/2)/n_θh², the
+    /// The resolution stated with the lobe (`Tail::Table`): the tangent of the first θh bin edge, (π/2)/n_θh², the
     /// table's angular resolution at the specular direction (≈ 1.94e-4 for 90 bins).
     pub fn resolution_slope(&self) -> f64 {
         let nh = self.dims[0] as f64;
@@ -292,10 +334,10 @@ impl Brdf for MerlBrdf {
         vec![Term {
             label: format!("measured table (MERL, {lookup} lookup)"),
             kind: TermKind::Lobe(Lobe {
-                slope_width: self.resolution_slope(),
+                slope_width: self.half_width,
                 medium_eta: 1.0,
                 label: "measured (MERL)".to_string(),
-                tail: crate::brdf::Tail::Table { half_width: self.half_width },
+                tail: crate::brdf::Tail::Table { half_width: self.half_width, resolution: self.resolution_slope() },
             }),
         }]
     }

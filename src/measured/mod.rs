@@ -16,10 +16,12 @@
 //! The RGL, in-plane CSV and E1392 files are read with the tables' size limit (`crate::input::MAX_TABLE_BYTES`);
 //! a MERL file is checked against its own header.
 //!
-//! Every reader tells the integrator the table's angular resolution as the lobe width (`Lobe::slope_width`),
-//! so the adaptive cubature splits at the table's finest structure and cannot step over its peak, and the
-//! lobe's own half width at half maximum, measured from the table at load (`Tail::Table`,
-//! `table::specular_half_width`); a table that is a constant (`table::is_flat`) is a diffuse term instead.
+//! Every reader tells the integrator the lobe's own half width at half maximum, measured from the table at
+//! load (`table::specular_half_width`), as the lobe width (`Lobe::slope_width`: where the partition splits, so
+//! it cannot step over the peak), and the table's angular resolution at the specular direction beside it
+//! (`Tail::Table`); the kinks at the table's cells are left to the adaptive refinement, which meets the
+//! tolerance the data allow far sooner than a partition split at every cell (`docs/instrument.md`
+//! §Quadrature, *Measured tables*). A table that is a constant (`table::is_flat`) is a diffuse term instead.
 pub mod e1392;
 pub mod inplane;
 pub mod merl;

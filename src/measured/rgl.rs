@@ -598,7 +598,7 @@ impl RglBrdf {
         &self.description
     }
 
-    /// Slope width reported to the integrator: tan of the polar angle of the first node off the pole of the
+    /// The resolution stated with the lobe (`Tail::Table`): tan of the polar angle of the first node off the pole of the
     /// finer of the NDF and VNDF grids, θ = (π/2)/(n − 1)² (u_θ = √(2θ/π) puts the nodes densest there).
     pub fn resolution_slope(&self) -> f64 {
         let n = self.ndf.nx.max(self.vndf.nx) as f64;
@@ -647,10 +647,10 @@ impl Brdf for RglBrdf {
         vec![Term {
             label: "measured table (RGL .bsdf, pbrt-v4 evaluation)".into(),
             kind: TermKind::Lobe(Lobe {
-                slope_width: self.resolution_slope(),
+                slope_width: self.half_width,
                 medium_eta: 1.0,
                 label: "measured (RGL)".into(),
-                tail: crate::brdf::Tail::Table { half_width: self.half_width },
+                tail: crate::brdf::Tail::Table { half_width: self.half_width, resolution: self.resolution_slope() },
             }),
         }]
     }

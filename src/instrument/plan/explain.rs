@@ -57,13 +57,15 @@ impl Plan {
                     l.slope_width,
                     if l.medium_eta != 1.0 { format!(" inside a medium of index {}", l.medium_eta) } else { String::new() },
                     match l.tail {
-                        Tail::Table { half_width } if half_width.is_finite() => format!(
-                            ", a measured table's tail (its own half width at half maximum {half_width:.3e}, kinks at \
-                             its cells; the partition)"
+                        Tail::Table { half_width, resolution } if half_width.is_finite() => format!(
+                            ", a measured table's tail (its own half width at half maximum {half_width:.3e}; also \
+                             split at 0 and ± its first ring, resolution {resolution:.3e}; the other kinks at its \
+                             cells left to the adaptive partition)"
                         ),
-                        Tail::Table { .. } => format!(
-                            ", a measured table's tail (it does not fall to half within {}° of tilt; kinks at its \
-                             cells; the partition)",
+                        Tail::Table { resolution, .. } => format!(
+                            ", a measured table's tail (it does not fall to half within {}° of tilt; split at 0 and \
+                             ± its first ring, resolution {resolution:.3e}; the other kinks at its cells left to the \
+                             adaptive partition)",
                             crate::measured::table::HALF_WIDTH_MAX_TILT_DEG
                         ),
                         t if t.is_heavy() => ", heavy tail".to_string(),
