@@ -78,7 +78,7 @@ pub fn mirror_overlap(source: Stop, receptor: Stop) -> Option<([f64; 2], [f64; 2
 pub fn lobe_splits(lobes: &[Lobe], theta: f64, source: Stop, receptor: Stop) -> [Vec<f64>; 2] {
     let ap = AxisMap { s: source.p, r: receptor.p };
     let aq = AxisMap { s: source.q, r: receptor.q };
-    let widths: Vec<[f64; 2]> = lobes.iter().map(|l| lobe_widths_uv(l, theta)).collect();
+    let widths: Vec<[f64; 2]> = lobes.iter().map(|l| seen_widths(l, theta, ap, aq)).collect();
     let mut up = ap.splits(&widths.iter().zip(lobes).map(|(w, l)| (w[0], l.tail.is_heavy())).collect::<Vec<_>>());
     let mut uq = aq.splits(&widths.iter().zip(lobes).map(|(w, l)| (w[1], l.tail.is_heavy())).collect::<Vec<_>>());
     for pole in lobes.iter().filter_map(|l| table_pole_widths(l, theta)) {
@@ -105,6 +105,25 @@ pub fn table_pole_widths(lobe: &Lobe, theta: f64) -> Option<[f64; 2]> {
         }
         _ => None,
     }
+}
+
+/// The widths (u, v) a lobe shows over these stops: [`lobe_widths_uv`], except for a GGX tail
+/// (`Tail::InverseQuartic`) whose centre lies outside the range of one axis. Along the other axis the
+/// GGX kernel at scaled distance x = u/w_u is 1/(1 + x² + y²)² = 1/(c² + y²)², c = √(1 + x²): a peak c
+/// widths wide, and c only grows away from the centre, so the splits use the width times c at the range's
+/// nearest point (an E430 haze receptor 2° off specular sees a GGX α = 0.003 lobe 5.3 times wider across the
+/// plane of incidence than the specular receptor does; `docs/instrument.md` §Quadrature).
+pub fn seen_widths(lobe: &Lobe, theta: f64, ap: AxisMap, aq: AxisMap) -> [f64; 2] {
+    let w = lobe_widths_uv(lobe, theta);
+    if lobe.tail != Tail::InverseQuartic || !(w[0] > 0.0 && w[1] > 0.0 && w[0].is_finite() && w[1].is_finite()) {
+        return w;
+    }
+    let gap = |a: AxisMap| {
+        let [lo, hi] = a.range();
+        lo.max(-hi).max(0.0)
+    };
+    let c = |g: f64, w: f64| (1.0 + (g / w) * (g / w)).sqrt();
+    [w[0] * c(gap(aq), w[1]), w[1] * c(gap(ap), w[0])]
 }
 
 /// The initial boxes of the lobe chart in (u, t_p, v, t_q): the product of the split intervals, t ∈ [0, 1].

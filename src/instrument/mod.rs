@@ -11,7 +11,7 @@
 //!   [`geometry::Integral`]s (aperture, sphere hemisphere, specular port);
 //! * `aperture.rs`: questions about one aperture integral: [`aperture::clip`], [`aperture::mirror_overlap`],
 //!   the [`aperture::Chart`] ([`aperture::choose_chart`]), [`aperture::lobe_widths_uv`],
-//!   [`aperture::lobe_splits`], [`aperture::lobe_boxes`], the kinks that cross the stops
+//!   [`aperture::seen_widths`], [`aperture::lobe_splits`], [`aperture::lobe_boxes`], the kinks that cross the stops
 //!   ([`aperture::delta_kinks`], [`aperture::regular_kinks`], [`aperture::regular_kinks_between`],
 //!   [`aperture::kinked_position`]) and
 //!   [`aperture::DELTA_SHARE`];

@@ -21,6 +21,19 @@ use crate::quadrature::{tensor, Cell, Refine};
 /// [`Rule::LobePolar`]: the polar piece then holds the peak and the tail pieces only the tail.
 pub const POLAR_REACH: f64 = 2.0;
 
+/// At geometry angles of [`POLAR_GRAZING`] and above, [`Rule::LobePolar`] needs the overlap kinks and range
+/// ends at least [`POLAR_REACH_GRAZING`] lobe widths from the centre on the u axis (the plane of incidence).
+/// Near grazing the geometric factors vary across the stops (z ∝ cos θ ∓ p sin θ: ±40 % over D523 85°'s
+/// receptor), a smooth variation the polar square resolves only at high levels when the square spans few
+/// widths. Measured at D523 85°, n = 1.5, rtol 10⁻⁶ (polar against the Genz–Malik partition of the same
+/// lobe chart, exact evaluation counts; `docs/instrument.md` §Quadrature): GGX α = 0.001, 0.0013, 0.0016
+/// (u reach 14.2, 10.9, 8.9 widths) 29 536 against 39 216, 38 304, 34 998; α = 0.002, 0.003, 0.005 (7.1,
+/// 4.7, 2.8 widths) 80 736, 80 736, 87 136 against 32 832, 28 386, 25 308. At TAPPI T480 75° (u reach 4.4–7.0)
+/// and at 20°–60° the polar rule won at every α tried down to [`POLAR_REACH`].
+pub const POLAR_REACH_GRAZING: f64 = 8.0;
+/// See [`POLAR_REACH_GRAZING`]: 80°, between TAPPI T480's 75° and D523's 85°.
+pub const POLAR_GRAZING: f64 = 80.0 * std::f64::consts::PI / 180.0;
+
 /// [`Rule::TensorGauss`] is chosen ([`smooth_rule`]) when every lobe is at least [`TENSOR_MIN_WIDTH_U`]
 /// times the u-range wide (smooth in the plane of incidence) and between [`TENSOR_MIN_WIDTH`] and
 /// [`TENSOR_MAX_WIDTH_V`] of the v-range (a lobe the v axis must resolve, but not so narrow that its order
@@ -252,7 +265,8 @@ pub fn smooth_rule(lobes: &[Lobe], theta: f64, src: Stop, rec: Stop) -> Option<R
 /// the rule was measured on every shipped table and on MERL-format GGX tables and lost or fell back on each,
 /// because the table's interpolation kinks at its cells, not its tail, set the cost, see
 /// `docs/instrument.md` §Quadrature, *Measured tables*) whose centre u = v = 0 is inside the range of the lobe variables and at least
-/// [`POLAR_REACH`] widths from every kink of the overlap length and every end of the range, on both axes.
+/// [`POLAR_REACH`] widths from every kink of the overlap length and every end of the range, on both axes
+/// (on the u axis [`POLAR_REACH_GRAZING`] widths at geometry angles of [`POLAR_GRAZING`] and above).
 pub fn polar_rule(lobes: &[Lobe], has_diffuse: bool, theta: f64, src: Stop, rec: Stop) -> Option<Rule> {
     let [lobe] = lobes else { return None };
     if has_diffuse || lobe.tail != Tail::InverseQuartic {
@@ -268,6 +282,9 @@ pub fn polar_rule(lobes: &[Lobe], has_diffuse: bool, theta: f64, src: Stop, rec:
     };
     let u = breaks(AxisMap { s: src.p, r: rec.p }, width[0])?;
     let v = breaks(AxisMap { s: src.q, r: rec.q }, width[1])?;
+    if theta >= POLAR_GRAZING && !u.iter().all(|k| k.abs() >= POLAR_REACH_GRAZING * width[0]) {
+        return None;
+    }
     Some(Rule::LobePolar { width, u, v, levels: [1; 9] })
 }
 

@@ -22,7 +22,7 @@
 //!   [`RegularPart`], [`Projection`], [`Target`]), the [`Flux`] it produces and [`Method::is_frozen`];
 //! - `design.rs`: [`Method::design`], [`Method::for_material`] and [`Method::expected_evaluations`] (the
 //!   scheduling guess of `Plan::run_all`), the rule choosers ([`delta_rule`], [`lobe_rule`], [`polar_rule`],
-//!   [`smooth_rule`]) and the gates they choose by ([`DELTA_GATE`], [`LOBE_REACH`], [`POLAR_REACH`],
+//!   [`smooth_rule`]) and the gates they choose by ([`DELTA_GATE`], [`LOBE_REACH`], [`POLAR_REACH`], [`POLAR_REACH_GRAZING`],
 //!   [`TENSOR_MIN_WIDTH`], [`TENSOR_MAX_WIDTH_V`], [`TENSOR_MIN_WIDTH_U`]);
 //! - `execute.rs`: [`Method::execute`] and its variants (a deadline, freezing), [`Method::sample_regular`],
 //!   the regular part's integrand and [`LATE_START_SHARE`];
@@ -44,8 +44,8 @@ pub use delta::{
     DELTA_SAFETY, DELTA_TAIL_SAFETY, DELTA_T_ORDERS,
 };
 pub use design::{
-    delta_rule, lobe_rule, polar_rule, smooth_rule, DELTA_GATE, LOBE_REACH, POLAR_REACH, TENSOR_MAX_WIDTH_V,
-    TENSOR_MIN_WIDTH, TENSOR_MIN_WIDTH_U,
+    delta_rule, lobe_rule, polar_rule, smooth_rule, DELTA_GATE, LOBE_REACH, POLAR_GRAZING, POLAR_REACH,
+    POLAR_REACH_GRAZING, TENSOR_MAX_WIDTH_V, TENSOR_MIN_WIDTH, TENSOR_MIN_WIDTH_U,
 };
 pub use execute::{deadline_after, LATE_START_SHARE};
 pub use gauss::{tensor_boxes, LOBE_LEVELS, TENSOR_MAX_LEVEL};
