@@ -104,6 +104,9 @@ impl ChebTable {
         pieces: usize,
         tol: f64,
     ) -> Vec<Fit> {
+        if which.is_empty() {
+            return Vec::new();
+        }
         // cos(πk(j + ½)/N) and the nodes cos(π(j + ½)/N), once per fit rather than per piece.
         let nodes: [f64; N] = std::array::from_fn(|j| (std::f64::consts::PI * (j as f64 + 0.5) / N as f64).cos());
         let basis: [[f64; N]; N] = std::array::from_fn(|k| {
@@ -318,6 +321,41 @@ mod tests {
         // A jump cannot be interpolated to 1e-12 with any number of pieces that misses it...
         assert!(ChebTable::fit(|x| if x > 0.3141 { 1.0 } else { 0.0 }, 0.0, 1.0, 1e-12).is_none());
         assert!(ChebTable::fit(|x| 1.0 / (x - 0.5), 0.0, 1.0, 1e-12).is_none());
+    }
+
+    /// Fitted together, the functions get the tables each gets alone, to the bit (also one that needs more
+    /// pieces than the others, and one that is not finite); no point is asked of no function.
+    #[test]
+    fn fitting_together_gives_each_function_its_own_table() {
+        let fs: [fn(f64) -> f64; 4] = [
+            |x| (3.0 * x).sin(),
+            |x| (40.0 * x).cos() * (-x).exp(),
+            |x| if x > 0.5 { f64::NAN } else { x },
+            |x| x.powi(3),
+        ];
+        let calls = std::cell::Cell::new(0);
+        let together = ChebTable::fit_each(
+            |x, which, v| {
+                assert!(!which.is_empty());
+                calls.set(calls.get() + 1);
+                for (v, &k) in v.iter_mut().zip(which) {
+                    *v = fs[k](x);
+                }
+            },
+            fs.len(),
+            0.0,
+            1.0,
+            1e-12,
+        );
+        for (k, f) in fs.iter().enumerate() {
+            let alone = ChebTable::fit(f, 0.0, 1.0, 1e-12);
+            assert_eq!(format!("{alone:?}"), format!("{:?}", together[k]), "function {k}");
+        }
+        assert!(
+            together[2].is_none() && together[1].as_ref().unwrap().pieces() > together[0].as_ref().unwrap().pieces()
+        );
+        let none = ChebTable::fit_each_with_pieces(|_, _, _| unreachable!(), &[], 0.0, 1.0, 8, 1e-12);
+        assert!(none.is_empty() && calls.get() > 0);
     }
 
     #[test]

@@ -490,6 +490,37 @@ mod tests {
         }
     }
 
+    /// The stack at several wavelengths at once is the stack at each, to the bit: coherent and incoherent
+    /// layers, absorbing ones, a repeated layer, total internal reflection, grazing incidence, and a stack
+    /// long enough for the heap path.
+    #[test]
+    fn the_spectrum_at_once_is_each_wavelength_to_the_bit() {
+        let tio2 = coh(c(2.5, 0.0), 60.0);
+        let long: Vec<FilmLayer> = (0..30).map(|i| coh(c(1.4 + 0.03 * i as f64, 0.01), 40.0 + i as f64)).collect();
+        let stacks: Vec<(f64, Vec<FilmLayer>, Complex64)> = vec![
+            (1.5, vec![tio2, inc(c(1.58, 0.0), 400.0), tio2], c(1.5, 0.0)),
+            (1.8, vec![tio2, inc(c(1.55, 0.0), 400.0), tio2], c(1.8, 0.0)),
+            (1.0, vec![coh(c(2.5, 0.05), 110.0), inc(c(1.58, 0.001), 500.0), coh(c(2.5, 0.05), 110.0)], c(0.2, 3.0)),
+            (1.5, vec![coh(c(1.38, 0.0), 100.0)], c(1.0, 0.0)),
+            (1.0, vec![], c(1.5, 0.0)),
+            (1.0, long, c(1.52, 0.0)),
+        ];
+        let lambdas: Vec<f64> = (0..21).map(|i| 380.0 + 20.0 * i as f64).collect();
+        for (n_in, layers, n_out) in &stacks {
+            for ci in angles().chain([-0.1, 1e-9, 0.3]) {
+                let mut seen = 0;
+                stack_spectrum(*n_in, layers, *n_out, ci, lambdas.iter().copied(), |i, r| {
+                    let alone = stack(*n_in, layers, *n_out, ci, lambdas[i]);
+                    for (x, y) in [(r.rs, alone.rs), (r.rp, alone.rp), (r.ts, alone.ts), (r.tp, alone.tp)] {
+                        assert_eq!(x.to_bits(), y.to_bits(), "{n_in} {layers:?} {ci} {}", lambdas[i]);
+                    }
+                    seen += 1;
+                });
+                assert_eq!(seen, lambdas.len());
+            }
+        }
+    }
+
     #[test]
     fn long_stacks_take_the_heap_path_and_agree() {
         // 40 zero-thickness layers (beyond INLINE_MEDIA) change nothing; a quarter-wave pair repeated is
