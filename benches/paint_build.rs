@@ -29,8 +29,11 @@ type Setter = Box<dyn Fn(&mut serde_json::Value, f64)>;
 /// (n + ik)/η, the pearl stack's surrounding resin η) and the flake area ratio (no table depends on it).
 fn sweep_points() {
     println!("### What a sweep point rebuilds: building a paint whose one field alternates between two values\n");
-    println!("| fixture | field | values | without the table memo (before) | with it | builds timed each |");
-    println!("|---|---|---|---|---|---|");
+    println!(
+        "| fixture | field | values | no memo, tables per sample | memo, tables per sample (before) | memo, \
+         samples at once (after) | builds timed each | stack set-ups / ρ(μ, λ) a point, before → after |"
+    );
+    println!("|---|---|---|---|---|---|---|---|");
     let fixtures = [
         "cerulean-blue-c",
         "cerulean-blue-c-literal",
@@ -62,35 +65,49 @@ fn sweep_points() {
                     serde_json::to_string(&v).expect("json")
                 })
                 .collect();
-            // Interleaved: a build without the memo (forgotten first: every table computed, the engine before it),
-            // then one with it, alternating the two values.
-            let (mut cold, mut warm) = (vec![], vec![]);
+            // Interleaved: a build without the memo, tables one sample at a time (forgotten first: every table
+            // computed, the engine before both), one with the memo and tables one sample at a time (the engine
+            // before `docs/model.md` §Evaluation cost "shared across samples"), one with the memo and the samples
+            // fitted at once (after). A memo build is timed right after an untimed build of the other value in
+            // the same mode (the memo then holds what a sweep's previous point left), the values alternating.
+            let modes = [(true, true), (false, true), (false, false)];
+            let mut times: [Vec<f64>; 3] = Default::default();
+            let mut work = [(0, 0); 3];
             let start = Instant::now();
             let mut i = 0;
-            while start.elapsed().as_secs_f64() < 0.6 || warm.len() < 6 {
-                for forget in [true, false] {
-                    if forget {
-                        glossmeter::brdf::paint::forget_tables();
+            while start.elapsed().as_secs_f64() < 0.9 || times[2].len() < 6 {
+                for (m, &(cold, per_sample)) in modes.iter().enumerate() {
+                    glossmeter::brdf::paint::build_tables_per_sample(per_sample);
+                    glossmeter::brdf::paint::forget_tables();
+                    if !cold {
+                        let neighbour = glossmeter::recipe::parse_str(&texts[(i + 1) % 2], "bench.json");
+                        std::hint::black_box(neighbour.expect("recipe"));
                     }
+                    let before = glossmeter::brdf::paint::table_work();
                     let t = Instant::now();
-                    let m = glossmeter::recipe::parse_str(&texts[i % 2], "bench.json").expect("recipe");
+                    let b = glossmeter::recipe::parse_str(&texts[i % 2], "bench.json").expect("recipe");
                     let dt = t.elapsed().as_secs_f64();
-                    std::hint::black_box(m);
-                    if forget {
-                        cold.push(dt)
-                    } else {
-                        warm.push(dt)
-                    }
-                    i += 1;
+                    let after = glossmeter::brdf::paint::table_work();
+                    std::hint::black_box(b);
+                    times[m].push(dt);
+                    work[m] = (after.0 - before.0, after.1 - before.1);
                 }
+                i += 1;
             }
-            let n = warm.len();
+            glossmeter::brdf::paint::build_tables_per_sample(false);
+            let n = times[2].len();
+            let [cold, before, after] = times.map(median);
             println!(
-                "| {f} | `{name}` | {} / {} | {:.3} ms | {:.3} ms | {n} |",
+                "| {f} | `{name}` | {} / {} | {:.3} ms | {:.3} ms | {:.3} ms | {n} | {} / {} → {} / {} |",
                 values[0],
                 values[1],
-                median(cold) * 1e3,
-                median(warm) * 1e3
+                cold * 1e3,
+                before * 1e3,
+                after * 1e3,
+                work[1].0,
+                work[1].1,
+                work[2].0,
+                work[2].1
             );
         }
     }

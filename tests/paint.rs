@@ -1229,3 +1229,45 @@ fn smooth_is_claimed_only_for_the_physical_form_under_a_smooth_coat() {
     spec.form = Form::PaperEq1;
     assert!(!Paint::new(spec).unwrap().smooth(), "paper Eq. (1): V-cavity G");
 }
+
+/// The flake tables built for all samples at once (`docs/model.md` §Evaluation cost: the film stack's angles
+/// and interface amplitudes shared by every wavelength at one cosine, the samples fitted together) are the
+/// tables built one sample at a time, to the bit: every shipped paint, at coat indices that put the pearl's
+/// mica below and above the resin (1.8: a total-internal-reflection kink in ρ), with the split flake light and
+/// the paper's. Compared through the paint's Debug print, which writes every table coefficient, the tables'
+/// deviations and the split light's constants in round-trip form.
+#[test]
+fn flake_tables_built_for_all_samples_at_once_are_those_built_one_at_a_time() {
+    use glossmeter::brdf::paint::{build_tables_per_sample, forget_tables};
+    let dir = format!("{}/fixtures/recipes", env!("CARGO_MANIFEST_DIR"));
+    let (mut paints, mut pearls, mut tabled) = (0, 0, 0);
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        let path = entry.unwrap().path();
+        let text = std::fs::read_to_string(&path).unwrap();
+        let base = parse_json(&text, "fixture").unwrap();
+        if base["model"] != "paint" {
+            continue;
+        }
+        paints += 1;
+        pearls += base.get("pearlescent_flakes").is_some() as usize;
+        for eta in [1.5, 1.52, 1.8] {
+            for light in ["split", "paper"] {
+                let mut v = base.clone();
+                v["clear_coat"]["index"] = eta.into();
+                v["flake_light"] = light.into();
+                let build = |per_sample: bool| {
+                    build_tables_per_sample(per_sample);
+                    forget_tables();
+                    let b = from_json(&v).unwrap();
+                    build_tables_per_sample(false);
+                    format!("{b:?}")
+                };
+                let (alone, together) = (build(true), build(false));
+                tabled += together.contains("ChebTable") as usize;
+                assert!(alone == together, "{}, coat index {eta}, {light} light: the tables differ", path.display());
+            }
+        }
+    }
+    assert!(paints >= 5, "{paints} paint fixtures found");
+    assert!(pearls >= 2 && tabled >= 6 * paints / 2, "{pearls} pearl paints, {tabled} builds with tables");
+}

@@ -12,6 +12,7 @@
 //!   ([`kubelka_munk::layer`] → [`kubelka_munk::Layer`]), [`kubelka_munk::mix`],
 //!   [`kubelka_munk::invert_white_black`];
 //! * `thin_film.rs`: coherent and incoherent layer stacks, the pearlescent flake ([`thin_film::stack`],
+//!   [`thin_film::stack_spectrum`] (one angle, several wavelengths),
 //!   [`thin_film::FilmLayer`], [`thin_film::StackResult`]);
 //! * `microfacet.rs`: Beckmann and GGX distributions with Smith and V-cavity masking
 //!   ([`microfacet::Microfacet`], [`microfacet::Distribution`], [`microfacet::Shadowing`]);

@@ -36,66 +36,135 @@ impl ChebTable {
     /// (the N + 1 Chebyshev–Lobatto points of every piece, which interleave the nodes and include the piece
     /// ends) is ≤ `tol`. `None` if no table of at most `MAX_PIECES` pieces meets it, or if `f` is not finite.
     pub fn fit(f: impl Fn(f64) -> f64, a: f64, b: f64, tol: f64) -> Option<ChebTable> {
-        let mut pieces = 8;
-        while pieces <= MAX_PIECES {
-            match ChebTable::fit_pieces(&f, a, b, pieces, tol) {
-                Fit::Met(t) => return Some(t),
-                Fit::NotFinite => return None,
-                Fit::Missed => pieces *= 2,
-            }
-        }
-        None
+        ChebTable::fit_each(|x, _, v| v[0] = f(x), 1, a, b, tol).pop().flatten()
     }
 
     /// The table of `pieces` pieces, if its deviation at the check points is ≤ `tol` (`fit` at one piece
     /// count: what [`ChebTable::on_grid_of`] needs to put tables on a common grid).
     pub fn fit_with_pieces(f: impl Fn(f64) -> f64, a: f64, b: f64, pieces: usize, tol: f64) -> Option<ChebTable> {
-        match ChebTable::fit_pieces(&f, a, b, pieces, tol) {
-            Fit::Met(t) => Some(t),
-            _ => None,
-        }
+        ChebTable::fit_each_with_pieces(|x, _, v| v[0] = f(x), &[0], a, b, pieces, tol).pop().flatten()
     }
 
-    fn fit_pieces(f: &impl Fn(f64) -> f64, a: f64, b: f64, pieces: usize, tol: f64) -> Fit {
+    /// [`ChebTable::fit`] of `count` functions f_0 … f_{count−1} on the same [a, b] at once: the same tables to
+    /// the bit as fitting each alone, but every point is asked of all the functions that need it in one call,
+    /// `f(x, which, values)` setting `values[i]` = f_{which[i]}(x), so that work they share at one x (a film
+    /// stack's angles and interface amplitudes, the same for every wavelength) is done once. A function whose
+    /// table is met leaves `which` at the next piece count.
+    pub fn fit_each(
+        mut f: impl FnMut(f64, &[usize], &mut [f64]),
+        count: usize,
+        a: f64,
+        b: f64,
+        tol: f64,
+    ) -> Vec<Option<ChebTable>> {
+        let mut out = vec![None; count];
+        let mut which: Vec<usize> = (0..count).collect();
+        let mut pieces = 8;
+        while !which.is_empty() && pieces <= MAX_PIECES {
+            let fits = ChebTable::fit_pieces(&mut f, &which, a, b, pieces, tol);
+            let mut missed = Vec::new();
+            for (&i, fit) in which.iter().zip(fits) {
+                match fit {
+                    Fit::Met(t) => out[i] = Some(t),
+                    Fit::NotFinite => {}
+                    Fit::Missed => missed.push(i),
+                }
+            }
+            which = missed;
+            pieces *= 2;
+        }
+        out
+    }
+
+    /// [`ChebTable::fit_with_pieces`] of the functions `which` of `f` at once (as [`ChebTable::fit_each`]):
+    /// one result per entry of `which`.
+    pub fn fit_each_with_pieces(
+        mut f: impl FnMut(f64, &[usize], &mut [f64]),
+        which: &[usize],
+        a: f64,
+        b: f64,
+        pieces: usize,
+        tol: f64,
+    ) -> Vec<Option<ChebTable>> {
+        ChebTable::fit_pieces(&mut f, which, a, b, pieces, tol)
+            .into_iter()
+            .map(|fit| match fit {
+                Fit::Met(t) => Some(t),
+                _ => None,
+            })
+            .collect()
+    }
+
+    /// One piece count for the functions `which` of `f`: each one's outcome.
+    fn fit_pieces(
+        f: &mut impl FnMut(f64, &[usize], &mut [f64]),
+        which: &[usize],
+        a: f64,
+        b: f64,
+        pieces: usize,
+        tol: f64,
+    ) -> Vec<Fit> {
+        if which.is_empty() {
+            return Vec::new();
+        }
         // cos(πk(j + ½)/N) and the nodes cos(π(j + ½)/N), once per fit rather than per piece.
         let nodes: [f64; N] = std::array::from_fn(|j| (std::f64::consts::PI * (j as f64 + 0.5) / N as f64).cos());
         let basis: [[f64; N]; N] = std::array::from_fn(|k| {
             std::array::from_fn(|j| (std::f64::consts::PI * k as f64 * (j as f64 + 0.5) / N as f64).cos())
         });
+        let m = which.len();
         let width = (b - a) / pieces as f64;
-        let mut coeffs = Vec::with_capacity(pieces * N);
-        let mut vals = [0.0; N];
+        let mut coeffs: Vec<Vec<f64>> = (0..m).map(|_| Vec::with_capacity(pieces * N)).collect();
+        let mut finite = vec![true; m];
+        let mut vals = vec![[0.0; N]; m];
+        let mut at = vec![0.0; m];
         for p in 0..pieces {
             let (lo, hi) = (a + p as f64 * width, a + (p + 1) as f64 * width);
-            for (v, x) in vals.iter_mut().zip(&nodes) {
-                *v = f(0.5 * (lo + hi) + 0.5 * (hi - lo) * x);
-                if !v.is_finite() {
-                    return Fit::NotFinite;
+            for (j, x) in nodes.iter().enumerate() {
+                f(0.5 * (lo + hi) + 0.5 * (hi - lo) * x, which, &mut at);
+                for ((v, fin), y) in vals.iter_mut().zip(&mut finite).zip(&at) {
+                    v[j] = *y;
+                    *fin &= y.is_finite();
                 }
             }
-            for (k, row) in basis.iter().enumerate() {
-                let mut c = 0.0;
-                for (v, b) in vals.iter().zip(row) {
-                    c += v * b;
+            for (v, c) in vals.iter().zip(&mut coeffs) {
+                for (k, row) in basis.iter().enumerate() {
+                    let mut s = 0.0;
+                    for (v, b) in v.iter().zip(row) {
+                        s += v * b;
+                    }
+                    c.push(if k == 0 { s / N as f64 } else { 2.0 * s / N as f64 });
                 }
-                coeffs.push(if k == 0 { c / N as f64 } else { 2.0 * c / N as f64 });
             }
         }
-        let mut table = ChebTable { a, b, pieces, coeffs, max_error: 0.0 };
-        let mut worst: f64 = 0.0;
+        let tables: Vec<ChebTable> =
+            coeffs.into_iter().map(|coeffs| ChebTable { a, b, pieces, coeffs, max_error: 0.0 }).collect();
+        let mut worst = vec![0.0f64; m];
         for p in 0..pieces {
             let (lo, hi) = (a + p as f64 * width, a + (p + 1) as f64 * width);
             for j in 0..=N {
                 let x = 0.5 * (lo + hi) + 0.5 * (hi - lo) * (std::f64::consts::PI * j as f64 / N as f64).cos();
-                worst = worst.max((table.eval(x) - f(x)).abs());
+                f(x, which, &mut at);
+                for ((w, t), y) in worst.iter_mut().zip(&tables).zip(&at) {
+                    *w = w.max((t.eval(x) - y).abs());
+                }
             }
         }
-        if worst <= tol {
-            table.max_error = worst;
-            Fit::Met(table)
-        } else {
-            Fit::Missed
-        }
+        tables
+            .into_iter()
+            .zip(worst)
+            .zip(finite)
+            .map(|((mut table, worst), finite)| {
+                if !finite {
+                    Fit::NotFinite
+                } else if worst <= tol {
+                    table.max_error = worst;
+                    Fit::Met(table)
+                } else {
+                    Fit::Missed
+                }
+            })
+            .collect()
     }
 
     pub fn pieces(&self) -> usize {
@@ -252,6 +321,41 @@ mod tests {
         // A jump cannot be interpolated to 1e-12 with any number of pieces that misses it...
         assert!(ChebTable::fit(|x| if x > 0.3141 { 1.0 } else { 0.0 }, 0.0, 1.0, 1e-12).is_none());
         assert!(ChebTable::fit(|x| 1.0 / (x - 0.5), 0.0, 1.0, 1e-12).is_none());
+    }
+
+    /// Fitted together, the functions get the tables each gets alone, to the bit (also one that needs more
+    /// pieces than the others, and one that is not finite); no point is asked of no function.
+    #[test]
+    fn fitting_together_gives_each_function_its_own_table() {
+        let fs: [fn(f64) -> f64; 4] = [
+            |x| (3.0 * x).sin(),
+            |x| (40.0 * x).cos() * (-x).exp(),
+            |x| if x > 0.5 { f64::NAN } else { x },
+            |x| x.powi(3),
+        ];
+        let calls = std::cell::Cell::new(0);
+        let together = ChebTable::fit_each(
+            |x, which, v| {
+                assert!(!which.is_empty());
+                calls.set(calls.get() + 1);
+                for (v, &k) in v.iter_mut().zip(which) {
+                    *v = fs[k](x);
+                }
+            },
+            fs.len(),
+            0.0,
+            1.0,
+            1e-12,
+        );
+        for (k, f) in fs.iter().enumerate() {
+            let alone = ChebTable::fit(f, 0.0, 1.0, 1e-12);
+            assert_eq!(format!("{alone:?}"), format!("{:?}", together[k]), "function {k}");
+        }
+        assert!(
+            together[2].is_none() && together[1].as_ref().unwrap().pieces() > together[0].as_ref().unwrap().pieces()
+        );
+        let none = ChebTable::fit_each_with_pieces(|_, _, _| unreachable!(), &[], 0.0, 1.0, 8, 1e-12);
+        assert!(none.is_empty() && calls.get() > 0);
     }
 
     #[test]

@@ -83,31 +83,39 @@ impl Medium {
     }
 }
 
+/// The amplitudes [(r_s, t_s), (r_p, t_p)] of one interface ([`amplitudes`]).
+type Interface = [(Complex64, Complex64); 2];
+
+fn interface(x: &Medium, y: &Medium) -> Interface {
+    let c = amplitudes(x.n, x.cos, y.n, y.cos);
+    [(c.rs, c.ts), (c.rp, c.tp)]
+}
+
 /// Amplitudes r, t (s and p together) of a coherent group of layers between two semi-infinite media, light
 /// incident from the first: the Airy recursion from the last interface upward (Hirayama et al. 2001; paper
 /// Eq. 6 corrected): ρ ← r_{N,N+1}, τ ← t_{N,N+1}; for j = N..1 with interface (j−1 → j) coefficients r, t
 /// and layer phase φⱼ: ρ ← (r + ρ e^{2iφⱼ})/(1 + r ρ e^{2iφⱼ}), τ ← t τ e^{iφⱼ}/(1 + r ρ e^{2iφⱼ}).
 ///
 /// The group is media[a..=b] (or the same media in reverse order, light coming from below), with `phase[j]`
-/// = e^{iφⱼ} precomputed per medium; nothing is allocated (this runs inside the BRDF evaluation). Returns
-/// [(ρs, τs), (ρp, τp)].
+/// = e^{iφⱼ} precomputed per medium and the interface amplitudes precomputed per pair of neighbours
+/// (`down[m]`: from medium m into m + 1, `up[m]`: from m + 1 into m; they do not depend on the wavelength);
+/// nothing is allocated (this runs inside the BRDF evaluation). Returns [(ρs, τs), (ρp, τp)].
 fn coherent_amplitudes(
-    media: &[Medium],
+    down: &[Interface],
+    up: &[Interface],
     phase: &[Complex64],
     (a, b): (usize, usize),
     reversed: bool,
 ) -> [(Complex64, Complex64); 2] {
     let at = |j: usize| if reversed { b - j } else { a + j };
-    let iface = |x: &Medium, y: &Medium| {
-        let c = amplitudes(x.n, x.cos, y.n, y.cos);
-        [(c.rs, c.ts), (c.rp, c.tp)]
-    };
+    // The interface from medium at(j − 1) into at(j).
+    let iface = |j: usize| if reversed { up[b - j] } else { down[a + j - 1] };
     let last = b - a;
-    let mut acc = iface(&media[at(last - 1)], &media[at(last)]);
+    let mut acc = iface(last);
     for j in (1..last).rev() {
         let e1 = phase[at(j)];
         let e2 = e1 * e1;
-        let rt = iface(&media[at(j - 1)], &media[at(j)]);
+        let rt = iface(j);
         for ((rho, tau), (r, t)) in acc.iter_mut().zip(rt) {
             let den = 1.0 + r * *rho * e2;
             *rho = (r + *rho * e2) / den;
@@ -119,8 +127,14 @@ fn coherent_amplitudes(
 
 /// Power R, T of a coherent group (its first and last media semi-infinite), Byrnes Eqs. 13–15:
 /// [(Rs, Ts), (Rp, Tp)].
-fn coherent_power(media: &[Medium], phase: &[Complex64], (a, b): (usize, usize), reversed: bool) -> [(f64, f64); 2] {
-    let amp = coherent_amplitudes(media, phase, (a, b), reversed);
+fn coherent_power(
+    media: &[Medium],
+    (down, up): (&[Interface], &[Interface]),
+    phase: &[Complex64],
+    (a, b): (usize, usize),
+    reversed: bool,
+) -> [(f64, f64); 2] {
+    let amp = coherent_amplitudes(down, up, phase, (a, b), reversed);
     let (first, last) = if reversed { (b, a) } else { (a, b) };
     let mut out = [(0.0, 0.0); 2];
     for ((o, (r, t)), pol) in out.iter_mut().zip(amp).zip([Pol::S, Pol::P]) {
@@ -153,83 +167,148 @@ const INLINE_MEDIA: usize = 26;
 /// describe everything below the incoherent layer. This matches `tmm.inc_tmm`.
 /// Grazing incidence (cos_i ≤ 0) returns the limit R = 1, T = 0.
 pub fn stack(n_in: f64, layers: &[FilmLayer], n_out: Complex64, cos_i: f64, wavelength_nm: f64) -> StackResult {
+    let mut out = StackResult { rs: 1.0, rp: 1.0, ts: 0.0, tp: 0.0 };
+    stack_spectrum(n_in, layers, n_out, cos_i, [wavelength_nm], |_, r| out = r);
+    out
+}
+
+/// [`stack`] at one angle of incidence and several wavelengths: `each(i, result)` for the i-th wavelength, the
+/// same bits as `stack(n_in, layers, n_out, cos_i, wavelength)`. What does not depend on the wavelength (every
+/// medium's cos θ, every interface's amplitudes r, t) is computed once for all of them; per wavelength only
+/// the layers' phases e^{iφⱼ} (once per distinct layer: a stack that repeats a layer, as the pearl's
+/// TiO₂/mica/TiO₂ does, computes its phase once) and the recursions remain (`docs/model.md` §Evaluation cost).
+pub fn stack_spectrum(
+    n_in: f64,
+    layers: &[FilmLayer],
+    n_out: Complex64,
+    cos_i: f64,
+    wavelengths_nm: impl IntoIterator<Item = f64>,
+    mut each: impl FnMut(usize, StackResult),
+) {
     if cos_i <= 0.0 {
-        return StackResult { rs: 1.0, rp: 1.0, ts: 0.0, tp: 0.0 };
+        for (i, _) in wavelengths_nm.into_iter().enumerate() {
+            each(i, StackResult { rs: 1.0, rp: 1.0, ts: 0.0, tp: 0.0 });
+        }
+        return;
     }
     let total = layers.len() + 2;
+    let none = [(Complex64::new(0.0, 0.0), Complex64::new(0.0, 0.0)); 2];
     if total > INLINE_MEDIA {
-        let mut media = vec![Medium::VACUUM; total];
-        let mut phase = vec![Complex64::new(1.0, 0.0); total];
-        let mut inc = vec![0usize; total];
-        return stack_in(n_in, layers, n_out, cos_i, wavelength_nm, &mut media, &mut phase, &mut inc);
+        let mut s = Scratch {
+            media: &mut vec![Medium::VACUUM; total],
+            phase: &mut vec![Complex64::new(1.0, 0.0); total],
+            inc: &mut vec![0usize; total],
+            same: &mut vec![0usize; total],
+            down: &mut vec![none; total],
+            up: &mut vec![none; total],
+        };
+        return stack_in(n_in, layers, n_out, cos_i, wavelengths_nm, &mut each, &mut s);
     }
     let mut media = [Medium::VACUUM; INLINE_MEDIA];
     let mut phase = [Complex64::new(1.0, 0.0); INLINE_MEDIA];
     let mut inc = [0usize; INLINE_MEDIA];
-    stack_in(n_in, layers, n_out, cos_i, wavelength_nm, &mut media, &mut phase, &mut inc)
+    let mut same = [0usize; INLINE_MEDIA];
+    let mut down = [none; INLINE_MEDIA];
+    let mut up = [none; INLINE_MEDIA];
+    let mut s =
+        Scratch { media: &mut media, phase: &mut phase, inc: &mut inc, same: &mut same, down: &mut down, up: &mut up };
+    stack_in(n_in, layers, n_out, cos_i, wavelengths_nm, &mut each, &mut s)
 }
 
-/// [`stack`] on caller-provided scratch of at least `layers.len() + 2` entries.
-#[allow(clippy::too_many_arguments)]
+/// Caller-provided scratch of at least `layers.len() + 2` entries each.
+struct Scratch<'s> {
+    media: &'s mut [Medium],
+    phase: &'s mut [Complex64],
+    /// The incoherent media, top to bottom.
+    inc: &'s mut [usize],
+    /// `same[j]`: the first medium with layer j's index and thickness (its cos θ and phase are j's).
+    same: &'s mut [usize],
+    down: &'s mut [Interface],
+    up: &'s mut [Interface],
+}
+
+/// [`stack_spectrum`] on caller-provided scratch.
 fn stack_in(
     n_in: f64,
     layers: &[FilmLayer],
     n_out: Complex64,
     cos_i: f64,
-    wavelength_nm: f64,
-    media: &mut [Medium],
-    phase: &mut [Complex64],
-    inc: &mut [usize],
-) -> StackResult {
+    wavelengths_nm: impl IntoIterator<Item = f64>,
+    each: &mut impl FnMut(usize, StackResult),
+    s: &mut Scratch,
+) {
     let cos_i = cos_i.min(1.0);
     let n0 = Complex64::new(n_in, 0.0);
     let c0 = Complex64::new(cos_i, 0.0);
     let total = layers.len() + 2;
-    // All media top to bottom: ambient, the layers, the exit medium; each phase e^{iφ} computed once.
-    media[0] = Medium { n: n0, cos: c0, d: 0.0 };
+    let key = |l: &FilmLayer| [l.n.re.to_bits(), l.n.im.to_bits(), l.thickness_nm.max(0.0).to_bits()];
+    // All media top to bottom: ambient, the layers, the exit medium (a layer equal to one above it, to the
+    // bit, takes that one's cos θ).
+    s.media[0] = Medium { n: n0, cos: c0, d: 0.0 };
+    s.same[0] = 0;
     for (j, l) in layers.iter().enumerate() {
-        media[j + 1] = Medium { n: l.n, cos: complex_cos_transmitted(n0, c0, l.n), d: l.thickness_nm.max(0.0) };
+        let first = layers[..j].iter().position(|m| key(m) == key(l)).unwrap_or(j);
+        s.same[j + 1] = first + 1;
+        let cos = if first < j { s.media[first + 1].cos } else { complex_cos_transmitted(n0, c0, l.n) };
+        s.media[j + 1] = Medium { n: l.n, cos, d: l.thickness_nm.max(0.0) };
     }
-    media[total - 1] = Medium { n: n_out, cos: complex_cos_transmitted(n0, c0, n_out), d: 0.0 };
-    for j in 0..total {
-        phase[j] = media[j].phase(wavelength_nm);
-    }
+    s.same[total - 1] = total - 1;
+    s.media[total - 1] = Medium { n: n_out, cos: complex_cos_transmitted(n0, c0, n_out), d: 0.0 };
     // The incoherent media (ambient, incoherent layers, exit) split the stack into coherent groups: group
     // i is media[inc[i]..=inc[i+1]], whose end media are treated as semi-infinite.
     let mut n_inc = 0;
-    inc[n_inc] = 0;
+    s.inc[n_inc] = 0;
     n_inc += 1;
     for (j, l) in layers.iter().enumerate() {
         if !l.coherent {
-            inc[n_inc] = j + 1;
+            s.inc[n_inc] = j + 1;
             n_inc += 1;
         }
     }
-    inc[n_inc] = total - 1;
+    s.inc[n_inc] = total - 1;
     n_inc += 1;
     let groups = n_inc - 1;
-    let media = &media[..total];
-    let phase = &phase[..total];
-
     let k = groups - 1;
-    let mut below = coherent_power(media, phase, (inc[k], inc[k + 1]), false);
-    for i in (0..k).rev() {
-        let g = (inc[i], inc[i + 1]);
-        let front = coherent_power(media, phase, g, false);
-        let back = if front.iter().any(|(_, tf)| *tf != 0.0) { coherent_power(media, phase, g, true) } else { front };
-        let p = phase[inc[i + 1]].norm_sqr();
-        for ((b, (rf, tf)), (rb, tb)) in below.iter_mut().zip(front).zip(back) {
-            if tf == 0.0 {
-                *b = (rf, 0.0);
-                continue;
-            }
-            let (r_below, t_below) = *b;
-            let den = 1.0 - rb * p * p * r_below;
-            *b = (rf + tf * tb * p * p * r_below / den, tf * p * t_below / den);
-        }
+    let inc = &s.inc[..n_inc];
+    let media = &s.media[..total];
+    // The interfaces: every one downward, and upward those above the last group (only those groups are
+    // also crossed from below).
+    for m in 0..total - 1 {
+        s.down[m] = interface(&media[m], &media[m + 1]);
     }
-    let out = below;
-    StackResult { rs: out[0].0, rp: out[1].0, ts: out[0].1, tp: out[1].1 }
+    for m in 0..inc[k] {
+        s.up[m] = interface(&media[m + 1], &media[m]);
+    }
+    let (down, up) = (&s.down[..total - 1], &s.up[..total - 1]);
+    let phase = &mut s.phase[..total];
+    for (i, wavelength_nm) in wavelengths_nm.into_iter().enumerate() {
+        // The phases of the layers (the semi-infinite ambient and exit media have none that is used).
+        for j in 1..total - 1 {
+            phase[j] = if s.same[j] < j { phase[s.same[j]] } else { media[j].phase(wavelength_nm) };
+        }
+        let phase = &*phase;
+        let mut below = coherent_power(media, (down, up), phase, (inc[k], inc[k + 1]), false);
+        for g in (0..k).rev() {
+            let group = (inc[g], inc[g + 1]);
+            let front = coherent_power(media, (down, up), phase, group, false);
+            let back = if front.iter().any(|(_, tf)| *tf != 0.0) {
+                coherent_power(media, (down, up), phase, group, true)
+            } else {
+                front
+            };
+            let p = phase[inc[g + 1]].norm_sqr();
+            for ((b, (rf, tf)), (rb, tb)) in below.iter_mut().zip(front).zip(back) {
+                if tf == 0.0 {
+                    *b = (rf, 0.0);
+                    continue;
+                }
+                let (r_below, t_below) = *b;
+                let den = 1.0 - rb * p * p * r_below;
+                *b = (rf + tf * tb * p * p * r_below / den, tf * p * t_below / den);
+            }
+        }
+        each(i, StackResult { rs: below[0].0, rp: below[1].0, ts: below[0].1, tp: below[1].1 });
+    }
 }
 
 #[cfg(test)]
@@ -407,6 +486,37 @@ mod tests {
                     let f = fresnel_conductor(ci, m);
                     assert!((r.rs - f.rs).abs() < 1e-14 && (r.rp - f.rp).abs() < 1e-14, "{r:?} {f:?}");
                 }
+            }
+        }
+    }
+
+    /// The stack at several wavelengths at once is the stack at each, to the bit: coherent and incoherent
+    /// layers, absorbing ones, a repeated layer, total internal reflection, grazing incidence, and a stack
+    /// long enough for the heap path.
+    #[test]
+    fn the_spectrum_at_once_is_each_wavelength_to_the_bit() {
+        let tio2 = coh(c(2.5, 0.0), 60.0);
+        let long: Vec<FilmLayer> = (0..30).map(|i| coh(c(1.4 + 0.03 * i as f64, 0.01), 40.0 + i as f64)).collect();
+        let stacks: Vec<(f64, Vec<FilmLayer>, Complex64)> = vec![
+            (1.5, vec![tio2, inc(c(1.58, 0.0), 400.0), tio2], c(1.5, 0.0)),
+            (1.8, vec![tio2, inc(c(1.55, 0.0), 400.0), tio2], c(1.8, 0.0)),
+            (1.0, vec![coh(c(2.5, 0.05), 110.0), inc(c(1.58, 0.001), 500.0), coh(c(2.5, 0.05), 110.0)], c(0.2, 3.0)),
+            (1.5, vec![coh(c(1.38, 0.0), 100.0)], c(1.0, 0.0)),
+            (1.0, vec![], c(1.5, 0.0)),
+            (1.0, long, c(1.52, 0.0)),
+        ];
+        let lambdas: Vec<f64> = (0..21).map(|i| 380.0 + 20.0 * i as f64).collect();
+        for (n_in, layers, n_out) in &stacks {
+            for ci in angles().chain([-0.1, 1e-9, 0.3]) {
+                let mut seen = 0;
+                stack_spectrum(*n_in, layers, *n_out, ci, lambdas.iter().copied(), |i, r| {
+                    let alone = stack(*n_in, layers, *n_out, ci, lambdas[i]);
+                    for (x, y) in [(r.rs, alone.rs), (r.rp, alone.rp), (r.ts, alone.ts), (r.tp, alone.tp)] {
+                        assert_eq!(x.to_bits(), y.to_bits(), "{n_in} {layers:?} {ci} {}", lambdas[i]);
+                    }
+                    seen += 1;
+                });
+                assert_eq!(seen, lambdas.len());
             }
         }
     }

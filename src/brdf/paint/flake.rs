@@ -3,16 +3,18 @@
 //! it kinks, the cover's Kubelka–Munk reflectance over it (paper Eqs. 5–8 corrected) and its verified
 //! Chebyshev tables, and the split flake light's unscattered transmission τ and diffuse weight
 //! (`docs/model.md` §Metallic flakes, §Pearlescent flakes, §Flake light through the pigment).
-use super::hemisphere::{hemispherical_mean, DIFFUSE_FRESNEL_NODES};
+use super::hemisphere::{hemispherical_mean, hemispherical_means, DIFFUSE_FRESNEL_NODES};
 use super::memo::Memo;
 use crate::optics::fresnel::{critical_cosine_complex, fr_conductor};
 use crate::optics::kubelka_munk::Layer;
 use crate::optics::microfacet::Microfacet;
 use crate::optics::tabulated::ChebTable;
-use crate::optics::thin_film::{stack, FilmLayer};
+use crate::optics::thin_film::{stack, stack_spectrum, FilmLayer};
 use crate::quadrature::gauss_legendre;
 use num_complex::Complex64;
+use std::cell::Cell;
 use std::f64::consts::PI;
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 
 /// Largest accepted deviation of a flake-reflectance table from the direct evaluation (absolute, on a
 /// reflectance ≤ 1): far below any tolerance a reading is asked for.
@@ -80,11 +82,46 @@ impl FlakeTerm {
     /// or the bare flake reflectance ρ for the split flake light (the cover's attenuation is applied by the
     /// caller, it depends on both directions).
     pub(super) fn reflectance_direct(&self, k: usize, cos_local: f64, wavelength_nm: f64) -> f64 {
-        let rho = self.rho(k, cos_local, wavelength_nm).clamp(0.0, 1.0);
+        self.lobe_part(k, self.rho(k, cos_local, wavelength_nm).clamp(0.0, 1.0))
+    }
+
+    /// What the lobe carries for sample `k` given its clamped flake reflectance ρ: ρ for the split light,
+    /// else the cover over it (R_m or R_p).
+    #[inline]
+    fn lobe_part(&self, k: usize, rho: f64) -> f64 {
         if self.split {
             rho
         } else {
             self.cover[k].over(rho)
+        }
+    }
+
+    /// The clamped flake reflectance ρ of the samples `which` at the local cosine `cos_local`, into `out`
+    /// (each the bits of `self.rho(k, …).clamp(0, 1)`): the pearl's stack at every wavelength at once
+    /// (`optics::thin_film::stack_spectrum`: its angles and interface amplitudes computed once), a metal's
+    /// Fresnel reflectance per sample. `work` counts the stack set-ups and the reflectances.
+    fn rho_each(&self, cos_local: f64, which: &[usize], wavelengths_nm: &[f64], out: &mut [f64], work: &Work) {
+        work.count(1, which.len());
+        match &self.optics {
+            FlakeOptics::Metal(eta) => {
+                for (o, &k) in out.iter_mut().zip(which) {
+                    *o = fr_conductor(cos_local, eta[k]).clamp(0.0, 1.0);
+                }
+            }
+            FlakeOptics::Pearl { layers, medium } => {
+                let lambdas = which.iter().map(|&k| wavelengths_nm[k]);
+                stack_spectrum(*medium, layers, Complex64::new(*medium, 0.0), cos_local, lambdas, |i, r| {
+                    out[i] = r.r().clamp(0.0, 1.0)
+                });
+            }
+        }
+    }
+
+    /// [`FlakeTerm::reflectance_direct`] of the samples `which` at once ([`FlakeTerm::rho_each`]).
+    fn reflectance_each(&self, cos_local: f64, which: &[usize], wavelengths_nm: &[f64], out: &mut [f64], work: &Work) {
+        self.rho_each(cos_local, which, wavelengths_nm, out, work);
+        for (o, &k) in out.iter_mut().zip(which) {
+            *o = self.lobe_part(k, *o);
         }
     }
 
@@ -136,17 +173,56 @@ impl FlakeTerm {
         kinks
     }
 
-    /// Precompute the split flake light's per-sample constants (`depth`, `diffuse`).
-    fn split_constants(&mut self, k_mix: &[f64], s_mix: &[f64], depth_mm: f64, wavelengths_nm: &[f64]) {
+    /// Precompute the split flake light's per-sample constants (`depth`, `diffuse`): one sample at a time
+    /// (`per_sample`, the engine before `docs/model.md` §Evaluation cost "shared across samples") or every
+    /// sample with the same kinks at once; the same bits either way.
+    fn split_constants(
+        &mut self,
+        k_mix: &[f64],
+        s_mix: &[f64],
+        depth_mm: f64,
+        wavelengths_nm: &[f64],
+        per_sample: bool,
+        work: &Work,
+    ) {
         let (x, w) = gauss_legendre(DIFFUSE_FRESNEL_NODES);
         let n = self.cover.len();
         self.depth = (0..n).map(|j| 0.5 * (k_mix[j] + s_mix[j]) * depth_mm).collect();
+        // ρ_d = 2∫ρ(μ)μ dμ (split at ρ's kinks), by Gauss–Legendre in μ.
+        let kinks: Vec<Vec<f64>> = (0..n).map(|j| self.rho_kinks(j)).collect();
+        let mut rho_d = vec![0.0; n];
+        if per_sample {
+            for (j, r) in rho_d.iter_mut().enumerate() {
+                *r = hemispherical_mean(
+                    |mu| {
+                        work.count(1, 1);
+                        self.rho(j, mu, wavelengths_nm[j]).clamp(0.0, 1.0)
+                    },
+                    &kinks[j],
+                );
+            }
+        } else {
+            let bits = |k: &[f64]| k.iter().map(|c| c.to_bits()).collect::<Vec<u64>>();
+            let mut done = vec![false; n];
+            for j in 0..n {
+                if done[j] {
+                    continue;
+                }
+                let group: Vec<usize> = (j..n).filter(|&i| !done[i] && bits(&kinks[i]) == bits(&kinks[j])).collect();
+                let means = hemispherical_means(
+                    |mu, out| self.rho_each(mu, &group, wavelengths_nm, out, work),
+                    group.len(),
+                    &kinks[j],
+                );
+                for (&i, m) in group.iter().zip(means) {
+                    rho_d[i] = m;
+                    done[i] = true;
+                }
+            }
+        }
         self.diffuse = (0..n)
             .map(|j| {
-                // ρ_d = 2∫ρ(μ)μ dμ (split at ρ's kinks) and 1 − τ̄ = 2∫(1 − τ(μ))μ dμ (smooth on [0, 1]), by
-                // Gauss–Legendre in μ.
-                let rho_d =
-                    hemispherical_mean(|mu| self.rho(j, mu, wavelengths_nm[j]).clamp(0.0, 1.0), &self.rho_kinks(j));
+                // 1 − τ̄ = 2∫(1 − τ(μ))μ dμ (smooth on [0, 1]).
                 let mut one_minus_tau_bar = 0.0;
                 for (&xi, &wi) in x.iter().zip(&w) {
                     let mu = 0.5 * (xi + 1.0);
@@ -155,36 +231,59 @@ impl FlakeTerm {
                 if one_minus_tau_bar <= 0.0 {
                     return 0.0;
                 }
-                self.cover[j].over(rho_d.clamp(0.0, 1.0)) / (PI * one_minus_tau_bar)
+                self.cover[j].over(rho_d[j].clamp(0.0, 1.0)) / (PI * one_minus_tau_bar)
             })
             .collect();
     }
 
-    /// Build the per-sample tables; all or none.
-    fn tabulate(&mut self, wavelengths_nm: &[f64]) {
-        let tables: Option<Vec<ChebTable>> = (0..self.cover.len())
-            .map(|k| ChebTable::fit(|c| self.reflectance_direct(k, c, wavelengths_nm[k]), 0.0, 1.0, TABLE_TOLERANCE))
-            .collect();
-        self.table = tables;
+    /// Build the per-sample tables; all or none. `per_sample`: each sample's table fitted alone (the engine
+    /// before), else all at once ([`ChebTable::fit_each`], the same tables to the bit).
+    fn tabulate(&mut self, wavelengths_nm: &[f64], per_sample: bool, work: &Work) {
+        let n = self.cover.len();
+        self.table = if per_sample {
+            (0..n)
+                .map(|k| {
+                    let f = |c| {
+                        work.count(1, 1);
+                        self.reflectance_direct(k, c, wavelengths_nm[k])
+                    };
+                    ChebTable::fit(f, 0.0, 1.0, TABLE_TOLERANCE)
+                })
+                .collect()
+        } else {
+            let f = |c, which: &[usize], out: &mut [f64]| self.reflectance_each(c, which, wavelengths_nm, out, work);
+            ChebTable::fit_each(f, n, 0.0, 1.0, TABLE_TOLERANCE).into_iter().collect()
+        };
     }
 
-    /// The tables on one grid ([`FlakeTerm::grid`]).
-    fn on_one_grid(&self, wavelengths_nm: &[f64]) -> Option<Vec<ChebTable>> {
+    /// The tables on one grid ([`FlakeTerm::grid`]): a table with fewer pieces than the most among them is
+    /// fitted again at that count (alone, or all such at once as in [`FlakeTerm::tabulate`]).
+    fn on_one_grid(&self, wavelengths_nm: &[f64], per_sample: bool, work: &Work) -> Option<Vec<ChebTable>> {
         let t = self.table.as_ref()?;
         let pieces = t.iter().map(ChebTable::pieces).max()?;
-        t.iter()
-            .enumerate()
-            .map(|(k, tk)| match tk.pieces() == pieces {
-                true => Some(tk.clone()),
-                false => ChebTable::fit_with_pieces(
-                    |c| self.reflectance_direct(k, c, wavelengths_nm[k]),
-                    0.0,
-                    1.0,
-                    pieces,
-                    TABLE_TOLERANCE,
-                ),
-            })
-            .collect()
+        if per_sample {
+            return t
+                .iter()
+                .enumerate()
+                .map(|(k, tk)| match tk.pieces() == pieces {
+                    true => Some(tk.clone()),
+                    false => ChebTable::fit_with_pieces(
+                        |c| {
+                            work.count(1, 1);
+                            self.reflectance_direct(k, c, wavelengths_nm[k])
+                        },
+                        0.0,
+                        1.0,
+                        pieces,
+                        TABLE_TOLERANCE,
+                    ),
+                })
+                .collect();
+        }
+        let refit: Vec<usize> = (0..t.len()).filter(|&k| t[k].pieces() != pieces).collect();
+        let f = |c, which: &[usize], out: &mut [f64]| self.reflectance_each(c, which, wavelengths_nm, out, work);
+        let mut again = ChebTable::fit_each_with_pieces(f, &refit, 0.0, 1.0, pieces, TABLE_TOLERANCE).into_iter();
+        t.iter().map(|tk| if tk.pieces() == pieces { Some(tk.clone()) } else { again.next().flatten() }).collect()
     }
 
     /// Everything the term computes from its optics, its cover and the samples: the tables ([`FlakeTerm::table`],
@@ -193,19 +292,28 @@ impl FlakeTerm {
     /// that varies an area ratio, a spread, the primer or the coat's roughness meets), else computed and kept.
     pub(super) fn prepare(&mut self, k_mix: &[f64], s_mix: &[f64], depth_mm: f64, wavelengths_nm: &[f64]) {
         let key = self.key(k_mix, s_mix, depth_mm, wavelengths_nm);
-        let made = TABLES.get_or_make(key, || {
-            let mut t = self.clone();
-            t.tabulate(wavelengths_nm);
-            t.grid = t.on_one_grid(wavelengths_nm);
-            if t.split {
-                t.split_constants(k_mix, s_mix, depth_mm, wavelengths_nm);
-            }
-            Prepared { table: t.table, grid: t.grid, depth: t.depth, diffuse: t.diffuse }
-        });
+        let made = TABLES.get_or_make(key, || self.compute(k_mix, s_mix, depth_mm, wavelengths_nm));
         self.table = made.table.clone();
         self.grid = made.grid.clone();
         self.depth = made.depth.clone();
         self.diffuse = made.diffuse.clone();
+    }
+
+    /// What [`FlakeTerm::prepare`] computes when the memo does not have it, counted in [`table_work`].
+    fn compute(&self, k_mix: &[f64], s_mix: &[f64], depth_mm: f64, wavelengths_nm: &[f64]) -> Prepared {
+        let per_sample = PER_SAMPLE.load(Ordering::Relaxed);
+        let work = Work::default();
+        let mut t = self.clone();
+        t.tabulate(wavelengths_nm, per_sample, &work);
+        t.grid = t.on_one_grid(wavelengths_nm, per_sample, &work);
+        if t.split {
+            t.split_constants(k_mix, s_mix, depth_mm, wavelengths_nm, per_sample, &work);
+        }
+        if let FlakeOptics::Pearl { .. } = t.optics {
+            STACK_SETUPS.fetch_add(work.setups.get(), Ordering::Relaxed);
+            STACK_WAVELENGTHS.fetch_add(work.evaluations.get(), Ordering::Relaxed);
+        }
+        Prepared { table: t.table, grid: t.grid, depth: t.depth, diffuse: t.diffuse }
     }
 
     /// The bits of every input [`FlakeTerm::prepare`] reads: the optics, the cover per sample, whether the light
@@ -251,4 +359,37 @@ struct Prepared {
     grid: Option<Vec<ChebTable>>,
     depth: Vec<f64>,
     diffuse: Vec<f64>,
+}
+
+/// Build the flake tables one sample at a time (`true`: the engine before `docs/model.md` §Evaluation cost
+/// "shared across samples", what `benches/paint_build.rs` times as "before") or all samples at once (`false`,
+/// the default). The tables are the same bits either way (`tests/paint.rs`), so the memo serves both.
+pub fn build_tables_per_sample(on: bool) {
+    PER_SAMPLE.store(on, Ordering::Relaxed);
+}
+
+static PER_SAMPLE: AtomicBool = AtomicBool::new(false);
+static STACK_SETUPS: AtomicU64 = AtomicU64::new(0);
+static STACK_WAVELENGTHS: AtomicU64 = AtomicU64::new(0);
+
+/// The film-stack work the pearl flake tables built so far in this process have done (exact counts, what
+/// `benches/paint_build.rs` reports beside its times): (stack set-ups, i.e. angles of incidence at which a
+/// stack's angles and interface amplitudes were computed; wavelength evaluations, i.e. reflectances ρ(μ, λ)
+/// computed). Per sample, one of each per evaluation; shared, one set-up serves every sample at its angle.
+pub fn table_work() -> (u64, u64) {
+    (STACK_SETUPS.load(Ordering::Relaxed), STACK_WAVELENGTHS.load(Ordering::Relaxed))
+}
+
+/// Counts of one table build ([`table_work`]).
+#[derive(Default)]
+struct Work {
+    setups: Cell<u64>,
+    evaluations: Cell<u64>,
+}
+
+impl Work {
+    fn count(&self, setups: usize, evaluations: usize) {
+        self.setups.set(self.setups.get() + setups as u64);
+        self.evaluations.set(self.evaluations.get() + evaluations as u64);
+    }
 }

@@ -19,14 +19,25 @@ pub const DIFFUSE_FRESNEL_NODES: usize = 64;
 /// turns √(μ − μc) into the smooth h^½·s, so that each piece's rule again converges like a smooth integrand's
 /// (docs/model.md §Pearlescent flakes).
 pub fn hemispherical_mean(f: impl Fn(f64) -> f64, kinks: &[f64]) -> f64 {
+    hemispherical_means(|mu, v| v[0] = f(mu), 1, kinks)[0]
+}
+
+/// [`hemispherical_mean`] of `count` functions with the same kinks at once: `f(μ, values)` sets every
+/// function's value at μ (so what they share at one μ is computed once), and each mean is summed in the same
+/// order, to the same bits, as [`hemispherical_mean`] sums it alone.
+pub fn hemispherical_means(mut f: impl FnMut(f64, &mut [f64]), count: usize, kinks: &[f64]) -> Vec<f64> {
     let (x, w) = gauss_legendre(DIFFUSE_FRESNEL_NODES);
+    let mut at = vec![0.0; count];
+    let mut sums = vec![0.0; count];
     if kinks.is_empty() {
-        let mut sum = 0.0;
         for (&xi, &wi) in x.iter().zip(&w) {
             let mu = 0.5 * (xi + 1.0);
-            sum += wi * mu * f(mu);
+            f(mu, &mut at);
+            for (s, v) in sums.iter_mut().zip(&at) {
+                *s += wi * mu * v;
+            }
         }
-        return sum;
+        return sums;
     }
     // Pieces (from, to) with `from` a kink: μ = from + (to − from)·s², from the kink towards the piece's
     // other end (which is 0, 1 or a midpoint between kinks).
@@ -37,19 +48,24 @@ pub fn hemispherical_mean(f: impl Fn(f64) -> f64, kinks: &[f64]) -> f64 {
         pieces.push((c, below));
         pieces.push((c, above));
     }
-    let mut sum = 0.0;
+    let mut piece = vec![0.0; count];
     for (from, to) in pieces {
         let h = to - from;
-        let mut piece = 0.0;
+        piece.iter_mut().for_each(|p| *p = 0.0);
         for (&xi, &wi) in x.iter().zip(&w) {
             let s = 0.5 * (xi + 1.0);
             let mu = from + h * s * s;
+            f(mu, &mut at);
             // dμ = 2h·s ds, and ds = wi/2 on [0, 1]: 2 f μ dμ = 2 f μ · h s wi.
-            piece += wi * 2.0 * h.abs() * s * mu * f(mu);
+            for (p, v) in piece.iter_mut().zip(&at) {
+                *p += wi * 2.0 * h.abs() * s * mu * v;
+            }
         }
-        sum += piece;
+        for (s, p) in sums.iter_mut().zip(&piece) {
+            *s += p;
+        }
     }
-    sum
+    sums
 }
 
 /// Diffuse (hemispherical) reflectance of the air → coat interface for light incident from air,

@@ -53,7 +53,7 @@ mod hemisphere;
 mod memo;
 mod spec;
 
-pub use flake::{forget_tables, TABLE_TOLERANCE};
+pub use flake::{build_tables_per_sample, forget_tables, table_work, TABLE_TOLERANCE};
 pub use hemisphere::{
     diffuse_fresnel_reflectance, hemispherical_mean, internal_diffuse_reflectance, DIFFUSE_FRESNEL_NODES,
 };
