@@ -370,7 +370,7 @@ fn roughness_or_populations(obj: &Obj) -> Result<Option<f64>> {
         (false, false) => Err(obj.err(
             &r.key(),
             format!(
-                "missing: give exactly one of `roughness` (Beckmann rms slope m or GGX α, {}) and `populations` (1 to {} objects {{weight, roughness, distribution}})",
+                "missing required field: give exactly one of `roughness` (Beckmann rms slope m or GGX α, {}) and `populations` (1 to {} objects {{weight, roughness, distribution}})",
                 r.range().describe(),
                 reg::MAX_POPULATIONS
             ),
