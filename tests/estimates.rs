@@ -341,7 +341,10 @@ fn slope_mixtures_estimates_cover_their_actual_error() {
             checked += 1;
             let actual = (v - vr).abs();
             if actual > a.error_estimate {
-                failures.push(format!("{} {}: actual {actual:e} > estimate {:e}: {json}", a.geometry, a.name, a.error_estimate));
+                failures.push(format!(
+                    "{} {}: actual {actual:e} > estimate {:e}: {json}",
+                    a.geometry, a.name, a.error_estimate
+                ));
             }
         }
     }

@@ -66,9 +66,9 @@ fn the_orange_peel_panel_is_not_reproduced_and_the_85_degree_gloss_is_why() {
     // lacquer (GGX facet slopes with a Rayleigh–Rice halo at the smooth-surface bound, σ = 22 nm), started at
     // its best fit (docs/instrument.md §1.10). It reproduces 20° gloss and haze within about 2u; with the facet
     // slopes that Rspec and DOI set (~0.1°) and the halo that 20° gloss and haze set, it reads 85° gloss ~98
-    // against 94.0 (only a second, steep slope population, which glossmeter does not model, lowers 85° gloss
-    // with 60° gloss near 88: §1.10): the fit must say it cannot reproduce the readings (exit 1) and name 85°
-    // gloss as the largest residual.
+    // against 94.0 (only a second, steep slope population lowers 85° gloss with 60° gloss near 88: §1.10, and
+    // the next test): one slope scale with a halo must say it cannot reproduce the readings (exit 1) and name
+    // 85° gloss as the largest residual.
     let (code, doc, err) = fit(&[
         "fixtures/real/models/panel-two-scale.json",
         "--target",

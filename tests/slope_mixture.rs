@@ -45,7 +45,8 @@ fn a_one_population_mixture_is_the_microfacet_model() {
     for (dist, m, ior, shadow) in cases {
         let one = load(&format!(r#"{{"model": "microfacet", {dist}, "roughness": {m}, "ior": {ior}{shadow}}}"#));
         for pops in [format!(r#"[{{"weight": 1, "roughness": {m}}}]"#), format!(r#"[{{"roughness": {m}}}]"#)] {
-            let mix = load(&format!(r#"{{"model": "microfacet", {dist}, "populations": {pops}, "ior": {ior}{shadow}}}"#));
+            let mix =
+                load(&format!(r#"{{"model": "microfacet", {dist}, "populations": {pops}, "ior": {ior}{shadow}}}"#));
             let n = one.brdf.sampling().len();
             let (mut a, mut b) = (vec![0.0; n], vec![0.0; n]);
             for &wi in &dirs() {
@@ -81,7 +82,10 @@ fn mixtures() -> Vec<(SlopeMixture, Shadowing)> {
     let g = |m| Microfacet::new(Distribution::Ggx, m);
     vec![
         (SlopeMixture::new(vec![(0.9325, b(0.0074)), (0.0675, b(0.0741))]), Shadowing::SmithHeightCorrelated),
-        (SlopeMixture::new(vec![(0.3, g(0.00064)), (0.57, b(0.008)), (0.13, b(0.028))]), Shadowing::SmithHeightCorrelated),
+        (
+            SlopeMixture::new(vec![(0.3, g(0.00064)), (0.57, b(0.008)), (0.13, b(0.028))]),
+            Shadowing::SmithHeightCorrelated,
+        ),
         (SlopeMixture::new(vec![(0.5, g(0.1)), (0.3, b(0.4)), (0.2, g(0.8))]), Shadowing::SmithHeightCorrelated),
         (SlopeMixture::new(vec![(0.6, b(0.2)), (0.4, g(0.6))]), Shadowing::SmithSeparable),
     ]
@@ -170,7 +174,8 @@ fn measure(json: &str, name: &str) -> (i32, String) {
 /// Bad populations exit 2 with the file, the JSON Pointer and what is allowed.
 #[test]
 fn bad_populations_are_refused_with_file_field_and_range() {
-    let base = |pops: &str| format!(r#"{{"model": "microfacet", "distribution": "ggx", "ior": 1.5, "populations": {pops}}}"#);
+    let base =
+        |pops: &str| format!(r#"{{"model": "microfacet", "distribution": "ggx", "ior": 1.5, "populations": {pops}}}"#);
     let cases: Vec<(String, &str, &str)> = vec![
         (base(r#"[{"weight": 0, "roughness": 0.01}, {"roughness": 0.1}]"#), "/populations/0/weight", "(0, 1]"),
         (base(r#"[{"weight": 1.5, "roughness": 0.01}]"#), "/populations/0/weight", "(0, 1]"),

@@ -37,9 +37,10 @@ impl MixtureSurface {
         if pops.is_empty() {
             return Err(Error::Usage("slope mixture: no population".into()));
         }
-        if let Some((w, m)) = pops.iter().find(|(w, m)| {
-            !(*w > 0.0 && *w <= 1.0) || !(m.alpha >= Microfacet::SMOOTH_THRESHOLD && m.alpha.is_finite())
-        }) {
+        if let Some((w, m)) = pops
+            .iter()
+            .find(|(w, m)| !(*w > 0.0 && *w <= 1.0 && m.alpha >= Microfacet::SMOOTH_THRESHOLD && m.alpha.is_finite()))
+        {
             return Err(Error::Usage(format!(
                 "slope mixture: population of weight {w} and roughness {}; allowed: weight in (0, 1], roughness ≥ {}",
                 m.alpha,
