@@ -439,8 +439,50 @@ pub const MICROFACET_ROUGHNESS: Param = p(
     Type::Number,
     "slope",
     Some(ROUGHNESS_RANGE),
+    Opt("none: give `populations`"),
+    "Beckmann rms slope m or GGX α; 0 = smooth (a delta below 1e-7); give exactly one of roughness and populations",
+);
+/// Maximum number of slope populations of a `microfacet` recipe.
+pub const MAX_POPULATIONS: usize = 8;
+/// A population's roughness: rough (a delta population is not a mixture member) up to the single lobe's bound.
+pub const POPULATION_ROUGHNESS_RANGE: Range = Range::closed(1e-7, 10.0);
+/// A population's weight: (0, 1].
+pub const WEIGHT_RANGE: Range = Range { lo: 0.0, lo_closed: false, hi: 1.0, hi_closed: true };
+pub const MICROFACET_POPULATIONS: Param = p(
+    "/populations",
+    &["microfacet"],
+    Type::Objects,
+    "",
+    NONE,
+    Opt("one population: `roughness`"),
+    "1 to 8 slope populations {weight, roughness, distribution}: D = Σ wᵢ Dᵢ, Smith Λ = Σ wᵢ Λᵢ (docs/optics.md §4.1); weights sum to 1",
+);
+pub const MICROFACET_POP_WEIGHT: Param = p(
+    "/populations/*/weight",
+    &["microfacet"],
+    Type::Number,
+    "",
+    Some(WEIGHT_RANGE),
+    Opt("1 − the others' weights (at most one population omits it)"),
+    "the share wᵢ of the facets in this population; Σ wᵢ = 1 within 1e-9",
+);
+pub const MICROFACET_POP_ROUGHNESS: Param = p(
+    "/populations/*/roughness",
+    &["microfacet"],
+    Type::Number,
+    "slope",
+    Some(POPULATION_ROUGHNESS_RANGE),
     Req,
-    "Beckmann rms slope m or GGX α; 0 = smooth (a delta below 1e-7)",
+    "the population's Beckmann rms slope m or GGX α (no delta population: ≥ 1e-7)",
+);
+pub const MICROFACET_POP_DISTRIBUTION: Param = p(
+    "/populations/*/distribution",
+    &["microfacet"],
+    Type::Choice(&["beckmann", "ggx"]),
+    "",
+    NONE,
+    Opt("the recipe's `distribution`"),
+    "the population's facet-normal distribution",
 );
 pub const SHADOWING: Param = p(
     "/shadowing",
@@ -680,8 +722,12 @@ pub const SPREAD_DEG_RANGE: Range = Range::closed(0.0, 60.0);
 pub const SPREAD_SLOPE_RANGE: Range = Range::closed(0.0, 1.732);
 
 /// Groups of alternative fields of which a recipe gives exactly one: (object pointer, field, field).
-pub const EXACTLY_ONE: &[(&str, &str, &str)] =
-    &[("/metallic_flakes", "spread_deg", "spread_slope"), ("/pearlescent_flakes", "spread_deg", "spread_slope")];
+/// Keyed by the object's pointer and the fields: the group applies to the models that have both fields there.
+pub const EXACTLY_ONE: &[(&str, &str, &str)] = &[
+    ("/metallic_flakes", "spread_deg", "spread_slope"),
+    ("/pearlescent_flakes", "spread_deg", "spread_slope"),
+    ("", "roughness", "populations"),
+];
 
 pub const METALLIC: Param =
     p("/metallic_flakes", PAINT, Type::Object, "", NONE, Opt("no metallic flakes"), "aluminium-like flakes");
@@ -1002,6 +1048,10 @@ pub static PARAMS: &[&Param] = &[
     // microfacet
     &MICROFACET_DISTRIBUTION,
     &MICROFACET_ROUGHNESS,
+    &MICROFACET_POPULATIONS,
+    &MICROFACET_POP_WEIGHT,
+    &MICROFACET_POP_ROUGHNESS,
+    &MICROFACET_POP_DISTRIBUTION,
     &SHADOWING,
     &MICROFACET_SCATTER.object,
     &MICROFACET_SCATTER.psd,

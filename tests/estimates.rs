@@ -304,3 +304,50 @@ fn a_lobe_between_half_and_the_whole_range_wide_is_covered_on_the_pixel_array() 
         );
     }
 }
+
+/// The slope mixtures (`microfacet` with `populations`, docs/optics.md §4.1): one lobe per population for the
+/// planner, widths from 6·10⁻⁴ to 0.6 side by side. Every default reading's estimate at every shipped geometry
+/// the mixture compiles for must cover its actual error against the rtol-10⁻¹⁰ reading (as the generated
+/// recipes above).
+#[test]
+fn slope_mixtures_estimates_cover_their_actual_error() {
+    let gloss = standards::builtin().unwrap();
+    let all = standards::builtin_all().unwrap();
+    let tight = PlanOptions { rtol: 1e-10, max_seconds: None, rtol_from_data: false, ..PlanOptions::default() };
+    let recipes = [
+        // check_85.py §3's two-scale surface (tools/iq/check_mixture.py).
+        r#"{"model":"microfacet","distribution":"beckmann","ior":1.52285,"populations":[{"roughness":0.0074049},{"weight":0.0675,"roughness":0.074116}]}"#,
+        // The orange-peel panel's three populations (fixtures/real/models/panel-three-populations.json).
+        r#"{"model":"microfacet","distribution":"ggx","ior":1.5202,"populations":[{"roughness":0.00064412},{"weight":0.56828,"roughness":0.0080461,"distribution":"beckmann"},{"weight":0.13205,"roughness":0.028039,"distribution":"beckmann"}]}"#,
+        // GGX and Beckmann, rough, a conductor.
+        r#"{"model":"microfacet","distribution":"ggx","ior":[0.2,3.5],"populations":[{"weight":0.5,"roughness":0.1},{"weight":0.3,"roughness":0.4,"distribution":"beckmann"},{"weight":0.2,"roughness":0.6}]}"#,
+        // A narrow lobe beside a broad one with a halo (the two-scale surface over a mixture).
+        r#"{"model":"microfacet","distribution":"ggx","ior":1.5,"populations":[{"roughness":0.002},{"weight":0.1,"roughness":0.05,"distribution":"beckmann"}],"scatter":{"psd":"k-correlation","rms_roughness_nm":10,"correlation_length_um":1.5,"c":4}}"#,
+    ];
+    let (mut checked, mut failures) = (0, Vec::new());
+    for json in recipes {
+        let m = glossmeter::recipe::parse_str(json, "fixtures/recipes/generated.json").unwrap();
+        let geos = match Plan::compile(m.brdf.clone(), all.clone(), PlanOptions::default()) {
+            Ok(_) => all.clone(),
+            Err(_) => gloss.clone(),
+        };
+        let d = Plan::compile(m.brdf.clone(), geos.clone(), PlanOptions::default()).unwrap().execute();
+        let r = Plan::compile(m.brdf.clone(), geos.clone(), tight.clone()).unwrap().execute();
+        for (a, b) in d.iter().zip(&r) {
+            let (Some(v), Some(vr)) = (a.value, b.value) else { continue };
+            if !b.converged {
+                continue;
+            }
+            checked += 1;
+            let actual = (v - vr).abs();
+            if actual > a.error_estimate {
+                failures.push(format!(
+                    "{} {}: actual {actual:e} > estimate {:e}: {json}",
+                    a.geometry, a.name, a.error_estimate
+                ));
+            }
+        }
+    }
+    assert!(checked >= 4 * 20, "only {checked} readings checked");
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}

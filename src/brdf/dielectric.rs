@@ -54,7 +54,7 @@ impl Ior {
     }
 }
 
-fn describe_iors(ior: &[Ior]) -> String {
+pub(crate) fn describe_iors(ior: &[Ior]) -> String {
     if ior.len() == 1 || ior.windows(2).all(|w| w[0] == w[1]) {
         ior[0].describe()
     } else {

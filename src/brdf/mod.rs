@@ -18,7 +18,8 @@
 //! * the models, one per file, each over the optics it cites: `lambert.rs` ([`lambert::Lambert`]),
 //!   `dielectric.rs` (the smooth dielectric [`dielectric::SmoothDielectric`] and the rough interface of a
 //!   dielectric or a conductor [`dielectric::MicrofacetSurface`], with its [`dielectric::Ior`]), `conductor.rs`
-//!   ([`conductor::SmoothConductor`]), `phong.rs` ([`phong::Phong`]), `ward.rs` ([`ward::Ward`]),
+//!   ([`conductor::SmoothConductor`]), `mixture.rs` (a rough interface of several slope populations,
+//!   [`mixture::MixtureSurface`]), `phong.rs` ([`phong::Phong`]), `ward.rs` ([`ward::Ward`]),
 //!   `multilobe.rs` ([`multilobe::CookTorranceLobes`]), `halo.rs` (a Rayleigh–Rice scatter halo on a model's
 //!   mirror, [`halo::WithHalo`] over [`halo::Halo`]), `two_scale.rs` (a rough interface with that halo,
 //!   [`two_scale::RoughWithHalo`]) and `paint`, the paint model of Ďurikovič & Ágošton
@@ -37,6 +38,7 @@ pub mod conductor;
 pub mod dielectric;
 pub mod halo;
 pub mod lambert;
+pub mod mixture;
 pub mod multilobe;
 pub mod paint;
 pub mod phong;

@@ -3,7 +3,8 @@
 //! Each function cites its source in its doc comment and in `docs/model.md`.
 //!
 //! The folder (`thin_film.rs` builds on `fresnel.rs`; `coat_albedo.rs` on `fresnel.rs`, `microfacet.rs`,
-//! `tabulated.rs` and the quadrature's Gauss–Legendre rule; the others only the crate's `Vec3`):
+//! `tabulated.rs` and the quadrature's Gauss–Legendre rule; `slope_mixture.rs` on `microfacet.rs`; the others only
+//! the crate's `Vec3`):
 //! * `fresnel.rs`: dielectric and conducting interfaces, the decaying-wave branch, refraction into a coat and
 //!   the critical angles ([`fresnel::fresnel_dielectric`], [`fresnel::fr_dielectric`],
 //!   [`fresnel::fresnel_conductor`], [`fresnel::fr_conductor`], [`fresnel::amplitudes`],
@@ -16,6 +17,8 @@
 //!   [`thin_film::FilmLayer`], [`thin_film::StackResult`]);
 //! * `microfacet.rs`: Beckmann and GGX distributions with Smith and V-cavity masking
 //!   ([`microfacet::Microfacet`], [`microfacet::Distribution`], [`microfacet::Shadowing`]);
+//! * `slope_mixture.rs` (on `microfacet.rs`): a mixture of slope populations, D = Σ wᵢ Dᵢ with the Smith
+//!   masking of the mixture, Λ = Σ wᵢ Λᵢ ([`slope_mixture::SlopeMixture`]);
 //! * `scatter.rs`: smooth-surface (Rayleigh–Rice) scatter from a surface PSD, K-correlation or Gaussian
 //!   ([`scatter::Psd`], [`scatter::rayleigh_rice`], [`scatter::polarisation_factor`]);
 //! * `tabulated.rs`: piecewise Chebyshev tables of smooth functions of one variable, accepted only with their
@@ -28,5 +31,6 @@ pub mod fresnel;
 pub mod kubelka_munk;
 pub mod microfacet;
 pub mod scatter;
+pub mod slope_mixture;
 pub mod tabulated;
 pub mod thin_film;

@@ -23,6 +23,7 @@ use crate::brdf::conductor::SmoothConductor;
 use crate::brdf::dielectric::{Ior, MicrofacetSurface, SmoothDielectric};
 use crate::brdf::halo::WithHalo;
 use crate::brdf::lambert::Lambert;
+use crate::brdf::mixture::MixtureSurface;
 use crate::brdf::multilobe::{CookTorranceLobes, CtLobe};
 use crate::brdf::phong::{Phong, PhongVariant};
 use crate::brdf::two_scale::RoughWithHalo;
@@ -30,6 +31,7 @@ use crate::brdf::ward::Ward;
 use crate::brdf::Brdf;
 use crate::input::json::{kind, parse_json, Obj};
 use crate::optics::microfacet::{Distribution, Microfacet, Shadowing};
+use crate::optics::slope_mixture::SlopeMixture;
 use crate::registry::{self as reg, Param};
 use crate::spectrum::Sampling;
 use crate::{Error, Result};
@@ -142,7 +144,7 @@ pub fn parse_brdf(obj: &Obj) -> Result<Arc<dyn Brdf>> {
         },
         "microfacet" => {
             let distribution = distribution(obj, &reg::MICROFACET_DISTRIBUTION)?;
-            let alpha = obj.param(&reg::MICROFACET_ROUGHNESS)?;
+            let alpha = roughness_or_populations(obj)?;
             let shadowing = shadowing(obj)?;
             let ior = parse_ior(obj, &reg::MICROFACET_IOR)?;
             let sampling = if ior.len() == 3 { Sampling::rgb() } else { Sampling::grey() };
@@ -153,13 +155,23 @@ pub fn parse_brdf(obj: &Obj) -> Result<Arc<dyn Brdf>> {
                     Ior::Dielectric(n) => Complex64::new(*n, 0.0),
                 })
                 .collect();
-            let facets = Microfacet::new(distribution, alpha);
-            let surface: Arc<dyn Brdf> = Arc::new(MicrofacetSurface::new(facets, shadowing, ior, sampling.clone())?);
+            let (surface, smooth): (Arc<dyn Brdf>, bool) = match alpha {
+                Some(alpha) => {
+                    let facets = Microfacet::new(distribution, alpha);
+                    let s = MicrofacetSurface::new(facets, shadowing, ior, sampling.clone())?;
+                    (Arc::new(s), facets.effectively_smooth())
+                }
+                // A mixture of slope populations (every one rough: the registry's range).
+                None => {
+                    let mix = populations(obj, distribution)?;
+                    (Arc::new(MixtureSurface::new(mix, shadowing, ior, sampling.clone())?), false)
+                }
+            };
             match obj.opt_obj("scatter")? {
                 None => surface,
                 Some(s) => {
                     let halo = scatter::parse_scatter(&s, &reg::MICROFACET_SCATTER, model, &index, &sampling)?;
-                    if facets.effectively_smooth() {
+                    if smooth {
                         Arc::new(WithHalo::new(surface, halo)?)
                     } else {
                         // A rough interface: the two-scale surface (facets' slopes and the micro-roughness's
@@ -345,6 +357,84 @@ fn shadowing(obj: &Obj) -> Result<Shadowing> {
             format!("unknown shadowing {other:?}; allowed: \"smith\" (height-correlated, the default), \"smith-separable\" (G1·G1, as Mitsuba 3), \"v-cavity\""),
         )),
     }
+}
+
+/// A `microfacet` recipe's slopes: exactly one of `roughness` (one population: Some) and `populations` (None).
+fn roughness_or_populations(obj: &Obj) -> Result<Option<f64>> {
+    let (r, p) = (&reg::MICROFACET_ROUGHNESS, &reg::MICROFACET_POPULATIONS);
+    match (obj.get(&r.key()).is_some(), obj.get(&p.key()).is_some()) {
+        (true, true) => Err(obj.err(
+            &p.key(),
+            "give exactly one of `roughness` (one slope population) and `populations` (a mixture), not both",
+        )),
+        (false, false) => Err(obj.err(
+            &r.key(),
+            format!(
+                "missing required field: give exactly one of `roughness` (Beckmann rms slope m or GGX α, {}) and `populations` (1 to {} objects {{weight, roughness, distribution}})",
+                r.range().describe(),
+                reg::MAX_POPULATIONS
+            ),
+        )),
+        (true, false) => obj.param(r).map(Some),
+        (false, true) => Ok(None),
+    }
+}
+
+/// `populations`: 1 to 8 objects {weight, roughness, distribution}; each distribution defaults to the
+/// recipe's; the weights in (0, 1] sum to 1 within 1e-9, or one population omits its weight and takes the
+/// rest (so that a fit can free the others' weights: docs/recipe-format.md §microfacet).
+fn populations(obj: &Obj, default: Distribution) -> Result<SlopeMixture> {
+    let key = obj.param_key(&reg::MICROFACET_POPULATIONS);
+    let items = obj.array(&key)?;
+    if items.is_empty() || items.len() > reg::MAX_POPULATIONS {
+        return Err(obj.err(&key, format!("{} populations; allowed: 1 to {}", items.len(), reg::MAX_POPULATIONS)));
+    }
+    let mut raw: Vec<(Option<f64>, Microfacet)> = Vec::new();
+    let mut omitted: Option<usize> = None;
+    for (i, item) in items.iter().enumerate() {
+        let po = Obj::new(obj.file, obj.element(&key, i), item)?;
+        po.deny_unknown_in("microfacet")?;
+        let w = po.opt_param(&reg::MICROFACET_POP_WEIGHT)?;
+        if w.is_none() {
+            if let Some(j) = omitted {
+                return Err(po.err(
+                    "weight",
+                    format!("missing, as is population {j}'s: at most one population omits its weight (it takes 1 − the others'); allowed: a number in (0, 1]"),
+                ));
+            }
+            omitted = Some(i);
+        }
+        let alpha = po.param(&reg::MICROFACET_POP_ROUGHNESS)?;
+        let dist = if po.get("distribution").is_some() {
+            distribution(&po, &reg::MICROFACET_POP_DISTRIBUTION)?
+        } else {
+            default
+        };
+        raw.push((w, Microfacet::new(dist, alpha)));
+    }
+    let given: f64 = raw.iter().filter_map(|p| p.0).sum();
+    let weights: Vec<f64> = match omitted {
+        Some(j) => {
+            let rest = 1.0 - given;
+            if !(rest > 0.0) {
+                return Err(obj.err(
+                    &key,
+                    format!("population {j} omits its weight, which would be 1 − {given} = {rest}; allowed: the other weights sum below 1"),
+                ));
+            }
+            raw.iter().map(|p| p.0.unwrap_or(rest)).collect()
+        }
+        None => {
+            if (given - 1.0).abs() > 1e-9 {
+                return Err(obj.err(
+                    &key,
+                    format!("the weights sum to {given}; allowed: a sum of 1 (within 1e-9), or omit one population's weight to give it the rest"),
+                ));
+            }
+            raw.iter().map(|p| p.0.unwrap_or(0.0)).collect()
+        }
+    };
+    Ok(SlopeMixture::new(weights.into_iter().zip(raw).map(|(w, (_, m))| (w, m)).collect()))
 }
 
 /// `cook-torrance-lobes`: kd, lobes[{ks, r, m}], optional distribution and shadowing.

@@ -78,8 +78,11 @@ fn object(model: &str, pointer: &str) -> Value {
             }
         }
     }
+    let group = registry::EXACTLY_ONE
+        .iter()
+        .find(|(at, a, b)| *at == pointer && props.contains_key(*a) && props.contains_key(*b));
     let mut o = json!({"type": "object", "properties": props, "required": required, "additionalProperties": false});
-    if let Some((_, a, b)) = registry::EXACTLY_ONE.iter().find(|(at, _, _)| *at == pointer) {
+    if let Some((_, a, b)) = group {
         o["oneOf"] = json!([{"required": [a]}, {"required": [b]}]);
     }
     o
@@ -113,6 +116,10 @@ fn node(model: &str, e: &Param) -> Value {
             if e.pointer == registry::CT_LOBES.pointer {
                 a["minItems"] = json!(1);
                 a["maxItems"] = json!(MAX_LOBES);
+            }
+            if e.pointer == registry::MICROFACET_POPULATIONS.pointer {
+                a["minItems"] = json!(1);
+                a["maxItems"] = json!(registry::MAX_POPULATIONS);
             }
             a
         }
