@@ -712,6 +712,21 @@ fn registry_object(
             obj.insert(e.key(), registry_value(model, e, samples, rng));
         }
     }
+    // Alternatives of which a recipe gives exactly one (`registry::EXACTLY_ONE`): two given keep the first,
+    // none given gets the first, so that the choice is not what refuses most generated recipes.
+    for (at, first, second) in registry::EXACTLY_ONE.iter().filter(|(at, _, _)| *at == prefix) {
+        let entry = |key: &str| registry::of_model(model).find(|e| e.pointer == format!("{at}/{key}"));
+        let (Some(e1), Some(_)) = (entry(first), entry(second)) else { continue };
+        match (obj.contains_key(*first), obj.contains_key(*second)) {
+            (true, true) => {
+                obj.remove(*second);
+            }
+            (false, false) => {
+                obj.insert(e1.key(), registry_value(model, e1, samples, rng));
+            }
+            _ => {}
+        }
+    }
     obj
 }
 
