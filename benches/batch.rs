@@ -36,7 +36,7 @@ fn bits(rs: &[Vec<Reading>]) -> Bits {
 /// The order of the thread counts in a round: 1 then 2, then 2 then 1, so that a load that drifts during a
 /// round does not always favour the same one.
 fn turns(round: usize) -> [usize; 2] {
-    if round % 2 == 0 {
+    if round.is_multiple_of(2) {
         [0, 1]
     } else {
         [1, 0]

@@ -1270,7 +1270,7 @@ fn batch(md: &mut String, quick: bool) {
     use rayon::prelude::*;
     let n = if quick { 16 } else { 64 };
     let microfacet = |i: usize| -> String {
-        let dist = if i % 2 == 0 { "beckmann" } else { "ggx" };
+        let dist = if i.is_multiple_of(2) { "beckmann" } else { "ggx" };
         let r = 0.02 + 0.48 * i as f64 / (n - 1) as f64;
         format!(r#"{{"model": "microfacet", "distribution": "{dist}", "roughness": {r}, "ior": 1.5}}"#)
     };

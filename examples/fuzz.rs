@@ -111,9 +111,9 @@ fn main() {
                 t.accepted += 1;
                 if let Some(m) = m {
                     accepted_recipes += 1;
-                    let which = if accepted_recipes % full_every == 0 {
+                    let which = if accepted_recipes.is_multiple_of(full_every) {
                         Some(&full)
-                    } else if accepted_recipes % light_every == 0 {
+                    } else if accepted_recipes.is_multiple_of(light_every) {
                         Some(&light)
                     } else {
                         None
@@ -174,7 +174,7 @@ fn main() {
         if (k + 1) % 10_000 == 0 {
             eprintln!("{} cases, {:.0} s, {} failures", k + 1, start.elapsed().as_secs_f64(), failures.len());
         }
-        if (k + 1 - first) % 100_000 == 0 {
+        if (k + 1 - first).is_multiple_of(100_000) {
             println!("\n## After {} cases\n", k + 1 - first);
             let wall = start.elapsed().as_secs_f64();
             let so_far = Summary { cases: k + 1 - first, seed, first, light_every, full_every, cli_every, wall };
