@@ -89,10 +89,15 @@ pub fn parse_scatter(
                 Psd::KCorrelation { a, .. } => a,
                 Psd::Gaussian { .. } => f64::NAN,
             };
+            // σ overflows for an A near the largest double: say so rather than print a non-finite number.
+            let sigma = if s.is_finite() {
+                format!("σ = {} nm", crate::error::number(s))
+            } else {
+                "a σ beyond double precision".to_string()
+            };
             format!(
-                "A = {} nm²·µm gives σ = {} nm; allowed with this B and C: A ≤ {} nm²·µm",
+                "A = {} nm²·µm gives {sigma}; allowed with this B and C: A ≤ {} nm²·µm",
                 crate::error::number(psd_a(&psd)),
-                crate::error::number(s),
                 crate::error::number(a_max)
             )
         } else {
@@ -181,6 +186,10 @@ mod tests {
         assert!(m.contains("allowed: σ ≤ 22.28") && m.contains("4πσ/λ ≤ 0.5"), "{m}");
         let (_, m) = err(&with(r#"{"psd": "k-correlation", "a_nm2_um": 1e9, "b_um": 30}"#));
         assert!(m.contains("allowed with this B and C: A ≤"), "{m}");
+        // An A whose σ overflows names the overflow, never a printed "inf" (the 10⁶-case fuzz, case 58125).
+        let (f, m) = err(&with(r#"{"psd": "k-correlation", "a_nm2_um": 1e308, "b_um": 30}"#));
+        assert_eq!(f, "/scatter/a_nm2_um");
+        assert!(m.contains("beyond double precision") && !m.contains("inf"), "{m}");
         let (_, m) =
             err(&with(r#"{"psd": "k-correlation", "rms_roughness_nm": 2, "correlation_length_um": 5, "c": 1}"#));
         assert!(m.contains("(1, 10]"), "{m}");
