@@ -266,7 +266,7 @@ fn a_lobe_about_as_wide_as_the_stops_at_85_degrees_is_covered() {
         let m = glossmeter::recipe::parse_str(&json, "fixtures/recipes/generated.json").unwrap();
         let d = &Plan::compile(m.brdf.clone(), vec![g.clone()], PlanOptions::default()).unwrap().execute()[0];
         let r = &Plan::compile(m.brdf.clone(), vec![g.clone()], tight.clone()).unwrap().execute()[0];
-        assert!(d.converged && r.converged, "{json}");
+        assert!(d.converged && r.converged, "{json}: {d:?} {r:?}");
         let actual = (d.value.unwrap() - r.value.unwrap()).abs();
         assert!(actual <= d.error_estimate, "{json}: actual {actual:e} > estimate {:e}", d.error_estimate);
     }
