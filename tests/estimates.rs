@@ -186,10 +186,32 @@ fn recipe(i: usize, rng: &mut Rng) -> (String, String, String) {
 #[test]
 fn every_default_reading_s_estimate_covers_its_actual_error() {
     let cases: usize = std::env::var("GLOSSMETER_ESTIMATE_CASES").ok().and_then(|s| s.parse().ok()).unwrap_or(36);
+    campaign(cases, None);
+}
+
+/// The same promise at other tolerances on the first 12 recipes (one of each family): rtol 10⁻⁴ and 10⁻⁸
+/// (the estimate's calibration and its limits were measured there too, docs/accuracy.md §5.1–5.2; a chance
+/// agreement of I₇ and I₅ at 10⁻⁷–10⁻⁸ was found by a sweep, not by this test at the default rtol). Against the
+/// same rtol-10⁻¹⁰ reference, whose own estimate is added to the bound (at 10⁻⁸ it is no longer negligible).
+#[test]
+fn the_estimate_covers_its_actual_error_at_rtol_1e_4_and_1e_8() {
+    campaign(12, Some(&[1e-4, 1e-8]));
+}
+
+/// Read the first `cases` generated recipes at the default settings (`rtols` None) or at each of `rtols`, and
+/// compare each reading with the rtol-10⁻¹⁰ reference (plus the reference's own estimate when `rtols` is given).
+fn campaign(cases: usize, rtols: Option<&[f64]>) {
     let report = std::env::var_os("GLOSSMETER_ESTIMATE_REPORT").is_some();
     let gloss = standards::builtin().unwrap();
     let all = standards::builtin_all().unwrap();
     let default = PlanOptions::default();
+    let runs: Vec<(PlanOptions, bool)> = match rtols {
+        None => vec![(default.clone(), false)],
+        Some(rtols) => rtols
+            .iter()
+            .map(|&rtol| (PlanOptions { rtol, max_seconds: None, rtol_from_data: false, ..default.clone() }, true))
+            .collect(),
+    };
     // Without a wall-clock budget: what is checked must not depend on the machine's load.
     let tight = PlanOptions { rtol: 1e-10, max_seconds: None, rtol_from_data: false, ..PlanOptions::default() };
     let mut rng = Rng(0x0005_EED0_FE57);
@@ -204,27 +226,31 @@ fn every_default_reading_s_estimate_covers_its_actual_error() {
             Ok(_) => all.clone(),
             Err(_) => gloss.clone(),
         };
-        let d = Plan::compile(m.brdf.clone(), geos.clone(), default.clone()).unwrap().execute();
         let r = Plan::compile(m.brdf.clone(), geos.clone(), tight.clone()).unwrap().execute();
-        for (a, b) in d.iter().zip(&r) {
-            assert_eq!((&a.geometry, &a.name), (&b.geometry, &b.name));
-            let (Some(v), Some(vr)) = (a.value, b.value) else { continue };
-            if !b.converged {
-                unchecked += 1;
-                continue;
-            }
-            checked += 1;
-            let actual = (v - vr).abs();
-            if actual == 0.0 {
-                exact += 1;
-            } else {
-                ratios.push(a.error_estimate / actual);
-            }
-            if actual > a.error_estimate {
-                failures.push(format!(
-                    "case {i} ({label}) {} {}: value {v:e}, reference {vr:e}: actual {actual:e} > estimate {:e}\n  {json}",
-                    a.geometry, a.name, a.error_estimate
-                ));
+        for (options, add_reference) in &runs {
+            let d = Plan::compile(m.brdf.clone(), geos.clone(), options.clone()).unwrap().execute();
+            for (a, b) in d.iter().zip(&r) {
+                assert_eq!((&a.geometry, &a.name), (&b.geometry, &b.name));
+                let (Some(v), Some(vr)) = (a.value, b.value) else { continue };
+                if !b.converged {
+                    unchecked += 1;
+                    continue;
+                }
+                checked += 1;
+                let actual = (v - vr).abs();
+                let bound = a.error_estimate + if *add_reference { b.error_estimate } else { 0.0 };
+                if actual == 0.0 {
+                    exact += 1;
+                } else {
+                    ratios.push(bound / actual);
+                }
+                if actual > bound {
+                    failures.push(format!(
+                        "case {i} ({label}) {} {} at rtol {:e}: value {v:e}, reference {vr:e} ± {:e}: actual {actual:e} \
+                         > estimate {:e}\n  {json}",
+                        a.geometry, a.name, options.rtol, b.error_estimate, a.error_estimate
+                    ));
+                }
             }
         }
     }
@@ -232,7 +258,7 @@ fn every_default_reading_s_estimate_covers_its_actual_error() {
     let q = |p: f64| ratios.get(((ratios.len() as f64 - 1.0) * p) as usize).copied().unwrap_or(f64::NAN);
     if report {
         eprintln!(
-            "{cases} recipes, {checked} readings checked ({exact} exact), {unchecked} unchecked; estimate/actual: \
+            "{cases} recipes (rtol {rtols:?}, None: the default), {checked} readings checked ({exact} exact), {unchecked} unchecked; estimate/actual: \
              min {:.3e}, 1 % {:.3e}, 10 % {:.3e}, median {:.3e}, 90 % {:.3e}, max {:.3e}",
             q(0.0),
             q(0.01),
@@ -242,7 +268,10 @@ fn every_default_reading_s_estimate_covers_its_actual_error() {
             q(1.0)
         );
     }
-    assert!(checked >= 20 * cases, "only {checked} readings checked over {cases} recipes ({unchecked} unchecked)");
+    assert!(
+        checked >= 20 * cases * runs.len(),
+        "only {checked} readings checked over {cases} recipes ({unchecked} unchecked)"
+    );
     // Almost all checked: at most 1 in 25 references may reach the evaluation budget unconverged (mostly
     // tables at 85° and plain-chart integrals at 10⁻¹⁰, whose boxes keep N₁: 71 of 3 412 in the first 36
     // recipes, 262 of 22 777 in 240; docs/accuracy.md §The estimate property).
@@ -266,7 +295,7 @@ fn a_lobe_about_as_wide_as_the_stops_at_85_degrees_is_covered() {
         let m = glossmeter::recipe::parse_str(&json, "fixtures/recipes/generated.json").unwrap();
         let d = &Plan::compile(m.brdf.clone(), vec![g.clone()], PlanOptions::default()).unwrap().execute()[0];
         let r = &Plan::compile(m.brdf.clone(), vec![g.clone()], tight.clone()).unwrap().execute()[0];
-        assert!(d.converged && r.converged, "{json}");
+        assert!(d.converged && r.converged, "{json}: {d:?} {r:?}");
         let actual = (d.value.unwrap() - r.value.unwrap()).abs();
         assert!(actual <= d.error_estimate, "{json}: actual {actual:e} > estimate {:e}", d.error_estimate);
     }
