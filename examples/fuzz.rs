@@ -186,6 +186,10 @@ fn main() {
     let summary =
         Summary { cases, seed, first, light_every, full_every, cli_every, wall: start.elapsed().as_secs_f64() };
     summary.print(&tally, slowest_light, over_10s, &slowest, &failures);
+    // A campaign that found failures does not pass (docs/reliability.md).
+    if !failures.is_empty() {
+        std::process::exit(1);
+    }
 }
 
 struct Summary {
