@@ -109,7 +109,7 @@ fn the_rgl_fixture_reads_converged_within_its_data_uncertainty_in_its_default_pa
     let r85 = run.readings.iter().find(|r| r.geometry == "astm-d523-85" && r.name == "gloss").unwrap();
     assert!((r85.value.unwrap() - 9.919).abs() <= r85.data_uncertainty.unwrap(), "{r85:?}");
     // Deterministic: 61 742 evaluations on the lobe-width partition with the pole ring (docs/performance.md
-    // §Measured tables: the partition at the lobe's width; the target of issue 29 is 100 k); 176 540 on the
+    // §Measured tables: the partition at the lobe's width; the target there is 100 k); 176 540 on the
     // resolution partition, and 3.48 M and unconverged at 85° at rtol 10⁻⁶ before the data tolerance.
     assert!(run.evaluations() <= 100_000, "{} evaluations", run.evaluations());
 }
