@@ -134,6 +134,18 @@ impl Brdf for SmoothDielectric {
     }
 }
 
+/// One finite index per spectral sample (a conductor's n + k checked as one number), else an error.
+pub(crate) fn check_iors(ior: &[Ior], sampling: &Sampling) -> crate::Result<()> {
+    let parts: Vec<f64> = ior
+        .iter()
+        .map(|i| match i {
+            Ior::Dielectric(n) => *n,
+            Ior::Conductor(c) => c.re + c.im,
+        })
+        .collect();
+    super::per_sample("index of refraction", &parts, sampling)
+}
+
 /// A rough interface (dielectric or conductor) with a single microfacet lobe; see the module documentation.
 #[derive(Clone, Debug, PartialEq)]
 pub struct MicrofacetSurface {
@@ -147,14 +159,7 @@ pub struct MicrofacetSurface {
 impl MicrofacetSurface {
     /// One finite index per spectral sample, else an error.
     pub fn new(facets: Microfacet, shadowing: Shadowing, ior: Vec<Ior>, sampling: Sampling) -> crate::Result<Self> {
-        let parts: Vec<f64> = ior
-            .iter()
-            .map(|i| match i {
-                Ior::Dielectric(n) => *n,
-                Ior::Conductor(c) => c.re + c.im,
-            })
-            .collect();
-        super::per_sample("index of refraction", &parts, &sampling)?;
+        check_iors(&ior, &sampling)?;
         Ok(MicrofacetSurface { facets, shadowing, ior, sampling })
     }
 }

@@ -90,6 +90,22 @@ impl Halo {
         k4 * k4 * self.psd.band_limited(s, lam * 1e-3)
     }
 
+    /// Take the halo's light from a mirror: out[k] −= R(θi)·g(θi) (first order, docs/optics.md §8).
+    pub fn take_from_mirror(&self, wi: Vec3, out: &mut [f64]) {
+        if wi.z > 0.0 {
+            let c = wi.z.min(1.0);
+            for (k, o) in out.iter_mut().enumerate() {
+                *o -= self.mirror_reflectance(k, c) * self.loss(k, c);
+            }
+        }
+    }
+
+    /// The halo as a term of the model it is added to (its [`Halo::lobe`]).
+    pub fn term(&self) -> Term {
+        let lobe = self.lobe();
+        Term { label: lobe.label.clone(), kind: TermKind::Lobe(lobe) }
+    }
+
     /// The halo as a lobe for the planner: its width as a slope is half the spread of the scattered
     /// direction cosines at the PSD's knee at normal incidence, λ·f_knee/2 at the shortest wavelength (the
     /// halo widens as 1/cos θ off normal, so the splits are at least as fine as it needs); its tail is a power
@@ -191,19 +207,13 @@ impl Brdf for WithHalo {
         if !self.inner.delta_reflectance(wi, out) {
             return false;
         }
-        if wi.z > 0.0 {
-            let c = wi.z.min(1.0);
-            for (k, o) in out.iter_mut().enumerate() {
-                *o -= self.halo.mirror_reflectance(k, c) * self.halo.loss(k, c);
-            }
-        }
+        self.halo.take_from_mirror(wi, out);
         true
     }
 
     fn terms(&self) -> Vec<Term> {
         let mut t = self.inner.terms();
-        let lobe = self.halo.lobe();
-        t.push(Term { label: lobe.label.clone(), kind: TermKind::Lobe(lobe) });
+        t.push(self.halo.term());
         t
     }
 

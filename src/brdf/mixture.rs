@@ -5,7 +5,7 @@
 //! slopes (craters, inclusions, a coarse texture) is such a surface (`docs/instrument.md` §1.10). Each
 //! population is a lobe for the planner, of its own width and tail. Every population is rough (roughness ≥
 //! [`Microfacet::SMOOTH_THRESHOLD`]; the recipe refuses a delta population).
-use super::dielectric::{describe_facets, describe_iors, describe_shadowing, Ior};
+use super::dielectric::{check_iors, describe_facets, describe_iors, describe_shadowing, Ior};
 use super::{Brdf, Kink, Lobe, Term, TermKind};
 use crate::optics::microfacet::{Microfacet, Shadowing};
 use crate::optics::slope_mixture::SlopeMixture;
@@ -25,14 +25,7 @@ impl MixtureSurface {
     /// One finite index per spectral sample; at least one population, each rough, weights in (0, 1] summing
     /// to 1 within 1e-9 (the recipe parser names the field of a violation; this is the library's check).
     pub fn new(facets: SlopeMixture, shadowing: Shadowing, ior: Vec<Ior>, sampling: Sampling) -> crate::Result<Self> {
-        let parts: Vec<f64> = ior
-            .iter()
-            .map(|i| match i {
-                Ior::Dielectric(n) => *n,
-                Ior::Conductor(c) => c.re + c.im,
-            })
-            .collect();
-        super::per_sample("index of refraction", &parts, &sampling)?;
+        check_iors(&ior, &sampling)?;
         let pops = &facets.populations;
         if pops.is_empty() {
             return Err(Error::Usage("slope mixture: no population".into()));

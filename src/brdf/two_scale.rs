@@ -16,7 +16,7 @@
 //! slopes: for slope widths far below the halo's angular width (orange peel ~0.1°, the halo ~1° and more)
 //! the convolution changes it to second order in their ratio.
 use super::halo::Halo;
-use super::{Brdf, Kink, Term, TermKind};
+use super::{Brdf, Kink, Term};
 use crate::optics::tabulated::ChebTable;
 use crate::spectrum::Sampling;
 use crate::{Error, Result, Vec3};
@@ -79,19 +79,13 @@ impl Brdf for RoughWithHalo {
         if !self.inner.delta_reflectance(wi, out) {
             return false;
         }
-        if wi.z > 0.0 {
-            let c = wi.z.min(1.0);
-            for (k, o) in out.iter_mut().enumerate() {
-                *o -= self.halo.mirror_reflectance(k, c) * self.halo.loss(k, c);
-            }
-        }
+        self.halo.take_from_mirror(wi, out);
         true
     }
 
     fn terms(&self) -> Vec<Term> {
         let mut t = self.inner.terms();
-        let lobe = self.halo.lobe();
-        t.push(Term { label: lobe.label.clone(), kind: TermKind::Lobe(lobe) });
+        t.push(self.halo.term());
         t
     }
 

@@ -173,24 +173,31 @@ impl Microfacet {
     ///
     /// Both are symmetric in (ωi, ωo) and in [0, 1].
     pub fn g(&self, wi: Vec3, wo: Vec3, h: Vec3, shadowing: Shadowing) -> f64 {
-        let len = h.length();
-        if !positive(len) || !positive(wi.z) || !positive(wo.z) {
-            return 0.0;
-        }
-        let h = h / len;
-        let (ih, oh) = (wi.dot(h), wo.dot(h));
-        if !positive(ih) || !positive(oh) {
-            return 0.0;
-        }
-        match shadowing {
-            // Λi + Λo first: IEEE addition is commutative, so G is bitwise symmetric.
-            Shadowing::SmithHeightCorrelated => 1.0 / (1.0 + (self.lambda_in_g(wi) + self.lambda_in_g(wo))),
-            // Multiplication is commutative in IEEE arithmetic too: bitwise symmetric.
-            Shadowing::SmithSeparable => 1.0 / ((1.0 + self.lambda_in_g(wi)) * (1.0 + self.lambda_in_g(wo))),
-            Shadowing::VCavity => {
-                let k = 2.0 * h.z;
-                (k * wo.z / oh).min(k * wi.z / ih).min(1.0)
-            }
+        g_with_lambda(wi, wo, h, shadowing, |w| self.lambda_in_g(w))
+    }
+}
+
+/// G(ωi, ωo) for the half vector `h` from a Λ as it enters G ([`Microfacet::g`]'s forms; a slope mixture
+/// passes its Λ = Σ wᵢ Λᵢ, docs/optics.md §4.1). The V-cavity form does not use Λ.
+#[inline]
+pub fn g_with_lambda(wi: Vec3, wo: Vec3, h: Vec3, shadowing: Shadowing, lambda: impl Fn(Vec3) -> f64) -> f64 {
+    let len = h.length();
+    if !positive(len) || !positive(wi.z) || !positive(wo.z) {
+        return 0.0;
+    }
+    let h = h / len;
+    let (ih, oh) = (wi.dot(h), wo.dot(h));
+    if !positive(ih) || !positive(oh) {
+        return 0.0;
+    }
+    match shadowing {
+        // Λi + Λo first: IEEE addition is commutative, so G is bitwise symmetric.
+        Shadowing::SmithHeightCorrelated => 1.0 / (1.0 + (lambda(wi) + lambda(wo))),
+        // Multiplication is commutative in IEEE arithmetic too: bitwise symmetric.
+        Shadowing::SmithSeparable => 1.0 / ((1.0 + lambda(wi)) * (1.0 + lambda(wo))),
+        Shadowing::VCavity => {
+            let k = 2.0 * h.z;
+            (k * wo.z / oh).min(k * wi.z / ih).min(1.0)
         }
     }
 }

@@ -7,7 +7,7 @@
 //! ω's azimuth, itself linear in P₂₂), so the mixture's Λ is Σ wᵢ Λᵢ exactly, and the masking-shadowing of
 //! the mixture is the project's one-population form with that Λ (Heitz 2014 Eqs. 98–99). Derivation:
 //! `docs/optics.md` §4.1.
-use super::microfacet::{Microfacet, Shadowing};
+use super::microfacet::{g_with_lambda, Microfacet, Shadowing};
 use crate::Vec3;
 
 /// Weighted slope populations (weights in (0, 1], summing to 1; the caller checks).
@@ -36,23 +36,7 @@ impl SlopeMixture {
     /// G(ωi, ωo) for the half vector `h`, as `Microfacet::g` with the mixture's Λ (the V-cavity G does not
     /// depend on the distribution). Symmetric in (ωi, ωo) bit for bit, in [0, 1].
     pub fn g(&self, wi: Vec3, wo: Vec3, h: Vec3, shadowing: Shadowing) -> f64 {
-        let len = h.length();
-        if !(len > 0.0) || !(wi.z > 0.0) || !(wo.z > 0.0) {
-            return 0.0;
-        }
-        let h = h / len;
-        let (ih, oh) = (wi.dot(h), wo.dot(h));
-        if !(ih > 0.0) || !(oh > 0.0) {
-            return 0.0;
-        }
-        match shadowing {
-            Shadowing::SmithHeightCorrelated => 1.0 / (1.0 + (self.lambda_in_g(wi) + self.lambda_in_g(wo))),
-            Shadowing::SmithSeparable => 1.0 / ((1.0 + self.lambda_in_g(wi)) * (1.0 + self.lambda_in_g(wo))),
-            Shadowing::VCavity => {
-                let k = 2.0 * h.z;
-                (k * wo.z / oh).min(k * wi.z / ih).min(1.0)
-            }
-        }
+        g_with_lambda(wi, wo, h, shadowing, |w| self.lambda_in_g(w))
     }
 }
 
