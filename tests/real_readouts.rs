@@ -6,6 +6,23 @@ use std::process::Command;
 
 use serde_json::Value;
 
+/// The orange-peel panel's readout as printed (`fixtures/real/konica-orange-peel-panel.csv`), its haze read as
+/// log haze (docs/instrument.md §1.10).
+const PANEL_TARGETS: [&str; 12] = [
+    "--target",
+    "astm-d523-20/gloss=66.3",
+    "--target",
+    "astm-d523-60/gloss=88.3",
+    "--target",
+    "astm-d523-85/gloss=94.0",
+    "--target",
+    "rhopoint-iq-20/log-haze=14.2",
+    "--target",
+    "rhopoint-iq-20/doi=77.5",
+    "--target",
+    "rhopoint-iq-20/rspec=26.1",
+];
+
 fn fit(args: &[&str]) -> (i32, Value, String) {
     let out = Command::new(env!("CARGO_BIN_EXE_glossmeter"))
         .arg("fit")
@@ -70,26 +87,18 @@ fn the_orange_peel_panel_is_not_reproduced_and_the_85_degree_gloss_is_why() {
     // the next test): one slope scale with a halo must say it cannot reproduce the readings (exit 1) and name
     // 85° gloss as the largest residual.
     let (code, doc, err) = fit(&[
-        "fixtures/real/models/panel-two-scale.json",
-        "--target",
-        "astm-d523-20/gloss=66.3",
-        "--target",
-        "astm-d523-60/gloss=88.3",
-        "--target",
-        "astm-d523-85/gloss=94.0",
-        "--target",
-        "rhopoint-iq-20/log-haze=14.2",
-        "--target",
-        "rhopoint-iq-20/doi=77.5",
-        "--target",
-        "rhopoint-iq-20/rspec=26.1",
-        "--free",
-        "/roughness=log:1e-4..0.02",
-        "--free",
-        "/ior=1.3..1.8",
-        "--free",
-        "/scatter/correlation_length_um=log:0.3..100",
-    ]);
+        &["fixtures/real/models/panel-two-scale.json"][..],
+        &PANEL_TARGETS,
+        &[
+            "--free",
+            "/roughness=log:1e-4..0.02",
+            "--free",
+            "/ior=1.3..1.8",
+            "--free",
+            "/scatter/correlation_length_um=log:0.3..100",
+        ],
+    ]
+    .concat());
     assert_eq!(code, 1, "{err}");
     assert_eq!(doc["reproduces"], false);
     let targets = doc["targets"].as_array().unwrap();
@@ -112,30 +121,22 @@ fn the_orange_peel_panel_is_not_reproduced_and_the_85_degree_gloss_is_why() {
 #[test]
 fn the_orange_peel_panel_is_a_lacquer_of_three_slope_populations() {
     let (code, doc, err) = fit(&[
-        "fixtures/real/models/panel-three-populations.json",
-        "--target",
-        "astm-d523-20/gloss=66.3",
-        "--target",
-        "astm-d523-60/gloss=88.3",
-        "--target",
-        "astm-d523-85/gloss=94.0",
-        "--target",
-        "rhopoint-iq-20/log-haze=14.2",
-        "--target",
-        "rhopoint-iq-20/doi=77.5",
-        "--target",
-        "rhopoint-iq-20/rspec=26.1",
-        "--free",
-        "/ior=1.3..1.8",
-        "--free",
-        "/populations/1/roughness=log:1e-3..0.05",
-        "--free",
-        "/populations/1/weight=0.001..0.7",
-        "--free",
-        "/populations/2/roughness=log:0.01..0.5",
-        "--free",
-        "/populations/2/weight=0.001..0.5",
-    ]);
+        &["fixtures/real/models/panel-three-populations.json"][..],
+        &PANEL_TARGETS,
+        &[
+            "--free",
+            "/ior=1.3..1.8",
+            "--free",
+            "/populations/1/roughness=log:1e-3..0.05",
+            "--free",
+            "/populations/1/weight=0.001..0.7",
+            "--free",
+            "/populations/2/roughness=log:0.01..0.5",
+            "--free",
+            "/populations/2/weight=0.001..0.5",
+        ],
+    ]
+    .concat());
     assert_eq!(code, 0, "{err}");
     check(&doc, 6);
     let p = doc["parameters"].as_array().unwrap();
