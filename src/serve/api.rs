@@ -360,7 +360,7 @@ pub fn run_sweep(s: &Sweep, mut line: impl FnMut(String) -> Result<()>) -> Resul
 }
 
 /// The sheet of a request: `{"name": …, "base64": …}` (any file `compare` reads) or `{"name": …, "text": …}`,
-/// read by the same code as `compare`'s files (`comparison::sheet::parse_bytes`); `name` names it in
+/// read by the same code as `compare`'s files (`comparison::sheet::from_bytes`: text or workbook); `name` names it in
 /// messages and nothing is written to disk.
 fn sheet(o: &Obj) -> Result<Sheet> {
     let s = o.obj("sheet")?;
@@ -381,7 +381,7 @@ fn sheet(o: &Obj) -> Result<Sheet> {
         ignore_columns: strings(o, "ignore_columns")?,
         sheet_name: o.opt_str("sheet_name")?.map(str::to_owned),
     };
-    sheet::parse_bytes(&bytes, &name, &options)
+    sheet::from_bytes(&bytes, &name, &options)
 }
 
 fn parse_delimiter(s: &str) -> std::result::Result<u8, String> {
