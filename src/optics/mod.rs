@@ -21,6 +21,9 @@
 //!   masking of the mixture, Λ = Σ wᵢ Λᵢ ([`slope_mixture::SlopeMixture`]);
 //! * `scatter.rs`: smooth-surface (Rayleigh–Rice) scatter from a surface PSD, K-correlation or Gaussian
 //!   ([`scatter::Psd`], [`scatter::rayleigh_rice`], [`scatter::polarisation_factor`]);
+//! * `levelling.rs` (on the quadrature's Gauss–Legendre rule): the levelling of an applied texture by surface tension
+//!   as the film dries, Orchard's rate integrated over a rising viscosity and a thinning film, and the cured
+//!   PSD's transfer ([`levelling::Application`], [`levelling::psd_transfer`]);
 //! * `tabulated.rs`: piecewise Chebyshev tables of smooth functions of one variable, accepted only with their
 //!   error verified when built ([`tabulated::ChebTable`]; the node and basis helpers the coat-albedo table uses);
 //! * `coat_albedo.rs`: the directional albedo E(μ) of a rough coat's lobe and its mean Ē
@@ -29,6 +32,7 @@
 pub mod coat_albedo;
 pub mod fresnel;
 pub mod kubelka_munk;
+pub mod levelling;
 pub mod microfacet;
 pub mod scatter;
 pub mod slope_mixture;

@@ -1,0 +1,292 @@
+//! Levelling of a wet film's surface texture by surface tension, from application to cure: the linearised
+//! thin-film (lubrication) equation with a viscosity that rises and a film that thins as solvent leaves.
+//! Formulas, assumptions and sources: `docs/model.md` §Levelling of the applied texture.
+//!
+//! Units: lengths in µm, spatial frequencies in 1/µm, times in s, viscosities in Pa·s, surface tension in
+//! mN/m; the levelling integral L in µm⁴.
+//!
+//! * A sinusoid of wavelength Λ (spatial frequency f = 1/Λ) on a film of thickness h ≪ Λ decays at the rate
+//!   r = γ h³ k⁴/(3η), k = 2πf, i.e. 16π⁴γh³/(3ηΛ⁴) (Orchard 1962);
+//! * with h(t) and η(t) changing slowly against that decay, the mode equation da/dt = −r(t)·a integrates to
+//!   a(T)/a(0) = exp(−(16π⁴/3)·f⁴·L), L = ∫₀ᵀ γ h(t)³/η(t) dt (the levelling integral);
+//! * the dry film keeps the resin: with the solids spread evenly through the film's depth (no
+//!   surface-tension gradients), a texture frozen at the end of flow dries to `volume_solids` of its wet
+//!   amplitude, so the cured PSD is S_cured(f) = v²·S_applied(f)·exp(−(32π⁴/3)·f⁴·L).
+use crate::quadrature::gauss_legendre;
+use std::f64::consts::PI;
+
+/// One point of the film's viscosity against time since application.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ViscosityPoint {
+    /// Time since application, s.
+    pub t_s: f64,
+    /// Viscosity of the wet film at that time, Pa·s.
+    pub eta_pa_s: f64,
+}
+
+/// How a film was applied and how it dried: what a formulator controls.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Application {
+    /// Wet film thickness as applied, µm.
+    pub wet_film_um: f64,
+    /// Volume solids v in (0, 1]: dry thickness = v × wet thickness.
+    pub volume_solids: f64,
+    /// Surface tension of the wet film, mN/m.
+    pub surface_tension_mn_m: f64,
+    /// Flash-off time, s: the solvent leaves at a constant rate over it (the drying's constant-rate period),
+    /// so the thickness falls linearly from wet to dry; after it the film has its dry thickness.
+    pub flash_off_s: f64,
+    /// The viscosity against time, from t = 0, times increasing, viscosities not decreasing; between points
+    /// ln η is linear in t. The last point ends the flow (the gel point, or the end of the open time).
+    pub viscosity: Vec<ViscosityPoint>,
+}
+
+/// Gauss–Legendre points per sub-interval of the levelling integral. On a sub-interval the integrand is a
+/// cubic in t times exp(−b t) with |b|·Δt ≤ 1 (`MAX_LOG_STEP`), which 16 points integrate to rounding.
+const NODES: usize = 16;
+/// The largest change of ln η across one sub-interval of the levelling integral.
+const MAX_LOG_STEP: f64 = 1.0;
+/// The most sub-intervals the levelling integral may use (a viscosity table spanning e^4096 in one step is
+/// refused before it gets here; real tables use tens).
+const MAX_PIECES: usize = 100_000;
+
+impl Application {
+    /// Check every field, naming it and what is allowed.
+    pub fn validate(&self) -> Result<(), String> {
+        let positive = |name: &str, v: f64, unit: &str| -> Result<(), String> {
+            if !(v > 0.0) || !v.is_finite() {
+                return Err(format!("{name}: must be a finite number > 0 {unit} (got {v})"));
+            }
+            Ok(())
+        };
+        positive("wet_film_um", self.wet_film_um, "µm")?;
+        if !(self.wet_film_um <= 10_000.0) {
+            return Err(format!("wet_film_um: at most 10 000 µm (got {})", self.wet_film_um));
+        }
+        if !(self.volume_solids > 0.0 && self.volume_solids <= 1.0) {
+            return Err(format!("volume_solids: must be in (0, 1] (got {})", self.volume_solids));
+        }
+        positive("surface_tension_mn_m", self.surface_tension_mn_m, "mN/m")?;
+        if !(self.flash_off_s >= 0.0) || !self.flash_off_s.is_finite() {
+            return Err(format!("flash_off_s: must be a finite number ≥ 0 s (got {})", self.flash_off_s));
+        }
+        if self.viscosity.is_empty() {
+            return Err("viscosity: needs at least one point {t_s, eta_pa_s}".into());
+        }
+        let mut log_span = 0.0;
+        for (i, p) in self.viscosity.iter().enumerate() {
+            positive(&format!("viscosity/{i}/eta_pa_s"), p.eta_pa_s, "Pa·s")?;
+            if !(p.t_s >= 0.0) || !p.t_s.is_finite() {
+                return Err(format!("viscosity/{i}/t_s: must be a finite number ≥ 0 s (got {})", p.t_s));
+            }
+            if i == 0 && p.t_s != 0.0 {
+                return Err(format!("viscosity/0/t_s: the table starts at application, t = 0 s (got {})", p.t_s));
+            }
+            if i > 0 {
+                let q = self.viscosity[i - 1];
+                if !(p.t_s > q.t_s) {
+                    return Err(format!("viscosity/{i}/t_s: times must increase (got {} after {})", p.t_s, q.t_s));
+                }
+                if p.eta_pa_s < q.eta_pa_s {
+                    return Err(format!(
+                        "viscosity/{i}/eta_pa_s: a drying film's viscosity does not fall (got {} after {} Pa·s)",
+                        p.eta_pa_s, q.eta_pa_s
+                    ));
+                }
+                log_span += (p.eta_pa_s / q.eta_pa_s).ln();
+            }
+        }
+        if log_span / MAX_LOG_STEP > MAX_PIECES as f64 / 2.0 {
+            return Err(format!("viscosity: rises by e^{log_span:.0}, beyond what the model resolves (e^50 000)"));
+        }
+        Ok(())
+    }
+
+    /// Dry film thickness, µm: v × wet.
+    pub fn dry_film_um(&self) -> f64 {
+        self.volume_solids * self.wet_film_um
+    }
+
+    /// The time flow ends, s: the viscosity table's last time.
+    pub fn end_of_flow_s(&self) -> f64 {
+        self.viscosity.last().map_or(0.0, |p| p.t_s)
+    }
+
+    /// Film thickness at time t, µm: linear from wet to dry over the flash-off, dry after it.
+    pub fn thickness_um(&self, t: f64) -> f64 {
+        let dry = self.dry_film_um();
+        if self.flash_off_s <= 0.0 || t >= self.flash_off_s {
+            return dry;
+        }
+        self.wet_film_um + (dry - self.wet_film_um) * (t / self.flash_off_s).max(0.0)
+    }
+
+    /// Viscosity at time t, Pa·s: ln η linear between the table's points, its ends held beyond them.
+    pub fn viscosity_pa_s(&self, t: f64) -> f64 {
+        let v = &self.viscosity;
+        if t <= v[0].t_s {
+            return v[0].eta_pa_s;
+        }
+        for w in v.windows(2) {
+            if t <= w[1].t_s {
+                let s = (t - w[0].t_s) / (w[1].t_s - w[0].t_s);
+                return (w[0].eta_pa_s.ln() * (1.0 - s) + w[1].eta_pa_s.ln() * s).exp();
+            }
+        }
+        v[v.len() - 1].eta_pa_s
+    }
+
+    /// The levelling integral L = ∫₀ᵀ γ h³/η dt in µm⁴, T the end of flow.
+    ///
+    /// The breakpoints (the table's times and the end of the flash-off) cut [0, T] into intervals on which h
+    /// is linear and ln η linear; each is split so that ln η changes by at most `MAX_LOG_STEP` per piece, and
+    /// each piece takes `NODES` Gauss–Legendre points. γ/η in (N/m)/(Pa·s) = m/s, times h³ in µm³ and dt in
+    /// s, is 10⁶ µm⁴ per unit.
+    pub fn levelling_integral_um4(&self) -> f64 {
+        let end = self.end_of_flow_s();
+        let mut cuts: Vec<f64> = self.viscosity.iter().map(|p| p.t_s).collect();
+        if self.flash_off_s > 0.0 && self.flash_off_s < end {
+            cuts.push(self.flash_off_s);
+        }
+        cuts.sort_by(f64::total_cmp);
+        cuts.dedup();
+        let (x, w) = gauss_legendre(NODES);
+        let gamma = self.surface_tension_mn_m * 1e-3;
+        let mut sum = 0.0;
+        for pair in cuts.windows(2) {
+            let (a, b) = (pair[0], pair[1]);
+            let rise = (self.viscosity_pa_s(b) / self.viscosity_pa_s(a)).ln().abs();
+            let pieces = ((rise / MAX_LOG_STEP).ceil() as usize).clamp(1, MAX_PIECES);
+            let step = (b - a) / pieces as f64;
+            for k in 0..pieces {
+                let (lo, hi) = (a + k as f64 * step, a + (k + 1) as f64 * step);
+                let (mid, half) = (0.5 * (lo + hi), 0.5 * (hi - lo));
+                for (xi, wi) in x.iter().zip(&w) {
+                    let t = mid + half * xi;
+                    sum += wi * half * gamma * self.thickness_um(t).powi(3) / self.viscosity_pa_s(t);
+                }
+            }
+        }
+        sum * 1e6
+    }
+
+    /// The wet surface's amplitude transfer at spatial frequency f (1/µm): a(T)/a(0) = exp(−(16π⁴/3) f⁴ L).
+    pub fn amplitude_transfer(&self, f_per_um: f64) -> f64 {
+        amplitude_transfer(self.levelling_integral_um4(), f_per_um)
+    }
+
+    /// The frequency (1/µm) whose amplitude the levelling takes down by 1/e: f_e = (3/(16π⁴ L))^{1/4}.
+    pub fn levelled_frequency_per_um(&self) -> f64 {
+        levelled_frequency(self.levelling_integral_um4())
+    }
+}
+
+/// exp(−(16π⁴/3) f⁴ L): the amplitude left of a mode of spatial frequency f (1/µm) after a levelling
+/// integral L (µm⁴).
+pub fn amplitude_transfer(l_um4: f64, f_per_um: f64) -> f64 {
+    (-(16.0 * PI.powi(4) / 3.0) * f_per_um.powi(4) * l_um4).exp()
+}
+
+/// (3/(16π⁴ L))^{1/4}: the spatial frequency (1/µm) levelled to 1/e of its amplitude by L (µm⁴); infinite
+/// for L = 0.
+pub fn levelled_frequency(l_um4: f64) -> f64 {
+    (3.0 / (16.0 * PI.powi(4) * l_um4)).powf(0.25)
+}
+
+/// The cured PSD's factor at spatial frequency f (1/µm): v²·exp(−(32π⁴/3) f⁴ L), for a PSD of the applied
+/// texture's heights (docs/model.md §Levelling of the applied texture).
+pub fn psd_transfer(volume_solids: f64, l_um4: f64, f_per_um: f64) -> f64 {
+    volume_solids * volume_solids * amplitude_transfer(l_um4, f_per_um).powi(2)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn film(viscosity: Vec<(f64, f64)>, flash: f64) -> Application {
+        Application {
+            wet_film_um: 60.0,
+            volume_solids: 0.5,
+            surface_tension_mn_m: 30.0,
+            flash_off_s: flash,
+            viscosity: viscosity.into_iter().map(|(t_s, eta_pa_s)| ViscosityPoint { t_s, eta_pa_s }).collect(),
+        }
+    }
+
+    #[test]
+    fn constant_viscosity_and_thickness_give_orchards_exponential() {
+        // v = 1: no thinning; η constant: L = γ h³ T/η exactly, and a(T)/a(0) = exp(−rT), r = 16π⁴γh³/(3ηΛ⁴).
+        let mut a = film(vec![(0.0, 0.5), (120.0, 0.5)], 0.0);
+        a.volume_solids = 1.0;
+        let l = a.levelling_integral_um4();
+        let exact = 30e-3 * 60f64.powi(3) * 120.0 / 0.5 * 1e6;
+        assert!((l / exact - 1.0).abs() < 1e-14, "{l} vs {exact}");
+        let lambda_um = 5000.0; // r·T ≈ 1.3
+        let rate = 16.0 * PI.powi(4) * 30e-3 * (60e-6f64).powi(3) / (3.0 * 0.5 * (lambda_um * 1e-6f64).powi(4));
+        let got = a.amplitude_transfer(1.0 / lambda_um);
+        assert!((got / (-rate * 120.0).exp() - 1.0).abs() < 1e-12, "{got} vs {}", (-rate * 120.0).exp());
+    }
+
+    #[test]
+    fn exponential_viscosity_rise_integrates_in_closed_form() {
+        // η = η0·e^{t/τ} from 0 to T at constant h (v = 1): L = γh³τ(1 − e^{−T/τ})/η0 — the table's log-linear
+        // interpolation is exact for this η, over a rise of e^12 in one interval.
+        let (eta0, tau, t_end) = (0.2, 30.0, 360.0);
+        let mut a = film(vec![(0.0, eta0), (t_end, eta0 * (t_end / tau).exp())], 0.0);
+        a.volume_solids = 1.0;
+        let exact = 30e-3 * 60f64.powi(3) * tau * (1.0 - (-t_end / tau).exp()) / eta0 * 1e6;
+        let l = a.levelling_integral_um4();
+        assert!((l / exact - 1.0).abs() < 1e-13, "{l} vs {exact}");
+    }
+
+    #[test]
+    fn linear_thinning_integrates_the_cube_exactly() {
+        // η constant, h from 60 to 30 µm linearly over the flash-off F, then 30 µm to T:
+        // L = γ/η·[F·(h0⁴ − h1⁴)/(4(h0 − h1)) + h1³(T − F)].
+        let a = film(vec![(0.0, 1.0), (300.0, 1.0)], 100.0);
+        let (h0, h1, f, t) = (60.0f64, 30.0f64, 100.0, 300.0);
+        let exact = 30e-3 / 1.0 * (f * (h0.powi(4) - h1.powi(4)) / (4.0 * (h0 - h1)) + h1.powi(3) * (t - f)) * 1e6;
+        let l = a.levelling_integral_um4();
+        assert!((l / exact - 1.0).abs() < 1e-13, "{l} vs {exact}");
+    }
+
+    #[test]
+    fn the_transfer_falls_with_frequency_and_rises_with_thickness() {
+        let thin = film(vec![(0.0, 0.3), (60.0, 3.0), (600.0, 300.0)], 60.0);
+        let mut thick = thin.clone();
+        thick.wet_film_um = 90.0;
+        let mut prev = 1.0;
+        for f in [1e-4, 1e-3, 2e-3, 5e-3, 1e-2] {
+            let t = thin.amplitude_transfer(f);
+            assert!(t < prev && t > 0.0 || t == 0.0, "f = {f}: {t} after {prev}");
+            assert!(thick.amplitude_transfer(f) <= t, "a thicker film levels more at f = {f}");
+            prev = t;
+        }
+        let fe = thin.levelled_frequency_per_um();
+        assert!((thin.amplitude_transfer(fe) - (-1f64).exp()).abs() < 1e-12);
+    }
+
+    #[test]
+    fn bad_applications_name_the_field() {
+        let good = film(vec![(0.0, 0.3), (60.0, 3.0)], 30.0);
+        assert!(good.validate().is_ok());
+        let mut a = good.clone();
+        a.wet_film_um = -1.0;
+        assert!(a.validate().unwrap_err().starts_with("wet_film_um"));
+        let mut a = good.clone();
+        a.volume_solids = 0.0;
+        assert!(a.validate().unwrap_err().starts_with("volume_solids"));
+        let mut a = good.clone();
+        a.surface_tension_mn_m = f64::NAN;
+        assert!(a.validate().unwrap_err().starts_with("surface_tension_mn_m"));
+        let mut a = good.clone();
+        a.viscosity[1].eta_pa_s = 0.1;
+        assert!(a.validate().unwrap_err().starts_with("viscosity/1/eta_pa_s"), "{:?}", a.validate());
+        let mut a = good.clone();
+        a.viscosity[1].t_s = 0.0;
+        assert!(a.validate().unwrap_err().starts_with("viscosity/1/t_s"));
+        let mut a = good;
+        a.viscosity[0].t_s = 5.0;
+        assert!(a.validate().unwrap_err().starts_with("viscosity/0/t_s"));
+    }
+}
