@@ -9,9 +9,9 @@ use super::common::{pad_table, Format};
 use super::output::OutputTarget;
 use super::plot;
 use crate::instrument::convergence::{self, ReferenceKind, Sweep};
-use crate::request::ConvergenceRequest;
 use crate::recipe::{self, Material};
 use crate::report::plain;
+use crate::request::ConvergenceRequest;
 use crate::{Error, Result};
 
 /// The geometries swept when none is given.

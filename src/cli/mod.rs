@@ -39,8 +39,8 @@ pub mod profile;
 pub mod progress;
 pub mod sweep;
 
-use args::{Cli, Command, OutputSchema};
 use crate::request::PlanRequest;
+use args::{Cli, Command, OutputSchema};
 use common::{readings_status, Format};
 use output::{print, OutputTarget, STDOUT};
 

@@ -11,10 +11,10 @@ use serde_json::json;
 use super::common::readings_status;
 use super::output::OutputTarget;
 use super::plot::plot_err;
-use crate::request::{PlanRequest, ProfileRequest};
 use crate::instrument::profile::{self, Profile};
 use crate::recipe::{self, Material};
 use crate::report::plain;
+use crate::request::{PlanRequest, ProfileRequest};
 use crate::{Error, Result};
 
 /// The geometry profiled when none is given.

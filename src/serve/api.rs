@@ -11,8 +11,8 @@ use serde_json::{json, Value};
 
 use super::security::{table_path, Limits};
 use crate::colorimetry::{Illuminant, Observer};
-use crate::comparison::sheet::{self, Sheet};
 use crate::comparison;
+use crate::comparison::sheet::{self, Sheet};
 use crate::fit::{self, FitOptions};
 use crate::input::json::{kind, parse_json, Obj};
 use crate::instrument::plan::{Plan, PlanOptions, DEFAULT_RTOL};
@@ -247,7 +247,6 @@ pub fn explain(req: &Request, ctx: Context) -> Result<Reply> {
         "plan": plan.explain(),
     })))
 }
-
 
 /// `POST /api/plot`: an SVG picture drawn by the command line's code: `kind` `section` (the in-plane BRDF
 /// section with the apertures, `plot --kind section`), `profile` (the goniophotometric profile of
