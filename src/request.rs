@@ -253,7 +253,8 @@ impl VsParameterRequest {
         let label = parameter_label(&s.template, &pointer);
         let mut series: Vec<(String, Vec<(f64, f64)>)> = Vec::new();
         s.run(0..s.len(), |r| {
-            let readings = r.outcome.map_err(|why| Error::argument("vary", format!(" {pointer} = {}: {why}", r.values[0])))?;
+            let readings =
+                r.outcome.map_err(|why| Error::argument("vary", format!(" {pointer} = {}: {why}", r.values[0])))?;
             for reading in readings {
                 let label = format!("{} {} ({})", reading.geometry, reading.name, reading.unit);
                 let Some(v) = reading.value else { continue };
@@ -352,8 +353,7 @@ impl Default for ConvergenceRequest {
 impl ConvergenceRequest {
     /// The tolerances and the sweep's options, checked before the (possibly long) sweep.
     pub fn options(&self) -> Result<(Vec<f64>, SweepOptions)> {
-        let tolerances =
-            if self.tolerances.is_empty() { DEFAULT_TOLERANCES.to_vec() } else { self.tolerances.clone() };
+        let tolerances = if self.tolerances.is_empty() { DEFAULT_TOLERANCES.to_vec() } else { self.tolerances.clone() };
         convergence::validate_tolerances(&tolerances).map_err(|e| Error::argument("tolerances", format!(": {e}")))?;
         if !(self.min_time_ms.is_finite() && self.min_time_ms >= 0.0) {
             return Err(Error::argument(
@@ -495,6 +495,21 @@ impl FitRequest {
             None => Ok((self.targets.iter().map(|t| TargetReading::parse(t)).collect::<Result<_>>()?, vec![])),
         }
     }
+}
+
+/// `serve`: where the server listens and what it may read (the command line's `glossmeter serve`).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ServeRequest {
+    /// The port (0: any free port).
+    pub port: u16,
+    /// The address to listen on.
+    pub host: String,
+    /// The directory recipes may name table files in (None: no table file is read).
+    pub data_dir: Option<std::path::PathBuf>,
+    /// Other names the server answers to in the Host header.
+    pub allow_hosts: Vec<String>,
+    /// Computations running at once.
+    pub jobs: usize,
 }
 
 #[cfg(test)]
