@@ -497,6 +497,21 @@ impl FitRequest {
     }
 }
 
+/// `serve`: where the server listens and what it may read (the command line's `glossmeter serve`).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ServeRequest {
+    /// The port (0: any free port).
+    pub port: u16,
+    /// The address to listen on.
+    pub host: String,
+    /// The directory recipes may name table files in (None: no table file is read).
+    pub data_dir: Option<std::path::PathBuf>,
+    /// Other names the server answers to in the Host header.
+    pub allow_hosts: Vec<String>,
+    /// Computations running at once.
+    pub jobs: usize,
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

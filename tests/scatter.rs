@@ -96,7 +96,7 @@ fn values_agree_with_the_independent_implementation() {
 
 /// Energy: the halo's hemispherical integral H (by the script's adaptive 2-D quadrature of the BRDF) against
 /// the loss R·g the mirror takes. The first-order TIS (4π σ cos θi/λ)² treats Q·cos θs as R·cos θi over the
-/// halo; docs/optics.md §Energy states the accuracy this test holds: within 0.2 % of R·g for incidence up
+/// halo; docs/optics.md §The mirror's loss and energy states the accuracy this test holds: within 0.2 % of R·g for incidence up
 /// to 20° on halos with ℓ ≥ 3 µm, within 3 % up to 60° on them, and, for every case and angle, |H − R·g| below
 /// 10⁻⁴ of the mirror R (the energy a reading can gain or lose).
 #[test]

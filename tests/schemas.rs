@@ -222,3 +222,42 @@ fn the_schemas_refuse_what_no_output_holds() {
     assert!(violations(&s, &serde_json::json!({"index": 0, "parameters": {"/a": 0.5}})).is_empty());
     assert!(!violations(&s, &serde_json::json!({"index": 0, "parameters": {"/a": "0.5"}})).is_empty());
 }
+
+#[test]
+fn profile_and_convergence_follow_their_schemas() {
+    // A profile with a value on every pixel, and one whose budget leaves pixels without one (nulls).
+    let p = schema("profile");
+    let required = |s: &Value, def: &str| -> Vec<String> {
+        s["$defs"][def]["required"].as_array().unwrap().iter().map(|v| v.as_str().unwrap().to_string()).collect()
+    };
+    assert!(required(&p, "ProfileRowDoc").contains(&"problem".to_string()), "nullable fields are written");
+    for args in [
+        &["profile", "fixtures/recipes/black-glass.json", "--format", "json"][..],
+        &["profile", "fixtures/recipes/black-glass.json", "--format", "json", "--max-total-evals", "1000"],
+    ] {
+        let (_, text) = gm(args);
+        let v: Value = serde_json::from_str(&text).unwrap_or_else(|e| panic!("{args:?}: {e}: {text}"));
+        assert!(v["rows"].as_array().is_some_and(|r| !r.is_empty()), "{args:?}");
+        assert_valid(&p, &v, &format!("{args:?}"));
+    }
+    // Against a closed form (Lambert) and against a reference run (glass).
+    let c = schema("convergence");
+    for recipe in ["fixtures/recipes/grey-lambert.json", "fixtures/recipes/glass-n1.5.json"] {
+        let args = [
+            "convergence",
+            recipe,
+            "-g",
+            "astm-d523-60",
+            "--tolerances",
+            "1e-3,1e-4",
+            "--format",
+            "json",
+            "--max-repetitions",
+            "1",
+        ];
+        let (code, text) = gm(&args);
+        assert_eq!(code, 0, "{args:?}");
+        let v: Value = serde_json::from_str(&text).unwrap();
+        assert_valid(&c, &v, &format!("{args:?}"));
+    }
+}

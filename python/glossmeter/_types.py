@@ -55,6 +55,8 @@ class Reading(_ReadingRequired, total=False):
     seconds: float
     problem: str
     note: str
+    #: The reading's uncertainty from its data (measured tables; absent elsewhere), in its unit.
+    data_uncertainty: float
 
 
 Readings = List[Reading]

@@ -299,10 +299,34 @@ fn describe_geometry(py: Python<'_>, id: &Bound<'_, PyAny>) -> PyResult<String> 
     guarded(|| Ok(stds::describe(&load_geometry(py, id, "id")?)))
 }
 
-/// schema() -> dict: the JSON Schema of the recipe format (`glossmeter schema`).
+/// schema(output_format=None) -> dict: the JSON Schema of the recipe format (`glossmeter schema`), or of an
+/// output, "measure", "compare", "sweep" or "fit" (`glossmeter schema --output-format …`).
 #[pyfunction]
-fn schema(py: Python<'_>) -> PyResult<Bound<'_, PyAny>> {
-    guarded(|| from_json(py, &recipe::schema::schema()))
+#[pyo3(signature = (output_format=None))]
+fn schema<'py>(py: Python<'py>, output_format: Option<&str>) -> PyResult<Bound<'py, PyAny>> {
+    guarded(|| {
+        let schema = match output_format {
+            None => recipe::schema::schema(),
+            Some("measure") => report::schema::measure(),
+            Some("compare") => report::schema::compare(),
+            Some("sweep") => report::schema::sweep(),
+            Some("fit") => report::schema::fit(),
+            Some(other) => {
+                return Err(PyValueError::new_err(format!(
+                    "output_format: unknown output {other:?}; allowed: \"measure\", \"compare\", \"sweep\", \"fit\""
+                )))
+            }
+        };
+        from_json(py, &schema)
+    })
+}
+
+/// _cli(argv) -> int: the command line (`glossmeter::cli::run`, the binary's own code) on `argv` (`argv[0]` the
+/// program's name); returns its exit status. The wheel's console command `glossmeter` calls it
+/// (`glossmeter/_cli.py`), so a pip user runs every command without Rust; `serve` needs the binary.
+#[pyfunction]
+fn _cli(py: Python<'_>, argv: Vec<String>) -> i32 {
+    py.detach(|| glossmeter::cli::run(argv))
 }
 
 /// describe(recipe) -> str: the one-line description of the model a recipe builds.
@@ -325,6 +349,7 @@ fn _glossmeter(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(describe_geometry, m)?)?;
     m.add_function(wrap_pyfunction!(schema, m)?)?;
     m.add_function(wrap_pyfunction!(describe, m)?)?;
+    m.add_function(wrap_pyfunction!(_cli, m)?)?;
     m.add_function(wrap_pyfunction!(_panic, m)?)?;
     m.add_function(wrap_pyfunction!(pybrdf::measure_brdf, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;

@@ -229,7 +229,7 @@ pub trait Brdf: Send + Sync + std::fmt::Debug {
     /// a tabulated factor of one direction changes piece or is held constant (the rough coat's E(μ),
     /// `optics::coat_albedo`), so that its value or derivative jumps by more than rounding. Sorted, in (0, 1);
     /// none by default. The directional albedo (`brdf::albedo`) puts them on its panel boundaries: a
-    /// Gauss–Kronrod panel across a seam underestimates its own error (docs/accuracy.md §Sphere readings).
+    /// Gauss–Kronrod panel across a seam underestimates its own error (docs/accuracy.md §The estimate property, over generated recipes).
     fn seams(&self) -> Vec<f64> {
         Vec::new()
     }

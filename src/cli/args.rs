@@ -27,6 +27,8 @@ pub enum OutputSchema {
     Compare,
     Sweep,
     Fit,
+    Profile,
+    Convergence,
 }
 
 #[derive(Subcommand, Debug)]
@@ -87,7 +89,8 @@ pub enum Command {
         /// A geometry id.
         id: Option<String>,
     },
-    /// Print the JSON Schema of the recipe format, or of an output (`--output-format measure|compare|sweep|fit`).
+    /// Print the JSON Schema of the recipe format, or of an output (`--output-format
+    /// measure|compare|sweep|fit|profile|convergence`).
     Schema {
         #[arg(long, value_enum)]
         output_format: Option<OutputSchema>,
@@ -110,6 +113,19 @@ pub enum Command {
     /// serves until stopped.
     #[cfg(feature = "serve")]
     Serve(ServeArgs),
+}
+
+impl ServeArgs {
+    /// The request of a command line (the server, `glossmeter::serve`, takes it from the binary).
+    pub fn request(&self) -> crate::request::ServeRequest {
+        crate::request::ServeRequest {
+            port: self.port,
+            host: self.host.clone(),
+            data_dir: self.data_dir.clone(),
+            allow_hosts: self.allow_hosts.clone(),
+            jobs: self.jobs,
+        }
+    }
 }
 
 /// The arguments of `glossmeter serve` (the server is `glossmeter::serve`, wired in by the binary).

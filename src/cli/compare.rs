@@ -6,11 +6,11 @@
 use std::path::PathBuf;
 
 use crate::cli::common::{pad_table, readings_status, ColourArgs};
-use crate::cli::junit;
 use crate::cli::output::OutputTarget;
 use crate::comparison::sheet::{self, Sheet};
 use crate::comparison::{self, ColourDifference, Comparison, Drift, Recipes, Verdict, VerdictRule};
 use crate::report;
+use crate::report::junit;
 use crate::request::{CompareRequest, SheetRequest};
 use crate::{Error, Result};
 

@@ -3,8 +3,6 @@
 //! time (SVG). The computation is `instrument::convergence::sweep`; this module parses, formats and writes.
 use std::path::PathBuf;
 
-use serde_json::json;
-
 use super::common::{pad_table, Format};
 use super::output::OutputTarget;
 use super::plot;
@@ -218,49 +216,5 @@ pub fn csv(sweep: &Sweep) -> Result<String> {
 
 /// JSON: the sweep's settings and one object per row (null where there is no value).
 pub fn json(material: &Material, sweep: &Sweep) -> String {
-    let rows: Vec<serde_json::Value> = sweep
-        .rows
-        .iter()
-        .map(|r| {
-            json!({
-                "rtol": r.rtol,
-                "geometry": r.geometry,
-                "reading": r.reading,
-                "quantity": r.quantity,
-                "unit": r.unit,
-                "value": r.value,
-                "error_estimate": r.error_estimate,
-                "actual_error": r.actual_error,
-                "reference": r.reference,
-                "reference_error": r.reference_error,
-                "reference_kind": r.reference_kind,
-                "evaluations": r.evaluations,
-                "seconds": r.seconds,
-                "plan_seconds": r.plan_seconds,
-                "repetitions": r.repetitions,
-                "converged": r.converged,
-                "problem": r.problem,
-            })
-        })
-        .collect();
-    let reference = match &sweep.reference {
-        ReferenceKind::ClosedForm => json!({"kind": "closed form", "rtol": null, "seconds": null}),
-        ReferenceKind::Run { rtol } => {
-            json!({"kind": sweep.reference.label(), "rtol": rtol, "seconds": sweep.reference_seconds})
-        }
-    };
-    let doc = json!({
-        "material": {"name": material.name, "file": material.file, "model": material.brdf.describe()},
-        "tolerances": sweep.tolerances,
-        "reference": reference,
-        "timing": {
-            "statistic": "minimum over repeated executions",
-            "min_seconds": sweep.options.min_seconds,
-            "max_repetitions": sweep.options.max_repetitions,
-        },
-        "rows": rows,
-    });
-    let mut s = serde_json::to_string_pretty(&doc).expect("finite values serialise");
-    s.push('\n');
-    s
+    crate::report::convergence::ConvergenceDoc::new(material, sweep).text()
 }

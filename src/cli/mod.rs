@@ -31,7 +31,6 @@ pub mod compare;
 pub mod convergence;
 pub mod fit;
 pub mod format;
-pub mod junit;
 pub mod output;
 pub mod pictures;
 pub mod plot;
@@ -55,7 +54,7 @@ where
 }
 
 /// The server of `glossmeter serve`, given by the caller ([`run_with`]).
-pub type Serve<'a> = &'a dyn Fn(&args::ServeArgs) -> Result<()>;
+pub type Serve<'a> = &'a dyn Fn(&crate::request::ServeRequest) -> Result<()>;
 
 /// Run the CLI with `serve` as the server of `glossmeter serve`; returns the process exit status.
 pub fn run_with<I, T>(args: I, serve: Serve) -> i32
@@ -220,7 +219,7 @@ fn dispatch(cli: Cli, #[allow(unused_variables)] serve: Serve) -> Result<()> {
         Command::Profile(args) => profile::run(args),
         Command::Sweep(args) => sweep::run(args),
         #[cfg(feature = "serve")]
-        Command::Serve(args) => serve(&args),
+        Command::Serve(args) => serve(&args.request()),
         Command::Schema { output_format } => {
             let schema = match output_format {
                 None => recipe::schema::schema(),
@@ -228,6 +227,8 @@ fn dispatch(cli: Cli, #[allow(unused_variables)] serve: Serve) -> Result<()> {
                 Some(OutputSchema::Compare) => crate::report::schema::compare(),
                 Some(OutputSchema::Sweep) => crate::report::schema::sweep(),
                 Some(OutputSchema::Fit) => crate::report::schema::fit(),
+                Some(OutputSchema::Profile) => crate::report::schema::profile(),
+                Some(OutputSchema::Convergence) => crate::report::schema::convergence(),
             };
             let text = serde_json::to_string_pretty(&schema)
                 .map_err(|e| Error::Numeric(format!("the schema does not serialise: {e}")))?;

@@ -4,15 +4,12 @@
 //! computation is `instrument::profile::measure`; this module parses, formats and writes.
 use std::path::PathBuf;
 
-use plotters::coord::Shift;
-use plotters::prelude::*;
-use serde_json::json;
-
 use super::common::readings_status;
 use super::output::OutputTarget;
-use super::plot::plot_err;
 use crate::instrument::profile::{self, Profile};
 use crate::recipe::{self, Material};
+use crate::report::pictures::profile::draw;
+pub use crate::report::pictures::profile::svg;
 use crate::report::plain;
 use crate::request::{PlanRequest, ProfileRequest};
 use crate::{Error, Result};
@@ -126,82 +123,7 @@ pub fn csv(p: &Profile) -> Result<String> {
     crate::report::csv_text(COLUMNS, rows)
 }
 
-/// JSON: the material, the array and one object per pixel (null where there is no value).
+/// JSON: the material, the array and one object per pixel (null where there is no value): `report::profile`.
 pub fn json(material: &Material, p: &Profile) -> String {
-    let rows: Vec<serde_json::Value> = p
-        .rows
-        .iter()
-        .map(|r| {
-            let value = r.reading.value;
-            json!({
-                "pixel": r.pixel,
-                "angle_deg": r.angle_deg,
-                "angle_half_width_deg": r.half_width_deg,
-                "value": value,
-                "error_estimate": value.map(|_| r.reading.error_estimate),
-                "unit": r.reading.unit,
-                "converged": r.reading.converged,
-                "evaluations": r.reading.evaluations,
-                "problem": r.reading.problem,
-            })
-        })
-        .collect();
-    let doc = json!({
-        "material": {"name": material.name, "file": material.file, "model": material.brdf.describe()},
-        "geometry": p.geometry,
-        "pixels": p.spec.pixels,
-        "pixel_deg": p.spec.pixel_deg,
-        "perpendicular_deg": p.spec.perpendicular.to_degrees(),
-        "normalisation": "100·Φ(specimen, pixel) / Φ(gloss standard, a pixel-sized window centred on the specular \
-                          direction): the standard reads 100 inside its source image (docs/instrument.md §1.8)",
-        "evaluations": p.rows.iter().map(|r| r.reading.evaluations).sum::<usize>(),
-        "budget": {
-            "max_evals": p.budget.per_part,
-            "max_total_evals": p.budget.total,
-            "per_part": p.part_budget,
-            "rule": "each part of each pixel's integral gets min(max_evals, max_total_evals / (2 · pixels)) \
-                     evaluations; a pixel that reaches it is not converged",
-        },
-        "rows": rows,
-    });
-    let mut s = serde_json::to_string_pretty(&doc).expect("finite values serialise");
-    s.push('\n');
-    s
-}
-
-/// Draw the profile: reading (GU) against the angle from the specular direction, one point per pixel joined
-/// by a line; pixels without a value are left out (the caption says how many).
-fn draw<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, p: &Profile, title: &str) -> Result<()> {
-    root.fill(&WHITE).map_err(plot_err)?;
-    let pts: Vec<(f64, f64)> = p.rows.iter().filter_map(|r| r.reading.value.map(|v| (r.angle_deg, v))).collect();
-    let missing = p.rows.len() - pts.len();
-    let (x0, x1) =
-        p.rows.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), r| (a.min(r.angle_deg), b.max(r.angle_deg)));
-    let (x0, x1) = if x0 < x1 { (x0, x1) } else { (x0 - 1.0, x0 + 1.0) };
-    let ymax = pts.iter().map(|(_, v)| *v).fold(0.0, f64::max);
-    let ymin = pts.iter().map(|(_, v)| *v).fold(0.0, f64::min);
-    let ymax = if ymax > ymin { ymax * 1.05 } else { ymin + 1.0 };
-    let caption = if missing > 0 { format!(" ({missing} pixels without a value left out)") } else { String::new() };
-    let mut chart = ChartBuilder::on(&root)
-        .caption(format!("{title}{caption}"), ("sans-serif", 22))
-        .margin(16)
-        .x_label_area_size(44)
-        .y_label_area_size(64)
-        .build_cartesian_2d(x0..x1, ymin..ymax)
-        .map_err(plot_err)?;
-    chart
-        .configure_mesh()
-        .x_desc("angle from the specular direction (°)")
-        .y_desc("reading (GU, standard = 100)")
-        .label_style(("sans-serif", 15))
-        .draw()
-        .map_err(plot_err)?;
-    chart.draw_series(LineSeries::new(pts.iter().copied(), BLUE.stroke_width(2))).map_err(plot_err)?;
-    root.present().map_err(plot_err)?;
-    Ok(())
-}
-
-/// The profile's picture as an SVG document in memory (the server's `/api/plot`).
-pub fn svg(p: &Profile, title: &str) -> Result<String> {
-    super::plot::to_svg((1000, 640), |root| draw(root, p, title))
+    crate::report::profile::ProfileDoc::new(material, p).text()
 }

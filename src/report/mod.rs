@@ -2,7 +2,7 @@
 //! written by the library so that every program (the command line, the Python bindings) gets the same fields.
 //! The JSON form is a contract for scripts and CI (docs/instrument.md §Output), and its schemas are beside the
 //! writers. A reading without a finite value is null in JSON and empty in CSV, with the reason: never NaN or
-//! inf. The text tables for people and the JUnit XML are the command line's (`cli::format`, `cli::junit`); the
+//! inf. The text tables for people are the command line's (`cli::format`), the JUnit XML is `junit` (feature `junit`); the
 //! command line chooses a document, prints it and writes it.
 //!
 //! The folder, a file per family of documents:
@@ -18,8 +18,14 @@
 //!   that the writers serialise ([`ReadingDoc`], [`measure::MeasureDoc`], [`compare::CompareDoc`],
 //!   [`fit::FitDoc`], ...), so a field cannot be written without being in its schema.
 pub mod compare;
+#[cfg(feature = "junit")]
+pub mod convergence;
 pub mod fit;
+pub mod junit;
 pub mod measure;
+#[cfg(feature = "pictures")]
+pub mod pictures;
+pub mod profile;
 pub mod schema;
 
 use crate::comparison::Drift;

@@ -1,6 +1,6 @@
-//! JSON Schemas (draft 2020-12) of the JSON outputs of `measure` (one recipe or many), `compare`, `fit` and
-//! the JSON lines of `sweep`: the contract that scripts and CI rely on, printed by
-//! `glossmeter schema --output-format measure|compare|sweep|fit`. Each is derived (`schemars`) from the types
+//! JSON Schemas (draft 2020-12) of the JSON outputs of `measure` (one recipe or many), `compare`, `fit`,
+//! `profile`, `convergence` and the JSON lines of `sweep`: the contract that scripts and CI rely on, printed by
+//! `glossmeter schema --output-format measure|compare|sweep|fit|profile|convergence`. Each is derived (`schemars`) from the types
 //! the writers serialise, so the schema and the output cannot drift apart: a field exists in both or in
 //! neither, and its doc comment is its description. `tests/schemas.rs` validates real outputs against them
 //! with the `jsonschema` crate.
@@ -8,8 +8,10 @@ use schemars::schema_for;
 use serde_json::Value;
 
 use super::compare::CompareDoc;
+use super::convergence::ConvergenceDoc;
 use super::fit::FitOutput;
 use super::measure::MeasureOutput;
+use super::profile::ProfileDoc;
 use super::{to_json, SweepLineDoc};
 
 /// `measure --format json`: one recipe (`material`), or many (`materials`, and `material` on each reading).
@@ -31,4 +33,14 @@ pub fn sweep() -> Value {
 /// document of a fit that could not run.
 pub fn fit() -> Value {
     to_json(&schema_for!(FitOutput))
+}
+
+/// `profile --format json`.
+pub fn profile() -> Value {
+    to_json(&schema_for!(ProfileDoc))
+}
+
+/// `convergence --format json`.
+pub fn convergence() -> Value {
+    to_json(&schema_for!(ConvergenceDoc))
 }

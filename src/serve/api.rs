@@ -1,6 +1,6 @@
-//! The server's API (docs/serve.md §API): one function per endpoint, synchronous (the server runs it on its
+//! The server's API (docs/serve.md §The API): one function per endpoint, synchronous (the server runs it on its
 //! blocking pool), JSON in and the command line's documents out, written by the same code (`crate::report`,
-//! the pictures of `cli::pictures` and `cli::profile`, the JUnit of `cli::junit`). A request is one JSON
+//! the pictures of `report::pictures`, the JUnit of `report::junit`). A request is one JSON
 //! object: the recipe (the JSON of a recipe file, under `recipe`) and the options, named as the command
 //! line's flags are (`rtol`, `geometries`, `vary`, `free`, `target`, `k`, `tolerance`, …). The recipe's text
 //! is read as sent, as `measure` reads a file, so that a reading is the same bits as `measure`'s.
@@ -209,7 +209,7 @@ fn timing(o: &Obj) -> Result<bool> {
 const MEASURE_FIELDS: &[&str] = &["recipe", "geometries", "rtol", "max_evals", "illuminant", "observer", "timing"];
 
 /// A profile's evaluation budget on this server: the command line's, each part held to the server's per-integral
-/// limit and the whole profile to ten times it (docs/serve.md §Limits).
+/// limit and the whole profile to ten times it (docs/serve.md §Safety).
 fn profile_budget(ctx: Context) -> crate::instrument::profile::Budget {
     let d = crate::instrument::profile::Budget::default();
     crate::instrument::profile::Budget {
@@ -271,16 +271,16 @@ pub fn plot(req: &Request, ctx: Context) -> Result<Reply> {
     let svg = match kind {
         "section" => {
             let geos = geometries(&o, ctx, PLOT_GEOMETRIES)?;
-            crate::cli::pictures::section_svg(&material(req, ctx)?, &geos)?
+            crate::report::pictures::charts::section_svg(&material(req, ctx)?, &geos)?
         }
         "profile" => {
             let options = plan_options(&o, ctx, DEFAULT_RTOL)?;
-            let id = o.opt_str("geometry")?.unwrap_or(crate::cli::profile::DEFAULT_GEOMETRY);
+            let id = o.opt_str("geometry")?.unwrap_or(crate::request::PROFILE_GEOMETRY);
             let g = standards::find(id).map_err(|e| o.err("geometry", e.to_string()))?;
             standards::profile::of(&g).map_err(|e| o.err("geometry", e.to_string()))?;
             let m = material(req, ctx)?;
             let prof = crate::instrument::profile::measure(m.brdf.clone(), &g, options, profile_budget(ctx))?;
-            crate::cli::profile::svg(&prof, &format!("{}: {} profile", m.name, prof.geometry))?
+            crate::report::pictures::profile::svg(&prof, &format!("{}: {} profile", m.name, prof.geometry))?
         }
         "gloss-vs-parameter" => {
             plan_options(&o, ctx, PLOT_RTOL)?;
@@ -302,7 +302,7 @@ pub fn plot(req: &Request, ctx: Context) -> Result<Reply> {
             };
             let geos = geometries(&o, ctx, PLOT_GEOMETRIES)?;
             let v = request.read(&recipe_text(req, ctx)?, RECIPE, geos).map_err(|e| at_field(&o, e))?;
-            crate::cli::pictures::vs_parameter_svg(&v.name, &v.label, v.log, &v.series)?
+            crate::report::pictures::charts::vs_parameter_svg(&v.name, &v.label, v.log, &v.series)?
         }
         other => {
             return Err(o.err(
@@ -435,7 +435,7 @@ pub fn compare(req: &Request, ctx: Context) -> Result<Reply> {
     let des = comparison::colour_differences(&mut cmp, max_de00);
     Ok(match format {
         "csv" => Reply { content_type: "text/csv; charset=utf-8", body: report::compare::csv(&cmp)? },
-        "junit" => Reply { content_type: "application/xml", body: crate::cli::junit::compare(&sheet, &cmp, &[])? },
+        "junit" => Reply { content_type: "application/xml", body: crate::report::junit::compare(&sheet, &cmp, &[])? },
         _ => Reply::json(&report::to_json(&report::compare::json_doc(&sheet, &cmp, &rule, &[], None, &des))),
     })
 }

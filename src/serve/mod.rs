@@ -22,7 +22,7 @@ use axum::routing::{get, post};
 use axum::Router;
 use tokio::sync::Semaphore;
 
-use crate::cli::args::ServeArgs;
+use crate::request::ServeRequest;
 use crate::{Error, Result};
 
 pub mod api;
@@ -147,7 +147,7 @@ impl Server {
 }
 
 /// `glossmeter serve`: bind, print the address (and a warning beyond loopback), serve until stopped.
-pub fn run_command(a: &ServeArgs) -> Result<()> {
+pub fn run_command(a: &ServeRequest) -> Result<()> {
     let limits = Limits { jobs: a.jobs, ..Limits::default() };
     let server = Server::bind(ServeOptions {
         host: a.host.clone(),
