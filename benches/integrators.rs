@@ -1150,7 +1150,7 @@ fn b5(md: &mut String) {
 /// Replace the regular rule of every specimen integral of `plan` that has one (None: keep the planner's).
 fn force_plan_rule(plan: &mut Plan, rule: Option<Rule>) {
     let Some(rule) = rule else { return };
-    for job in plan.jobs.iter_mut().filter(|j| j.method.target == Target::Specimen) {
+    for job in plan.jobs.iter_mut().filter(|j| j.method.aperture.target == Target::Specimen) {
         if let Some(part) = job.method.regular.as_mut() {
             part.rule = rule;
         }
@@ -1197,7 +1197,7 @@ fn b5_rules(md: &mut String) {
     let _ = writeln!(md, "| # | used by | rule | evaluations | est. | actual | actual / est. | what ran |");
     let _ = writeln!(md, "|---|---|---|---|---|---|---|---|");
     let plan = Plan::compile(brdf.clone(), panel(), opts).expect("plan compiles");
-    for (j, job) in plan.jobs.iter().enumerate().filter(|(_, j)| j.method.target == Target::Specimen) {
+    for (j, job) in plan.jobs.iter().enumerate().filter(|(_, j)| j.method.aperture.target == Target::Specimen) {
         let mut tight = job.method.clone();
         if let Some(p) = tight.regular.as_mut() {
             (p.rule, p.rtol, p.atol) = (Rule::GenzMalik75, 1e-4 * p.rtol, 1e-4 * p.atol);
@@ -1362,7 +1362,7 @@ fn wide_lobes(md: &mut String) {
         let mut evals = [0usize; 3];
         let mut worst = [0.0f64; 3];
         let mut n = 0;
-        for job in plan.jobs.iter().filter(|j| j.method.target == Target::Specimen) {
+        for job in plan.jobs.iter().filter(|j| j.method.aperture.target == Target::Specimen) {
             n += 1;
             let mut tight = job.method.clone();
             if let Some(p) = tight.regular.as_mut() {

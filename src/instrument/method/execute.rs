@@ -78,8 +78,8 @@ impl Method {
         (ncomp, in_material): (usize, bool),
         vars: &'a std::cell::Cell<TensorChart>,
     ) -> impl FnMut(&[[f64; 4]], &mut [f64]) + 'a {
-        let axes = Axes::new(self.theta);
-        let rec_axes = Axes::new(self.viewing);
+        let axes = Axes::new(self.aperture.theta);
+        let rec_axes = Axes::new(self.aperture.viewing);
         let ap = AxisMap { s: src.p, r: rec.p };
         let aq = AxisMap { s: src.q, r: rec.q };
         let (weighting, projection) = (&self.weighting, self.projection);
@@ -150,7 +150,8 @@ impl Method {
     /// integrand (`tests/delta_limit.rs`); empty when there is no regular part or the stops are below the
     /// horizon.
     pub fn sample_regular(&self, brdf: &dyn Brdf, pts: &[[f64; 4]]) -> Vec<f64> {
-        let (Some(part), Some(stops), Integral::Aperture) = (&self.regular, self.clipped, self.integral) else {
+        let (Some(part), Some(stops), Integral::Aperture) = (&self.regular, self.clipped, self.aperture.integral)
+        else {
             return Vec::new();
         };
         let chart = if part.chart == Chart::Plain { TensorChart::Plain } else { TensorChart::Lobe };
@@ -179,13 +180,13 @@ impl Method {
         let k = self.weighting.len();
         let n = brdf.sampling().len();
         let mut frozen = keep.then(|| self.clone());
-        if self.integral != Integral::Aperture {
+        if self.aperture.integral != Integral::Aperture {
             // A sphere's integrals: per sample, then weighted (their integrators have no partition to freeze,
             // so the frozen method is the method).
-            let r = match self.integral {
-                Integral::Hemisphere => sphere::hemisphere_reflectance(brdf, self.theta),
+            let r = match self.aperture.integral {
+                Integral::Hemisphere => sphere::hemisphere_reflectance(brdf, self.aperture.theta),
                 Integral::Port { half_angle } => {
-                    sphere::port_reflectance(brdf, self.theta, half_angle, self.rtol, self.max_evals)
+                    sphere::port_reflectance(brdf, self.aperture.theta, half_angle, self.rtol, self.max_evals)
                 }
                 Integral::Aperture => unreachable!("handled below"),
             };
@@ -202,7 +203,7 @@ impl Method {
         let Some((src, rec)) = self.clipped else {
             return (Flux::zero(k), frozen);
         };
-        let axes = Axes::new(self.theta);
+        let axes = Axes::new(self.aperture.theta);
         // The material sums the one weighted component itself when `in_material`.
         let (ncomp, in_material) = self.components(brdf);
         let weighting = &self.weighting;

@@ -22,7 +22,8 @@ impl Plan {
         let mut s = String::new();
         s.push_str(&format!("Material: {}\n", m.describe()));
         s.push_str(&format!("Spectral samples: {}\n", m.sampling().describe()));
-        let projection = self.jobs.iter().find(|j| j.method.target == Target::Specimen).map(|j| j.method.projection);
+        let projection =
+            self.jobs.iter().find(|j| j.method.aperture.target == Target::Specimen).map(|j| j.method.projection);
         s.push_str(&format!(
             "Spectral weighting: {} ({} component(s) per flux, from {} sample(s)); {}\n",
             self.weighting.describe(),
@@ -123,7 +124,7 @@ impl Plan {
                 ));
             }
         }
-        let n_spec = self.jobs.iter().filter(|j| j.method.target == Target::Specimen).count();
+        let n_spec = self.jobs.iter().filter(|j| j.method.aperture.target == Target::Specimen).count();
         let n_std = self.jobs.len() - n_spec;
         let uses: usize = self.readings.iter().map(|r| r.specimen_jobs.len() + r.standard_jobs.len()).sum();
         s.push_str(&format!(
@@ -139,15 +140,18 @@ impl Plan {
             }
         ));
         for (i, j) in self.jobs.iter().enumerate() {
-            let viewing = if j.method.viewing != j.method.theta {
-                format!(", receptor axis {:.4}° (off specular: no mirror image)", j.method.viewing.to_degrees())
+            let viewing = if j.method.aperture.viewing != j.method.aperture.theta {
+                format!(
+                    ", receptor axis {:.4}° (off specular: no mirror image)",
+                    j.method.aperture.viewing.to_degrees()
+                )
             } else {
                 String::new()
             };
             s.push_str(&format!(
                 "  #{i}: {:?} at {:.4}°{viewing}, {} component(s), {}; used by {}\n",
-                j.method.target,
-                j.method.theta.to_degrees(),
+                j.method.aperture.target,
+                j.method.aperture.theta.to_degrees(),
                 j.method.weighting.len(),
                 describe_method(&j.method, &self.terms),
                 j.used_by.join(", ")
@@ -183,7 +187,7 @@ impl Plan {
 
 /// One method in words, from its stored fields.
 fn describe_method(m: &Method, terms: &[Term]) -> String {
-    match m.integral {
+    match m.aperture.integral {
         Integral::Hemisphere => {
             return "d/8 sphere: directional–hemispherical reflectance at the viewing angle per sample (brdf::albedo of \
                     the transposed BRDF, Gauss–Kronrod in half-vector coordinates), delta included, then weighted"
@@ -201,7 +205,7 @@ fn describe_method(m: &Method, terms: &[Term]) -> String {
     if m.clipped.is_none() {
         return "stops below the horizon: zero".to_string();
     }
-    let material_has_delta = m.target == Target::Standard || terms.iter().any(|t| t.kind == TermKind::Delta);
+    let material_has_delta = m.aperture.target == Target::Standard || terms.iter().any(|t| t.kind == TermKind::Delta);
     let frozen = |r: Refine| if r == Refine::Frozen { ", frozen" } else { "" };
     let delta = match (&m.delta, material_has_delta, m.mirror.is_some()) {
         (Some(p), _, _) => format!(
