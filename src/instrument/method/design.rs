@@ -7,7 +7,7 @@ use super::delta::DELTA_COST;
 use super::gauss::TENSOR_MAX_LEVEL;
 use super::gauss::{tensor_boxes, LOBE_LEVELS};
 use super::polar::{POLAR_LEVELS, TAIL_LEVELS};
-use super::{Aperture, DeltaPart, Design, MaterialFacts, Method, Projection, RegularPart, Rule, Target, TensorChart};
+use super::{Aperture, DeltaPart, Design, MaterialFacts, Method, Projection, RegularPart, Rule, Target};
 use crate::brdf::{Brdf, Lobe, Tail};
 use crate::colorimetry::weighting::Weighting;
 use crate::instrument::aperture::{
@@ -108,7 +108,7 @@ impl Method {
                     Chart::Lobe
                 };
                 let (splits, boxes) = match chart {
-                    Chart::Lobe => {
+                    Chart::Lobe | Chart::PlainPLobeQ => {
                         let splits = lobe_splits(&facts.lobes, a.theta, src, rec);
                         let boxes = kinked_boxes(lobe_boxes(&splits), kinks.len());
                         (splits, boxes)
@@ -236,7 +236,7 @@ pub fn delta_rule(l: &LobesAt, src: Stop, rec: Stop, rtol: f64) -> Option<Rule> 
 }
 
 /// The smooth-integrand rule of a lobe-chart part without kinks, if it fits: [`Rule::TensorGauss`] in the
-/// variables (p_s, p_r, v, t_q) ([`TensorChart::PlainPLobeQ`]: plain in the plane of incidence, where the
+/// variables (p_s, p_r, v, t_q) ([`Chart::PlainPLobeQ`]: plain in the plane of incidence, where the
 /// lobe is far wider than the stops, the lobe variable across it, where the ridge v = q_s + q_r becomes an
 /// axis) within the bounds of [`TENSOR_MIN_WIDTH`] (B4's GGX α = 0.3 at 85°: 0.6 wide in u against a u-range
 /// of 0.083, 0.052 in v against 0.15). The levels start at 1 (2 points) on every axis.
@@ -250,7 +250,7 @@ pub fn smooth_rule(l: &LobesAt, src: Stop, rec: Stop) -> Option<Rule> {
     if l.lobes.is_empty() || !l.widths.iter().all(fits) {
         return None;
     }
-    Some(Rule::TensorGauss { chart: TensorChart::PlainPLobeQ, levels: [1; 4], path: tensor::Path::default() })
+    Some(Rule::TensorGauss { chart: Chart::PlainPLobeQ, levels: [1; 4], path: tensor::Path::default() })
 }
 
 /// The polar rule of a lobe-chart part, if one fits ([`Rule::LobePolar`]): a material whose regular part is

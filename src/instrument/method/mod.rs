@@ -19,7 +19,7 @@
 //!
 //! The folder, one idea per file:
 //! - `mod.rs`: the method as plain data ([`Method`], its identity [`Aperture`], [`Design`] and the
-//!   [`MaterialFacts`] it reads, [`Rule`], [`TensorChart`], [`DeltaPart`],
+//!   [`MaterialFacts`] it reads, [`Rule`], [`DeltaPart`],
 //!   [`RegularPart`], [`Projection`], [`Target`]), the [`Flux`] it produces and [`Method::is_frozen`];
 //! - `design.rs`: [`Method::design`], [`Method::for_material`] and [`Method::expected_evaluations`] (the
 //!   scheduling guess of `Plan::run_all`), the rule choosers ([`delta_rule`], [`lobe_rule`], [`polar_rule`],
@@ -34,12 +34,15 @@
 //! - `polar.rs`: [`Rule::LobePolar`]'s executor ([`POLAR_LEVELS`], [`TAIL_LEVELS`]).
 //!
 //! A rule's tuning constants live in the file of the rule that uses them; the design gates in `design.rs`.
+mod chart;
 mod delta;
 mod design;
 mod execute;
 mod gauss;
 mod polar;
+mod rule;
 
+pub use chart::ChartMap;
 pub use delta::{
     delta_fit, delta_stencil, DeltaFit, DELTA_COST, DELTA_DIRECTIONS, DELTA_FIT_RADIUS, DELTA_RADII, DELTA_RADIUS,
     DELTA_SAFETY, DELTA_TAIL_SAFETY, DELTA_T_ORDERS,
@@ -51,6 +54,7 @@ pub use design::{
 pub use execute::{deadline_after, LATE_START_SHARE};
 pub use gauss::{tensor_boxes, LOBE_LEVELS, TENSOR_MAX_LEVEL};
 pub use polar::{POLAR_LEVELS, TAIL_LEVELS};
+pub use rule::{Integrand, Outcome, RuleRun, ShapedRule};
 
 #[cfg(doc)]
 use crate::instrument::aperture::DELTA_SHARE;
@@ -59,7 +63,7 @@ use delta::delta_node;
 
 use crate::brdf::{Brdf, Kink, Lobe, TermKind};
 use crate::colorimetry::weighting::Weighting;
-use crate::instrument::aperture::Chart;
+pub use crate::instrument::aperture::Chart;
 use crate::instrument::geometry::{Integral, Stop};
 use crate::quadrature::{tensor, Cell, Refine};
 
@@ -211,20 +215,7 @@ pub enum Rule {
     /// sum of the per-axis differences of successive orders (the error estimate) meets the part's tolerance. If they do
     /// not, the part's Genz–Malik partition is integrated instead (the fallback). `path` is empty when designed; a
     /// frozen method keeps the raises of its run and replays them (the same points, the same bits).
-    TensorGauss { chart: TensorChart, levels: [usize; 4], path: tensor::Path },
-}
-
-/// The variables of [`Rule::TensorGauss`].
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum TensorChart {
-    /// (p_s, q_s, p_r, q_r) on the one box of the stops' product.
-    Plain,
-    /// (u, t_p, v, t_q) on the boxes between the overlap kinks of u and v.
-    Lobe,
-    /// (p_s, p_r, v, t_q): plain in the plane of incidence, lobe variables across it, on the boxes between
-    /// the overlap kinks of v (a lobe wider than the stops in u but not in v: the ridge v = q_s + q_r
-    /// becomes an axis).
-    PlainPLobeQ,
+    TensorGauss { chart: Chart, levels: [usize; 4], path: tensor::Path },
 }
 
 /// When the spectral weighting is applied.
@@ -349,7 +340,8 @@ pub struct Flux {
     pub budget_spent: bool,
     /// Wall time of the integral.
     pub seconds: f64,
-    /// The chart the regular part was integrated in (None: there was no regular part).
+    /// The chart the regular part was integrated in: the part's, or the shaped rule's that gave the value
+    /// (None: there was no regular part).
     pub chart: Option<Chart>,
     /// The data (resolution) uncertainty per component, absolute, for a measured table read through the
     /// plan (`Plan::run`; `docs/accuracy.md` §Data uncertainty of measured tables); None for a model, and for

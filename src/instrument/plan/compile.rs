@@ -129,28 +129,7 @@ impl Planner {
         if geometries.is_empty() {
             return Err(Error::Usage("no geometry to measure".into()));
         }
-        // Requested geometries first, then the dependencies of composites.
-        let mut queue: Vec<(StandardGeometry, bool)> = geometries.into_iter().map(|g| (g, true)).collect();
-        let mut i = 0;
-        while i < queue.len() {
-            let parts: Vec<String> = queue[i]
-                .0
-                .geometry
-                .readings
-                .iter()
-                .filter_map(|spec| match spec {
-                    ReadingSpec::HazeIndex { minuend, subtrahend } => Some([minuend.clone(), subtrahend.clone()]),
-                    _ => None,
-                })
-                .flatten()
-                .collect();
-            for id in parts {
-                if !queue.iter().any(|(q, _)| q.geometry.id == id) {
-                    queue.push((self.geometry(&id)?, false));
-                }
-            }
-            i += 1;
-        }
+        let queue = self.with_dependencies(geometries)?;
         // The spectral weighting: the kinds the readings ask for, each once, in order of first use.
         let colour = options.colour;
         let kinds: Vec<WeightingKind> =
@@ -169,22 +148,7 @@ impl Planner {
         for (g, reported) in &queue {
             add_geometry(g, *reported, colour, options.share_fluxes, &mut drafts, &mut readings, &mut index)?;
         }
-        // Composites: resolve their parts now that every gloss reading exists.
-        for r in 0..readings.len() {
-            if let ReadingSpec::HazeIndex { minuend, subtrahend } = readings[r].spec.clone() {
-                let mut parts = Vec::new();
-                for id in [&minuend, &subtrahend] {
-                    let part = readings
-                        .iter()
-                        .position(|x| &x.geometry == id && matches!(x.spec, ReadingSpec::Gloss { .. }))
-                        .ok_or_else(|| {
-                            Error::Usage(format!("{}: geometry `{id}` has no gloss reading", readings[r].geometry))
-                        })?;
-                    parts.push(part);
-                }
-                readings[r].parts = parts;
-            }
-        }
+        resolve_composites(&mut readings)?;
 
         // Step 1a: the standards' methods, executed now (cached across plans).
         let standard_weighting = Weighting::luminous(&Sampling::grey())?;
@@ -281,6 +245,33 @@ impl Planner {
         })
     }
 
+    /// The requested geometries (reported), then the geometries their composites combine (not reported),
+    /// each once.
+    fn with_dependencies(&self, geometries: Vec<StandardGeometry>) -> Result<Vec<(StandardGeometry, bool)>> {
+        let mut queue: Vec<(StandardGeometry, bool)> = geometries.into_iter().map(|g| (g, true)).collect();
+        let mut i = 0;
+        while i < queue.len() {
+            let parts: Vec<String> = queue[i]
+                .0
+                .geometry
+                .readings
+                .iter()
+                .filter_map(|spec| match spec {
+                    ReadingSpec::HazeIndex { minuend, subtrahend } => Some([minuend.clone(), subtrahend.clone()]),
+                    _ => None,
+                })
+                .flatten()
+                .collect();
+            for id in parts {
+                if !queue.iter().any(|(q, _)| q.geometry.id == id) {
+                    queue.push((self.geometry(&id)?, false));
+                }
+            }
+            i += 1;
+        }
+        Ok(queue)
+    }
+
     /// The fluxes of the gloss standards, from the cache or computed (and cached): the cache is read once,
     /// under one lock, and only the fluxes it lacks are computed, in parallel (in a batch every plan after
     /// the first finds them all, and then hands nothing to the pool). With sharing off, always computed (the
@@ -316,6 +307,27 @@ impl Planner {
         }
         flux.into_iter().map(|f| f.expect("every standard computed")).collect()
     }
+}
+
+/// Composites: their parts (the gloss readings of the geometries they combine) resolved, now that every gloss
+/// reading exists.
+fn resolve_composites(readings: &mut [PlannedReading]) -> Result<()> {
+    for r in 0..readings.len() {
+        if let ReadingSpec::HazeIndex { minuend, subtrahend } = readings[r].spec.clone() {
+            let mut parts = Vec::new();
+            for id in [&minuend, &subtrahend] {
+                let part = readings
+                    .iter()
+                    .position(|x| &x.geometry == id && matches!(x.spec, ReadingSpec::Gloss { .. }))
+                    .ok_or_else(|| {
+                        Error::Usage(format!("{}: geometry `{id}` has no gloss reading", readings[r].geometry))
+                    })?;
+                parts.push(part);
+            }
+            readings[r].parts = parts;
+        }
+    }
+    Ok(())
 }
 
 /// Add the readings of one geometry and the drafts of the jobs they need (shared by key when `share`).

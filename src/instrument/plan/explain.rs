@@ -7,8 +7,8 @@ use crate::colorimetry::weighting::Weighting;
 use crate::instrument::aperture::{lobe_widths_uv, Chart, DELTA_SHARE};
 use crate::instrument::geometry::Integral;
 use crate::instrument::method::{
-    Method, Projection, Rule, Target, TensorChart, DELTA_FIT_RADIUS, DELTA_RADII, DELTA_RADIUS, DELTA_SAFETY,
-    DELTA_TAIL_SAFETY, DELTA_T_ORDERS, LOBE_LEVELS, LOBE_REACH, POLAR_LEVELS, POLAR_REACH, TENSOR_MAX_LEVEL,
+    Method, Projection, Rule, Target, DELTA_FIT_RADIUS, DELTA_RADII, DELTA_RADIUS, DELTA_SAFETY, DELTA_TAIL_SAFETY,
+    DELTA_T_ORDERS, LOBE_LEVELS, LOBE_REACH, POLAR_LEVELS, POLAR_REACH, TENSOR_MAX_LEVEL,
 };
 use crate::instrument::reading::ReadingSpec;
 use crate::quadrature::{tensor, Refine};
@@ -223,7 +223,7 @@ fn describe_method(m: &Method, terms: &[Term]) -> String {
                 "plain variables (no lobe narrower than the stops){}",
                 describe_kinks(&p.kinks, "p_s cut along ωi·h = cos θc")
             ),
-            Chart::Lobe => format!(
+            Chart::Lobe | Chart::PlainPLobeQ => format!(
                 "lobe variables, {} × {} split points{}",
                 p.splits[0].len(),
                 p.splits[1].len(),
@@ -316,12 +316,12 @@ fn describe_polar(width: [f64; 2], u: [f64; 4], v: [f64; 4], levels: [u8; 9], bo
 
 /// [`Rule::TensorGauss`] in words: its boxes, its orders (the starting ones, or the final ones of a frozen
 /// method's path) and its fallback.
-fn describe_tensor(chart: TensorChart, levels: [usize; 4], path: tensor::Path, fallback_boxes: usize) -> String {
+fn describe_tensor(chart: Chart, levels: [usize; 4], path: tensor::Path, fallback_boxes: usize) -> String {
     let orders = path.replayed(levels, tensor::MAX_BOXES).map(|l| tensor::ORDERS[l]);
     let (vars, boxes) = match chart {
-        TensorChart::Plain => ("(p_s, q_s, p_r, q_r)", "on the one box of the stops' product"),
-        TensorChart::Lobe => ("(u, t_p, v, t_q)", "on the boxes between the overlap kinks of u and v"),
-        TensorChart::PlainPLobeQ => ("(p_s, p_r, v, t_q)", "on the boxes between the overlap kinks of v"),
+        Chart::Plain => ("(p_s, q_s, p_r, q_r)", "on the one box of the stops' product"),
+        Chart::Lobe => ("(u, t_p, v, t_q)", "on the boxes between the overlap kinks of u and v"),
+        Chart::PlainPLobeQ => ("(p_s, p_r, v, t_q)", "on the boxes between the overlap kinks of v"),
     };
     format!(
         "smooth integrand: tensor Gauss–Legendre in {vars} {boxes}, orders {} {}, per-axis orders raised \
