@@ -31,7 +31,7 @@ use std::time::Instant;
 
 use glossmeter::brdf::{Brdf, Lobe, Tail, Term, TermKind};
 use glossmeter::instrument::geometry::{solid_angle_density, Axes, Stop};
-use glossmeter::instrument::method::{Flux, Method, Rule, Target, TensorChart};
+use glossmeter::instrument::method::{Chart, Flux, Method, Rule, Target};
 use glossmeter::instrument::plan::{Plan, PlanOptions, Reading};
 use glossmeter::instrument::standards::{self, StandardGeometry};
 use glossmeter::optics::fresnel::fr_dielectric;
@@ -249,12 +249,12 @@ fn forced(c: &Case, rtol: f64, rule: Option<Rule>) -> Problem<'_> {
 /// variables, so a forced shaped rule that fell back says so, and the tensor rule's mixed chart is not called
 /// the lobe chart.
 fn rule_label(m: &Method, brdf: &dyn Brdf) -> String {
-    use glossmeter::instrument::method::TensorChart;
     let (_, frozen) = m.execute_and_freeze(brdf);
     let Some(part) = frozen.regular.as_ref() else { return "no regular part".into() };
     let chart = match part.chart {
         glossmeter::instrument::aperture::Chart::Plain => "plain (p_s, q_s, p_r, q_r)",
         glossmeter::instrument::aperture::Chart::Lobe => "lobe (u, t_p, v, t_q)",
+        glossmeter::instrument::aperture::Chart::PlainPLobeQ => "mixed (p_s, p_r, v, t_q)",
     };
     match part.rule {
         Rule::GenzMalik75 => {
@@ -285,9 +285,9 @@ fn rule_label(m: &Method, brdf: &dyn Brdf) -> String {
         Rule::TensorGauss { chart, .. } => format!(
             "tensor Gauss–Legendre, {} chart",
             match chart {
-                TensorChart::Plain => "plain (p_s, q_s, p_r, q_r)",
-                TensorChart::Lobe => "lobe (u, t_p, v, t_q) kink-partition",
-                TensorChart::PlainPLobeQ => "mixed (p_s, p_r, v, t_q)",
+                Chart::Plain => "plain (p_s, q_s, p_r, q_r)",
+                Chart::Lobe => "lobe (u, t_p, v, t_q) kink-partition",
+                Chart::PlainPLobeQ => "mixed (p_s, p_r, v, t_q)",
             }
         ),
     }
@@ -653,11 +653,7 @@ fn main() {
             &[
                 (
                     "ours, tensor Gauss–Legendre forced (p_s, p_r, v, t_q)",
-                    Some(Rule::TensorGauss {
-                        chart: TensorChart::PlainPLobeQ,
-                        levels: [1; 4],
-                        path: Default::default(),
-                    }),
+                    Some(Rule::TensorGauss { chart: Chart::PlainPLobeQ, levels: [1; 4], path: Default::default() }),
                 ),
                 ("ours, Genz–Malik 7/5 forced (planner's partition)", Some(Rule::GenzMalik75)),
             ],
@@ -1150,7 +1146,7 @@ fn b5(md: &mut String) {
 /// Replace the regular rule of every specimen integral of `plan` that has one (None: keep the planner's).
 fn force_plan_rule(plan: &mut Plan, rule: Option<Rule>) {
     let Some(rule) = rule else { return };
-    for job in plan.jobs.iter_mut().filter(|j| j.method.target == Target::Specimen) {
+    for job in plan.jobs.iter_mut().filter(|j| j.method.aperture.target == Target::Specimen) {
         if let Some(part) = job.method.regular.as_mut() {
             part.rule = rule;
         }
@@ -1160,7 +1156,7 @@ fn force_plan_rule(plan: &mut Plan, rule: Option<Rule>) {
 /// B5 with the narrow flake lobes (cerulean-blue-c-literal) over the default panel, side by side in one run
 /// (`docs/performance.md` §"B5 with narrow flake lobes"): the planner's methods, Genz–Malik 7/5 forced on every
 /// specimen integral (the engine before the shaped, delta and tensor rules), and the tensor Gauss–Legendre rule with
-/// p-refinement forced on the overlap-kink partition (`TensorChart::Lobe`, orders shared by its boxes; its fallback is
+/// p-refinement forced on the overlap-kink partition (`Chart::Lobe`, orders shared by its boxes; its fallback is
 /// the Genz–Malik partition). Whole-panel evaluations (exact, counted by a wrapper) and single-core times; then, per
 /// specimen integral, where the evaluations go and each rule's actual error against a Genz–Malik run at 10⁻⁴ of the
 /// integral's tolerance.
@@ -1168,7 +1164,7 @@ fn b5_rules(md: &mut String) {
     let file = "cerulean-blue-c-literal.json";
     let Some(brdf) = recipe(file) else { return };
     let opts = PlanOptions { rtol: 1e-6, ..Default::default() };
-    let tensor = Rule::TensorGauss { chart: TensorChart::Lobe, levels: [1; 4], path: Default::default() };
+    let tensor = Rule::TensorGauss { chart: Chart::Lobe, levels: [1; 4], path: Default::default() };
     let rules: [(&str, Option<Rule>); 3] = [
         ("planner's choice", None),
         ("Genz–Malik 7/5 forced", Some(Rule::GenzMalik75)),
@@ -1197,7 +1193,7 @@ fn b5_rules(md: &mut String) {
     let _ = writeln!(md, "| # | used by | rule | evaluations | est. | actual | actual / est. | what ran |");
     let _ = writeln!(md, "|---|---|---|---|---|---|---|---|");
     let plan = Plan::compile(brdf.clone(), panel(), opts).expect("plan compiles");
-    for (j, job) in plan.jobs.iter().enumerate().filter(|(_, j)| j.method.target == Target::Specimen) {
+    for (j, job) in plan.jobs.iter().enumerate().filter(|(_, j)| j.method.aperture.target == Target::Specimen) {
         let mut tight = job.method.clone();
         if let Some(p) = tight.regular.as_mut() {
             (p.rule, p.rtol, p.atol) = (Rule::GenzMalik75, 1e-4 * p.rtol, 1e-4 * p.atol);
@@ -1316,11 +1312,11 @@ fn batch(md: &mut String, quick: bool) {
 /// specimen integrals' exact evaluation counts with the planner's methods (today: the Genz–Malik partition for all of
 /// them), beside two alternatives forced on the same methods in the same run: Genz–Malik on the overlap-kink partition
 /// alone (no lobe splits) and the tensor Gauss–Legendre rule with orders shared by the kink partition's boxes
-/// (`TensorChart::Lobe`, falling back to the Genz–Malik partition). For each, the largest actual / estimate over the
+/// (`Chart::Lobe`, falling back to the Genz–Malik partition). For each, the largest actual / estimate over the
 /// recipe's integrals against a Genz–Malik run at 10⁻³ of the integral's tolerances (skipping integrals whose flux is
 /// below the absolute floor). The limit a rule can reach is measured by independent code (`tools/limit_wide_lobes.py`).
 fn wide_lobes(md: &mut String) {
-    use glossmeter::instrument::aperture::{lobe_boxes, AxisMap, Chart};
+    use glossmeter::instrument::aperture::{lobe_boxes, AxisMap};
     use glossmeter::quadrature::Cell;
     let _ = writeln!(md, "\n## Lobes as wide as the stops (one run; load average at the start {})\n", loadavg());
     let _ = writeln!(md, "| recipe | geometries | specimen integrals | planner: evaluations | time (1 thread) | worst actual/est. | Genz–Malik, kink partition: evaluations | worst actual/est. | tensor GL shared orders, kink partition: evaluations | worst actual/est. |");
@@ -1362,7 +1358,7 @@ fn wide_lobes(md: &mut String) {
         let mut evals = [0usize; 3];
         let mut worst = [0.0f64; 3];
         let mut n = 0;
-        for job in plan.jobs.iter().filter(|j| j.method.target == Target::Specimen) {
+        for job in plan.jobs.iter().filter(|j| j.method.aperture.target == Target::Specimen) {
             n += 1;
             let mut tight = job.method.clone();
             if let Some(p) = tight.regular.as_mut() {
@@ -1385,8 +1381,7 @@ fn wide_lobes(md: &mut String) {
                         p.cells = Cell::from_boxes(&lobe_boxes(&sp));
                     }
                     if eligible && v == 2 {
-                        p.rule =
-                            Rule::TensorGauss { chart: TensorChart::Lobe, levels: [1; 4], path: Default::default() };
+                        p.rule = Rule::TensorGauss { chart: Chart::Lobe, levels: [1; 4], path: Default::default() };
                     }
                 }
                 let f = m.execute(brdf.as_ref());

@@ -417,7 +417,7 @@ impl Sweep {
                             .jobs
                             .iter()
                             .zip(&e.fluxes)
-                            .filter(|(j, _)| j.method.target == Target::Specimen)
+                            .filter(|(j, _)| j.method.aperture.target == Target::Specimen)
                             .map(|(_, f)| f.seconds)
                             .sum();
                         (Ok(e.readings), planning + integrals)

@@ -243,7 +243,7 @@ fn compensated_readings_share_the_haze_integrals_and_explain_shows_them() {
         let g = standards::find(id).unwrap();
         let plan = Plan::compile(m.brdf.clone(), vec![g.clone()], PlanOptions::default()).unwrap();
         // One specimen integral per receptor: the compensated readings add only the compensation receptor's.
-        let specimen = plan.jobs.iter().filter(|j| j.method.target == Target::Specimen).count();
+        let specimen = plan.jobs.iter().filter(|j| j.method.aperture.target == Target::Specimen).count();
         let used: std::collections::BTreeSet<&String> =
             plan.readings.iter().flat_map(|r| r.specimen_jobs.keys()).collect();
         assert_eq!(specimen, used.len(), "{id}");

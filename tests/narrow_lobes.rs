@@ -149,7 +149,7 @@ fn flux_and_reference_at(
         .jobs
         .iter()
         .find(|j| {
-            j.method.target == glossmeter::instrument::method::Target::Specimen
+            j.method.aperture.target == glossmeter::instrument::method::Target::Specimen
                 && j.used_by.iter().any(|u| u == reading)
         })
         .unwrap();
@@ -180,7 +180,7 @@ fn near_grazing_the_polar_rule_needs_eight_widths_in_the_plane_of_incidence() {
         b.sort_by(f64::total_cmp);
         b
     };
-    let width = glossmeter::instrument::aperture::lobe_widths_uv(&brdf.lobes()[0], method.theta);
+    let width = glossmeter::instrument::aperture::lobe_widths_uv(&brdf.lobes()[0], method.aperture.theta);
     let mut forced = method.clone();
     forced.regular.as_mut().unwrap().rule =
         Rule::LobePolar { width, u: breaks(src.p, rec.p), v: breaks(src.q, rec.q), levels: [1; 9] };
@@ -203,7 +203,7 @@ fn an_off_specular_receptor_splits_a_ggx_tail_at_the_width_it_sees() {
     let (src, rec) = haze.clipped.unwrap();
     let (ap, aq) = (AxisMap { s: src.p, r: rec.p }, AxisMap { s: src.q, r: rec.q });
     let lobe = material("ggx", 0.003).lobes()[0].clone();
-    let (w, seen) = (lobe_widths_uv(&lobe, haze.theta), seen_widths(&lobe, haze.theta, ap, aq));
+    let (w, seen) = (lobe_widths_uv(&lobe, haze.aperture.theta), seen_widths(&lobe, haze.aperture.theta, ap, aq));
     let gap = ap.range()[0];
     assert!(gap > 5.0 * w[0], "{gap} vs {w:?}");
     assert_eq!(seen[0], w[0]);

@@ -5,7 +5,7 @@
 use std::sync::Arc;
 
 use glossmeter::brdf::Brdf;
-use glossmeter::instrument::method::{Method, Rule, TensorChart};
+use glossmeter::instrument::method::{Chart, Method, Rule};
 use glossmeter::instrument::plan::{Plan, PlanOptions};
 use glossmeter::instrument::reference::lambertian_flux_reference;
 use glossmeter::instrument::standards;
@@ -16,7 +16,7 @@ fn fixture(name: &str) -> Arc<dyn Brdf> {
     glossmeter::recipe::load_file(&path).expect("fixture loads").brdf
 }
 
-fn tensor_rule(chart: TensorChart) -> Rule {
+fn tensor_rule(chart: Chart) -> Rule {
     Rule::TensorGauss { chart, levels: [1; 4], path: tensor::Path::default() }
 }
 
@@ -33,7 +33,7 @@ fn the_tensor_rule_meets_the_lambert_polygon_closed_form_within_its_estimate() {
         for name in ["gloss", "haze-narrow"] {
             let Some(rec) = g.receptor(name) else { continue };
             let exact = lambertian_flux_reference(theta, src, *rec, f_lum);
-            for chart in [TensorChart::Plain, TensorChart::Lobe, TensorChart::PlainPLobeQ] {
+            for chart in [Chart::Plain, Chart::Lobe, Chart::PlainPLobeQ] {
                 for rtol in [1e-6, 1e-9] {
                     let mut m =
                         Method::for_material(lambert.as_ref(), theta, src, *rec, (rtol, 0.0), 10_000_000).unwrap();

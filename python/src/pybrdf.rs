@@ -262,8 +262,10 @@ fn specimen_angles(geos: &[glossmeter::instrument::standards::StandardGeometry])
         .map_err(to_py_err)?;
     let mut out: Vec<f64> = Vec::new();
     for j in &plan.jobs {
-        if j.method.target == Target::Specimen && !out.iter().any(|t| t.to_bits() == j.method.theta.to_bits()) {
-            out.push(j.method.theta);
+        if j.method.aperture.target == Target::Specimen
+            && !out.iter().any(|t| t.to_bits() == j.method.aperture.theta.to_bits())
+        {
+            out.push(j.method.aperture.theta);
         }
     }
     Ok(out)

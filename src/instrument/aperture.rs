@@ -36,7 +36,10 @@ pub fn lobe_widths_uv(lobe: &Lobe, theta: f64) -> [f64; 2] {
     [2.0 * m * eta * ct / c, 2.0 * m * eta * ct]
 }
 
-/// The variables (chart) a regular part is integrated in, chosen per integral by [`choose_chart`].
+/// The variables (chart) of a regular part's integrand: a part's chart is chosen per integral by
+/// [`choose_chart`] (plain or lobe); a shaped rule may integrate in another one (the tensor rule's
+/// `PlainPLobeQ`). The map from a chart's point to the two directions and its Jacobian is
+/// `method::ChartMap`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Chart {
     /// The plain product of the stops, (p_s, q_s, p_r, q_r): one box, no kinks. Right when every lobe is at
@@ -46,6 +49,10 @@ pub enum Chart {
     /// The lobe variables (u, t_p, v, t_q) with splits at the overlap kinks and at multiples of the lobe
     /// widths: needed as soon as one lobe is narrower than the apertures.
     Lobe,
+    /// (p_s, p_r, v, t_q): plain in the plane of incidence, lobe variables across it (a lobe wider than the
+    /// stops in u but not in v: the ridge v = q_s + q_r becomes an axis). Only a shaped rule's
+    /// (`Rule::TensorGauss`), never a part's.
+    PlainPLobeQ,
 }
 
 /// Choose the chart of the regular part for these (clipped) stops and lobes at angle θ.

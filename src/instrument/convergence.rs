@@ -214,7 +214,7 @@ pub fn lambertian_value(brdf: &dyn Brdf) -> Option<f64> {
 
 /// The reference flux of one job of the plan, for a Lambertian specimen of luminous value `f_lum`.
 fn closed_form_flux(job: &Job, f_lum: f64) -> f64 {
-    let m = &job.method;
+    let m = &job.method.aperture;
     match m.target {
         Target::Specimen => lambertian_flux_reference(m.theta, m.source, m.receptor, f_lum),
         Target::Standard => {

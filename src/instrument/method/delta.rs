@@ -1,7 +1,9 @@
 //! [`Rule::LobeDelta`](super::Rule::LobeDelta): the delta limit of a narrow Gaussian-tailed lobe and its majorant, at
 //! the Gauss–Legendre nodes of (t_p, t_q) — the executor ([`lobe_delta`]), the fit at one node ([`delta_fit`],
 //! [`DeltaFit`], on the points of [`delta_stencil`]) and the constants of its stencil and bound.
-use crate::quadrature::{legendre_on_into, Estimate, Options};
+use super::rule::{Integrand, Outcome, RuleRun, ShapedRule};
+use super::Rule;
+use crate::quadrature::{legendre_on_into, Estimate, Options, Refine};
 
 /// The radii (in lobe widths) of the rings on which [`Rule::LobeDelta`](super::Rule::LobeDelta) samples the even part
 /// of h (four directions, 0°, 45°, 90°, 135°, each with its opposite point; with the curvature ring): the majorant's
@@ -53,16 +55,26 @@ pub const DELTA_DIRECTIONS: [[f64; 2]; 4] = [
 /// curvature.
 pub const DELTA_FIT_RADIUS: f64 = 1.0;
 
+/// [`Rule::LobeDelta`]'s parameters: the lobe's widths in (u, v).
+pub(super) struct Delta {
+    pub width: [f64; 2],
+}
+
+impl ShapedRule for Delta {
+    /// The delta limit, accepted when its majorant meets the tolerance (or when frozen: the same points);
+    /// otherwise not (the lobe's Gauss–Hermite rule runs next, [`Rule::fallback`]).
+    fn estimate(&self, f: &mut Integrand, run: &RuleRun) -> Outcome {
+        let (est, spent) = lobe_delta(f, run.ncomp, self.width, run.opts);
+        let done = est.filter(|e| e.converged || run.refine == Refine::Frozen);
+        Outcome::shaped(done.map(|e| (e, Rule::LobeDelta { width: self.width })), spent)
+    }
+}
+
 /// Run [`Rule::LobeDelta`](super::Rule::LobeDelta): the delta limit and its majorant (see [`delta_node`]); `converged`
 /// when the majorant meets max(atol, rtol·|I|) in every component. None when an evaluation is not finite, the lobe is
 /// not log-concave at its peak (the curvature fit fails) or the budget would be exceeded; and the evaluations
 /// spent either way.
-pub(super) fn lobe_delta(
-    f: &mut impl FnMut(&[[f64; 4]], &mut [f64]),
-    ncomp: usize,
-    width: [f64; 2],
-    opts: &Options,
-) -> (Option<Estimate>, usize) {
+fn lobe_delta(f: &mut Integrand, ncomp: usize, width: [f64; 2], opts: &Options) -> (Option<Estimate>, usize) {
     let (lo, hi) = DELTA_T_ORDERS;
     let ((ring, full), cost) = (DELTA_NODE_POINTS, DELTA_COST);
     if cost > opts.max_evals {
@@ -244,5 +256,56 @@ pub fn delta_stencil(width: [f64; 2], tp: f64, tq: f64, radii: &[f64], pts: &mut
                 pts.push([s * r * d[0] * width[0], tp, s * r * d[1] * width[1], tq]);
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::instrument::geometry::Stop;
+    use crate::quadrature::{Cell, Refine};
+
+    fn run(opts: &Options) -> RuleRun<'_> {
+        let stop = Stop { p: [-0.02, 0.02], q: [-0.02, 0.02] };
+        RuleRun { ncomp: 1, opts, refine: Refine::Adaptive, stops: (stop, stop), cells: &[] as &[Cell<4>], keep: false }
+    }
+
+    /// A Gaussian of widths `a` in (u, v) times a polynomial of degree 3 in (t_p, t_q), optionally with a kink
+    /// (1 + |u|/a₀) at its centre.
+    fn lobe(a: [f64; 2], kink: bool) -> impl FnMut(&[[f64; 4]], &mut [f64]) {
+        move |pts: &[[f64; 4]], out: &mut [f64]| {
+            for (x, o) in pts.iter().zip(out.iter_mut()) {
+                let (u, v) = (x[0] / a[0], x[2] / a[1]);
+                let k = if kink { 1.0 + u.abs() } else { 1.0 };
+                *o = (-u * u - v * v).exp() * k * (1.0 + x[1] + x[3] * x[3]);
+            }
+        }
+    }
+
+    #[test]
+    fn the_delta_limit_is_exact_on_a_gaussian_narrower_than_its_scale() {
+        // The lobe 0.8 times the rule's widths: the fitted curvature B = I/0.64, the mass 0.64 × F(0).
+        let w = [0.001, 0.0007];
+        let a = [0.8 * w[0], 0.8 * w[1]];
+        let exact = std::f64::consts::PI * a[0] * a[1] * (1.0 + 0.5 + 1.0 / 3.0);
+        let opts = Options { rtol: 1e-9, ..Options::default() };
+        let out = Delta { width: w }.estimate(&mut lobe(a, false), &run(&opts));
+        let (est, frozen, _) = out.done.expect("the majorant meets 1e-9 on an exact Gaussian");
+        let actual = (est.value[0] - exact).abs();
+        assert!(actual <= 1e-12 * exact && actual <= est.error[0] + 1e-15 * exact, "{actual:e} {:e}", est.error[0]);
+        assert_eq!((frozen, out.spent), (Rule::LobeDelta { width: w }, DELTA_COST));
+    }
+
+    #[test]
+    fn the_delta_limit_refuses_a_kink_at_the_peak() {
+        let w = [0.001, 0.0007];
+        let opts = Options { rtol: 1e-6, ..Options::default() };
+        let out = Delta { width: w }.estimate(&mut lobe(w, true), &run(&opts));
+        assert!(out.done.is_none(), "{:?}", out.done);
+        assert_eq!(out.spent, DELTA_COST);
+        assert_eq!(
+            Rule::LobeDelta { width: w }.fallback(),
+            Some(Rule::LobeGaussHermite { width: w, levels: (0, super::super::LOBE_LEVELS.len() - 1) })
+        );
     }
 }

@@ -7,8 +7,8 @@ use super::delta::DELTA_COST;
 use super::gauss::TENSOR_MAX_LEVEL;
 use super::gauss::{tensor_boxes, LOBE_LEVELS};
 use super::polar::{POLAR_LEVELS, TAIL_LEVELS};
-use super::{DeltaPart, Design, Method, Projection, RegularPart, Rule, Target, TensorChart};
-use crate::brdf::{Brdf, Lobe, Tail, TermKind};
+use super::{Aperture, DeltaPart, Design, MaterialFacts, Method, Projection, RegularPart, Rule, Target};
+use crate::brdf::{Brdf, Lobe, Tail};
 use crate::colorimetry::weighting::Weighting;
 use crate::instrument::aperture::{
     choose_chart, clip, delta_kinks, lobe_boxes, lobe_splits, lobe_widths_uv, mirror_overlap, regular_kinks,
@@ -62,18 +62,18 @@ pub const DELTA_GATE: f64 = 1.0e3;
 impl Method {
     /// Design the method of one integral.
     pub fn design(d: Design<'_>) -> Method {
-        let aperture = d.integral == Integral::Aperture;
-        let clipped = match (clip(d.source, d.theta, true), clip(d.receptor, d.viewing, false)) {
-            (Some(s), Some(r)) if aperture => Some((s, r)),
+        let (a, facts) = (d.aperture, d.facts);
+        let clipped = match (clip(a.source, a.theta, true), clip(a.receptor, a.viewing, false)) {
+            (Some(s), Some(r)) if a.integral == Integral::Aperture => Some((s, r)),
             _ => None,
         };
         // The mirror image is only ever seen by a receptor on the mirror axis.
-        let on_mirror_axis = d.viewing == d.theta;
+        let on_mirror_axis = a.viewing == a.theta;
         let mirror = clipped.filter(|_| on_mirror_axis).and_then(|(s, r)| mirror_overlap(s, r));
-        let delta_share = if d.has_regular { DELTA_SHARE } else { 1.0 };
-        let delta = match (d.has_delta, mirror) {
+        let delta_share = if facts.has_regular { DELTA_SHARE } else { 1.0 };
+        let delta = match (facts.has_delta, mirror) {
             (true, Some((lo, hi))) => {
-                let kinks = delta_kinks(d.kinks, d.theta, Stop { p: [lo[0], hi[0]], q: [lo[1], hi[1]] });
+                let kinks = delta_kinks(&facts.kinks, a.theta, Stop { p: [lo[0], hi[0]], q: [lo[1], hi[1]] });
                 let boxes = if kinks.is_empty() {
                     vec![(lo, hi)]
                 } else {
@@ -91,25 +91,25 @@ impl Method {
             }
             _ => None,
         };
-        let regular = match (d.has_regular, clipped) {
+        let regular = match (facts.has_regular, clipped) {
             (true, Some((src, rec))) => {
                 // Off the mirror axis no lobe is centred in the stops: the plain variables, with p_s cut at the
                 // kinks there (`RegularPart::kinks`).
                 let kinks = if on_mirror_axis {
-                    regular_kinks(d.kinks, d.theta, src, rec)
+                    regular_kinks(&facts.kinks, a.theta, src, rec)
                 } else {
-                    regular_kinks_between(d.kinks, d.theta + d.viewing, src, rec)
+                    regular_kinks_between(&facts.kinks, a.theta + a.viewing, src, rec)
                 };
                 let chart = if !on_mirror_axis {
                     Chart::Plain
                 } else if kinks.is_empty() {
-                    choose_chart(d.lobes, d.theta, src, rec)
+                    choose_chart(&facts.lobes, a.theta, src, rec)
                 } else {
                     Chart::Lobe
                 };
                 let (splits, boxes) = match chart {
-                    Chart::Lobe => {
-                        let splits = lobe_splits(d.lobes, d.theta, src, rec);
+                    Chart::Lobe | Chart::PlainPLobeQ => {
+                        let splits = lobe_splits(&facts.lobes, a.theta, src, rec);
                         let boxes = kinked_boxes(lobe_boxes(&splits), kinks.len());
                         (splits, boxes)
                     }
@@ -134,10 +134,12 @@ impl Method {
                 let share = 1.0 - DELTA_SHARE;
                 let rule = match chart {
                     Chart::Lobe if kinks.is_empty() && on_mirror_axis => {
-                        delta_rule(d.lobes, d.has_diffuse, d.theta, src, rec, share * d.rtol)
-                            .or_else(|| lobe_rule(d.lobes, d.has_diffuse, d.theta, src, rec))
-                            .or_else(|| polar_rule(d.lobes, d.has_diffuse, d.theta, src, rec))
-                            .or_else(|| smooth_rule(d.lobes, d.theta, src, rec))
+                        // The lobes' widths at this angle, once for every chooser.
+                        let l = LobesAt::new(facts, a.theta);
+                        delta_rule(&l, src, rec, share * d.rtol)
+                            .or_else(|| lobe_rule(&l, src, rec))
+                            .or_else(|| polar_rule(&l, src, rec))
+                            .or_else(|| smooth_rule(&l, src, rec))
                             .unwrap_or(Rule::GenzMalik75)
                     }
                     _ => Rule::GenzMalik75,
@@ -156,12 +158,7 @@ impl Method {
             _ => None,
         };
         Method {
-            target: d.target,
-            integral: d.integral,
-            theta: d.theta,
-            viewing: d.viewing,
-            source: d.source,
-            receptor: d.receptor,
+            aperture: a,
             clipped,
             mirror,
             delta,
@@ -185,17 +182,15 @@ impl Method {
         max_evals: usize,
     ) -> crate::Result<Method> {
         Ok(Method::design(Design {
-            target: Target::Specimen,
-            integral: Integral::Aperture,
-            theta,
-            viewing: theta,
-            source,
-            receptor,
-            lobes: &brdf.lobes(),
-            kinks: &brdf.kinks(),
-            has_delta: brdf.has_delta(),
-            has_regular: brdf.has_regular(),
-            has_diffuse: brdf.terms().iter().any(|t| t.kind == TermKind::Diffuse),
+            aperture: Aperture {
+                target: Target::Specimen,
+                integral: Integral::Aperture,
+                theta,
+                viewing: theta,
+                source,
+                receptor,
+            },
+            facts: &MaterialFacts::of(brdf),
             weighting: Weighting::luminous(brdf.sampling())?,
             projection: Projection::FoldInMaterial,
             rtol: tolerance.0,
@@ -210,12 +205,12 @@ impl Method {
 /// part is one Gaussian-tailed lobe (no diffuse term, no heavy tail) whose centre u = v = 0 is inside the
 /// range of the lobe variables and at least
 /// [`LOBE_REACH`] widths from every kink of the overlap length and every end of the range, on both axes.
-pub fn lobe_rule(lobes: &[Lobe], has_diffuse: bool, theta: f64, src: Stop, rec: Stop) -> Option<Rule> {
-    let [lobe] = lobes else { return None };
-    if has_diffuse || lobe.tail.is_heavy() {
+pub fn lobe_rule(l: &LobesAt, src: Stop, rec: Stop) -> Option<Rule> {
+    let ([lobe], [width]) = (l.lobes, l.widths.as_slice()) else { return None };
+    if l.has_diffuse || lobe.tail.is_heavy() {
         return None;
     }
-    let width = lobe_widths_uv(lobe, theta);
+    let width = *width;
     let clear = |a: AxisMap, w: f64| {
         let [lo, hi] = a.range();
         let kinks = [lo, hi, a.s[1] + a.r[0], a.s[0] + a.r[1]];
@@ -232,8 +227,8 @@ pub fn lobe_rule(lobes: &[Lobe], has_diffuse: bool, theta: f64, src: Stop, rec: 
 /// measured at 50–270·w² at 20°, 60°, E430 and ISO 13803 (≈ 1.8·10⁴·w² at 85°), so the rule is tried only
 /// when [`DELTA_GATE`]·w² ≤ rtol (otherwise its evaluations would be spent for nothing before the
 /// Gauss–Hermite rule). Whether the majorant meets the tolerance is decided when it runs, on the material.
-pub fn delta_rule(lobes: &[Lobe], has_diffuse: bool, theta: f64, src: Stop, rec: Stop, rtol: f64) -> Option<Rule> {
-    let Some(Rule::LobeGaussHermite { width, .. }) = lobe_rule(lobes, has_diffuse, theta, src, rec) else {
+pub fn delta_rule(l: &LobesAt, src: Stop, rec: Stop, rtol: f64) -> Option<Rule> {
+    let Some(Rule::LobeGaussHermite { width, .. }) = lobe_rule(l, src, rec) else {
         return None;
     };
     let w = width[0].max(width[1]);
@@ -241,22 +236,21 @@ pub fn delta_rule(lobes: &[Lobe], has_diffuse: bool, theta: f64, src: Stop, rec:
 }
 
 /// The smooth-integrand rule of a lobe-chart part without kinks, if it fits: [`Rule::TensorGauss`] in the
-/// variables (p_s, p_r, v, t_q) ([`TensorChart::PlainPLobeQ`]: plain in the plane of incidence, where the
+/// variables (p_s, p_r, v, t_q) ([`Chart::PlainPLobeQ`]: plain in the plane of incidence, where the
 /// lobe is far wider than the stops, the lobe variable across it, where the ridge v = q_s + q_r becomes an
 /// axis) within the bounds of [`TENSOR_MIN_WIDTH`] (B4's GGX α = 0.3 at 85°: 0.6 wide in u against a u-range
 /// of 0.083, 0.052 in v against 0.15). The levels start at 1 (2 points) on every axis.
-pub fn smooth_rule(lobes: &[Lobe], theta: f64, src: Stop, rec: Stop) -> Option<Rule> {
+pub fn smooth_rule(l: &LobesAt, src: Stop, rec: Stop) -> Option<Rule> {
     let range = [(src.p[1] - src.p[0]) + (rec.p[1] - rec.p[0]), (src.q[1] - src.q[0]) + (rec.q[1] - rec.q[0])];
-    let fits = |l: &Lobe| {
-        let w = lobe_widths_uv(l, theta);
+    let fits = |w: &[f64; 2]| {
         w.iter().all(|w| w.is_finite())
             && w[0] >= TENSOR_MIN_WIDTH_U * range[0]
             && (TENSOR_MIN_WIDTH * range[1]..=TENSOR_MAX_WIDTH_V * range[1]).contains(&w[1])
     };
-    if lobes.is_empty() || !lobes.iter().all(fits) {
+    if l.lobes.is_empty() || !l.widths.iter().all(fits) {
         return None;
     }
-    Some(Rule::TensorGauss { chart: TensorChart::PlainPLobeQ, levels: [1; 4], path: tensor::Path::default() })
+    Some(Rule::TensorGauss { chart: Chart::PlainPLobeQ, levels: [1; 4], path: tensor::Path::default() })
 }
 
 /// The polar rule of a lobe-chart part, if one fits ([`Rule::LobePolar`]): a material whose regular part is
@@ -267,12 +261,12 @@ pub fn smooth_rule(lobes: &[Lobe], theta: f64, src: Stop, rec: Stop) -> Option<R
 /// `docs/instrument.md` §Quadrature, *Measured tables*) whose centre u = v = 0 is inside the range of the lobe variables and at least
 /// [`POLAR_REACH`] widths from every kink of the overlap length and every end of the range, on both axes
 /// (on the u axis [`POLAR_REACH_GRAZING`] widths at geometry angles of [`POLAR_GRAZING`] and above).
-pub fn polar_rule(lobes: &[Lobe], has_diffuse: bool, theta: f64, src: Stop, rec: Stop) -> Option<Rule> {
-    let [lobe] = lobes else { return None };
-    if has_diffuse || lobe.tail != Tail::InverseQuartic {
+pub fn polar_rule(l: &LobesAt, src: Stop, rec: Stop) -> Option<Rule> {
+    let ([lobe], [width]) = (l.lobes, l.widths.as_slice()) else { return None };
+    if l.has_diffuse || lobe.tail != Tail::InverseQuartic {
         return None;
     }
-    let width = lobe_widths_uv(lobe, theta);
+    let width = *width;
     let breaks = |a: AxisMap, w: f64| {
         let [lo, hi] = a.range();
         let mut b = [lo, a.s[1] + a.r[0], a.s[0] + a.r[1], hi];
@@ -282,10 +276,29 @@ pub fn polar_rule(lobes: &[Lobe], has_diffuse: bool, theta: f64, src: Stop, rec:
     };
     let u = breaks(AxisMap { s: src.p, r: rec.p }, width[0])?;
     let v = breaks(AxisMap { s: src.q, r: rec.q }, width[1])?;
-    if theta >= POLAR_GRAZING && !u.iter().all(|k| k.abs() >= POLAR_REACH_GRAZING * width[0]) {
+    if l.theta >= POLAR_GRAZING && !u.iter().all(|k| k.abs() >= POLAR_REACH_GRAZING * width[0]) {
         return None;
     }
     Some(Rule::LobePolar { width, u, v, levels: [1; 9] })
+}
+
+/// What the rule choosers read about a material's lobes at one geometry angle θ: the lobes, their widths
+/// in (u, v) there (`aperture::lobe_widths_uv`, computed once per design for every chooser) and whether a
+/// diffuse term lies under them.
+#[derive(Clone, Debug)]
+pub struct LobesAt<'a> {
+    pub lobes: &'a [Lobe],
+    pub widths: Vec<[f64; 2]>,
+    pub has_diffuse: bool,
+    pub theta: f64,
+}
+
+impl<'a> LobesAt<'a> {
+    /// The lobes of `facts` at θ.
+    pub fn new(facts: &'a MaterialFacts, theta: f64) -> LobesAt<'a> {
+        let widths = facts.lobes.iter().map(|l| lobe_widths_uv(l, theta)).collect();
+        LobesAt { lobes: &facts.lobes, widths, has_diffuse: facts.has_diffuse, theta }
+    }
 }
 
 /// The initial boxes of a lobe chart with `kinks` kinks: every box cut on t_p into kinks + 1 equal pieces
@@ -319,7 +332,7 @@ impl Method {
     /// from their first two levels (what they evaluate before they can first stop), doubled for one raise; a
     /// sphere integral is a flat guess (4 096).
     pub fn expected_evaluations(&self) -> f64 {
-        if self.integral != Integral::Aperture {
+        if self.aperture.integral != Integral::Aperture {
             return 4096.0;
         }
         let genz_malik = |points: f64, cells: usize, refine: Refine| -> f64 {

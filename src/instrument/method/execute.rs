@@ -3,15 +3,12 @@
 //! the [`Flux`]; with freezing, also the method with its final partitions. The regular part's integrand (the
 //! BRDF batch in the chart's variables, times the geometric factor and the weighting) is built here once
 //! per execution and handed to the rules of `delta.rs`, `gauss.rs` and `polar.rs`.
-use super::delta::lobe_delta;
-use super::gauss::{lobe_gauss_hermite, tensor_boxes, tensor_gauss, LOBE_LEVELS};
-use super::polar::lobe_polar;
-use super::{Flux, Method, Projection, RegularPart, Rule, TensorChart};
+use super::chart::ChartMap;
+use super::rule::RuleRun;
+use super::{Flux, Method, Projection, RegularPart};
 use crate::brdf::Brdf;
 use crate::colorimetry::weighting::Weighting;
-use crate::instrument::aperture::{
-    half_angle_kink_point, incidence_kink_point, kinked_position, plain_kink_point, AxisMap, Chart,
-};
+use crate::instrument::aperture::{incidence_kink_point, kinked_position, Chart};
 use crate::instrument::geometry::{solid_angle_density, Axes, Integral, Stop};
 use crate::instrument::sphere;
 use crate::quadrature::{
@@ -66,61 +63,28 @@ impl Method {
         (ncomp, in_material)
     }
 
-    /// The integrand of the regular part `part` in the chart `vars` holds (the part's own, or a tensor rule's
-    /// while it runs): for each point of `pts`, `ncomp` values written to `out` — the weighted BRDF times
-    /// cos θi cos θo, the solid-angle densities of the two direction-cosine charts and the chart's Jacobian.
-    /// A point outside the overlap or below the horizon leaves its values as they were (the rules zero `out`).
+    /// The regular part's integrand in the chart `map` (the part's own, or a shaped rule's): for each point
+    /// of `pts`, `ncomp` values written to `out` — the weighted BRDF times cos θi cos θo, the solid-angle
+    /// densities of the two direction-cosine charts and the chart's Jacobian. A point outside the overlap
+    /// or below the horizon leaves its values as they were (the rules zero `out`).
     fn regular_integrand<'a>(
         &'a self,
         brdf: &'a dyn Brdf,
-        part: &'a RegularPart,
-        (src, rec): (Stop, Stop),
+        map: ChartMap<'a>,
         (ncomp, in_material): (usize, bool),
-        vars: &'a std::cell::Cell<TensorChart>,
     ) -> impl FnMut(&[[f64; 4]], &mut [f64]) + 'a {
-        let axes = Axes::new(self.theta);
-        let rec_axes = Axes::new(self.viewing);
-        let ap = AxisMap { s: src.p, r: rec.p };
-        let aq = AxisMap { s: src.q, r: rec.q };
         let (weighting, projection) = (&self.weighting, self.projection);
         let n = brdf.sampling().len();
-        let plain_kinked = part.chart == Chart::Plain && !part.kinks.is_empty();
         let mut batch = PairBatch::default();
         move |pts: &[[f64; 4]], out: &mut [f64]| {
             batch.clear(pts.len());
             for (i, x) in pts.iter().enumerate() {
-                let (ps, qs, pr, qr, jac) = if vars.get() == TensorChart::Plain && plain_kinked {
-                    // The plain chart cut at the kinks: x[0] is the kinked position t of p_s.
-                    let wo = rec_axes.receptor_dir(x[2], x[3]);
-                    let (ps, jp) = kinked_position(x[0], src.p[0], src.p[1], part.kinks.len(), |k| {
-                        let c = part.kinks[k];
-                        plain_kink_point(&axes, 2.0 * c * c - 1.0, x[1], wo, src.p[0], src.p[1])
-                    });
-                    (ps, x[1], x[2], x[3], jp)
-                } else if vars.get() == TensorChart::Plain {
-                    (x[0], x[1], x[2], x[3], 1.0)
-                } else if vars.get() == TensorChart::PlainPLobeQ {
-                    let (qs, qr, jq) = aq.at(x[2], x[3]);
-                    (x[0], qs, x[1], qr, jq)
-                } else if part.kinks.is_empty() {
-                    let (ps, pr, jp) = ap.at(x[0], x[1]);
-                    let (qs, qr, jq) = aq.at(x[2], x[3]);
-                    (ps, qs, pr, qr, jp * jq)
-                } else {
-                    let (qs, qr, jq) = aq.at(x[2], x[3]);
-                    let u = x[0];
-                    let (lo, hi) = ap.overlap(u);
-                    let (ps, jp) = kinked_position(x[1], lo, hi, part.kinks.len(), |k| {
-                        let c = part.kinks[k];
-                        half_angle_kink_point(&axes, 2.0 * c * c - 1.0, u, qs, qr, lo, hi)
-                    });
-                    (ps, qs, u - ps, qr, jp * jq)
-                };
+                let ([ps, qs, pr, qr], jac) = map.map(x);
                 if jac <= 0.0 {
                     continue;
                 }
-                let wi = axes.source_dir(ps, qs);
-                let wo = rec_axes.receptor_dir(pr, qr);
+                let wi = map.axes().source_dir(ps, qs);
+                let wo = map.rec_axes().receptor_dir(pr, qr);
                 if wi.z <= 0.0 || wo.z <= 0.0 {
                     continue;
                 }
@@ -144,28 +108,35 @@ impl Method {
         }
     }
 
+    /// The map of the regular part `part`'s integrand in `chart`: the part's kinks cut the part's own chart
+    /// (and a lobe chart a rule asks for); a plain rule on a lobe part, and the mixed chart, have none.
+    fn chart_map<'a>(&self, part: &'a RegularPart, chart: Chart, stops: (Stop, Stop)) -> ChartMap<'a> {
+        let kinks: &[f64] = if chart == Chart::Plain && part.chart != Chart::Plain { &[] } else { &part.kinks };
+        ChartMap::new(chart, kinks, self.aperture.theta, self.aperture.viewing, stops)
+    }
+
     /// The regular part's integrand at points `pts` of its chart (u, t_p, v, t_q in the lobe chart; p_s, q_s,
     /// p_r, q_r in the plain one): per point, the method's weighted components (or samples), exactly the
     /// values its rules integrate. For checking a rule's assumptions against a denser sampling of the same
     /// integrand (`tests/delta_limit.rs`); empty when there is no regular part or the stops are below the
     /// horizon.
     pub fn sample_regular(&self, brdf: &dyn Brdf, pts: &[[f64; 4]]) -> Vec<f64> {
-        let (Some(part), Some(stops), Integral::Aperture) = (&self.regular, self.clipped, self.integral) else {
+        let (Some(part), Some(stops), Integral::Aperture) = (&self.regular, self.clipped, self.aperture.integral)
+        else {
             return Vec::new();
         };
-        let chart = if part.chart == Chart::Plain { TensorChart::Plain } else { TensorChart::Lobe };
-        let vars = std::cell::Cell::new(chart);
         let comps = self.components(brdf);
         let mut out = vec![0.0; pts.len() * comps.0];
-        self.regular_integrand(brdf, part, stops, comps, &vars)(pts, &mut out);
+        self.regular_integrand(brdf, self.chart_map(part, part.chart, stops), comps)(pts, &mut out);
         out
     }
 
-    fn run(&self, brdf: &dyn Brdf, keep: bool, shared: Option<Instant>) -> (Flux, Option<Method>) {
-        let start = Instant::now();
-        // None stands for "no deadline" (also a budget too long to be an instant: never reached).
+    /// The instant the integral stops refining: its own budget from `start`, under a `shared` deadline (see
+    /// [`Method::execute_until`]). None stands for "no deadline" (also a budget too long to be an instant:
+    /// never reached).
+    fn deadline(&self, start: Instant, shared: Option<Instant>) -> Option<Instant> {
         let after = |s: f64| deadline_after(start, s);
-        let deadline = match (self.max_seconds, shared) {
+        match (self.max_seconds, shared) {
             (Some(s), Some(d)) => {
                 let late = after(LATE_START_SHARE * s).map(|l| d.max(l));
                 match (after(s), late) {
@@ -175,34 +146,44 @@ impl Method {
             }
             (Some(s), None) => after(s),
             (None, d) => d,
+        }
+    }
+
+    /// A sphere's integral (`Integral::Hemisphere`, `Integral::Port`): per sample, then weighted.
+    fn run_sphere(&self, brdf: &dyn Brdf, start: Instant) -> Flux {
+        let k = self.weighting.len();
+        let r = match self.aperture.integral {
+            Integral::Hemisphere => sphere::hemisphere_reflectance(brdf, self.aperture.theta),
+            Integral::Port { half_angle } => {
+                sphere::port_reflectance(brdf, self.aperture.theta, half_angle, self.rtol, self.max_evals)
+            }
+            Integral::Aperture => unreachable!("an aperture integral is not a sphere's"),
         };
+        let mut flux = Flux::zero(k);
+        flux.regular = self.weighting.apply(&r.value);
+        flux.error = (0..k).map(|c| self.weighting.component_error(c, &r.error)).collect();
+        flux.value = flux.regular.clone();
+        flux.evaluations = r.evaluations;
+        flux.converged = r.converged;
+        flux.budget_spent = !r.converged;
+        flux.seconds = start.elapsed().as_secs_f64();
+        flux
+    }
+
+    fn run(&self, brdf: &dyn Brdf, keep: bool, shared: Option<Instant>) -> (Flux, Option<Method>) {
+        let start = Instant::now();
+        let deadline = self.deadline(start, shared);
         let k = self.weighting.len();
         let n = brdf.sampling().len();
         let mut frozen = keep.then(|| self.clone());
-        if self.integral != Integral::Aperture {
-            // A sphere's integrals: per sample, then weighted (their integrators have no partition to freeze,
-            // so the frozen method is the method).
-            let r = match self.integral {
-                Integral::Hemisphere => sphere::hemisphere_reflectance(brdf, self.theta),
-                Integral::Port { half_angle } => {
-                    sphere::port_reflectance(brdf, self.theta, half_angle, self.rtol, self.max_evals)
-                }
-                Integral::Aperture => unreachable!("handled below"),
-            };
-            let mut flux = Flux::zero(k);
-            flux.regular = self.weighting.apply(&r.value);
-            flux.error = (0..k).map(|c| self.weighting.component_error(c, &r.error)).collect();
-            flux.value = flux.regular.clone();
-            flux.evaluations = r.evaluations;
-            flux.converged = r.converged;
-            flux.budget_spent = !r.converged;
-            flux.seconds = start.elapsed().as_secs_f64();
-            return (flux, frozen);
+        if self.aperture.integral != Integral::Aperture {
+            // Their integrators have no partition to freeze, so the frozen method is the method.
+            return (self.run_sphere(brdf, start), frozen);
         }
         let Some((src, rec)) = self.clipped else {
             return (Flux::zero(k), frozen);
         };
-        let axes = Axes::new(self.theta);
+        let axes = Axes::new(self.aperture.theta);
         // The material sums the one weighted component itself when `in_material`.
         let (ncomp, in_material) = self.components(brdf);
         let weighting = &self.weighting;
@@ -274,73 +255,36 @@ impl Method {
 
         // 2. The regular part, in its chart.
         if let Some(part) = &self.regular {
-            // The chart the integrand is evaluated in: the part's, or the shaped rule's while it runs.
-            let part_vars = if part.chart == Chart::Plain { TensorChart::Plain } else { TensorChart::Lobe };
-            let vars = std::cell::Cell::new(part_vars);
             let delta_min = flux.delta.iter().map(|d| d.abs()).fold(f64::INFINITY, f64::min);
             let atol = part.atol.max(part.rtol * delta_min);
-            let mut integrand = self.regular_integrand(brdf, part, (src, rec), (ncomp, in_material), &vars);
             // A smooth material's region estimates are trusted further (`docs/accuracy.md` §5): checked
             // children, and on the lobe chart (whose boxes are cut to the lobe's widths and kinks) a deeper
             // shrink; the plain chart's boxes are not cut to anything, and shrink least.
             let max_shrink = match part.chart {
                 Chart::Plain => MAX_SHRINK_PLAIN,
-                Chart::Lobe if smooth => MAX_SHRINK_LOBE,
+                Chart::Lobe | Chart::PlainPLobeQ if smooth => MAX_SHRINK_LOBE,
                 _ => MAX_SHRINK,
             };
             // The parent's check shrinks no estimate on the plain chart either: it was fooled there as the
             // null rules were (E2539 −15° on GGX tails, 11×; `docs/accuracy.md` §5.2).
             let checked = smooth && part.chart == Chart::Lobe;
             let opts = Options { rtol: part.rtol, atol, max_evals: self.max_evals, deadline, max_shrink, checked };
-            // A shaped rule first (when the planner chose one), the Genz–Malik partition if it does not agree.
-            let mut spent = 0;
-            let shaped = match part.rule {
-                Rule::LobeGaussHermite { width, levels } => {
-                    let r = lobe_gauss_hermite(&mut integrand, ncomp, width, levels, &opts, part.refine);
-                    spent = r.1;
-                    r.0.map(|(est, level)| (est, Rule::LobeGaussHermite { width, levels: (level - 1, level) }))
+            let run = RuleRun { ncomp, opts: &opts, refine: part.refine, stops: (src, rec), cells: &part.cells, keep };
+            // The part's rule, then its fallbacks (`Rule::fallback`) until one agrees; the Genz–Malik partition
+            // at the end of every chain always does. Each rule gets the integrand in its own chart.
+            let (mut spent, mut next) = (0, Some(part.rule));
+            let (mut est, rule, cells) = loop {
+                let rule = next.expect("the Genz–Malik partition ends every fallback chain");
+                let map = self.chart_map(part, rule.chart(part.chart), (src, rec));
+                let outcome = rule.estimate(&mut self.regular_integrand(brdf, map, (ncomp, in_material)), &run);
+                spent += outcome.spent;
+                if let Some(done) = outcome.done {
+                    break done;
                 }
-                Rule::LobeDelta { width } => {
-                    let (est, n) = lobe_delta(&mut integrand, ncomp, width, &opts);
-                    spent = n;
-                    match est {
-                        Some(est) if est.converged || part.refine == Refine::Frozen => {
-                            Some((est, Rule::LobeDelta { width }))
-                        }
-                        _ => {
-                            // The majorant did not meet the tolerance: the lobe's Gauss–Hermite rule.
-                            let levels = (0, LOBE_LEVELS.len() - 1);
-                            let r = lobe_gauss_hermite(&mut integrand, ncomp, width, levels, &opts, part.refine);
-                            spent += r.1;
-                            r.0.map(|(est, level)| (est, Rule::LobeGaussHermite { width, levels: (level - 1, level) }))
-                        }
-                    }
-                }
-                Rule::LobePolar { width, u, v, levels } => {
-                    let r = lobe_polar(&mut integrand, ncomp, width, [u, v], levels, &opts, part.refine);
-                    spent = r.1;
-                    r.0.map(|(est, levels)| (est, Rule::LobePolar { width, u, v, levels }))
-                }
-                Rule::TensorGauss { chart, levels, path } => {
-                    vars.set(chart);
-                    let replay = (part.refine == Refine::Frozen).then_some(path);
-                    let boxes = tensor_boxes(chart, src, rec);
-                    let r = tensor_gauss(&mut integrand, ncomp, chart, boxes, levels, &opts, replay);
-                    vars.set(part_vars);
-                    spent = r.1;
-                    r.0
-                }
-                Rule::GenzMalik75 => None,
+                next = rule.fallback();
             };
-            let (mut est, cells, rule) = match shaped {
-                Some((est, rule)) => (est, part.cells.clone(), rule),
-                None => {
-                    let (est, cells) =
-                        integrate_partition::<4, _>(&mut integrand, ncomp, &part.cells, &opts, part.refine, keep);
-                    (est, cells, Rule::GenzMalik75)
-                }
-            };
-            est.evaluations += spent;
+            est.evaluations = spent;
+            let cells = cells.unwrap_or_else(|| part.cells.clone());
             let (regular, regular_err) = weighted(&est);
             flux.regular = regular;
             flux.error = flux.error.iter().zip(&regular_err).map(|(a, b)| a + b).collect();
@@ -349,11 +293,7 @@ impl Method {
             flux.converged &= est.converged;
             flux.out_of_time |= est.out_of_time;
             flux.budget_spent |= !est.converged && !est.out_of_time && part.refine == Refine::Adaptive;
-            flux.chart = Some(match rule {
-                Rule::TensorGauss { chart: TensorChart::Plain, .. } => Chart::Plain,
-                Rule::TensorGauss { .. } => Chart::Lobe,
-                _ => part.chart,
-            });
+            flux.chart = Some(rule.chart(part.chart));
             if let Some(m) = frozen.as_mut() {
                 let p = m.regular.as_mut().expect("the same parts");
                 p.cells = cells;

@@ -18,7 +18,8 @@
 //! tolerance).
 //!
 //! The folder, one idea per file:
-//! - `mod.rs`: the method as plain data ([`Method`], [`Design`], [`Rule`], [`TensorChart`], [`DeltaPart`],
+//! - `mod.rs`: the method as plain data ([`Method`], its identity [`Aperture`], [`Design`] and the
+//!   [`MaterialFacts`] it reads, [`Rule`], [`DeltaPart`],
 //!   [`RegularPart`], [`Projection`], [`Target`]), the [`Flux`] it produces and [`Method::is_frozen`];
 //! - `design.rs`: [`Method::design`], [`Method::for_material`] and [`Method::expected_evaluations`] (the
 //!   scheduling guess of `Plan::run_all`), the rule choosers ([`delta_rule`], [`lobe_rule`], [`polar_rule`],
@@ -33,32 +34,36 @@
 //! - `polar.rs`: [`Rule::LobePolar`]'s executor ([`POLAR_LEVELS`], [`TAIL_LEVELS`]).
 //!
 //! A rule's tuning constants live in the file of the rule that uses them; the design gates in `design.rs`.
+mod chart;
 mod delta;
 mod design;
 mod execute;
 mod gauss;
 mod polar;
+mod rule;
 
+pub use chart::ChartMap;
 pub use delta::{
     delta_fit, delta_stencil, DeltaFit, DELTA_COST, DELTA_DIRECTIONS, DELTA_FIT_RADIUS, DELTA_RADII, DELTA_RADIUS,
     DELTA_SAFETY, DELTA_TAIL_SAFETY, DELTA_T_ORDERS,
 };
 pub use design::{
-    delta_rule, lobe_rule, polar_rule, smooth_rule, DELTA_GATE, LOBE_REACH, POLAR_GRAZING, POLAR_REACH,
+    delta_rule, lobe_rule, polar_rule, smooth_rule, LobesAt, DELTA_GATE, LOBE_REACH, POLAR_GRAZING, POLAR_REACH,
     POLAR_REACH_GRAZING, TENSOR_MAX_WIDTH_V, TENSOR_MIN_WIDTH, TENSOR_MIN_WIDTH_U,
 };
 pub use execute::{deadline_after, LATE_START_SHARE};
 pub use gauss::{tensor_boxes, LOBE_LEVELS, TENSOR_MAX_LEVEL};
 pub use polar::{POLAR_LEVELS, TAIL_LEVELS};
+pub use rule::{Integrand, Outcome, RuleRun, ShapedRule};
 
 #[cfg(doc)]
 use crate::instrument::aperture::DELTA_SHARE;
 #[cfg(doc)]
 use delta::delta_node;
 
-use crate::brdf::{Kink, Lobe};
+use crate::brdf::{Brdf, Kink, Lobe, TermKind};
 use crate::colorimetry::weighting::Weighting;
-use crate::instrument::aperture::Chart;
+pub use crate::instrument::aperture::Chart;
 use crate::instrument::geometry::{Integral, Stop};
 use crate::quadrature::{tensor, Cell, Refine};
 
@@ -67,6 +72,101 @@ use crate::quadrature::{tensor, Cell, Refine};
 pub enum Target {
     Specimen,
     Standard,
+}
+
+/// The identity of one integral: which material, what kind of integral, the geometry angle, the receptor's
+/// axis and the two stops as the geometry gives them. Everything a method's design depends on besides the
+/// material, the weighting and the tolerances, held once by the planner's draft, the [`Design`] and the
+/// [`Method`]. Equal and hashed by the bits of its numbers: it is the key under which a plan shares one
+/// flux between readings and the planner caches a standard's flux (`plan::compile`), so two integrals are
+/// one when, and only when, their designs are the same bits.
+#[derive(Clone, Copy, Debug)]
+pub struct Aperture {
+    pub target: Target,
+    /// What is integrated: an aperture integral, or a d/8 sphere's hemisphere or specular port (then the
+    /// stops are unused, and zero).
+    pub integral: Integral,
+    /// Geometry angle θ (the source lens axis; a sphere's viewing angle).
+    pub theta: f64,
+    /// The receptor lens axis, radians, signed: θ for gloss; θ − aspecular for multi-angle colour, whose
+    /// receptor never sees the mirror image (no delta part, the plain chart).
+    pub viewing: f64,
+    pub source: Stop,
+    pub receptor: Stop,
+}
+
+impl Aperture {
+    /// Every field as bits, the integral's kind as a code: what equality and the hash compare.
+    fn bits(&self) -> [u64; 13] {
+        let (kind, half_angle) = match self.integral {
+            Integral::Aperture => (0, 0.0),
+            Integral::Hemisphere => (1, 0.0),
+            Integral::Port { half_angle } => (2, half_angle),
+        };
+        let [s, r] = [self.source, self.receptor];
+        [
+            self.target as u64,
+            kind,
+            half_angle.to_bits(),
+            self.theta.to_bits(),
+            self.viewing.to_bits(),
+            s.p[0].to_bits(),
+            s.p[1].to_bits(),
+            s.q[0].to_bits(),
+            s.q[1].to_bits(),
+            r.p[0].to_bits(),
+            r.p[1].to_bits(),
+            r.q[0].to_bits(),
+            r.q[1].to_bits(),
+        ]
+    }
+}
+
+impl PartialEq for Aperture {
+    fn eq(&self, other: &Aperture) -> bool {
+        self.bits() == other.bits()
+    }
+}
+
+impl Eq for Aperture {}
+
+impl std::hash::Hash for Aperture {
+    fn hash<H: std::hash::Hasher>(&self, state: &mut H) {
+        self.bits().hash(state)
+    }
+}
+
+/// What the designer needs to know about a material, read from its terms once per plan (not once per
+/// integral): its lobes (for the chart, the split points and the shaped rules), its kinks (put on partition
+/// boundaries) and which kinds of terms it has.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MaterialFacts {
+    pub lobes: Vec<Lobe>,
+    /// The material's kinks (`Brdf::kinks`).
+    pub kinks: Vec<Kink>,
+    /// Whether the material has a delta term, a regular (diffuse or lobe) term, and a diffuse one.
+    pub has_delta: bool,
+    pub has_regular: bool,
+    pub has_diffuse: bool,
+}
+
+impl MaterialFacts {
+    /// The facts of `brdf`'s terms and kinks.
+    pub fn of(brdf: &dyn Brdf) -> MaterialFacts {
+        let terms = brdf.terms();
+        MaterialFacts {
+            lobes: brdf.lobes(),
+            kinks: brdf.kinks(),
+            has_delta: terms.iter().any(|t| t.kind == TermKind::Delta),
+            has_regular: terms.iter().any(|t| t.kind != TermKind::Delta),
+            has_diffuse: terms.iter().any(|t| t.kind == TermKind::Diffuse),
+        }
+    }
+
+    /// A gloss standard's: an ideal mirror and nothing else.
+    pub fn mirror() -> MaterialFacts {
+        MaterialFacts { lobes: vec![], kinks: vec![], has_delta: true, has_regular: false, has_diffuse: false }
+    }
 }
 
 /// The cubature rule of a part, chosen by the planner ([`Method::design`]) from the material's lobes and the
@@ -115,20 +215,7 @@ pub enum Rule {
     /// sum of the per-axis differences of successive orders (the error estimate) meets the part's tolerance. If they do
     /// not, the part's Genz–Malik partition is integrated instead (the fallback). `path` is empty when designed; a
     /// frozen method keeps the raises of its run and replays them (the same points, the same bits).
-    TensorGauss { chart: TensorChart, levels: [usize; 4], path: tensor::Path },
-}
-
-/// The variables of [`Rule::TensorGauss`].
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum TensorChart {
-    /// (p_s, q_s, p_r, q_r) on the one box of the stops' product.
-    Plain,
-    /// (u, t_p, v, t_q) on the boxes between the overlap kinks of u and v.
-    Lobe,
-    /// (p_s, p_r, v, t_q): plain in the plane of incidence, lobe variables across it, on the boxes between
-    /// the overlap kinks of v (a lobe wider than the stops in u but not in v: the ridge v = q_s + q_r
-    /// becomes an axis).
-    PlainPLobeQ,
+    TensorGauss { chart: Chart, levels: [usize; 4], path: tensor::Path },
 }
 
 /// When the spectral weighting is applied.
@@ -186,18 +273,10 @@ pub struct RegularPart {
 /// One aperture integral, designed.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Method {
-    pub target: Target,
-    /// What is integrated: an aperture integral, or a d/8 sphere's hemisphere or specular port (then the
-    /// stops, parts and partitions below are unused and the sphere's own integrators run, `instrument::sphere`).
-    pub integral: Integral,
-    /// Geometry angle θ (the source lens axis; a sphere's viewing angle).
-    pub theta: f64,
-    /// The receptor lens axis, radians, signed: θ for gloss; θ − aspecular for multi-angle colour, whose
-    /// receptor never sees the mirror image (no delta part, the plain chart).
-    pub viewing: f64,
-    /// The stops as the geometry gives them.
-    pub source: Stop,
-    pub receptor: Stop,
+    /// Which integral this is (the material, the kind of integral, the axes, the stops as the geometry gives
+    /// them). A sphere's integral (`Integral::Hemisphere`, `Integral::Port`) leaves the stops, parts and
+    /// partitions below unused: the sphere's own integrators run (`instrument::sphere`).
+    pub aperture: Aperture,
     /// The stops clipped to the upper hemisphere; None: one is entirely below the horizon (the flux is 0).
     pub clipped: Option<(Stop, Stop)>,
     /// The mirror overlap of the clipped stops (whether the receptor sees the mirror image of the source),
@@ -223,20 +302,9 @@ pub struct Method {
 /// What the designer needs to know about an integral.
 #[derive(Clone, Debug)]
 pub struct Design<'a> {
-    pub target: Target,
-    pub integral: Integral,
-    pub theta: f64,
-    pub viewing: f64,
-    pub source: Stop,
-    pub receptor: Stop,
-    /// The material's lobes (for the chart and the split points).
-    pub lobes: &'a [Lobe],
-    /// The material's kinks (`Brdf::kinks`): put on partition boundaries.
-    pub kinks: &'a [Kink],
-    /// Whether the material has a delta term and a regular (diffuse or lobe) term, and a diffuse one.
-    pub has_delta: bool,
-    pub has_regular: bool,
-    pub has_diffuse: bool,
+    pub aperture: Aperture,
+    /// What the designer needs to know about the material (computed once per plan).
+    pub facts: &'a MaterialFacts,
     pub weighting: Weighting,
     pub projection: Projection,
     /// Relative tolerance of the flux and its absolute floor.
@@ -272,7 +340,8 @@ pub struct Flux {
     pub budget_spent: bool,
     /// Wall time of the integral.
     pub seconds: f64,
-    /// The chart the regular part was integrated in (None: there was no regular part).
+    /// The chart the regular part was integrated in: the part's, or the shaped rule's that gave the value
+    /// (None: there was no regular part).
     pub chart: Option<Chart>,
     /// The data (resolution) uncertainty per component, absolute, for a measured table read through the
     /// plan (`Plan::run`; `docs/accuracy.md` §Data uncertainty of measured tables); None for a model, and for

@@ -1,7 +1,7 @@
 //! [`Rule::LobePolar`]: a lobe with GGX's heavy tail, its (u, v) range cut at the overlap kinks into up to
 //! 3 × 3 pieces — the one that holds the lobe centre in polar variables, the others in tail variables — each
 //! raised level by level ([`POLAR_LEVELS`], [`TAIL_LEVELS`]) where the error is largest.
-#[cfg(doc)]
+use super::rule::{Integrand, Outcome, RuleRun, ShapedRule};
 use super::Rule;
 use crate::quadrature::{
     legendre_on_into, mapped_legendre_into, polar_rectangle_into, Estimate, Map, Options, PolarBuffers, Refine,
@@ -93,7 +93,7 @@ fn polar_piece_points(width: [f64; 2], interval: [[f64; 2]; 2], central: bool, l
 
 /// The sum of the points in `s` per component into `sum` (non-finite values count as 0, as in
 /// `gauss::lobe_tensor_sum`).
-fn polar_piece_sum(f: &mut impl FnMut(&[[f64; 4]], &mut [f64]), ncomp: usize, s: &mut PolarScratch, sum: &mut [f64]) {
+fn polar_piece_sum(f: &mut Integrand, ncomp: usize, s: &mut PolarScratch, sum: &mut [f64]) {
     s.vals.clear();
     s.vals.resize(s.pts.len() * ncomp, 0.0);
     f(&s.pts, &mut s.vals);
@@ -107,14 +107,31 @@ fn polar_piece_sum(f: &mut impl FnMut(&[[f64; 4]], &mut [f64]), ncomp: usize, s:
     }
 }
 
+/// [`Rule::LobePolar`]'s parameters: the lobe's widths, the cuts of u and v, the pieces' levels.
+pub(super) struct Polar {
+    pub width: [f64; 2],
+    pub breaks: [[f64; 4]; 2],
+    pub levels: [u8; 9],
+}
+
+impl ShapedRule for Polar {
+    /// The pieces raised where the error is largest until the sum meets the tolerance (frozen: the levels
+    /// reached before).
+    fn estimate(&self, f: &mut Integrand, run: &RuleRun) -> Outcome {
+        let (width, [u, v]) = (self.width, self.breaks);
+        let (done, spent) = lobe_polar(f, run.ncomp, width, self.breaks, self.levels, run.opts, run.refine);
+        Outcome::shaped(done.map(|(est, levels)| (est, Rule::LobePolar { width, u, v, levels })), spent)
+    }
+}
+
 /// Run [`Rule::LobePolar`]: every piece at its level and the one below; while the summed differences exceed
 /// max(atol, rtol·|I|) in some component, the piece with the largest difference (relative to that tolerance;
 /// the first on ties) goes one level up (adaptive; a frozen rule keeps its levels). Returns the estimate and
 /// the pieces' levels when the sum meets the tolerance, None when the piece to raise has no level left or the
 /// budget would be exceeded, and the evaluations spent either way. Its buffers are made once here (per
 /// piece and per execution, not per level).
-pub(super) fn lobe_polar(
-    f: &mut impl FnMut(&[[f64; 4]], &mut [f64]),
+fn lobe_polar(
+    f: &mut Integrand,
     ncomp: usize,
     width: [f64; 2],
     breaks: [[f64; 4]; 2],
@@ -210,5 +227,55 @@ pub(super) fn lobe_polar(
         let p = &mut pieces[worst];
         p.at = at;
         p.level = level;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::instrument::geometry::Stop;
+    use crate::quadrature::Cell;
+
+    /// ∫₀^a ∫₀^b dx dy / (1 + x² + y²)²: the GGX kernel over a rectangle with a corner at its centre (the
+    /// form factor of a rectangle; checked against a 3 000² midpoint sum to 3·10⁻⁹).
+    fn corner(a: f64, b: f64) -> f64 {
+        let (ra, rb) = ((1.0 + a * a).sqrt(), (1.0 + b * b).sqrt());
+        a / (2.0 * ra) * (b / ra).atan() + b / (2.0 * rb) * (a / rb).atan()
+    }
+
+    #[test]
+    fn the_polar_rule_integrates_the_ggx_kernel_over_its_nine_pieces() {
+        let w = [0.002, 0.0015];
+        // The u and v ranges cut at ±2 and ±(5, 4) widths: a polar centre and eight tail pieces.
+        let (bu, bv) = ([-5.0, -2.0, 2.0, 5.0], [-4.0, -2.0, 2.0, 4.0]);
+        let breaks = [bu.map(|x| x * w[0]), bv.map(|x| x * w[1])];
+        let exact = w[0] * w[1] * 4.0 * corner(5.0, 4.0);
+        let mut f = |pts: &[[f64; 4]], out: &mut [f64]| {
+            for (x, o) in pts.iter().zip(out.iter_mut()) {
+                let (u, v) = (x[0] / w[0], x[2] / w[1]);
+                *o = 1.0 / (1.0 + u * u + v * v).powi(2);
+            }
+        };
+        let opts = Options { rtol: 1e-9, ..Options::default() };
+        let stop = Stop { p: [-0.02, 0.02], q: [-0.02, 0.02] };
+        let run = RuleRun {
+            ncomp: 1,
+            opts: &opts,
+            refine: Refine::Adaptive,
+            stops: (stop, stop),
+            cells: &[] as &[Cell<4>],
+            keep: false,
+        };
+        let out = Polar { width: w, breaks, levels: [1; 9] }.estimate(&mut f, &run);
+        let (est, frozen, _) = out.done.expect("converges");
+        let actual = (est.value[0] - exact).abs();
+        assert!(actual <= est.error[0] && est.error[0] <= 1e-9 * exact, "{actual:e} {:e}", est.error[0]);
+        let Rule::LobePolar { levels, .. } = frozen else { panic!("{frozen:?}") };
+        assert!(levels.iter().all(|&l| l >= 1) && levels.iter().any(|&l| l > 1), "{levels:?}");
+        // Frozen at the levels it reached: the same bits again, at the same cost.
+        let again = RuleRun { refine: Refine::Frozen, ..run };
+        let out2 = Polar { width: w, breaks, levels }.estimate(&mut f, &again);
+        let (est2, _, _) = out2.done.unwrap();
+        assert_eq!(est2.value[0].to_bits(), est.value[0].to_bits());
     }
 }

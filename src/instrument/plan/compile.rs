@@ -8,12 +8,12 @@ use std::sync::{Arc, Mutex};
 
 use rayon::prelude::*;
 
-use crate::brdf::{Brdf, Lobe, TermKind};
+use crate::brdf::Brdf;
 use crate::colorimetry::weighting::{Weighting, WeightingKind};
 use crate::colorimetry::Conditions;
 use crate::instrument::geometry::{Integral, Stop};
 use crate::instrument::method::Flux;
-use crate::instrument::method::{Design, Method, Projection, Target};
+use crate::instrument::method::{Aperture, Design, MaterialFacts, Method, Projection, Target};
 use crate::instrument::reading::{ReadingSpec, Scale};
 use crate::instrument::standards::{self, StandardGeometry};
 use crate::spectrum::Sampling;
@@ -28,47 +28,38 @@ pub fn rtol_refusal(rtol: f64) -> Option<String> {
         .then(|| format!("must be a number in (0, 1), got {}", crate::error::given(rtol)))
 }
 
-/// The identity of a job for sharing: every input of its design, as bits.
-#[derive(Clone, Debug, PartialEq, Eq, Hash)]
-struct JobKey(Vec<u64>);
+/// The identity of a job for sharing: its integral, and for a standard the scale (which standard is
+/// integrated); as bits.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+struct JobKey {
+    aperture: Aperture,
+    scale: Option<[u64; 3]>,
+}
 
-fn job_key(
-    target: Target,
-    integral: Integral,
-    theta: f64,
-    viewing: f64,
-    scale: Scale,
-    source: Stop,
-    receptor: Stop,
-) -> JobKey {
-    let (kind, half_angle) = match integral {
-        Integral::Aperture => (0, 0.0),
-        Integral::Hemisphere => (1, 0.0),
-        Integral::Port { half_angle } => (2, half_angle),
-    };
-    let mut k = vec![target as u64, theta.to_bits(), kind, half_angle.to_bits(), viewing.to_bits()];
-    if target == Target::Standard {
-        k.extend(scale.key());
+impl JobKey {
+    fn new(aperture: Aperture, scale: Scale) -> JobKey {
+        JobKey { aperture, scale: (aperture.target == Target::Standard).then(|| scale.key()) }
     }
-    for s in [source, receptor] {
-        k.extend([s.p[0], s.p[1], s.q[0], s.q[1]].iter().map(|x| x.to_bits()));
-    }
-    JobKey(k)
+}
+
+/// The key of a standard's flux in the planner's cache: the job's, and the options its method depends on
+/// (tolerance and budgets), as bits.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+struct StandardKey {
+    job: JobKey,
+    rtol: u64,
+    max_evals: usize,
+    max_seconds: Option<u64>,
 }
 
 /// A job before its method is designed.
 struct Draft {
-    target: Target,
-    integral: Integral,
-    theta: f64,
-    viewing: f64,
+    aperture: Aperture,
     /// The weightings of the readings that use it (each once, sorted: the job's k × n matrix stacks them).
     kinds: Vec<WeightingKind>,
     /// The smallest perfect-diffuser flux of the colour readings that use it (their absolute floor).
     colour_white: Option<f64>,
     scale: Scale,
-    source: Stop,
-    receptor: Stop,
     used_by: Vec<String>,
 }
 
@@ -80,7 +71,7 @@ pub struct Planner {
     /// Every builtin geometry (gloss, then colour), copied on first use only: a planner that only compiles
     /// plans never needs them (the geometries come resolved), and `geometry` borrows the per-process parse.
     builtin: std::sync::OnceLock<Vec<StandardGeometry>>,
-    standards: Mutex<HashMap<JobKey, Flux>>,
+    standards: Mutex<HashMap<StandardKey, Flux>>,
 }
 
 impl Planner {
@@ -138,28 +129,7 @@ impl Planner {
         if geometries.is_empty() {
             return Err(Error::Usage("no geometry to measure".into()));
         }
-        // Requested geometries first, then the dependencies of composites.
-        let mut queue: Vec<(StandardGeometry, bool)> = geometries.into_iter().map(|g| (g, true)).collect();
-        let mut i = 0;
-        while i < queue.len() {
-            let parts: Vec<String> = queue[i]
-                .0
-                .geometry
-                .readings
-                .iter()
-                .filter_map(|spec| match spec {
-                    ReadingSpec::HazeIndex { minuend, subtrahend } => Some([minuend.clone(), subtrahend.clone()]),
-                    _ => None,
-                })
-                .flatten()
-                .collect();
-            for id in parts {
-                if !queue.iter().any(|(q, _)| q.geometry.id == id) {
-                    queue.push((self.geometry(&id)?, false));
-                }
-            }
-            i += 1;
-        }
+        let queue = self.with_dependencies(geometries)?;
         // The spectral weighting: the kinds the readings ask for, each once, in order of first use.
         let colour = options.colour;
         let kinds: Vec<WeightingKind> =
@@ -178,38 +148,15 @@ impl Planner {
         for (g, reported) in &queue {
             add_geometry(g, *reported, colour, options.share_fluxes, &mut drafts, &mut readings, &mut index)?;
         }
-        // Composites: resolve their parts now that every gloss reading exists.
-        for r in 0..readings.len() {
-            if let ReadingSpec::HazeIndex { minuend, subtrahend } = readings[r].spec.clone() {
-                let mut parts = Vec::new();
-                for id in [&minuend, &subtrahend] {
-                    let part = readings
-                        .iter()
-                        .position(|x| &x.geometry == id && matches!(x.spec, ReadingSpec::Gloss { .. }))
-                        .ok_or_else(|| {
-                            Error::Usage(format!("{}: geometry `{id}` has no gloss reading", readings[r].geometry))
-                        })?;
-                    parts.push(part);
-                }
-                readings[r].parts = parts;
-            }
-        }
+        resolve_composites(&mut readings)?;
 
         // Step 1a: the standards' methods, executed now (cached across plans).
         let standard_weighting = Weighting::luminous(&Sampling::grey())?;
+        let mirror = MaterialFacts::mirror();
         let standard_method = |d: &Draft| {
             Method::design(Design {
-                target: Target::Standard,
-                integral: d.integral,
-                theta: d.theta,
-                viewing: d.viewing,
-                source: d.source,
-                receptor: d.receptor,
-                lobes: &[],
-                kinks: &[],
-                has_delta: true,
-                has_regular: false,
-                has_diffuse: false,
+                aperture: d.aperture,
+                facts: &mirror,
                 weighting: standard_weighting.clone(),
                 projection: Projection::Fold,
                 rtol: STANDARD_SHARE * options.rtol,
@@ -218,7 +165,8 @@ impl Planner {
                 max_seconds: options.max_seconds,
             })
         };
-        let std_idx: Vec<usize> = (0..drafts.len()).filter(|&j| drafts[j].target == Target::Standard).collect();
+        let std_idx: Vec<usize> =
+            (0..drafts.len()).filter(|&j| drafts[j].aperture.target == Target::Standard).collect();
         let std_methods: Vec<Method> = std_idx.iter().map(|&j| standard_method(&drafts[j])).collect();
         let std_drafts: Vec<&Draft> = std_idx.iter().map(|&j| &drafts[j]).collect();
         let std_flux = self.standard_fluxes(&std_drafts, &std_methods, &options);
@@ -230,13 +178,13 @@ impl Planner {
             let m = std_idx
                 .iter()
                 .zip(&std_flux)
-                .filter(|(&j, _)| drafts[j].theta == theta)
+                .filter(|(&j, _)| drafts[j].aperture.theta == theta)
                 .map(|(_, f)| f.value[0])
                 .fold(0.0, f64::max);
             1e-4 * options.rtol * m
         };
         let specimen_floor = |d: &Draft| -> f64 {
-            let gloss = d.kinds.contains(&WeightingKind::Luminous).then(|| floor(d.theta));
+            let gloss = d.kinds.contains(&WeightingKind::Luminous).then(|| floor(d.aperture.theta));
             let colour = d.colour_white.map(|w| 1e-2 * options.rtol * w);
             match (gloss, colour) {
                 (Some(a), Some(b)) => a.min(b),
@@ -244,13 +192,9 @@ impl Planner {
             }
         };
 
-        // Step 1b: the specimen's methods.
+        // Step 1b: the specimen's methods, from the material's facts read once.
         let terms = material.terms();
-        let lobes: Vec<Lobe> = material.lobes();
-        let kinks = material.kinks();
-        let has_delta = material.has_delta();
-        let has_regular = material.has_regular();
-        let has_diffuse = terms.iter().any(|t| t.kind == TermKind::Diffuse);
+        let facts = MaterialFacts::of(material.as_ref());
         let projection = match (options.fold_spectral, options.fold_in_material) {
             (false, _) => Projection::Separate,
             (true, false) => Projection::Fold,
@@ -260,24 +204,15 @@ impl Planner {
         let mut standard_flux = vec![None; drafts.len()];
         let mut std_results = std_methods.into_iter().zip(std_flux.iter().cloned());
         for (j, d) in drafts.iter().enumerate() {
-            let method = match d.target {
+            let method = match d.aperture.target {
                 Target::Standard => {
                     let (m, f) = std_results.next().expect("one standard method per standard job");
                     standard_flux[j] = Some(f);
                     m
                 }
                 Target::Specimen => Method::design(Design {
-                    target: Target::Specimen,
-                    integral: d.integral,
-                    theta: d.theta,
-                    viewing: d.viewing,
-                    source: d.source,
-                    receptor: d.receptor,
-                    lobes: &lobes,
-                    kinks: &kinks,
-                    has_delta,
-                    has_regular,
-                    has_diffuse,
+                    aperture: d.aperture,
+                    facts: &facts,
                     // Only the kinds of the readings that use this flux: a gloss flux stays one luminous
                     // component (and the same bits) whatever colour readings share the plan.
                     weighting: Weighting::stack(&d.kinds, material.sampling())?,
@@ -310,6 +245,33 @@ impl Planner {
         })
     }
 
+    /// The requested geometries (reported), then the geometries their composites combine (not reported),
+    /// each once.
+    fn with_dependencies(&self, geometries: Vec<StandardGeometry>) -> Result<Vec<(StandardGeometry, bool)>> {
+        let mut queue: Vec<(StandardGeometry, bool)> = geometries.into_iter().map(|g| (g, true)).collect();
+        let mut i = 0;
+        while i < queue.len() {
+            let parts: Vec<String> = queue[i]
+                .0
+                .geometry
+                .readings
+                .iter()
+                .filter_map(|spec| match spec {
+                    ReadingSpec::HazeIndex { minuend, subtrahend } => Some([minuend.clone(), subtrahend.clone()]),
+                    _ => None,
+                })
+                .flatten()
+                .collect();
+            for id in parts {
+                if !queue.iter().any(|(q, _)| q.geometry.id == id) {
+                    queue.push((self.geometry(&id)?, false));
+                }
+            }
+            i += 1;
+        }
+        Ok(queue)
+    }
+
     /// The fluxes of the gloss standards, from the cache or computed (and cached): the cache is read once,
     /// under one lock, and only the fluxes it lacks are computed, in parallel (in a batch every plan after
     /// the first finds them all, and then hands nothing to the pool). With sharing off, always computed (the
@@ -319,13 +281,13 @@ impl Planner {
         if !options.share_fluxes {
             return drafts.par_iter().zip(methods).map(|(d, m)| compute(d, m)).collect();
         }
-        let keys: Vec<JobKey> = drafts
+        let keys: Vec<StandardKey> = drafts
             .iter()
-            .map(|d| {
-                let mut key = job_key(Target::Standard, d.integral, d.theta, d.viewing, d.scale, d.source, d.receptor);
-                key.0.extend([options.rtol.to_bits(), options.max_evals as u64]);
-                key.0.extend(options.max_seconds.map(f64::to_bits));
-                key
+            .map(|d| StandardKey {
+                job: JobKey::new(d.aperture, d.scale),
+                rtol: options.rtol.to_bits(),
+                max_evals: options.max_evals,
+                max_seconds: options.max_seconds.map(f64::to_bits),
             })
             .collect();
         let mut flux: Vec<Option<Flux>> = match self.standards.lock() {
@@ -345,6 +307,27 @@ impl Planner {
         }
         flux.into_iter().map(|f| f.expect("every standard computed")).collect()
     }
+}
+
+/// Composites: their parts (the gloss readings of the geometries they combine) resolved, now that every gloss
+/// reading exists.
+fn resolve_composites(readings: &mut [PlannedReading]) -> Result<()> {
+    for r in 0..readings.len() {
+        if let ReadingSpec::HazeIndex { minuend, subtrahend } = readings[r].spec.clone() {
+            let mut parts = Vec::new();
+            for id in [&minuend, &subtrahend] {
+                let part = readings
+                    .iter()
+                    .position(|x| &x.geometry == id && matches!(x.spec, ReadingSpec::Gloss { .. }))
+                    .ok_or_else(|| {
+                        Error::Usage(format!("{}: geometry `{id}` has no gloss reading", readings[r].geometry))
+                    })?;
+                parts.push(part);
+            }
+            readings[r].parts = parts;
+        }
+    }
+    Ok(())
 }
 
 /// Add the readings of one geometry and the drafts of the jobs they need (shared by key when `share`).
@@ -401,7 +384,8 @@ fn add_geometry(
                         (Integral::Aperture, g.viewing, g.source, stop)
                     }
                 };
-                let key = job_key(target, integral, g.theta, viewing, g.scale, source, stop);
+                let aperture = Aperture { target, integral, theta: g.theta, viewing, source, receptor: stop };
+                let key = JobKey::new(aperture, g.scale);
                 let used = format!("{}/{rx}", g.id);
                 let job_kind = if target == Target::Standard { WeightingKind::Luminous } else { kind };
                 let j = match index.get(&key) {
@@ -421,15 +405,10 @@ fn add_geometry(
                     }
                     _ => {
                         drafts.push(Draft {
-                            target,
-                            integral,
-                            theta: g.theta,
-                            viewing,
+                            aperture,
                             kinds: vec![job_kind],
                             colour_white,
                             scale: g.scale,
-                            source,
-                            receptor: stop,
                             used_by: vec![used],
                         });
                         index.insert(key, drafts.len() - 1);
@@ -514,7 +493,7 @@ mod tests {
         for j in &plan.jobs {
             let m = &j.method;
             assert!(m.clipped.is_some());
-            match m.target {
+            match m.aperture.target {
                 Target::Standard => {
                     assert!(m.regular.is_none());
                     assert_eq!(m.delta.is_some(), m.mirror.is_some());
@@ -535,7 +514,7 @@ mod tests {
         }
         assert!(text.contains("plain variables"), "{text}");
         // The offset receptors of E430 do not see the mirror image: the standard's method says so.
-        assert!(plan.jobs.iter().any(|j| j.method.target == Target::Standard) && text.contains("Standard"));
+        assert!(plan.jobs.iter().any(|j| j.method.aperture.target == Target::Standard) && text.contains("Standard"));
     }
 
     #[test]

@@ -7,8 +7,8 @@ use crate::colorimetry::weighting::Weighting;
 use crate::instrument::aperture::{lobe_widths_uv, Chart, DELTA_SHARE};
 use crate::instrument::geometry::Integral;
 use crate::instrument::method::{
-    Method, Projection, Rule, Target, TensorChart, DELTA_FIT_RADIUS, DELTA_RADII, DELTA_RADIUS, DELTA_SAFETY,
-    DELTA_TAIL_SAFETY, DELTA_T_ORDERS, LOBE_LEVELS, LOBE_REACH, POLAR_LEVELS, POLAR_REACH, TENSOR_MAX_LEVEL,
+    Method, Projection, Rule, Target, DELTA_FIT_RADIUS, DELTA_RADII, DELTA_RADIUS, DELTA_SAFETY, DELTA_TAIL_SAFETY,
+    DELTA_T_ORDERS, LOBE_LEVELS, LOBE_REACH, POLAR_LEVELS, POLAR_REACH, TENSOR_MAX_LEVEL,
 };
 use crate::instrument::reading::ReadingSpec;
 use crate::quadrature::{tensor, Refine};
@@ -22,7 +22,8 @@ impl Plan {
         let mut s = String::new();
         s.push_str(&format!("Material: {}\n", m.describe()));
         s.push_str(&format!("Spectral samples: {}\n", m.sampling().describe()));
-        let projection = self.jobs.iter().find(|j| j.method.target == Target::Specimen).map(|j| j.method.projection);
+        let projection =
+            self.jobs.iter().find(|j| j.method.aperture.target == Target::Specimen).map(|j| j.method.projection);
         s.push_str(&format!(
             "Spectral weighting: {} ({} component(s) per flux, from {} sample(s)); {}\n",
             self.weighting.describe(),
@@ -123,7 +124,7 @@ impl Plan {
                 ));
             }
         }
-        let n_spec = self.jobs.iter().filter(|j| j.method.target == Target::Specimen).count();
+        let n_spec = self.jobs.iter().filter(|j| j.method.aperture.target == Target::Specimen).count();
         let n_std = self.jobs.len() - n_spec;
         let uses: usize = self.readings.iter().map(|r| r.specimen_jobs.len() + r.standard_jobs.len()).sum();
         s.push_str(&format!(
@@ -139,15 +140,18 @@ impl Plan {
             }
         ));
         for (i, j) in self.jobs.iter().enumerate() {
-            let viewing = if j.method.viewing != j.method.theta {
-                format!(", receptor axis {:.4}° (off specular: no mirror image)", j.method.viewing.to_degrees())
+            let viewing = if j.method.aperture.viewing != j.method.aperture.theta {
+                format!(
+                    ", receptor axis {:.4}° (off specular: no mirror image)",
+                    j.method.aperture.viewing.to_degrees()
+                )
             } else {
                 String::new()
             };
             s.push_str(&format!(
                 "  #{i}: {:?} at {:.4}°{viewing}, {} component(s), {}; used by {}\n",
-                j.method.target,
-                j.method.theta.to_degrees(),
+                j.method.aperture.target,
+                j.method.aperture.theta.to_degrees(),
                 j.method.weighting.len(),
                 describe_method(&j.method, &self.terms),
                 j.used_by.join(", ")
@@ -183,7 +187,7 @@ impl Plan {
 
 /// One method in words, from its stored fields.
 fn describe_method(m: &Method, terms: &[Term]) -> String {
-    match m.integral {
+    match m.aperture.integral {
         Integral::Hemisphere => {
             return "d/8 sphere: directional–hemispherical reflectance at the viewing angle per sample (brdf::albedo of \
                     the transposed BRDF, Gauss–Kronrod in half-vector coordinates), delta included, then weighted"
@@ -201,7 +205,7 @@ fn describe_method(m: &Method, terms: &[Term]) -> String {
     if m.clipped.is_none() {
         return "stops below the horizon: zero".to_string();
     }
-    let material_has_delta = m.target == Target::Standard || terms.iter().any(|t| t.kind == TermKind::Delta);
+    let material_has_delta = m.aperture.target == Target::Standard || terms.iter().any(|t| t.kind == TermKind::Delta);
     let frozen = |r: Refine| if r == Refine::Frozen { ", frozen" } else { "" };
     let delta = match (&m.delta, material_has_delta, m.mirror.is_some()) {
         (Some(p), _, _) => format!(
@@ -219,7 +223,7 @@ fn describe_method(m: &Method, terms: &[Term]) -> String {
                 "plain variables (no lobe narrower than the stops){}",
                 describe_kinks(&p.kinks, "p_s cut along ωi·h = cos θc")
             ),
-            Chart::Lobe => format!(
+            Chart::Lobe | Chart::PlainPLobeQ => format!(
                 "lobe variables, {} × {} split points{}",
                 p.splits[0].len(),
                 p.splits[1].len(),
@@ -312,12 +316,12 @@ fn describe_polar(width: [f64; 2], u: [f64; 4], v: [f64; 4], levels: [u8; 9], bo
 
 /// [`Rule::TensorGauss`] in words: its boxes, its orders (the starting ones, or the final ones of a frozen
 /// method's path) and its fallback.
-fn describe_tensor(chart: TensorChart, levels: [usize; 4], path: tensor::Path, fallback_boxes: usize) -> String {
+fn describe_tensor(chart: Chart, levels: [usize; 4], path: tensor::Path, fallback_boxes: usize) -> String {
     let orders = path.replayed(levels, tensor::MAX_BOXES).map(|l| tensor::ORDERS[l]);
     let (vars, boxes) = match chart {
-        TensorChart::Plain => ("(p_s, q_s, p_r, q_r)", "on the one box of the stops' product"),
-        TensorChart::Lobe => ("(u, t_p, v, t_q)", "on the boxes between the overlap kinks of u and v"),
-        TensorChart::PlainPLobeQ => ("(p_s, p_r, v, t_q)", "on the boxes between the overlap kinks of v"),
+        Chart::Plain => ("(p_s, q_s, p_r, q_r)", "on the one box of the stops' product"),
+        Chart::Lobe => ("(u, t_p, v, t_q)", "on the boxes between the overlap kinks of u and v"),
+        Chart::PlainPLobeQ => ("(p_s, p_r, v, t_q)", "on the boxes between the overlap kinks of v"),
     };
     format!(
         "smooth integrand: tensor Gauss–Legendre in {vars} {boxes}, orders {} {}, per-axis orders raised \

@@ -293,7 +293,7 @@ impl Plan {
 
     /// Whether every specimen method is frozen.
     pub fn is_frozen(&self) -> bool {
-        self.jobs.iter().all(|j| j.method.target == Target::Standard || j.method.is_frozen())
+        self.jobs.iter().all(|j| j.method.aperture.target == Target::Standard || j.method.is_frozen())
     }
 
     /// Execute the plan adaptively and return its readings together with the frozen plan: every specimen
