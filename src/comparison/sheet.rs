@@ -296,13 +296,19 @@ impl Sheet {
     }
 }
 
-/// Read a sheet file (or `-`, standard input): a workbook if its bytes are one ([`workbook::is_workbook`]),
-/// else text.
+/// Read a sheet file (or `-`, standard input): its bytes, then [`from_bytes`].
 pub fn load(path: &Path, options: &SheetOptions) -> Result<Sheet> {
     let file = crate::input::name(path);
     let bytes = crate::input::read_bytes(path, "sheet")?;
-    if workbook::is_workbook(&bytes) {
-        return parse_workbook(&bytes, &file, options);
+    from_bytes(&bytes, &file, options)
+}
+
+/// The one entry point of every front end (command line, server, Python): a sheet's bytes, a workbook if they
+/// are one ([`workbook::is_workbook`]: `.xlsx`, `.xls`, `.ods`, … read within the limits of
+/// docs/instrument.md §Workbooks), else text in any of the encodings of [`decode`]. `file` names it in errors.
+pub fn from_bytes(bytes: &[u8], file: &str, options: &SheetOptions) -> Result<Sheet> {
+    if workbook::is_workbook(bytes) {
+        return parse_workbook(bytes, file, options);
     }
     if options.sheet_name.is_some() {
         return Err(Error::Argument(
@@ -311,7 +317,7 @@ pub fn load(path: &Path, options: &SheetOptions) -> Result<Sheet> {
                 .and(" names a sheet of an .xlsx, .xls or .ods workbook"),
         ));
     }
-    parse_bytes(&bytes, &file, options)
+    parse_bytes(bytes, file, options)
 }
 
 /// A workbook's sheet (`options.sheet_name`, or the first) read by the rules of a text sheet.
@@ -1030,6 +1036,20 @@ mod tests {
         // Colour readings one per row in the long layout.
         let sh = parse("geometry,quantity,value\nd8-sce,L*,50\nd8-sce,h,200\n", "l.csv", &o).unwrap();
         assert_eq!((sh.rows[0].reading.as_str(), sh.rows[1].reading.as_str()), ("L*", "h"));
+    }
+
+    #[test]
+    fn from_bytes_reads_text_and_workbooks_alike() {
+        let o = SheetOptions::default();
+        let text = from_bytes(b"sample,60\np,89.1\n", "t.csv", &o).unwrap();
+        assert_eq!((text.encoding.as_str(), text.rows[0].value), ("UTF-8", 89.1));
+        let book = include_bytes!("../../fixtures/sheets/byk-smart-chart-export.xlsx");
+        let sh = from_bytes(book, "b.xlsx", &o).unwrap();
+        assert_eq!(sh.encoding, "xlsx workbook");
+        assert!(!sh.rows.is_empty());
+        let named = SheetOptions { sheet_name: Some("x".into()), ..SheetOptions::default() };
+        let e = from_bytes(b"sample,60\np,1\n", "t.csv", &named).unwrap_err().to_string();
+        assert!(e.contains("t.csv is a text sheet"), "{e}");
     }
 
     fn p(text: &str) -> Result<Sheet> {
