@@ -186,6 +186,11 @@ pub const GLOSS_ANGLES: &[(&str, &str)] = &[
     ("85", "astm-d523-85"),
 ];
 
+/// The most readings one sheet may hold (a QC sheet of 10 000 panels × 20 readings has 200 000): each is a
+/// [`SheetRow`] of about 250 bytes, so that a 16 MiB sheet of one-digit cells stays far below 512 MiB
+/// (docs/instrument.md §Sheets).
+pub const MAX_READINGS: usize = 500_000;
+
 /// What the reader was asked to do differently from its defaults.
 #[derive(Clone, Debug, Default)]
 pub struct SheetOptions {
@@ -599,7 +604,15 @@ impl Place {
 }
 
 fn at(place: &Place, line: usize, col: usize, header: &str) -> String {
-    format!("{} ({header})", place.column(line, col))
+    format!("{} ({})", place.column(line, col), short(header))
+}
+
+/// A header or cell as messages quote it: at most 60 characters (a cell may hold megabytes).
+fn short(text: &str) -> String {
+    match text.char_indices().nth(60) {
+        Some((i, _)) => format!("{}…", &text[..i]),
+        None => text.to_string(),
+    }
 }
 
 /// A statistics cell of a row, checked once the whole sheet is read.
@@ -662,11 +675,12 @@ fn parse_at(text: &str, file: &str, options: &SheetOptions, place: &Place) -> Re
                     file,
                     at(place, hline, j, h),
                     Words::from(format!(
-                        "unrecognised column `{h}` (the columns glossmeter reads are listed in docs/instrument.md \
-                         §Sheets; pass "
+                        "unrecognised column `{}` (the columns glossmeter reads are listed in docs/instrument.md \
+                         §Sheets; pass ",
+                        short(h)
                     ))
                     .and_argument("ignore_columns")
-                    .and(format!(" '{h}' to skip it)")),
+                    .and(format!(" '{}' to skip it)", short(h))),
                 ))
             }
         }
@@ -792,6 +806,13 @@ fn parse_at(text: &str, file: &str, options: &SheetOptions, place: &Place) -> Re
             continue;
         }
         let line = lines.line_of(&rec);
+        if rows.len() >= MAX_READINGS {
+            return Err(Error::input(
+                file,
+                place.line(line),
+                format!("the sheet has more than {MAX_READINGS} readings, the most one comparison reads"),
+            ));
+        }
         if rec.len() != headers.len() {
             let j = rec.len().min(headers.len());
             return Err(Error::input(

@@ -253,3 +253,38 @@ impl OdsTable {
             .then(|| format!("a table stores {} cells (repeated columns counted)", self.stored))
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The review's 1.1 kB `.ods`: one valued row repeated 10⁶ times is over the limit; trailing empty rows
+    /// repeated to the sheet's end (as LibreOffice writes them) count nothing.
+    #[test]
+    fn ods_repeats_are_counted_as_calamine_expands_them() {
+        let mut t = OdsTable::default();
+        t.row_start(1_000_000);
+        t.cell(3, true);
+        t.row_end();
+        assert!(t.over().unwrap().contains("1000000 rows × 3 columns"), "{:?}", t.over());
+        let mut t = OdsTable::default();
+        t.row_start(1);
+        t.cell(4, true);
+        t.row_end();
+        t.row_start(1_048_575);
+        t.cell(1024, false);
+        t.row_end();
+        assert_eq!((t.over(), t.area()), (None, 4));
+        // The tables before count too (calamine reads them all).
+        let mut t = OdsTable::default();
+        t.row_start(600_000);
+        t.cell(1, true);
+        t.row_end();
+        assert!(t.over().is_none());
+        let mut u = OdsTable::after(&t);
+        u.row_start(500_000);
+        u.cell(1, true);
+        u.row_end();
+        assert!(u.over().is_some());
+    }
+}

@@ -5,7 +5,7 @@
 //! The values are far above any instrument export (a QC sheet of 10 000 panels × 20 readings is 200 000 cells
 //! and a few MB of XML) and far below what would matter to the machine: the largest allocations they allow are
 //! the decompressed sheet member (64 MiB, which the XML reader may buffer as one event) and the sheet's cells
-//! as text (2·10⁶ cells, about 48 MiB of string headers plus their text).
+//! as text (10⁶ cells, about 24 MiB of string headers plus their text).
 
 /// The largest decompressed size of one member of a zip workbook (`.xlsx`, `.xlsb`, `.ods`): 64 MiB.
 pub const MAX_MEMBER_BYTES: u64 = 64 << 20;
@@ -20,7 +20,7 @@ pub const RATIO_FLOOR_BYTES: u64 = 1 << 20;
 pub const MAX_MEMBERS: usize = 10_000;
 /// The most cells of a sheet's used range (rows × columns, from its first to its last non-empty cell), and
 /// of all the sheets of an `.xls` together (its reader reads every sheet when it opens the file).
-pub const MAX_CELLS: u64 = 2_000_000;
+pub const MAX_CELLS: u64 = 1_000_000;
 /// The most shared strings (`.xlsx` `uniqueCount` and `count`, `.xls` SST counts).
 pub const MAX_SHARED_STRINGS: u64 = 1_000_000;
 /// The most sheets of a workbook.

@@ -337,3 +337,32 @@ fn records(stream: &[u8], pos: usize) -> impl Iterator<Item = (u16, std::result:
         }
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn dim(rf: u32, rl: u32, cf: u16, cl: u16) -> Vec<u8> {
+        [&rf.to_le_bytes()[..], &rl.to_le_bytes(), &cf.to_le_bytes(), &cl.to_le_bytes(), &[0, 0]].concat()
+    }
+
+    #[test]
+    fn dimensions_records() {
+        assert_eq!(dimensions(&dim(0, 10, 0, 4)), Ok(40));
+        assert!(dimensions(&dim(10, 2, 0, 4)).unwrap_err().contains("reversed"));
+        assert!(dimensions(&dim(0, 1_000_000, 0, 255)).unwrap_err().contains("at most 1000000"));
+        assert_eq!(dimensions(&dim(0, 0, 0, 0)), Ok(1));
+        assert!(dimensions(&[0; 7]).is_err());
+    }
+
+    #[test]
+    fn chains_that_loop_or_leave_the_file_are_refused() {
+        // 0 → 1 → 0: a loop.
+        assert!(walk(0, &[1, 0], 2, "x").unwrap_err().contains("loops"));
+        assert!(walk(0, &[5], 1, "x").unwrap_err().contains("past the end"));
+        assert_eq!(walk(0, &[1, END_OF_CHAIN], 2, "x"), Ok(vec![0, 1]));
+        let records = [&0x0200u16.to_le_bytes()[..], &14u16.to_le_bytes(), &dim(0, 3, 0, 2)].concat();
+        assert_eq!(sheet_cells(&records, 0), Ok(6));
+        assert!(sheet_cells(&records[..10], 0).unwrap_err().contains("runs past"));
+    }
+}
