@@ -35,6 +35,10 @@ pub struct FitArgs {
     #[arg(long, value_name = "NAME", requires = "sheet")]
     pub sheet_name: Option<String>,
     /// A sheet column to skip (repeatable), as in `compare`.
+    /// The line (or workbook row, 1-based) of the sheet's header; the rows above it are title and metadata
+    /// rows (default: the first row naming known columns, else the first row).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..), requires = "sheet")]
+    pub header_row: Option<u64>,
     #[arg(long = "ignore-column", value_name = "HEADER", requires = "sheet")]
     pub ignore_columns: Vec<String>,
     /// A user geometry file (JSON, the format of `measure --geometry-file`) whose readings may be targets,
@@ -82,6 +86,7 @@ pub fn run(a: FitArgs) -> Result<()> {
                 delimiter: a.delimiter.as_deref().map(parse_delimiter).transpose()?,
                 ignore_columns: a.ignore_columns.clone(),
                 sheet_name: a.sheet_name.clone(),
+                header_row: a.header_row.map(|n| n as usize),
             };
             let (targets, notes) = fit::targets_from_sheet(&sheet::load(s, &options)?, a.sample.as_deref())?;
             for n in notes {

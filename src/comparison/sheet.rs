@@ -164,6 +164,8 @@ pub const INFO_COLUMNS: &[&str] = &[
     "index",
     "unit",
     "units",
+    "batch",
+    "lot",
 ];
 /// The long layout's columns.
 pub const GEOMETRY_COLUMNS: &[&str] = &["geometry", "geometryid"];
@@ -200,6 +202,10 @@ pub struct SheetOptions {
     pub ignore_columns: Vec<String>,
     /// The sheet of a workbook to read (the first when None); refused for a text sheet.
     pub sheet_name: Option<String>,
+    /// The 1-based line (or workbook row) of the header; the rows above it are title and metadata rows. When
+    /// None, the header is the first row whose cells all name known columns (within the first rows), else the
+    /// first row.
+    pub header_row: Option<usize>,
 }
 
 /// One measured value.
@@ -626,6 +632,102 @@ struct StatCell {
     value: f64,
     /// The cell as written (its decimals are the statistic's precision).
     text: String,
+    /// The readings it summarises, for a statistics row (the column's readings above it, back to the header or
+    /// the previous statistics rows); None for a statistics column (the sample's readings in the whole sheet).
+    series: Option<Vec<f64>>,
+}
+
+/// How many rows above the header a sheet may have (titles, metadata) for the header to be found by its names.
+const TITLE_ROWS: usize = 20;
+
+/// The line of the header: the record at or after `options.header_row` (1-based) when given; else the first of
+/// the first [`TITLE_ROWS`] + 1 records whose cells are all names of columns the reader knows, with a reading
+/// among them (a title such as `BYK-Gardner smart-chart 4.2 - Gloss report` is not). None: no such record (the
+/// first record is then the header, and its unknown column the error).
+fn header_line(
+    mut rdr: csv::Reader<&[u8]>,
+    lines: &Lines,
+    file: &str,
+    options: &SheetOptions,
+) -> Result<Option<usize>> {
+    let mut seen = 0;
+    for rec in rdr.records() {
+        let rec = rec.map_err(|e| csv_error(file, lines, &e))?;
+        if rec.iter().all(|f| f.is_empty()) {
+            continue;
+        }
+        let line = lines.line_of(&rec);
+        if let Some(h) = options.header_row {
+            if line >= h {
+                return Ok(Some(line));
+            }
+            continue;
+        }
+        let roles: Option<Vec<Role>> =
+            rec.iter().map(|f| if f.is_empty() { None } else { role(f, &options.ignore_columns) }).collect();
+        let reads = |r: &Role| {
+            matches!(r, Role::Reading { .. } | Role::Geometry | Role::Value | Role::Lab(_) | Role::Statistic { .. })
+        };
+        if roles.is_some_and(|r| r.iter().any(reads)) {
+            return Ok(Some(line));
+        }
+        seen += 1;
+        if seen > TITLE_ROWS {
+            break;
+        }
+    }
+    if let Some(h) = options.header_row {
+        return Err(Error::input(file, "", format!("no header row at or after row {h} (`header_row`)")));
+    }
+    Ok(None)
+}
+
+/// A row above the header as metadata: each `Key: value` cell a pair (`Key:` then the value in the next cell),
+/// or a short key and its value in two cells (`Instrument`, `micro-TRI-gloss`); any other row is a `title`.
+fn title_row(rec: &csv::StringRecord) -> Vec<(String, String)> {
+    let cells: Vec<&str> = rec.iter().filter(|f| !f.is_empty()).collect();
+    let key_ok = |k: &str| {
+        !k.is_empty()
+            && k.len() <= 40
+            && k.split_whitespace().count() <= 4
+            && k.chars().all(|c| c.is_alphanumeric() || " _-.".contains(c))
+    };
+    let mut pairs: Vec<(String, String)> = vec![];
+    for cell in &cells {
+        match cell.split_once(':') {
+            Some((k, v)) if key_ok(k.trim()) => pairs.push((k.trim().to_lowercase(), v.trim().to_string())),
+            _ => match pairs.last_mut() {
+                Some((_, v)) if v.is_empty() => *v = cell.to_string(),
+                _ => {
+                    pairs.clear();
+                    break;
+                }
+            },
+        }
+    }
+    if !pairs.is_empty() {
+        return pairs;
+    }
+    if cells.len() == 2 && key_ok(cells[0]) && cells[0].parse::<f64>().is_err() {
+        return vec![(cells[0].to_lowercase(), cells[1].to_string())];
+    }
+    vec![("title".into(), cells.join(" "))]
+}
+
+/// The statistic a cell names alone (`Mean`, `Std. dev.`, `Min`, `Max`, `Range`, `x̄` is not read).
+fn statistics_label(cell: &str) -> Option<Statistic> {
+    match series::split(&normalise(cell)) {
+        Some((stat, "")) => Some(stat),
+        _ => None,
+    }
+}
+
+/// The statistic of a statistics row: its first non-empty cell names one, in the sample column, an info column
+/// or the first column.
+fn statistics_row(rec: &csv::StringRecord, roles: &[Role]) -> Option<Statistic> {
+    let (j, cell) = rec.iter().enumerate().find(|(_, f)| !f.is_empty())?;
+    let labelled = j == 0 || matches!(roles.get(j), Some(Role::Sample | Role::Info));
+    labelled.then(|| statistics_label(cell)).flatten()
 }
 
 /// Parse a text sheet (`file` names it in messages).
@@ -634,32 +736,48 @@ pub fn parse(text: &str, file: &str, options: &SheetOptions) -> Result<Sheet> {
 }
 
 fn parse_at(text: &str, file: &str, options: &SheetOptions, place: &Place) -> Result<Sheet> {
-    let metadata: Vec<(String, String)> = text.lines().filter_map(metadata_line).collect();
-    let header_line = text.lines().find(|l| !l.trim().is_empty() && !l.trim_start().starts_with('#'));
-    let Some(header_line) = header_line else {
+    let mut metadata: Vec<(usize, (String, String))> =
+        text.lines().enumerate().filter_map(|(i, l)| metadata_line(l).map(|m| (i + 1, m))).collect();
+    let content = || text.lines().filter(|l| !l.trim().is_empty() && !l.trim_start().starts_with('#'));
+    let Some(first_line) = content().next() else {
         return Err(Error::input(file, "", "the sheet is empty (no header line)"));
     };
-    let delimiter = options.delimiter.unwrap_or_else(|| detect_delimiter(header_line));
-    let mut rdr = csv::ReaderBuilder::new()
-        .delimiter(delimiter)
-        .has_headers(false)
-        .flexible(true)
-        .comment(Some(b'#'))
-        .trim(csv::Trim::All)
-        .from_reader(text.as_bytes());
+    // The separator of the first content line that has one (a title line above the header has none).
+    let delimiter = options.delimiter.unwrap_or_else(|| {
+        let with_one = content().take(TITLE_ROWS + 1).find(|l| l.bytes().any(|c| matches!(c, b',' | b';' | b'\t')));
+        detect_delimiter(with_one.unwrap_or(first_line))
+    });
+    let reader = || {
+        csv::ReaderBuilder::new()
+            .delimiter(delimiter)
+            .has_headers(false)
+            .flexible(true)
+            .comment(Some(b'#'))
+            .trim(csv::Trim::All)
+            .from_reader(text.as_bytes())
+    };
     let lines = Lines::new(text);
+    let header_at = header_line(reader(), &lines, file, options)?;
+    let mut rdr = reader();
     let mut records = rdr.records();
     let mut header: Option<(usize, Vec<String>)> = None;
-    // The first record that is not blank is the header.
+    // The header is the record at `header_at` (the first that is not blank when none was found); the records
+    // above it are title and metadata rows.
     for rec in records.by_ref() {
         let rec = rec.map_err(|e| csv_error(file, &lines, &e))?;
         if rec.iter().all(|f| f.is_empty()) {
             continue;
         }
         let line = lines.line_of(&rec);
+        if header_at.is_some_and(|h| line < h) {
+            metadata.extend(title_row(&rec).into_iter().map(|m| (line, m)));
+            continue;
+        }
         header = Some((line, rec.iter().map(str::to_string).collect()));
         break;
     }
+    metadata.sort_by_key(|(line, _)| *line);
+    let metadata: Vec<(String, String)> = metadata.into_iter().map(|(_, m)| m).collect();
     let Some((hline, headers)) = header else {
         return Err(Error::input(file, "", "the sheet is empty (no header line)"));
     };
@@ -800,6 +918,8 @@ fn parse_at(text: &str, file: &str, options: &SheetOptions, place: &Place) -> Re
     let sample_c = find(&Role::Sample);
     let ignored_columns = (0..roles.len()).filter(|&j| roles[j] == Role::Ignored).map(|j| headers[j].clone()).collect();
     let mut rows = Vec::new();
+    // Statistics rows summarise the rows from `block_start` (after the previous statistics rows).
+    let (mut block_start, mut in_statistics) = (0usize, false);
     for rec in records {
         let rec = rec.map_err(|e| csv_error(file, &lines, &e))?;
         if rec.iter().all(|f| f.is_empty()) {
@@ -834,6 +954,37 @@ fn parse_at(text: &str, file: &str, options: &SheetOptions, place: &Place) -> Re
             }
             Ok(v)
         };
+        if layout == Layout::Wide {
+            if let Some(stat) = statistics_row(&rec, &roles) {
+                // A statistics row (`Mean`, `Std`, … in the sample or first column) under the data: each of its
+                // reading cells is a stated statistic of that column's series of the sample of the rows above.
+                in_statistics = true;
+                for &c in &reading_cols {
+                    if rec[c].is_empty() || statistics_label(&rec[c]).is_some() {
+                        continue;
+                    }
+                    let Role::Reading { geometry, reading, .. } = &roles[c] else { unreachable!() };
+                    let value = num(c, &format!("the stated {}", stat.name()), false)?;
+                    let of = |r: &&SheetRow| r.geometry == *geometry && r.reading == *reading;
+                    let series: Vec<f64> = rows[block_start..].iter().filter(of).map(|r| r.value).collect();
+                    stat_cells.push(StatCell {
+                        line,
+                        column: c,
+                        stat,
+                        sample: String::new(),
+                        geometry: geometry.to_string(),
+                        reading: reading.to_string(),
+                        value,
+                        text: rec[c].to_string(),
+                        series: Some(series),
+                    });
+                }
+                continue;
+            }
+            if in_statistics {
+                (block_start, in_statistics) = (rows.len(), false);
+            }
+        }
         let sample = get(sample_c);
         match layout {
             Layout::Long => {
@@ -941,6 +1092,7 @@ fn parse_at(text: &str, file: &str, options: &SheetOptions, place: &Place) -> Re
                 reading,
                 value,
                 text: rec[c].to_string(),
+                series: None,
             });
         }
     }
@@ -952,7 +1104,12 @@ fn parse_at(text: &str, file: &str, options: &SheetOptions, place: &Place) -> Re
     for sc in &stat_cells {
         let (c, text) = (sc.column, &headers[sc.column]);
         let sample = if sc.sample.is_empty() { String::new() } else { format!(" of sample `{}`", sc.sample) };
-        let Some(values) = series_of.get(&(sc.sample.as_str(), sc.geometry.as_str(), sc.reading.as_str())) else {
+        let values = match &sc.series {
+            Some(v) if !v.is_empty() => Some(v),
+            Some(_) => None,
+            None => series_of.get(&(sc.sample.as_str(), sc.geometry.as_str(), sc.reading.as_str())),
+        };
+        let Some(values) = values else {
             return Err(Error::input(
                 file,
                 at(place, sc.line, c, text),

@@ -380,6 +380,7 @@ fn sheet(o: &Obj) -> Result<Sheet> {
         delimiter: o.opt_str("delimiter")?.map(parse_delimiter).transpose().map_err(|e| o.err("delimiter", e))?,
         ignore_columns: strings(o, "ignore_columns")?,
         sheet_name: o.opt_str("sheet_name")?.map(str::to_owned),
+        header_row: None,
     };
     sheet::parse_bytes(&bytes, &name, &options)
 }
