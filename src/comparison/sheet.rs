@@ -781,6 +781,100 @@ fn parse_at(text: &str, file: &str, options: &SheetOptions, place: &Place) -> Re
     let Some((hline, headers)) = header else {
         return Err(Error::input(file, "", "the sheet is empty (no header line)"));
     };
+    let roles = header_roles(&headers, hline, file, options, place)?;
+    let (layout, wide_reading) = layout_of(&roles, &headers, hline, file, place)?;
+    let find = |r: &Role| roles.iter().position(|x| x == r);
+    let (geo_c, val_c) = (find(&Role::Geometry), find(&Role::Value));
+    let reading_cols: Vec<usize> = (0..roles.len()).filter(|&j| matches!(roles[j], Role::Reading { .. })).collect();
+    let lab_cols: Vec<Option<usize>> = (0..3).map(|i| find(&Role::Lab(i))).collect();
+    let stat_cols: Vec<usize> = (0..roles.len()).filter(|&j| matches!(roles[j], Role::Statistic { .. })).collect();
+    let mut stat_cells: Vec<StatCell> = vec![];
+    let sample_c = find(&Role::Sample);
+    let ignored_columns = (0..roles.len()).filter(|&j| roles[j] == Role::Ignored).map(|j| headers[j].clone()).collect();
+    let mut rows = Vec::new();
+    // Statistics rows summarise the rows from `block_start` (after the previous statistics rows).
+    let (mut block_start, mut in_statistics) = (0usize, false);
+    for rec in records {
+        let rec = rec.map_err(|e| csv_error(file, &lines, &e))?;
+        if rec.iter().all(|f| f.is_empty()) {
+            continue;
+        }
+        let line = lines.line_of(&rec);
+        if rows.len() >= MAX_READINGS {
+            return Err(Error::input(
+                file,
+                place.line(line),
+                format!("the sheet has more than {MAX_READINGS} readings, the most one comparison reads"),
+            ));
+        }
+        if rec.len() != headers.len() {
+            let j = rec.len().min(headers.len());
+            return Err(Error::input(
+                file,
+                place.column(line, j),
+                format!("{} fields, but the header (line {hline}) has {}", rec.len(), headers.len()),
+            ));
+        }
+        let r = Record { rec: &rec, line, headers: &headers, file, place };
+        if layout == Layout::Wide {
+            if let Some(stat) = statistics_row(&rec, &roles) {
+                // A statistics row (`Mean`, `Std`, … in the sample or first column) under the data: each of its
+                // reading cells is a stated statistic of that column's series of the sample of the rows above.
+                in_statistics = true;
+                stat_cells.extend(statistics_row_cells(&r, stat, &reading_cols, &roles, &rows[block_start..])?);
+                continue;
+            }
+            if in_statistics {
+                (block_start, in_statistics) = (rows.len(), false);
+            }
+        }
+        let sample = r.get(sample_c);
+        rows.extend(match layout {
+            Layout::Long => {
+                let (g, v) = (geo_c.expect("long"), val_c.expect("long"));
+                long_row(&r, &sample, g, v, find(&Role::Quantity), find(&Role::Uncertainty))?
+            }
+            Layout::Colour => colour_rows(&r, &sample, geo_c.expect("colour"), &lab_cols)?,
+            Layout::Wide => wide_rows(&r, &sample, &reading_cols, &roles)?,
+        });
+        let last = rows.last().filter(|r| r.line == line);
+        stat_cells.extend(statistics_column_cells(&r, &sample, &stat_cols, &roles, layout, wide_reading, last)?);
+    }
+    check_statistics(&stat_cells, &rows, &headers, file, place)?;
+    if rows.is_empty() {
+        return Err(Error::input(
+            file,
+            format!("{} (header)", place.line(hline)),
+            "the sheet has a header but no readings",
+        ));
+    }
+    Ok(Sheet {
+        file: file.to_string(),
+        encoding: "UTF-8".into(),
+        delimiter,
+        layout,
+        metadata,
+        ignored_columns,
+        header_line: hline,
+        headers,
+        sample_column: sample_c,
+        geometry_column: geo_c,
+        quantity_column: find(&Role::Quantity),
+        rows,
+        workbook_sheet: None,
+        first_column: 0,
+        statistics_checked: stat_cells.len(),
+    })
+}
+
+/// Stage 1, the header's roles: what each column is ([`role`]), refused when empty, unknown or duplicated.
+fn header_roles(
+    headers: &[String],
+    hline: usize,
+    file: &str,
+    options: &SheetOptions,
+    place: &Place,
+) -> Result<Vec<Role>> {
     let mut roles = Vec::new();
     for (j, h) in headers.iter().enumerate() {
         if h.is_empty() {
@@ -821,6 +915,18 @@ fn parse_at(text: &str, file: &str, options: &SheetOptions, place: &Place) -> Re
             }
         }
     }
+    Ok(roles)
+}
+
+/// Stage 2, the layout: colour, long or wide from the columns' roles, with the columns that do not belong to it
+/// refused; and the wide layout's one reading, when it has one (the reading of a bare statistics column).
+fn layout_of(
+    roles: &[Role],
+    headers: &[String],
+    hline: usize,
+    file: &str,
+    place: &Place,
+) -> Result<(Layout, Option<(&'static str, &'static str)>)> {
     let find = |r: &Role| roles.iter().position(|x| x == r);
     let (geo_c, val_c) = (find(&Role::Geometry), find(&Role::Value));
     let reading_cols: Vec<usize> = (0..roles.len()).filter(|&j| matches!(roles[j], Role::Reading { .. })).collect();
@@ -913,195 +1019,24 @@ fn parse_at(text: &str, file: &str, options: &SheetOptions, place: &Place) -> Re
             }
         }
     }
-    let stat_cols: Vec<usize> = (0..roles.len()).filter(|&j| matches!(roles[j], Role::Statistic { .. })).collect();
-    let mut stat_cells: Vec<StatCell> = vec![];
-    let sample_c = find(&Role::Sample);
-    let ignored_columns = (0..roles.len()).filter(|&j| roles[j] == Role::Ignored).map(|j| headers[j].clone()).collect();
-    let mut rows = Vec::new();
-    // Statistics rows summarise the rows from `block_start` (after the previous statistics rows).
-    let (mut block_start, mut in_statistics) = (0usize, false);
-    for rec in records {
-        let rec = rec.map_err(|e| csv_error(file, &lines, &e))?;
-        if rec.iter().all(|f| f.is_empty()) {
-            continue;
-        }
-        let line = lines.line_of(&rec);
-        if rows.len() >= MAX_READINGS {
-            return Err(Error::input(
-                file,
-                place.line(line),
-                format!("the sheet has more than {MAX_READINGS} readings, the most one comparison reads"),
-            ));
-        }
-        if rec.len() != headers.len() {
-            let j = rec.len().min(headers.len());
-            return Err(Error::input(
-                file,
-                place.column(line, j),
-                format!("{} fields, but the header (line {hline}) has {}", rec.len(), headers.len()),
-            ));
-        }
-        let get = |c: Option<usize>| c.and_then(|c| rec.get(c)).unwrap_or("").to_string();
-        let num = |c: usize, what: &str, nonneg: bool| -> Result<f64> {
-            let v = parse_number(&rec[c])
-                .map_err(|m| Error::input(file, at(place, line, c, &headers[c]), format!("{what}: {m}")))?;
-            if nonneg && v < 0.0 {
-                return Err(Error::input(
-                    file,
-                    at(place, line, c, &headers[c]),
-                    format!("{what} must be ≥ 0, got {v}"),
-                ));
-            }
-            Ok(v)
-        };
-        if layout == Layout::Wide {
-            if let Some(stat) = statistics_row(&rec, &roles) {
-                // A statistics row (`Mean`, `Std`, … in the sample or first column) under the data: each of its
-                // reading cells is a stated statistic of that column's series of the sample of the rows above.
-                in_statistics = true;
-                for &c in &reading_cols {
-                    if rec[c].is_empty() || statistics_label(&rec[c]).is_some() {
-                        continue;
-                    }
-                    let Role::Reading { geometry, reading, .. } = &roles[c] else { unreachable!() };
-                    let value = num(c, &format!("the stated {}", stat.name()), false)?;
-                    let of = |r: &&SheetRow| r.geometry == *geometry && r.reading == *reading;
-                    let series: Vec<f64> = rows[block_start..].iter().filter(of).map(|r| r.value).collect();
-                    stat_cells.push(StatCell {
-                        line,
-                        column: c,
-                        stat,
-                        sample: String::new(),
-                        geometry: geometry.to_string(),
-                        reading: reading.to_string(),
-                        value,
-                        text: rec[c].to_string(),
-                        series: Some(series),
-                    });
-                }
-                continue;
-            }
-            if in_statistics {
-                (block_start, in_statistics) = (rows.len(), false);
-            }
-        }
-        let sample = get(sample_c);
-        match layout {
-            Layout::Long => {
-                let (g, v) = (geo_c.expect("long"), val_c.expect("long"));
-                let geometry = get(Some(g));
-                if geometry.is_empty() {
-                    return Err(Error::input(file, at(place, line, g, &headers[g]), "empty geometry id"));
-                }
-                let reading = match get(find(&Role::Quantity)) {
-                    q if q.is_empty() => "gloss".to_string(),
-                    q => q.to_lowercase().split_whitespace().collect::<Vec<_>>().join("-"),
-                };
-                let reading = COLOUR_QUANTITIES
-                    .iter()
-                    .find(|(q, _)| *q == reading)
-                    .map(|(_, name)| name.to_string())
-                    .unwrap_or(reading);
-                let not_predicted = READING_COLUMNS
-                    .iter()
-                    .find(|c| c.reading == reading && c.geometry == geometry)
-                    .and_then(|c| c.not_predicted)
-                    .map(String::from);
-                let value = num(v, "the measured value", false)?;
-                let uncertainty = match find(&Role::Uncertainty) {
-                    Some(c) if !rec[c].is_empty() => Some(num(c, "the uncertainty", true)?),
-                    _ => None,
-                };
-                rows.push(SheetRow {
-                    line,
-                    column: headers[v].clone(),
-                    sample: sample.clone(),
-                    geometry,
-                    reading,
-                    value,
-                    uncertainty,
-                    not_predicted,
-                });
-            }
-            Layout::Colour => {
-                let g = geo_c.expect("colour");
-                let geometry = get(Some(g));
-                if geometry.is_empty() {
-                    return Err(Error::input(file, at(place, line, g, &headers[g]), "empty geometry id"));
-                }
-                for (i, c) in lab_cols.iter().enumerate() {
-                    let c = c.expect("colour layout has all three");
-                    let reading = LAB_COLUMNS[i].1;
-                    let value = num(c, &format!("the measured {reading}"), false)?;
-                    rows.push(SheetRow {
-                        line,
-                        column: headers[c].clone(),
-                        sample: sample.clone(),
-                        geometry: geometry.clone(),
-                        reading: reading.to_string(),
-                        value,
-                        uncertainty: None,
-                        not_predicted: None,
-                    });
-                }
-            }
-            Layout::Wide => {
-                for &c in &reading_cols {
-                    if rec[c].is_empty() {
-                        continue;
-                    }
-                    let Role::Reading { geometry, reading, not_predicted, .. } = &roles[c] else { unreachable!() };
-                    let value = num(c, "the measured value", false)?;
-                    rows.push(SheetRow {
-                        line,
-                        column: headers[c].clone(),
-                        sample: sample.clone(),
-                        geometry: geometry.to_string(),
-                        reading: reading.to_string(),
-                        value,
-                        uncertainty: None,
-                        not_predicted: not_predicted.map(String::from),
-                    });
-                }
-            }
-        }
-        for &c in &stat_cols {
-            if rec[c].is_empty() {
-                continue;
-            }
-            let Role::Statistic { stat, of } = roles[c] else { unreachable!() };
-            let value = num(c, &format!("the stated {}", stat.name()), false)?;
-            let (geometry, reading) = match (of, layout) {
-                (Some((g, r)), _) => (g.to_string(), r.to_string()),
-                (None, Layout::Wide) => {
-                    let (g, r) = wide_reading.expect("a wide sheet has a reading column");
-                    (g.to_string(), r.to_string())
-                }
-                // The long layout: the row's own reading.
-                (None, _) => match rows.last().filter(|r| r.line == line) {
-                    Some(r) => (r.geometry.clone(), r.reading.clone()),
-                    None => continue,
-                },
-            };
-            stat_cells.push(StatCell {
-                line,
-                column: c,
-                stat,
-                sample: sample.clone(),
-                geometry,
-                reading,
-                value,
-                text: rec[c].to_string(),
-                series: None,
-            });
-        }
-    }
+    Ok((layout, wide_reading))
+}
+
+/// Stage 4, the statistics check: each stated statistic against its series (a statistics row's own, or the
+/// sample's readings of that reading in the whole sheet for a statistics column).
+fn check_statistics(
+    stat_cells: &[StatCell],
+    rows: &[SheetRow],
+    headers: &[String],
+    file: &str,
+    place: &Place,
+) -> Result<()> {
     // Each stated statistic against its series: the sample's readings of that reading in the whole sheet.
     let mut series_of: HashMap<(&str, &str, &str), Vec<f64>> = HashMap::new();
-    for r in &rows {
+    for r in rows {
         series_of.entry((r.sample.as_str(), r.geometry.as_str(), r.reading.as_str())).or_default().push(r.value);
     }
-    for sc in &stat_cells {
+    for sc in stat_cells {
         let (c, text) = (sc.column, &headers[sc.column]);
         let sample = if sc.sample.is_empty() { String::new() } else { format!(" of sample `{}`", sc.sample) };
         let values = match &sc.series {
@@ -1124,30 +1059,203 @@ fn parse_at(text: &str, file: &str, options: &SheetOptions, place: &Place) -> Re
         series::check(sc.stat, sc.value, &sc.text, &Series::of(values))
             .map_err(|m| Error::input(file, at(place, sc.line, c, text), format!("{m}{sample}")))?;
     }
-    if rows.is_empty() {
-        return Err(Error::input(
-            file,
-            format!("{} (header)", place.line(hline)),
-            "the sheet has a header but no readings",
-        ));
+    Ok(())
+}
+
+/// One data record being read (stage 3): its cells, its line and the header, for the row readers.
+struct Record<'a> {
+    rec: &'a csv::StringRecord,
+    line: usize,
+    headers: &'a [String],
+    file: &'a str,
+    place: &'a Place,
+}
+
+impl Record<'_> {
+    fn get(&self, c: Option<usize>) -> String {
+        c.and_then(|c| self.rec.get(c)).unwrap_or("").to_string()
     }
-    Ok(Sheet {
-        file: file.to_string(),
-        encoding: "UTF-8".into(),
-        delimiter,
-        layout,
-        metadata,
-        ignored_columns,
-        header_line: hline,
-        headers,
-        sample_column: sample_c,
-        geometry_column: geo_c,
-        quantity_column: find(&Role::Quantity),
-        rows,
-        workbook_sheet: None,
-        first_column: 0,
-        statistics_checked: stat_cells.len(),
-    })
+
+    fn at(&self, c: usize) -> String {
+        at(self.place, self.line, c, &self.headers[c])
+    }
+
+    /// Cell `c` as a number (`what` names it in the error), non-negative when `nonneg`.
+    fn num(&self, c: usize, what: &str, nonneg: bool) -> Result<f64> {
+        let v = parse_number(&self.rec[c]).map_err(|m| Error::input(self.file, self.at(c), format!("{what}: {m}")))?;
+        if nonneg && v < 0.0 {
+            return Err(Error::input(self.file, self.at(c), format!("{what} must be ≥ 0, got {v}")));
+        }
+        Ok(v)
+    }
+}
+
+/// Stage 3, the long layout's row: one reading, its geometry, quantity (gloss when empty) and uncertainty.
+fn long_row(
+    r: &Record,
+    sample: &str,
+    g: usize,
+    v: usize,
+    quantity: Option<usize>,
+    uncertainty: Option<usize>,
+) -> Result<Vec<SheetRow>> {
+    let geometry = r.get(Some(g));
+    if geometry.is_empty() {
+        return Err(Error::input(r.file, r.at(g), "empty geometry id"));
+    }
+    let reading = match r.get(quantity) {
+        q if q.is_empty() => "gloss".to_string(),
+        q => q.to_lowercase().split_whitespace().collect::<Vec<_>>().join("-"),
+    };
+    let reading =
+        COLOUR_QUANTITIES.iter().find(|(q, _)| *q == reading).map(|(_, name)| name.to_string()).unwrap_or(reading);
+    let not_predicted = READING_COLUMNS
+        .iter()
+        .find(|c| c.reading == reading && c.geometry == geometry)
+        .and_then(|c| c.not_predicted)
+        .map(String::from);
+    let value = r.num(v, "the measured value", false)?;
+    let uncertainty = match uncertainty {
+        Some(c) if !r.rec[c].is_empty() => Some(r.num(c, "the uncertainty", true)?),
+        _ => None,
+    };
+    Ok(vec![SheetRow {
+        line: r.line,
+        column: r.headers[v].clone(),
+        sample: sample.to_string(),
+        geometry,
+        reading,
+        value,
+        uncertainty,
+        not_predicted,
+    }])
+}
+
+/// Stage 3, the colour layout's row: L*, a* and b* of one geometry.
+fn colour_rows(r: &Record, sample: &str, g: usize, lab: &[Option<usize>]) -> Result<Vec<SheetRow>> {
+    let mut rows = vec![];
+
+    let geometry = r.get(Some(g));
+    if geometry.is_empty() {
+        return Err(Error::input(r.file, r.at(g), "empty geometry id"));
+    }
+    for (i, c) in lab.iter().enumerate() {
+        let c = c.expect("colour layout has all three");
+        let reading = LAB_COLUMNS[i].1;
+        let value = r.num(c, &format!("the measured {reading}"), false)?;
+        rows.push(SheetRow {
+            line: r.line,
+            column: r.headers[c].clone(),
+            sample: sample.to_string(),
+            geometry: geometry.clone(),
+            reading: reading.to_string(),
+            value,
+            uncertainty: None,
+            not_predicted: None,
+        });
+    }
+    Ok(rows)
+}
+
+/// Stage 3, the wide layout's row: one reading per non-empty reading column.
+fn wide_rows(r: &Record, sample: &str, reading_cols: &[usize], roles: &[Role]) -> Result<Vec<SheetRow>> {
+    let mut rows = vec![];
+    for &c in reading_cols {
+        if r.rec[c].is_empty() {
+            continue;
+        }
+        let Role::Reading { geometry, reading, not_predicted, .. } = &roles[c] else { unreachable!() };
+        let value = r.num(c, "the measured value", false)?;
+        rows.push(SheetRow {
+            line: r.line,
+            column: r.headers[c].clone(),
+            sample: sample.to_string(),
+            geometry: geometry.to_string(),
+            reading: reading.to_string(),
+            value,
+            uncertainty: None,
+            not_predicted: not_predicted.map(String::from),
+        });
+    }
+    Ok(rows)
+}
+
+/// Stage 3, a statistics row's cells: each of its reading cells is a stated statistic of that column's readings
+/// in `above` (the rows back to the header or the previous statistics rows).
+fn statistics_row_cells(
+    r: &Record,
+    stat: Statistic,
+    reading_cols: &[usize],
+    roles: &[Role],
+    above: &[SheetRow],
+) -> Result<Vec<StatCell>> {
+    let mut cells = vec![];
+    for &c in reading_cols {
+        if r.rec[c].is_empty() || statistics_label(&r.rec[c]).is_some() {
+            continue;
+        }
+        let Role::Reading { geometry, reading, .. } = &roles[c] else { unreachable!() };
+        let value = r.num(c, &format!("the stated {}", stat.name()), false)?;
+        let of = |row: &&SheetRow| row.geometry == *geometry && row.reading == *reading;
+        let series: Vec<f64> = above.iter().filter(of).map(|row| row.value).collect();
+        cells.push(StatCell {
+            line: r.line,
+            column: c,
+            stat,
+            sample: String::new(),
+            geometry: geometry.to_string(),
+            reading: reading.to_string(),
+            value,
+            text: r.rec[c].to_string(),
+            series: Some(series),
+        });
+    }
+    Ok(cells)
+}
+
+/// Stage 3, a row's statistics columns: each stated value, of the reading its header names, of the wide
+/// sheet's one reading, or (long layout) of the row's own reading (`last`, the row just read).
+fn statistics_column_cells(
+    r: &Record,
+    sample: &str,
+    stat_cols: &[usize],
+    roles: &[Role],
+    layout: Layout,
+    wide_reading: Option<(&'static str, &'static str)>,
+    last: Option<&SheetRow>,
+) -> Result<Vec<StatCell>> {
+    let mut cells = vec![];
+    for &c in stat_cols {
+        if r.rec[c].is_empty() {
+            continue;
+        }
+        let Role::Statistic { stat, of } = roles[c] else { unreachable!() };
+        let value = r.num(c, &format!("the stated {}", stat.name()), false)?;
+        let (geometry, reading) = match (of, layout) {
+            (Some((g, r)), _) => (g.to_string(), r.to_string()),
+            (None, Layout::Wide) => {
+                let (g, r) = wide_reading.expect("a wide sheet has a reading column");
+                (g.to_string(), r.to_string())
+            }
+            // The long layout: the row's own reading.
+            (None, _) => match last {
+                Some(row) => (row.geometry.clone(), row.reading.clone()),
+                None => continue,
+            },
+        };
+        cells.push(StatCell {
+            line: r.line,
+            column: c,
+            stat,
+            sample: sample.to_string(),
+            geometry,
+            reading,
+            value,
+            text: r.rec[c].to_string(),
+            series: None,
+        });
+    }
+    Ok(cells)
 }
 
 /// Line numbers of records. The `csv` crate's own line count is off after comment and blank lines, and its
