@@ -381,6 +381,8 @@ pub struct SheetRequest {
     pub ignore_columns: Vec<String>,
     /// The sheet of a workbook (default: its first).
     pub sheet_name: Option<String>,
+    /// The header's 1-based row, for exports with title or metadata rows above it (default: found).
+    pub header_row: Option<usize>,
 }
 
 impl SheetRequest {
@@ -389,6 +391,7 @@ impl SheetRequest {
             delimiter: self.delimiter.as_deref().map(parse_delimiter).transpose()?,
             ignore_columns: self.ignore_columns.clone(),
             sheet_name: self.sheet_name.clone(),
+            header_row: self.header_row,
         })
     }
 }

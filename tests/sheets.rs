@@ -277,3 +277,45 @@ fn a_sample_name_with_an_equals_sign_takes_its_recipe() {
     assert_eq!(code, 0, "{out}{err}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Exports as they are (docs/instrument.md §Sheets, "Title rows and statistics rows"): the BYK smart-chart,
+/// Rhopoint IQ and Elcometer 408 shaped exports (fixtures/sheets/PROVENANCE.md) compare without edits, their
+/// title and metadata rows kept as the sheet's metadata and their statistics rows checked.
+#[test]
+fn instrument_exports_compare_without_edits() {
+    for (file, stats, meta) in [
+        ("fixtures/sheets/byk-smart-chart-report.csv", 12, ("instrument", "micro-TRI-gloss")),
+        ("fixtures/sheets/rhopoint-iq-export.csv", 0, ("", "")),
+        ("fixtures/sheets/elcometer-408-export.csv", 5, ("gauge", "Elcometer 408 Gloss & DOI Meter")),
+    ] {
+        let (code, doc) = json_of(&["compare", GLASS, file, "--tolerance", "1"]);
+        assert_eq!(code, 0, "{file}: {doc}");
+        let (_, table, _) = gm(&["compare", GLASS, file, "--tolerance", "1"]);
+        assert_eq!(stats > 0, table.contains(&format!("statistics: {stats} stated value(s)")), "{file}: {table}");
+        if !meta.0.is_empty() {
+            assert_eq!(doc["sheet"]["metadata"][meta.0], meta.1, "{file}: {}", doc["sheet"]);
+        }
+    }
+    // A statistics row that disagrees with the readings above it is an error naming its cell.
+    let bad = tmp("byk-wrong-mean.csv");
+    let text = std::fs::read_to_string("fixtures/sheets/byk-smart-chart-report.csv").unwrap();
+    std::fs::write(&bad, text.replace(",Mean,,82.02,", ",Mean,,83.02,")).unwrap();
+    let (code, _, err) = gm(&["compare", GLASS, bad.to_str().unwrap(), "--tolerance", "1"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("line 12, column 4 (20° [GU])") && err.contains("mean"), "{err}");
+    // --header-row names the header; the rows above are metadata, whatever they hold.
+    let (code, doc) = json_of(&[
+        "compare",
+        GLASS,
+        "fixtures/sheets/byk-smart-chart-report.csv",
+        "--header-row",
+        "5",
+        "--tolerance",
+        "1",
+    ]);
+    assert_eq!(code, 0, "{doc}");
+    assert_eq!(doc["sheet"]["metadata"]["title"], "BYK-Gardner smart-chart 4.2 - Gloss report");
+    let (code, _, err) = gm(&["compare", GLASS, "fixtures/sheets/byk-smart-chart-report.csv", "--header-row", "6"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("unrecognised column"), "{err}");
+}

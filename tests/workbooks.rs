@@ -119,3 +119,24 @@ fn statistics_columns_in_text_sheets_are_checked_too() {
         }
     }
 }
+
+/// The reproducers of docs/reliability.md §Workbooks (crafted and mutated books that made the reader panic,
+/// abort on a huge allocation, inflate a zip bomb or pass a bad CRC): each ends with exit 2 and an error naming
+/// the file, through `compare` and `fit --sheet` alike.
+#[test]
+fn hostile_workbooks_end_in_exit_2_naming_the_file() {
+    let dir = "fixtures/sheets/hostile";
+    let mut names: Vec<String> =
+        std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    names.sort();
+    assert_eq!(names.len(), 9, "{names:?}");
+    for name in &names {
+        let path = format!("{dir}/{name}");
+        for args in [vec!["compare", GLASS, &path], vec!["fit", GLASS, "--sheet", &path, "--free", "/ior=1.3..1.8"]] {
+            let (code, out, err) = gm(&args);
+            assert_eq!(code, 2, "{args:?}: {out}{err}");
+            assert!(err.contains("error:") && err.contains(name.as_str()), "{args:?}: {err}");
+            assert!(!err.contains("panicked"), "{args:?}: {err}");
+        }
+    }
+}

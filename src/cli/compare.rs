@@ -43,6 +43,10 @@ pub struct CompareArgs {
     #[arg(long, value_name = "NAME")]
     pub sheet_name: Option<String>,
     /// Skip a column the reader does not know (repeatable; case and spaces do not matter).
+    /// The line (or workbook row, 1-based) of the sheet's header; the rows above it are title and metadata
+    /// rows (default: the first row naming known columns, else the first row).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
+    pub header_row: Option<u64>,
     #[arg(long = "ignore-column", value_name = "HEADER")]
     pub ignore_columns: Vec<String>,
     /// Standard errors of the mean allowed for repeated readings (k·s/√n).
@@ -89,6 +93,7 @@ pub fn request(a: &CompareArgs) -> CompareRequest {
             delimiter: a.delimiter.clone(),
             ignore_columns: a.ignore_columns.clone(),
             sheet_name: a.sheet_name.clone(),
+            header_row: a.header_row.map(|n| n as usize),
         },
     }
 }

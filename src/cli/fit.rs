@@ -35,6 +35,10 @@ pub struct FitArgs {
     #[arg(long, value_name = "NAME", requires = "sheet")]
     pub sheet_name: Option<String>,
     /// A sheet column to skip (repeatable), as in `compare`.
+    /// The line (or workbook row, 1-based) of the sheet's header; the rows above it are title and metadata
+    /// rows (default: the first row naming known columns, else the first row).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..), requires = "sheet")]
+    pub header_row: Option<u64>,
     #[arg(long = "ignore-column", value_name = "HEADER", requires = "sheet")]
     pub ignore_columns: Vec<String>,
     /// A user geometry file (JSON, the format of `measure --geometry-file`) whose readings may be targets,
@@ -74,6 +78,7 @@ pub fn request(a: &FitArgs) -> FitRequest {
             delimiter: a.delimiter.clone(),
             ignore_columns: a.ignore_columns.clone(),
             sheet_name: a.sheet_name.clone(),
+            header_row: a.header_row.map(|n| n as usize),
         },
         sample: a.sample.clone(),
     }

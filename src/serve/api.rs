@@ -384,6 +384,7 @@ fn sheet(o: &Obj) -> Result<Sheet> {
         delimiter: o.opt_str("delimiter")?.map(str::to_owned),
         ignore_columns: strings(o, "ignore_columns")?,
         sheet_name: o.opt_str("sheet_name")?.map(str::to_owned),
+        header_row: whole(o, "header_row", 1, 1_000_000, "the header's 1-based row")?,
     }
     .options()
     .map_err(|e| at_field(o, e))?;
@@ -400,6 +401,7 @@ pub fn compare(req: &Request, ctx: Context) -> Result<Reply> {
         "sheet",
         "delimiter",
         "ignore_columns",
+        "header_row",
         "k",
         "tolerance",
         "max_de00",
@@ -452,6 +454,7 @@ pub fn fit(req: &Request, ctx: Context) -> Result<Reply> {
         "sample",
         "delimiter",
         "ignore_columns",
+        "header_row",
         "uncertainty",
         "restarts",
         "rtol",
