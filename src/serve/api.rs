@@ -15,7 +15,7 @@ use crate::comparison::sheet::{self, Sheet, SheetOptions};
 use crate::comparison::{self, VerdictRule};
 use crate::fit::{self, FitOptions, FreeParameter, TargetReading};
 use crate::input::json::{kind, parse_json, Obj};
-use crate::instrument::plan::{rtol_refusal, Plan, PlanOptions};
+use crate::instrument::plan::{rtol_refusal, Cancel, Plan, PlanOptions};
 use crate::instrument::standards::{self, StandardGeometry};
 use crate::recipe::{self, Material};
 use crate::registry::{self, Type};
@@ -33,6 +33,8 @@ pub struct Context<'a> {
     pub limits: &'a Limits,
     /// Where recipes may name table files (None: nowhere).
     pub data_dir: Option<&'a Path>,
+    /// The request's stop signal (its client gone, its time limit passed), handed to every plan it runs.
+    pub cancel: &'a Cancel,
 }
 
 /// An answer: its media type and its body.
@@ -173,7 +175,7 @@ fn plan_options(o: &Obj, ctx: Context, rtol: f64) -> Result<PlanOptions> {
         observer: Observer::parse(o.opt_str("observer")?.unwrap_or("10"))
             .map_err(|e| o.err("observer", e.to_string()))?,
     };
-    Ok(PlanOptions { rtol, max_evals, colour, rtol_from_data, ..PlanOptions::default() })
+    Ok(PlanOptions { rtol, max_evals, colour, rtol_from_data, cancel: ctx.cancel.clone(), ..PlanOptions::default() })
 }
 
 fn timing(o: &Obj) -> Result<bool> {
@@ -476,6 +478,7 @@ pub fn fit(req: &Request, ctx: Context) -> Result<Reply> {
         restarts: whole(&o, "restarts", 0, l.fit_restarts, "restarts")?
             .unwrap_or(fit::DEFAULT_RESTARTS.min(l.fit_restarts)),
         max_iterations: l.fit_iterations,
+        cancel: ctx.cancel.clone(),
         ..FitOptions::default()
     };
     let material = material(req, ctx)?;
@@ -555,7 +558,7 @@ mod tests {
     #[test]
     fn a_table_needs_the_data_directory() {
         let l = Limits::default();
-        let ctx = Context { limits: &l, data_dir: None };
+        let ctx = Context { limits: &l, data_dir: None, cancel: &Cancel::default() };
         let r = Request::parse(br#"{"recipe": {"model": "merl", "file": "x.binary"}}"#).unwrap();
         let e = measure(&r, ctx).unwrap_err().to_string();
         assert!(e.contains("--data-dir"), "{e}");

@@ -33,7 +33,24 @@ pub struct Limits {
     /// Free parameters and targets of one fit.
     pub fit_free: usize,
     pub fit_targets: usize,
+    /// Seconds a client has to send a request's headers, counted from the connection's opening or from the
+    /// previous answer on it (so also how long an idle keep-alive connection stays open); then it is closed.
+    pub header_seconds: f64,
+    /// Seconds a client has to send a request's body once its headers are in (else 408).
+    pub body_seconds: f64,
+    /// Wall-clock seconds of one computation (`--request-seconds`): the integrals running then stop, those
+    /// not started are skipped, and the answer has the readings finished, the others without a value.
+    pub request_seconds: f64,
+    /// Open connections at most (`--max-connections`); the server also stays [`RESERVED_FDS`] +
+    /// [`FDS_PER_JOB`]·`jobs` below the process's open-file limit (`ulimit -n`), whichever is lower.
+    pub connections: usize,
 }
+
+/// File descriptors the server keeps free of connections: standard streams, the listener, the runtime's
+/// poller and room for connections being closed; and [`FDS_PER_JOB`] more for each computation (the table
+/// files it reads).
+pub const RESERVED_FDS: u64 = 32;
+pub const FDS_PER_JOB: u64 = 4;
 
 impl Default for Limits {
     fn default() -> Self {
@@ -48,6 +65,10 @@ impl Default for Limits {
             fit_restarts: 4,
             fit_free: 6,
             fit_targets: 32,
+            header_seconds: 10.0,
+            body_seconds: 60.0,
+            request_seconds: 60.0,
+            connections: 1024,
         }
     }
 }
