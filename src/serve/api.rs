@@ -15,7 +15,7 @@ use crate::comparison::sheet::{self, Sheet, SheetOptions};
 use crate::comparison::{self, VerdictRule};
 use crate::fit::{self, FitOptions, FreeParameter, TargetReading};
 use crate::input::json::{kind, parse_json, Obj};
-use crate::instrument::plan::{rtol_refusal, Cancel, Plan, PlanOptions};
+use crate::instrument::plan::{rtol_refusal, Cancel, Plan, PlanOptions, MIN_RTOL};
 use crate::instrument::standards::{self, StandardGeometry};
 use crate::recipe::{self, Material};
 use crate::registry::{self, Type};
@@ -163,6 +163,15 @@ fn plan_options(o: &Obj, ctx: Context, rtol: f64) -> Result<PlanOptions> {
             let x = v.as_f64().ok_or_else(|| o.err("rtol", format!("expected a number, got {}", kind(v))))?;
             if let Some(why) = rtol_refusal(x) {
                 return Err(o.err("rtol", why));
+            }
+            if x < MIN_RTOL {
+                return Err(o.err(
+                    "rtol",
+                    format!(
+                        "{} is below {MIN_RTOL:e}, the tightest relative tolerance this server computes to",
+                        crate::error::given(x)
+                    ),
+                ));
             }
             x
         }

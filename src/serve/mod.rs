@@ -70,6 +70,32 @@ impl Shared {
     fn context<'a>(&'a self, cancel: &'a Cancel) -> Context<'a> {
         Context { limits: &self.limits, data_dir: self.data_dir.as_deref(), cancel }
     }
+
+    /// A message or an answer without the data directory's absolute path: a table's path reads relative to
+    /// the directory, as the recipe named it (docs/serve.md §Safety). The path is taken out as written and as
+    /// JSON writes it in a string.
+    fn scrub(&self, text: String) -> String {
+        let Some(dir) = &self.data_dir else { return text };
+        let plain = dir.display().to_string();
+        let json = serde_json::to_string(&plain).unwrap_or_default();
+        let json = json.trim_matches('"').to_string();
+        let mut out = text;
+        for d in [plain, json] {
+            if d.is_empty() || !out.contains(&d) {
+                continue;
+            }
+            for sep in ["/", "\\\\", "\\"] {
+                out = out.replace(&format!("{d}{sep}"), "");
+            }
+            out = out.replace(&d, "(the data directory)");
+        }
+        out
+    }
+
+    /// A library error as a 400 answer, scrubbed.
+    fn refusal(&self, e: &Error) -> Response {
+        message(StatusCode::BAD_REQUEST, &self.scrub(e.naming(&|a| format!("`{a}`"))))
+    }
 }
 
 /// A server bound to its address, not yet serving.
@@ -228,11 +254,7 @@ fn router(shared: Arc<Shared>, guard: Arc<Guard>) -> Router {
 
 /// Refuse a request whose `Host` or `Origin` is not this server's (403).
 async fn check_request(State(guard): State<Arc<Guard>>, req: Request, next: Next) -> Response {
-    let verdict = {
-        let h = |name: &str| req.headers().get(name).and_then(|v| v.to_str().ok());
-        guard.check(h("host"), h("origin"), h("sec-fetch-site"))
-    };
-    match verdict {
+    match guard.check_headers(req.headers()) {
         Ok(()) => next.run(req).await,
         Err(why) => message(StatusCode::FORBIDDEN, &why),
     }
@@ -375,8 +397,8 @@ async fn work(s: Arc<Shared>, req: Request, f: Endpoint) -> Response {
     .await;
     drop(on_leave);
     match out {
-        Ok(Ok(r)) => reply(r),
-        Ok(Err(e)) => error(StatusCode::BAD_REQUEST, &e),
+        Ok(Ok(r)) => reply(Reply { body: s.scrub(r.body), ..r }),
+        Ok(Err(e)) => s.refusal(&e),
         Err(_) => message(
             StatusCode::INTERNAL_SERVER_ERROR,
             "the computation failed unexpectedly (a bug: please report the request)",
@@ -402,22 +424,23 @@ async fn sweep(State(s): State<Arc<Shared>>, req: Request) -> Response {
     .await;
     let sw = match checked {
         Ok(Ok(sw)) => sw,
-        Ok(Err(e)) => return error(StatusCode::BAD_REQUEST, &e),
+        Ok(Err(e)) => return s.refusal(&e),
         Err(_) => return message(StatusCode::INTERNAL_SERVER_ERROR, "the sweep failed unexpectedly"),
     };
     let points = sw.len();
     let (tx, rx) = tokio::sync::mpsc::channel::<std::result::Result<String, std::io::Error>>(8);
+    let shared = s.clone();
     tokio::task::spawn_blocking(move || {
         let _permit = permit;
         let gone = || Error::Usage("the client went away".into());
         let out = api::run_sweep(&sw, |line| {
-            tx.blocking_send(Ok(line)).map_err(|_| {
+            tx.blocking_send(Ok(shared.scrub(line))).map_err(|_| {
                 cancel.raise();
                 gone()
             })
         });
         if let Err(e) = out {
-            let line = serde_json::json!({"error": e.naming(&|a| format!("`{a}`"))}).to_string() + "\n";
+            let line = serde_json::json!({"error": shared.scrub(e.naming(&|a| format!("`{a}`")))}).to_string() + "\n";
             let _ = tx.blocking_send(Ok(line));
         }
     });

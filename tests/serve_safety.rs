@@ -1,9 +1,12 @@
-//! `glossmeter serve` stays up and frees its work (docs/serve.md §Connections, §Limits): at an open-file limit
-//! of 256 with 2 000 idle connections it still answers a new client and is alive afterwards (and it kept
-//! fewer connections open than its cap); a client that sends no headers, or too slow a body, is closed or
-//! answered 408; a computation whose client leaves gives its slot back at its next integral; one that runs
-//! past the time limit answers with the readings it finished. Time bounds here are generous liveness checks,
-//! not speed assertions: each failure mode they catch would take minutes.
+//! `glossmeter serve` is safe to leave running (docs/serve.md §Safety, §Connections, §Limits). It stays up
+//! and frees its work: at an open-file limit of 256 with 2 000 idle connections it still answers a new client
+//! and is alive afterwards (and it kept fewer connections open than its cap); a client that sends no
+//! headers, or too slow a body, is closed or answered 408; a computation whose client leaves gives its slot
+//! back at its next integral; one that runs past the time limit answers with the readings it finished. Time
+//! bounds here are generous liveness checks, not speed assertions: each failure mode they catch would take
+//! minutes. And it tells a client nothing it should not: a `Host` or `Origin` sent twice and
+//! `Sec-Fetch-Site: Cross-Site` are refused, no answer shows the data directory's absolute path, a link to an
+//! outside directory does not tell whether a file exists there, and refusals name their field.
 use std::io::{BufRead, BufReader, Read, Write};
 use std::net::{SocketAddr, TcpStream};
 use std::time::{Duration, Instant};
@@ -259,4 +262,111 @@ fn a_computation_past_the_time_limit_answers_with_the_readings_it_finished() {
     if status != 200 {
         assert!(text.contains("time limit of 1 s"), "{status} {text}");
     }
+}
+
+/// One request with any headers (`Host` among them as given); the status and the body.
+fn raw_request(addr: SocketAddr, path: &str, body: &[u8], headers: &[(&str, &str)]) -> (u16, String) {
+    let mut s = TcpStream::connect(addr).unwrap();
+    s.set_read_timeout(Some(Duration::from_secs(120))).unwrap();
+    let mut head = format!("POST {path} HTTP/1.1\r\nConnection: close\r\nContent-Length: {}\r\n", body.len());
+    for (k, v) in headers {
+        head.push_str(&format!("{k}: {v}\r\n"));
+    }
+    s.write_all(format!("{head}\r\n").as_bytes()).unwrap();
+    s.write_all(body).unwrap();
+    let mut raw = Vec::new();
+    let _ = s.read_to_end(&mut raw);
+    let text = String::from_utf8_lossy(&raw).to_string();
+    let status = text.split(' ').nth(1).unwrap().parse().unwrap();
+    (status, text.split_once("\r\n\r\n").map(|(_, b)| b.to_string()).unwrap_or_default())
+}
+
+#[test]
+fn a_host_or_origin_sent_twice_and_a_cross_site_fetch_in_any_case_are_refused() {
+    let addr = start(Limits::default());
+    let me = addr.to_string();
+    let origin = format!("http://{addr}");
+    let body = cheap_measure();
+    assert_eq!(raw_request(addr, "/api/measure", &body, &[("Host", &me)]).0, 200);
+    assert_eq!(raw_request(addr, "/api/measure", &body, &[("Host", &me), ("Origin", &origin)]).0, 200);
+    for headers in [
+        vec![("Host", me.as_str()), ("Host", "evil.example")],
+        vec![("Host", me.as_str()), ("Host", me.as_str())],
+        vec![("Host", me.as_str()), ("Origin", origin.as_str()), ("Origin", "http://evil.example")],
+        vec![("Host", me.as_str()), ("Sec-Fetch-Site", "Cross-Site")],
+        vec![("Host", me.as_str()), ("Sec-Fetch-Site", "CROSS-SITE")],
+    ] {
+        let (status, text) = raw_request(addr, "/api/measure", &body, &headers);
+        assert_eq!(status, 403, "{headers:?}: {text}");
+    }
+}
+
+fn scratch(name: &str) -> std::path::PathBuf {
+    let d = std::env::temp_dir().join(format!("glossmeter-serve-safety-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+#[test]
+fn no_answer_shows_the_data_directory_and_a_link_out_tells_nothing() {
+    let root = scratch("paths");
+    let data = root.join("data");
+    std::fs::create_dir_all(data.join("tables")).unwrap();
+    std::fs::copy("fixtures/materials/inplane/beckmann.csv", data.join("tables/good.csv")).unwrap();
+    std::fs::write(data.join("tables/bad.csv"), "theta_o,theta_i,brdf\n0,0,oops\n").unwrap();
+    std::fs::create_dir_all(root.join("outside")).unwrap();
+    std::fs::write(root.join("outside/there.csv"), "x").unwrap();
+    #[cfg(unix)]
+    std::os::unix::fs::symlink(root.join("outside"), data.join("dirlink")).unwrap();
+    let server = Server::bind(ServeOptions { port: 0, data_dir: Some(data.clone()), ..ServeOptions::default() });
+    let server = server.unwrap();
+    let addr = server.addr();
+    std::thread::spawn(move || server.run());
+    let canonical = data.canonicalize().unwrap().display().to_string();
+    let given = data.display().to_string();
+    let body = |file: &str| {
+        json!({"recipe": {"model": "inplane-csv", "file": file}, "geometries": ["astm-d523-60"]}).to_string()
+    };
+    let mut answers = Vec::new();
+    for file in ["tables/good.csv", "tables/bad.csv", "tables/missing.csv", "dirlink/there.csv", "dirlink/not.csv"] {
+        for path in ["/api/measure", "/api/explain"] {
+            let (status, text) = request(addr, "POST", path, body(file).as_bytes()).unwrap();
+            assert!(!text.contains(&canonical) && !text.contains(&given), "{file} {path}: {text}");
+            answers.push((file, path, status, text));
+        }
+    }
+    let find = |f: &str| answers.iter().find(|a| a.0 == f && a.1 == "/api/measure").unwrap();
+    assert_eq!(find("tables/good.csv").2, 200, "{}", find("tables/good.csv").3);
+    let bad = find("tables/bad.csv");
+    assert_eq!(bad.2, 400);
+    assert!(bad.3.contains("tables/bad.csv"), "the table is named as the recipe named it: {}", bad.3);
+    if cfg!(unix) {
+        let (there, not) = (find("dirlink/there.csv"), find("dirlink/not.csv"));
+        assert_eq!((there.2, not.2), (400, 400));
+        assert_eq!(there.3.replace("there.csv", "not.csv"), not.3, "a link out tells nothing of what is there");
+    }
+    std::fs::remove_dir_all(&root).unwrap();
+}
+
+#[test]
+fn refusals_name_their_field_and_print_no_long_numbers() {
+    let addr = start(Limits::default());
+    let (status, text) = request(
+        addr,
+        "POST",
+        "/api/measure",
+        json!({"recipe": {"model": "lambert", "albedo": 0.5}, "rtol": 1e-13}).to_string().as_bytes(),
+    )
+    .unwrap();
+    assert_eq!(status, 400);
+    assert!(text.contains("request: field `/rtol`") && text.contains("1e-13"), "{text}");
+    // A start of 1e-300 outside the bounds is printed as 1e-300, not with 300 zeros.
+    let recipe = json!({"model": "microfacet", "distribution": "ggx", "ior": 1.5,
+        "populations": [{"roughness": 0.01}, {"weight": 1e-300, "roughness": 0.1}]});
+    let fit =
+        json!({"recipe": recipe, "free": ["/populations/1/weight=0.1..0.9"], "target": ["astm-d523-60/gloss=50"]});
+    let (status, text) = request(addr, "POST", "/api/fit", fit.to_string().as_bytes()).unwrap();
+    assert_eq!(status, 400, "{text}");
+    assert!(text.contains("1e-300") && !text.contains("00000000"), "{text}");
 }
