@@ -5,10 +5,13 @@
 //!
 //! Safe to leave running (docs/serve.md §Safety): it binds to loopback unless told otherwise (and warns
 //! then), answers only to its own names in `Host` and to its own `Origin` (DNS rebinding, cross-site
-//! requests), reads a body of at most `Limits::body_bytes`, bounds every request's work in evaluations, runs
-//! at most `Limits::jobs` computations at once and answers the excess 503 at once, reads table files only
-//! inside `--data-dir`, and writes nothing to disk. Errors are the library's messages as JSON with status
-//! 400 (403 for a refused Host or Origin, 413 for a body too large, 503 when busy).
+//! requests), reads a body of at most `Limits::body_bytes` within `Limits::body_seconds`, bounds every
+//! request's work in evaluations and in wall-clock time (`Limits::request_seconds`) and stops it when its
+//! client leaves ([`Cancel`]), runs at most `Limits::jobs` computations at once and answers the excess 503 at
+//! once, keeps its connections below the open-file limit and survives every accept error ([`connections`]),
+//! reads table files only inside `--data-dir` and never shows that directory's path, and writes nothing to
+//! disk. Errors are the library's messages as JSON with status 400 (403 for a refused Host or Origin, 408
+//! for a body too slow, 413 for a body too large, 503 when busy).
 use std::net::{IpAddr, Ipv4Addr, SocketAddr};
 use std::path::PathBuf;
 use std::sync::Arc;

@@ -264,7 +264,7 @@ fn compute_reading(
         _ => None,
     };
     match value {
-        Ok((v, e)) if v.is_finite() && e.is_finite() => Reading {
+        Ok((v, e)) if v.is_finite() && e.is_finite() && e >= 0.0 => Reading {
             data_uncertainty,
             problem: (!converged).then(|| {
                 if used.iter().any(|f| f.budget_spent) {
@@ -380,7 +380,7 @@ fn no_finite_value(v: f64) -> String {
     } else if v.is_infinite() {
         "an overflow".to_string()
     } else {
-        format!("the value {} with no finite error estimate", crate::error::number(v))
+        format!("the value {} with an error estimate that is not a finite number ≥ 0", crate::error::number(v))
     };
     format!("the reading's formula gives {what} from these fluxes; they are out of its range")
 }
