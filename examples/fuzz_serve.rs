@@ -68,14 +68,37 @@ fn bodies(panel: &str) -> Vec<(&'static str, String)> {
     vec![
         ("/api/measure", format!(r#"{{"recipe": {lambert}, "geometries": ["astm-d523-60"]}}"#)),
         ("/api/measure", format!(r#"{{"recipe": {glass}, "rtol": 1e-4}}"#)),
-        ("/api/measure", r#"{"recipe": {"model": "inplane-csv", "file": "inplane/beckmann.csv"}, "geometries": ["astm-d523-60"]}"#.into()),
-        ("/api/measure", r#"{"recipe": {"model": "merl", "file": "merl/lambert-tiny.binary"}, "geometries": ["astm-d523-60"]}"#.into()),
+        (
+            "/api/measure",
+            r#"{"recipe": {"model": "inplane-csv", "file": "inplane/beckmann.csv"}, "geometries": ["astm-d523-60"]}"#
+                .into(),
+        ),
+        (
+            "/api/measure",
+            r#"{"recipe": {"model": "merl", "file": "merl/lambert-tiny.binary"}, "geometries": ["astm-d523-60"]}"#
+                .into(),
+        ),
         ("/api/explain", format!(r#"{{"recipe": {glass}}}"#)),
         ("/api/plot", format!(r#"{{"recipe": {glass}, "kind": "section"}}"#)),
-        ("/api/plot", format!(r#"{{"recipe": {glass}, "kind": "gloss-vs-parameter", "vary": "/ior=1.4..1.6", "points": 3, "rtol": 1e-3}}"#)),
-        ("/api/sweep", format!(r#"{{"recipe": {glass}, "vary": ["/ior=1.4..1.6:3"], "rtol": 1e-3, "geometries": ["astm-d523-60"]}}"#)),
+        (
+            "/api/plot",
+            format!(
+                r#"{{"recipe": {glass}, "kind": "gloss-vs-parameter", "vary": "/ior=1.4..1.6", "points": 3, "rtol": 1e-3}}"#
+            ),
+        ),
+        (
+            "/api/sweep",
+            format!(
+                r#"{{"recipe": {glass}, "vary": ["/ior=1.4..1.6:3"], "rtol": 1e-3, "geometries": ["astm-d523-60"]}}"#
+            ),
+        ),
         ("/api/compare", format!(r#"{{"recipe": {glass}, "sheet": {{"text": "sample,60°\na,90\n"}}}}"#)),
-        ("/api/fit", format!(r#"{{"recipe": {glass}, "free": ["/ior=1.3..1.8"], "target": ["astm-d523-60/gloss=90"], "rtol": 1e-4}}"#)),
+        (
+            "/api/fit",
+            format!(
+                r#"{{"recipe": {glass}, "free": ["/ior=1.3..1.8"], "target": ["astm-d523-60/gloss=90"], "rtol": 1e-4}}"#
+            ),
+        ),
         ("/api/measure", format!(r#"{{"recipe": {glass}, "geometries": {panel}}}"#)),
     ]
 }
@@ -84,10 +107,23 @@ fn bodies(panel: &str) -> Vec<(&'static str, String)> {
 fn heavy() -> Vec<(&'static str, String)> {
     let panel = std::fs::read_to_string("fixtures/real/models/panel-three-populations.json").unwrap();
     vec![
-        ("/api/plot", format!(r#"{{"recipe": {panel}, "kind": "gloss-vs-parameter", "vary": "/populations/2/roughness=0.01..0.1", "points": 41, "geometries": {ALL}, "rtol": 1e-12}}"#)),
+        (
+            "/api/plot",
+            format!(
+                r#"{{"recipe": {panel}, "kind": "gloss-vs-parameter", "vary": "/populations/2/roughness=0.01..0.1", "points": 41, "geometries": {ALL}, "rtol": 1e-12}}"#
+            ),
+        ),
         ("/api/measure", format!(r#"{{"recipe": {panel}, "geometries": {ALL}, "rtol": 1e-12}}"#)),
-        ("/api/fit", format!(r#"{{"recipe": {panel}, "free": ["/populations/2/roughness=0.01..0.1", "/ior=1.3..1.8"], "target": ["astm-d523-60/gloss=40", "astm-d523-20/gloss=10", "astm-d523-85/gloss=90"], "rtol": 1e-12}}"#)),
-        ("/api/sweep", format!(r#"{{"recipe": {panel}, "vary": ["/ior=1.3..1.8:20"], "geometries": {ALL}, "rtol": 1e-12}}"#)),
+        (
+            "/api/fit",
+            format!(
+                r#"{{"recipe": {panel}, "free": ["/populations/2/roughness=0.01..0.1", "/ior=1.3..1.8"], "target": ["astm-d523-60/gloss=40", "astm-d523-20/gloss=10", "astm-d523-85/gloss=90"], "rtol": 1e-12}}"#
+            ),
+        ),
+        (
+            "/api/sweep",
+            format!(r#"{{"recipe": {panel}, "vary": ["/ior=1.3..1.8:20"], "geometries": {ALL}, "rtol": 1e-12}}"#),
+        ),
     ]
 }
 
@@ -177,8 +213,9 @@ fn exchange(addr: SocketAddr, head: &[u8], body: &[u8], pieces: usize, pause_ms:
     }
 }
 
-/// The checks of one answer: well-formed, an allowed status, no panic, no data-directory path.
-fn check(raw: &[u8], data: &str) -> Result<u16, String> {
+/// The checks of one answer: well-formed, an allowed status, no panic, no data-directory path, and a JSON
+/// error body with its message (but for the answer to a HEAD request, which has no body).
+fn check(raw: &[u8], data: &str, head_request: bool) -> Result<u16, String> {
     let text = String::from_utf8_lossy(raw);
     if raw.is_empty() {
         return Ok(0); // closed without an answer (a cut head, a header timeout): allowed
@@ -197,10 +234,10 @@ fn check(raw: &[u8], data: &str) -> Result<u16, String> {
     if text.contains(data) {
         return Err(format!("the data directory's path in the answer: {}", &text[..text.len().min(600)]));
     }
-    if status != 200 && text.contains("application/json") {
+    if status != 200 && text.contains("application/json") && !head_request {
         let body = text.split_once("\r\n\r\n").map(|x| x.1).unwrap_or("");
-        let v: serde_json::Value =
-            serde_json::from_str(body).map_err(|e| format!("a {status} whose JSON body does not parse ({e}): {body}"))?;
+        let v: serde_json::Value = serde_json::from_str(body)
+            .map_err(|e| format!("a {status} whose JSON body does not parse ({e}): {body}"))?;
         if v.get("error").and_then(|e| e.as_str()).is_none() {
             return Err(format!("a {status} without an error message: {body}"));
         }
@@ -222,7 +259,11 @@ fn cheap_served(addr: SocketAddr, within: Duration) -> Result<Duration, String> 
     let h = head(
         "POST",
         "/api/measure",
-        &[("Host".into(), addr.to_string()), ("Content-Length".into(), body.len().to_string()), ("Connection".into(), "close".into())],
+        &[
+            ("Host".into(), addr.to_string()),
+            ("Content-Length".into(), body.len().to_string()),
+            ("Connection".into(), "close".into()),
+        ],
     );
     let clock = Instant::now();
     loop {
@@ -241,7 +282,13 @@ fn cheap_served(addr: SocketAddr, within: Duration) -> Result<Duration, String> 
 }
 
 /// One case; Ok(what it saw) or the failure.
-fn run(kind: usize, rng: &mut Rng, s: &Server, bodies: &[(&str, String)], heavy: &[(&str, String)]) -> Result<String, String> {
+fn run(
+    kind: usize,
+    rng: &mut Rng,
+    s: &Server,
+    bodies: &[(&str, String)],
+    heavy: &[(&str, String)],
+) -> Result<String, String> {
     let addr = s.addr;
     let data = s.data.display().to_string();
     let me = addr.to_string();
@@ -272,10 +319,16 @@ fn run(kind: usize, rng: &mut Rng, s: &Server, bodies: &[(&str, String)], heavy:
                 _ => hs.push(("Host".into(), me.clone())),
             }
             if rng.chance(0.2) {
-                hs.push(("Origin".into(), rng.pick(&[format!("http://{me}"), "http://evil.example".into(), "null".into()]).clone()));
+                hs.push((
+                    "Origin".into(),
+                    rng.pick(&[format!("http://{me}"), "http://evil.example".into(), "null".into()]).clone(),
+                ));
             }
             if rng.chance(0.2) {
-                hs.push(("Sec-Fetch-Site".into(), rng.pick(&["cross-site", "Cross-Site", "same-origin", "none"]).to_string()));
+                hs.push((
+                    "Sec-Fetch-Site".into(),
+                    rng.pick(&["cross-site", "Cross-Site", "same-origin", "none"]).to_string(),
+                ));
             }
             let chunked = rng.chance(0.15);
             let mut payload = body.clone();
@@ -287,7 +340,10 @@ fn run(kind: usize, rng: &mut Rng, s: &Server, bodies: &[(&str, String)], heavy:
             }
             match rng.below(12) {
                 0 => hs.push(("Content-Length".into(), (body.len() + 1 + rng.below(100)).to_string())),
-                1 => hs.push(("Content-Length".into(), rng.pick(&["-1", "1e20", "99999999999999999999", "x"]).to_string())),
+                1 => hs.push((
+                    "Content-Length".into(),
+                    rng.pick(&["-1", "1e20", "99999999999999999999", "x"]).to_string(),
+                )),
                 2 => {
                     hs.push(("Content-Length".into(), body.len().to_string()));
                     hs.push(("Content-Length".into(), (body.len() + 1).to_string()));
@@ -306,15 +362,19 @@ fn run(kind: usize, rng: &mut Rng, s: &Server, bodies: &[(&str, String)], heavy:
                 Err(e) if e.starts_with("read") => Vec::new(),
                 Err(e) => return Err(e),
             };
-            check(&raw, &data).map(|st| format!("status {st}"))
+            check(&raw, &data, method == "HEAD").map(|st| format!("status {st}"))
         }
         1 => {
             let (path, body) = rng.pick(bodies).clone();
-            let hs = [("Host".into(), me.clone()), ("Content-Length".into(), body.len().to_string()), ("Connection".into(), "close".into())];
+            let hs = [
+                ("Host".into(), me.clone()),
+                ("Content-Length".into(), body.len().to_string()),
+                ("Connection".into(), "close".into()),
+            ];
             let pieces = 2 + rng.below(10);
             let pause = rng.below(3000 / pieces) as u64;
             let raw = exchange(addr, &head("POST", path, &hs), body.as_bytes(), pieces, pause)?;
-            let st = check(&raw, &data)?;
+            let st = check(&raw, &data, false)?;
             if st != 200 && st != 503 && st != 400 {
                 return Err(format!("a slow valid request answered {st}"));
             }
@@ -323,7 +383,8 @@ fn run(kind: usize, rng: &mut Rng, s: &Server, bodies: &[(&str, String)], heavy:
         2 => {
             let (path, body) = rng.pick(heavy).clone();
             let mut c = TcpStream::connect(addr).map_err(|e| format!("connect: {e}"))?;
-            let h = head("POST", path, &[("Host".into(), me.clone()), ("Content-Length".into(), body.len().to_string())]);
+            let h =
+                head("POST", path, &[("Host".into(), me.clone()), ("Content-Length".into(), body.len().to_string())]);
             c.write_all(&h).map_err(|e| e.to_string())?;
             c.write_all(body.as_bytes()).map_err(|e| e.to_string())?;
             std::thread::sleep(Duration::from_millis(rng.below(700) as u64));
@@ -333,14 +394,19 @@ fn run(kind: usize, rng: &mut Rng, s: &Server, bodies: &[(&str, String)], heavy:
         }
         3 => {
             let n = 300;
-            let idle: Vec<TcpStream> = (0..n).filter_map(|_| TcpStream::connect_timeout(&addr, Duration::from_secs(5)).ok()).collect();
+            let idle: Vec<TcpStream> =
+                (0..n).filter_map(|_| TcpStream::connect_timeout(&addr, Duration::from_secs(5)).ok()).collect();
             let t = cheap_served(addr, Duration::from_secs(30))?;
             drop(idle);
             Ok(format!("served in {:.3} s beside {n} idle connections", t.as_secs_f64()))
         }
         _ => {
             let (path, body) = rng.pick(bodies).clone();
-            let full = [head("POST", path, &[("Host".into(), me.clone()), ("Content-Length".into(), body.len().to_string())]), body.into_bytes()].concat();
+            let full = [
+                head("POST", path, &[("Host".into(), me.clone()), ("Content-Length".into(), body.len().to_string())]),
+                body.into_bytes(),
+            ]
+            .concat();
             let bytes: Vec<u8> = if rng.chance(0.5) {
                 (0..rng.below(2000)).map(|_| rng.next() as u8).collect()
             } else {
@@ -353,7 +419,7 @@ fn run(kind: usize, rng: &mut Rng, s: &Server, bodies: &[(&str, String)], heavy:
                 c.set_read_timeout(Some(Duration::from_secs(ANSWER_S))).unwrap();
                 let mut raw = Vec::new();
                 let _ = c.read_to_end(&mut raw);
-                check(&raw, &data).map(|st| format!("status {st}"))
+                check(&raw, &data, false).map(|st| format!("status {st}"))
             } else {
                 Ok("left".into())
             }
@@ -376,7 +442,11 @@ fn main() {
     let bin = exe.parent().and_then(|d| d.parent()).unwrap().join("glossmeter");
     assert!(bin.exists(), "{} not built: cargo build --bin glossmeter (same profile) first", bin.display());
     let data = std::env::temp_dir().join(format!("glossmeter-fuzz-serve-{}", std::process::id()));
-    for (from, to) in [("fixtures/materials/inplane", "inplane"), ("fixtures/materials/merl", "merl"), ("fixtures/materials/rgl", "rgl")] {
+    for (from, to) in [
+        ("fixtures/materials/inplane", "inplane"),
+        ("fixtures/materials/merl", "merl"),
+        ("fixtures/materials/rgl", "rgl"),
+    ] {
         std::fs::create_dir_all(data.join(to)).unwrap();
         for f in std::fs::read_dir(from).unwrap() {
             let f = f.unwrap().path();
