@@ -175,30 +175,36 @@ impl http_body::Body for MarkedBody {
     }
 }
 
-/// Logs accept errors to standard error: one line per kind at most once a second, with the count of those
-/// not logged since.
+/// Logs accept errors to standard error: one line per kind of error at most once a second, with the count of
+/// those of the kind not logged since its last line.
 #[derive(Default)]
 struct ErrorLog {
-    last: Option<(std::io::ErrorKind, Instant)>,
-    quiet: u64,
+    kinds: HashMap<std::io::ErrorKind, (Instant, u64)>,
 }
 
 impl ErrorLog {
     fn log(&mut self, e: &std::io::Error, what: &str) {
-        let now = Instant::now();
-        if let Some((kind, at)) = self.last {
-            if kind == e.kind() && now.duration_since(at) < Duration::from_secs(1) {
-                self.quiet += 1;
-                return;
-            }
+        if let Some(line) = self.line(e, what, Instant::now()) {
+            eprintln!("{line}");
         }
-        let more = match self.quiet {
+    }
+
+    /// The line to log for an error at `now`, if one is due.
+    fn line(&mut self, e: &std::io::Error, what: &str, now: Instant) -> Option<String> {
+        let quiet = match self.kinds.get_mut(&e.kind()) {
+            Some((at, quiet)) if now.duration_since(*at) < Duration::from_secs(1) => {
+                *quiet += 1;
+                return None;
+            }
+            Some((_, quiet)) => *quiet,
+            None => 0,
+        };
+        self.kinds.insert(e.kind(), (now, 0));
+        let more = match quiet {
             0 => String::new(),
             n => format!(" ({n} more since the last line)"),
         };
-        eprintln!("glossmeter serve: accept failed: {e}{more}; {what}");
-        self.last = Some((e.kind(), now));
-        self.quiet = 0;
+        Some(format!("glossmeter serve: accept failed: {e}{more}; {what}"))
     }
 }
 
@@ -300,6 +306,23 @@ mod tests {
         assert_eq!(body["status"], 503);
         let length = format!("Content-Length: {}\r\n", full.len() - head - 4);
         assert!(String::from_utf8_lossy(&full[..head + 2]).contains(&length));
+    }
+
+    #[test]
+    fn accept_errors_are_logged_once_a_second_per_kind_with_the_count_between() {
+        let mut log = ErrorLog::default();
+        let t = Instant::now();
+        let emfile = std::io::Error::from_raw_os_error(24);
+        let first = log.line(&emfile, "retrying", t).unwrap();
+        assert!(first.contains("accept failed") && first.contains("retrying"), "{first}");
+        for k in 1..=5 {
+            assert!(log.line(&emfile, "retrying", t + Duration::from_millis(100 * k)).is_none());
+        }
+        let other = std::io::Error::new(std::io::ErrorKind::OutOfMemory, "no memory");
+        assert!(log.line(&other, "retrying", t + Duration::from_millis(600)).is_some(), "another kind at once");
+        assert!(log.line(&emfile, "retrying", t + Duration::from_millis(700)).is_none());
+        let again = log.line(&emfile, "retrying", t + Duration::from_millis(1000)).unwrap();
+        assert!(again.contains("(6 more since the last line)"), "{again}");
     }
 
     #[test]
