@@ -96,9 +96,10 @@ fn raise_open_files(want: u64) -> u64 {
 
 #[test]
 fn at_an_open_file_limit_of_256_two_thousand_idle_connections_do_not_stop_the_server() {
+    // 2 000 where the hard limit allows (it does on Linux by default); at least twice the server's cap of 216.
     let have = raise_open_files(2_300);
     let n = 2_000.min(have.saturating_sub(200) as usize);
-    assert!(n >= 1_000, "this test needs an open-file limit of about 2 300 (hard limit allows {have})");
+    assert!(n >= 432, "this test needs an open-file limit of at least 632 (the hard limit allows {have})");
     let mut child = std::process::Command::new("sh")
         .args(["-c", &format!("ulimit -n 256 && exec {} serve --port 0", env!("CARGO_BIN_EXE_glossmeter"))])
         .stdout(std::process::Stdio::piped())
