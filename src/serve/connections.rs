@@ -1,8 +1,8 @@
 //! The server's connections (docs/serve.md §Connections): its own accept loop and HTTP/1.1 connections
 //! (hyper, as axum's own server would run them), so that
 //!
-//! * every accept error is survived and logged: a connection error (reset before it was accepted) is
-//!   skipped; a resource error (out of file descriptors, `EMFILE`/`ENFILE`, or memory) closes the connection
+//! * every accept error is survived and logged: a connection error (reset before it was accepted) skips
+//!   that connection; a resource error (out of file descriptors, `EMFILE`/`ENFILE`, or memory) closes the connection
 //!   idle longest and waits 50 ms before the next accept. Repeats of one kind of error are logged at most
 //!   once a second, with their count;
 //! * the open connections are capped below the process's open-file limit ([`connection_cap`], said in the
@@ -226,8 +226,7 @@ fn full_answer() -> Vec<u8> {
     .into_bytes()
 }
 
-/// Accept and serve connections until the process ends (an error only if the listener itself fails for
-/// good, which no accept error does).
+/// Accept and serve connections until the process ends: no accept error ends it.
 pub async fn serve(listener: TcpListener, app: Router, limits: &Limits, cap: usize) {
     let table = Arc::new(Table { start: Instant::now(), conns: Mutex::new(HashMap::new()), next: AtomicU64::new(0) });
     let header_timeout = Duration::try_from_secs_f64(limits.header_seconds).unwrap_or(Duration::from_secs(10));
@@ -239,7 +238,10 @@ pub async fn serve(listener: TcpListener, app: Router, limits: &Limits, cap: usi
         }
         let stream = match listener.accept().await {
             Ok((stream, _)) => stream,
-            Err(e) if is_connection_error(&e) => continue,
+            Err(e) if is_connection_error(&e) => {
+                log.log(&e, "that connection is skipped");
+                continue;
+            }
             Err(e) => {
                 let freed = table.close_idlest();
                 log.log(&e, if freed { "closed the idlest connection; retrying" } else { "retrying in 50 ms" });
