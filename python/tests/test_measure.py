@@ -161,3 +161,16 @@ def test_schema_and_describe():
     assert "properties" in json.dumps(glossmeter.schema())
     assert "Beckmann" in glossmeter.describe(RECIPES / "bench-b2-beckmann-0.1.json") or "beckmann" in \
         glossmeter.describe(RECIPES / "bench-b2-beckmann-0.1.json").lower()
+
+
+def test_a_huge_or_tiny_number_in_a_refusal_is_short():
+    import numpy as np
+
+    def f(wi, wo):
+        return np.full(len(wi), 0.1)
+
+    for bad in [1e308, -1e308]:
+        with pytest.raises(ValueError) as e:
+            glossmeter.measure_brdf(f, lobes=[bad], geometries=["astm-d523-60"])
+        msg = str(e.value)
+        assert "slope width" in msg and "0000000000" not in msg and len(msg) < 300, msg
