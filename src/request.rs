@@ -501,7 +501,7 @@ impl FitRequest {
 }
 
 /// `serve`: where the server listens and what it may read (the command line's `glossmeter serve`).
-#[derive(Clone, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct ServeRequest {
     /// The port (0: any free port).
     pub port: u16,
@@ -513,6 +513,10 @@ pub struct ServeRequest {
     pub allow_hosts: Vec<String>,
     /// Computations running at once.
     pub jobs: usize,
+    /// A request's time limit in seconds (None: the server's default, docs/serve.md §Limits).
+    pub request_seconds: Option<f64>,
+    /// Connections kept open at most (None: the server's default, below the open-file limit).
+    pub max_connections: Option<usize>,
 }
 
 #[cfg(test)]

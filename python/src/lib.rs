@@ -17,7 +17,7 @@ use glossmeter::recipe::{self, Material};
 use glossmeter::{report, Error};
 use pyo3::exceptions::{PyFileNotFoundError, PyOSError, PyRuntimeError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyList, PyString};
+use pyo3::types::{PyDict, PyFloat, PyList, PyString, PyTuple};
 
 mod args;
 mod probe;
@@ -54,13 +54,46 @@ pub(crate) fn guarded<T>(f: impl FnOnce() -> PyResult<T>) -> PyResult<T> {
     }
 }
 
-/// A Python object as JSON text: a `str` as is, anything else through `json.dumps`.
+/// A Python object as JSON text: a `str` as is, anything else through `json.dumps`. A float that is not
+/// finite (NaN, ±inf) anywhere inside is refused with its place as a JSON Pointer: JSON has no such number,
+/// and `json.dumps` would write `NaN`, which the reader then calls malformed JSON at a column.
 fn json_text(py: Python<'_>, obj: &Bound<'_, PyAny>) -> PyResult<String> {
     if let Ok(s) = obj.cast::<PyString>() {
         return Ok(s.to_cow()?.into_owned());
     }
+    if let Some((at, x)) = non_finite_at(obj, String::new(), 0) {
+        return Err(PyValueError::new_err(format!(
+            "<dict>: field `{at}`: `{x}` is not a finite number (JSON has no NaN or infinity); give a finite number"
+        )));
+    }
     let json = py.import("json")?;
     json.call_method1("dumps", (obj,))?.extract()
+}
+
+/// The JSON Pointer of the first float that is not finite inside `obj` (through dicts, lists and tuples, to a
+/// depth of 128, as deep as the recipe reader reads), and its value.
+fn non_finite_at(obj: &Bound<'_, PyAny>, at: String, depth: usize) -> Option<(String, f64)> {
+    if depth > 128 {
+        return None;
+    }
+    if let Ok(f) = obj.cast::<PyFloat>() {
+        let x = f.value();
+        return (!x.is_finite()).then_some((at, x));
+    }
+    let inside = |key: String, v: Bound<'_, PyAny>| {
+        let key = key.replace('~', "~0").replace('/', "~1");
+        non_finite_at(&v, format!("{at}/{key}"), depth + 1)
+    };
+    if let Ok(d) = obj.cast::<PyDict>() {
+        return d.iter().find_map(|(k, v)| inside(k.str().map(|s| s.to_string()).unwrap_or_default(), v));
+    }
+    if let Ok(l) = obj.cast::<PyList>() {
+        return l.iter().enumerate().find_map(|(i, v)| inside(i.to_string(), v));
+    }
+    if let Ok(t) = obj.cast::<PyTuple>() {
+        return t.iter().enumerate().find_map(|(i, v)| inside(i.to_string(), v));
+    }
+    None
 }
 
 /// A JSON value as the Python objects `json.loads` makes of its text, built directly: null → None, a boolean →

@@ -340,10 +340,10 @@ fn parse_lobes(lobes: &Bound<'_, PyAny>) -> PyResult<Vec<Lobe>> {
             (slope, true, 1.0, format!("lobe {i} of f (hinted)"))
         };
         if !(slope.is_finite() && slope > 0.0 && slope <= 10.0) {
-            return Err(bad(i, format!("slope width {slope} is outside (0, 10]")));
+            return Err(bad(i, format!("slope width {} is outside (0, 10]", glossmeter::error::given(slope))));
         }
         if !(eta.is_finite() && (1.0..=4.0).contains(&eta)) {
-            return Err(bad(i, format!("eta {eta} is outside [1, 4]")));
+            return Err(bad(i, format!("eta {} is outside [1, 4]", glossmeter::error::given(eta))));
         }
         // A heavy tail of a user's function has no stated shape: `Tail::Unknown` (split out to the range ends).
         let tail = if heavy { Tail::Unknown } else { Tail::Gaussian };
@@ -459,7 +459,10 @@ pub fn measure_brdf<'py>(
                 )));
             }
             if let Some(x) = r.iter().find(|x| !(x.is_finite() && **x >= 0.0 && **x <= 1.0)) {
-                return Err(PyValueError::new_err(format!("delta: reflectance {x} is outside [0, 1]")));
+                return Err(PyValueError::new_err(format!(
+                    "delta: reflectance {} is outside [0, 1]",
+                    glossmeter::error::given(*x)
+                )));
             }
             Some(Delta::Constant(r))
         }

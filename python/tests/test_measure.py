@@ -101,6 +101,19 @@ def test_bad_input_raises_value_error_with_the_cli_message(tmp_path):
         glossmeter.measure({"albedo": 0.5})
 
 
+@pytest.mark.parametrize("bad", [float("nan"), float("inf"), -float("inf")])
+def test_a_non_finite_number_in_a_dict_recipe_is_named_by_its_field(bad):
+    recipe = {"model": "microfacet", "distribution": "ggx", "ior": 1.5,
+              "populations": [{"roughness": 0.01}, {"weight": 0.5, "roughness": bad}]}
+    with pytest.raises(ValueError) as e:
+        glossmeter.measure(recipe)
+    msg = str(e.value)
+    assert "field `/populations/1/roughness`" in msg and "not a finite number" in msg, msg
+    assert "malformed JSON" not in msg, msg
+    with pytest.raises(ValueError, match="field `/albedo`"):
+        glossmeter.measure({"model": "lambert", "albedo": bad})
+
+
 def test_unknown_geometry_bad_rtol_and_missing_file():
     lam = {"model": "lambert", "albedo": 0.5}
     with pytest.raises(ValueError, match="unknown geometry id \"nope\"") as e:
@@ -148,3 +161,16 @@ def test_schema_and_describe():
     assert "properties" in json.dumps(glossmeter.schema())
     assert "Beckmann" in glossmeter.describe(RECIPES / "bench-b2-beckmann-0.1.json") or "beckmann" in \
         glossmeter.describe(RECIPES / "bench-b2-beckmann-0.1.json").lower()
+
+
+def test_a_huge_or_tiny_number_in_a_refusal_is_short():
+    import numpy as np
+
+    def f(wi, wo):
+        return np.full(len(wi), 0.1)
+
+    for bad in [1e308, -1e308]:
+        with pytest.raises(ValueError) as e:
+            glossmeter.measure_brdf(f, lobes=[bad], geometries=["astm-d523-60"])
+        msg = str(e.value)
+        assert "slope width" in msg and "0000000000" not in msg and len(msg) < 300, msg

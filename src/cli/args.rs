@@ -124,6 +124,8 @@ impl ServeArgs {
             data_dir: self.data_dir.clone(),
             allow_hosts: self.allow_hosts.clone(),
             jobs: self.jobs,
+            request_seconds: self.request_seconds,
+            max_connections: self.max_connections,
         }
     }
 }
@@ -148,4 +150,11 @@ pub struct ServeArgs {
     /// Computations running at once; further requests are answered 503 (busy) at once.
     #[arg(long, default_value_t = 2)]
     pub jobs: usize,
+    /// Wall-clock seconds of one computation [default: 60]: then the answer has the readings finished and
+    /// the others without a value (docs/serve.md §Limits).
+    #[arg(long, value_name = "SECONDS")]
+    pub request_seconds: Option<f64>,
+    /// Connections kept open at most [default: 1024, and 64 below the open-file limit].
+    #[arg(long, value_name = "N")]
+    pub max_connections: Option<usize>,
 }

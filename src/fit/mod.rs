@@ -51,7 +51,7 @@ use nalgebra::{DMatrix, DVector};
 use serde_json::Value;
 
 use crate::error::Words;
-use crate::instrument::plan::{PlanOptions, Planner};
+use crate::instrument::plan::{Cancel, PlanOptions, Planner};
 use crate::instrument::standards::StandardGeometry;
 use crate::{recipe, Error, Result};
 use params::check_free;
@@ -84,6 +84,8 @@ pub struct FitOptions {
     /// User geometries (loaded from geometry files) that targets may name besides the shipped ones; a
     /// target's geometry id is looked up here first.
     pub geometries: Vec<StandardGeometry>,
+    /// A stop signal for the whole fit (`PlanOptions::cancel`, passed to every forward run; default: none).
+    pub cancel: Cancel,
 }
 
 /// Restarts of an exactly determined fit by default.
@@ -97,6 +99,7 @@ impl Default for FitOptions {
             max_iterations: 200,
             restarts: DEFAULT_RESTARTS,
             geometries: Vec::new(),
+            cancel: Cancel::default(),
         }
     }
 }
@@ -274,7 +277,7 @@ pub fn fit(
             }),
         })
         .collect::<Result<_>>()?;
-    let plan_options = PlanOptions { rtol: options.rtol, ..PlanOptions::default() };
+    let plan_options = PlanOptions { rtol: options.rtol, cancel: options.cancel.clone(), ..PlanOptions::default() };
     // Match every target to a reading of the plan.
     let probe = planner.compile(
         recipe::parse_str(&recipe_json.to_string(), file)?.brdf,

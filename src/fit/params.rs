@@ -224,8 +224,8 @@ pub(super) fn check_free(recipe: &Value, free: &[FreeParameter]) -> Result<Vec<f
         if !(r.contains(p.lower) || p.lower == r.lo) || !(r.contains(p.upper) || p.upper == r.hi) {
             return Err(bad(format!(
                 "bounds {}..{} leave the allowed range of {} ({}: {})",
-                p.lower,
-                p.upper,
+                crate::error::number(p.lower),
+                crate::error::number(p.upper),
                 entry.pointer,
                 r.describe(),
                 entry.description
@@ -233,8 +233,10 @@ pub(super) fn check_free(recipe: &Value, free: &[FreeParameter]) -> Result<Vec<f
         }
         if !(x > p.lower && x < p.upper) {
             return Err(bad(format!(
-                "the start (the recipe's value {x}) is outside the bounds; it must lie strictly between {} and {}",
-                p.lower, p.upper
+                "the start (the recipe's value {}) is outside the bounds; it must lie strictly between {} and {}",
+                crate::error::number(x),
+                crate::error::number(p.lower),
+                crate::error::number(p.upper)
             )));
         }
         start.push(x);

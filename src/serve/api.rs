@@ -15,7 +15,7 @@ use crate::comparison;
 use crate::comparison::sheet::{self, Sheet};
 use crate::fit::{self, FitOptions};
 use crate::input::json::{kind, parse_json, Obj};
-use crate::instrument::plan::{Plan, PlanOptions, DEFAULT_RTOL};
+use crate::instrument::plan::{Cancel, Plan, PlanOptions, DEFAULT_RTOL, MIN_RTOL};
 use crate::instrument::standards::{self, StandardGeometry};
 use crate::recipe::{self, Material};
 use crate::registry::{self, Type};
@@ -37,6 +37,8 @@ pub struct Context<'a> {
     pub limits: &'a Limits,
     /// Where recipes may name table files (None: nowhere).
     pub data_dir: Option<&'a Path>,
+    /// The request's stop signal (its client gone, its time limit passed), handed to every plan it runs.
+    pub cancel: &'a Cancel,
 }
 
 /// An answer: its media type and its body.
@@ -173,7 +175,20 @@ fn at_field(o: &Obj, e: Error) -> Error {
 fn plan_request(o: &Obj, ctx: Context) -> Result<PlanRequest> {
     let rtol = match o.get("rtol") {
         None => None,
-        Some(v) => Some(v.as_f64().ok_or_else(|| o.err("rtol", format!("expected a number, got {}", kind(v))))?),
+        Some(v) => {
+            let x = v.as_f64().ok_or_else(|| o.err("rtol", format!("expected a number, got {}", kind(v))))?;
+            // The server's own floor, below the library's (docs/serve.md §Limits).
+            if x.is_finite() && x > 0.0 && x < MIN_RTOL {
+                return Err(o.err(
+                    "rtol",
+                    format!(
+                        "{} is below {MIN_RTOL:e}, the tightest relative tolerance this server computes to",
+                        crate::error::given(x)
+                    ),
+                ));
+            }
+            Some(x)
+        }
     };
     let max_evals = whole(o, "max_evals", 1, ctx.limits.max_evals, "evaluations per aperture integral")?
         .unwrap_or(ctx.limits.max_evals);
@@ -195,7 +210,8 @@ fn plan_options(o: &Obj, ctx: Context, default_rtol: f64) -> Result<PlanOptions>
     if let Some(x) = &request.observer {
         Observer::parse(x).map_err(|e| o.err("observer", e.to_string()))?;
     }
-    request.options_or(default_rtol).map_err(|e| at_field(o, e))
+    let options = request.options_or(default_rtol).map_err(|e| at_field(o, e))?;
+    Ok(PlanOptions { cancel: ctx.cancel.clone(), ..options })
 }
 
 fn timing(o: &Obj) -> Result<bool> {
@@ -489,7 +505,7 @@ pub fn fit(req: &Request, ctx: Context) -> Result<Reply> {
     if targets.len() > l.fit_targets {
         return Err(o.err("target", format!("{} targets; this server fits at most {}", targets.len(), l.fit_targets)));
     }
-    let options = FitOptions { max_iterations: l.fit_iterations, ..options };
+    let options = FitOptions { max_iterations: l.fit_iterations, cancel: ctx.cancel.clone(), ..options };
     let material = material(req, ctx)?;
     let report = fit::fit(&material.json, &material.file, &free, &targets, &options)?;
     Ok(Reply::json(&report::fit::json(&report, false)))
@@ -567,7 +583,7 @@ mod tests {
     #[test]
     fn a_table_needs_the_data_directory() {
         let l = Limits::default();
-        let ctx = Context { limits: &l, data_dir: None };
+        let ctx = Context { limits: &l, data_dir: None, cancel: &Cancel::default() };
         let r = Request::parse(br#"{"recipe": {"model": "merl", "file": "x.binary"}}"#).unwrap();
         let e = measure(&r, ctx).unwrap_err().to_string();
         assert!(e.contains("--data-dir"), "{e}");

@@ -5,10 +5,13 @@
 //!
 //! Safe to leave running (docs/serve.md §Safety): it binds to loopback unless told otherwise (and warns
 //! then), answers only to its own names in `Host` and to its own `Origin` (DNS rebinding, cross-site
-//! requests), reads a body of at most `Limits::body_bytes`, bounds every request's work in evaluations, runs
-//! at most `Limits::jobs` computations at once and answers the excess 503 at once, reads table files only
-//! inside `--data-dir`, and writes nothing to disk. Errors are the library's messages as JSON with status
-//! 400 (403 for a refused Host or Origin, 413 for a body too large, 503 when busy).
+//! requests), reads a body of at most `Limits::body_bytes` within `Limits::body_seconds`, bounds every
+//! request's work in evaluations and in wall-clock time (`Limits::request_seconds`) and stops it when its
+//! client leaves ([`Cancel`]), runs at most `Limits::jobs` computations at once and answers the excess 503 at
+//! once, keeps its connections below the open-file limit and survives every accept error ([`connections`]),
+//! reads table files only inside `--data-dir` and never shows that directory's path, and writes nothing to
+//! disk. Errors are the library's messages as JSON with status 400 (403 for a refused Host or Origin, 408
+//! for a body too slow, 413 for a body too large, 503 when busy).
 use std::net::{IpAddr, Ipv4Addr, SocketAddr};
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -22,11 +25,13 @@ use axum::routing::{get, post};
 use axum::Router;
 use tokio::sync::Semaphore;
 
+use crate::instrument::plan::Cancel;
 use crate::request::ServeRequest;
 use crate::{Error, Result};
 
 pub mod api;
 pub mod assets;
+pub mod connections;
 pub mod security;
 
 use api::{Context, Reply};
@@ -65,8 +70,34 @@ struct Shared {
 }
 
 impl Shared {
-    fn context(&self) -> Context<'_> {
-        Context { limits: &self.limits, data_dir: self.data_dir.as_deref() }
+    fn context<'a>(&'a self, cancel: &'a Cancel) -> Context<'a> {
+        Context { limits: &self.limits, data_dir: self.data_dir.as_deref(), cancel }
+    }
+
+    /// A message or an answer without the data directory's absolute path: a table's path reads relative to
+    /// the directory, as the recipe named it (docs/serve.md §Safety). The path is taken out as written and as
+    /// JSON writes it in a string.
+    fn scrub(&self, text: String) -> String {
+        let Some(dir) = &self.data_dir else { return text };
+        let plain = dir.display().to_string();
+        let json = serde_json::to_string(&plain).unwrap_or_default();
+        let json = json.trim_matches('"').to_string();
+        let mut out = text;
+        for d in [plain, json] {
+            if d.is_empty() || !out.contains(&d) {
+                continue;
+            }
+            for sep in ["/", "\\\\", "\\"] {
+                out = out.replace(&format!("{d}{sep}"), "");
+            }
+            out = out.replace(&d, "(the data directory)");
+        }
+        out
+    }
+
+    /// A library error as a 400 answer, scrubbed.
+    fn refusal(&self, e: &Error) -> Response {
+        message(StatusCode::BAD_REQUEST, &self.scrub(e.naming(&|a| format!("`{a}`"))))
     }
 }
 
@@ -76,6 +107,9 @@ pub struct Server {
     addr: SocketAddr,
     shared: Arc<Shared>,
     guard: Arc<Guard>,
+    /// The process's open-file limit when bound, and the connections kept open at most.
+    fd_limit: Option<u64>,
+    connections: usize,
 }
 
 impl Server {
@@ -107,9 +141,18 @@ impl Server {
             .map_err(|e| Error::Usage(format!("cannot listen on {}: {e}", SocketAddr::new(ip, o.port))))?;
         listener.set_nonblocking(true).map_err(|e| Error::Usage(format!("cannot listen: {e}")))?;
         let addr = listener.local_addr().map_err(|e| Error::Usage(format!("cannot listen: {e}")))?;
+        let fd_limit = connections::open_file_limit();
+        let connections = connections::connection_cap(o.limits.connections, fd_limit, o.limits.jobs)?;
         let permits = Arc::new(Semaphore::new(o.limits.jobs));
         let guard = Arc::new(Guard::new(addr, &o.allow_hosts));
-        Ok(Server { listener, addr, shared: Arc::new(Shared { limits: o.limits, data_dir, permits }), guard })
+        let shared = Arc::new(Shared { limits: o.limits, data_dir, permits });
+        Ok(Server { listener, addr, shared, guard, fd_limit, connections })
+    }
+
+    /// The connections the server keeps open at most ([`connections::connection_cap`]) and the open-file
+    /// limit it stays below (None: none).
+    pub fn connections(&self) -> (usize, Option<u64>) {
+        (self.connections, self.fd_limit)
     }
 
     /// The bound address.
@@ -130,25 +173,38 @@ impl Server {
     /// Serve until the process is stopped.
     pub fn run(self) -> Result<()> {
         let io = |e: std::io::Error| Error::Usage(format!("the server stopped: {e}"));
+        // Timers as well as I/O: the header, body and request timeouts, and the pause after an accept error.
         let runtime = tokio::runtime::Builder::new_multi_thread()
             .worker_threads(2)
             .max_blocking_threads(self.shared.limits.jobs + 2)
-            .enable_io()
+            .enable_all()
             .build()
             .map_err(io)?;
+        let limits = self.shared.limits.clone();
         let app = router(self.shared, self.guard);
-        runtime
-            .block_on(async move {
-                let listener = tokio::net::TcpListener::from_std(self.listener)?;
-                axum::serve(listener, app).await
-            })
-            .map_err(io)
+        runtime.block_on(async move {
+            let listener = tokio::net::TcpListener::from_std(self.listener).map_err(io)?;
+            connections::serve(listener, app, &limits, self.connections).await;
+            Ok(())
+        })
     }
 }
 
 /// `glossmeter serve`: bind, print the address (and a warning beyond loopback), serve until stopped.
 pub fn run_command(a: &ServeRequest) -> Result<()> {
-    let limits = Limits { jobs: a.jobs, ..Limits::default() };
+    let d = Limits::default();
+    let limits = Limits {
+        jobs: a.jobs,
+        request_seconds: a.request_seconds.unwrap_or(d.request_seconds),
+        connections: a.max_connections.unwrap_or(d.connections),
+        ..d
+    };
+    if !(limits.request_seconds.is_finite() && limits.request_seconds > 0.0) {
+        return Err(Error::argument(
+            "request_seconds",
+            format!(" must be a positive number of seconds, got {}", crate::error::given(limits.request_seconds)),
+        ));
+    }
     let server = Server::bind(ServeOptions {
         host: a.host.clone(),
         port: a.port,
@@ -163,7 +219,13 @@ pub fn run_command(a: &ServeRequest) -> Result<()> {
             server.addr()
         );
     }
-    println!("glossmeter serve: {} (stop with Ctrl-C)", server.url());
+    let (connections, fd_limit) = server.connections();
+    let fd = fd_limit.map_or("no open-file limit".to_string(), |n| format!("open-file limit {n}"));
+    println!(
+        "glossmeter serve: {} (stop with Ctrl-C; at most {connections} connections, {fd}; {} s per computation)",
+        server.url(),
+        server.shared.limits.request_seconds
+    );
     use std::io::Write;
     let _ = std::io::stdout().flush();
     server.run()
@@ -195,11 +257,7 @@ fn router(shared: Arc<Shared>, guard: Arc<Guard>) -> Router {
 
 /// Refuse a request whose `Host` or `Origin` is not this server's (403).
 async fn check_request(State(guard): State<Arc<Guard>>, req: Request, next: Next) -> Response {
-    let verdict = {
-        let h = |name: &str| req.headers().get(name).and_then(|v| v.to_str().ok());
-        guard.check(h("host"), h("origin"), h("sec-fetch-site"))
-    };
-    match verdict {
+    match guard.check_headers(req.headers()) {
         Ok(()) => next.run(req).await,
         Err(why) => message(StatusCode::FORBIDDEN, &why),
     }
@@ -262,7 +320,13 @@ async fn body(s: &Shared, req: Request) -> std::result::Result<axum::body::Bytes
     if declared.is_some_and(|n| n > limit as u64) {
         return Err(too_large());
     }
-    axum::body::to_bytes(req.into_body(), limit).await.map_err(|_| too_large())
+    let wait = s.limits.body_seconds;
+    let late = || message(StatusCode::REQUEST_TIMEOUT, &format!("the request body did not arrive within {wait} s"));
+    let within = std::time::Duration::try_from_secs_f64(wait).unwrap_or(std::time::Duration::MAX);
+    match tokio::time::timeout(within, axum::body::to_bytes(req.into_body(), limit)).await {
+        Ok(read) => read.map_err(|_| too_large()),
+        Err(_) => Err(late()),
+    }
 }
 
 fn busy(s: &Shared) -> Response {
@@ -287,22 +351,57 @@ async fn admit(
 
 type Endpoint = fn(&api::Request, Context) -> Result<Reply>;
 
-/// Run an endpoint on the blocking pool, if a permit is free (else 503 at once).
+/// Raises a request's [`Cancel`] when dropped: when the handler's future is dropped because the client went
+/// away (hyper drops it on the connection's end), the computation stops at its next integral and gives its
+/// permit back.
+struct RaiseOnDrop(Cancel);
+
+impl Drop for RaiseOnDrop {
+    fn drop(&mut self) {
+        self.0.raise();
+    }
+}
+
+/// A request's stop signal: its computation's deadline, `limits.request_seconds` from now.
+fn request_cancel(s: &Shared) -> Cancel {
+    let now = std::time::Instant::now();
+    Cancel::new(crate::instrument::method::deadline_after(now, s.limits.request_seconds))
+}
+
+/// An endpoint's failure after its time limit passed says so (the failure itself is the limit's doing).
+fn late_error(s: &Shared, cancel: &Cancel, e: Error) -> Error {
+    if cancel.is_late() {
+        let limit = s.limits.request_seconds;
+        Error::Usage(format!(
+            "the request reached the server's time limit of {limit} s per computation (docs/serve.md §Limits) \
+             before it could answer: {}",
+            e.naming(&|a| format!("`{a}`"))
+        ))
+    } else {
+        e
+    }
+}
+
+/// Run an endpoint on the blocking pool, if a permit is free (else 503 at once). The computation stops
+/// when its client goes away or its time limit passes ([`Cancel`]).
 async fn work(s: Arc<Shared>, req: Request, f: Endpoint) -> Response {
     let (bytes, permit) = match admit(&s, req).await {
         Ok(a) => a,
         Err(r) => return r,
     };
     let shared = s.clone();
+    let cancel = request_cancel(&s);
+    let on_leave = RaiseOnDrop(cancel.clone());
     let out = tokio::task::spawn_blocking(move || {
         let _permit = permit;
         let req = api::Request::parse(&bytes)?;
-        f(&req, shared.context())
+        f(&req, shared.context(&cancel)).map_err(|e| late_error(&shared, &cancel, e))
     })
     .await;
+    drop(on_leave);
     match out {
-        Ok(Ok(r)) => reply(r),
-        Ok(Err(e)) => error(StatusCode::BAD_REQUEST, &e),
+        Ok(Ok(r)) => reply(Reply { body: s.scrub(r.body), ..r }),
+        Ok(Err(e)) => s.refusal(&e),
         Err(_) => message(
             StatusCode::INTERNAL_SERVER_ERROR,
             "the computation failed unexpectedly (a bug: please report the request)",
@@ -319,32 +418,59 @@ async fn sweep(State(s): State<Arc<Shared>>, req: Request) -> Response {
         Err(r) => return r,
     };
     let shared = s.clone();
+    let cancel = request_cancel(&s);
+    let (sweep_cancel, on_leave) = (cancel.clone(), cancel.clone());
     let checked = tokio::task::spawn_blocking(move || {
         let req = api::Request::parse(&bytes)?;
-        api::sweep(&req, shared.context())
+        api::sweep(&req, shared.context(&sweep_cancel))
     })
     .await;
     let sw = match checked {
         Ok(Ok(sw)) => sw,
-        Ok(Err(e)) => return error(StatusCode::BAD_REQUEST, &e),
+        Ok(Err(e)) => return s.refusal(&e),
         Err(_) => return message(StatusCode::INTERNAL_SERVER_ERROR, "the sweep failed unexpectedly"),
     };
     let points = sw.len();
     let (tx, rx) = tokio::sync::mpsc::channel::<std::result::Result<String, std::io::Error>>(8);
+    let shared = s.clone();
     tokio::task::spawn_blocking(move || {
         let _permit = permit;
         let gone = || Error::Usage("the client went away".into());
-        let out = api::run_sweep(&sw, |line| tx.blocking_send(Ok(line)).map_err(|_| gone()));
+        let out = api::run_sweep(&sw, |line| {
+            tx.blocking_send(Ok(shared.scrub(line))).map_err(|_| {
+                cancel.raise();
+                gone()
+            })
+        });
         if let Err(e) = out {
-            let line = serde_json::json!({"error": e.naming(&|a| format!("`{a}`"))}).to_string() + "\n";
+            let line = serde_json::json!({"error": shared.scrub(e.naming(&|a| format!("`{a}`")))}).to_string() + "\n";
             let _ = tx.blocking_send(Ok(line));
         }
     });
-    let mut r = Body::from_stream(tokio_stream::wrappers::ReceiverStream::new(rx)).into_response();
+    let lines = RaisingStream { lines: tokio_stream::wrappers::ReceiverStream::new(rx), _raise: RaiseOnDrop(on_leave) };
+    let mut r = Body::from_stream(lines).into_response();
     let h = r.headers_mut();
     h.insert(header::CONTENT_TYPE, HeaderValue::from_static("application/x-ndjson"));
     if let Ok(v) = HeaderValue::from_str(&points.to_string()) {
         h.insert("x-points", v);
     }
     secure(r)
+}
+
+/// A streamed answer's lines that raise the request's [`Cancel`] when the answer is dropped (the client went
+/// away, or the stream ended), so that a sweep stops at its next integral, not after its current point.
+struct RaisingStream<S> {
+    lines: S,
+    _raise: RaiseOnDrop,
+}
+
+impl<S: tokio_stream::Stream + Unpin> tokio_stream::Stream for RaisingStream<S> {
+    type Item = S::Item;
+
+    fn poll_next(
+        mut self: std::pin::Pin<&mut Self>,
+        cx: &mut std::task::Context<'_>,
+    ) -> std::task::Poll<Option<S::Item>> {
+        std::pin::Pin::new(&mut self.lines).poll_next(cx)
+    }
 }

@@ -33,7 +33,24 @@ pub struct Limits {
     /// Free parameters and targets of one fit.
     pub fit_free: usize,
     pub fit_targets: usize,
+    /// Seconds a client has to send a request's headers, counted from the connection's opening or from the
+    /// previous answer on it (so also how long an idle keep-alive connection stays open); then it is closed.
+    pub header_seconds: f64,
+    /// Seconds a client has to send a request's body once its headers are in (else 408).
+    pub body_seconds: f64,
+    /// Wall-clock seconds of one computation (`--request-seconds`): the integrals running then stop, those
+    /// not started are skipped, and the answer has the readings finished, the others without a value.
+    pub request_seconds: f64,
+    /// Open connections at most (`--max-connections`); the server also stays [`RESERVED_FDS`] +
+    /// [`FDS_PER_JOB`]·`jobs` below the process's open-file limit (`ulimit -n`), whichever is lower.
+    pub connections: usize,
 }
+
+/// File descriptors the server keeps free of connections: standard streams, the listener, the runtime's
+/// poller and room for connections being closed; and [`FDS_PER_JOB`] more for each computation (the table
+/// files it reads).
+pub const RESERVED_FDS: u64 = 32;
+pub const FDS_PER_JOB: u64 = 4;
 
 impl Default for Limits {
     fn default() -> Self {
@@ -48,6 +65,10 @@ impl Default for Limits {
             fit_restarts: 4,
             fit_free: 6,
             fit_targets: 32,
+            header_seconds: 10.0,
+            body_seconds: 60.0,
+            request_seconds: 60.0,
+            connections: 1024,
         }
     }
 }
@@ -79,6 +100,20 @@ impl Guard {
         Guard { hosts }
     }
 
+    /// Whether a request with these headers may be answered ([`Guard::check`]); the reason if not. A `Host`
+    /// or an `Origin` sent twice is refused, whatever the two say (no browser sends either twice, and which
+    /// of two a proxy or a framework would read is not this server's to guess).
+    pub fn check_headers(&self, headers: &axum::http::HeaderMap) -> std::result::Result<(), String> {
+        for name in ["host", "origin", "sec-fetch-site"] {
+            let n = headers.get_all(name).iter().count();
+            if n > 1 {
+                return Err(format!("the request has {n} {name} headers; one at most is allowed"));
+            }
+        }
+        let h = |name: &str| headers.get(name).map(|v| v.to_str().unwrap_or("\u{fffd}"));
+        self.check(h("host"), h("origin"), h("sec-fetch-site"))
+    }
+
     /// Whether a request with this `Host` (and `Origin`, `Sec-Fetch-Site`, if sent) may be answered; the
     /// reason if not.
     pub fn check(
@@ -104,7 +139,7 @@ impl Guard {
                 return Err(format!("Origin `{origin}` is another site: cross-site requests are refused"));
             }
         }
-        if fetch_site == Some("cross-site") {
+        if fetch_site.is_some_and(|f| f.trim().eq_ignore_ascii_case("cross-site")) {
             return Err("a cross-site request (Sec-Fetch-Site: cross-site) is refused".into());
         }
         Ok(())
@@ -137,16 +172,18 @@ pub fn table_path(data_dir: Option<&Path>, given: &str, file: &str, field: &str)
     let root = root
         .canonicalize()
         .map_err(|e| Error::input(file, field, format!("the server's data directory cannot be read: {e}")))?;
-    let found = root
-        .join(p)
-        .canonicalize()
-        .map_err(|_| Error::input(file, field, format!("`{given}`: no such file in the data directory")))?;
-    if !found.starts_with(&root) {
-        return Err(Error::input(
+    // A path that does not resolve and one that resolves outside (through a symbolic link) get the same
+    // answer, so that a link to an outside directory does not tell whether a file exists there.
+    let none = || {
+        Error::input(
             file,
             field,
-            format!("`{given}`: leads out of the data directory (through a symbolic link); refused"),
-        ));
+            format!("`{given}`: no such file in the data directory (a symbolic link out of it counts as none)"),
+        )
+    };
+    let found = root.join(p).canonicalize().map_err(|_| none())?;
+    if !found.starts_with(&root) {
+        return Err(none());
     }
     if !found.is_file() {
         return Err(Error::input(file, field, format!("`{given}`: not a file in the data directory")));
@@ -169,6 +206,28 @@ mod tests {
         assert!(g.check(Some("localhost:8080"), Some("http://evil.example"), None).is_err());
         assert!(g.check(Some("localhost:8080"), Some("null"), None).is_err());
         assert!(g.check(Some("localhost:8080"), None, Some("cross-site")).is_err());
+        assert!(g.check(Some("localhost:8080"), None, Some("Cross-Site")).is_err());
+        assert!(g.check(Some("localhost:8080"), None, Some("same-origin")).is_ok());
+        let headers = |pairs: &[(&'static str, &'static str)]| {
+            let mut h = axum::http::HeaderMap::new();
+            for (k, v) in pairs {
+                h.append(*k, axum::http::HeaderValue::from_static(v));
+            }
+            h
+        };
+        assert!(g.check_headers(&headers(&[("host", "localhost:8080")])).is_ok());
+        for twice in [
+            headers(&[("host", "localhost:8080"), ("host", "evil.example")]),
+            headers(&[("host", "localhost:8080"), ("host", "localhost:8080")]),
+            headers(&[
+                ("host", "localhost:8080"),
+                ("origin", "http://localhost:8080"),
+                ("origin", "http://evil.example"),
+            ]),
+        ] {
+            let e = g.check_headers(&twice).unwrap_err();
+            assert!(e.contains("one at most"), "{e}");
+        }
         let g = Guard::new("0.0.0.0:80".parse().unwrap(), &["Lab-PC".into()]);
         assert!(g.check(Some("lab-pc"), None, None).is_ok());
         assert!(g.check(Some("0.0.0.0"), None, None).is_err());
@@ -191,7 +250,12 @@ mod tests {
         {
             std::os::unix::fs::symlink(dir.join("secret.csv"), inner.join("link.csv")).unwrap();
             let e = table_path(Some(&inner), "link.csv", "r", "/file").unwrap_err().to_string();
-            assert!(e.contains("leads out"), "{e}");
+            assert!(e.contains("a symbolic link out of it counts as none"), "{e}");
+            // A link to an outside directory: a file there and a file not there get the same words.
+            std::os::unix::fs::symlink(&dir, inner.join("dirlink")).unwrap();
+            let there = table_path(Some(&inner), "dirlink/secret.csv", "r", "/file").unwrap_err().to_string();
+            let not_there = table_path(Some(&inner), "dirlink/nothing.csv", "r", "/file").unwrap_err().to_string();
+            assert_eq!(there.replace("secret", "nothing"), not_there);
         }
         std::fs::remove_dir_all(&dir).unwrap();
     }

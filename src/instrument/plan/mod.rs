@@ -49,10 +49,12 @@ use crate::instrument::standards::StandardGeometry;
 use crate::spectrum::Sampling;
 use crate::{Error, Result};
 
+mod cancel;
 mod compile;
 mod explain;
 mod readings;
 
+pub use cancel::Cancel;
 pub use compile::{rtol_refusal, Planner};
 pub use readings::{
     colour_value, colour_xyz, haze_index_value, neutral_chroma, reading_value, NEUTRAL_CHROMA_FLOOR, NEUTRAL_HUE,
@@ -136,6 +138,10 @@ pub struct PlanOptions {
     /// and never tighter than `rtol` (docs/accuracy.md §Data uncertainty of measured tables). False: `rtol`
     /// is used as given (the command line's `--rtol` sets this false). No effect on other materials.
     pub rtol_from_data: bool,
+    /// A stop signal for the caller's whole work ([`Cancel`]; default: none): once raised, or once its
+    /// deadline passes, integrals not yet started are skipped and running ones stop refining, and their
+    /// readings have no value. It changes no method and no other reading.
+    pub cancel: Cancel,
 }
 
 impl Default for PlanOptions {
@@ -149,6 +155,7 @@ impl Default for PlanOptions {
             max_seconds: None,
             colour: Conditions::default(),
             rtol_from_data: true,
+            cancel: Cancel::default(),
         }
     }
 }
@@ -326,7 +333,9 @@ impl Plan {
     /// The shared deadline of one execution: now + the wall-clock budget.
     fn deadline(&self) -> Option<std::time::Instant> {
         let now = std::time::Instant::now();
-        self.options.max_seconds.and_then(|s| crate::instrument::method::deadline_after(now, s))
+        self.options
+            .cancel
+            .earliest(self.options.max_seconds.and_then(|s| crate::instrument::method::deadline_after(now, s)))
     }
 
     /// Execute the plan: every specimen method on the material (the standards' fluxes were computed when the
@@ -346,6 +355,7 @@ impl Plan {
     /// every variant's) holds them all to one limit counted from its start. The integrals still take their
     /// budget from [`PlanOptions::max_seconds`] ([`Method::execute_until`]).
     pub fn run_until(&self, deadline: Option<std::time::Instant>) -> Execution {
+        let deadline = self.options.cancel.earliest(deadline);
         let todo = self.specimen_jobs();
         let computed: Vec<Flux> = todo.par_iter().map(|&j| self.run_job(j, deadline, false).0).collect();
         let mut flux = self.known_fluxes();
@@ -451,6 +461,11 @@ impl Plan {
     /// the pilots is counted in the flux's. A frozen method runs as frozen on all of them, once.
     fn run_job(&self, j: usize, deadline: Option<std::time::Instant>, freeze: bool) -> (Flux, Option<Method>) {
         let method = &self.jobs[j].method;
+        if self.options.cancel.is_stopped() {
+            // Stopped before it started (`PlanOptions::cancel`): no evaluation, and no value for its readings.
+            let skipped = Flux { converged: false, out_of_time: true, ..Flux::zero(method.weighting.len()) };
+            return (skipped, freeze.then(|| method.clone()));
+        }
         let material = self.material.as_ref();
         let exec = |m: &Method, b: &dyn Brdf| -> (Flux, Option<Method>) {
             if freeze {
@@ -509,7 +524,7 @@ impl Plan {
             spent.0 += e;
             spent.1 += s;
             let (u, resolved) = uncertainty(&f, &c);
-            let late = f.out_of_time || c.iter().any(|c| c.out_of_time);
+            let late = f.out_of_time || c.iter().any(|c| c.out_of_time) || self.options.cancel.is_stopped();
             pilot = Some((Flux { data_uncertainty: Some(u), ..f }, fm, rp));
             if resolved || late {
                 break;

@@ -264,7 +264,7 @@ fn compute_reading(
         _ => None,
     };
     match value {
-        Ok((v, e)) if v.is_finite() && e.is_finite() => Reading {
+        Ok((v, e)) if v.is_finite() && e.is_finite() && e >= 0.0 => Reading {
             data_uncertainty,
             problem: (!converged).then(|| {
                 if used.iter().any(|f| f.budget_spent) {
@@ -277,14 +277,7 @@ fn compute_reading(
             }),
             ..valued_reading(r, (v, e), evaluations, seconds, converged)
         },
-        Ok((v, e)) => problem_reading(
-            r,
-            format!(
-                "the reading's arithmetic overflowed (value {}, error estimate {}); the fluxes are out of range",
-                crate::error::number(v),
-                crate::error::number(e)
-            ),
-        ),
+        Ok((v, _)) => problem_reading(r, no_finite_value(v)),
         // The hue of a neutral colour has no value by definition, not by failure: null, with the reason as
         // its note, converged as its fluxes are (it changes no exit status).
         Err(why) if why.starts_with(NEUTRAL_HUE) => Reading {
@@ -375,5 +368,33 @@ impl Plan {
             .filter(|(_, p)| p.reported)
             .map(|(r, _)| r.expect("every reading computed"))
             .collect()
+    }
+}
+
+/// Why a reading whose formula gave the value `v` from its fluxes (with an error estimate that is not a
+/// finite number ≥ 0, if `v` is finite) has no value, in words: never a NaN, an infinity or a negative error
+/// estimate printed as if it were a number (docs/instrument.md §Numbers in text).
+fn no_finite_value(v: f64) -> String {
+    let what = if v.is_nan() {
+        "an undefined result (0/0, ∞ − ∞ or the logarithm of a negative number)".to_string()
+    } else if v.is_infinite() {
+        "an overflow".to_string()
+    } else {
+        format!("the value {} with an error estimate that is not a finite number ≥ 0", crate::error::number(v))
+    };
+    format!("the reading's formula gives {what} from these fluxes; they are out of its range")
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn a_reading_without_a_finite_value_says_why_without_printing_nan() {
+        for v in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY, 1e-300] {
+            let m = super::no_finite_value(v);
+            for bad in ["NaN", "inf", "0000000000"] {
+                assert!(!m.contains(bad), "{m}");
+            }
+        }
+        assert!(super::no_finite_value(1e-300).contains("1e-300"));
     }
 }
