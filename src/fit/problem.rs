@@ -45,6 +45,11 @@ pub(super) enum Mode<'p> {
 pub(super) type Predictions = (Vec<(f64, f64)>, Option<Plan>);
 
 impl Forward<'_> {
+    /// Forward runs so far.
+    pub(super) fn runs(&self) -> usize {
+        self.runs.get()
+    }
+
     pub(super) fn recipe_at(&self, x: &[f64]) -> Value {
         let mut v = self.recipe.clone();
         for (p, xi) in self.free.iter().zip(x) {
