@@ -15,9 +15,14 @@ fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
 
-/// Run `glossmeter fit ARGS --format json --no-timing`; the exit code and stdout.
-fn fit(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_glossmeter"))
+/// Run `glossmeter fit ARGS --format json --no-timing` on `threads` rayon threads (the machine's default for
+/// `None`); the exit code and stdout.
+fn fit(args: &[&str], threads: Option<usize>) -> (i32, String, String) {
+    let mut command = Command::new(env!("CARGO_BIN_EXE_glossmeter"));
+    if let Some(t) = threads {
+        command.env("RAYON_NUM_THREADS", t.to_string());
+    }
+    let out = command
         .arg("fit")
         .args(args)
         .args(["--format", "json", "--no-timing"])
@@ -44,7 +49,12 @@ fn recipe_with(fixture: &str, pointer: &str, value: serde_json::Value, name: &st
 }
 
 fn check(name: &str, want_exit: i32, args: &[&str]) {
-    let (code, stdout, stderr) = fit(args);
+    check_on(name, want_exit, args, None);
+}
+
+/// The document of a run on `threads` threads.
+fn check_on(name: &str, want_exit: i32, args: &[&str], threads: Option<usize>) {
+    let (code, stdout, stderr) = fit(args, threads);
     assert_eq!(code, want_exit, "{name}: {stdout}{stderr}");
     let file = root().join("tests/fit_documents").join(format!("{name}.json"));
     if std::env::var_os("GLOSSMETER_BLESS_FIT").is_some() {
@@ -55,7 +65,7 @@ fn check(name: &str, want_exit: i32, args: &[&str]) {
     if stdout != want {
         let line = stdout.lines().zip(want.lines()).position(|(a, b)| a != b).unwrap_or(0);
         panic!(
-            "{name}: the document differs from {} at line {}:\n now: {}\n was: {}",
+            "{name} ({threads:?} threads): the document differs from {} at line {}:\n now: {}\n was: {}",
             file.display(),
             line + 1,
             stdout.lines().nth(line).unwrap_or(""),
@@ -67,7 +77,15 @@ fn check(name: &str, want_exit: i32, args: &[&str]) {
 /// Two parameters, two readings (exactly determined): the scan of the bounds seeds the restarts.
 #[test]
 fn sample_a_two_parameters_scan_and_restarts() {
-    check(
+    for threads in [Some(1), Some(2), Some(3)] {
+        sample_a(threads);
+    }
+}
+
+/// The scan's points, the restarts and a Jacobian's displaced points run in parallel (docs/inverse.md
+/// §Method, "Parallel runs"): the same document, byte for byte, on one, two and three threads.
+fn sample_a(threads: Option<usize>) {
+    check_on(
         "sample-a",
         0,
         &[
@@ -81,13 +99,20 @@ fn sample_a_two_parameters_scan_and_restarts() {
             "--free",
             "/ior=1.3..1.8",
         ],
+        threads,
     );
 }
 
 /// Five parameters, six readings: the linearity check, the correlations, no scan.
 #[test]
 fn orange_peel_panel_five_parameters() {
-    check(
+    for threads in [Some(1), Some(2)] {
+        panel(threads);
+    }
+}
+
+fn panel(threads: Option<usize>) {
+    check_on(
         "panel-three-populations",
         0,
         &[
@@ -115,6 +140,7 @@ fn orange_peel_panel_five_parameters() {
             "--free",
             "/populations/2/weight=0.001..0.5",
         ],
+        threads,
     );
 }
 

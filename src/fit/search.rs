@@ -3,9 +3,10 @@
 //! exactly determined fit, each restart's run, and the choice of the fit among the ends.
 use levenberg_marquardt::{LevenbergMarquardt, TerminationReason};
 use nalgebra::DVector;
+use rayon::prelude::*;
 
 use super::params::FreeParameter;
-use super::problem::{u_of_t, Mode, Problem};
+use super::problem::{u_of_t, weighted, Mode, Problem};
 
 /// Tolerance of the scan's runs (at least; the fit's own when looser): the scan only seeds the restarts, and
 /// a coarse grid needs readings to a few digits.
@@ -228,8 +229,9 @@ pub(super) fn search<'a>(first: Problem<'a>, budget: &Budget) -> Search<'a> {
     // integrated adaptively at the scan's loose tolerance; the grid's local minima of χ² seed the restarts
     // (docs/inverse.md §Every root).
     let scan: Vec<ScanPoint> = if n <= 2 && budget.restarts > 0 {
+        // The points do not depend on each other: they run in parallel, each into its own slot.
         scan_grid(n)
-            .into_iter()
+            .into_par_iter()
             .map(|f| {
                 let t: Vec<f64> = (0..n)
                     .map(|k| {
@@ -237,8 +239,8 @@ pub(super) fn search<'a>(first: Problem<'a>, budget: &Budget) -> Search<'a> {
                         a + f[k] * (b - a)
                     })
                     .collect();
-                let pred = fwd.run(&main.problem.x_of_t(&t), Mode::Scan).ok().flatten().map(|p| p.0);
-                let r = pred.as_ref().map(|p| main.problem.weighted(p));
+                let pred = fwd.run(&fwd.x_of_t(&t), Mode::Scan).ok().flatten().map(|p| p.0);
+                let r = pred.as_ref().map(|p| weighted(targets, &u_sigma, p));
                 let chi2 = r.as_ref().map_or(f64::INFINITY, |r| r.norm_squared());
                 ScanPoint { t, pred, r, chi2 }
             })
@@ -249,16 +251,18 @@ pub(super) fn search<'a>(first: Problem<'a>, budget: &Budget) -> Search<'a> {
     let scan_evaluations = fwd.runs() - runs_before_restarts;
     let seeds = scan_minima(&scan, n);
     let halton = halton_count(m, n, budget.restarts, seeds.len());
-    let mut failed = 0usize;
+    // The restarts do not depend on each other (nor on the main run's end): they run in parallel, and their
+    // ends are kept in the order of their starts.
+    let restarted: Vec<Option<Solved>> = starts(free, &scan, &seeds, halton)
+        .par_iter()
+        .map(|u_k| {
+            let p_k = Problem::new(fwd, targets, &u_sigma, u_k);
+            p_k.current.is_ok().then(|| solve(p_k, restart_patience))
+        })
+        .collect();
+    let failed = restarted.iter().filter(|e| e.is_none()).count();
     let mut ends: Vec<Solved> = vec![main];
-    for u_k in &starts(free, &scan, &seeds, halton) {
-        let p_k = Problem::new(fwd, targets, &u_sigma, u_k);
-        if p_k.current.is_err() {
-            failed += 1;
-            continue;
-        }
-        ends.push(solve(p_k, restart_patience));
-    }
+    ends.extend(restarted.into_iter().flatten());
     let restart_evaluations = fwd.runs() - runs_before_restarts;
     let chi2: Vec<f64> = ends.iter().map(|s| s.chi2().unwrap_or(f64::INFINITY)).collect();
     let chosen = choose(&chi2);
