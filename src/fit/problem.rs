@@ -163,6 +163,15 @@ pub(super) fn u_of_t(t: f64, (a, b): (f64, f64)) -> f64 {
 /// the search inside the constraints without ever ending it (docs/inverse.md §Constraints).
 const BARRIER: f64 = 1e100;
 
+/// A point whose χ² is at most this (every residual within 10⁻³ of its uncertainty, as a whole) is an exact
+/// fit for the solver: its residuals are handed to it as zero, so it stops there (an exact fit).
+/// The Gauss–Newton step that remains from such a point is at most ‖r‖ = 10⁻³ uncertainties, a tenth of what
+/// the fit's own check of a converged stop accepts (`STEP_TOLERANCE`); polishing further only follows the
+/// forward model's noise, and along a direction the targets barely see (a curved valley of exact fits) it
+/// used to spend the whole budget (docs/inverse.md §Method, "Solver"). The report's residuals and χ² are
+/// always the point's own.
+pub(super) const EXACT_CHI2: f64 = 1e-6;
+
 impl Problem<'_> {
     /// The problem at the start u0 (its point evaluated; see `current`).
     pub(super) fn new<'a>(
@@ -297,7 +306,10 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_> {
 
     fn residuals(&self) -> Option<DVector<f64>> {
         match &self.current {
-            Ok(c) => Some(self.weighted(&c.predictions)),
+            Ok(c) => {
+                let r = self.weighted(&c.predictions);
+                Some(if r.norm_squared() <= EXACT_CHI2 { DVector::zeros(r.len()) } else { r })
+            }
             Err(e) => {
                 // A trial point that does not evaluate: the barrier, so the step is refused (see BARRIER).
                 *self.last_error.borrow_mut() = Some(e.clone());

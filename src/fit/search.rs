@@ -130,7 +130,9 @@ pub(super) fn solve(problem: Problem<'_>, patience: usize) -> Solved<'_> {
     let (converged, termination) = match &report.termination {
         TerminationReason::Converged { .. } => (true, "converged (ftol/xtol)".to_string()),
         TerminationReason::Orthogonal => (true, "converged (the residuals are orthogonal to the Jacobian)".into()),
-        TerminationReason::ResidualsZero => (true, "converged (the residuals are zero)".into()),
+        TerminationReason::ResidualsZero => {
+            (true, "converged (an exact fit: every residual within 10⁻³ of its uncertainty, χ² ≤ 10⁻⁶)".into())
+        }
         TerminationReason::NoImprovementPossible(w) => {
             (true, format!("converged to the noise floor of the forward model ({w} cannot improve further)"))
         }
