@@ -138,7 +138,7 @@ pub(super) fn remaining_step(scaled: &DMatrix<f64>, r: &DVector<f64>, at_bound: 
     let smax_i = svd_i.singular_values.max();
     (0..svd_i.singular_values.len())
         .filter(|&c| svd_i.singular_values[c] >= 1.0 && svd_i.singular_values[c] > 1e-12 * smax_i)
-        .map(|c| u_i.column(c).dot(&r).powi(2))
+        .map(|c| u_i.column(c).dot(r).powi(2))
         .sum::<f64>()
         .sqrt()
 }

@@ -148,12 +148,12 @@ mod tests {
     fn counts_are_checked() {
         let f = FreeParameter { pointer: "/a".into(), lower: 0.0, upper: 1.0, log: false };
         let o = FitOptions::default();
-        assert!(check_counts(&[f.clone()], &[], &o).unwrap_err().to_string().contains("no targets"));
+        assert!(check_counts(std::slice::from_ref(&f), &[], &o).unwrap_err().to_string().contains("no targets"));
         assert!(check_counts(&[], &[target("g", "n")], &o).unwrap_err().to_string().contains("no free parameters"));
         let two = [f.clone(), FreeParameter { pointer: "/b".into(), ..f.clone() }];
         assert!(check_counts(&two, &[target("g", "n")], &o).unwrap_err().to_string().contains("2 free parameters"));
         let bad = FitOptions { default_uncertainty: f64::NAN, ..FitOptions::default() };
-        assert!(check_counts(&[f.clone()], &[target("g", "n")], &bad).is_err());
+        assert!(check_counts(std::slice::from_ref(&f), &[target("g", "n")], &bad).is_err());
         assert!(check_counts(&[f], &[target("g", "n")], &o).is_ok());
     }
 }
