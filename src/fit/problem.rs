@@ -1,10 +1,12 @@
 //! The forward model and the least-squares problem: recipe values → predictions of the targets (adaptively,
 //! keeping the final partitions, or on a Jacobian centre's frozen methods), and the weighted residuals and
 //! Jacobian that the Levenberg–Marquardt solver sees in the unbounded variables u.
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Arc;
 
 use levenberg_marquardt::LeastSquaresProblem;
 use nalgebra::{DMatrix, DVector, Dyn, Owned};
+use rayon::prelude::*;
 use serde_json::Value;
 
 use super::params::{FreeParameter, TargetReading};
@@ -25,7 +27,9 @@ pub(super) struct Forward<'a> {
     pub(super) scan_options: PlanOptions,
     /// Index of each target in the plan's readings.
     pub(super) index: Vec<usize>,
-    pub(super) runs: std::cell::Cell<usize>,
+    /// Forward runs so far (counted from every thread; runs that do not depend on each other run in parallel,
+    /// docs/inverse.md §Method, "Parallel runs").
+    pub(super) runs: AtomicUsize,
 }
 
 /// How a forward run integrates.
@@ -45,6 +49,16 @@ pub(super) enum Mode<'p> {
 pub(super) type Predictions = (Vec<(f64, f64)>, Option<Plan>);
 
 impl Forward<'_> {
+    /// Forward runs so far.
+    pub(super) fn runs(&self) -> usize {
+        self.runs.load(Ordering::Relaxed)
+    }
+
+    /// x of t, each clamped to its bounds (the same as [`Problem::x_of_t`]).
+    pub(super) fn x_of_t(&self, t: &[f64]) -> Vec<f64> {
+        self.free.iter().zip(t).map(|(p, &ti)| p.x_of(ti).clamp(p.lower, p.upper)).collect()
+    }
+
     pub(super) fn recipe_at(&self, x: &[f64]) -> Value {
         let mut v = self.recipe.clone();
         for (p, xi) in self.free.iter().zip(x) {
@@ -64,7 +78,7 @@ impl Forward<'_> {
     /// Predictions of the targets at x (see [`Mode`]); `Ok(None)` only for `Mode::Frozen` on a material of
     /// another shape.
     pub(super) fn run(&self, x: &[f64], mode: Mode) -> Result<Option<Predictions>> {
-        self.runs.set(self.runs.get() + 1);
+        self.runs.fetch_add(1, Ordering::Relaxed);
         let brdf = self.material(x)?;
         let (readings, frozen): (Vec<Reading>, Option<Plan>) = match mode {
             Mode::Freeze => {
@@ -97,6 +111,15 @@ impl Forward<'_> {
         }
         Ok(Some((out, frozen)))
     }
+}
+
+/// The weighted residuals (v − target)/√(u² + e²) of predictions (v, e) against the targets, u their
+/// uncertainties.
+pub(super) fn weighted(targets: &[TargetReading], u_sigma: &[f64], pred: &[(f64, f64)]) -> DVector<f64> {
+    DVector::from_iterator(
+        pred.len(),
+        pred.iter().enumerate().map(|(i, &(v, e))| (v - targets[i].value) / (u_sigma[i].powi(2) + e * e).sqrt()),
+    )
 }
 
 pub(super) fn describe_point(free: &[FreeParameter], x: &[f64]) -> String {
@@ -140,6 +163,15 @@ pub(super) fn u_of_t(t: f64, (a, b): (f64, f64)) -> f64 {
 /// the search inside the constraints without ever ending it (docs/inverse.md §Constraints).
 const BARRIER: f64 = 1e100;
 
+/// A point whose χ² is at most this (every residual within 10⁻³ of its uncertainty, as a whole) is an exact
+/// fit for the solver: its residuals are handed to it as zero, so it stops there (an exact fit).
+/// The Gauss–Newton step that remains from such a point is at most ‖r‖ = 10⁻³ uncertainties, a tenth of what
+/// the fit's own check of a converged stop accepts (`STEP_TOLERANCE`); polishing further only follows the
+/// forward model's noise, and along a direction the targets barely see (a curved valley of exact fits) it
+/// used to spend the whole budget (docs/inverse.md §Method, "Solver"). The report's residuals and χ² are
+/// always the point's own.
+pub(super) const EXACT_CHI2: f64 = 1e-6;
+
 impl Problem<'_> {
     /// The problem at the start u0 (its point evaluated; see `current`).
     pub(super) fn new<'a>(
@@ -174,7 +206,7 @@ impl Problem<'_> {
     }
 
     pub(super) fn x_of_t(&self, t: &[f64]) -> Vec<f64> {
-        self.fwd.free.iter().zip(t).map(|(p, &ti)| p.x_of(ti).clamp(p.lower, p.upper)).collect()
+        self.fwd.x_of_t(t)
     }
 
     fn sigma(&self, i: usize, e: f64) -> f64 {
@@ -182,10 +214,7 @@ impl Problem<'_> {
     }
 
     pub(super) fn weighted(&self, pred: &[(f64, f64)]) -> DVector<f64> {
-        DVector::from_iterator(
-            pred.len(),
-            pred.iter().enumerate().map(|(i, &(v, e))| (v - self.targets[i].value) / self.sigma(i, e)),
-        )
+        weighted(self.targets, &self.u_sigma, pred)
     }
 
     /// The weighted Jacobian in t (m × n) at t, whose adaptive run gave `centre` and `frozen`: central
@@ -201,22 +230,43 @@ impl Problem<'_> {
         let m = centre.len();
         let n = t.len();
         let eps = centre.iter().map(|&(v, e)| e / v.abs().max(1e-300)).fold(1e-13, f64::max).min(1e-2);
+        let fwd = self.fwd;
+        // The steps, and the 2n displaced points in t (None outside the bounds), k-th column's lower then upper.
+        let steps: Vec<f64> = (0..n)
+            .map(|k| {
+                let p = &fwd.free[k];
+                let (a, b) = p.t_bounds();
+                let scale = if p.log { 1.0 } else { t[k].abs().max(1e-3 * (b - a)) };
+                (eps.cbrt() * scale).clamp(1e-9 * (b - a), 0.05 * (b - a))
+            })
+            .collect();
+        let points: Vec<Option<Vec<f64>>> = (0..2 * n)
+            .map(|i| {
+                let (k, sign) = (i / 2, if i % 2 == 0 { -1.0 } else { 1.0 });
+                let tk = t[k] + sign * steps[k];
+                let (a, b) = fwd.free[k].t_bounds();
+                (a..=b).contains(&tk).then(|| {
+                    let mut tt = t.to_vec();
+                    tt[k] = tk;
+                    tt
+                })
+            })
+            .collect();
+        // The displaced points do not depend on each other: they run in parallel, each on the same frozen
+        // methods, and land in their own slot, so the Jacobian is the same bits for any number of threads.
+        let runs: Vec<Option<Vec<(f64, f64)>>> = points
+            .par_iter()
+            .map(|tt| {
+                let tt = tt.as_ref()?;
+                fwd.run(&fwd.x_of_t(tt), Mode::Frozen(frozen)).ok().flatten().map(|r| r.0)
+            })
+            .collect();
+        let mut runs = runs.into_iter();
         let mut j = DMatrix::zeros(m, n);
         let mut dead = Vec::new();
         for k in 0..n {
-            let p = &self.fwd.free[k];
-            let (a, b) = p.t_bounds();
-            let scale = if p.log { 1.0 } else { t[k].abs().max(1e-3 * (b - a)) };
-            let h = (eps.cbrt() * scale).clamp(1e-9 * (b - a), 0.05 * (b - a));
-            let eval = |tk: f64| -> Option<Vec<(f64, f64)>> {
-                if !(a..=b).contains(&tk) {
-                    return None;
-                }
-                let mut tt = t.to_vec();
-                tt[k] = tk;
-                self.fwd.run(&self.x_of_t(&tt), Mode::Frozen(frozen)).ok().flatten().map(|r| r.0)
-            };
-            let (lo, hi) = (eval(t[k] - h), eval(t[k] + h));
+            let h = steps[k];
+            let (lo, hi) = (runs.next().flatten(), runs.next().flatten());
             let (f_lo, t_lo, f_hi, t_hi) = match (lo, hi) {
                 (Some(l), Some(u)) => (l, t[k] - h, u, t[k] + h),
                 (Some(l), None) => (l, t[k] - h, centre.to_vec(), t[k]),
@@ -256,7 +306,10 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_> {
 
     fn residuals(&self) -> Option<DVector<f64>> {
         match &self.current {
-            Ok(c) => Some(self.weighted(&c.predictions)),
+            Ok(c) => {
+                let r = self.weighted(&c.predictions);
+                Some(if r.norm_squared() <= EXACT_CHI2 { DVector::zeros(r.len()) } else { r })
+            }
             Err(e) => {
                 // A trial point that does not evaluate: the barrier, so the step is refused (see BARRIER).
                 *self.last_error.borrow_mut() = Some(e.clone());
