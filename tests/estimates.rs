@@ -442,7 +442,10 @@ fn pearl_paints_estimates_cover_their_actual_error_on_every_haze_receptor() {
                 let (Some(v), Some(vr)) = (a.value, b.value) else { continue };
                 if !b.converged || !a.converged {
                     if report {
-                        eprintln!("unchecked: pearl {i} {} {} at rtol {rtol:e} ({}, {})", a.geometry, a.name, a.converged, b.converged);
+                        eprintln!(
+                            "unchecked: pearl {i} {} {} at rtol {rtol:e} ({}, {})",
+                            a.geometry, a.name, a.converged, b.converged
+                        );
                     }
                     unchecked += 1;
                     continue;
