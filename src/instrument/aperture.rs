@@ -82,7 +82,18 @@ pub fn lobe_splits(lobes: &[Lobe], theta: f64, source: Stop, receptor: Stop) -> 
     let mut up = ap.splits(&widths.iter().zip(lobes).map(|(w, l)| (w[0], l.tail.is_heavy())).collect::<Vec<_>>());
     let mut uq = aq.splits(&widths.iter().zip(lobes).map(|(w, l)| (w[1], l.tail.is_heavy())).collect::<Vec<_>>());
     for pole in lobes.iter().filter_map(|l| table_pole_widths(l, theta)) {
-        for (pts, a, w) in [(&mut up, ap, pole[0]), (&mut uq, aq, pole[1])] {
+        // The cusp is at the pole alone (u = v = 0, inside the first ring): a receptor whose range on the
+        // other axis stays a ring's width away from 0 never meets it (an E430 or ISO 13803 receptor off the
+        // specular direction), and that axis takes no pole splits.
+        let reaches = |a: AxisMap, w: f64| {
+            let [lo, hi] = a.range();
+            lo < w && hi > -w
+        };
+        let (near_u, near_v) = (reaches(ap, pole[0]), reaches(aq, pole[1]));
+        for (pts, a, w, near) in [(&mut up, ap, pole[0], near_v), (&mut uq, aq, pole[1], near_u)] {
+            if !near {
+                continue;
+            }
             let [lo, hi] = a.range();
             pts.extend([0.0, -w, w].into_iter().filter(|x| *x > lo && *x < hi));
             pts.sort_by(f64::total_cmp);
