@@ -262,3 +262,54 @@ fn the_partition_at_the_lobe_width_reports_an_error_estimate_above_its_actual_er
 
 /// The reference's tolerance (the partition split at the table's resolution, `AtResolution`).
 const REFERENCE_RTOL: f64 = 1e-4;
+
+/// The receptors off the specular direction (ASTM E430 30°: haze, DOI, compensation; ISO 13803: haze ±,
+/// compensation), whose range never reaches the table's pole and which take no pole splits on the other axis
+/// (`aperture::lobe_splits`, docs/instrument.md §Quadrature, *Measured tables*): every reading of tables
+/// generated from analytic BRDFs, at the default (data) tolerance and at the forced tolerances 1e-2 and 1e-3,
+/// within its numerical error estimate (plus the reference's) of the same table integrated at rtol 1e-4 on the
+/// partition split at the table's resolution.
+#[test]
+fn the_receptors_off_the_specular_direction_report_an_error_estimate_above_their_actual_error() {
+    let forced = |rtol| PlanOptions { rtol, rtol_from_data: false, ..PlanOptions::default() };
+    let geos: Vec<_> = ["astm-e430-30", "iso-13803-20"].iter().map(|g| standards::find(g).unwrap()).collect();
+    let read = |b: Arc<dyn Brdf>, o: PlanOptions| Plan::compile(b, geos.clone(), o).unwrap().execute();
+    let tables: Vec<(&str, Arc<dyn Brdf>)> = vec![
+        ("MERL 90×90×180 GGX 0.01", Arc::new(merl_of(model("ggx", 0.01).as_ref(), [90, 90, 180]))),
+        ("MERL 90×90×180 GGX 0.1", Arc::new(merl_of(model("ggx", 0.1).as_ref(), [90, 90, 180]))),
+        ("MERL 90×90×180 Beckmann 0.02", Arc::new(merl_of(model("beckmann", 0.02).as_ref(), [90, 90, 180]))),
+        (
+            "RGL beckmann-iso-16",
+            Arc::new(
+                glossmeter::measured::rgl::RglBrdf::load(std::path::Path::new(
+                    "fixtures/materials/rgl/beckmann-iso-16.bsdf",
+                ))
+                .unwrap(),
+            ),
+        ),
+    ];
+    let mut checked = 0;
+    for (what, table) in tables {
+        let reference =
+            read(Arc::new(AtResolution(table.clone())), PlanOptions { rtol: REFERENCE_RTOL, ..PlanOptions::default() });
+        for options in [PlanOptions::default(), forced(1e-2), forced(1e-3)] {
+            for (r, a) in read(table.clone(), options.clone()).iter().zip(&reference) {
+                assert_eq!((&r.geometry, &r.name), (&a.geometry, &a.name));
+                let (Some(v), Some(va)) = (r.value, a.value) else { continue };
+                assert!(r.converged && a.converged, "{what} {} {}: not converged", r.geometry, r.name);
+                checked += 1;
+                let actual = (v - va).abs();
+                assert!(
+                    actual <= r.error_estimate + a.error_estimate,
+                    "{what} {} {} at rtol {:e}: |Δ| {actual:.3e} above the estimate {:.3e} + the reference's {:.3e}",
+                    r.geometry,
+                    r.name,
+                    options.rtol,
+                    r.error_estimate,
+                    a.error_estimate
+                );
+            }
+        }
+    }
+    assert!(checked >= 4 * 3 * 8, "only {checked} readings checked");
+}

@@ -89,7 +89,18 @@ pub fn lobe_splits(lobes: &[Lobe], theta: f64, source: Stop, receptor: Stop) -> 
     let mut up = ap.splits(&widths.iter().zip(lobes).map(|(w, l)| (w[0], l.tail.is_heavy())).collect::<Vec<_>>());
     let mut uq = aq.splits(&widths.iter().zip(lobes).map(|(w, l)| (w[1], l.tail.is_heavy())).collect::<Vec<_>>());
     for pole in lobes.iter().filter_map(|l| table_pole_widths(l, theta)) {
-        for (pts, a, w) in [(&mut up, ap, pole[0]), (&mut uq, aq, pole[1])] {
+        // The cusp is at the pole alone (u = v = 0, inside the first ring): a receptor whose range on the
+        // other axis stays a ring's width away from 0 never meets it (an E430 or ISO 13803 receptor off the
+        // specular direction), and that axis takes no pole splits.
+        let reaches = |a: AxisMap, w: f64| {
+            let [lo, hi] = a.range();
+            lo < w && hi > -w
+        };
+        let (near_u, near_v) = (reaches(ap, pole[0]), reaches(aq, pole[1]));
+        for (pts, a, w, near) in [(&mut up, ap, pole[0], near_v), (&mut uq, aq, pole[1], near_u)] {
+            if !near {
+                continue;
+            }
             let [lo, hi] = a.range();
             pts.extend([0.0, -w, w].into_iter().filter(|x| *x > lo && *x < hi));
             pts.sort_by(f64::total_cmp);
@@ -544,6 +555,36 @@ mod tests {
         // The boxes tile the product of the split intervals.
         let boxes = lobe_boxes(&[u.clone(), v.clone()]);
         assert_eq!(boxes.len(), (u.len() - 1) * (v.len() - 1));
+    }
+
+    /// A measured table's pole ring (splits at 0 and ± the first ring's width on both axes) is cut only on an
+    /// axis whose partner axis's range reaches the pole: a receptor off the specular direction on u (an E430
+    /// haze receptor) takes no ring splits on v, while its lobe splits stay.
+    #[test]
+    fn the_pole_ring_splits_only_where_the_range_reaches_the_pole() {
+        let table = Lobe {
+            slope_width: 3e-3,
+            medium_eta: 1.0,
+            label: "test".into(),
+            tail: crate::brdf::Tail::Table { half_width: 3e-3, resolution: 1e-4 },
+        };
+        let (theta, src) = (0.0, Stop { p: [-0.002, 0.002], q: [-0.01, 0.01] });
+        let ring = table_pole_widths(&table, theta).unwrap();
+        let has = |v: &[f64], x: f64| v.iter().any(|y| (y - x).abs() <= 1e-15);
+        // On the specular receptor both axes reach the pole: the ring is cut on both.
+        let [u, v] = lobe_splits(&[table.clone()], theta, src, Stop { p: [-0.002, 0.002], q: [-0.01, 0.01] });
+        assert!(has(&u, ring[0]) && has(&u, -ring[0]) && has(&v, ring[1]) && has(&v, -ring[1]), "{u:?} {v:?}");
+        // 0.03 off specular on p: u never comes within a ring of 0, so v has no ring splits (its lobe splits at
+        // 0 and ± the lobe widths remain); u's range holds no pole to split at.
+        let [u, v] = lobe_splits(&[table.clone()], theta, src, Stop { p: [0.028, 0.032], q: [-0.01, 0.01] });
+        assert!(!has(&v, ring[1]) && !has(&v, -ring[1]), "{v:?}");
+        let w = lobe_widths_uv(&table, theta);
+        assert!(has(&v, 0.0) && has(&v, w[1]) && has(&v, -w[1]), "{v:?}");
+        assert!(u.iter().all(|&x| x >= 0.026), "{u:?}");
+        // A u-range that starts inside the ring (half a ring from 0) still reaches the pole.
+        let rec = Stop { p: [0.002 + 0.5 * ring[0], 0.01], q: [-0.01, 0.01] };
+        let [_, v] = lobe_splits(&[table], theta, src, rec);
+        assert!(has(&v, ring[1]), "{v:?}");
     }
 
     /// A lobe narrower than the range but wider than half of it (the 0.1° source of `rhopoint-iq-20` against
