@@ -620,6 +620,15 @@ fn parse_at(text: &str, file: &str, options: &SheetOptions, place: &Place) -> Re
     let Some(header_line) = header_line else {
         return Err(Error::input(file, "", "the sheet is empty (no header line)"));
     };
+    // A JSON file given where a sheet goes (`compare RECIPE RECIPE`): say so, not "unrecognised column '{'".
+    if header_line.trim_start_matches('\u{feff}').trim_start().starts_with(['{', '[']) {
+        return Err(Error::input(
+            file,
+            "",
+            "this is a JSON file (a recipe?), not an instrument sheet: `compare` takes [RECIPE] SHEET, the sheet \
+             being a CSV or a workbook (.xlsx, .xlsm, .xlsb, .xls, .ods) of readings (docs/instrument.md §Sheets)",
+        ));
+    }
     let delimiter = options.delimiter.unwrap_or_else(|| detect_delimiter(header_line));
     let mut rdr = csv::ReaderBuilder::new()
         .delimiter(delimiter)

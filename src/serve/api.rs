@@ -410,6 +410,7 @@ pub fn compare(req: &Request, ctx: Context) -> Result<Reply> {
     let rule = VerdictRule {
         k: o.opt_num("k", 0.0, f64::INFINITY, "k")?.unwrap_or(2.0),
         tolerance: o.opt_num("tolerance", 0.0, f64::INFINITY, "tolerance")?,
+        per_reading: vec![],
     };
     let max_de00 = o.opt_num("max_de00", 0.0, f64::INFINITY, "largest ΔE00")?;
     let options = plan_options(&o, ctx, 1e-6)?;
