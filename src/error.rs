@@ -83,6 +83,21 @@ impl Words {
         self
     }
 
+    /// The argument these words begin with, and the words after it (`` `rtol` must be … `` → `rtol` and
+    /// ` must be …`), so that a front end can name the argument apart (the server: as the field of its body).
+    pub fn leading_argument(&self) -> Option<(&'static str, Words)> {
+        let (span, name) = self.arguments.first()?;
+        if span.start != 0 {
+            return None;
+        }
+        let at = span.end;
+        let rest = Words {
+            text: self.text[at..].to_string(),
+            arguments: self.arguments[1..].iter().map(|(r, a)| (r.start - at..r.end - at, *a)).collect(),
+        };
+        Some((name, rest))
+    }
+
     /// The words with each argument written by `name`.
     pub fn naming(&self, name: &dyn Fn(&'static str) -> String) -> String {
         let mut out = String::with_capacity(self.text.len());

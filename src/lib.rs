@@ -17,6 +17,8 @@
 //! * [`instrument`]: aperture geometry, the standards as data, the measurement plan and the readings.
 //! * [`api`]: the one-call API ([`measure`], the default panel, geometry resolution).
 //! * [`batch`], [`sweep`]: many recipes at once, and sweeps over a template's JSON Pointer paths (streamed, sharded).
+//! * [`request`]: the front door: one typed request per action, owning its defaults and validation; the
+//!   command line, the server and Python only convert into them.
 //! * [`report`]: the readings as documents (JSON, JSON lines, CSV) and the JSON Schemas of the outputs.
 //! * [`comparison`]: predictions beside instrument sheets: statistics, verdicts, many samples, baselines.
 //! * `cli` (feature `cli`, on by default): the thin command-line layer. The library builds and works without
@@ -40,6 +42,7 @@ pub mod quadrature;
 pub mod recipe;
 pub mod registry;
 pub mod report;
+pub mod request;
 #[cfg(feature = "serve")]
 pub mod serve;
 pub mod spectrum;
@@ -47,7 +50,7 @@ pub mod sweep;
 
 pub use api::{measure, measure_file, resolve_geometries, resolve_geometries_or, DEFAULT_PANEL};
 pub use error::{Error, Result};
-pub use instrument::plan::{PlanOptions, Reading};
+pub use instrument::plan::{PlanOptions, Reading, DEFAULT_RTOL};
 
 /// Double-precision 3-vector used for directions. Local shading frame: z is the specimen normal,
 /// x–z is the plane of measurement, and every direction points away from the surface.

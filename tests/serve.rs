@@ -232,6 +232,60 @@ fn the_endpoints_answer_on_the_command_lines_documents() {
     assert!((doc["targets"][0]["predicted"].as_f64().unwrap() - 90.0).abs() < 0.1);
 }
 
+/// The bytes of a file in base64 (the page's upload), written here so that the test needs no crate for it.
+fn base64(bytes: &[u8]) -> String {
+    const ABC: &[u8] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    let mut out = String::new();
+    for c in bytes.chunks(3) {
+        let n = (c[0] as u32) << 16 | (*c.get(1).unwrap_or(&0) as u32) << 8 | *c.get(2).unwrap_or(&0) as u32;
+        for k in 0..4 {
+            out.push(if k <= c.len() { ABC[(n >> (18 - 6 * k) & 63) as usize] as char } else { '=' });
+        }
+    }
+    out
+}
+
+#[test]
+fn a_workbook_upload_gives_the_verdicts_of_the_command_line() {
+    // The page's file picker offers .xlsx: the server reads it as `compare` reads the same bytes
+    // (`comparison::sheet::from_bytes`), verdict for verdict and number for number.
+    let addr = default_server();
+    let book = "fixtures/sheets/byk-smart-chart-export.xlsx";
+    let bytes = std::fs::read(book).unwrap();
+    let recipe = std::fs::read_to_string("fixtures/recipes/glass-n1.5.json").unwrap();
+    let body = with_recipe(
+        &recipe,
+        json!({"sheet": {"name": "byk-smart-chart-export.xlsx", "base64": base64(&bytes)}, "format": "json"}),
+    );
+    let a = request(addr, "POST", "/api/compare", &body, &[]);
+    assert_eq!(a.status, 200, "{}", a.body);
+    let served = a.json();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_glossmeter"))
+        .args(["compare", "fixtures/recipes/glass-n1.5.json", book, "--format", "json"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let cli: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let (s, c) = (served["comparisons"].as_array().unwrap(), cli["comparisons"].as_array().unwrap());
+    assert_eq!(s.len(), 3);
+    assert_eq!(s.len(), c.len());
+    for (s, c) in s.iter().zip(c) {
+        for key in ["geometry", "reading", "verdict", "n", "mean", "std", "predicted"] {
+            assert_eq!(s[key], c[key], "{key}: {s} vs {c}");
+        }
+    }
+    assert_eq!(served["sheet"]["encoding"], "xlsx workbook");
+    // `fit` reads the same upload.
+    let body = with_recipe(
+        &recipe,
+        json!({"free": ["/ior=1.3..1.8"], "sheet": {"name": "book.xlsx", "base64": base64(&bytes)}, "restarts": 0}),
+    );
+    let a = request(addr, "POST", "/api/fit", &body, &[]);
+    assert_eq!(a.status, 200, "{}", a.body);
+    let ior = a.json()["parameters"][0]["value"].as_f64().unwrap();
+    assert!((ior - 1.5).abs() < 0.01, "{ior}");
+}
+
 #[test]
 fn bad_requests_get_the_librarys_message_as_json_400() {
     let addr = default_server();

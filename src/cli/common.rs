@@ -3,8 +3,8 @@
 //! exit status), and the text table's padding.
 use clap::ValueEnum;
 
-use crate::colorimetry::{Conditions, Illuminant, Observer};
-use crate::instrument::plan::rtol_refusal;
+use crate::colorimetry::Conditions;
+use crate::request::{PlanRequest, DEFAULT_ILLUMINANT, DEFAULT_OBSERVER};
 use crate::{Error, Result};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -18,16 +18,26 @@ pub enum Format {
 #[derive(clap::Args, Debug, Clone)]
 pub struct ColourArgs {
     /// Illuminant of colour readings: D65, D50, A or C.
-    #[arg(long, default_value = "D65")]
+    #[arg(long, default_value = DEFAULT_ILLUMINANT)]
     pub illuminant: String,
     /// Observer of colour readings: 10 (CIE 1964 10°) or 2 (CIE 1931 2°).
-    #[arg(long, default_value = "10")]
+    #[arg(long, default_value = DEFAULT_OBSERVER)]
     pub observer: String,
 }
 
 impl ColourArgs {
     pub fn conditions(&self) -> Result<Conditions> {
-        Ok(Conditions { illuminant: Illuminant::parse(&self.illuminant)?, observer: Observer::parse(&self.observer)? })
+        self.plan(None).colour()
+    }
+
+    /// The plan's request: these conditions and the tolerance `rtol` (`None`: the request's default).
+    pub fn plan(&self, rtol: Option<f64>) -> PlanRequest {
+        PlanRequest {
+            rtol,
+            max_evals: None,
+            illuminant: Some(self.illuminant.clone()),
+            observer: Some(self.observer.clone()),
+        }
     }
 }
 
@@ -56,12 +66,9 @@ pub fn readings_status(readings: &[crate::Reading], allow_unconverged: bool) -> 
 
 pub use crate::instrument::plan::NEUTRAL_HUE;
 
-/// `--rtol` in (0, 1), checked before any work (the planner's check, `plan::rtol_refusal`, with the flag's name).
+/// `--rtol` in (0, 1), checked before any work (`request::check_rtol`, written with the flag's name).
 pub fn check_rtol(rtol: f64) -> Result<()> {
-    match rtol_refusal(rtol) {
-        Some(why) => Err(Error::Usage(format!("--rtol {why}"))),
-        None => Ok(()),
-    }
+    crate::request::check_rtol(rtol).map(|_| ())
 }
 
 /// The flag of an argument that a library error names ([`crate::error::Words`]): the library says `tolerance`,

@@ -5,13 +5,13 @@
 //! gets its CIEDE2000 ΔE00 (`comparison::colour_differences`; `--max-de00` makes it the check).
 use std::path::PathBuf;
 
-use crate::cli::common::{check_rtol, pad_table, readings_status, ColourArgs};
+use crate::cli::common::{pad_table, readings_status, ColourArgs};
 use crate::cli::junit;
 use crate::cli::output::OutputTarget;
-use crate::comparison::sheet::{self, Sheet, SheetOptions};
+use crate::comparison::sheet::{self, Sheet};
 use crate::comparison::{self, ColourDifference, Comparison, Drift, Recipes, Verdict, VerdictRule};
-use crate::instrument::plan::PlanOptions;
 use crate::report;
+use crate::request::{CompareRequest, SheetRequest};
 use crate::{Error, Result};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -80,33 +80,30 @@ pub struct CompareArgs {
     pub plot: Option<PathBuf>,
 }
 
-/// `,`, `;`, `tab` (or a literal tab).
-pub fn parse_delimiter(s: &str) -> Result<u8> {
-    match s {
-        "," => Ok(b','),
-        ";" => Ok(b';'),
-        "tab" | "\t" | "\\t" => Ok(b'\t'),
-        _ => Err(Error::Usage(format!("--delimiter must be `,`, `;` or `tab`, got `{s}`"))),
+/// The request of a command line (the one place where `compare`'s arguments become the library's).
+pub fn request(a: &CompareArgs) -> CompareRequest {
+    CompareRequest {
+        k: a.k,
+        tolerance: None,
+        tolerances: a.tolerance.clone(),
+        max_de00: a.max_de00,
+        plan: a.colour.plan(a.rtol),
+        sheet: SheetRequest {
+            delimiter: a.delimiter.clone(),
+            ignore_columns: a.ignore_columns.clone(),
+            sheet_name: a.sheet_name.clone(),
+        },
     }
 }
 
 pub fn run(a: CompareArgs) -> Result<()> {
-    let rule = VerdictRule::with_tolerances(a.k, &a.tolerance)?;
-    let rtol_from_data = a.rtol.is_none();
-    let rtol = a.rtol.unwrap_or(PlanOptions::default().rtol);
-    check_rtol(rtol)?;
+    let request = request(&a);
+    let rule = request.rule()?;
+    let plan_options = request.plan.options()?;
     if let Some(p) = &a.plot {
         crate::cli::plot::check_plot_path(p, "--plot")?;
     }
-    if let Some(m) = a.max_de00 {
-        if !(m.is_finite() && m >= 0.0) {
-            return Err(Error::Usage(format!(
-                "--max-de00 must be a finite number ≥ 0, got {}",
-                crate::error::given(m)
-            )));
-        }
-    }
-    let colour = a.colour.conditions()?;
+    let max_de00 = request.max_de00()?;
     let target = OutputTarget::new(a.output.as_deref(), "--output")?;
     let (default, sheet_path) = match a.paths.as_slice() {
         [s] => (None, s.clone()),
@@ -136,16 +133,11 @@ pub fn run(a: CompareArgs) -> Result<()> {
         a.paths.iter().chain(&a.baseline).map(PathBuf::as_path).chain(per_sample.iter().map(|(_, f)| f.as_path())),
     )?;
     let recipes = Recipes { default, dir: a.recipe_dir.clone(), per_sample };
-    let options = SheetOptions {
-        delimiter: a.delimiter.as_deref().map(parse_delimiter).transpose()?,
-        ignore_columns: a.ignore_columns.clone(),
-        sheet_name: a.sheet_name.clone(),
-    };
+    let options = request.sheet.options()?;
     let baseline = a.baseline.as_deref().map(comparison::load_baseline).transpose()?;
     let sheet = sheet::load(&sheet_path, &options)?;
-    let plan_options = PlanOptions { rtol, colour, rtol_from_data, ..PlanOptions::default() };
     let mut cmp = comparison::compare_sheet(&sheet, &recipes, &rule, &plan_options)?;
-    let des = comparison::colour_differences(&mut cmp, a.max_de00);
+    let des = comparison::colour_differences(&mut cmp, max_de00);
     let drift = match &baseline {
         Some(b) => comparison::check_baseline(
             cmp.iter().filter_map(|c| c.predicted.as_ref().map(|p| (c.material.as_str(), p))),

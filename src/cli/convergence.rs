@@ -8,13 +8,14 @@ use serde_json::json;
 use super::common::{pad_table, Format};
 use super::output::OutputTarget;
 use super::plot;
-use crate::instrument::convergence::{self, ReferenceKind, Sweep, SweepOptions, DEFAULT_TOLERANCES};
+use crate::instrument::convergence::{self, ReferenceKind, Sweep};
 use crate::recipe::{self, Material};
 use crate::report::plain;
+use crate::request::ConvergenceRequest;
 use crate::{Error, Result};
 
 /// The geometries swept when none is given.
-pub const DEFAULT_GEOMETRIES: &[&str] = &["astm-d523-20", "astm-d523-60", "astm-d523-85"];
+pub const DEFAULT_GEOMETRIES: &[&str] = crate::request::CONVERGENCE_GEOMETRIES;
 
 /// Arguments of `glossmeter convergence`.
 #[derive(clap::Args, Debug)]
@@ -50,19 +51,19 @@ pub struct ConvergenceArgs {
     pub reference_run: bool,
 }
 
+/// The request of a command line (the one place where `convergence`'s arguments become the library's).
+pub fn request(a: &ConvergenceArgs) -> ConvergenceRequest {
+    ConvergenceRequest {
+        tolerances: a.tolerances.clone(),
+        min_time_ms: a.min_time_ms,
+        max_repetitions: a.max_repetitions,
+        reference_run: a.reference_run,
+    }
+}
+
 pub fn run(args: ConvergenceArgs) -> Result<()> {
     // Every check that can fail cheaply comes before the (possibly long) sweep.
-    let tolerances = if args.tolerances.is_empty() { DEFAULT_TOLERANCES.to_vec() } else { args.tolerances.clone() };
-    convergence::validate_tolerances(&tolerances).map_err(|e| Error::Usage(format!("--tolerances: {e}")))?;
-    if !(args.min_time_ms.is_finite() && args.min_time_ms >= 0.0) {
-        return Err(Error::Usage(format!(
-            "--min-time-ms must be a number ≥ 0, got {}",
-            crate::error::given(args.min_time_ms)
-        )));
-    }
-    if args.max_repetitions == 0 {
-        return Err(Error::Usage("--max-repetitions must be at least 1".into()));
-    }
+    let (tolerances, options) = request(&args).options()?;
     let target = OutputTarget::new(args.output.as_deref(), "--output")?;
     if let Some(p) = &args.plot {
         plot::check_plot_path(p, "--plot")?;
@@ -72,12 +73,6 @@ pub fn run(args: ConvergenceArgs) -> Result<()> {
     }
     let material = recipe::load_file(&args.recipe)?;
     let geometries = crate::resolve_geometries_or(&args.geometries, &args.geometry_files, DEFAULT_GEOMETRIES)?;
-    let options = SweepOptions {
-        min_seconds: args.min_time_ms * 1e-3,
-        max_repetitions: args.max_repetitions,
-        force_run_reference: args.reference_run,
-        ..SweepOptions::default()
-    };
     let sweep = convergence::sweep(material.brdf.clone(), geometries, &tolerances, &options)?;
     let text = match args.format {
         Format::Table => table(&material, &sweep),

@@ -3,11 +3,11 @@
 //! `report::fit`.
 use std::path::PathBuf;
 
-use crate::cli::common::{check_rtol, Format};
-use crate::cli::compare::parse_delimiter;
+use crate::cli::common::Format;
 use crate::cli::output::{print, OutputTarget};
-use crate::comparison::sheet::{self, SheetOptions};
-use crate::fit::{self, FitOptions, FitReport, FreeParameter, TargetReading};
+use crate::comparison::sheet;
+use crate::fit::{self, FitOptions, FitReport};
+use crate::request::{FitRequest, SheetRequest};
 use crate::{recipe, Error, Result};
 
 #[derive(clap::Args, Debug)]
@@ -50,7 +50,7 @@ pub struct FitArgs {
     #[arg(long, default_value_t = fit::DEFAULT_RESTARTS)]
     pub restarts: usize,
     /// Relative tolerance of every forward reading.
-    #[arg(long, default_value_t = 1e-6)]
+    #[arg(long, default_value_t = crate::DEFAULT_RTOL)]
     pub rtol: f64,
     #[arg(long, value_enum, default_value_t = Format::Table)]
     pub format: Format,
@@ -62,44 +62,43 @@ pub struct FitArgs {
     pub no_timing: bool,
 }
 
-pub fn run(a: FitArgs) -> Result<()> {
-    check_rtol(a.rtol)?;
-    if !(a.uncertainty.is_finite() && a.uncertainty > 0.0) {
-        return Err(Error::Usage(format!(
-            "--uncertainty must be a finite number > 0, got {}",
-            crate::error::given(a.uncertainty)
-        )));
+/// The request of a command line (the one place where `fit`'s arguments become the library's).
+pub fn request(a: &FitArgs) -> FitRequest {
+    FitRequest {
+        free: a.free.clone(),
+        targets: a.targets.clone(),
+        uncertainty: a.uncertainty,
+        restarts: a.restarts,
+        rtol: a.rtol,
+        sheet: SheetRequest {
+            delimiter: a.delimiter.clone(),
+            ignore_columns: a.ignore_columns.clone(),
+            sheet_name: a.sheet_name.clone(),
+        },
+        sample: a.sample.clone(),
     }
+}
+
+pub fn run(a: FitArgs) -> Result<()> {
+    let request = request(&a);
+    let options = request.options()?;
     // Refused before any work if it exists (or its directory does not); written whole or not at all.
     let output = OutputTarget::new(a.output.as_deref(), "-o")?;
     crate::input::at_most_one_stdin(
         std::iter::once(&a.recipe).chain(&a.sheet).chain(&a.geometry_files).map(PathBuf::as_path),
     )?;
-    let free: Vec<FreeParameter> = a.free.iter().map(|f| FreeParameter::parse(f)).collect::<Result<_>>()?;
-    let targets: Vec<TargetReading> = match &a.sheet {
-        Some(s) => {
-            let options = SheetOptions {
-                delimiter: a.delimiter.as_deref().map(parse_delimiter).transpose()?,
-                ignore_columns: a.ignore_columns.clone(),
-                sheet_name: a.sheet_name.clone(),
-            };
-            let (targets, notes) = fit::targets_from_sheet(&sheet::load(s, &options)?, a.sample.as_deref())?;
-            for n in notes {
-                eprintln!("note: {n}");
-            }
-            targets
-        }
-        None => a.targets.iter().map(|t| TargetReading::parse(t)).collect::<Result<_>>()?,
+    let free = request.free()?;
+    let sheet = match &a.sheet {
+        Some(s) => Some(sheet::load(s, &request.sheet.options()?)?),
+        None => None,
     };
+    let (targets, notes) = request.targets(sheet.as_ref())?;
+    for n in notes {
+        eprintln!("note: {n}");
+    }
     let material = recipe::load_file(&a.recipe)?;
     let geometries = crate::resolve_geometries_or::<&str, _>(&[], &a.geometry_files, &[])?;
-    let options = FitOptions {
-        rtol: a.rtol,
-        default_uncertainty: a.uncertainty,
-        restarts: a.restarts,
-        geometries,
-        ..FitOptions::default()
-    };
+    let options = FitOptions { geometries, ..options };
     let report = match fit::fit(&material.json, &material.file, &free, &targets, &options) {
         Ok(report) => report,
         // A fit that cannot run still writes its document, with the failure in it (then exits 1).

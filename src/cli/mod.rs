@@ -39,8 +39,9 @@ pub mod profile;
 pub mod progress;
 pub mod sweep;
 
+use crate::request::PlanRequest;
 use args::{Cli, Command, OutputSchema};
-use common::{check_rtol, readings_status, Format};
+use common::{readings_status, Format};
 use output::{print, OutputTarget, STDOUT};
 
 /// Run the CLI; returns the process exit status. `glossmeter serve` needs the server, which stands above
@@ -121,20 +122,12 @@ fn dispatch(cli: Cli, #[allow(unused_variables)] serve: Serve) -> Result<()> {
             max_seconds,
             envelope,
         } => {
-            let rtol_from_data = rtol.is_none();
-            let rtol = rtol.unwrap_or(PlanOptions::default().rtol);
-            check_rtol(rtol)?;
-            let colour = colour.conditions()?;
-            if max_evals == 0 {
-                return Err(Error::Usage("--max-evals must be at least 1".into()));
-            }
-            if !(max_seconds.is_finite() && max_seconds >= 0.0) {
-                return Err(Error::Usage(format!(
-                    "--max-seconds must be a finite number of seconds ≥ 0 (0: no wall-clock budget), got {}",
-                    crate::error::given(max_seconds)
-                )));
-            }
-            let max_seconds = (max_seconds > 0.0).then_some(max_seconds);
+            let request = crate::request::MeasureRequest {
+                plan: PlanRequest { max_evals: Some(max_evals), ..colour.plan(rtol) },
+                max_seconds,
+            };
+            let options = request.options()?;
+            let max_seconds = options.max_seconds;
             // The limit is the whole command's, counted from here: the nominal readings and every envelope
             // variant share it (docs/instrument.md §Bounded work).
             let deadline =
@@ -150,8 +143,6 @@ fn dispatch(cli: Cli, #[allow(unused_variables)] serve: Serve) -> Result<()> {
             let target = OutputTarget::new(output.as_deref(), "--output")?;
             let baseline_file = baseline.as_deref().map(crate::input::name);
             let baseline = baseline.as_deref().map(crate::comparison::load_baseline).transpose()?;
-            let options =
-                PlanOptions { rtol, max_evals, max_seconds, colour, rtol_from_data, ..PlanOptions::default() };
             if recipes.len() > 1 || recipes[0].is_dir() {
                 if explain {
                     return Err(Error::Usage("--explain takes one recipe".into()));

@@ -8,13 +8,12 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use serde_json::Value;
 
-use super::common::check_rtol;
 use super::plot::{plot_err, Mark};
 use crate::brdf::{mirror, Brdf};
 use crate::colorimetry::weighting::Weighting;
 use crate::comparison::Comparison;
-use crate::instrument::plan::{Plan, PlanOptions};
 use crate::instrument::standards::StandardGeometry;
+use crate::request::{self, PlanRequest, VsParameterRequest};
 use crate::{recipe, Error, Result, Vec3};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -35,7 +34,7 @@ pub struct PlotArgs {
     #[arg(long = "geometry", short = 'g')]
     pub geometries: Vec<String>,
     /// For gloss-vs-parameter: the recipe number to vary, as a JSON Pointer, and its range, e.g.
-    /// `/roughness=0.02..0.3`.
+    /// `/roughness=0.02..0.3` (the grammar of `sweep --vary`; `:N` there sets --points).
     #[arg(long)]
     pub vary: Option<String>,
     /// For gloss-vs-parameter: how many values.
@@ -45,9 +44,10 @@ pub struct PlotArgs {
     /// decade or more (LO > 0 and HI ≥ 10·LO, as a roughness range does), else evenly.
     #[arg(long, value_enum, default_value_t = Spacing::Auto)]
     pub spacing: Spacing,
-    /// Relative tolerance of the readings (gloss-vs-parameter).
-    #[arg(long, default_value_t = 1e-5)]
-    pub rtol: f64,
+    /// Relative tolerance of the readings (gloss-vs-parameter; default 1e-5, for a measured table a quarter of
+    /// each integral's data uncertainty: given here, it is used as given).
+    #[arg(long)]
+    pub rtol: Option<f64>,
     /// The picture: FILE.png or FILE.svg (never overwritten).
     #[arg(long, short = 'o')]
     pub output: PathBuf,
@@ -61,32 +61,30 @@ pub enum Spacing {
     Log,
 }
 
-const DEFAULT: &[&str] = &["astm-d523-20", "astm-d523-60", "astm-d523-85"];
+const DEFAULT: &[&str] = crate::request::PLOT_GEOMETRIES;
 
-/// The axis name of a recipe number (docs/instrument.md §Pictures): the registry's words for it, the
-/// alternative that names the recipe's own choice where the words offer several (`GGX α` out of `Beckmann rms
-/// slope m or GGX α` for a GGX recipe), its unit, and the pointer: `GGX α (slope), /roughness`.
-pub fn parameter_label(recipe: &Value, pointer: &str) -> String {
-    let model = recipe.get("model").and_then(Value::as_str).unwrap_or("");
-    let Some(p) = crate::registry::lookup(model, pointer) else { return format!("recipe {pointer}") };
-    let first = p.description.split(';').next().unwrap_or("").trim();
-    let parent = pointer.rsplit_once('/').map_or("", |(a, _)| a);
-    let choices: Vec<String> = recipe
-        .pointer(parent)
-        .and_then(Value::as_object)
-        .map(|o| o.values().filter_map(Value::as_str).map(str::to_lowercase).collect())
-        .unwrap_or_default();
-    let words = first
-        .split(" or ")
-        .find(|alt| choices.iter().any(|c| !c.is_empty() && alt.to_lowercase().contains(c.as_str())))
-        .unwrap_or(first);
-    let unit = if p.unit.is_empty() { String::new() } else { format!(" ({})", p.unit) };
-    format!("{words}{unit}, {pointer}")
+pub use crate::request::parameter_label;
+
+/// The request of a command line (the one place where `plot --kind gloss-vs-parameter`'s arguments become the
+/// library's).
+pub fn request(a: &PlotArgs) -> VsParameterRequest {
+    VsParameterRequest {
+        vary: a.vary.clone(),
+        points: Some(a.points),
+        spacing: match a.spacing {
+            Spacing::Auto => request::Spacing::Auto,
+            Spacing::Linear => request::Spacing::Linear,
+            Spacing::Log => request::Spacing::Log,
+        },
+        plan: PlanRequest { rtol: a.rtol, ..PlanRequest::default() },
+    }
 }
 
 pub fn run(a: PlotArgs) -> Result<()> {
     super::plot::check_plot_path(&a.output, "--output")?;
-    check_rtol(a.rtol)?;
+    if let Some(rtol) = a.rtol {
+        request::check_rtol(rtol)?;
+    }
     let geos = crate::resolve_geometries_or(&a.geometries, &[] as &[&str], DEFAULT)?;
     match a.kind {
         PlotKind::Section => {
@@ -104,89 +102,16 @@ pub fn run(a: PlotArgs) -> Result<()> {
             crate::render_plot!(&a.output, "--output", (1000, h), |root| draw_sections(root, &material.name, &panels))?;
         }
         PlotKind::GlossVsParameter => {
-            let spec = a
-                .vary
-                .as_deref()
-                .ok_or_else(|| Error::Usage("--kind gloss-vs-parameter needs --vary PATH=LO..HI".into()))?;
-            let (pointer, lo, hi) = parse_vary(spec)?;
-            if !(2..=200).contains(&a.points) {
-                return Err(Error::Usage(format!("--points must be 2 to 200, got {}", a.points)));
-            }
             let file = crate::input::name(&a.recipe);
             let text = crate::input::read_text(&a.recipe, "recipe")?;
-            let json: Value = crate::input::json::parse_json(&text, &file)?;
-            match json.pointer(&pointer) {
-                Some(Value::Number(_)) => {}
-                Some(v) => {
-                    return Err(Error::input(
-                        &file,
-                        &pointer,
-                        format!("--vary needs a number here, got {}", crate::input::json::kind(v)),
-                    ))
-                }
-                None => return Err(Error::input(&file, &pointer, "--vary: no such field in the recipe")),
-            }
-            let name = recipe::parse_str(&text, &file)?.name;
-            let log = match a.spacing {
-                Spacing::Log if !(lo > 0.0) => {
-                    return Err(Error::Usage(format!("--spacing log needs LO > 0, got {}", crate::error::given(lo))))
-                }
-                Spacing::Log => true,
-                Spacing::Linear => false,
-                Spacing::Auto => lo > 0.0 && hi >= 10.0 * lo,
-            };
-            let label = parameter_label(&json, &pointer);
-            let mut series: Vec<(String, Vec<(f64, f64)>)> = Vec::new();
-            for k in 0..a.points {
-                let t = k as f64 / (a.points - 1) as f64;
-                let x = match k {
-                    0 => lo,
-                    k if k == a.points - 1 => hi,
-                    _ if log => (lo.ln() + (hi.ln() - lo.ln()) * t).exp(),
-                    _ => lo + (hi - lo) * t,
-                };
-                let mut j = json.clone();
-                *j.pointer_mut(&pointer).expect("checked above") = serde_json::json!(x);
-                let m = recipe::parse_str(&j.to_string(), &file)
-                    .map_err(|e| Error::Usage(format!("--vary {pointer} = {x}: {e}")))?;
-                let plan = Plan::compile(
-                    m.brdf.clone(),
-                    geos.clone(),
-                    PlanOptions { rtol: a.rtol, ..PlanOptions::default() },
-                )?;
-                for r in plan.execute() {
-                    let label = format!("{} {} ({})", r.geometry, r.name, r.unit);
-                    let Some(v) = r.value else { continue };
-                    match series.iter_mut().find(|s| s.0 == label) {
-                        Some(s) => s.1.push((x, v)),
-                        None => series.push((label, vec![(x, v)])),
-                    }
-                }
-            }
-            if series.is_empty() {
-                return Err(Error::Numeric("no reading has a value over the range".into()));
-            }
+            let v = request(&a).read(&text, &file, geos)?;
             crate::render_plot!(&a.output, "--output", (1000, 640), |root| draw_vs_parameter(
-                root, &name, &label, log, &series
+                root, &v.name, &v.label, v.log, &v.series
             ))?;
         }
     }
     eprintln!("plot: {}", a.output.display());
     Ok(())
-}
-
-/// `PATH=LO..HI` with PATH a JSON Pointer.
-fn parse_vary(s: &str) -> Result<(String, f64, f64)> {
-    let bad = || {
-        Error::Usage(format!("--vary {s}: expected PATH=LO..HI with PATH a JSON Pointer, e.g. /roughness=0.02..0.3"))
-    };
-    let (path, range) = s.split_once('=').ok_or_else(bad)?;
-    let (lo, hi) = range.split_once("..").ok_or_else(bad)?;
-    let (lo, hi): (f64, f64) = (lo.trim().parse().map_err(|_| bad())?, hi.trim().parse().map_err(|_| bad())?);
-    if !(path.starts_with('/') && lo.is_finite() && hi.is_finite() && lo < hi) {
-        return Err(bad());
-    }
-    Ok((path.to_string(), lo, hi))
 }
 
 /// One panel of the section plot.

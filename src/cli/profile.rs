@@ -8,17 +8,17 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use serde_json::json;
 
-use super::common::{check_rtol, readings_status};
+use super::common::readings_status;
 use super::output::OutputTarget;
 use super::plot::plot_err;
-use crate::instrument::plan::PlanOptions;
 use crate::instrument::profile::{self, Profile};
 use crate::recipe::{self, Material};
 use crate::report::plain;
+use crate::request::{PlanRequest, ProfileRequest};
 use crate::{Error, Result};
 
 /// The geometry profiled when none is given.
-pub const DEFAULT_GEOMETRY: &str = "rspec-20";
+pub const DEFAULT_GEOMETRY: &str = crate::request::PROFILE_GEOMETRY;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum ProfileFormat {
@@ -45,9 +45,10 @@ pub struct ProfileArgs {
     /// Write the CSV/JSON to this new file instead of stdout (refuses to overwrite).
     #[arg(long, short = 'o')]
     pub output: Option<PathBuf>,
-    /// Relative tolerance of every pixel's reading.
-    #[arg(long, default_value_t = 1e-6)]
-    pub rtol: f64,
+    /// Relative tolerance of every pixel's reading (default 1e-6; for a measured table, by default a quarter of
+    /// each integral's data uncertainty, as in `measure`: given here, it is used as given).
+    #[arg(long)]
+    pub rtol: Option<f64>,
     /// Exit 0 even if a pixel did not converge within its budget (it is still marked in the output).
     #[arg(long)]
     pub allow_unconverged: bool,
@@ -61,11 +62,17 @@ pub struct ProfileArgs {
     pub max_total_evals: usize,
 }
 
-pub fn run(args: ProfileArgs) -> Result<()> {
-    check_rtol(args.rtol)?;
-    if args.max_evals == 0 || args.max_total_evals == 0 {
-        return Err(Error::Usage("--max-evals and --max-total-evals must be at least 1".into()));
+/// The request of a command line (the one place where `profile`'s arguments become the library's).
+pub fn request(a: &ProfileArgs) -> ProfileRequest {
+    ProfileRequest {
+        plan: PlanRequest { rtol: a.rtol, ..PlanRequest::default() },
+        max_evals: a.max_evals,
+        max_total_evals: a.max_total_evals,
     }
+}
+
+pub fn run(args: ProfileArgs) -> Result<()> {
+    let (options, budget) = request(&args).options()?;
     let target = OutputTarget::new(args.output.as_deref(), "--output")?;
     if let Some(p) = &args.plot {
         super::plot::check_plot_path(p, "--plot")?;
@@ -80,8 +87,6 @@ pub fn run(args: ProfileArgs) -> Result<()> {
     };
     // Checked before any work: the geometry must have a profile array.
     crate::instrument::standards::profile::of(&g)?;
-    let options = PlanOptions { rtol: args.rtol, ..PlanOptions::default() };
-    let budget = profile::Budget { per_part: args.max_evals, total: args.max_total_evals };
     let prof = profile::measure(material.brdf.clone(), &g, options, budget)?;
     let text = match args.format {
         ProfileFormat::Csv => csv(&prof)?,

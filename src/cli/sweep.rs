@@ -4,10 +4,10 @@
 use std::io::IsTerminal;
 use std::path::PathBuf;
 
-use crate::cli::common::check_rtol;
 use crate::cli::output::OutputTarget;
 use crate::instrument::plan::PlanOptions;
-use crate::sweep::{self, Sweep, SweepDesign};
+use crate::request::{PlanRequest, SweepRequest};
+use crate::sweep;
 use crate::{resolve_geometries, Error, Result};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -40,9 +40,10 @@ pub struct SweepArgs {
     pub shard: Option<String>,
     #[arg(long, value_enum, default_value_t = SweepFormat::Csv)]
     pub format: SweepFormat,
-    /// Relative tolerance of every reading.
-    #[arg(long, default_value_t = 1e-6)]
-    pub rtol: f64,
+    /// Relative tolerance of every reading (default 1e-6; for a measured table, by default a quarter of each
+    /// integral's data uncertainty, as in `measure`: given here, it is used as given).
+    #[arg(long)]
+    pub rtol: Option<f64>,
     /// Leave the per-point wall time out (then the output is reproducible byte for byte).
     #[arg(long)]
     pub no_timing: bool,
@@ -55,33 +56,28 @@ pub struct SweepArgs {
     pub output: Option<PathBuf>,
 }
 
+/// The request of a command line (the one place where `sweep`'s arguments become the library's).
+pub fn request(a: &SweepArgs) -> SweepRequest {
+    SweepRequest {
+        vary: a.vary.clone(),
+        log: a.log.clone(),
+        lhs: a.lhs,
+        seed: a.seed,
+        plan: PlanRequest { rtol: a.rtol, max_evals: Some(a.max_evals), ..PlanRequest::default() },
+    }
+}
+
 pub fn run(a: SweepArgs) -> Result<()> {
-    check_rtol(a.rtol)?;
-    let mut axes = a.vary.iter().map(|v| sweep::parse_vary(v)).collect::<Result<Vec<_>>>()?;
-    for l in &a.log {
-        match axes.iter_mut().find(|x| &x.path == l) {
-            Some(x) => x.log = true,
-            None => return Err(Error::Usage(format!("--log {l}: not a --vary path"))),
-        }
-    }
-    let design = match a.lhs {
-        Some(n) => SweepDesign::Lhs { n, seed: a.seed },
-        None => SweepDesign::Grid,
-    };
+    let request = request(&a);
+    // Every check that needs no file comes before any work.
+    request.plan.options()?;
+    request.axes()?;
     let (k, m) = a.shard.as_deref().map(sweep::parse_shard).transpose()?.unwrap_or((1, 1));
-    if a.max_evals == 0 {
-        return Err(Error::Usage("--max-evals must be at least 1".into()));
-    }
     let target = OutputTarget::new(a.output.as_deref(), "--output")?;
     let file = crate::input::name(&a.template);
     let text = crate::input::read_text(&a.template, "recipe")?;
-    let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
-    let template: serde_json::Value = serde_json::from_str(text).map_err(|e| {
-        Error::input(&file, "", format!("malformed JSON at line {}, column {}: {e}", e.line(), e.column()))
-    })?;
     let geos = resolve_geometries(&a.geometries, &[] as &[&str])?;
-    let options = PlanOptions { rtol: a.rtol, max_evals: a.max_evals, ..PlanOptions::default() };
-    let s = Sweep::new(template, &file, axes, design, geos, options)?;
+    let s = request.sweep(&text, &file, geos)?;
     let range = s.shard(k, m);
     let timing = !a.no_timing;
     let bar = crate::cli::progress::Bar::new(range.end - range.start, std::io::stderr().is_terminal());

@@ -301,8 +301,15 @@ impl Sheet {
 pub fn load(path: &Path, options: &SheetOptions) -> Result<Sheet> {
     let file = crate::input::name(path);
     let bytes = crate::input::read_bytes(path, "sheet")?;
-    if workbook::is_workbook(&bytes) {
-        return parse_workbook(&bytes, &file, options);
+    from_bytes(&bytes, &file, options)
+}
+
+/// A sheet from its bytes, named `file` in messages: a workbook (.xlsx, .xlsm, .xlsb, .xls, .ods) by its
+/// signature, else a text sheet. The one entry point of every front end (the command line through [`load`],
+/// the server and Python with the bytes they were given), so that the same bytes give the same sheet.
+pub fn from_bytes(bytes: &[u8], file: &str, options: &SheetOptions) -> Result<Sheet> {
+    if workbook::is_workbook(bytes) {
+        return parse_workbook(bytes, file, options);
     }
     if options.sheet_name.is_some() {
         return Err(Error::Argument(
@@ -311,7 +318,7 @@ pub fn load(path: &Path, options: &SheetOptions) -> Result<Sheet> {
                 .and(" names a sheet of an .xlsx, .xls or .ods workbook"),
         ));
     }
-    parse_bytes(&bytes, &file, options)
+    parse_bytes(bytes, file, options)
 }
 
 /// A workbook's sheet (`options.sheet_name`, or the first) read by the rules of a text sheet.

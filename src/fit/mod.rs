@@ -92,7 +92,7 @@ pub const DEFAULT_RESTARTS: usize = 2;
 impl Default for FitOptions {
     fn default() -> Self {
         FitOptions {
-            rtol: 1e-6,
+            rtol: crate::instrument::plan::DEFAULT_RTOL,
             default_uncertainty: DEFAULT_UNCERTAINTY,
             max_iterations: 200,
             restarts: DEFAULT_RESTARTS,

@@ -10,16 +10,20 @@ use std::path::Path;
 use serde_json::{json, Value};
 
 use super::security::{table_path, Limits};
-use crate::colorimetry::{Conditions, Illuminant, Observer};
-use crate::comparison::sheet::{self, Sheet, SheetOptions};
-use crate::comparison::{self, VerdictRule};
-use crate::fit::{self, FitOptions, FreeParameter, TargetReading};
+use crate::colorimetry::{Illuminant, Observer};
+use crate::comparison;
+use crate::comparison::sheet::{self, Sheet};
+use crate::fit::{self, FitOptions};
 use crate::input::json::{kind, parse_json, Obj};
-use crate::instrument::plan::{rtol_refusal, Plan, PlanOptions};
+use crate::instrument::plan::{Plan, PlanOptions, DEFAULT_RTOL};
 use crate::instrument::standards::{self, StandardGeometry};
 use crate::recipe::{self, Material};
 use crate::registry::{self, Type};
-use crate::sweep::{Sweep, SweepAxis, SweepDesign};
+use crate::request::{
+    CompareRequest, FitRequest, PlanRequest, SheetRequest, Spacing, SweepRequest, VsParameterRequest, DEFAULT_K,
+    PLOT_GEOMETRIES, PLOT_RTOL,
+};
+use crate::sweep::Sweep;
 use crate::{report, Error, Result};
 
 /// How a request body is named in messages.
@@ -150,30 +154,48 @@ fn geometries(o: &Obj, ctx: Context, default: &[&str]) -> Result<Vec<StandardGeo
         .map_err(|e| o.err("geometries", e.naming(&|a| format!("`{a}`"))))
 }
 
-/// `rtol`, `max_evals` (at most the server's), `illuminant`, `observer`: the plan's options.
-fn plan_options(o: &Obj, ctx: Context, rtol: f64) -> Result<PlanOptions> {
-    // As `measure --rtol`: a tolerance given is used as given; without one a measured table's tolerance comes
-    // from its data (docs/accuracy.md §Data uncertainty of measured tables).
-    let rtol_from_data = o.get("rtol").is_none();
-    let rtol = match o.get("rtol") {
-        None => rtol,
-        Some(v) => {
-            let x = v.as_f64().ok_or_else(|| o.err("rtol", format!("expected a number, got {}", kind(v))))?;
-            if let Some(why) = rtol_refusal(x) {
-                return Err(o.err("rtol", why));
+/// An error of a request that names an argument first (`` `rtol` must be … ``) as the field of the body it
+/// came from (`request: field `/rtol`: must be …`); any other error as it is.
+fn at_field(o: &Obj, e: Error) -> Error {
+    match e {
+        Error::Argument(words) => match words.leading_argument() {
+            Some((name, rest)) => {
+                o.err(name, rest.naming(&|a| format!("`{a}`")).trim_start_matches(':').trim_start().to_string())
             }
-            x
-        }
+            None => Error::Argument(words),
+        },
+        e => e,
+    }
+}
+
+/// The body's `rtol`, `max_evals` (at most the server's, which is also the default), `illuminant` and
+/// `observer`: the plan's request (the one place where the server's JSON becomes the library's).
+fn plan_request(o: &Obj, ctx: Context) -> Result<PlanRequest> {
+    let rtol = match o.get("rtol") {
+        None => None,
+        Some(v) => Some(v.as_f64().ok_or_else(|| o.err("rtol", format!("expected a number, got {}", kind(v))))?),
     };
     let max_evals = whole(o, "max_evals", 1, ctx.limits.max_evals, "evaluations per aperture integral")?
         .unwrap_or(ctx.limits.max_evals);
-    let colour = Conditions {
-        illuminant: Illuminant::parse(o.opt_str("illuminant")?.unwrap_or("D65"))
-            .map_err(|e| o.err("illuminant", e.to_string()))?,
-        observer: Observer::parse(o.opt_str("observer")?.unwrap_or("10"))
-            .map_err(|e| o.err("observer", e.to_string()))?,
-    };
-    Ok(PlanOptions { rtol, max_evals, colour, rtol_from_data, ..PlanOptions::default() })
+    Ok(PlanRequest {
+        rtol,
+        max_evals: Some(max_evals),
+        illuminant: o.opt_str("illuminant")?.map(str::to_owned),
+        observer: o.opt_str("observer")?.map(str::to_owned),
+    })
+}
+
+/// The plan's options of the body ([`plan_request`]), `default_rtol` without a tolerance.
+fn plan_options(o: &Obj, ctx: Context, default_rtol: f64) -> Result<PlanOptions> {
+    let request = plan_request(o, ctx)?;
+    // Each colour condition's message under its own field.
+    if let Some(i) = &request.illuminant {
+        Illuminant::parse(i).map_err(|e| o.err("illuminant", e.to_string()))?;
+    }
+    if let Some(x) = &request.observer {
+        Observer::parse(x).map_err(|e| o.err("observer", e.to_string()))?;
+    }
+    request.options_or(default_rtol).map_err(|e| at_field(o, e))
 }
 
 fn timing(o: &Obj) -> Result<bool> {
@@ -201,7 +223,7 @@ fn profile_budget(ctx: Context) -> crate::instrument::profile::Budget {
 pub fn measure(req: &Request, ctx: Context) -> Result<Reply> {
     let o = req.obj();
     o.deny_unknown(MEASURE_FIELDS)?;
-    let options = plan_options(&o, ctx, 1e-6)?;
+    let options = plan_options(&o, ctx, DEFAULT_RTOL)?;
     let geos = geometries(&o, ctx, crate::api::DEFAULT_PANEL)?;
     let timing = timing(&o)?;
     let material = material(req, ctx)?;
@@ -216,7 +238,7 @@ pub fn measure(req: &Request, ctx: Context) -> Result<Reply> {
 pub fn explain(req: &Request, ctx: Context) -> Result<Reply> {
     let o = req.obj();
     o.deny_unknown(MEASURE_FIELDS)?;
-    let options = plan_options(&o, ctx, 1e-6)?;
+    let options = plan_options(&o, ctx, DEFAULT_RTOL)?;
     let geos = geometries(&o, ctx, crate::api::DEFAULT_PANEL)?;
     let material = material(req, ctx)?;
     let plan = Plan::compile(material.brdf.clone(), geos, options)?;
@@ -225,9 +247,6 @@ pub fn explain(req: &Request, ctx: Context) -> Result<Reply> {
         "plan": plan.explain(),
     })))
 }
-
-/// The geometries `plot --kind section` draws by default.
-const SECTION_DEFAULT: &[&str] = &["astm-d523-20", "astm-d523-60", "astm-d523-85"];
 
 /// `POST /api/plot`: an SVG picture drawn by the command line's code: `kind` `section` (the in-plane BRDF
 /// section with the apertures, `plot --kind section`), `profile` (the goniophotometric profile of
@@ -242,6 +261,7 @@ pub fn plot(req: &Request, ctx: Context) -> Result<Reply> {
         "geometry",
         "vary",
         "points",
+        "spacing",
         "rtol",
         "max_evals",
         "illuminant",
@@ -250,11 +270,11 @@ pub fn plot(req: &Request, ctx: Context) -> Result<Reply> {
     let kind = o.str("kind")?;
     let svg = match kind {
         "section" => {
-            let geos = geometries(&o, ctx, SECTION_DEFAULT)?;
+            let geos = geometries(&o, ctx, PLOT_GEOMETRIES)?;
             crate::cli::pictures::section_svg(&material(req, ctx)?, &geos)?
         }
         "profile" => {
-            let options = plan_options(&o, ctx, 1e-6)?;
+            let options = plan_options(&o, ctx, DEFAULT_RTOL)?;
             let id = o.opt_str("geometry")?.unwrap_or(crate::cli::profile::DEFAULT_GEOMETRY);
             let g = standards::find(id).map_err(|e| o.err("geometry", e.to_string()))?;
             standards::profile::of(&g).map_err(|e| o.err("geometry", e.to_string()))?;
@@ -263,33 +283,26 @@ pub fn plot(req: &Request, ctx: Context) -> Result<Reply> {
             crate::cli::profile::svg(&prof, &format!("{}: {} profile", m.name, prof.geometry))?
         }
         "gloss-vs-parameter" => {
-            let options = plan_options(&o, ctx, 1e-5)?;
-            let geos = geometries(&o, ctx, SECTION_DEFAULT)?;
-            let points = whole(&o, "points", 2, ctx.limits.plot_points, "values of the varied number")?.unwrap_or(9);
-            let vary = o.str("vary")?;
-            let axis = crate::sweep::parse_vary(&format!("{vary}:{points}"))
-                .map_err(|e| o.err("vary", e.naming(&|a| format!("`{a}`"))))?;
-            let text = recipe_text(req, ctx)?;
-            let name = recipe::parse_str(&text, RECIPE)?.name;
-            let template = parse_json(&text, RECIPE)?;
-            let pointer = axis.path.clone();
-            let (log, label) = (axis.log, crate::cli::pictures::parameter_label(&template, &pointer));
-            let s = Sweep::new(template, RECIPE, vec![axis], SweepDesign::Grid, geos, options)?;
-            let mut series: Vec<(String, Vec<(f64, f64)>)> = Vec::new();
-            s.run(0..s.len(), |r| {
-                let readings =
-                    r.outcome.map_err(|why| Error::Usage(format!("`vary` {pointer} = {}: {why}", r.values[0])))?;
-                for reading in readings {
-                    let label = format!("{} {} ({})", reading.geometry, reading.name, reading.unit);
-                    let Some(v) = reading.value else { continue };
-                    match series.iter_mut().find(|s| s.0 == label) {
-                        Some(s) => s.1.push((r.values[0], v)),
-                        None => series.push((label, vec![(r.values[0], v)])),
+            plan_options(&o, ctx, PLOT_RTOL)?;
+            let request = VsParameterRequest {
+                vary: Some(o.str("vary")?.to_owned()),
+                points: whole(&o, "points", 2, ctx.limits.plot_points, "values of the varied number")?,
+                spacing: match o.opt_str("spacing")? {
+                    None | Some("auto") => Spacing::Auto,
+                    Some("linear") => Spacing::Linear,
+                    Some("log") => Spacing::Log,
+                    Some(other) => {
+                        return Err(o.err(
+                            "spacing",
+                            format!("unknown spacing {other:?}; allowed: \"auto\", \"linear\", \"log\""),
+                        ))
                     }
-                }
-                Ok(())
-            })?;
-            crate::cli::pictures::vs_parameter_svg(&name, &label, log, &series)?
+                },
+                plan: plan_request(&o, ctx)?,
+            };
+            let geos = geometries(&o, ctx, PLOT_GEOMETRIES)?;
+            let v = request.read(&recipe_text(req, ctx)?, RECIPE, geos).map_err(|e| at_field(&o, e))?;
+            crate::cli::pictures::vs_parameter_svg(&v.name, &v.label, v.log, &v.series)?
         }
         other => {
             return Err(o.err(
@@ -317,26 +330,17 @@ pub fn sweep(req: &Request, ctx: Context) -> Result<Sweep> {
         "illuminant",
         "observer",
     ])?;
-    let options = plan_options(&o, ctx, 1e-6)?;
+    plan_options(&o, ctx, DEFAULT_RTOL)?;
     let geos = geometries(&o, ctx, crate::api::DEFAULT_PANEL)?;
-    let mut axes: Vec<SweepAxis> =
-        strings(&o, "vary")?.iter().map(|v| crate::sweep::parse_vary(v)).collect::<Result<_>>()?;
-    for l in strings(&o, "log")? {
-        match axes.iter_mut().find(|x| x.path == l) {
-            Some(x) => x.log = true,
-            None => return Err(o.err("log", format!("{l}: not a `vary` path"))),
-        }
-    }
-    let design = match whole(&o, "lhs", 1, ctx.limits.sweep_points as usize, "points of the Latin hypercube")? {
-        Some(n) => {
-            SweepDesign::Lhs { n: n as u64, seed: whole(&o, "seed", 0, usize::MAX, "seed")?.unwrap_or(0) as u64 }
-        }
-        None => SweepDesign::Grid,
+    let request = SweepRequest {
+        vary: strings(&o, "vary")?,
+        log: strings(&o, "log")?,
+        lhs: whole(&o, "lhs", 1, ctx.limits.sweep_points as usize, "points of the Latin hypercube")?.map(|n| n as u64),
+        seed: whole(&o, "seed", 0, usize::MAX, "seed")?.unwrap_or(0) as u64,
+        plan: plan_request(&o, ctx)?,
     };
-    let template: Value = serde_json::from_str(&recipe_text(req, ctx)?).map_err(|e| {
-        Error::input(RECIPE, "", format!("malformed JSON at line {}, column {}: {e}", e.line(), e.column()))
-    })?;
-    let s = Sweep::new(template, RECIPE, axes, design, geos, options)?;
+    request.axes().map_err(|e| at_field(&o, e))?;
+    let s = request.sweep(&recipe_text(req, ctx)?, RECIPE, geos)?;
     if s.len() > ctx.limits.sweep_points {
         return Err(o.err(
             "vary",
@@ -360,7 +364,7 @@ pub fn run_sweep(s: &Sweep, mut line: impl FnMut(String) -> Result<()>) -> Resul
 }
 
 /// The sheet of a request: `{"name": …, "base64": …}` (any file `compare` reads) or `{"name": …, "text": …}`,
-/// read by the same code as `compare`'s files (`comparison::sheet::parse_bytes`); `name` names it in
+/// read by the same code as `compare`'s files (`comparison::sheet::from_bytes`: text or workbook); `name` names it in
 /// messages and nothing is written to disk.
 fn sheet(o: &Obj) -> Result<Sheet> {
     let s = o.obj("sheet")?;
@@ -376,16 +380,14 @@ fn sheet(o: &Obj) -> Result<Sheet> {
         (None, Some(t)) => t.as_bytes().to_vec(),
         _ => return Err(s.err("text", "give the sheet as `base64` (its bytes) or as `text`, one of the two")),
     };
-    let options = SheetOptions {
-        delimiter: o.opt_str("delimiter")?.map(parse_delimiter).transpose().map_err(|e| o.err("delimiter", e))?,
+    let options = SheetRequest {
+        delimiter: o.opt_str("delimiter")?.map(str::to_owned),
         ignore_columns: strings(o, "ignore_columns")?,
         sheet_name: o.opt_str("sheet_name")?.map(str::to_owned),
-    };
-    sheet::parse_bytes(&bytes, &name, &options)
-}
-
-fn parse_delimiter(s: &str) -> std::result::Result<u8, String> {
-    crate::cli::compare::parse_delimiter(s).map_err(|_| format!("must be \",\", \";\" or \"tab\", got {s:?}"))
+    }
+    .options()
+    .map_err(|e| at_field(o, e))?;
+    sheet::from_bytes(&bytes, &name, &options)
 }
 
 /// `POST /api/compare`: the sheet beside the recipe's predictions (the one recipe for every sample), as
@@ -407,13 +409,17 @@ pub fn compare(req: &Request, ctx: Context) -> Result<Reply> {
         "observer",
         "format",
     ])?;
-    let rule = VerdictRule {
-        k: o.opt_num("k", 0.0, f64::INFINITY, "k")?.unwrap_or(2.0),
+    let request = CompareRequest {
+        k: o.opt_num("k", 0.0, f64::INFINITY, "k")?.unwrap_or(DEFAULT_K),
         tolerance: o.opt_num("tolerance", 0.0, f64::INFINITY, "tolerance")?,
-        per_reading: vec![],
+        tolerances: vec![],
+        max_de00: o.opt_num("max_de00", 0.0, f64::INFINITY, "largest ΔE00")?,
+        plan: plan_request(&o, ctx)?,
+        sheet: SheetRequest::default(),
     };
-    let max_de00 = o.opt_num("max_de00", 0.0, f64::INFINITY, "largest ΔE00")?;
-    let options = plan_options(&o, ctx, 1e-6)?;
+    let rule = request.rule().map_err(|e| at_field(&o, e))?;
+    let max_de00 = request.max_de00().map_err(|e| at_field(&o, e))?;
+    let options = plan_options(&o, ctx, DEFAULT_RTOL)?;
     let format = o.opt_str("format")?.unwrap_or("json");
     if !["json", "csv", "junit"].contains(&format) {
         return Err(o.err("format", format!("unknown format {format:?}; allowed: \"json\", \"csv\", \"junit\"")));
@@ -452,33 +458,36 @@ pub fn fit(req: &Request, ctx: Context) -> Result<Reply> {
         "rtol",
     ])?;
     let l = ctx.limits;
-    let rtol = plan_options(&o, ctx, 1e-6)?.rtol;
-    let free: Vec<FreeParameter> =
-        strings(&o, "free")?.iter().map(|f| FreeParameter::parse(f)).collect::<Result<_>>()?;
-    if free.len() > l.fit_free {
-        return Err(o.err("free", format!("{} free parameters; this server fits at most {}", free.len(), l.fit_free)));
-    }
-    let targets: Vec<TargetReading> = if o.get("sheet").is_some() {
-        if o.get("target").is_some() {
-            return Err(o.err("target", "give `target` readings or a `sheet`, not both"));
-        }
-        fit::targets_from_sheet(&sheet(&o)?, o.opt_str("sample")?)?.0
-    } else {
-        strings(&o, "target")?.iter().map(|t| TargetReading::parse(t)).collect::<Result<_>>()?
-    };
-    if targets.len() > l.fit_targets {
-        return Err(o.err("target", format!("{} targets; this server fits at most {}", targets.len(), l.fit_targets)));
-    }
-    let options = FitOptions {
-        rtol,
-        default_uncertainty: o
+    let rtol = plan_options(&o, ctx, DEFAULT_RTOL)?.rtol;
+    let request = FitRequest {
+        free: strings(&o, "free")?,
+        targets: strings(&o, "target")?,
+        uncertainty: o
             .opt_num("uncertainty", f64::MIN_POSITIVE, f64::INFINITY, "uncertainty")?
             .unwrap_or(fit::DEFAULT_UNCERTAINTY),
         restarts: whole(&o, "restarts", 0, l.fit_restarts, "restarts")?
             .unwrap_or(fit::DEFAULT_RESTARTS.min(l.fit_restarts)),
-        max_iterations: l.fit_iterations,
-        ..FitOptions::default()
+        rtol,
+        sheet: SheetRequest::default(),
+        sample: o.opt_str("sample")?.map(str::to_owned),
     };
+    let options = request.options().map_err(|e| at_field(&o, e))?;
+    let free = request.free()?;
+    if free.len() > l.fit_free {
+        return Err(o.err("free", format!("{} free parameters; this server fits at most {}", free.len(), l.fit_free)));
+    }
+    let sheet = match o.get("sheet") {
+        Some(_) if o.get("target").is_some() => {
+            return Err(o.err("target", "give `target` readings or a `sheet`, not both"))
+        }
+        Some(_) => Some(sheet(&o)?),
+        None => None,
+    };
+    let targets = request.targets(sheet.as_ref())?.0;
+    if targets.len() > l.fit_targets {
+        return Err(o.err("target", format!("{} targets; this server fits at most {}", targets.len(), l.fit_targets)));
+    }
+    let options = FitOptions { max_iterations: l.fit_iterations, ..options };
     let material = material(req, ctx)?;
     let report = fit::fit(&material.json, &material.file, &free, &targets, &options)?;
     Ok(Reply::json(&report::fit::json(&report, false)))

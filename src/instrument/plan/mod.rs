@@ -101,6 +101,10 @@ pub const DATA_PILOT_RTOL: [f64; 3] = [1e-2, 1e-3, 1e-4];
 /// uncertainty u = |Φ_coarse − Φ_table| + e_coarse + e_table is at most 3 × the difference).
 pub const DATA_RESOLVED: f64 = 2.0;
 
+/// The relative tolerance of every reading when none is given: the one default of every request and front
+/// end (`crate::request`), and of [`PlanOptions::default`].
+pub const DEFAULT_RTOL: f64 = 1e-6;
+
 /// Knobs of the planner. The defaults are what `measure` uses; the others exist to measure what each
 /// optimisation saves (`docs/performance.md`).
 #[derive(Clone, Debug, PartialEq)]
@@ -137,7 +141,7 @@ pub struct PlanOptions {
 impl Default for PlanOptions {
     fn default() -> Self {
         PlanOptions {
-            rtol: 1e-6,
+            rtol: DEFAULT_RTOL,
             fold_spectral: true,
             fold_in_material: true,
             share_fluxes: true,
