@@ -256,7 +256,7 @@ impl VerdictRule {
             match parse_tolerance(a)? {
                 (None, plain) => {
                     if rule.tolerance.replace(plain).is_some() {
-                        return Err(Error::argument("tolerance", " was given two plain numbers; give one".to_string()));
+                        return Err(Error::argument("tolerance", " was given two plain numbers; give one"));
                     }
                 }
                 (Some(t), _) => {
@@ -776,7 +776,7 @@ mod tests {
         assert!(err(&["gloss=-1"]).contains("≥ 0"));
         assert!(err(&["gloss=NaN"]).contains("≥ 0"));
         assert!(err(&["=2"]).contains("names no reading"));
-        assert!(err(&["60/gloss=2"]).contains("did you mean \"astm-d523-60\""), "{}", err(&["60/gloss=2"]));
+        assert!(err(&["d523-60/gloss=2"]).contains("did you mean \"astm-d523-60\""), "{}", err(&["d523-60/gloss=2"]));
         assert!(err(&["gloss=1", "gloss=2"]).contains("twice"));
         assert!(err(&["1", "2"]).contains("two plain numbers"));
         assert!(err(&["two"]).contains("KEY=NUMBER"));
