@@ -401,8 +401,11 @@ impl SheetRequest {
 pub struct CompareRequest {
     /// Standard errors of the mean allowed for repeated readings.
     pub k: f64,
-    /// Allowed |predicted − measured| for rows without an uncertainty.
+    /// Allowed |predicted − measured| for rows without an uncertainty (and that no `tolerances` key names).
     pub tolerance: Option<f64>,
+    /// Tolerances as `--tolerance` writes them, `[KEY=]NUMBER` (`gloss=2`, `astm-e430-30/doi=3`, `1`;
+    /// [`crate::comparison::parse_tolerance`]).
+    pub tolerances: Vec<String>,
     /// Largest allowed CIEDE2000 ΔE00.
     pub max_de00: Option<f64>,
     pub plan: PlanRequest,
@@ -414,6 +417,7 @@ impl Default for CompareRequest {
         CompareRequest {
             k: DEFAULT_K,
             tolerance: None,
+            tolerances: vec![],
             max_de00: None,
             plan: PlanRequest::default(),
             sheet: SheetRequest::default(),
@@ -424,7 +428,12 @@ impl Default for CompareRequest {
 impl CompareRequest {
     /// The verdict rule, checked.
     pub fn rule(&self) -> Result<VerdictRule> {
-        let rule = VerdictRule { k: self.k, tolerance: self.tolerance };
+        let mut rule = VerdictRule::with_tolerances(self.k, &self.tolerances)?;
+        if let Some(t) = self.tolerance {
+            if rule.tolerance.replace(t).is_some() {
+                return Err(Error::argument("tolerance", " was given two plain numbers; give one"));
+            }
+        }
         rule.check()?;
         Ok(rule)
     }

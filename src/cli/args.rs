@@ -18,6 +18,10 @@ use crate::instrument::plan::PlanOptions;
 pub struct Cli {
     #[command(subcommand)]
     pub command: Command,
+    /// Replace output files that exist (`-o`, `--plot`, ...; for re-runs in a Makefile). Each is still
+    /// written whole first and renamed over the old one, so a failed run leaves the old file as it was.
+    #[arg(long, global = true)]
+    pub force: bool,
 }
 
 /// The outputs whose JSON Schema `glossmeter schema --output-format` prints.
@@ -97,7 +101,8 @@ pub enum Command {
     },
     /// Measure a template recipe over a grid or a Latin hypercube of JSON Pointer paths (CSV or JSON lines).
     Sweep(sweep::SweepArgs),
-    /// Set predictions beside a glossmeter sheet (CSV); exits 1 if a reading falls outside its uncertainty.
+    /// Set predictions beside an instrument sheet (CSV, or an .xlsx/.xls/.ods workbook); exits 1 if a reading
+    /// falls outside its allowance.
     Compare(compare::CompareArgs),
     /// Error against run time over a sweep of tolerances (table, CSV, JSON, and a log–log plot).
     Convergence(convergence::ConvergenceArgs),
@@ -113,6 +118,14 @@ pub enum Command {
     /// serves until stopped.
     #[cfg(feature = "serve")]
     Serve(ServeArgs),
+    /// Print the shell completions of glossmeter (e.g. `glossmeter completions bash >
+    /// ~/.local/share/bash-completion/completions/glossmeter`).
+    Completions {
+        #[arg(value_enum)]
+        shell: clap_complete::Shell,
+    },
+    /// Print the man page of glossmeter, roff (`glossmeter man > glossmeter.1; man ./glossmeter.1`).
+    Man,
 }
 
 impl ServeArgs {

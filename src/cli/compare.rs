@@ -52,9 +52,11 @@ pub struct CompareArgs {
     /// Standard errors of the mean allowed for repeated readings (k·s/√n).
     #[arg(short = 'k', long = "k", default_value_t = 2.0)]
     pub k: f64,
-    /// Allowed |predicted − measured| in the reading's unit, for rows without an `uncertainty`.
-    #[arg(long)]
-    pub tolerance: Option<f64>,
+    /// Allowed |predicted − measured| in the reading's unit, for rows without an `uncertainty`: a number for
+    /// every reading, or per reading (repeatable): `gloss=2`, `haze=5`, `astm-e430-30/doi=3` (the most specific
+    /// key applies).
+    #[arg(long, value_name = "[KEY=]NUMBER")]
+    pub tolerance: Vec<String>,
     /// A previous `measure` or `compare` JSON: fail any prediction that moved by more than both error estimates.
     #[arg(long, value_name = "PREVIOUS.json")]
     pub baseline: Option<PathBuf>,
@@ -86,7 +88,8 @@ pub struct CompareArgs {
 pub fn request(a: &CompareArgs) -> CompareRequest {
     CompareRequest {
         k: a.k,
-        tolerance: a.tolerance,
+        tolerance: None,
+        tolerances: a.tolerance.clone(),
         max_de00: a.max_de00,
         plan: a.colour.plan(a.rtol),
         sheet: SheetRequest {
@@ -209,38 +212,37 @@ pub fn summary(cmp: &[Comparison]) -> String {
 }
 
 fn table(sheet: &Sheet, cmp: &[Comparison], rule: &VerdictRule, drift: &[Drift], with_baseline: bool) -> String {
+    // Ten columns, so that a sheet's table fits 120 columns: the material is named once per sample below the
+    // table, min and max are in the CSV and JSON, the standard deviation stands beside the mean.
     let head = [
         "sample",
-        "material",
         "geometry",
         "reading",
         "n",
-        "mean",
-        "std",
-        "min",
-        "max",
+        "mean ± std",
         "predicted",
-        "numerical error",
-        "predicted − measured",
+        "num. error",
+        "difference",
         "allowance",
         "verdict",
     ];
     let mut rows = vec![head.map(String::from).to_vec()];
     let mut notes = vec![];
+    let mut materials: Vec<String> = vec![];
     for c in cmp {
         let p = c.predicted.as_ref();
         let v = p.and_then(|p| p.value);
         let s = c.group.stats;
+        let material = format!("{}: {} ({})", c.group.sample, c.material, c.recipe);
+        if !materials.contains(&material) {
+            materials.push(material);
+        }
         rows.push(vec![
             c.group.sample.clone(),
-            c.material.clone(),
             c.group.geometry.clone(),
             c.group.reading.clone(),
             s.n.to_string(),
-            format!("{:.3}", s.mean),
-            if s.n > 1 { format!("{:.3}", s.std) } else { "—".into() },
-            format!("{:.3}", s.min),
-            format!("{:.3}", s.max),
+            if s.n > 1 { format!("{:.3} ± {:.3}", s.mean, s.std) } else { format!("{:.3}", s.mean) },
             fmt(v),
             p.filter(|p| p.value.is_some()).map(|p| format!("{:.1e}", p.error_estimate)).unwrap_or("—".into()),
             fmt(c.difference()),
@@ -266,9 +268,14 @@ fn table(sheet: &Sheet, cmp: &[Comparison], rule: &VerdictRule, drift: &[Drift],
         s.push_str(&format!("# {k}: {v}\n"));
     }
     s.push('\n');
-    s.push_str(&pad_table(&rows, &[4, 5, 6, 7, 8, 9, 10, 11, 12]));
+    s.push_str(&pad_table(&rows, &[3, 4, 5, 6, 7, 8]));
+    s.push('\n');
+    for m in &materials {
+        s.push_str(&format!("sample {m}\n"));
+    }
     s.push_str(&format!(
-        "\nallowance = {}·s/√n + stated uncertainty + the prediction's error estimate\n{}\n",
+        "difference = predicted − measured; num. error = the prediction's numerical error estimate\nallowance = \
+         {}·s/√n + stated uncertainty + num. error\n{}\n",
         rule.k,
         summary(cmp)
     ));

@@ -78,7 +78,10 @@ where
             };
         }
     };
-    match dispatch(cli, serve) {
+    output::set_force(cli.force);
+    let result = dispatch(cli, serve);
+    output::set_force(false);
+    match result {
         Ok(()) => 0,
         // A reader that went away (`glossmeter standards | head -1`) is not an error: end quietly, as
         // ripgrep does. Only standard output is treated so; a file that cannot be written is an error.
@@ -233,6 +236,18 @@ fn dispatch(cli: Cli, #[allow(unused_variables)] serve: Serve) -> Result<()> {
             let text = serde_json::to_string_pretty(&schema)
                 .map_err(|e| Error::Numeric(format!("the schema does not serialise: {e}")))?;
             print(&(text + "\n"))
+        }
+        Command::Completions { shell } => {
+            let mut bytes = Vec::new();
+            clap_complete::generate(shell, &mut <Cli as clap::CommandFactory>::command(), "glossmeter", &mut bytes);
+            print(&String::from_utf8_lossy(&bytes))
+        }
+        Command::Man => {
+            let mut bytes = Vec::new();
+            clap_mangen::Man::new(<Cli as clap::CommandFactory>::command())
+                .render(&mut bytes)
+                .map_err(|e| Error::Io { file: STDOUT.into(), source: e })?;
+            print(&String::from_utf8_lossy(&bytes))
         }
     }
 }

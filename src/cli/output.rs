@@ -8,6 +8,11 @@
 //! rename), so nothing is ever clobbered, even by a file that appeared during the run. On any failure the
 //! temporary file is removed when it is dropped. The target is checked before any work is done
 //! ([`OutputTarget::new`]), so a long computation is not wasted on a name that would be refused.
+//!
+//! `--force` ([`set_force`], for re-runs in a Makefile) lets an existing regular file be replaced: the new file
+//! is still written to a temporary file and renamed over the old one only when it is complete (`persist`, an
+//! atomic `rename(2)`), so a failed run leaves the old file as it was. A directory is never replaced.
+use std::cell::Cell;
 use std::fs::File;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -16,6 +21,20 @@ use crate::{Error, Result};
 
 /// How standard output is named in errors.
 pub const STDOUT: &str = "<stdout>";
+
+thread_local! {
+    /// `--force`: replace existing files (set by the command line for its run, on the thread that writes).
+    static FORCE: Cell<bool> = const { Cell::new(false) };
+}
+
+/// Whether the files this thread writes may replace existing ones (`--force`).
+pub fn set_force(force: bool) {
+    FORCE.with(|f| f.set(force));
+}
+
+fn force() -> bool {
+    FORCE.with(Cell::get)
+}
 
 /// Standard output, or a file that must not exist yet.
 #[derive(Clone, Debug)]
@@ -72,11 +91,17 @@ impl OutputTarget {
 
 /// Refuse an existing path (never overwritten) and a path whose directory does not exist.
 pub fn check_new_file(p: &Path, option: &str) -> Result<()> {
-    if p.symlink_metadata().is_ok() {
-        return Err(Error::Usage(format!(
-            "{option} {}: already exists; glossmeter never overwrites a file (choose another name)",
-            p.display()
-        )));
+    if let Ok(meta) = p.symlink_metadata() {
+        if meta.is_dir() {
+            return Err(Error::Usage(format!("{option} {}: is a directory, not a file", p.display())));
+        }
+        if !force() {
+            return Err(Error::Usage(format!(
+                "{option} {}: already exists; glossmeter never overwrites a file (choose another name, or give \
+                 --force to replace it)",
+                p.display()
+            )));
+        }
     }
     let dir = parent(p);
     if !dir.is_dir() {
@@ -129,11 +154,18 @@ pub fn write_new_file_by(path: &Path, body: impl FnOnce(&mut File) -> Result<()>
     // On an error here `tmp` is dropped, which removes the temporary file.
     body(tmp.as_file_mut())?;
     tmp.as_file_mut().flush().and_then(|_| tmp.as_file().sync_all()).map_err(io)?;
+    if force() {
+        if path.is_dir() {
+            return Err(Error::Usage(format!("{}: is a directory, not a file", path.display())));
+        }
+        return tmp.persist(path).map(drop).map_err(|e| io(e.error));
+    }
     tmp.persist_noclobber(path).map(drop).map_err(|e| {
         // `e.file` (the temporary file) is dropped with `e`, which removes it.
         if e.error.kind() == std::io::ErrorKind::AlreadyExists {
             Error::Usage(format!(
-                "{}: already exists; glossmeter never overwrites a file (choose another name)",
+                "{}: already exists; glossmeter never overwrites a file (choose another name, or give --force to \
+                 replace it)",
                 path.display()
             ))
         } else {
@@ -158,6 +190,30 @@ mod tests {
             std::fs::read_dir(d).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
         v.sort();
         v
+    }
+
+    #[test]
+    fn force_replaces_a_file_whole_and_a_failed_write_keeps_the_old_one() {
+        let d = dir("force");
+        let p = d.join("readings.csv");
+        std::fs::write(&p, "old").unwrap();
+        assert!(check_new_file(&p, "-o").unwrap_err().to_string().contains("--force"));
+        set_force(true);
+        check_new_file(&p, "-o").unwrap();
+        write_new_file(&p, b"new").unwrap();
+        assert_eq!(std::fs::read_to_string(&p).unwrap(), "new");
+        // A write that fails half-way leaves the previous file as it was, and no temporary file.
+        let r = write_new_file_with(&p, b"0123456789", |f, b| {
+            f.write_all(&b[..5])?;
+            Err(std::io::Error::from(std::io::ErrorKind::StorageFull))
+        });
+        assert!(r.is_err());
+        assert_eq!(std::fs::read_to_string(&p).unwrap(), "new");
+        assert_eq!(entries(&d), ["readings.csv"]);
+        // A directory is never replaced.
+        assert!(check_new_file(&d, "-o").unwrap_err().to_string().contains("directory"));
+        set_force(false);
+        assert!(check_new_file(&p, "-o").is_err());
     }
 
     #[test]

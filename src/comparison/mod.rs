@@ -12,7 +12,9 @@
 //! ```
 //!
 //! k·s/√n being k standard errors of the mean (k = 2 by default, about 95 % for a normal mean) and u the
-//! stated uncertainty (the largest of the rows' `uncertainty`, else `--tolerance`). With n = 1 and no stated
+//! stated uncertainty (the largest of the rows' `uncertainty`, else the reading's tolerance: the most specific
+//! `--tolerance` key naming it, `astm-e430-30/doi=3` before `doi=3` before a plain `3`,
+//! [`VerdictRule::tolerance_for`]). With n = 1 and no stated
 //! uncertainty there is no allowance: the row is unchecked, which fails the check like an outside row.
 //!
 //! The folder:
@@ -130,18 +132,93 @@ pub fn read_targets(path: &Path, options: &SheetOptions) -> Result<(Sheet, Vec<G
 }
 
 /// How verdicts are reached.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct VerdictRule {
     /// Standard errors of the mean allowed (default 2).
     pub k: f64,
-    /// The uncertainty of rows that state none.
+    /// The uncertainty of rows that state none and that no entry of `per_reading` names.
     pub tolerance: Option<f64>,
+    /// Tolerances of some readings (`gloss=2`, `astm-e430-30/doi=3`), in the readings' own units; the most
+    /// specific one that names a row applies ([`VerdictRule::tolerance_for`]).
+    pub per_reading: Vec<ReadingTolerance>,
 }
 
 impl Default for VerdictRule {
     fn default() -> Self {
-        VerdictRule { k: 2.0, tolerance: None }
+        VerdictRule { k: 2.0, tolerance: None, per_reading: vec![] }
     }
+}
+
+/// A tolerance for the readings a key names (docs/instrument.md §Repeated readings and the verdict): `KEY=VALUE`
+/// where KEY is a reading's name or quantity (`gloss`, `haze`, `log-haze`, `doi`, `haze-narrow`, `L*`) or
+/// `GEOMETRY/READING` (`astm-e430-30/doi`); a plain number is the tolerance of every other reading.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ReadingTolerance {
+    /// The geometry id, when the key names one.
+    pub geometry: Option<String>,
+    /// The reading's name or quantity.
+    pub reading: String,
+    pub value: f64,
+}
+
+impl ReadingTolerance {
+    /// The key as written (`gloss`, `astm-e430-30/doi`).
+    pub fn key(&self) -> String {
+        match &self.geometry {
+            Some(g) => format!("{g}/{}", self.reading),
+            None => self.reading.clone(),
+        }
+    }
+
+    /// How specifically this entry names a reading of `geometry` with this name and quantity: 3 for its
+    /// geometry and name, 2 for its name, 1 for its quantity, None when it does not name it.
+    fn names(&self, geometry: &str, name: &str, quantity: &str) -> Option<u8> {
+        let of_reading = if self.reading == name {
+            Some(2)
+        } else if self.reading == quantity {
+            Some(1)
+        } else {
+            None
+        };
+        match &self.geometry {
+            Some(g) if g == geometry => of_reading.map(|_| 3),
+            Some(_) => None,
+            None => of_reading,
+        }
+    }
+}
+
+/// One `--tolerance` argument: a plain number (`2`, every reading without a more specific one) or `KEY=VALUE`
+/// ([`ReadingTolerance`]). Returns (None, plain) or (Some(entry), _).
+pub fn parse_tolerance(text: &str) -> Result<(Option<ReadingTolerance>, f64)> {
+    let bad = |why: String| Error::argument("tolerance", format!(" {text:?}: {why}"));
+    let number = |v: &str| -> Result<f64> {
+        let x: f64 = v.trim().parse().map_err(|_| bad(format!("`{}` is not a number", v.trim())))?;
+        if !(x.is_finite() && x >= 0.0) {
+            return Err(bad("a tolerance must be a finite number ≥ 0".into()));
+        }
+        Ok(x)
+    };
+    let Some((key, value)) = text.split_once('=') else {
+        return number(text).map(|x| (None, x)).map_err(|_| {
+            bad("give a number (every reading) or KEY=NUMBER, KEY a reading (`gloss`, `haze`, `doi`) or \
+                 GEOMETRY/READING (`astm-e430-30/doi`)"
+                .into())
+        });
+    };
+    let value = number(value)?;
+    let key = key.trim();
+    let (geometry, reading) = match key.split_once('/') {
+        Some((g, r)) => (Some(g.trim().to_string()), r.trim().to_string()),
+        None => (None, key.to_string()),
+    };
+    if reading.is_empty() || geometry.as_deref().is_some_and(str::is_empty) {
+        return Err(bad("the key before `=` names no reading (`gloss=2`, `astm-e430-30/doi=3`)".into()));
+    }
+    if let Some(g) = &geometry {
+        standards::find(g).map_err(|e| bad(e.to_string()))?;
+    }
+    Ok((Some(ReadingTolerance { geometry, reading, value }), value))
 }
 
 impl VerdictRule {
@@ -157,6 +234,77 @@ impl VerdictRule {
                 return Err(Error::argument(
                     "tolerance",
                     format!(" must be a finite number ≥ 0, got {}", crate::error::given(t)),
+                ));
+            }
+        }
+        for t in &self.per_reading {
+            if !(t.value.is_finite() && t.value >= 0.0) {
+                return Err(Error::argument(
+                    "tolerance",
+                    format!(" {}: must be a finite number ≥ 0, got {}", t.key(), crate::error::given(t.value)),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// The rule of `--tolerance` arguments ([`parse_tolerance`]), each a plain number (at most one) or
+    /// `KEY=VALUE` (at most one per key).
+    pub fn with_tolerances(k: f64, arguments: &[String]) -> Result<VerdictRule> {
+        let mut rule = VerdictRule { k, ..VerdictRule::default() };
+        for a in arguments {
+            match parse_tolerance(a)? {
+                (None, plain) => {
+                    if rule.tolerance.replace(plain).is_some() {
+                        return Err(Error::argument("tolerance", " was given two plain numbers; give one"));
+                    }
+                }
+                (Some(t), _) => {
+                    if rule.per_reading.iter().any(|u| u.key() == t.key()) {
+                        return Err(Error::argument("tolerance", format!(" {} was given twice", t.key())));
+                    }
+                    rule.per_reading.push(t);
+                }
+            }
+        }
+        rule.check()?;
+        Ok(rule)
+    }
+
+    /// The tolerance of a reading of `geometry` with this name and quantity: the most specific entry of
+    /// `per_reading` that names it (geometry and reading, then the reading's name, then its quantity), else
+    /// the plain `tolerance`.
+    pub fn tolerance_for(&self, geometry: &str, name: &str, quantity: &str) -> Option<f64> {
+        self.per_reading
+            .iter()
+            .filter_map(|t| t.names(geometry, name, quantity).map(|rank| (rank, t.value)))
+            .max_by_key(|(rank, _)| *rank)
+            .map(|(_, v)| v)
+            .or(self.tolerance)
+    }
+
+    /// An entry of `per_reading` that names none of the comparisons' readings (a mistyped key): an error
+    /// listing the readings there are.
+    fn check_every_key_used(&self, comparisons: &[Comparison]) -> Result<()> {
+        for t in &self.per_reading {
+            let used = comparisons.iter().any(|c| {
+                let (name, quantity) = match &c.predicted {
+                    Some(p) => (p.name.as_str(), p.quantity.as_str()),
+                    None => (c.group.reading.as_str(), c.group.reading.as_str()),
+                };
+                t.names(&c.group.geometry, name, quantity).is_some()
+            });
+            if !used {
+                let mut have: Vec<String> = comparisons
+                    .iter()
+                    .map(|c| format!("{}/{}", c.group.geometry, c.group.reading))
+                    .collect::<std::collections::BTreeSet<_>>()
+                    .into_iter()
+                    .collect();
+                have.truncate(12);
+                return Err(Error::argument(
+                    "tolerance",
+                    format!(" {}={}: names no reading of the sheet (it has: {})", t.key(), t.value, have.join(", ")),
                 ));
             }
         }
@@ -265,7 +413,7 @@ pub fn judge(group: Group, material: &Material, readings: &[Reading], rule: &Ver
         );
     };
     let s = group.stats;
-    let stated = group.uncertainty.or(rule.tolerance);
+    let stated = group.uncertainty.or_else(|| rule.tolerance_for(&p.geometry, &p.name, &p.quantity));
     let Some(v) = p.value else {
         let why = p.problem.clone().unwrap_or_else(|| "no finite value".into());
         return mk(Some(p), None, Verdict::NoValue(why));
@@ -463,6 +611,7 @@ fn judge_all(
         }
         out.push(judge(g, &materials[i], &readings[i], rule));
     }
+    rule.check_every_key_used(&out)?;
     Ok(out)
 }
 
@@ -597,6 +746,41 @@ pub fn check_baseline<'a>(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_most_specific_tolerance_names_each_reading() {
+        let args: Vec<String> =
+            ["gloss=2", "haze=5", "astm-e430-30/doi=3", "doi=0.5", "1"].iter().map(|s| s.to_string()).collect();
+        let rule = VerdictRule::with_tolerances(2.0, &args).unwrap();
+        assert_eq!(rule.tolerance, Some(1.0));
+        assert_eq!(rule.tolerance_for("astm-d523-60", "gloss", "gloss"), Some(2.0));
+        // haze-narrow's quantity is haze; log-haze is neither: the plain number.
+        assert_eq!(rule.tolerance_for("astm-e430-30", "haze-narrow", "haze"), Some(5.0));
+        assert_eq!(rule.tolerance_for("iso-13803-20", "log-haze", "log-haze"), Some(1.0));
+        // geometry/reading before the reading alone, which holds elsewhere.
+        assert_eq!(rule.tolerance_for("astm-e430-30", "doi", "doi"), Some(3.0));
+        assert_eq!(rule.tolerance_for("rhopoint-iq-20", "doi", "doi"), Some(0.5));
+        // No plain number: a reading no key names has none.
+        let only = VerdictRule::with_tolerances(2.0, &["gloss=2".to_string()]).unwrap();
+        assert_eq!(only.tolerance_for("astm-e430-30", "doi", "doi"), None);
+    }
+
+    #[test]
+    fn bad_tolerances_are_refused_with_what_is_allowed() {
+        let err = |a: &[&str]| {
+            VerdictRule::with_tolerances(2.0, &a.iter().map(|s| s.to_string()).collect::<Vec<_>>())
+                .unwrap_err()
+                .to_string()
+        };
+        assert!(err(&["gloss=abc"]).contains("not a number"), "{}", err(&["gloss=abc"]));
+        assert!(err(&["gloss=-1"]).contains("≥ 0"));
+        assert!(err(&["gloss=NaN"]).contains("≥ 0"));
+        assert!(err(&["=2"]).contains("names no reading"));
+        assert!(err(&["d523-60/gloss=2"]).contains("did you mean \"astm-d523-60\""), "{}", err(&["d523-60/gloss=2"]));
+        assert!(err(&["gloss=1", "gloss=2"]).contains("twice"));
+        assert!(err(&["1", "2"]).contains("two plain numbers"));
+        assert!(err(&["two"]).contains("KEY=NUMBER"));
+    }
 
     #[test]
     fn statistics_of_known_values() {

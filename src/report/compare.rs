@@ -135,7 +135,10 @@ pub struct SheetDoc {
 pub struct RuleDoc {
     #[schemars(range(min = 0))]
     pub k: f64,
+    /// The tolerance of readings that no `tolerances` key names.
     pub tolerance: Option<f64>,
+    /// Tolerances per reading (`--tolerance gloss=2`, `astm-e430-30/doi=3`), key → value.
+    pub tolerances: std::collections::BTreeMap<String, f64>,
 }
 
 /// How many comparisons ended in each verdict.
@@ -217,7 +220,11 @@ pub fn json_doc(
             metadata: sheet.metadata_json(),
             ignored_columns: sheet.ignored_columns.clone(),
         },
-        rule: RuleDoc { k: rule.k, tolerance: rule.tolerance },
+        rule: RuleDoc {
+            k: rule.k,
+            tolerance: rule.tolerance,
+            tolerances: rule.per_reading.iter().map(|t| (t.key(), t.value)).collect(),
+        },
         comparisons: cmp.iter().map(ComparisonDoc::new).collect(),
         summary: SummaryDoc {
             readings: cmp.len(),

@@ -430,6 +430,7 @@ pub fn compare(req: &Request, ctx: Context) -> Result<Reply> {
     let request = CompareRequest {
         k: o.opt_num("k", 0.0, f64::INFINITY, "k")?.unwrap_or(DEFAULT_K),
         tolerance: o.opt_num("tolerance", 0.0, f64::INFINITY, "tolerance")?,
+        tolerances: vec![],
         max_de00: o.opt_num("max_de00", 0.0, f64::INFINITY, "largest ΔE00")?,
         plan: plan_request(&o, ctx)?,
         sheet: SheetRequest::default(),

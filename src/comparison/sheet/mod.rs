@@ -219,6 +219,15 @@ fn parse_at(text: &str, file: &str, options: &SheetOptions, place: &Place) -> Re
     let Some(first_line) = content().next() else {
         return Err(Error::input(file, "", "the sheet is empty (no header line)"));
     };
+    // A JSON file given where a sheet goes (`compare RECIPE RECIPE`): say so, not "unrecognised column '{'".
+    if first_line.trim_start_matches('\u{feff}').trim_start().starts_with(['{', '[']) {
+        return Err(Error::input(
+            file,
+            "",
+            "this is a JSON file (a recipe?), not an instrument sheet: `compare` takes [RECIPE] SHEET, the sheet \
+             being a CSV or a workbook (.xlsx, .xlsm, .xlsb, .xls, .ods) of readings (docs/instrument.md §Sheets)",
+        ));
+    }
     // The separator of the first content line that has one (a title line above the header has none).
     let delimiter = options.delimiter.unwrap_or_else(|| {
         let with_one = content().take(TITLE_ROWS + 1).find(|l| l.bytes().any(|c| matches!(c, b',' | b';' | b'\t')));

@@ -131,11 +131,54 @@ pub fn find(id: &str) -> Result<StandardGeometry> {
     match all.iter().find(|g| g.geometry.id == id) {
         Some(g) => Ok(g.clone()),
         None => Err(Error::Usage(format!(
-            "unknown geometry id {id:?}; known ids: {}; colour: {}",
+            "unknown geometry id {id:?}{}; known ids: {}; colour: {}",
+            did_you_mean(id, all.iter().map(|g| g.geometry.id.as_str())),
             ids(&all[..gloss]),
             ids(&all[gloss..])
         ))),
     }
+}
+
+/// The ids an unknown `id` was probably meant as, as "; did you mean ...?" (empty when none is close): those that
+/// end with it as whole '-'-separated parts (`60` → `astm-d523-60`, `D523-60` → `astm-d523-60`, ignoring case),
+/// else the nearest within two single-character edits of it (`astm-d532-60` → `astm-d523-60`). At most five.
+fn did_you_mean<'a>(id: &str, known: impl Iterator<Item = &'a str> + Clone) -> String {
+    let id = id.trim().to_ascii_lowercase();
+    if id.is_empty() {
+        return String::new();
+    }
+    let suffix = format!("-{id}");
+    let mut hits: Vec<&str> = known.clone().filter(|k| k.to_ascii_lowercase().ends_with(&suffix)).collect();
+    if hits.is_empty() {
+        // The nearest ids only, within two edits.
+        let near: Vec<(usize, &str)> = known.map(|k| (edit_distance(&k.to_ascii_lowercase(), &id), k)).collect();
+        let best = near.iter().map(|(d, _)| *d).min().unwrap_or(usize::MAX);
+        hits = near.into_iter().filter(|(d, _)| *d <= 2 && *d == best).map(|(_, k)| k).collect();
+    }
+    hits.truncate(5);
+    match hits.as_slice() {
+        [] => String::new(),
+        [one] => format!("; did you mean {one:?}?"),
+        many => {
+            format!("; did you mean one of {}?", many.iter().map(|k| format!("{k:?}")).collect::<Vec<_>>().join(", "))
+        }
+    }
+}
+
+/// Levenshtein distance (insertions, deletions and substitutions of single characters).
+fn edit_distance(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut row: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut diagonal = row[0];
+        row[0] = i + 1;
+        for (j, &cb) in b.iter().enumerate() {
+            let next = (diagonal + usize::from(ca != cb)).min(row[j] + 1).min(row[j + 1] + 1);
+            diagonal = row[j + 1];
+            row[j + 1] = next;
+        }
+    }
+    row[b.len()]
 }
 
 /// Every builtin geometry: the gloss ones, then the colour ones (`standards/colour/`).
@@ -204,6 +247,24 @@ pub fn check_user(g: &StandardGeometry, shipped: &[StandardGeometry]) -> Result<
 mod tests {
     use super::colour::{colour_kind, is_colour_id, ColourKind};
     use super::*;
+
+    #[test]
+    fn an_unknown_id_gets_the_ids_it_was_probably_meant_as() {
+        let msg = |id: &str| find(id).unwrap_err().to_string();
+        assert!(msg("60").contains(r#"did you mean one of "astm-d523-60", "iso-2813-60"?"#), "{}", msg("60"));
+        assert!(msg("D523-85").contains(r#"did you mean "astm-d523-85"?"#), "{}", msg("D523-85"));
+        assert!(msg("astm-d532-60").contains(r#"did you mean "astm-d523-60"?"#), "{}", msg("astm-d532-60"));
+        // One edit from astm-d523-60, two from astm-d523-20 and -85: the nearest only.
+        assert!(msg("astm-d523-6").contains(r#"did you mean "astm-d523-60"?"#), "{}", msg("astm-d523-6"));
+        let twenty = msg("20");
+        assert!(twenty.contains("did you mean one of ") && twenty.contains(r#""astm-d523-20""#), "{twenty}");
+        assert!(twenty.contains(r#""iso-13803-20""#), "{twenty}");
+        // Nothing close: no suggestion, the list of known ids only.
+        let far = msg("goniophotometer");
+        assert!(!far.contains("did you mean") && far.contains("known ids: "), "{far}");
+        assert_eq!(edit_distance("kitten", "sitting"), 3);
+        assert_eq!(edit_distance("", "abc"), 3);
+    }
 
     #[test]
     fn builtin_colour_geometries_parse() {
