@@ -572,11 +572,13 @@ mod tests {
         let ring = table_pole_widths(&table, theta).unwrap();
         let has = |v: &[f64], x: f64| v.iter().any(|y| (y - x).abs() <= 1e-15);
         // On the specular receptor both axes reach the pole: the ring is cut on both.
-        let [u, v] = lobe_splits(&[table.clone()], theta, src, Stop { p: [-0.002, 0.002], q: [-0.01, 0.01] });
+        let [u, v] =
+            lobe_splits(std::slice::from_ref(&table), theta, src, Stop { p: [-0.002, 0.002], q: [-0.01, 0.01] });
         assert!(has(&u, ring[0]) && has(&u, -ring[0]) && has(&v, ring[1]) && has(&v, -ring[1]), "{u:?} {v:?}");
         // 0.03 off specular on p: u never comes within a ring of 0, so v has no ring splits (its lobe splits at
         // 0 and ± the lobe widths remain); u's range holds no pole to split at.
-        let [u, v] = lobe_splits(&[table.clone()], theta, src, Stop { p: [0.028, 0.032], q: [-0.01, 0.01] });
+        let [u, v] =
+            lobe_splits(std::slice::from_ref(&table), theta, src, Stop { p: [0.028, 0.032], q: [-0.01, 0.01] });
         assert!(!has(&v, ring[1]) && !has(&v, -ring[1]), "{v:?}");
         let w = lobe_widths_uv(&table, theta);
         assert!(has(&v, 0.0) && has(&v, w[1]) && has(&v, -w[1]), "{v:?}");

@@ -300,7 +300,7 @@ impl Planner {
             let mut cache = self.standards.lock().ok();
             for (&i, f) in missing.iter().zip(computed) {
                 if let Some(c) = cache.as_mut() {
-                    c.insert(keys[i].clone(), f.clone());
+                    c.insert(keys[i], f.clone());
                 }
                 flux[i] = Some(f);
             }
