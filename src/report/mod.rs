@@ -18,9 +18,9 @@
 //!   that the writers serialise ([`ReadingDoc`], [`measure::MeasureDoc`], [`compare::CompareDoc`],
 //!   [`fit::FitDoc`], ...), so a field cannot be written without being in its schema.
 pub mod compare;
-#[cfg(feature = "junit")]
 pub mod convergence;
 pub mod fit;
+#[cfg(feature = "junit")]
 pub mod junit;
 pub mod measure;
 #[cfg(feature = "pictures")]
