@@ -5,7 +5,7 @@
 //! Plain `main` (harness = false): each case runs `FIT_BENCH_REPEATS` times (default 1; a fit is seconds) in a
 //! local rayon pool, and the median wall time is reported. The machine's load average is printed beside it:
 //! on a shared machine the wall-time speed-up is bounded by the cores actually free. Run:
-//! `cargo bench --bench fit`; copy the table to docs/performance.md §Fit with the load.
+//! `cargo bench --bench fit`; copy the table to docs/performance.md §Converging again, and in parallel.
 use std::time::Instant;
 
 use glossmeter::fit::{fit, FitOptions, FitReport, FreeParameter, TargetReading};

@@ -17,7 +17,7 @@ use crate::comparison::VerdictRule;
 use crate::error::{given, Words};
 use crate::fit::{self, FitOptions, FreeParameter, TargetReading};
 use crate::instrument::convergence::{self, SweepOptions, DEFAULT_TOLERANCES};
-use crate::instrument::plan::{rtol_refusal, PlanOptions, DEFAULT_RTOL};
+use crate::instrument::plan::{rtol_refusal, Cancel, PlanOptions, DEFAULT_RTOL};
 use crate::instrument::profile;
 use crate::instrument::standards::StandardGeometry;
 use crate::sweep::{self, Sweep, SweepAxis, SweepDesign};
@@ -175,7 +175,19 @@ impl SweepRequest {
 
     /// The sweep of the template `text` (named `file` in messages) through `geometries`.
     pub fn sweep(&self, text: &str, file: &str, geometries: Vec<StandardGeometry>) -> Result<Sweep> {
-        let options = self.plan.options()?;
+        self.sweep_until(text, file, geometries, Cancel::default())
+    }
+
+    /// [`SweepRequest::sweep`], every point's plan stopped by `cancel` (the server's, raised when its client
+    /// leaves or its time is up).
+    pub fn sweep_until(
+        &self,
+        text: &str,
+        file: &str,
+        geometries: Vec<StandardGeometry>,
+        cancel: Cancel,
+    ) -> Result<Sweep> {
+        let options = PlanOptions { cancel, ..self.plan.options()? };
         let (axes, design) = self.axes()?;
         let template = read_template(text, file)?;
         Sweep::new(template, file, axes, design, geometries, options)
@@ -222,10 +234,22 @@ pub struct VsParameter {
 impl VsParameterRequest {
     /// The sweep of the template `text` (named `file`), checked before any work: one axis on a grid.
     pub fn sweep(&self, text: &str, file: &str, geometries: Vec<StandardGeometry>) -> Result<Sweep> {
+        self.sweep_until(text, file, geometries, Cancel::default())
+    }
+
+    /// [`VsParameterRequest::sweep`], every point's plan stopped by `cancel` (the server's, raised when its
+    /// client leaves or its time is up).
+    pub fn sweep_until(
+        &self,
+        text: &str,
+        file: &str,
+        geometries: Vec<StandardGeometry>,
+        cancel: Cancel,
+    ) -> Result<Sweep> {
         let spec = self.vary.as_deref().ok_or_else(|| {
             Error::Argument(Words::from("a gloss-vs-parameter picture needs ").and_argument("vary").and(" PATH=LO..HI"))
         })?;
-        let options = self.plan.options_or(PLOT_RTOL)?;
+        let options = PlanOptions { cancel, ..self.plan.options_or(PLOT_RTOL)? };
         let mut axis = sweep::parse_vary(spec)?;
         let n = axis.n.map(|n| n as usize).or(self.points).unwrap_or(PLOT_POINTS);
         if !(2..=PLOT_POINTS_MAX).contains(&n) {
@@ -247,7 +271,18 @@ impl VsParameterRequest {
     /// The picture's numbers: every point of the sweep read (in order); a point whose recipe is invalid is an
     /// error naming its value.
     pub fn read(&self, text: &str, file: &str, geometries: Vec<StandardGeometry>) -> Result<VsParameter> {
-        let s = self.sweep(text, file, geometries)?;
+        self.read_until(text, file, geometries, Cancel::default())
+    }
+
+    /// [`VsParameterRequest::read`], stopped by `cancel` as [`VsParameterRequest::sweep_until`] is.
+    pub fn read_until(
+        &self,
+        text: &str,
+        file: &str,
+        geometries: Vec<StandardGeometry>,
+        cancel: Cancel,
+    ) -> Result<VsParameter> {
+        let s = self.sweep_until(text, file, geometries, cancel)?;
         let name = recipe::parse_str(text, file)?.name;
         let (pointer, log) = (s.axes[0].path.clone(), s.axes[0].log);
         let label = parameter_label(&s.template, &pointer);

@@ -1,4 +1,4 @@
-//! The linear error analysis at the fit (docs/inverse.md §Standard errors): the weighted Jacobian's columns
+//! The linear error analysis at the fit (docs/inverse.md §Uncertainty): the weighted Jacobian's columns
 //! scaled by their bound widths, its singular value decomposition, the covariance s²·V Σ⁻² Vᵀ with the exact
 //! null directions left out, the standard errors and correlations; which parameters sit at a bound; and the
 //! Gauss–Newton step that remains (the independent check of the solver's stop).

@@ -1,4 +1,4 @@
-//! The linear error analysis, checked (docs/inverse.md §Standard errors): along every determined direction
+//! The linear error analysis, checked (docs/inverse.md §Uncertainty): along every determined direction
 //! (singular value s ≥ 1) step one standard error each way, t ± δ with δ_k = width_k·v_k/s, integrate there,
 //! and compare the actual change of χ² with the change the linearised model predicts, ‖r + Jδ‖² − ‖r‖²
 //! (≈ 1 at the optimum). A ratio outside [1/2, 2] means the readings are not linear in the parameters over one

@@ -41,11 +41,13 @@
 //! * `report.rs`: the result ([`FitReport`], [`FittedParameter`], [`FittedTarget`]) and the verdict;
 //! * `params.rs`: what is fitted to what: [`FreeParameter`], [`TargetReading`], [`targets_from_sheet`], and
 //!   the check of the free parameters against the recipe and the registry;
-//! * `mod.rs`: the options ([`FitOptions`]) and [`fit`], the stages in order.
+//! * `options.rs`: the options ([`FitOptions`]) and their defaults;
+//! * `mod.rs`: [`fit`], the stages in order.
 mod analysis;
 mod classify;
 mod goodness;
 mod linearity;
+mod options;
 mod params;
 mod problem;
 mod reach;
@@ -54,6 +56,7 @@ mod search;
 mod targets;
 
 pub use goodness::{chi2_survival, gamma_q, P_THRESHOLD};
+pub use options::{FitOptions, DEFAULT_RESTARTS, DEFAULT_UNCERTAINTY};
 pub use params::{targets_from_sheet, FreeParameter, TargetReading};
 pub use report::{FitReport, FittedParameter, FittedTarget};
 pub use search::restart_fractions;
@@ -63,58 +66,14 @@ use std::time::Instant;
 use nalgebra::DVector;
 use serde_json::Value;
 
-use crate::instrument::plan::{Cancel, PlanOptions, Planner};
-use crate::instrument::standards::StandardGeometry;
+use crate::instrument::plan::{PlanOptions, Planner};
 use crate::{recipe, Error, Result};
 use params::check_free;
 use problem::{describe_point, u_of_t, Forward, Mode, Problem};
 
-/// Uncertainty of a target given without one, in the reading's unit: the 0.2 GU repeatability that
-/// `docs/inverse.md` assumes for a glossmeter (its opening list, "Weights"), used for haze and DOI units alike.
-pub const DEFAULT_UNCERTAINTY: f64 = 0.2;
-
 /// The largest Gauss–Newton step, in standard uncertainties of the targets, that may remain at a fit called
 /// converged (an independent check of the solver's own stopping rule; see [`fit`]).
 pub const STEP_TOLERANCE: f64 = 0.01;
-
-/// Knobs of the fit.
-#[derive(Clone, Debug)]
-pub struct FitOptions {
-    /// Relative tolerance of every forward reading. The default is `measure`'s (1e-6): the Jacobians run on
-    /// frozen methods, so their differences do not need a tighter one, and a reading's 1e-6 is far below a
-    /// glossmeter's repeatability (60 GU × 1e-6 = 6·10⁻⁵ GU against 0.2 GU).
-    pub rtol: f64,
-    /// Uncertainty of a target without one.
-    pub default_uncertainty: f64,
-    /// Most forward-model runs (each a full set of readings) the solver may spend, Jacobians excluded.
-    pub max_iterations: usize,
-    /// For an exactly determined fit (as many targets as free parameters), how many further solver runs
-    /// from deterministic starts check that the solution is the only one ([`restart_fractions`]); 0 says
-    /// in the verdict that uniqueness is not checked. With one or two free parameters it also switches the
-    /// scan of the bounds, which seeds restarts for any number of targets (docs/inverse.md §Every root).
-    pub restarts: usize,
-    /// User geometries (loaded from geometry files) that targets may name besides the shipped ones; a
-    /// target's geometry id is looked up here first.
-    pub geometries: Vec<StandardGeometry>,
-    /// A stop signal for the whole fit (`PlanOptions::cancel`, passed to every forward run; default: none).
-    pub cancel: Cancel,
-}
-
-/// Restarts of an exactly determined fit by default.
-pub const DEFAULT_RESTARTS: usize = 2;
-
-impl Default for FitOptions {
-    fn default() -> Self {
-        FitOptions {
-            rtol: crate::instrument::plan::DEFAULT_RTOL,
-            default_uncertainty: DEFAULT_UNCERTAINTY,
-            max_iterations: 200,
-            restarts: DEFAULT_RESTARTS,
-            geometries: Vec::new(),
-            cancel: Cancel::default(),
-        }
-    }
-}
 
 /// Fit the free parameters of `recipe` (the JSON of a recipe file named `file`) to the targets.
 /// Bad arguments (paths, bounds, starts, targets, counts) are usage errors, [`Error::Argument`] where they

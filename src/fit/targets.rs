@@ -1,10 +1,10 @@
 //! Target matching, the fit's first stage: the request's counts checked, each target's geometry found (a
 //! user geometry first, then the shipped ones) and each target matched to one reading of the plan, by the
-//! reading's name or else its quantity, as `compare` matches them (docs/inverse.md §Targets).
+//! reading's name or else its quantity, as `compare` matches them (docs/inverse.md §Method, its targets).
 use std::collections::HashMap;
 
+use super::options::FitOptions;
 use super::params::{FreeParameter, TargetReading};
-use super::FitOptions;
 use crate::error::Words;
 use crate::instrument::plan::Planner;
 use crate::instrument::standards::StandardGeometry;

@@ -317,7 +317,8 @@ pub fn plot(req: &Request, ctx: Context) -> Result<Reply> {
                 plan: plan_request(&o, ctx)?,
             };
             let geos = geometries(&o, ctx, PLOT_GEOMETRIES)?;
-            let v = request.read(&recipe_text(req, ctx)?, RECIPE, geos).map_err(|e| at_field(&o, e))?;
+            let text = recipe_text(req, ctx)?;
+            let v = request.read_until(&text, RECIPE, geos, ctx.cancel.clone()).map_err(|e| at_field(&o, e))?;
             crate::report::pictures::charts::vs_parameter_svg(&v.name, &v.label, v.log, &v.series)?
         }
         other => {
@@ -356,7 +357,7 @@ pub fn sweep(req: &Request, ctx: Context) -> Result<Sweep> {
         plan: plan_request(&o, ctx)?,
     };
     request.axes().map_err(|e| at_field(&o, e))?;
-    let s = request.sweep(&recipe_text(req, ctx)?, RECIPE, geos)?;
+    let s = request.sweep_until(&recipe_text(req, ctx)?, RECIPE, geos, ctx.cancel.clone())?;
     if s.len() > ctx.limits.sweep_points {
         return Err(o.err(
             "vary",

@@ -1,7 +1,7 @@
 //! [`Rule::LobeDelta`](super::Rule::LobeDelta): the delta limit of a narrow Gaussian-tailed lobe and its majorant, at
 //! the Gauss–Legendre nodes of (t_p, t_q) — the executor ([`lobe_delta`]), the fit at one node ([`delta_fit`],
 //! [`DeltaFit`], on the points of [`delta_stencil`]) and the constants of its stencil and bound.
-use super::rule::{Integrand, Outcome, RuleRun, ShapedRule};
+use super::shape::{Integrand, Outcome, RuleRun, ShapedRule};
 use super::Rule;
 use crate::quadrature::{legendre_on_into, Estimate, Options, Refine};
 

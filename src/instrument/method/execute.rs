@@ -4,7 +4,7 @@
 //! BRDF batch in the chart's variables, times the geometric factor and the weighting) is built here once
 //! per execution and handed to the rules of `delta.rs`, `gauss.rs` and `polar.rs`.
 use super::chart::ChartMap;
-use super::rule::RuleRun;
+use super::shape::RuleRun;
 use super::{Flux, Method, Projection, RegularPart};
 use crate::brdf::Brdf;
 use crate::colorimetry::weighting::Weighting;

@@ -1,7 +1,7 @@
 //! The two Gauss product rules: [`Rule::LobeGaussHermite`] (Gauss–Hermite in the scaled lobe variables,
 //! Gauss–Legendre in t, level by level through [`LOBE_LEVELS`]) and [`Rule::TensorGauss`] (the anisotropic
 //! tensor Gauss–Legendre rule of `quadrature::tensor` on the boxes of [`tensor_boxes`]).
-use super::rule::{Integrand, Outcome, RuleRun, ShapedRule};
+use super::shape::{Integrand, Outcome, RuleRun, ShapedRule};
 use super::Rule;
 use crate::instrument::aperture::{lobe_boxes, AxisMap, Chart};
 use crate::instrument::geometry::Stop;

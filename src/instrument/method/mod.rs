@@ -31,7 +31,11 @@
 //!   its constants (`DELTA_*`, [`DELTA_COST`]);
 //! - `gauss.rs`: the executors of [`Rule::LobeGaussHermite`] ([`LOBE_LEVELS`]) and [`Rule::TensorGauss`]
 //!   ([`tensor_boxes`], [`TENSOR_MAX_LEVEL`]);
-//! - `polar.rs`: [`Rule::LobePolar`]'s executor ([`POLAR_LEVELS`], [`TAIL_LEVELS`]).
+//! - `polar.rs`: [`Rule::LobePolar`]'s executor ([`POLAR_LEVELS`], [`TAIL_LEVELS`]);
+//! - `shape.rs`: the interface every rule implements ([`ShapedRule`], [`Integrand`], [`RuleRun`],
+//!   [`Outcome`]), a leaf of the folder;
+//! - `rule.rs`: a [`Rule`] dispatched to its file's implementation, the fallback chain as data
+//!   ([`Rule::fallback`]) and the Genz–Malik partition, the end of every chain.
 //!
 //! A rule's tuning constants live in the file of the rule that uses them; the design gates in `design.rs`.
 mod chart;
@@ -41,6 +45,7 @@ mod execute;
 mod gauss;
 mod polar;
 mod rule;
+mod shape;
 
 pub use chart::ChartMap;
 pub use delta::{
@@ -54,12 +59,10 @@ pub use design::{
 pub use execute::{deadline_after, LATE_START_SHARE};
 pub use gauss::{tensor_boxes, LOBE_LEVELS, TENSOR_MAX_LEVEL};
 pub use polar::{POLAR_LEVELS, TAIL_LEVELS};
-pub use rule::{Integrand, Outcome, RuleRun, ShapedRule};
+pub use shape::{Integrand, Outcome, RuleRun, ShapedRule};
 
 #[cfg(doc)]
 use crate::instrument::aperture::DELTA_SHARE;
-#[cfg(doc)]
-use delta::delta_node;
 
 use crate::brdf::{Brdf, Kink, Lobe, TermKind};
 use crate::colorimetry::weighting::Weighting;
@@ -187,7 +190,7 @@ pub enum Rule {
     /// `docs/instrument.md` §Quadrature, "The delta limit of a narrow lobe"): in the scaled lobe
     /// variables x = u/w_u, y = v/w_v, at each Gauss–Legendre node of (t_p, t_q), the lobe's mass is Laplace's
     /// π·F(0)/√det B from its curvature B at the peak (measured on a ring of [`DELTA_FIT_RADIUS`] width), and the
-    /// error reported is the majorant of [`delta_node`] (second differences of the even part of F·e^{xᵀBx} on
+    /// error reported is the majorant of `delta::delta_node` (second differences of the even part of F·e^{xᵀBx} on
     /// rings of [`DELTA_RADII`] widths times [`DELTA_SAFETY`], the tail beyond the outer ring at its measured
     /// decay rate ÷ [`DELTA_TAIL_SAFETY`]) plus
     /// the t rule's difference of orders ([`DELTA_T_ORDERS`]: the engine's usual estimate of a Gauss–Legendre

@@ -1,7 +1,7 @@
 //! [`Rule::LobePolar`]: a lobe with GGX's heavy tail, its (u, v) range cut at the overlap kinks into up to
 //! 3 × 3 pieces — the one that holds the lobe centre in polar variables, the others in tail variables — each
 //! raised level by level ([`POLAR_LEVELS`], [`TAIL_LEVELS`]) where the error is largest.
-use super::rule::{Integrand, Outcome, RuleRun, ShapedRule};
+use super::shape::{Integrand, Outcome, RuleRun, ShapedRule};
 use super::Rule;
 use crate::quadrature::{
     legendre_on_into, mapped_legendre_into, polar_rectangle_into, Estimate, Map, Options, PolarBuffers, Refine,

@@ -1,4 +1,4 @@
-//! The rules behind one interface: every rule of a regular part ([`Rule`]) runs through [`ShapedRule`] —
+//! The rules behind one interface (`shape.rs`), dispatched: every rule of a regular part ([`Rule`]) runs through [`ShapedRule`] —
 //! given the integrand in its chart and a [`RuleRun`] (the components, the options, whether it may refine, the
 //! stops and the part's partition), it returns one [`Outcome`]: the estimate and the rule *frozen* at what
 //! it reached (the levels, the path of raises, the final partition), or nothing when it did not agree; and
@@ -12,61 +12,10 @@
 use super::delta::Delta;
 use super::gauss::{GaussHermite, Tensor, LOBE_LEVELS};
 use super::polar::Polar;
+use super::shape::{Integrand, Outcome, RuleRun, ShapedRule};
 use super::Rule;
 use crate::instrument::aperture::Chart;
-use crate::instrument::geometry::Stop;
-use crate::quadrature::{integrate_partition, Cell, Estimate, Options, Refine};
-
-/// The regular part's integrand as the rules see it: at each point of a batch (in the rule's chart), the
-/// `ncomp` values written point-major to the output (left as they were outside the overlap).
-pub type Integrand<'a> = dyn FnMut(&[[f64; 4]], &mut [f64]) + 'a;
-
-/// What a rule run is given besides its integrand.
-#[derive(Clone, Copy, Debug)]
-pub struct RuleRun<'a> {
-    /// Components per point.
-    pub ncomp: usize,
-    /// The part's tolerances, budget, deadline and the Genz–Malik calibration's limits.
-    pub opts: &'a Options,
-    /// Adaptive (raise levels, refine the partition) or frozen (replay what a run reached).
-    pub refine: Refine,
-    /// The clipped stops (the tensor rule's boxes are cut from them).
-    pub stops: (Stop, Stop),
-    /// The part's partition (the Genz–Malik rule's), and whether its final cells are kept (freezing).
-    pub cells: &'a [Cell<4>],
-    pub keep: bool,
-}
-
-/// The one result shape of every rule.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Outcome {
-    /// The estimate (its `evaluations` counts this run's), the rule frozen at what it reached, and the final
-    /// partition when the rule refined one (the Genz–Malik rule; None: the part keeps its own); None when the
-    /// rule did not agree (its fallback runs next).
-    pub done: Option<(Estimate, Rule, Option<Vec<Cell<4>>>)>,
-    /// Evaluations spent, whether or not the rule agreed.
-    pub spent: usize,
-}
-
-impl Outcome {
-    /// A shaped rule's outcome: its estimate and frozen self, or None; `spent` evaluations.
-    pub fn shaped(done: Option<(Estimate, Rule)>, spent: usize) -> Outcome {
-        Outcome {
-            done: done.map(|(mut est, rule)| {
-                est.evaluations = spent;
-                (est, rule, None)
-            }),
-            spent,
-        }
-    }
-}
-
-/// A rule of a regular part, run on the integrand in its chart.
-pub trait ShapedRule {
-    /// Run the rule: [`Outcome::done`] is the estimate and the rule frozen at what it reached when it agreed
-    /// with itself to the part's tolerance (or, frozen, replayed what it reached before), else None.
-    fn estimate(&self, f: &mut Integrand, run: &RuleRun) -> Outcome;
-}
+use crate::quadrature::integrate_partition;
 
 /// [`Rule::GenzMalik75`]: the part's partition, globally adaptive (or frozen); it always returns, converged or
 /// not (the end of every fallback chain).
@@ -117,6 +66,8 @@ impl Rule {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::instrument::geometry::Stop;
+    use crate::quadrature::{Cell, Options, Refine};
 
     #[test]
     fn the_fallback_chain_ends_at_the_partition() {

@@ -18,8 +18,22 @@ use super::{Plan, SPECIMEN_SHARE, STANDARD_SHARE};
 impl Plan {
     /// The plan in plain words: the stored methods, printed (nothing is worked out again here).
     pub fn explain(&self) -> String {
-        let m = &self.material;
         let mut s = String::new();
+        self.explain_material(&mut s);
+        self.explain_geometries(&mut s);
+        self.explain_integrals(&mut s);
+        self.explain_readings(&mut s);
+        s.push_str(&format!(
+            "Tolerance: relative {:e} on every reading; {} of it to each specimen flux ({} of that to its analytic \
+             part), {} to the gloss standard.\n",
+            self.options.rtol, SPECIMEN_SHARE, DELTA_SHARE, STANDARD_SHARE
+        ));
+        s
+    }
+
+    /// The material, its spectral sampling and weighting, and how each of its terms is integrated.
+    fn explain_material(&self, s: &mut String) {
+        let m = &self.material;
         s.push_str(&format!("Material: {}\n", m.describe()));
         s.push_str(&format!("Spectral samples: {}\n", m.sampling().describe()));
         let projection =
@@ -78,6 +92,10 @@ impl Plan {
             s.push_str(&format!("  - {}: {how}\n", t.label));
         }
         s.push_str("  Terms the material does not have are not built and cost nothing.\n");
+    }
+
+    /// Each geometry: its angle and standard, and the lobes' widths in its lobe variables.
+    fn explain_geometries(&self, s: &mut String) {
         let lobes: Vec<&Lobe> = self
             .terms
             .iter()
@@ -124,6 +142,10 @@ impl Plan {
                 ));
             }
         }
+    }
+
+    /// The aperture integrals of the plan, each with its method and the readings that use it.
+    fn explain_integrals(&self, s: &mut String) {
         let n_spec = self.jobs.iter().filter(|j| j.method.aperture.target == Target::Specimen).count();
         let n_std = self.jobs.len() - n_spec;
         let uses: usize = self.readings.iter().map(|r| r.specimen_jobs.len() + r.standard_jobs.len()).sum();
@@ -157,6 +179,10 @@ impl Plan {
                 j.used_by.join(", ")
             ));
         }
+    }
+
+    /// Each reported reading and the integrals it is made of.
+    fn explain_readings(&self, s: &mut String) {
         s.push_str("Readings, from the integrals above:\n");
         for r in self.readings.iter().filter(|r| r.reported) {
             let jobs = |m: &BTreeMap<String, usize>| m.iter().map(|(n, j)| format!("{n} #{j}")).collect::<Vec<_>>();
@@ -176,12 +202,6 @@ impl Plan {
                 if r.standard_jobs.is_empty() { "—".to_string() } else { jobs(&r.standard_jobs).join(", ") },
             ));
         }
-        s.push_str(&format!(
-            "Tolerance: relative {:e} on every reading; {} of it to each specimen flux ({} of that to its analytic \
-             part), {} to the gloss standard.\n",
-            self.options.rtol, SPECIMEN_SHARE, DELTA_SHARE, STANDARD_SHARE
-        ));
-        s
     }
 }
 
