@@ -10,12 +10,12 @@
 //! alone. Each failure is printed on stderr as it happens, and the summary so far every 100 000 cases on
 //! stdout, so that a run stopped early still says what it found.
 //!
-//! It runs CASES cases over the ten categories of `tests/common/fuzz_cases.rs`: every CLI_EVERY-th case
+//! It runs CASES cases over the eleven categories of `tests/common/fuzz_cases.rs`: every CLI_EVERY-th case
 //! (default 200) is a command line run as a process (`measure`, `compare`, `convergence`, `sweep`, `fit`, `plot`,
 //! `profile` with small budgets, `--baseline` files, and the rest); the others go round-robin over recipes
 //! generated from the parameter registry or from random fields, mutated recipes, mutated geometry files,
 //! generated and mutated sheets, generated and mutated MERL, RGL, in-plane CSV and E1392 tables (read through
-//! their recipes) and generated and mutated baselines, checked in the library. Each case is replayable from its
+//! their recipes), generated and mutated baselines and generated and mutated workbooks (`.xlsx`, `.ods`, `.xls`), checked in the library. Each case is replayable from its
 //! number and SEED. Every case must be accepted, or refused with an error naming the file and a field or line
 //! (a command line: exit 0, 1 or 2, no panic, no NaN/inf printed outside the quoted input, no file lost or left
 //! behind, ended within `CLI_TIMEOUT_S`); anything else is a failure.
@@ -186,6 +186,11 @@ fn main() {
     let summary =
         Summary { cases, seed, first, light_every, full_every, cli_every, wall: start.elapsed().as_secs_f64() };
     summary.print(&tally, slowest_light, over_10s, &slowest, &failures);
+    // The driver's peak resident memory (every library case runs in this process, workbooks included).
+    let status = std::fs::read_to_string("/proc/self/status").unwrap_or_default();
+    if let Some(hwm) = status.lines().find(|l| l.starts_with("VmHWM:")) {
+        println!("\nPeak resident memory of the driver: {}", hwm.trim_start_matches("VmHWM:").trim());
+    }
     // A campaign that found failures does not pass (docs/reliability.md).
     if !failures.is_empty() {
         std::process::exit(1);

@@ -50,6 +50,32 @@ proptest! {
 }
 
 proptest! {
+    #![proptest_config(ProptestConfig { cases: 200, failure_persistence: None, ..ProptestConfig::default() })]
+
+    /// Generated and mutated `.xlsx`, `.ods` and `.xls` workbooks through the one sheet reader: accepted with
+    /// finite rows or refused naming the file; never a panic or an abort (an abort ends the test binary).
+    #[test]
+    fn workbooks(seed in any::<u64>()) {
+        prop_assert!(one(Category::Workbook, seed).is_ok(), "{:?}", one(Category::Workbook, seed));
+    }
+}
+
+/// The workbook generator makes readable workbooks, not only broken ones: of 200 cases some are accepted
+/// and some refused (a generator whose every case is refused at the archive would test nothing past it).
+#[test]
+fn the_workbook_cases_reach_the_cells() {
+    let (mut accepted, mut refused) = (0, 0);
+    for seed in 0..200u64 {
+        match one(Category::Workbook, seed) {
+            Ok(Outcome::Accepted(_)) => accepted += 1,
+            Ok(Outcome::Refused) => refused += 1,
+            Err(e) => panic!("seed {seed}: {e}"),
+        }
+    }
+    assert!(accepted >= 10 && refused >= 10, "accepted {accepted}, refused {refused} of 200");
+}
+
+proptest! {
     #![proptest_config(ProptestConfig { cases: 24, failure_persistence: None, ..ProptestConfig::default() })]
 
     /// Accepted recipes are measured (one geometry, rtol 1e-2, 20 000 evaluations per integral): every reading

@@ -48,11 +48,12 @@ pub enum Category {
     InplaneTable,
     E1392Table,
     Baseline,
+    Workbook,
     CommandLine,
 }
 
 impl Category {
-    pub const ALL: [Category; 10] = [
+    pub const ALL: [Category; 11] = [
         Category::GeneratedRecipe,
         Category::MutatedRecipe,
         Category::MutatedGeometry,
@@ -62,10 +63,11 @@ impl Category {
         Category::InplaneTable,
         Category::E1392Table,
         Category::Baseline,
+        Category::Workbook,
         Category::CommandLine,
     ];
     /// The categories checked in the library (all but the command lines).
-    pub const IN_LIBRARY: [Category; 9] = [
+    pub const IN_LIBRARY: [Category; 10] = [
         Category::GeneratedRecipe,
         Category::MutatedRecipe,
         Category::MutatedGeometry,
@@ -75,6 +77,7 @@ impl Category {
         Category::InplaneTable,
         Category::E1392Table,
         Category::Baseline,
+        Category::Workbook,
     ];
     pub fn name(self) -> &'static str {
         match self {
@@ -87,6 +90,7 @@ impl Category {
             Category::InplaneTable => "generated and mutated in-plane CSV tables",
             Category::E1392Table => "generated and mutated E1392 tables",
             Category::Baseline => "generated and mutated baselines",
+            Category::Workbook => "generated and mutated workbooks (.xlsx, .ods, .xls)",
             Category::CommandLine => "command lines",
         }
     }
@@ -121,6 +125,9 @@ pub struct Seeds {
     pub e1392: Vec<String>,
     /// Baselines: `measure` and `compare` JSON documents of real readings ([`baseline_sources`]).
     pub baselines: Vec<String>,
+    /// Workbooks (`fixtures/sheets` and the reviewers' hostile reproducers in `fixtures/sheets/hostile`), as
+    /// bytes with their extension.
+    pub workbooks: Vec<(Vec<u8>, &'static str)>,
 }
 
 fn binaries(dir: &str, ext: &str) -> Vec<Vec<u8>> {
@@ -182,8 +189,19 @@ impl Seeds {
             inplane,
             e1392,
             baselines,
+            workbooks: workbook_seeds(),
         }
     }
+}
+
+fn workbook_seeds() -> Vec<(Vec<u8>, &'static str)> {
+    let mut out = Vec::new();
+    for dir in ["fixtures/sheets", "fixtures/sheets/hostile"] {
+        for ext in ["xlsx", "xls", "ods"] {
+            out.extend(binaries(dir, ext).into_iter().map(|b| (b, ext)));
+        }
+    }
+    out
 }
 
 /// Numbers that break naive code: zero, signs, the ends of f64, subnormals, overflow, near-integers.
@@ -477,6 +495,7 @@ pub fn run_case(cat: Category, text: &str) -> Result<Outcome, String> {
                 Err(e) => check_error(&e, "fuzz-geometry.json").map(|_| Outcome::Refused),
             }
         }
+        Category::Workbook => run_workbook(text),
         Category::Sheet => match sheet::parse(text, "fuzz.csv", &sheet::SheetOptions::default()) {
             Ok(sheet) => {
                 let rows = sheet.rows;
@@ -527,6 +546,7 @@ pub fn case_text(cat: Category, seeds: &Seeds, rng: &mut Rng) -> String {
             mutate(base, rng)
         }
         Category::Sheet => generate_sheet(rng, seeds),
+        Category::Workbook => generate_workbook(rng, seeds),
     }
 }
 
@@ -1915,4 +1935,327 @@ pub fn run_cli(text: &str) -> Result<Outcome, String> {
         let _ = std::fs::remove_file(f);
     }
     verdict
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// Workbooks: generated .xlsx and .ods (zip archives whose XML is written here, now and then mutated as text
+// before it is zipped, so the archive is sound and the reader sees the broken XML) and byte-mutated seeds
+// (the shipped workbooks and the hostile reproducers: broken archives, CRCs, compound files and records).
+// ---------------------------------------------------------------------------------------------------------
+
+/// A workbook case: its bytes written to a scratch file; the case's text is the file's path.
+pub fn generate_workbook(rng: &mut Rng, seeds: &Seeds) -> String {
+    let (bytes, ext) = match rng.below(10) {
+        0..=3 => (xlsx_bytes(rng), "xlsx"),
+        4 | 5 => (ods_bytes(rng), "ods"),
+        6 => {
+            let b = if rng.chance(0.5) { xlsx_bytes(rng) } else { ods_bytes(rng) };
+            (mutate_bytes(&b, rng), "xlsx")
+        }
+        _ => {
+            let (b, ext) = rng.pick(&seeds.workbooks);
+            (mutate_bytes(b, rng), *ext)
+        }
+    };
+    let path = scratch(&format!("wb-{:016x}.{ext}", rng.next()));
+    std::fs::write(&path, bytes).unwrap();
+    path.display().to_string()
+}
+
+/// Read a workbook case through the one sheet reader (`sheet::from_bytes`, as `compare`, `fit --sheet`, the
+/// server and Python read it): accepted with finite rows, or refused with an input error naming the file. A
+/// workbook's reasons about the whole file (not a workbook, a member too large, a bad CRC, no sheets) name no
+/// field or line; a cell's name its sheet and cell.
+pub fn run_workbook(path: &str) -> Result<Outcome, String> {
+    let bytes = std::fs::read(path).map_err(|e| format!("the case's file {path}: {e}"))?;
+    let _ = std::fs::remove_file(path);
+    let name = "fuzz.xlsx";
+    match sheet::from_bytes(&bytes, name, &sheet::SheetOptions::default()) {
+        Ok(sheet) => {
+            if sheet.rows.iter().any(|r| !r.value.is_finite() || r.uncertainty.is_some_and(|u| !u.is_finite())) {
+                return Err("a workbook row holds a non-finite number".into());
+            }
+            Ok(Outcome::Accepted(None))
+        }
+        Err(e) => {
+            let shown = e.to_string();
+            if prints_non_finite(&shown) {
+                return Err(format!("an error prints a non-finite number (outside the quoted input): {shown}"));
+            }
+            match &e {
+                Error::Input { file, message, .. } if file == name && !message.trim().is_empty() => {
+                    Ok(Outcome::Refused)
+                }
+                Error::Input { .. } => {
+                    Err(format!("an input error that does not name {name} or says nothing: {shown}"))
+                }
+                other => Err(format!("not an input error: {other:?}")),
+            }
+        }
+    }
+}
+
+/// A cell's text: a layout's header words, sample names, numbers (edge ones too), statistics rows' labels.
+fn workbook_cell(rng: &mut Rng) -> (bool, String) {
+    if rng.chance(0.45) {
+        let v =
+            *rng.pick(&["89.1", "0", "-3", "1e308", "1e400", "5e-324", "NaN", "INF", "12.5", "0.3", "-0", "1e-300"]);
+        return (true, v.to_string());
+    }
+    let t = *rng.pick(&[
+        "Sample",
+        "sample",
+        "geometry",
+        "quantity",
+        "value",
+        "uncertainty",
+        "20°",
+        "60°",
+        "85°",
+        "20",
+        "60",
+        "85",
+        "Haze",
+        "DOI",
+        "RIQ",
+        "Mean",
+        "Std",
+        "Min",
+        "Max",
+        "p1",
+        "panel 2",
+        "",
+        "BYK-Gardner smart-chart 4.2",
+        "Instrument: micro-TRI-gloss",
+        "astm-d523-60",
+        "gloss",
+        "log-haze",
+        "x",
+        "<&>",
+        "\u{0}",
+        "é",
+    ]);
+    (false, t.to_string())
+}
+
+/// A sheet's cells, row by row (true: a number): half the time an instrument's layout (title and metadata
+/// rows now and then, a header of sample and angle columns, sample rows of readings, statistics rows now and
+/// then) with a cell now and then replaced by a random one, half the time random cells.
+fn workbook_grid(rng: &mut Rng) -> Vec<Vec<(bool, String)>> {
+    let text = |t: &str| (false, t.to_string());
+    if rng.chance(0.5) {
+        return (0..1 + rng.below(8)).map(|_| (0..1 + rng.below(6)).map(|_| workbook_cell(rng)).collect()).collect();
+    }
+    let mut grid = Vec::new();
+    if rng.chance(0.3) {
+        grid.push(vec![text("BYK-Gardner smart-chart 4.2 - Gloss report")]);
+        grid.push(vec![text("Instrument: micro-TRI-gloss"), text(""), text("Serial No.: 1087654")]);
+        grid.push(vec![]);
+    }
+    const LAYOUTS: [&[&str]; 4] = [&["20°", "60°", "85°"], &["20", "60", "85"], &["60° [GU]"], &["Haze", "20°"]];
+    let angles: &[&str] = LAYOUTS[rng.below(LAYOUTS.len())];
+    let mut header = vec![text(if rng.chance(0.5) { "Sample" } else { "sample" })];
+    header.extend(angles.iter().map(|a| text(a)));
+    grid.push(header);
+    for i in 0..1 + rng.below(5) {
+        let mut row = vec![text(&format!("panel {}", i % 2))];
+        for _ in angles {
+            let v = 0.1 * rng.below(1000) as f64;
+            row.push(if rng.chance(0.05) { workbook_cell(rng) } else { (true, format!("{v}")) });
+        }
+        grid.push(row);
+    }
+    if rng.chance(0.2) {
+        for label in ["Mean", "Std"] {
+            let mut row = vec![text(label)];
+            row.extend(angles.iter().map(|_| (true, "1.5".to_string())));
+            grid.push(row);
+        }
+    }
+    grid
+}
+
+/// Column letters of a 0-based column index (A, …, Z, AA, …).
+fn column_letters(mut c: usize) -> String {
+    let mut s = Vec::new();
+    loop {
+        s.push(b'A' + (c % 26) as u8);
+        if c < 26 {
+            break;
+        }
+        c = c / 26 - 1;
+    }
+    s.reverse();
+    String::from_utf8(s).unwrap()
+}
+
+fn xml_escape(t: &str) -> String {
+    t.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('\u{0}', "")
+}
+
+fn zip_members(rng: &mut Rng, members: &[(&str, String)]) -> Vec<u8> {
+    use std::io::Write;
+    let mut w = zip::ZipWriter::new(std::io::Cursor::new(Vec::new()));
+    for (name, text) in members {
+        let method = if *name == "mimetype" || rng.chance(0.5) {
+            zip::CompressionMethod::Stored
+        } else {
+            zip::CompressionMethod::Deflated
+        };
+        let options = zip::write::SimpleFileOptions::default().compression_method(method);
+        w.start_file(*name, options).unwrap();
+        w.write_all(text.as_bytes()).unwrap();
+    }
+    w.finish().unwrap().into_inner()
+}
+
+/// A generated `.xlsx`: a title row now and then, a header, rows of cells (shared, inline strings and
+/// numbers), a declared dimension (sometimes absurd), a shared-string table whose counts may lie, a cell now
+/// and then far away; one XML part mutated as text in half of the cases.
+pub fn xlsx_bytes(rng: &mut Rng) -> Vec<u8> {
+    let mut shared: Vec<String> = Vec::new();
+    let mut rows = String::new();
+    let grid = workbook_grid(rng);
+    let nrows = grid.len();
+    let ncols = grid.iter().map(Vec::len).max().unwrap_or(1);
+    for (r, cells) in grid.into_iter().enumerate() {
+        rows.push_str(&format!("<row r=\"{}\">", r + 1));
+        for (c, (number, t)) in cells.into_iter().enumerate() {
+            let at = format!("{}{}", column_letters(c), r + 1);
+            if number {
+                rows.push_str(&format!("<c r=\"{at}\"><v>{}</v></c>", xml_escape(&t)));
+            } else if rng.chance(0.7) {
+                shared.push(t);
+                rows.push_str(&format!("<c r=\"{at}\" t=\"s\"><v>{}</v></c>", shared.len() - 1));
+            } else {
+                rows.push_str(&format!("<c r=\"{at}\" t=\"inlineStr\"><is><t>{}</t></is></c>", xml_escape(&t)));
+            }
+        }
+        rows.push_str("</row>");
+    }
+    if rng.chance(0.1) {
+        let far = *rng.pick(&["XFD1048576", "A1048576", "XFD1", "ZZZ99", "A0"]);
+        rows.push_str(&format!("<row r=\"{}\"><c r=\"{far}\"><v>1</v></c></row>", nrows + 1));
+    }
+    let dimension = if rng.chance(0.1) {
+        rng.pick(&["A1:XFD1048576", "B9:A1", "A1:A4294967296", "", "A1:"]).to_string()
+    } else {
+        format!("A1:{}{}", column_letters(ncols - 1), nrows)
+    };
+    let count = if rng.chance(0.1) {
+        *rng.pick(&[0u64, 1, 100_000_000_000_000, u32::MAX as u64, u64::MAX])
+    } else {
+        shared.len() as u64
+    };
+    let sst: String = shared.iter().map(|t| format!("<si><t>{}</t></si>", xml_escape(t))).collect();
+    let ns = "http://schemas.openxmlformats.org/spreadsheetml/2006/main";
+    let rel = "http://schemas.openxmlformats.org/officeDocument/2006/relationships";
+    let mut parts: Vec<(&str, String)> = vec![
+        (
+            "[Content_Types].xml",
+            "<?xml version=\"1.0\" encoding=\"UTF-8\"?><Types xmlns=\"http://schemas.openxmlformats.org/package/2006/content-types\">\
+             <Default Extension=\"rels\" ContentType=\"application/vnd.openxmlformats-package.relationships+xml\"/>\
+             <Default Extension=\"xml\" ContentType=\"application/xml\"/>\
+             <Override PartName=\"/xl/workbook.xml\" ContentType=\"application/vnd.openxmlformats-officedocument.spreadsheetml.sheet.main+xml\"/>\
+             <Override PartName=\"/xl/worksheets/sheet1.xml\" ContentType=\"application/vnd.openxmlformats-officedocument.spreadsheetml.worksheet+xml\"/>\
+             <Override PartName=\"/xl/sharedStrings.xml\" ContentType=\"application/vnd.openxmlformats-officedocument.spreadsheetml.sharedStrings+xml\"/>\
+             </Types>"
+                .to_string(),
+        ),
+        (
+            "_rels/.rels",
+            "<?xml version=\"1.0\" encoding=\"UTF-8\"?><Relationships xmlns=\"http://schemas.openxmlformats.org/package/2006/relationships\">\
+             <Relationship Id=\"rId1\" Type=\"http://schemas.openxmlformats.org/officeDocument/2006/relationships/officeDocument\" Target=\"xl/workbook.xml\"/>\
+             </Relationships>"
+                .to_string(),
+        ),
+        (
+            "xl/workbook.xml",
+            format!(
+                "<?xml version=\"1.0\" encoding=\"UTF-8\"?><workbook xmlns=\"{ns}\" xmlns:r=\"{rel}\"><sheets>\
+                 <sheet name=\"{}\" sheetId=\"1\" r:id=\"rId1\"/></sheets></workbook>",
+                rng.pick(&["Sheet1", "Gloss report", "", "&amp;"])
+            ),
+        ),
+        (
+            "xl/_rels/workbook.xml.rels",
+            "<?xml version=\"1.0\" encoding=\"UTF-8\"?><Relationships xmlns=\"http://schemas.openxmlformats.org/package/2006/relationships\">\
+             <Relationship Id=\"rId1\" Type=\"http://schemas.openxmlformats.org/officeDocument/2006/relationships/worksheet\" Target=\"worksheets/sheet1.xml\"/>\
+             <Relationship Id=\"rId2\" Type=\"http://schemas.openxmlformats.org/officeDocument/2006/relationships/sharedStrings\" Target=\"sharedStrings.xml\"/>\
+             </Relationships>"
+                .to_string(),
+        ),
+        (
+            "xl/worksheets/sheet1.xml",
+            format!(
+                "<?xml version=\"1.0\" encoding=\"UTF-8\"?><worksheet xmlns=\"{ns}\"><dimension ref=\"{dimension}\"/>\
+                 <sheetData>{rows}</sheetData></worksheet>"
+            ),
+        ),
+        (
+            "xl/sharedStrings.xml",
+            format!(
+                "<?xml version=\"1.0\" encoding=\"UTF-8\"?><sst xmlns=\"{ns}\" count=\"{count}\" uniqueCount=\"{count}\">{sst}</sst>"
+            ),
+        ),
+    ];
+    if rng.chance(0.5) {
+        let k = rng.below(parts.len());
+        parts[k].1 = mutate(&parts[k].1, rng);
+    }
+    if rng.chance(0.05) {
+        parts.remove(rng.below(parts.len()));
+    }
+    zip_members(rng, &parts)
+}
+
+/// A generated `.ods`: the same cells in `content.xml`, with `number-rows-repeated` and
+/// `number-columns-repeated` now and then large; the XML mutated as text in half of the cases.
+pub fn ods_bytes(rng: &mut Rng) -> Vec<u8> {
+    let mut table = String::new();
+    for cells in workbook_grid(rng) {
+        let rep = if rng.chance(0.1) { *rng.pick(&[2u64, 1000, 250_000, 1_000_000, 1 << 31, u64::MAX]) } else { 1 };
+        table.push_str(&format!("<table:table-row table:number-rows-repeated=\"{rep}\">"));
+        for (number, t) in cells {
+            let crep = if rng.chance(0.05) { *rng.pick(&[2u64, 16384, 1 << 20, u32::MAX as u64]) } else { 1 };
+            if number {
+                table.push_str(&format!(
+                    "<table:table-cell table:number-columns-repeated=\"{crep}\" office:value-type=\"float\" \
+                     office:value=\"{}\"><text:p>{}</text:p></table:table-cell>",
+                    xml_escape(&t),
+                    xml_escape(&t)
+                ));
+            } else {
+                table.push_str(&format!(
+                    "<table:table-cell table:number-columns-repeated=\"{crep}\" office:value-type=\"string\">\
+                     <text:p>{}</text:p></table:table-cell>",
+                    xml_escape(&t)
+                ));
+            }
+        }
+        table.push_str("</table:table-row>");
+    }
+    let content = format!(
+        "<?xml version=\"1.0\" encoding=\"UTF-8\"?><office:document-content \
+         xmlns:office=\"urn:oasis:names:tc:opendocument:xmlns:office:1.0\" \
+         xmlns:table=\"urn:oasis:names:tc:opendocument:xmlns:table:1.0\" \
+         xmlns:text=\"urn:oasis:names:tc:opendocument:xmlns:text:1.0\" office:version=\"1.2\"><office:body>\
+         <office:spreadsheet><table:table table:name=\"Sheet1\">{table}</table:table></office:spreadsheet>\
+         </office:body></office:document-content>"
+    );
+    let manifest = "<?xml version=\"1.0\" encoding=\"UTF-8\"?><manifest:manifest \
+                    xmlns:manifest=\"urn:oasis:names:tc:opendocument:xmlns:manifest:1.0\" manifest:version=\"1.2\">\
+                    <manifest:file-entry manifest:full-path=\"/\" manifest:media-type=\"application/vnd.oasis.opendocument.spreadsheet\"/>\
+                    <manifest:file-entry manifest:full-path=\"content.xml\" manifest:media-type=\"text/xml\"/>\
+                    </manifest:manifest>"
+        .to_string();
+    let mut parts: Vec<(&str, String)> = vec![
+        ("mimetype", "application/vnd.oasis.opendocument.spreadsheet".to_string()),
+        ("META-INF/manifest.xml", manifest),
+        ("content.xml", content),
+    ];
+    if rng.chance(0.5) {
+        parts[2].1 = mutate(&parts[2].1, rng);
+    }
+    zip_members(rng, &parts)
 }

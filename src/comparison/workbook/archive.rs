@@ -217,8 +217,14 @@ impl OdsTable {
         OdsTable { before, ..OdsTable::default() }
     }
 
+    /// Rows from the first with a value to the last (repeats counted; saturating: a repeat count near 2⁶⁴
+    /// must read as over the limit, not wrap to nothing).
+    fn rows_used(&self) -> u64 {
+        self.first.map_or(0, |f| (self.last - f).saturating_add(1))
+    }
+
     fn area(&self) -> u64 {
-        self.first.map_or(0, |f| self.last - f + 1).saturating_mul(self.width)
+        self.rows_used().saturating_mul(self.width)
     }
 
     fn row_start(&mut self, repeats: u64) {
@@ -245,7 +251,7 @@ impl OdsTable {
 
     /// What is over the limit, if anything.
     fn over(&self) -> Option<String> {
-        let rows = self.first.map_or(0, |f| self.last - f + 1);
+        let rows = self.rows_used();
         if self.before.saturating_add(self.area()) > MAX_CELLS {
             return Some(format!("a table's used range is {rows} rows × {} columns (repeats counted)", self.width));
         }
@@ -286,5 +292,11 @@ mod tests {
         u.cell(1, true);
         u.row_end();
         assert!(u.over().is_some());
+        // A repeat count of 2⁶⁴ − 1 on the first row is over the limit (it wrapped to an empty range once).
+        let mut t = OdsTable::default();
+        t.row_start(u64::MAX);
+        t.cell(1, true);
+        t.row_end();
+        assert!(t.over().is_some_and(|m| m.contains("18446744073709551615 rows")), "{:?}", t.over());
     }
 }
