@@ -171,7 +171,7 @@ pub struct SheetRowDoc {
 /// out about the file and every value, in the sheet's order.
 #[derive(Clone, Debug, Serialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
-#[schemars(title = "glossmeter sheet")]
+#[schemars(title = "glossmeter sheet", transform = sheet_read_doc_nullable)]
 pub struct SheetReadDoc {
     pub sheet: SheetDoc,
     /// The workbook's sheet read (null for a text sheet).
@@ -388,6 +388,10 @@ fn comparison_doc_nullable(schema: &mut schemars::Schema) {
             "unchecked",
         ],
     );
+}
+
+fn sheet_read_doc_nullable(schema: &mut schemars::Schema) {
+    super::nullable_but_written(schema, &["workbook_sheet"]);
 }
 
 fn sheet_row_doc_nullable(schema: &mut schemars::Schema) {
