@@ -61,7 +61,9 @@ pub(crate) fn interruptible<T: Send>(
                     }
                 }
                 Err(mpsc::RecvTimeoutError::Disconnected) => {
-                    return Err(PyRuntimeError::new_err("internal error in glossmeter: the work ended without a result"))
+                    return Err(PyRuntimeError::new_err(
+                        "internal error in glossmeter: the work ended without a result",
+                    ))
                 }
             }
         }
@@ -179,9 +181,9 @@ fn tolerances(v: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<String>> {
     if v.is_instance_of::<PyString>() || v.extract::<f64>().is_ok() {
         return Ok(vec![one("tolerance", v)?]);
     }
-    let items = v.try_iter().map_err(|_| {
-        PyTypeError::new_err(format!("tolerance: expected {ALLOWED}, got {}", args::type_name(v)))
-    })?;
+    let items = v
+        .try_iter()
+        .map_err(|_| PyTypeError::new_err(format!("tolerance: expected {ALLOWED}, got {}", args::type_name(v))))?;
     items.enumerate().map(|(i, x)| one(&format!("tolerance[{i}]"), &x?)).collect()
 }
 
@@ -493,7 +495,8 @@ pub fn fit<'py>(
     let out = interruptible(py, &cancel, || {
         let sheet = source.as_ref().map(|s| s.read(&request.sheet)).transpose().map_err(to_py_err)?;
         let (targets, _notes) = request.targets(sheet.as_ref()).map_err(to_py_err)?;
-        let report = glossmeter::fit::fit(&material.json, &material.file, &free, &targets, &options).map_err(to_py_err)?;
+        let report =
+            glossmeter::fit::fit(&material.json, &material.file, &free, &targets, &options).map_err(to_py_err)?;
         Ok(report::fit::json(&report, timing))
     })?;
     guarded(|| from_json(py, &out))
@@ -537,7 +540,8 @@ pub fn profile<'py>(
     guarded(|| stds::profile::of(&g).map(|_| ()).map_err(to_py_err))?;
     let material = guarded(|| load_recipe(py, recipe))?;
     let out = interruptible(py, &cancel, || {
-        let prof = glossmeter::instrument::profile::measure(material.brdf.clone(), &g, options, budget).map_err(to_py_err)?;
+        let prof =
+            glossmeter::instrument::profile::measure(material.brdf.clone(), &g, options, budget).map_err(to_py_err)?;
         Ok(report::to_json(&report::profile::ProfileDoc::new(&material, &prof)))
     })?;
     guarded(|| from_json(py, &out))
@@ -581,7 +585,8 @@ pub fn convergence<'py>(
     })?;
     let material = guarded(|| load_recipe(py, recipe))?;
     let out = interruptible(py, &Cancel::default(), || {
-        let sweep = glossmeter::instrument::convergence::sweep(material.brdf.clone(), geos, &tolerances, &options).map_err(to_py_err)?;
+        let sweep = glossmeter::instrument::convergence::sweep(material.brdf.clone(), geos, &tolerances, &options)
+            .map_err(to_py_err)?;
         Ok(report::to_json(&report::convergence::ConvergenceDoc::new(&material, &sweep)))
     })?;
     guarded(|| from_json(py, &out))

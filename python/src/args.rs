@@ -108,9 +108,8 @@ pub fn strings(name: &str, v: Option<&Bound<'_, PyAny>>, allowed: &str) -> PyRes
     if let Ok(s) = v.cast::<PyString>() {
         return Ok(vec![s.to_cow()?.into_owned()]);
     }
-    let refuse = || {
-        PyTypeError::new_err(format!("{name}: expected a str or a list of str ({allowed}), got {}", type_name(&v)))
-    };
+    let refuse =
+        || PyTypeError::new_err(format!("{name}: expected a str or a list of str ({allowed}), got {}", type_name(&v)));
     if v.is_instance_of::<pyo3::types::PyDict>() {
         return Err(refuse());
     }

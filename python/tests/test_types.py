@@ -77,7 +77,7 @@ def test_every_definition_of_the_documents_has_its_typed_dict():
             assert (output, name) in never | listed, (output, name)
 
 
-@pytest.mark.parametrize("output", ["measure", "compare", "sweep", "fit", "profile", "convergence"])
+@pytest.mark.parametrize("output", ["measure", "compare", "sweep", "fit", "profile", "convergence", "sheet"])
 def test_the_schemas_are_the_command_line_s(output):
     exe = cli_binary()
     if exe is None:
