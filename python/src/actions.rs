@@ -1,7 +1,8 @@
 //! The actions besides `measure` (docs/python.md §Actions): `read_sheet`, `compare`, `sweep`, `fit`, `profile`
 //! and `convergence`. Each converts its keyword arguments into the library's typed request
-//! (`glossmeter::request`) in one place, its `*_request` function, as the command line converts its flags
-//! (`cli::*::request`) and the server its JSON bodies; the request checks them with the library's messages,
+//! (`glossmeter::request`) in one place, the request built at the top of its function (with
+//! [`sheet_request`] for the sheet's keywords), as the command line converts its flags (`cli::*::request`)
+//! and the server its JSON bodies; the request checks them with the library's messages,
 //! which name each argument as its keyword ([`crate::args::keyword`]). Each returns the library's own document
 //! (`glossmeter::report`), the one `glossmeter ACTION --format json` prints, as Python dicts and lists.
 //!
