@@ -175,6 +175,41 @@ def test_convergence_returns_the_command_line_s_document_but_its_times():
     assert [r["rtol"] for r in doc["rows"]] == [1e-3, 1e-5]
 
 
+# ---- as_frame ---------------------------------------------------------------------------------------------
+
+def test_a_sheet_and_a_sweep_as_frames_hold_the_same_doubles():
+    pytest.importorskip("pandas", reason="pandas is not installed (pip install pandas); .ci/run installs it")
+    doc = glossmeter.read_sheet(SHEETS / "rhopoint-iq.csv")
+    frame = glossmeter.read_sheet(SHEETS / "rhopoint-iq.csv", as_frame=True)
+    assert list(frame.columns) == ["line", "column", "sample", "geometry", "reading", "value", "uncertainty",
+                                   "not_predicted"]
+    assert frame["value"].tolist() == [r["value"] for r in doc["rows"]]
+    assert frame["geometry"].tolist() == [r["geometry"] for r in doc["rows"]]
+    assert frame["uncertainty"].isna().all() and str(frame["uncertainty"].dtype) == "float64"
+
+    args = (ROUGH, ["/roughness=0.05..0.3:3", "/ior=1.4..1.6:2"])
+    kwargs = {"geometries": ["astm-d523-20", "astm-d523-60"], "timing": False}
+    points = glossmeter.sweep(*args, **kwargs)
+    frame = glossmeter.sweep(*args, **kwargs, as_frame=True)
+    readings = [(p, r) for p in points for r in p["readings"]]
+    assert len(frame) == len(readings) == 3 * 2 * 2
+    assert frame["value"].tolist() == [r["value"] for _, r in readings]
+    assert frame["/ior"].tolist() == [p["parameters"]["/ior"] for p, _ in readings]
+    assert frame["index"].tolist() == [p["index"] for p, _ in readings]
+    assert "seconds" not in frame
+    assert "seconds" in glossmeter.sweep(ROUGH, "/roughness=0.1..0.2:2", geometries="astm-d523-60", as_frame=True)
+
+
+def test_a_point_without_readings_is_one_row_with_its_problem():
+    rows = glossmeter.sweep_rows([{"index": 4, "parameters": {"/ior": 9.0}, "problem": "ior out of range"},
+                                  {"index": 5, "parameters": {"/ior": 1.5}, "seconds": 0.25,
+                                   "readings": [{"geometry": "g", "name": "gloss", "unit": "GU", "value": 1.0,
+                                                 "error_estimate": 0.0, "converged": True}]}])
+    assert rows[0] == {"index": 4, "/ior": 9.0, "geometry": None, "name": None, "unit": None, "value": None,
+                       "error_estimate": None, "converged": False, "problem": "ior out of range"}
+    assert rows[1]["seconds"] == 0.25 and rows[1]["value"] == 1.0 and rows[1]["problem"] is None
+
+
 # ---- bad keywords -------------------------------------------------------------------------------------------
 
 CHECK = SHEETS / "black-glass-check.csv"
@@ -233,6 +268,8 @@ CHECK = SHEETS / "black-glass-check.csv"
     (lambda: glossmeter.convergence(BLACK, max_repetitions=0), ValueError, ["`max_repetitions`"]),
     (lambda: glossmeter.convergence(BLACK, min_time_ms=-1), ValueError, ["`min_time_ms`"]),
     (lambda: glossmeter.convergence(BLACK, reference_run=1), TypeError, ["reference_run:", "True or False"]),
+    (lambda: glossmeter.read_sheet(CHECK, as_frame=1), TypeError, ["as_frame:", "True or False"]),
+    (lambda: glossmeter.sweep(ROUGH, "/roughness=0.1..0.2:3", as_frame="yes"), TypeError, ["as_frame:"]),
 ])
 def test_a_bad_keyword_is_refused_naming_it(call, exc, words):
     with pytest.raises(exc) as e:

@@ -47,6 +47,9 @@ def usage() -> None:
     report: CompareReport = glossmeter.compare(pathlib.Path("r.json"), b"sample,60\nx,1\n", tolerance={"gloss": 2})
     print(report["summary"]["outside"] + 1, report["comparisons"][0]["verdict"], report.get("baseline"))
     points: List[SweepPoint] = glossmeter.sweep("r.json", ["/roughness=0.1..0.2:3"], shard=(1, 2), timing=False)
+    rows: pd.DataFrame = glossmeter.read_sheet(b"sample,60\nx,1\n", as_frame=True)
+    grid: pd.DataFrame = glossmeter.sweep("r.json", "/roughness=0.1..0.2:3", as_frame=True)
+    print(rows.shape, grid.shape, glossmeter.sweep_rows(points)[0]["index"])
     for p in points:
         for r in p.get("readings") or []:
             print(p["index"], p["parameters"]["/roughness"], r["value"])
@@ -64,9 +67,10 @@ def usage() -> None:
     bad_hint: LobeHint = {"slope": 0.05, "tail": "fat"}  # type: ignore[typeddict-item]
     wrong: List[Reading] = glossmeter.measure("r.json", as_frame=True)  # type: ignore[assignment]
     not_a_str: int = glossmeter.describe("r.json")  # type: ignore[assignment]
-    glossmeter.read_sheet(42)  # type: ignore[arg-type]
-    glossmeter.sweep("r.json", vary=5)  # type: ignore[arg-type]
+    glossmeter.read_sheet(42)  # type: ignore[call-overload]
+    glossmeter.sweep("r.json", vary=5)  # type: ignore[call-overload]
     glossmeter.fit("r.json", ["astm-d523-60/gloss=60"])  # type: ignore[call-arg]
     not_points: Sheet = glossmeter.sweep("r.json", "/roughness=0.1..0.2:3")  # type: ignore[assignment]
+    not_a_frame: Sheet = glossmeter.read_sheet("s.csv", as_frame=True)  # type: ignore[assignment]
     bad_field = glossmeter.profile("r.json")["pixel"]  # type: ignore[typeddict-item]
-    print(bad_hint, wrong, not_a_str, not_points, bad_field)
+    print(bad_hint, wrong, not_a_str, not_points, not_a_frame, bad_field)
