@@ -476,16 +476,21 @@ impl Sweep {
         csv_line(&row)
     }
 
-    /// One JSON line (the report's [`report::SweepLineDoc`], each reading a [`report::SweepReadingDoc`]).
-    pub fn jsonl_row(&self, r: &PointResult, timing: bool) -> String {
-        let line = report::SweepLineDoc {
+    /// One point as a document: the report's [`report::SweepLineDoc`], each reading a
+    /// [`report::SweepReadingDoc`] (what a JSON line holds; the Python bindings' `sweep` returns them).
+    pub fn line_doc(&self, r: &PointResult, timing: bool) -> report::SweepLineDoc {
+        report::SweepLineDoc {
             index: r.index,
             parameters: self.axes.iter().zip(&r.values).map(|(a, v)| (a.path.clone(), *v)).collect(),
             readings: r.outcome.as_ref().ok().map(|rs| rs.iter().map(report::SweepReadingDoc::new).collect()),
             problem: r.outcome.as_ref().err().cloned(),
             seconds: timing.then_some(r.seconds),
-        };
-        report::to_json(&line).to_string() + "\n"
+        }
+    }
+
+    /// One JSON line ([`Sweep::line_doc`]).
+    pub fn jsonl_row(&self, r: &PointResult, timing: bool) -> String {
+        report::to_json(&self.line_doc(r, timing)).to_string() + "\n"
     }
 
     fn cells(&self, r: &PointResult, cols: &[(String, String, String)]) -> (Vec<Option<(f64, f64)>>, String) {

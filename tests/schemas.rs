@@ -261,3 +261,38 @@ fn profile_and_convergence_follow_their_schemas() {
         assert_valid(&c, &v, &format!("{args:?}"));
     }
 }
+
+#[test]
+fn sheets_as_read_follow_their_schema() {
+    // The document of the one sheet reader (the Python bindings' `read_sheet`): text sheets of every layout,
+    // a workbook, statistics rows, uncertainties and a column that is recognised but not predicted.
+    let s = schema("sheet");
+    for file in [
+        "black-glass-check.csv",
+        "byk-smart-chart-export.xlsx",
+        "byk-smart-chart-report.csv",
+        "colour-blue-metallic.csv",
+        "rhopoint-iq-export.csv",
+        "elcometer-408-export.csv",
+    ] {
+        let path = std::path::Path::new("fixtures/sheets").join(file);
+        let sheet = glossmeter::comparison::sheet::load(&path, &Default::default()).unwrap();
+        let doc = glossmeter::report::to_json(&glossmeter::report::compare::SheetReadDoc::new(&sheet));
+        assert_valid(&s, &doc, file);
+        assert_eq!(doc["rows"].as_array().unwrap().len(), sheet.rows.len(), "{file}");
+    }
+    // The `sheet` part is `compare`'s own.
+    let (_, text) = gm(&[
+        "compare",
+        "fixtures/recipes/black-glass.json",
+        "fixtures/sheets/black-glass-check.csv",
+        "--format",
+        "json",
+    ]);
+    let cmp: Value = serde_json::from_str(&text).unwrap();
+    let sheet =
+        glossmeter::comparison::sheet::load("fixtures/sheets/black-glass-check.csv".as_ref(), &Default::default())
+            .unwrap();
+    let doc = glossmeter::report::to_json(&glossmeter::report::compare::SheetReadDoc::new(&sheet));
+    assert_eq!(doc["sheet"], cmp["sheet"]);
+}

@@ -13,11 +13,18 @@ Every function is a thin layer over the library (see docs/python.md):
   as_frame=False, as_arrays=False)``: readings of a Python BRDF ``f(wi, wo)`` evaluated in batches of (N, 3)
   NumPy arrays.
 * ``standards()``, ``geometry(id)``, ``describe_geometry(id)``, ``schema()``, ``describe(recipe)``.
+* The other actions of the command line, each returning the document of ``glossmeter ACTION --format json``
+  as dicts and lists: ``read_sheet(sheet, ...)`` (the one sheet reader: CSV and .xlsx/.xls/.ods workbooks),
+  ``compare(recipe, sheet, tolerance=None, ...)``, ``sweep(template, vary, ...)``, ``fit(recipe, targets,
+  free=..., ...)``, ``profile(recipe, geometry=None, ...)``, ``convergence(recipe, geometries=None, ...)``.
+  ``sweep`` and ``fit`` (and ``compare``, ``profile``) release the GIL and stop on Ctrl-C
+  (``KeyboardInterrupt``). ``read_sheet(..., as_frame=True)`` and ``sweep(..., as_frame=True)`` give their
+  rows as a pandas DataFrame.
 
 Bad input raises ``ValueError`` with the message the CLI prints; an argument of the wrong type raises
 ``TypeError`` naming the argument and what it allows; an unreadable file raises ``OSError``.
 """
-from typing import TYPE_CHECKING, Any, Dict, Literal, Optional, Sequence, Union, overload
+from typing import TYPE_CHECKING, Any, Dict, List, Literal, Optional, Sequence, Union, overload
 
 import numpy as np
 import numpy.typing as npt
@@ -26,22 +33,57 @@ from . import _glossmeter
 from ._glossmeter import (
     DEFAULT_GEOMETRIES,
     __version__,
+    compare,
+    convergence,
     describe,
     describe_geometry,
+    fit,
     geometry,
+    profile,
     schema,
     standards,
 )
 from ._types import (
+    Allowance,
+    Baseline,
     BrdfFunction,
+    ColourDifference,
+    CompareReport,
+    CompareSummary,
+    Comparison,
+    ConvergenceReference,
+    ConvergenceReport,
+    ConvergenceRow,
+    ConvergenceTiming,
     Delta,
+    Drift,
+    Envelope,
+    EnvelopeVariation,
+    FitParameter,
+    FitReport,
+    FitTarget,
+    FreeParameters,
     Geometries,
     Geometry,
     LobeHint,
     Lobes,
+    Material,
+    ProfileBudget,
+    ProfileReport,
+    ProfileRow,
     Reading,
     Readings,
     Recipe,
+    Shard,
+    Sheet,
+    SheetInfo,
+    SheetRow,
+    SheetSource,
+    SweepPoint,
+    SweepReading,
+    Targets,
+    Tolerance,
+    VerdictRule,
 )
 
 if TYPE_CHECKING:
@@ -49,24 +91,62 @@ if TYPE_CHECKING:
 
 __all__ = [
     "DEFAULT_GEOMETRIES",
+    "Allowance",
     "Arrays",
+    "Baseline",
     "BrdfFunction",
+    "ColourDifference",
+    "CompareReport",
+    "CompareSummary",
+    "Comparison",
+    "ConvergenceReference",
+    "ConvergenceReport",
+    "ConvergenceRow",
+    "ConvergenceTiming",
     "Delta",
+    "Drift",
+    "Envelope",
+    "EnvelopeVariation",
+    "FitParameter",
+    "FitReport",
+    "FitTarget",
+    "FreeParameters",
     "Geometries",
     "Geometry",
     "LobeHint",
     "Lobes",
+    "Material",
+    "ProfileBudget",
+    "ProfileReport",
+    "ProfileRow",
     "Reading",
     "Readings",
     "Recipe",
+    "Shard",
+    "Sheet",
+    "SheetInfo",
+    "SheetRow",
+    "SheetSource",
+    "SweepPoint",
+    "SweepReading",
+    "Targets",
+    "Tolerance",
+    "VerdictRule",
     "__version__",
+    "compare",
+    "convergence",
     "describe",
     "describe_geometry",
+    "fit",
     "geometry",
     "measure",
     "measure_brdf",
+    "profile",
+    "read_sheet",
     "schema",
     "standards",
+    "sweep",
+    "sweep_rows",
     "to_arrays",
     "to_frame",
 ]
@@ -182,3 +262,91 @@ def measure_brdf(f: BrdfFunction, geometries: Geometries = None, rtol: Optional[
     _check_shape_flags(as_frame, as_arrays)
     readings = _glossmeter.measure_brdf(f, geometries, rtol, lobes, delta, wavelengths, timing)
     return _shaped(readings, as_frame, as_arrays)
+
+
+def _check_frame_flag(as_frame: object) -> bool:
+    """Refuse a bad ``as_frame`` before any work (and pandas missing, before a long sweep)."""
+    frame = _flag("as_frame", as_frame)
+    if frame:
+        try:
+            import pandas  # noqa: F401
+        except ImportError:
+            to_frame([])
+    return frame
+
+
+@overload
+def read_sheet(sheet: SheetSource, delimiter: Optional[str] = ..., sheet_name: Optional[str] = ...,
+               header_row: Optional[int] = ..., ignore_columns: Union[None, str, Sequence[str]] = ..., *,
+               as_frame: Literal[False] = ...) -> Sheet: ...
+@overload
+def read_sheet(sheet: SheetSource, delimiter: Optional[str] = ..., sheet_name: Optional[str] = ...,
+               header_row: Optional[int] = ..., ignore_columns: Union[None, str, Sequence[str]] = ..., *,
+               as_frame: Literal[True]) -> "pandas.DataFrame": ...
+def read_sheet(sheet: SheetSource, delimiter: Optional[str] = None, sheet_name: Optional[str] = None,
+               header_row: Optional[int] = None, ignore_columns: Union[None, str, Sequence[str]] = None, *,
+               as_frame: bool = False) -> Union[Sheet, "pandas.DataFrame"]:
+    """Read an instrument sheet (a CSV, or an .xlsx/.xls/.ods workbook; a path or its bytes) as ``glossmeter
+    compare`` reads it: what the reader found out about the file and every value with its line, column,
+    sample, geometry and reading (``schema("sheet")``). With ``as_frame=True``, the rows as a pandas
+    DataFrame, one row per value (``uncertainty`` NaN where the sheet states none). See docs/python.md."""
+    frame = _check_frame_flag(as_frame)
+    doc = _glossmeter.read_sheet(sheet, delimiter, sheet_name, header_row, ignore_columns)
+    if not frame:
+        return doc
+    import pandas as pd
+
+    columns = ["line", "column", "sample", "geometry", "reading", "value", "uncertainty", "not_predicted"]
+    out = pd.DataFrame(doc["rows"], columns=columns)
+    out["uncertainty"] = out["uncertainty"].astype(np.float64)
+    return out
+
+
+def sweep_rows(points: Sequence[SweepPoint]) -> List[Dict[str, Any]]:
+    """A sweep's points as flat rows, one per (point, reading): ``index``, one column per varied path,
+    ``geometry``, ``name``, ``unit``, ``value``, ``error_estimate``, ``converged``, ``problem`` (the reading's,
+    or the point's when its recipe is invalid: then one row with no reading) and ``seconds`` when timed."""
+    rows: List[Dict[str, Any]] = []
+    for p in points:
+        base: Dict[str, Any] = {"index": p["index"], **p["parameters"]}
+        timed: Dict[str, Any] = {"seconds": p["seconds"]} if "seconds" in p else {}
+        readings = p.get("readings") or []
+        if not readings:
+            rows.append({**base, "geometry": None, "name": None, "unit": None, "value": None,
+                         "error_estimate": None, "converged": False, "problem": p.get("problem"), **timed})
+        for r in readings:
+            rows.append({**base, "geometry": r["geometry"], "name": r["name"], "unit": r["unit"],
+                         "value": r["value"], "error_estimate": r["error_estimate"], "converged": r["converged"],
+                         "problem": r.get("problem"), **timed})
+    return rows
+
+
+@overload
+def sweep(template: Recipe, vary: Union[str, Sequence[str]], log: Union[None, str, Sequence[str]] = ...,
+          lhs: Optional[int] = ..., seed: Optional[int] = ..., geometries: Geometries = ...,
+          shard: Optional[Shard] = ..., rtol: Optional[float] = ..., max_evals: Optional[int] = ...,
+          timing: bool = ..., *, as_frame: Literal[False] = ...) -> List[SweepPoint]: ...
+@overload
+def sweep(template: Recipe, vary: Union[str, Sequence[str]], log: Union[None, str, Sequence[str]] = ...,
+          lhs: Optional[int] = ..., seed: Optional[int] = ..., geometries: Geometries = ...,
+          shard: Optional[Shard] = ..., rtol: Optional[float] = ..., max_evals: Optional[int] = ...,
+          timing: bool = ..., *, as_frame: Literal[True]) -> "pandas.DataFrame": ...
+def sweep(template: Recipe, vary: Union[str, Sequence[str]], log: Union[None, str, Sequence[str]] = None,
+          lhs: Optional[int] = None, seed: Optional[int] = None, geometries: Geometries = None,
+          shard: Optional[Shard] = None, rtol: Optional[float] = None, max_evals: Optional[int] = None,
+          timing: bool = True, *, as_frame: bool = False) -> Union[List[SweepPoint], "pandas.DataFrame"]:
+    """Measure a template recipe over a grid (``vary`` "PATH=LO..HI:N", one or a list) or a Latin hypercube
+    (``lhs`` N points, ``vary`` "PATH=LO..HI"): one dict per point, the lines of ``glossmeter sweep --format
+    jsonl``. With ``as_frame=True``, a pandas DataFrame of :func:`sweep_rows`. Ctrl-C stops it
+    (KeyboardInterrupt). See docs/python.md."""
+    frame = _check_frame_flag(as_frame)
+    points = _glossmeter.sweep(template, vary, log, lhs, seed, geometries, shard, rtol, max_evals, timing)
+    if not frame:
+        return points
+    import pandas as pd
+
+    out = pd.DataFrame(sweep_rows(points))
+    for c in ("value", "error_estimate"):
+        if c in out:
+            out[c] = out[c].astype(np.float64)
+    return out

@@ -1,8 +1,27 @@
 """Stubs of the compiled module ``glossmeter._glossmeter`` (python/src/lib.rs, python/src/pybrdf.rs). The
 public API is ``glossmeter`` (``__init__.py``), which re-exports these with ``as_frame``/``as_arrays`` added."""
-from typing import Any, Dict, List, Literal, Optional, Sequence
+from typing import Any, Dict, List, Literal, Optional, Sequence, Union
 
-from ._types import BrdfFunction, Delta, Geometries, Geometry, Lobes, Reading, Recipe
+from ._types import (
+    BrdfFunction,
+    CompareReport,
+    ConvergenceReport,
+    Delta,
+    FitReport,
+    FreeParameters,
+    Geometries,
+    Geometry,
+    Lobes,
+    ProfileReport,
+    Reading,
+    Recipe,
+    Shard,
+    Sheet,
+    SheetSource,
+    SweepPoint,
+    Targets,
+    Tolerance,
+)
 
 __version__: str
 DEFAULT_GEOMETRIES: List[str]
@@ -25,7 +44,74 @@ def measure_brdf(
 def standards() -> List[Dict[str, Any]]: ...
 def geometry(id: Geometry) -> Dict[str, Any]: ...
 def describe_geometry(id: Geometry) -> str: ...
-def schema(output_format: Optional[Literal["measure", "compare", "sweep", "fit"]] = None) -> Dict[str, Any]: ...
+def schema(
+    output_format: Optional[Literal["measure", "compare", "sweep", "fit", "profile", "convergence", "sheet"]] = None,
+) -> Dict[str, Any]: ...
 def describe(recipe: Recipe) -> str: ...
+def read_sheet(
+    sheet: SheetSource,
+    delimiter: Optional[str] = None,
+    sheet_name: Optional[str] = None,
+    header_row: Optional[int] = None,
+    ignore_columns: Union[None, str, Sequence[str]] = None,
+) -> Sheet: ...
+def compare(
+    recipe: Recipe,
+    sheet: SheetSource,
+    tolerance: Optional[Tolerance] = None,
+    k: Optional[float] = None,
+    max_de00: Optional[float] = None,
+    rtol: Optional[float] = None,
+    illuminant: Optional[str] = None,
+    observer: Optional[str] = None,
+    delimiter: Optional[str] = None,
+    sheet_name: Optional[str] = None,
+    header_row: Optional[int] = None,
+    ignore_columns: Union[None, str, Sequence[str]] = None,
+) -> CompareReport: ...
+def sweep(
+    template: Recipe,
+    vary: Union[str, Sequence[str]],
+    log: Union[None, str, Sequence[str]] = None,
+    lhs: Optional[int] = None,
+    seed: Optional[int] = None,
+    geometries: Geometries = None,
+    shard: Optional[Shard] = None,
+    rtol: Optional[float] = None,
+    max_evals: Optional[int] = None,
+    timing: bool = True,
+) -> List[SweepPoint]: ...
+def fit(
+    recipe: Recipe,
+    targets: Optional[Targets] = None,
+    *,
+    free: FreeParameters,
+    sheet: Optional[SheetSource] = None,
+    sample: Optional[str] = None,
+    uncertainty: Optional[float] = None,
+    restarts: Optional[int] = None,
+    rtol: Optional[float] = None,
+    geometries: Geometries = None,
+    timing: bool = True,
+    delimiter: Optional[str] = None,
+    sheet_name: Optional[str] = None,
+    header_row: Optional[int] = None,
+    ignore_columns: Union[None, str, Sequence[str]] = None,
+) -> FitReport: ...
+def profile(
+    recipe: Recipe,
+    geometry: Optional[Geometry] = None,
+    rtol: Optional[float] = None,
+    max_evals: Optional[int] = None,
+    max_total_evals: Optional[int] = None,
+) -> ProfileReport: ...
+def convergence(
+    recipe: Recipe,
+    geometries: Geometries = None,
+    tolerances: Optional[Sequence[float]] = None,
+    min_time_ms: Optional[float] = None,
+    max_repetitions: Optional[int] = None,
+    reference_run: bool = False,
+) -> ConvergenceReport: ...
 def _cli(argv: List[str]) -> int: ...
 def _panic() -> None: ...

@@ -59,3 +59,73 @@ pub fn reals(name: &str, v: &Bound<'_, PyAny>, allowed: &str) -> PyResult<Vec<f6
     }
     Ok(out)
 }
+
+/// The keyword of an argument that a library error names ([`glossmeter::error::Words`]): the library says
+/// `target`, Python's `fit` takes `targets=` (as the command line writes `--target`); every other argument is
+/// its keyword.
+pub fn keyword(argument: &'static str) -> String {
+    match argument {
+        "target" => "`targets`".into(),
+        name => format!("`{name}`"),
+    }
+}
+
+fn given<'py>(v: Option<&Bound<'py, PyAny>>) -> Option<Bound<'py, PyAny>> {
+    v.filter(|v| !v.is_none()).cloned()
+}
+
+/// An optional real number (None: the default).
+pub fn opt_real(name: &str, v: Option<&Bound<'_, PyAny>>, allowed: &str) -> PyResult<Option<f64>> {
+    given(v).map(|v| real(name, &v, allowed)).transpose()
+}
+
+/// An optional whole number ≥ 0 (an int, or anything with `__index__`, e.g. a NumPy integer; a bool or a float
+/// is refused); a negative one is a `ValueError`.
+pub fn opt_count(name: &str, v: Option<&Bound<'_, PyAny>>, allowed: &str) -> PyResult<Option<u64>> {
+    let Some(v) = given(v) else { return Ok(None) };
+    let refuse = || PyTypeError::new_err(format!("{name}: expected a whole number ({allowed}), got {}", type_name(&v)));
+    if v.is_instance_of::<PyBool>() || v.is_instance_of::<pyo3::types::PyFloat>() || v.is_instance_of::<PyString>() {
+        return Err(refuse());
+    }
+    let i: i128 = v.extract().map_err(|_| refuse())?;
+    u64::try_from(i)
+        .map(Some)
+        .map_err(|_| PyValueError::new_err(format!("{name}: expected a whole number ({allowed}), got {i}")))
+}
+
+/// An optional str.
+pub fn opt_string(name: &str, v: Option<&Bound<'_, PyAny>>, allowed: &str) -> PyResult<Option<String>> {
+    let Some(v) = given(v) else { return Ok(None) };
+    match v.cast::<PyString>() {
+        Ok(s) => Ok(Some(s.to_cow()?.into_owned())),
+        Err(_) => Err(PyTypeError::new_err(format!("{name}: expected a str ({allowed}), got {}", type_name(&v)))),
+    }
+}
+
+/// Strings: None (none), one str, or any iterable of str; `name[i]` names a bad element.
+pub fn strings(name: &str, v: Option<&Bound<'_, PyAny>>, allowed: &str) -> PyResult<Vec<String>> {
+    let Some(v) = given(v) else { return Ok(vec![]) };
+    if let Ok(s) = v.cast::<PyString>() {
+        return Ok(vec![s.to_cow()?.into_owned()]);
+    }
+    let refuse =
+        || PyTypeError::new_err(format!("{name}: expected a str or a list of str ({allowed}), got {}", type_name(&v)));
+    if v.is_instance_of::<pyo3::types::PyDict>() {
+        return Err(refuse());
+    }
+    let items = v.try_iter().map_err(|_| refuse())?;
+    let mut out = Vec::new();
+    for (i, x) in items.enumerate() {
+        let x = x?;
+        match x.cast::<PyString>() {
+            Ok(s) => out.push(s.to_cow()?.into_owned()),
+            Err(_) => {
+                return Err(PyTypeError::new_err(format!(
+                    "{name}[{i}]: expected a str ({allowed}), got {}",
+                    type_name(&x)
+                )))
+            }
+        }
+    }
+    Ok(out)
+}

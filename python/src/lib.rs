@@ -19,16 +19,17 @@ use pyo3::exceptions::{PyFileNotFoundError, PyOSError, PyRuntimeError, PyTypeErr
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyFloat, PyList, PyString, PyTuple};
 
+mod actions;
 mod args;
 mod probe;
 mod pybrdf;
 
 /// A library error as the Python exception a caller expects, with the message the CLI prints after
-/// "error: " (an argument it names in the library's words, `` `vary` ``, where the CLI writes `--vary`). Bad
+/// "error: " (an argument it names as its keyword, `` `vary` ``, where the CLI writes `--vary`: [`args::keyword`]). Bad
 /// input and bad requests are `ValueError`; files that cannot be read are `OSError` (`FileNotFoundError` when
 /// missing); a computation without a finite result is `RuntimeError`.
 pub(crate) fn to_py_err(e: Error) -> PyErr {
-    let msg = e.to_string();
+    let msg = e.naming(&args::keyword);
     match &e {
         Error::Input { .. } | Error::Usage(_) | Error::Argument(_) => PyValueError::new_err(msg),
         Error::Io { source, .. } if source.kind() == std::io::ErrorKind::NotFound => PyFileNotFoundError::new_err(msg),
@@ -57,7 +58,7 @@ pub(crate) fn guarded<T>(f: impl FnOnce() -> PyResult<T>) -> PyResult<T> {
 /// A Python object as JSON text: a `str` as is, anything else through `json.dumps`. A float that is not
 /// finite (NaN, ±inf) anywhere inside is refused with its place as a JSON Pointer: JSON has no such number,
 /// and `json.dumps` would write `NaN`, which the reader then calls malformed JSON at a column.
-fn json_text(py: Python<'_>, obj: &Bound<'_, PyAny>) -> PyResult<String> {
+pub(crate) fn json_text(py: Python<'_>, obj: &Bound<'_, PyAny>) -> PyResult<String> {
     if let Ok(s) = obj.cast::<PyString>() {
         return Ok(s.to_cow()?.into_owned());
     }
@@ -100,7 +101,7 @@ fn non_finite_at(obj: &Bound<'_, PyAny>, at: String, depth: usize) -> Option<(St
 /// bool, an integer → int, any other number → float (the same double: serde_json writes the shortest decimal
 /// that reads back to it), a string → str, an array → list, an object → dict with the keys in the value's
 /// order (the order of its text).
-fn from_json<'py>(py: Python<'py>, v: &serde_json::Value) -> PyResult<Bound<'py, PyAny>> {
+pub(crate) fn from_json<'py>(py: Python<'py>, v: &serde_json::Value) -> PyResult<Bound<'py, PyAny>> {
     use serde_json::Value;
     Ok(match v {
         Value::Null => py.None().into_bound(py),
@@ -130,7 +131,7 @@ fn from_json<'py>(py: Python<'py>, v: &serde_json::Value) -> PyResult<Bound<'py,
 }
 
 /// A recipe given as a dict, a JSON string or a path (str or os.PathLike).
-fn load_recipe(py: Python<'_>, recipe: &Bound<'_, PyAny>) -> PyResult<Material> {
+pub(crate) fn load_recipe(py: Python<'_>, recipe: &Bound<'_, PyAny>) -> PyResult<Material> {
     if let Ok(s) = recipe.cast::<PyString>() {
         let s = s.to_cow()?;
         let t = s.trim_start();
@@ -168,7 +169,7 @@ fn builtin() -> PyResult<&'static [StandardGeometry]> {
 }
 
 /// A builtin geometry by id, with the library's message for an unknown one.
-fn find_builtin(id: &str) -> PyResult<StandardGeometry> {
+pub(crate) fn find_builtin(id: &str) -> PyResult<StandardGeometry> {
     match builtin()?.iter().find(|g| g.geometry.id == id) {
         Some(g) => Ok(g.clone()),
         None => stds::find(id).map_err(to_py_err),
@@ -177,7 +178,7 @@ fn find_builtin(id: &str) -> PyResult<StandardGeometry> {
 
 /// One geometry: a builtin id, a path to a geometry file (str ending in ".json" or os.PathLike), or a dict in
 /// the standards format. `name` is how a refusal names the argument (`id`, `geometries`, `geometries[2]`).
-fn load_geometry(py: Python<'_>, g: &Bound<'_, PyAny>, name: &str) -> PyResult<StandardGeometry> {
+pub(crate) fn load_geometry(py: Python<'_>, g: &Bound<'_, PyAny>, name: &str) -> PyResult<StandardGeometry> {
     if let Ok(s) = g.cast::<PyString>() {
         let s = s.to_cow()?;
         if s.ends_with(".json") || s.contains(std::path::MAIN_SEPARATOR) {
@@ -333,7 +334,8 @@ fn describe_geometry(py: Python<'_>, id: &Bound<'_, PyAny>) -> PyResult<String> 
 }
 
 /// schema(output_format=None) -> dict: the JSON Schema of the recipe format (`glossmeter schema`), or of an
-/// output, "measure", "compare", "sweep" or "fit" (`glossmeter schema --output-format …`).
+/// output, "measure", "compare", "sweep", "fit", "profile" or "convergence" (`glossmeter schema
+/// --output-format …`), or of a sheet as `read_sheet` reads it, "sheet".
 #[pyfunction]
 #[pyo3(signature = (output_format=None))]
 fn schema<'py>(py: Python<'py>, output_format: Option<&str>) -> PyResult<Bound<'py, PyAny>> {
@@ -344,9 +346,13 @@ fn schema<'py>(py: Python<'py>, output_format: Option<&str>) -> PyResult<Bound<'
             Some("compare") => report::schema::compare(),
             Some("sweep") => report::schema::sweep(),
             Some("fit") => report::schema::fit(),
+            Some("profile") => report::schema::profile(),
+            Some("convergence") => report::schema::convergence(),
+            Some("sheet") => report::schema::sheet(),
             Some(other) => {
                 return Err(PyValueError::new_err(format!(
-                    "output_format: unknown output {other:?}; allowed: \"measure\", \"compare\", \"sweep\", \"fit\""
+                    "output_format: unknown output {other:?}; allowed: \"measure\", \"compare\", \"sweep\", \"fit\", \
+                     \"profile\", \"convergence\", \"sheet\""
                 )))
             }
         };
@@ -385,6 +391,7 @@ fn _glossmeter(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(_cli, m)?)?;
     m.add_function(wrap_pyfunction!(_panic, m)?)?;
     m.add_function(wrap_pyfunction!(pybrdf::measure_brdf, m)?)?;
+    actions::add(m)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add("DEFAULT_GEOMETRIES", glossmeter::api::DEFAULT_PANEL.to_vec())?;
     Ok(())

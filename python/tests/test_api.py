@@ -150,28 +150,6 @@ def test_the_package_ships_its_types():
         assert callable(getattr(glossmeter, name))
 
 
-def _reading_fields(schema):
-    """The properties of the reading objects of ``measure``'s JSON Schema (``glossmeter schema --output-format
-    measure``): every definition with a geometry, a value and a converged flag."""
-    found = [d["properties"] for d in schema["$defs"].values() if {"geometry", "value", "converged"} <= set(d.get("properties", {}))]
-    assert found, "the measure schema has no reading definition"
-    return set().union(*found)
-
-
-def test_the_reading_type_has_every_field_of_the_measure_schema():
-    # A field added to the reading document and missing in the Python type fails here.
-    from glossmeter import Reading
-
-    fields = _reading_fields(glossmeter.schema("measure"))
-    typed = set(Reading.__annotations__)
-    # The envelope is `measure --envelope`'s alone, and `material` names the recipe of a reading of several
-    # recipes (`measure A.json B.json`); Python measures one recipe and reads no envelope.
-    command_line_only = {f for f in fields if f.startswith("envelope")} | {"material"}
-    assert fields - command_line_only - typed == set(), "fields of the schema missing in glossmeter.Reading"
-    assert typed - fields == set(), "fields of glossmeter.Reading that the schema does not have"
-    assert "data_uncertainty" in typed
-
-
 def test_schema_names_an_unknown_output():
     with pytest.raises(ValueError, match="output_format"):
         glossmeter.schema("pie")

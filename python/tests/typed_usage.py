@@ -10,7 +10,16 @@ import numpy.typing as npt
 import pandas as pd
 
 import glossmeter
-from glossmeter import LobeHint, Reading
+from glossmeter import (
+    CompareReport,
+    ConvergenceReport,
+    FitReport,
+    LobeHint,
+    ProfileReport,
+    Reading,
+    Sheet,
+    SweepPoint,
+)
 
 
 def grey(wi: npt.NDArray[np.float64], wo: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
@@ -33,6 +42,24 @@ def usage() -> None:
     text: str = glossmeter.describe_geometry(spec) + glossmeter.describe({"model": "lambert", "albedo": 0.5})
     print(text, glossmeter.schema()["title"], len(glossmeter.standards()), glossmeter.__version__)
 
+    sheet: Sheet = glossmeter.read_sheet("fixtures/sheets/black-glass-check.csv", header_row=3, ignore_columns="x")
+    print(sheet["rows"][0]["value"] + 1.0, sheet["sheet"]["layout"], sheet["workbook_sheet"])
+    report: CompareReport = glossmeter.compare(pathlib.Path("r.json"), b"sample,60\nx,1\n", tolerance={"gloss": 2})
+    print(report["summary"]["outside"] + 1, report["comparisons"][0]["verdict"], report.get("baseline"))
+    points: List[SweepPoint] = glossmeter.sweep("r.json", ["/roughness=0.1..0.2:3"], shard=(1, 2), timing=False)
+    rows: pd.DataFrame = glossmeter.read_sheet(b"sample,60\nx,1\n", as_frame=True)
+    grid: pd.DataFrame = glossmeter.sweep("r.json", "/roughness=0.1..0.2:3", as_frame=True)
+    print(rows.shape, grid.shape, glossmeter.sweep_rows(points)[0]["index"])
+    for p in points:
+        for r in p.get("readings") or []:
+            print(p["index"], p["parameters"]["/roughness"], r["value"])
+    fitted: FitReport = glossmeter.fit("r.json", {"astm-d523-60/gloss": (60.0, 0.2)}, free={"/roughness": (0.01, 0.5)})
+    fitted_to_sheet: FitReport = glossmeter.fit("r.json", free=["/ior=1.3..1.8"], sheet="s.xlsx", sample="a")
+    print(fitted["parameters"][0]["value"], fitted["recipe"], fitted_to_sheet["chi2"])
+    prof: ProfileReport = glossmeter.profile("r.json", "rspec-20", max_total_evals=10_000)
+    conv: ConvergenceReport = glossmeter.convergence({"model": "lambert", "albedo": 0.5}, tolerances=[1e-3])
+    print(prof["rows"][0]["angle_deg"], conv["rows"][0]["rtol"], glossmeter.schema("sheet")["title"])
+
     # What the types refuse (each ignore is needed, or mypy --strict fails on an unused one):
     glossmeter.measure(42)  # type: ignore[call-overload]
     glossmeter.measure("r.json", rtol="x")  # type: ignore[call-overload]
@@ -40,4 +67,10 @@ def usage() -> None:
     bad_hint: LobeHint = {"slope": 0.05, "tail": "fat"}  # type: ignore[typeddict-item]
     wrong: List[Reading] = glossmeter.measure("r.json", as_frame=True)  # type: ignore[assignment]
     not_a_str: int = glossmeter.describe("r.json")  # type: ignore[assignment]
-    print(bad_hint, wrong, not_a_str)
+    glossmeter.read_sheet(42)  # type: ignore[call-overload]
+    glossmeter.sweep("r.json", vary=5)  # type: ignore[call-overload]
+    glossmeter.fit("r.json", ["astm-d523-60/gloss=60"])  # type: ignore[call-arg]
+    not_points: Sheet = glossmeter.sweep("r.json", "/roughness=0.1..0.2:3")  # type: ignore[assignment]
+    not_a_frame: Sheet = glossmeter.read_sheet("s.csv", as_frame=True)  # type: ignore[assignment]
+    bad_field = glossmeter.profile("r.json")["pixel"]  # type: ignore[typeddict-item]
+    print(bad_hint, wrong, not_a_str, not_points, not_a_frame, bad_field)

@@ -33,6 +33,8 @@ pub enum OutputSchema {
     Fit,
     Profile,
     Convergence,
+    /// A sheet as the one sheet reader reads it (the Python bindings' `read_sheet`).
+    Sheet,
 }
 
 #[derive(Subcommand, Debug)]

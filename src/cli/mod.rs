@@ -232,6 +232,7 @@ fn dispatch(cli: Cli, #[allow(unused_variables)] serve: Serve) -> Result<()> {
                 Some(OutputSchema::Fit) => crate::report::schema::fit(),
                 Some(OutputSchema::Profile) => crate::report::schema::profile(),
                 Some(OutputSchema::Convergence) => crate::report::schema::convergence(),
+                Some(OutputSchema::Sheet) => crate::report::schema::sheet(),
             };
             let text = serde_json::to_string_pretty(&schema)
                 .map_err(|e| Error::Numeric(format!("the schema does not serialise: {e}")))?;

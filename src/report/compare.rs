@@ -128,6 +128,89 @@ pub struct SheetDoc {
     pub ignored_columns: Vec<String>,
 }
 
+impl SheetDoc {
+    pub fn new(sheet: &Sheet) -> SheetDoc {
+        SheetDoc {
+            file: sheet.file.clone(),
+            encoding: sheet.encoding.clone(),
+            delimiter: (sheet.delimiter as char).to_string(),
+            layout: match sheet.layout {
+                sheet::Layout::Long => "long",
+                sheet::Layout::Wide => "wide",
+                sheet::Layout::Colour => "colour",
+            }
+            .into(),
+            metadata: sheet.metadata_json(),
+            ignored_columns: sheet.ignored_columns.clone(),
+        }
+    }
+}
+
+/// One value of a sheet as read: where it stands, what it is a reading of, and its value.
+#[derive(Clone, Debug, Serialize, JsonSchema)]
+#[schemars(transform = sheet_row_doc_nullable)]
+#[serde(deny_unknown_fields)]
+pub struct SheetRowDoc {
+    /// The line of the file (or the workbook's row) the row starts on, 1-based.
+    #[schemars(range(min = 1))]
+    pub line: usize,
+    /// The header of the column the value came from.
+    pub column: String,
+    pub sample: String,
+    pub geometry: String,
+    /// A quantity (`gloss`, `haze`, `doi`, …) or a reading name (`haze-narrow`, …).
+    pub reading: String,
+    pub value: f64,
+    /// The row's stated uncertainty, if any.
+    pub uncertainty: Option<f64>,
+    /// Why the reading cannot be predicted (a recognised column whose formula is not public), if so.
+    pub not_predicted: Option<String>,
+}
+
+/// A sheet as the one sheet reader reads it (`compare`'s and `fit`'s; the Python `read_sheet`): what it found
+/// out about the file and every value, in the sheet's order.
+#[derive(Clone, Debug, Serialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+#[schemars(title = "glossmeter sheet", transform = sheet_read_doc_nullable)]
+pub struct SheetReadDoc {
+    pub sheet: SheetDoc,
+    /// The workbook's sheet read (null for a text sheet).
+    pub workbook_sheet: Option<String>,
+    /// The 1-based line (or workbook row) of the header.
+    #[schemars(range(min = 1))]
+    pub header_line: usize,
+    pub headers: Vec<String>,
+    /// The statistics cells (`Mean 20°`, …) checked against their series.
+    pub statistics_checked: usize,
+    pub rows: Vec<SheetRowDoc>,
+}
+
+impl SheetReadDoc {
+    pub fn new(sheet: &Sheet) -> SheetReadDoc {
+        SheetReadDoc {
+            sheet: SheetDoc::new(sheet),
+            workbook_sheet: sheet.workbook_sheet.clone(),
+            header_line: sheet.header_line,
+            headers: sheet.headers.clone(),
+            statistics_checked: sheet.statistics_checked,
+            rows: sheet
+                .rows
+                .iter()
+                .map(|r| SheetRowDoc {
+                    line: r.line,
+                    column: r.column.clone(),
+                    sample: r.sample.clone(),
+                    geometry: r.geometry.clone(),
+                    reading: r.reading.clone(),
+                    value: r.value,
+                    uncertainty: r.uncertainty,
+                    not_predicted: r.not_predicted.clone(),
+                })
+                .collect(),
+        }
+    }
+}
+
 /// The verdict rule: k standard errors of the mean, and the uncertainty of rows that state none.
 #[derive(Clone, Debug, Serialize, JsonSchema)]
 #[schemars(transform = rule_doc_nullable)]
@@ -207,19 +290,7 @@ pub fn json_doc(
 ) -> CompareDoc {
     let count = |f: &dyn Fn(&Verdict) -> bool| cmp.iter().filter(|c| f(&c.verdict)).count();
     CompareDoc {
-        sheet: SheetDoc {
-            file: sheet.file.clone(),
-            encoding: sheet.encoding.clone(),
-            delimiter: (sheet.delimiter as char).to_string(),
-            layout: match sheet.layout {
-                sheet::Layout::Long => "long",
-                sheet::Layout::Wide => "wide",
-                sheet::Layout::Colour => "colour",
-            }
-            .into(),
-            metadata: sheet.metadata_json(),
-            ignored_columns: sheet.ignored_columns.clone(),
-        },
+        sheet: SheetDoc::new(sheet),
         rule: RuleDoc {
             k: rule.k,
             tolerance: rule.tolerance,
@@ -317,6 +388,14 @@ fn comparison_doc_nullable(schema: &mut schemars::Schema) {
             "unchecked",
         ],
     );
+}
+
+fn sheet_read_doc_nullable(schema: &mut schemars::Schema) {
+    super::nullable_but_written(schema, &["workbook_sheet"]);
+}
+
+fn sheet_row_doc_nullable(schema: &mut schemars::Schema) {
+    super::nullable_but_written(schema, &["uncertainty", "not_predicted"]);
 }
 
 fn rule_doc_nullable(schema: &mut schemars::Schema) {

@@ -7,7 +7,7 @@
 use schemars::schema_for;
 use serde_json::Value;
 
-use super::compare::CompareDoc;
+use super::compare::{CompareDoc, SheetReadDoc};
 use super::convergence::ConvergenceDoc;
 use super::fit::FitOutput;
 use super::measure::MeasureOutput;
@@ -43,4 +43,9 @@ pub fn profile() -> Value {
 /// `convergence --format json`.
 pub fn convergence() -> Value {
     to_json(&schema_for!(ConvergenceDoc))
+}
+
+/// A sheet as the one sheet reader reads it (the Python bindings' `read_sheet`).
+pub fn sheet() -> Value {
+    to_json(&schema_for!(SheetReadDoc))
 }
