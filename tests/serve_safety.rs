@@ -228,10 +228,13 @@ fn a_client_that_leaves_frees_its_slot_at_the_next_integral() {
 
 #[test]
 fn a_computation_past_the_time_limit_answers_with_the_readings_it_finished() {
-    let addr = start(Limits { request_seconds: 1.0, ..Limits::default() });
+    // The budget is fifty times the default, so that no machine finishes every reading within the limit (a
+    // fast one did 22 million evaluations in 0.8 s under the default budget).
+    let addr = start(Limits { request_seconds: 1.0, max_evals: 100_000_000, ..Limits::default() });
     let body = json!({
         "geometries": ALL,
         "rtol": 1e-12,
+        "max_evals": 100_000_000,
         "recipe": recipe("fixtures/real/models/panel-three-populations.json"),
     })
     .to_string();
