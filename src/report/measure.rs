@@ -5,6 +5,7 @@ use schemars::JsonSchema;
 use serde::Serialize;
 
 use super::{csv_text, plain, pretty, to_json, BaselineDoc, ReadingDoc};
+use crate::comparison::propagation::PredictionUncertainty;
 use crate::comparison::Drift;
 use crate::instrument::envelope::Envelopes;
 use crate::instrument::plan::Reading;
@@ -65,6 +66,17 @@ impl MeasureDoc {
                 let cut = envelopes.cut.contains(&r.geometry);
                 r.with_envelope(e.as_ref(), cut)
             })
+            .collect();
+        self
+    }
+
+    /// Add each reading's prediction uncertainty (`uncertainties[i]` of reading i; `comparison::propagation`).
+    pub fn with_uncertainties(mut self, uncertainties: &[Option<PredictionUncertainty>]) -> MeasureDoc {
+        self.readings = self
+            .readings
+            .into_iter()
+            .enumerate()
+            .map(|(i, r)| r.with_uncertainty(uncertainties.get(i).and_then(Option::as_ref)))
             .collect();
         self
     }
