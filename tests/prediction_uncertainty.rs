@@ -268,3 +268,63 @@ fn a_two_sample_sheet_is_judged_with_the_predictions_uncertainty() {
         }
     }
 }
+
+/// The command line: the same sheet fails (exit 1) without the blocks and passes (exit 0) with them; the JSON
+/// names each part of the allowance and they add up to its total; `measure` prints u_pred under its table.
+#[cfg(feature = "cli")]
+#[test]
+fn the_command_line_reports_the_allowances_parts() {
+    let gm = |args: &[&str]| {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_glossmeter"))
+            .current_dir(root())
+            .args(args)
+            .output()
+            .unwrap();
+        (out.status.code().unwrap_or(-1), String::from_utf8_lossy(&out.stdout).into_owned())
+    };
+    let sheet = "fixtures/sheets/byk-smart-chart-two-samples.csv";
+    let (code, table) = gm(&[
+        "compare",
+        sheet,
+        "--recipe",
+        "Black 2K=fixtures/recipes/solid-black.json",
+        "--recipe",
+        "Satin white=fixtures/recipes/semigloss-white.json",
+    ]);
+    assert_eq!(code, 1, "{table}");
+    assert!(
+        table.contains("6 reading(s) of 2 sample(s): 0 ok, 6 outside") && table.contains("allowance = 2·s/√n"),
+        "{table}"
+    );
+    let with = [
+        "compare",
+        sheet,
+        "--recipe",
+        "Black 2K=fixtures/uncertainty/solid-black.json",
+        "--recipe",
+        "Satin white=fixtures/uncertainty/semigloss-white.json",
+    ];
+    let (code, table) = gm(&with);
+    assert_eq!(code, 0, "{table}");
+    assert!(table.contains("6 ok, 0 outside") && table.contains("allowance = 2·√(s²/n + u_pred²)"), "{table}");
+    assert!(table.contains("u_pred = ") && table.contains("/clear_coat/roughness"), "{table}");
+    let (code, json) = gm(&[&with[..], &["--format", "json"]].concat());
+    assert_eq!(code, 0);
+    let doc: Value = serde_json::from_str(&json).unwrap();
+    for c in doc["comparisons"].as_array().unwrap() {
+        let a = &c["allowance"];
+        let parts = a["parts"].as_array().unwrap();
+        let names: Vec<&str> = parts.iter().map(|p| p["name"].as_str().unwrap()).collect();
+        assert_eq!(names, ["statistical and prediction uncertainty", "stated", "numerical"]);
+        let sum: f64 = parts.iter().map(|p| p["value"].as_f64().unwrap()).sum();
+        assert_eq!(sum, a["total"].as_f64().unwrap());
+        assert_eq!(c["prediction_uncertainty"], a["prediction_uncertainty"]);
+        assert_eq!(c["verdict"], "ok");
+    }
+    let (code, table) = gm(&["measure", "fixtures/uncertainty/solid-black.json", "-g", "astm-d523-20", "--no-timing"]);
+    assert_eq!(code, 0);
+    assert!(
+        table.contains("astm-d523-20 gloss: u_pred = 3.77 GU (largest part: /clear_coat/index ± 0.0144"),
+        "{table}"
+    );
+}

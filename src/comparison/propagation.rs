@@ -9,11 +9,12 @@
 //! ```
 //!
 //! each sensitivity cᵢ by a central difference with the step hᵢ = u(xᵢ):
-//! cᵢ = [y(xᵢ + uᵢ) − y(xᵢ − uᵢ)] / (2uᵢ). The step is the input's own standard uncertainty, as GUM §5.1.3
-//! Note 2 evaluates a contribution numerically ("the change in y due to a change in xᵢ of +u(xᵢ) and −u(xᵢ)"):
-//! it measures the slope over the span the input actually varies in, so a curvature within ±u is averaged the
-//! way the input's spread samples it, and it is far larger than the readings' numerical error (a step near the
-//! rounding level would difference noise). Where one side leaves the registry's range of the number (a
+//! cᵢ = [y(xᵢ + uᵢ) − y(xᵢ − uᵢ)] / (2uᵢ). Why that step: GUM §5.1.3 reads cᵢ·u(xᵢ) as the variation of y
+//! that the input's standard uncertainty generates, and the spreadsheet method (Kragten 1994; EURACHEM/CITAC
+//! QUAM:2012 Appendix E.2) computes it by displacing each input by u(xᵢ). The central form cancels the
+//! curvature's leading term (its error is u²·y‴/6, not u·y″/2), the slope is taken over the span the input
+//! actually varies in, and the step is far larger than the readings' numerical error, which a step near the
+//! rounding level would difference into noise. Where one side leaves the registry's range of the number (a
 //! roughness of 0.001 with u = 0.002), the difference is one-sided on the other side (forward or backward),
 //! with the same step.
 //!
