@@ -41,11 +41,7 @@ pub struct Stated {
 pub fn candidates(json: &Value, model: &str) -> Vec<String> {
     fn walk(v: &Value, at: String, model: &str, out: &mut Vec<String>) {
         match v {
-            Value::Number(_) => {
-                if registry::lookup(model, &at).is_some_and(|e| e.ty.is_numeric()) {
-                    out.push(at);
-                }
-            }
+            Value::Number(_) if registry::lookup(model, &at).is_some_and(|e| e.ty.is_numeric()) => out.push(at),
             Value::Object(m) => {
                 for (k, x) in m {
                     if at.is_empty() && k == KEY {
