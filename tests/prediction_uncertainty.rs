@@ -327,4 +327,63 @@ fn the_command_line_reports_the_allowances_parts() {
         table.contains("astm-d523-20 gloss: u_pred = 3.77 GU (largest part: /clear_coat/index ± 0.0144"),
         "{table}"
     );
+    // Many recipes: the one with a block gets the fields, the other none.
+    let (code, json) = gm(&[
+        "measure",
+        "fixtures/uncertainty/solid-black.json",
+        "fixtures/recipes/glass-n1.5.json",
+        "-g",
+        "astm-d523-20",
+        "--format",
+        "json",
+    ]);
+    assert_eq!(code, 0);
+    let doc: Value = serde_json::from_str(&json).unwrap();
+    let rs = doc["readings"].as_array().unwrap();
+    assert_eq!(rs.len(), 2);
+    let u = |r: &Value| r["prediction_uncertainty"].as_f64();
+    assert!(u(&rs[0]).is_some_and(|u| (u - 3.77).abs() < 0.01) && u(&rs[1]).is_none(), "{json}");
+}
+
+/// The server converts its bodies into the same library requests: `/api/measure` gives each reading its
+/// prediction uncertainty and `/api/compare` counts it in the allowance (docs/serve.md).
+#[cfg(feature = "serve")]
+#[test]
+fn the_server_propagates_a_recipes_stated_uncertainties() {
+    use glossmeter::serve::{ServeOptions, Server};
+    use std::io::{Read, Write};
+    let server = Server::bind(ServeOptions { port: 0, ..ServeOptions::default() }).unwrap();
+    let addr = server.addr();
+    std::thread::spawn(move || server.run());
+    // HTTP/1.0, so that the answer is the body as it is (no chunks) up to the close.
+    let post = |path: &str, body: &Value| -> Value {
+        let body = body.to_string();
+        let mut s = std::net::TcpStream::connect(addr).unwrap();
+        write!(
+            s,
+            "POST {path} HTTP/1.0\r\nHost: {addr}\r\nContent-Type: application/json\r\nContent-Length: {}\r\n\r\n{body}",
+            body.len()
+        )
+        .unwrap();
+        let mut raw = String::new();
+        s.read_to_string(&mut raw).unwrap();
+        let (head, body) = raw.split_once("\r\n\r\n").unwrap();
+        assert!(head.split(' ').nth(1) == Some("200"), "{head}\n{body}");
+        serde_json::from_str(body).unwrap()
+    };
+    let text = std::fs::read_to_string(root().join("fixtures/uncertainty/semigloss-white.json")).unwrap();
+    let recipe: Value = serde_json::from_str(&text).unwrap();
+    let m = post("/api/measure", &json!({"recipe": recipe, "geometries": ["astm-d523-60"]}));
+    let r = &m["readings"][0];
+    assert!((r["prediction_uncertainty"].as_f64().unwrap() - 2.43).abs() < 0.01, "{m}");
+    assert_eq!(r["uncertainty_budget"].as_array().map(Vec::len), Some(2));
+    let sheet = std::fs::read_to_string(root().join("fixtures/sheets/byk-smart-chart-two-samples.csv")).unwrap();
+    let doc = post("/api/compare", &json!({"recipe": recipe, "sheet": {"name": "two.csv", "text": sheet}}));
+    let satin: Vec<&Value> =
+        doc["comparisons"].as_array().unwrap().iter().filter(|c| c["sample"] == "Satin white").collect();
+    assert_eq!(satin.len(), 3);
+    for c in satin {
+        assert_eq!(c["verdict"], "ok", "{c}");
+        assert_eq!(c["allowance"]["parts"][0]["name"], "statistical and prediction uncertainty");
+    }
 }

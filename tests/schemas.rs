@@ -47,6 +47,8 @@ fn outputs_follow_their_schemas() {
         &["measure", "fixtures/recipes/glass-n1.5.json", "--format", "json"][..],
         &["measure", "fixtures/recipes/glass-n1.5.json", "--format", "json", "--no-timing"],
         &["measure", "fixtures/recipes/glass-n1.5.json", "fixtures/recipes/black-glass.json", "--format", "json"],
+        // many recipes, one of which states uncertainties
+        &["measure", "fixtures/uncertainty/solid-black.json", "fixtures/recipes/glass-n1.5.json", "--format", "json"],
         &["measure", "fixtures/recipes/glass-n1.5.json", "-g", "astm-d523-60", "--format", "json", "--baseline", base],
         // the tolerance envelope on each reading (null where a standard gives no tolerance)
         &[

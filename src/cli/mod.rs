@@ -319,6 +319,14 @@ fn measure_batch(
             t
         }
         Format::Json => report::measure::batch_json_doc(&materials, &readings, how.timing, &evaluations)
+            // The recipes' stated uncertainties propagated to their readings (nothing is run without them).
+            .with_uncertainties(
+                &materials
+                    .iter()
+                    .zip(&readings)
+                    .map(|(m, rs)| crate::comparison::propagation::propagate(m, &geos, options, rs))
+                    .collect::<Result<Vec<_>>>()?,
+            )
             .with_baseline(drift.as_deref(), how.baseline.as_ref().map(|(_, f)| f.clone()))
             .text(),
         Format::Csv => report::measure::batch_csv(&materials, &readings, how.timing)?,

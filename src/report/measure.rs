@@ -220,6 +220,17 @@ pub fn batch_json_doc(
 }
 
 impl BatchDoc {
+    /// Add each reading's prediction uncertainty: `per_material[m][i]` of material m's reading i, as
+    /// `comparison::propagation::propagate` gives them (one per reading, in the order of [`batch_json_doc`]).
+    pub fn with_uncertainties(mut self, per_material: &[Vec<Option<PredictionUncertainty>>]) -> BatchDoc {
+        let flat: Vec<Option<&PredictionUncertainty>> =
+            per_material.iter().flat_map(|v| v.iter().map(Option::as_ref)).collect();
+        for (i, r) in self.readings.iter_mut().enumerate() {
+            r.reading = r.reading.clone().with_uncertainty(flat.get(i).copied().flatten());
+        }
+        self
+    }
+
     /// Add the baseline checks (when a baseline was given).
     pub fn with_baseline(mut self, drift: Option<&[Drift]>, file: Option<String>) -> BatchDoc {
         if let (Some(d), Some(file)) = (drift, file) {
