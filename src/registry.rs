@@ -333,6 +333,19 @@ pub const NAME: Param =
 pub const DESCRIPTION: Param = p("/description", ALL, Type::Text, "", NONE, Opt("none"), "free text");
 pub const PROVENANCE: Param = p("/provenance", ALL, Type::Text, "", NONE, Opt("none"), "where the numbers come from");
 pub const NOTES: Param = p("/notes", ALL, Type::Notes, "", NONE, Opt("none"), "free text for provenance");
+/// The standard uncertainties of some of the recipe's numbers, each key a JSON Pointer to one number of the recipe
+/// that a numeric entry of its model governs, each value u > 0 in that entry's unit (`recipe::uncertainty`;
+/// propagated to every reading, docs/instrument.md §The prediction's uncertainty). Its keys are pointers, not
+/// fields, so the entry has no children here; the schema gives it its own form (`recipe::schema`).
+pub const UNCERTAINTY: Param = p(
+    "/uncertainty",
+    ALL,
+    Type::Object,
+    "",
+    NONE,
+    Opt("none"),
+    "standard uncertainties of the recipe's numbers: {\"JSON Pointer\": u > 0}, e.g. {\"/clear_coat/roughness\": 0.002}; propagated to every reading (docs/instrument.md §The prediction's uncertainty)",
+);
 
 /// A dielectric's (real) refractive index: from air (1.0) to above the densest common optical materials
 /// (diamond 2.42, rutile TiO2 ≈ 2.9, Si in the visible ≈ 4).
@@ -1034,6 +1047,7 @@ pub static PARAMS: &[&Param] = &[
     &DESCRIPTION,
     &PROVENANCE,
     &NOTES,
+    &UNCERTAINTY,
     // smooth-dielectric, conductor, microfacet: the index
     &DIELECTRIC_IOR,
     &CONDUCTOR_IOR,
@@ -1282,7 +1296,7 @@ mod tests {
     fn children_follow_the_registry() {
         assert_eq!(
             children("lambert", ""),
-            ["model", "name", "description", "provenance", "notes", "albedo", "wavelengths_nm"]
+            ["model", "name", "description", "provenance", "notes", "uncertainty", "albedo", "wavelengths_nm"]
         );
         assert_eq!(children("cook-torrance-lobes", "/lobes/0"), ["ks", "r", "m"]);
         assert_eq!(children("paint", "/pigmented_layer/pigments/1/measured").len(), 5);

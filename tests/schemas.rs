@@ -47,6 +47,8 @@ fn outputs_follow_their_schemas() {
         &["measure", "fixtures/recipes/glass-n1.5.json", "--format", "json"][..],
         &["measure", "fixtures/recipes/glass-n1.5.json", "--format", "json", "--no-timing"],
         &["measure", "fixtures/recipes/glass-n1.5.json", "fixtures/recipes/black-glass.json", "--format", "json"],
+        // many recipes, one of which states uncertainties
+        &["measure", "fixtures/uncertainty/solid-black.json", "fixtures/recipes/glass-n1.5.json", "--format", "json"],
         &["measure", "fixtures/recipes/glass-n1.5.json", "-g", "astm-d523-60", "--format", "json", "--baseline", base],
         // the tolerance envelope on each reading (null where a standard gives no tolerance)
         &[
@@ -76,6 +78,13 @@ fn outputs_follow_their_schemas() {
     // A reading without a value (the DOI of a black body) and a note (the D4039 scope) are in the schema too.
     let (_, out) = gm(&["measure", "fixtures/recipes/phong.json", "--format", "json"]);
     assert_valid(&m, &serde_json::from_str(&out).unwrap(), "phong");
+    // A recipe that states uncertainties: each reading's prediction_uncertainty and its budget.
+    let (code, out) =
+        gm(&["measure", "fixtures/uncertainty/semigloss-white.json", "-g", "astm-d523-60", "--format", "json"]);
+    assert_eq!(code, 0);
+    let doc: Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(doc["readings"][0]["uncertainty_budget"].as_array().map(Vec::len), Some(2), "{out}");
+    assert_valid(&m, &doc, "stated uncertainties");
     let c = schema("compare");
     for (recipe, sheet) in [
         ("glass-n1.5.json", "rhopoint-iq.csv"),
@@ -107,6 +116,25 @@ fn outputs_follow_their_schemas() {
         base,
     ]);
     assert_valid(&c, &serde_json::from_str(&out).unwrap(), "many samples with a baseline");
+    // Recipes that state uncertainties: each comparison's prediction_uncertainty, its budget, and the
+    // allowance's parts.
+    let (code, out) = gm(&[
+        "compare",
+        "fixtures/sheets/byk-smart-chart-two-samples.csv",
+        "--recipe",
+        "Black 2K=fixtures/uncertainty/solid-black.json",
+        "--recipe",
+        "Satin white=fixtures/uncertainty/semigloss-white.json",
+        "--format",
+        "json",
+    ]);
+    assert_eq!(code, 0, "{out}");
+    let doc: Value = serde_json::from_str(&out).unwrap();
+    assert!(
+        doc["comparisons"][0]["uncertainty_budget"].is_array()
+            && doc["comparisons"][0]["allowance"]["parts"].is_array()
+    );
+    assert_valid(&c, &doc, "stated uncertainties");
     let s = schema("sweep");
     let (code, out) = gm(&[
         "sweep",

@@ -263,7 +263,13 @@ pub(crate) fn run_plan(
 ) -> PyResult<Vec<Reading>> {
     let run = move || {
         guarded(|| {
-            let material = Material { name: String::new(), file: String::new(), brdf, json: serde_json::Value::Null };
+            let material = Material {
+                name: String::new(),
+                file: String::new(),
+                brdf,
+                json: serde_json::Value::Null,
+                uncertainty: vec![],
+            };
             glossmeter::api::measure(&material, &geos, &options).map_err(to_py_err)
         })
     };

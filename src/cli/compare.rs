@@ -273,12 +273,39 @@ fn table(sheet: &Sheet, cmp: &[Comparison], rule: &VerdictRule, drift: &[Drift],
     for m in &materials {
         s.push_str(&format!("sample {m}\n"));
     }
+    // With a recipe's stated uncertainties, the prediction's own uncertainty u_pred joins the mean's spread
+    // (docs/instrument.md §The prediction's uncertainty).
+    let spread = if cmp.iter().any(|c| c.prediction_uncertainty.is_some()) {
+        format!("{}·√(s²/n + u_pred²)", rule.k)
+    } else {
+        format!("{}·s/√n", rule.k)
+    };
     s.push_str(&format!(
         "difference = predicted − measured; num. error = the prediction's numerical error estimate\nallowance = \
-         {}·s/√n + stated uncertainty + num. error\n{}\n",
-        rule.k,
+         {spread} + stated uncertainty + num. error\n{}\n",
         summary(cmp)
     ));
+    for c in cmp {
+        if let (Some(u), Some(a)) = (&c.prediction_uncertainty, &c.allowance) {
+            notes.push(format!(
+                "line {} ({} {} {}): u_pred = {:.3} from {}; allowance {:.3} = {:.3} + {:.3} + {:.1e}",
+                c.group.lines[0],
+                c.group.sample,
+                c.group.geometry,
+                c.group.reading,
+                u.u,
+                u.contributions
+                    .iter()
+                    .map(|p| format!("{} ({:.3})", p.pointer, p.contribution))
+                    .collect::<Vec<_>>()
+                    .join(", "),
+                a.total(),
+                a.random,
+                a.stated,
+                a.prediction
+            ));
+        }
+    }
     if sheet.statistics_checked > 0 {
         s.push_str(&format!(
             "statistics: {} stated value(s) (mean, std, min, max, range columns) agree with the readings\n",

@@ -2,10 +2,31 @@
 //! readings, the tolerance envelope, durations. A reading without a finite value is printed as "—", with the
 //! reason: never as NaN or inf.
 use crate::cli::common::pad_table;
+use crate::comparison::propagation::PredictionUncertainty;
 use crate::instrument::envelope::Envelopes;
 use crate::instrument::plan::Reading;
 use crate::recipe::Material;
 use crate::report::{decimals, shown};
+
+/// The prediction uncertainties of a recipe that states uncertainties of its numbers, one line per reading with
+/// its largest contribution (docs/instrument.md §The prediction's uncertainty); empty without them.
+pub fn uncertainty_text(readings: &[Reading], uncertainties: &[Option<PredictionUncertainty>]) -> String {
+    if uncertainties.iter().all(Option::is_none) {
+        return String::new();
+    }
+    let mut s =
+        String::from("\nPrediction uncertainty (standard, from the recipe's stated uncertainties, first order):\n");
+    for (r, u) in readings.iter().zip(uncertainties) {
+        let Some(u) = u else { continue };
+        let largest = u.contributions.iter().max_by(|a, b| a.contribution.total_cmp(&b.contribution));
+        s.push_str(&format!("  {} {}: u_pred = {:.2} {}", r.geometry, r.name, u.u, r.unit));
+        if let Some(c) = largest {
+            s.push_str(&format!(" (largest part: {} ± {}, {:.2} {})", c.pointer, c.u, c.contribution, r.unit));
+        }
+        s.push('\n');
+    }
+    s
+}
 
 /// A duration for people: µs, ms or s.
 pub fn secs(s: f64) -> String {

@@ -169,6 +169,11 @@ fn dispatch(cli: Cli, #[allow(unused_variables)] serve: Serve) -> Result<()> {
             let run = plan.run_until(deadline);
             let evaluations = run.evaluations();
             let readings = run.readings;
+            // The recipe's stated uncertainties propagated to each reading (nothing is run without them).
+            let uncertainties = match format {
+                Format::Csv => vec![],
+                _ => crate::comparison::propagation::propagate(&material, &geos, &options, &readings)?,
+            };
             let envelopes = if envelope {
                 Some(crate::instrument::envelope::read(material.brdf.clone(), &geos, &readings, options, deadline)?)
             } else {
@@ -178,12 +183,18 @@ fn dispatch(cli: Cli, #[allow(unused_variables)] serve: Serve) -> Result<()> {
                 .as_deref()
                 .map(|b| crate::comparison::check_baseline(readings.iter().map(|r| (material.name.as_str(), r)), b));
             text.push_str(&match (format, &envelopes) {
-                (Format::Table, None) => format::table(&material, &readings, !no_timing),
+                (Format::Table, None) => {
+                    format::table(&material, &readings, !no_timing)
+                        + &format::uncertainty_text(&readings, &uncertainties)
+                }
                 (Format::Table, Some(e)) => {
-                    format::table(&material, &readings, !no_timing) + &format::envelope_table(&readings, e)
+                    format::table(&material, &readings, !no_timing)
+                        + &format::uncertainty_text(&readings, &uncertainties)
+                        + &format::envelope_table(&readings, e)
                 }
                 (Format::Json, e) => {
                     let doc = report::measure::json_doc(&material, &readings, !no_timing, evaluations)
+                        .with_uncertainties(&uncertainties)
                         .with_baseline(drift.as_deref(), baseline_file.clone());
                     match e {
                         None => doc,
@@ -309,6 +320,14 @@ fn measure_batch(
             t
         }
         Format::Json => report::measure::batch_json_doc(&materials, &readings, how.timing, &evaluations)
+            // The recipes' stated uncertainties propagated to their readings (nothing is run without them).
+            .with_uncertainties(
+                &materials
+                    .iter()
+                    .zip(&readings)
+                    .map(|(m, rs)| crate::comparison::propagation::propagate(m, &geos, options, rs))
+                    .collect::<Result<Vec<_>>>()?,
+            )
             .with_baseline(drift.as_deref(), how.baseline.as_ref().map(|(_, f)| f.clone()))
             .text(),
         Format::Csv => report::measure::batch_csv(&materials, &readings, how.timing)?,

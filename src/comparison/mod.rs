@@ -8,14 +8,19 @@
 //! The allowance is
 //!
 //! ```text
-//! A = k·s/√n + u,      inside ⇔ |P − x̄| ≤ A + e_P,
+//! A = k·√(s²/n + u_pred²) + u,      inside ⇔ |P − x̄| ≤ A + e_P,
 //! ```
 //!
-//! k·s/√n being k standard errors of the mean (k = 2 by default, about 95 % for a normal mean) and u the
+//! k·s/√n being k standard errors of the mean (k = 2 by default, about 95 % for a normal mean), u_pred the
+//! prediction's own standard uncertainty, propagated from the standard uncertainties the recipe states for its
+//! numbers ([`propagation`]; 0 without them, when the first part is k·s/√n itself, the same bits), and u the
 //! stated uncertainty (the largest of the rows' `uncertainty`, else the reading's tolerance: the most specific
 //! `--tolerance` key naming it, `astm-e430-30/doi=3` before `doi=3` before a plain `3`,
-//! [`VerdictRule::tolerance_for`]). With n = 1 and no stated
-//! uncertainty there is no allowance: the row is unchecked, which fails the check like an outside row.
+//! [`VerdictRule::tolerance_for`]). The mean's spread and the prediction's uncertainty are independent
+//! standard uncertainties of the difference P − x̄, so they add in quadrature before the coverage factor k
+//! (docs/instrument.md §The prediction's uncertainty); the stated tolerance and the numerical error are bounds
+//! and add linearly. With n = 1, no stated uncertainty and no u_pred there is no allowance: the row is
+//! unchecked, which fails the check like an outside row.
 //!
 //! The folder:
 //! * `mod.rs`: the statistics of repeated readings ([`statistics`], [`group_rows`]), the verdict rule
@@ -30,7 +35,10 @@
 //!   two helpers:
 //! * [`workbook`]: one sheet of an `.xlsx`/`.xls`/`.ods` workbook (calamine) as the text the sheet reader reads;
 //! * [`series`]: the makers' statistics columns (`Mean 20°`, `Std 20°`, min, max, range) and their check
-//!   against the repeated readings.
+//!   against the repeated readings;
+//! * [`propagation`]: the prediction's uncertainty, the recipe's stated parameter uncertainties propagated to
+//!   every reading to first order ([`propagation::propagate`]).
+pub mod propagation;
 pub mod series;
 pub mod sheet;
 pub mod workbook;
@@ -40,6 +48,7 @@ use std::path::{Path, PathBuf};
 
 use rayon::prelude::*;
 
+use self::propagation::PredictionUncertainty;
 use self::sheet::{Layout, Sheet, SheetOptions, SheetRow};
 use crate::error::Words;
 use crate::instrument::plan::{Plan, PlanOptions, Reading};
@@ -317,6 +326,12 @@ impl VerdictRule {
 pub struct Allowance {
     /// k·s/√n.
     pub statistical: f64,
+    /// u_pred: the prediction's standard uncertainty propagated from the recipe's stated uncertainties (0
+    /// without them).
+    pub prediction_uncertainty: f64,
+    /// k·√(s²/n + u_pred²): the mean's spread and the prediction's uncertainty combined; `statistical`
+    /// itself (the same bits) when u_pred = 0.
+    pub random: f64,
     /// The stated uncertainty (or the tolerance).
     pub stated: f64,
     /// The prediction's error estimate, plus its data uncertainty when the material is a measured table (the
@@ -326,8 +341,26 @@ pub struct Allowance {
 }
 
 impl Allowance {
+    /// The allowance of k, the standard error of the mean s/√n (`statistical` is k·s/√n as the caller computed
+    /// it), u_pred, the stated uncertainty and the prediction's numerical error.
+    pub fn new(k: f64, statistical: f64, standard_error: f64, u_pred: f64, stated: f64, prediction: f64) -> Self {
+        let random =
+            if u_pred > 0.0 { k * (standard_error * standard_error + u_pred * u_pred).sqrt() } else { statistical };
+        Allowance { statistical, prediction_uncertainty: u_pred, random, stated, prediction }
+    }
+
     pub fn total(&self) -> f64 {
-        self.statistical + self.stated + self.prediction
+        self.random + self.stated + self.prediction
+    }
+
+    /// The parts that add up to [`Allowance::total`], in the order they are added: (name, formula, value).
+    pub fn parts(&self) -> [(&'static str, &'static str, f64); 3] {
+        let random = if self.prediction_uncertainty > 0.0 {
+            ("statistical and prediction uncertainty", "k·√(s²/n + u_pred²)", self.random)
+        } else {
+            ("statistical", "k·s/√n", self.random)
+        };
+        [random, ("stated", "stated uncertainty or tolerance", self.stated), ("numerical", "e_P", self.prediction)]
     }
 }
 
@@ -377,6 +410,8 @@ pub struct Comparison {
     pub recipe: String,
     pub group: Group,
     pub predicted: Option<Reading>,
+    /// The prediction's uncertainty from the recipe's stated uncertainties (None without them).
+    pub prediction_uncertainty: Option<PredictionUncertainty>,
     pub allowance: Option<Allowance>,
     pub verdict: Verdict,
 }
@@ -388,46 +423,60 @@ impl Comparison {
     }
 }
 
-/// The verdict of one group against the readings of its material.
-pub fn judge(group: Group, material: &Material, readings: &[Reading], rule: &VerdictRule) -> Comparison {
-    let mk = |predicted, allowance, verdict| Comparison {
+/// The verdict of one group against the readings of its material and their prediction uncertainties
+/// (`uncertainties[i]` of `readings[i]`; an empty slice when the recipe states none).
+pub fn judge(
+    group: Group,
+    material: &Material,
+    readings: &[Reading],
+    uncertainties: &[Option<PredictionUncertainty>],
+    rule: &VerdictRule,
+) -> Comparison {
+    let mk = |predicted, pu: Option<PredictionUncertainty>, allowance, verdict| Comparison {
         material: material.name.clone(),
         recipe: material.file.clone(),
         group: group.clone(),
         predicted,
+        prediction_uncertainty: pu,
         allowance,
         verdict,
     };
     if let Some(why) = &group.not_predicted {
-        return mk(None, None, Verdict::NotPredicted(why.clone()));
+        return mk(None, None, None, Verdict::NotPredicted(why.clone()));
     }
     let found = readings
         .iter()
-        .find(|r| r.geometry == group.geometry && (r.name == group.reading || r.quantity == group.reading))
-        .cloned();
-    let Some(p) = found else {
+        .position(|r| r.geometry == group.geometry && (r.name == group.reading || r.quantity == group.reading));
+    let Some(i) = found else {
         return mk(
+            None,
             None,
             None,
             Verdict::NotPredicted(format!("`{}` has no reading `{}`", group.geometry, group.reading)),
         );
     };
+    let p = readings[i].clone();
+    let pu = uncertainties.get(i).cloned().flatten();
     let s = group.stats;
     let stated = group.uncertainty.or_else(|| rule.tolerance_for(&p.geometry, &p.name, &p.quantity));
     let Some(v) = p.value else {
         let why = p.problem.clone().unwrap_or_else(|| "no finite value".into());
-        return mk(Some(p), None, Verdict::NoValue(why));
+        return mk(Some(p), pu, None, Verdict::NoValue(why));
     };
-    if s.n < 2 && stated.is_none() {
-        return mk(Some(p), None, Verdict::NoAllowance);
+    let u_pred = pu.as_ref().map_or(0.0, |u| u.u);
+    if s.n < 2 && stated.is_none() && !(u_pred > 0.0) {
+        return mk(Some(p), pu, None, Verdict::NoAllowance);
     }
-    let a = Allowance {
-        statistical: rule.k * s.std / (s.n as f64).sqrt(),
-        stated: stated.unwrap_or(0.0),
-        prediction: p.error_estimate + p.data_uncertainty.unwrap_or(0.0),
-    };
+    let a = Allowance::new(
+        rule.k,
+        rule.k * s.std / (s.n as f64).sqrt(),
+        s.std / (s.n as f64).sqrt(),
+        u_pred,
+        stated.unwrap_or(0.0),
+        p.error_estimate + p.data_uncertainty.unwrap_or(0.0),
+    );
     let verdict = if (v - s.mean).abs() <= a.total() { Verdict::Inside } else { Verdict::Outside };
-    mk(Some(p), Some(a), verdict)
+    mk(Some(p), pu, Some(a), verdict)
 }
 
 /// Where each sample's recipe comes from: `--recipe SAMPLE=FILE` first, then `DIR/<sample>.json`, then the
@@ -576,17 +625,22 @@ fn judge_all(
         }
         ids
     };
-    let readings: Vec<Vec<Reading>> = materials
+    type Predicted = (Vec<Reading>, Vec<Option<PredictionUncertainty>>);
+    let predicted: Vec<Predicted> = materials
         .par_iter()
         .enumerate()
         .map(|(i, m)| {
             let geos: Vec<StandardGeometry> = geometry_ids_of(i).iter().map(|id| geometries[id].clone()).collect();
             if geos.is_empty() {
-                return Ok(vec![]);
+                return Ok((vec![], vec![]));
             }
-            Ok(Plan::compile(m.brdf.clone(), geos, options.clone())?.execute())
+            let readings = Plan::compile(m.brdf.clone(), geos.clone(), options.clone())?.execute();
+            // Nothing more is run for a recipe without an `uncertainty` block.
+            let uncertainties = propagation::propagate(m, &geos, options, &readings)?;
+            Ok((readings, uncertainties))
         })
         .collect::<Result<_>>()?;
+    let (readings, uncertainties): (Vec<_>, Vec<_>) = predicted.into_iter().unzip();
     let mut out = Vec::with_capacity(groups.len());
     for mut g in groups {
         let i = material_of(&g.sample).expect("every sample has a recipe");
@@ -609,7 +663,7 @@ fn judge_all(
                 ),
             ));
         }
-        out.push(judge(g, &materials[i], &readings[i], rule));
+        out.push(judge(g, &materials[i], &readings[i], &uncertainties[i], rule));
     }
     rule.check_every_key_used(&out)?;
     Ok(out)
@@ -834,17 +888,62 @@ mod tests {
         let g = group(&[89.0, 91.0, 89.0, 91.0], None);
         assert!((g.stats.std - (4.0f64 / 3.0).sqrt()).abs() < 1e-15);
         let s = g.stats.std;
-        let c = judge(g.clone(), &m, &[reading(Some(90.0 + 2.0 * s / 2.0 + 0.1 - 1e-9), 0.1)], &rule);
+        let c = judge(g.clone(), &m, &[reading(Some(90.0 + 2.0 * s / 2.0 + 0.1 - 1e-9), 0.1)], &[], &rule);
         assert_eq!(c.verdict, Verdict::Inside);
-        let c = judge(g.clone(), &m, &[reading(Some(90.0 + 2.0 * s / 2.0 + 0.1 + 1e-9), 0.1)], &rule);
+        let c = judge(g.clone(), &m, &[reading(Some(90.0 + 2.0 * s / 2.0 + 0.1 + 1e-9), 0.1)], &[], &rule);
         assert_eq!(c.verdict, Verdict::Outside);
         // The stated uncertainty adds.
-        let c = judge(group(&[90.0], Some(0.5)), &m, &[reading(Some(90.55), 0.1)], &rule);
+        let c = judge(group(&[90.0], Some(0.5)), &m, &[reading(Some(90.55), 0.1)], &[], &rule);
         assert_eq!((c.verdict, c.allowance.unwrap().total()), (Verdict::Inside, 0.6));
-        assert_eq!(judge(group(&[90.0], None), &m, &[reading(Some(99.0), 0.1)], &rule).verdict, Verdict::NoAllowance);
+        assert_eq!(
+            judge(group(&[90.0], None), &m, &[reading(Some(99.0), 0.1)], &[], &rule).verdict,
+            Verdict::NoAllowance
+        );
         // A check that cannot be made fails.
-        assert!(judge(group(&[90.0], Some(1.0)), &m, &[reading(None, 0.0)], &rule).verdict.fails());
-        assert!(matches!(judge(group(&[90.0], Some(1.0)), &m, &[], &rule).verdict, Verdict::NotPredicted(_)));
+        assert!(judge(group(&[90.0], Some(1.0)), &m, &[reading(None, 0.0)], &[], &rule).verdict.fails());
+        assert!(matches!(judge(group(&[90.0], Some(1.0)), &m, &[], &[], &rule).verdict, Verdict::NotPredicted(_)));
+    }
+
+    #[test]
+    fn the_prediction_uncertainty_adds_in_quadrature_to_the_means_spread() {
+        use propagation::{Contribution, Difference};
+        let m = recipe::parse_str(r#"{"model": "lambert", "albedo": 0.5}"#, "m.json").unwrap();
+        let rule = VerdictRule::default();
+        let pu = |u: f64| {
+            Some(PredictionUncertainty {
+                u,
+                contributions: vec![Contribution {
+                    pointer: "/albedo".into(),
+                    u: 0.01,
+                    sensitivity: u / 0.01,
+                    contribution: u,
+                    difference: Difference::Central,
+                }],
+            })
+        };
+        // The values 90 ± 1.2 (n = 4): s² = 5.76/3, s²/n = 0.48; u_pred = 0.8: k·√(s²/n + u²) = 2·√(0.48 + 0.64).
+        let g = group(&[88.8, 91.2, 88.8, 91.2], None);
+        let se = g.stats.std / 2.0;
+        assert!((se * se - 0.48).abs() < 1e-12);
+        let random = 2.0 * (0.48f64 + 0.64).sqrt();
+        let c = judge(g.clone(), &m, &[reading(Some(90.0 + random + 0.1 - 1e-9), 0.1)], &[pu(0.8)], &rule);
+        let a = c.allowance.unwrap();
+        assert!((a.total() - (random + 0.1)).abs() < 1e-12 && (a.random - random).abs() < 1e-12, "{a:?}");
+        assert!((a.statistical - 2.0 * se).abs() < 1e-12 && a.prediction_uncertainty == 0.8);
+        assert_eq!(c.verdict, Verdict::Inside);
+        assert_eq!(a.parts().iter().map(|p| p.2).sum::<f64>(), a.total());
+        let c = judge(g.clone(), &m, &[reading(Some(90.0 + random + 0.1 + 1e-9), 0.1)], &[pu(0.8)], &rule);
+        assert_eq!(c.verdict, Verdict::Outside);
+        // Without it the first row is outside: k·s/√n + e ≈ 1.49.
+        let c = judge(g.clone(), &m, &[reading(Some(90.0 + random + 0.1 - 1e-9), 0.1)], &[], &rule);
+        assert_eq!(c.verdict, Verdict::Outside);
+        // Without a prediction uncertainty the allowance is the old one, bit for bit.
+        let a0 = judge(g.clone(), &m, &[reading(Some(90.0), 0.1)], &[None], &rule).allowance.unwrap();
+        assert_eq!(a0.total().to_bits(), (2.0 * g.stats.std / 2.0 + 0.0 + 0.1).to_bits());
+        // One reading and no stated uncertainty: u_pred alone makes an allowance.
+        let c = judge(group(&[90.0], None), &m, &[reading(Some(91.5), 0.1)], &[pu(0.8)], &rule);
+        assert_eq!(c.verdict, Verdict::Inside);
+        assert!((c.allowance.unwrap().total() - (2.0 * 0.8 + 0.1)).abs() < 1e-12);
     }
 
     #[test]

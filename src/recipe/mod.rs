@@ -18,7 +18,9 @@
 //!   ([`measured::resolve`], [`measured::parse_merl`], [`measured::parse_rgl`], [`measured::parse_inplane`]);
 //! * `scatter.rs`: the `scatter` object (a Rayleigh–Rice halo on a smooth interface's mirror) of `paint`,
 //!   `cook-torrance-lobes` and `microfacet` recipes ([`scatter::parse_scatter`]);
-//! * `schema.rs`: the JSON Schema of the format, generated from the registry ([`schema::schema`]).
+//! * `schema.rs`: the JSON Schema of the format, generated from the registry ([`schema::schema`]);
+//! * `uncertainty.rs`: the `uncertainty` block, standard uncertainties of the recipe's numbers
+//!   ([`uncertainty::parse`] → [`uncertainty::Stated`]).
 use crate::brdf::conductor::SmoothConductor;
 use crate::brdf::dielectric::{Ior, MicrofacetSurface, SmoothDielectric};
 use crate::brdf::halo::WithHalo;
@@ -45,6 +47,7 @@ pub mod measured;
 pub mod paint;
 pub mod scatter;
 pub mod schema;
+pub mod uncertainty;
 
 pub use crate::registry::{MAX_LOBES, MODELS};
 
@@ -65,6 +68,8 @@ pub struct Material {
     pub brdf: Arc<dyn Brdf>,
     /// The recipe as read (for reports).
     pub json: Value,
+    /// The standard uncertainties its `uncertainty` block states (empty without one; [`uncertainty`]).
+    pub uncertainty: Vec<uncertainty::Stated>,
 }
 
 /// Read and validate a recipe file. I/O errors name the file.
@@ -77,9 +82,11 @@ pub fn load_file(path: &std::path::Path) -> Result<Material> {
 /// Validate recipe text; `file` names it in messages.
 pub fn parse_str(text: &str, file: &str) -> Result<Material> {
     let json = parse_json(text, file)?;
-    let (name, brdf) = {
+    let (name, brdf, uncertainty) = {
         let obj = Obj::new(file, "", &json)?;
         let brdf = parse_brdf(&obj)?;
+        let model = obj.str("model")?;
+        let uncertainty = uncertainty::parse(&json, file, model)?;
         let name = match obj.opt_str("name")? {
             Some(n) => n.to_string(),
             None => std::path::Path::new(file)
@@ -87,9 +94,9 @@ pub fn parse_str(text: &str, file: &str) -> Result<Material> {
                 .map(|s| s.to_string_lossy().into_owned())
                 .unwrap_or_else(|| file.to_string()),
         };
-        (name, brdf)
+        (name, brdf, uncertainty)
     };
-    Ok(Material { name, file: file.to_string(), brdf, json })
+    Ok(Material { name, file: file.to_string(), brdf, json, uncertainty })
 }
 
 /// Validate the root object of a recipe into its BRDF.

@@ -110,6 +110,13 @@ fn node(model: &str, e: &Param) -> Value {
         Type::Bool => json!({"type": "boolean"}),
         Type::Text => json!({"type": "string"}),
         Type::Notes => json!({"oneOf": [{"type": "string"}, array_of(json!({"type": "string"}))]}),
+        // Its keys are JSON Pointers to the recipe's numbers, not fields (`recipe::uncertainty` checks each
+        // against the registry).
+        Type::Object if e.pointer == registry::UNCERTAINTY.pointer => json!({
+            "type": "object",
+            "propertyNames": {"pattern": "^/"},
+            "additionalProperties": {"type": "number", "exclusiveMinimum": 0},
+        }),
         Type::Object => object(model, e.pointer),
         Type::Objects => {
             let mut a = json!({"type": "array", "items": object(model, &format!("{}/*", e.pointer))});

@@ -7,26 +7,47 @@ use std::path::Path;
 use schemars::JsonSchema;
 use serde::Serialize;
 
-use super::{csv_text, pretty, to_json, BaselineDoc};
+use super::{csv_text, pretty, to_json, BaselineDoc, BudgetLineDoc};
 use crate::comparison::sheet::{self, Sheet};
 use crate::comparison::{ColourDifference, Comparison, Drift, Verdict, VerdictRule};
 use crate::Result;
 
-/// The allowed difference of a comparison: its parts and their total.
+/// The allowed difference of a comparison: its parts and their total, total = random + stated + prediction
+/// (docs/instrument.md §The prediction's uncertainty).
 #[derive(Clone, Debug, Serialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct AllowanceDoc {
     /// k·s/√n.
     #[schemars(range(min = 0))]
     pub statistical: f64,
+    /// u_pred, the prediction's standard uncertainty from the recipe's stated uncertainties (0 without them).
+    #[schemars(range(min = 0))]
+    pub prediction_uncertainty: f64,
+    /// k·√(s²/n + u_pred²), the part that enters the total: `statistical` when u_pred = 0.
+    #[schemars(range(min = 0))]
+    pub random: f64,
     /// The stated uncertainty (or the tolerance).
     #[schemars(range(min = 0))]
     pub stated: f64,
-    /// The prediction's error estimate.
+    /// The prediction's error estimate (the numerical error, with a measured table's data uncertainty).
     #[schemars(range(min = 0))]
     pub prediction: f64,
     #[schemars(range(min = 0))]
     pub total: f64,
+    /// The parts added to make the total, in order, each named with its formula.
+    pub parts: Vec<AllowancePartDoc>,
+}
+
+/// One part of an allowance.
+#[derive(Clone, Debug, Serialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct AllowancePartDoc {
+    #[schemars(extend("enum" = ["statistical", "statistical and prediction uncertainty", "stated", "numerical"]))]
+    pub name: String,
+    /// How it is computed (`k·√(s²/n + u_pred²)`, ...).
+    pub formula: String,
+    #[schemars(range(min = 0))]
+    pub value: f64,
 }
 
 /// One compared (sample, reading): the sheet's values and statistics, the prediction, the allowance and the
@@ -56,6 +77,14 @@ pub struct ComparisonDoc {
     pub uncertainty: Option<f64>,
     pub predicted: Option<f64>,
     pub error_estimate: Option<f64>,
+    /// When the recipe states uncertainties of its numbers: the prediction's standard uncertainty u_pred
+    /// (docs/instrument.md §The prediction's uncertainty).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    #[schemars(range(min = 0))]
+    pub prediction_uncertainty: Option<f64>,
+    /// With `prediction_uncertainty`: each stated number's share of it.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub uncertainty_budget: Option<Vec<BudgetLineDoc>>,
     /// predicted − measured mean.
     pub difference: Option<f64>,
     pub allowance: Option<AllowanceDoc>,
@@ -91,12 +120,25 @@ impl ComparisonDoc {
             uncertainty: c.group.uncertainty,
             predicted: p.and_then(|p| p.value),
             error_estimate: p.filter(|p| p.value.is_some()).map(|p| p.error_estimate),
+            prediction_uncertainty: c.prediction_uncertainty.as_ref().map(|u| u.u),
+            uncertainty_budget: c.prediction_uncertainty.as_ref().map(BudgetLineDoc::budget),
             difference: c.difference(),
             allowance: c.allowance.map(|a| AllowanceDoc {
                 statistical: a.statistical,
+                prediction_uncertainty: a.prediction_uncertainty,
+                random: a.random,
                 stated: a.stated,
                 prediction: a.prediction,
                 total: a.total(),
+                parts: a
+                    .parts()
+                    .iter()
+                    .map(|(name, formula, value)| AllowancePartDoc {
+                        name: (*name).into(),
+                        formula: (*formula).into(),
+                        value: *value,
+                    })
+                    .collect(),
             }),
             verdict: c.verdict.label().into(),
             inside: match c.verdict {

@@ -73,9 +73,10 @@ pub fn message(c: &Comparison) -> String {
         g(c.difference()),
         c.allowance
             .map(|a| format!(
-                "{} = {} (k·s/√n) + {} (stated) + {} (prediction)",
+                "{} = {} ({}) + {} (stated) + {} (prediction)",
                 report::measured(a.total()),
-                report::measured(a.statistical),
+                report::measured(a.random),
+                if a.prediction_uncertainty > 0.0 { "k·√(s²/n + u_pred²)" } else { "k·s/√n" },
                 report::measured(a.stated),
                 report::error_text(a.prediction)
             ))

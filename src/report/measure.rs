@@ -5,6 +5,7 @@ use schemars::JsonSchema;
 use serde::Serialize;
 
 use super::{csv_text, plain, pretty, to_json, BaselineDoc, ReadingDoc};
+use crate::comparison::propagation::PredictionUncertainty;
 use crate::comparison::Drift;
 use crate::instrument::envelope::Envelopes;
 use crate::instrument::plan::Reading;
@@ -65,6 +66,17 @@ impl MeasureDoc {
                 let cut = envelopes.cut.contains(&r.geometry);
                 r.with_envelope(e.as_ref(), cut)
             })
+            .collect();
+        self
+    }
+
+    /// Add each reading's prediction uncertainty (`uncertainties[i]` of reading i; `comparison::propagation`).
+    pub fn with_uncertainties(mut self, uncertainties: &[Option<PredictionUncertainty>]) -> MeasureDoc {
+        self.readings = self
+            .readings
+            .into_iter()
+            .enumerate()
+            .map(|(i, r)| r.with_uncertainty(uncertainties.get(i).and_then(Option::as_ref)))
             .collect();
         self
     }
@@ -208,6 +220,17 @@ pub fn batch_json_doc(
 }
 
 impl BatchDoc {
+    /// Add each reading's prediction uncertainty: `per_material[m][i]` of material m's reading i, as
+    /// `comparison::propagation::propagate` gives them (one per reading, in the order of [`batch_json_doc`]).
+    pub fn with_uncertainties(mut self, per_material: &[Vec<Option<PredictionUncertainty>>]) -> BatchDoc {
+        let flat: Vec<Option<&PredictionUncertainty>> =
+            per_material.iter().flat_map(|v| v.iter().map(Option::as_ref)).collect();
+        for (i, r) in self.readings.iter_mut().enumerate() {
+            r.reading = r.reading.clone().with_uncertainty(flat.get(i).copied().flatten());
+        }
+        self
+    }
+
     /// Add the baseline checks (when a baseline was given).
     pub fn with_baseline(mut self, drift: Option<&[Drift]>, file: Option<String>) -> BatchDoc {
         if let (Some(d), Some(file)) = (drift, file) {

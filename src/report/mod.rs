@@ -28,6 +28,7 @@ pub mod pictures;
 pub mod profile;
 pub mod schema;
 
+use crate::comparison::propagation::PredictionUncertainty;
 use crate::comparison::Drift;
 use crate::instrument::envelope::Envelope;
 use crate::instrument::plan::Reading;
@@ -260,6 +261,52 @@ pub struct ReadingDoc {
     #[serde(skip_serializing_if = "Option::is_none")]
     #[schemars(extend("const" = true))]
     pub envelope_cut: Option<bool>,
+    /// When the recipe states uncertainties of its numbers (its `uncertainty` block): the prediction's standard
+    /// uncertainty u_pred in the reading's unit, propagated to first order (docs/instrument.md §The
+    /// prediction's uncertainty). Separate from `error_estimate`, the numerical error.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    #[schemars(range(min = 0))]
+    pub prediction_uncertainty: Option<f64>,
+    /// With `prediction_uncertainty`: each stated number's share of it (u_pred² is the sum of the squared
+    /// contributions).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub uncertainty_budget: Option<Vec<BudgetLineDoc>>,
+}
+
+/// One line of a reading's uncertainty budget: a number of the recipe, its stated standard uncertainty, the
+/// reading's sensitivity to it and the contribution (docs/instrument.md §The prediction's uncertainty).
+#[derive(Clone, Debug, Serialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct BudgetLineDoc {
+    /// The JSON Pointer of the number in the recipe.
+    pub pointer: String,
+    /// Its stated standard uncertainty u(x), in its unit.
+    #[schemars(range(min = 0))]
+    pub u: f64,
+    /// ∂y/∂x by a difference with the step u(x): the reading's unit per the number's unit.
+    pub sensitivity: f64,
+    /// |∂y/∂x|·u(x), in the reading's unit.
+    #[schemars(range(min = 0))]
+    pub contribution: f64,
+    /// How the sensitivity was differenced: central, or one-sided where x ± u(x) leaves the number's range.
+    #[schemars(extend("enum" = ["central", "forward", "backward"]))]
+    pub difference: String,
+}
+
+impl BudgetLineDoc {
+    /// The budget of a prediction uncertainty.
+    pub fn budget(u: &PredictionUncertainty) -> Vec<BudgetLineDoc> {
+        u.contributions
+            .iter()
+            .map(|c| BudgetLineDoc {
+                pointer: c.pointer.clone(),
+                u: c.u,
+                sensitivity: c.sensitivity,
+                contribution: c.contribution,
+                difference: c.difference.label().into(),
+            })
+            .collect()
+    }
 }
 
 impl ReadingDoc {
@@ -281,7 +328,16 @@ impl ReadingDoc {
             envelope_max: None,
             envelope: None,
             envelope_cut: None,
+            prediction_uncertainty: None,
+            uncertainty_budget: None,
         }
+    }
+
+    /// With the prediction's uncertainty (None: the recipe states none, or the reading has no value).
+    pub fn with_uncertainty(mut self, u: Option<&PredictionUncertainty>) -> ReadingDoc {
+        self.prediction_uncertainty = u.map(|u| u.u);
+        self.uncertainty_budget = u.map(BudgetLineDoc::budget);
+        self
     }
 
     /// With the tolerance envelope of `measure --envelope` (`None`: the standard data give no tolerance).

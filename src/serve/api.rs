@@ -246,7 +246,11 @@ pub fn measure(req: &Request, ctx: Context) -> Result<Reply> {
     let plan = Plan::compile(material.brdf.clone(), geos, options)?;
     let run = plan.run();
     let evaluations = run.evaluations();
-    let doc = report::measure::json_doc(&material, &run.readings, timing, evaluations);
+    // The recipe's stated uncertainties propagated to each reading (nothing is run without them).
+    let uncertainties =
+        crate::comparison::propagation::propagate(&material, &plan.geometries, &plan.options, &run.readings)?;
+    let doc =
+        report::measure::json_doc(&material, &run.readings, timing, evaluations).with_uncertainties(&uncertainties);
     Ok(Reply::json(&report::to_json(&doc)))
 }
 
