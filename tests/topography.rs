@@ -110,6 +110,8 @@ fn the_command_prints_the_statistics_and_refuses_what_it_cannot_read() {
     assert_eq!(run(["glossmeter", "topography", csv, "--pixel-size", "1um", "--height-unit", "inch"]), 2);
     assert_eq!(run(["glossmeter", "topography", "fixtures/topography/gaussian.x3p", "--levelling", "poly9"]), 2);
     assert_eq!(run(["glossmeter", "topography", "fixtures/topography/missing.x3p"]), 2);
+    // The recipe of the same surface reads through the default panel.
+    assert_eq!(run(["glossmeter", "measure", "fixtures/topography/gaussian-panel.json"]), 0);
 }
 
 /// The error of reading `bytes` as `name`, and the command's exit status on the same file.
@@ -184,4 +186,102 @@ fn bad_files_exit_2_naming_the_file_and_the_field() {
     // Not a topography at all.
     let e = refused("noise.x3p", b"this is not a zip", &[]);
     assert!(e.contains("zip archive"), "{e}");
+}
+
+/// A periodic surface of `k` cosines of random direction, frequency and phase (SplitMix64, seeded), whose
+/// slopes are close to Gaussian (a sum of many independent terms), written as a GSF file of n × n points 1 µm
+/// apart, scaled to the rms slope `sdq`.
+fn random_cosines(path: &Path, n: usize, k: usize, sdq: f64, seed: u64) {
+    let mut state = seed;
+    let mut next = || {
+        state = state.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = state;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let terms: Vec<(f64, f64, f64)> = (0..k)
+        .map(|_| {
+            let (kx, ky) = ((next() * 25.0).floor() - 12.0, (next() * 25.0).floor() - 12.0);
+            let (kx, ky) = if kx == 0.0 && ky == 0.0 { (1.0, 0.0) } else { (kx, ky) };
+            (kx, ky, next() * 2.0 * std::f64::consts::PI)
+        })
+        .collect();
+    let mut z: Vec<f64> = Vec::with_capacity(n * n);
+    for j in 0..n {
+        for i in 0..n {
+            let t = |(kx, ky, ph): &(f64, f64, f64)| {
+                (2.0 * std::f64::consts::PI * (kx * i as f64 + ky * j as f64) / n as f64 + ph).cos()
+            };
+            z.push(terms.iter().map(t).sum::<f64>());
+        }
+    }
+    // Scale to the rms slope wanted (the cells' slopes, in units of 1 µm spacing).
+    let s = glossmeter::topography::slopes::slopes(&z, n, n, 1.0, 1.0, "s").unwrap().stats().sdq;
+    let mut b = b"Gwyddion Simple Field 1.0\n".to_vec();
+    b.extend_from_slice(
+        format!("XRes = {n}\nYRes = {n}\nXReal = {n}\nYReal = {n}\nXYUnits = um\nZUnits = um\n").as_bytes(),
+    );
+    let pad = 4 - b.len() % 4;
+    b.extend(std::iter::repeat_n(0u8, pad));
+    for v in &z {
+        b.extend_from_slice(&((v * sdq / s) as f32).to_le_bytes());
+    }
+    std::fs::write(path, b).unwrap();
+}
+
+#[test]
+fn the_facets_of_a_gaussian_slope_map_read_as_beckmann_of_the_same_rms_slope() {
+    use glossmeter::instrument::plan::PlanOptions;
+    use glossmeter::optics::slope_table::SlopeTable;
+    let map_path = tmp("cosines.gsf");
+    random_cosines(&map_path, 256, 400, 0.1, 41);
+    let recipe = tmp("cosines.json");
+    std::fs::write(&recipe, r#"{"model": "topography", "file": "cosines.gsf", "ior": 1.5, "levelling": "mean"}"#)
+        .unwrap();
+    let material = glossmeter::recipe::load_file(&recipe).unwrap();
+    // The same table, built here from the map, for its rms slope (the cells' Sdq widened by the kernel).
+    let map = glossmeter::topography::load(&map_path, None).unwrap();
+    let s = glossmeter::topography::slopes::slopes(&map.z, 256, 256, map.dx, map.dy, "m").unwrap();
+    let m = SlopeTable::from_slopes(&s.sx, &s.sy).unwrap().rms_slope();
+    assert!((m - 0.1).abs() < 0.01, "{m}");
+    let beckmann = glossmeter::recipe::parse_str(
+        &format!(r#"{{"model": "microfacet", "distribution": "beckmann", "roughness": {m}, "ior": 1.5}}"#),
+        "beckmann.json",
+    )
+    .unwrap();
+    let ids = ["astm-d523-20", "astm-d523-60", "astm-d523-85"];
+    let geos = glossmeter::resolve_geometries(&ids, &[] as &[&str]).unwrap();
+    let options = PlanOptions { rtol: 1e-5, ..PlanOptions::default() };
+    let a = glossmeter::measure(&material, &geos, &options).unwrap();
+    let b = glossmeter::measure(&beckmann, &geos, &options).unwrap();
+    for ((x, y), id) in a.iter().zip(&b).zip(ids) {
+        let (x, y) = (x.value.unwrap(), y.value.unwrap());
+        eprintln!("{id}: topography {x:.4} GU, Beckmann m = {m:.5} {y:.4} GU");
+        // The stated tolerance (docs/topography.md §The facet term of a measured surface): 3 % of the reading.
+        assert!((x - y).abs() < 0.03 * y, "{x} vs {y}");
+    }
+}
+
+#[test]
+fn a_topography_recipe_refuses_what_it_cannot_read() {
+    let dir = tmp("recipes");
+    std::fs::create_dir_all(&dir).unwrap();
+    let write = |name: &str, text: &str| {
+        let p = dir.join(name);
+        std::fs::write(&p, text).unwrap();
+        p
+    };
+    write("plain.csv", "1 2\n3 4\n");
+    let e = |text: &str| glossmeter::recipe::load_file(&write("r.json", text)).unwrap_err().to_string();
+    let csv = e(r#"{"model": "topography", "file": "plain.csv", "ior": 1.5}"#);
+    assert!(csv.contains("field `/file`") && csv.contains("carry their calibration"), "{csv}");
+    let missing = e(r#"{"model": "topography", "file": "none.x3p", "ior": 1.5}"#);
+    assert!(missing.contains("field `/file`") && missing.contains("cannot read"), "{missing}");
+    let x3p = std::fs::canonicalize(format!("{DIR}/gaussian.x3p")).unwrap();
+    let ok = format!(r#"{{"model": "topography", "file": "{}", "ior": 1.5}}"#, x3p.display());
+    assert!(glossmeter::recipe::load_file(&write("ok.json", &ok)).is_ok());
+    assert!(e(&ok.replace("1.5}", "1.5, \"levelling\": \"poly9\"}")).contains("field `/levelling`"));
+    assert!(e(&ok.replace("1.5}", "0.5}")).contains("field `/ior`"));
+    assert!(e(&ok.replace("1.5}", "1.5, \"roughness\": 0.1}")).contains("unknown field"));
 }
