@@ -285,3 +285,22 @@ fn a_topography_recipe_refuses_what_it_cannot_read() {
     assert!(e(&ok.replace("1.5}", "0.5}")).contains("field `/ior`"));
     assert!(e(&ok.replace("1.5}", "1.5, \"roughness\": 0.1}")).contains("unknown field"));
 }
+
+#[test]
+fn the_picture_is_drawn_and_never_overwritten() {
+    let (svg, png) = (tmp("map.svg"), tmp("map.png"));
+    let _ = std::fs::remove_file(&svg);
+    let _ = std::fs::remove_file(&png);
+    let x3p = "fixtures/topography/gaussian-masked.x3p";
+    assert_eq!(run(["glossmeter", "topography", x3p, "--plot", svg.to_str().unwrap()]), 0);
+    let text = std::fs::read_to_string(&svg).unwrap();
+    assert!(text.contains("<svg") && text.contains("radial PSD"), "{}", &text[..200.min(text.len())]);
+    assert_eq!(run(["glossmeter", "topography", x3p, "--plot", png.to_str().unwrap()]), 0);
+    let img = image::open(&png).unwrap();
+    assert_eq!((img.width(), img.height()), (1200, 560));
+    // An existing picture is not replaced, and nothing is written.
+    let before = std::fs::read(&png).unwrap();
+    assert_eq!(run(["glossmeter", "topography", x3p, "--plot", png.to_str().unwrap()]), 2);
+    assert_eq!(std::fs::read(&png).unwrap(), before);
+    assert_eq!(run(["glossmeter", "topography", x3p, "--plot", "map.gif"]), 2);
+}

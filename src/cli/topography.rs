@@ -1,16 +1,18 @@
 //! `glossmeter topography FILE`: a measured topography (X3P, SDF, GSF, or a text matrix with its calibration)
 //! read, levelled and described: the map, the ISO 25178-2 height and slope parameters, the slope-angle
 //! distribution and the radial PSD (docs/topography.md), as a table for people or the JSON document
-//! (`report::topography`). The computation is `request::TopographyRequest::read`; this module parses, formats
+//! (`report::topography`), and optionally a picture of the levelled height map and the radial PSD
+//! (`report::pictures::topography`). The computation is `request::TopographyRequest::read`; this module parses, formats
 //! and writes.
 use std::path::PathBuf;
 
 use super::common::pad_table;
 use super::output::OutputTarget;
+use crate::report::pictures::topography::draw;
 use crate::report::topography::TopographyDoc;
 use crate::request::TopographyRequest;
 use crate::topography::map::MAX_FILE_BYTES;
-use crate::Result;
+use crate::{Error, Result};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum TopographyFormat {
@@ -41,6 +43,9 @@ pub struct TopographyArgs {
     /// Write the result to this new file instead of stdout (refuses to overwrite).
     #[arg(long, short = 'o')]
     pub output: Option<PathBuf>,
+    /// Also draw the levelled height map and the radial PSD to this new .svg or .png file.
+    #[arg(long, value_name = "FILE.svg")]
+    pub plot: Option<PathBuf>,
 }
 
 /// The request of a command line (the one place where `topography`'s arguments become the library's).
@@ -59,6 +64,12 @@ pub fn run(args: TopographyArgs) -> Result<()> {
     req.levelling()?;
     req.calibration()?;
     let target = OutputTarget::new(args.output.as_deref(), "--output")?;
+    if let Some(p) = &args.plot {
+        super::plot::check_plot_path(p, "--plot")?;
+        if args.output.as_deref() == Some(p.as_path()) {
+            return Err(Error::Usage(format!("--plot and --output name the same file {}", p.display())));
+        }
+    }
     let file = crate::input::name(&args.file);
     let bytes = crate::input::read_bytes_limited(&args.file, "topography", MAX_FILE_BYTES)?;
     let ext = args.file.extension().map(|e| e.to_string_lossy().to_ascii_lowercase()).unwrap_or_default();
@@ -68,6 +79,11 @@ pub fn run(args: TopographyArgs) -> Result<()> {
         TopographyFormat::Json => doc.text(),
         TopographyFormat::Table => table(&doc),
     };
+    if let Some(p) = &args.plot {
+        let title = format!("{} ({}, levelling {})", map.file, map.format.name(), doc.levelling);
+        crate::render_plot!(p, "--plot", (1200, 560), |root| draw(root, &map, &analysis, &doc, &title))?;
+        eprintln!("plot: {} ({} × {} points)", p.display(), map.nx, map.ny);
+    }
     target.write(&text)
 }
 

@@ -13,6 +13,8 @@ pub struct Analysis {
     pub levelling: Levelling,
     /// The tilt removed (dz/dx, dz/dy).
     pub tilt: [f64; 2],
+    /// The levelled heights, metres (NaN: invalid), as the map's.
+    pub levelled: Vec<f64>,
     pub heights: Heights,
     pub slopes: Slopes,
     pub slope_stats: SlopeStats,
@@ -25,5 +27,5 @@ pub fn analyse(map: &HeightMap, levelling: Levelling) -> Result<Analysis> {
     let h = heights(&l.z, &map.file)?;
     let s = slopes(&l.z, map.nx, map.ny, map.dx, map.dy, &map.file)?;
     let p = psd(&l.z, map.nx, map.ny, map.dx, map.dy);
-    Ok(Analysis { levelling, tilt: l.tilt, heights: h, slope_stats: s.stats(), slopes: s, psd: p })
+    Ok(Analysis { levelling, tilt: l.tilt, levelled: l.z, heights: h, slope_stats: s.stats(), slopes: s, psd: p })
 }
