@@ -20,6 +20,8 @@
 //! * [`request`]: the front door: one typed request per action, owning its defaults and validation; the
 //!   command line, the server and Python only convert into them.
 //! * [`report`]: the readings as documents (JSON, JSON lines, CSV) and the JSON Schemas of the outputs.
+//! * [`topography`]: measured surface topographies (X3P, SDF, GSF, text matrices) read, levelled and described
+//!   (ISO 25178-2 parameters, slopes, PSD).
 //! * [`comparison`]: predictions beside instrument sheets: statistics, verdicts, many samples, baselines.
 //! * `cli` (feature `cli`, on by default): the thin command-line layer. The library builds and works without
 //!   it and its dependencies (clap, plotters): `cargo build --lib --no-default-features`.
@@ -47,6 +49,7 @@ pub mod request;
 pub mod serve;
 pub mod spectrum;
 pub mod sweep;
+pub mod topography;
 
 pub use api::{measure, measure_file, resolve_geometries, resolve_geometries_or, DEFAULT_PANEL};
 pub use error::{Error, Result};

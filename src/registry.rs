@@ -38,6 +38,7 @@ pub const MODELS: &[&str] = &[
     "rgl",
     "inplane-csv",
     "e1392",
+    "topography",
 ];
 
 /// An interval of allowed values; either end open or closed. An infinite end is always open. The crate's one
@@ -926,6 +927,35 @@ pub const INPLANE_OFF_PLANE: Param = p(
     "the isotropy assumption off the plane: f: f_r depends on (θh, θd) only (exact for a Lambertian); f-cos-cos: f_r·cos θi·cos θo does (exact for a microfacet lobe up to masking); microfacet: f_r·cos θi·cos θo/G2 does, G2 the Smith term of the table's own distribution (exact for an isotropic microfacet lobe with Smith masking)",
 );
 
+const TOPOGRAPHY: &[&str] = &["topography"];
+pub const TOPOGRAPHY_FILE: Param = p(
+    "/file",
+    TOPOGRAPHY,
+    Type::Text,
+    "",
+    NONE,
+    Req,
+    "path of the measured topography (.x3p, .sdf or .gsf: a file that carries its own lateral calibration), relative to the recipe's directory",
+);
+pub const TOPOGRAPHY_IOR: Param = p(
+    "/ior",
+    TOPOGRAPHY,
+    Type::Number,
+    "",
+    Some(DIELECTRIC_IOR_RANGE),
+    Req,
+    "real refractive index of the material beneath the surface (dielectric Fresnel)",
+);
+pub const TOPOGRAPHY_LEVELLING: Param = p(
+    "/levelling",
+    TOPOGRAPHY,
+    Type::Choice(&["mean", "plane", "poly2", "poly3", "poly4", "poly5"]),
+    "",
+    NONE,
+    Opt("\"plane\""),
+    "the reference surface removed before the slopes are read: the mean height, the least-squares plane or polynomial of that degree",
+);
+
 // ---------------------------------------------------------------------------------------------------------
 // Near-specular scatter: a Rayleigh–Rice halo from a surface PSD (docs/optics.md §Near-specular scatter), at
 // three places: the paint's clear coat, a Cook–Torrance model's clear coat, a smooth microfacet interface.
@@ -1162,6 +1192,10 @@ pub static PARAMS: &[&Param] = &[
     &INPLANE_FILE,
     &E1392_FILE,
     &INPLANE_OFF_PLANE,
+    // topography
+    &TOPOGRAPHY_FILE,
+    &TOPOGRAPHY_IOR,
+    &TOPOGRAPHY_LEVELLING,
 ];
 
 // ---------------------------------------------------------------------------------------------------------

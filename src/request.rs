@@ -1,5 +1,5 @@
 //! The front door (docs/architecture.md §The front door): one typed request per action (measure and explain,
-//! sweep, plot, profile, convergence, compare, fit). A request owns its defaults and its validation, with the
+//! sweep, plot, profile, convergence, compare, fit, topography). A request owns its defaults and its validation, with the
 //! messages every front end gives: an argument is named in the library's own words ([`Words`]), and each front
 //! end writes it its own way (the command line as its flag, `--rtol`; the server as the field of its body,
 //! `/rtol`; Python as the keyword). The command line's clap structs, the server's JSON bodies and Python's
@@ -21,6 +21,11 @@ use crate::instrument::plan::{rtol_refusal, Cancel, PlanOptions, DEFAULT_RTOL};
 use crate::instrument::profile;
 use crate::instrument::standards::StandardGeometry;
 use crate::sweep::{self, Sweep, SweepAxis, SweepDesign};
+use crate::topography::analysis::{analyse, Analysis};
+use crate::topography::level::Levelling;
+use crate::topography::map::HeightMap;
+use crate::topography::text::Calibration;
+use crate::topography::{self, units};
 use crate::{recipe, Error, Result};
 
 /// The illuminant of colour readings when none is given.
@@ -358,6 +363,81 @@ impl ProfileRequest {
             ));
         }
         Ok((options, profile::Budget { per_part: self.max_evals, total: self.max_total_evals }))
+    }
+}
+
+/// `topography`: a measured topography read, levelled and described (docs/topography.md).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct TopographyRequest {
+    /// The reference surface removed: `mean`, `plane` (the default), `poly2` … `poly5`.
+    pub levelling: Option<String>,
+    /// A plain matrix's point spacing, a length with its unit (`0.5um`); along x, and along y too unless
+    /// `pixel_size_y` is given.
+    pub pixel_size: Option<String>,
+    pub pixel_size_y: Option<String>,
+    /// A plain matrix's height unit (`um`, `nm`, ...).
+    pub height_unit: Option<String>,
+}
+
+impl TopographyRequest {
+    /// The levelling asked for.
+    pub fn levelling(&self) -> Result<Levelling> {
+        match self.levelling.as_deref() {
+            None => Ok(Levelling::Plane),
+            Some(s) => Levelling::parse(s).ok_or_else(|| {
+                Error::argument("levelling", format!(" must be one of {}, got `{s}`", Levelling::allowed()))
+            }),
+        }
+    }
+
+    /// A plain matrix's calibration: `None` unless the pixel size is given, which then needs the height unit.
+    pub fn calibration(&self) -> Result<Option<Calibration>> {
+        let length = |name: &'static str, v: &str| {
+            units::parse_length(v).ok_or_else(|| {
+                Error::argument(
+                    name,
+                    format!(" must be a length with its unit ({}), e.g. `0.5um`, got `{v}`", units::allowed()),
+                )
+            })
+        };
+        let Some(dx) = self.pixel_size.as_deref() else {
+            if self.pixel_size_y.is_some() || self.height_unit.is_some() {
+                return Err(Error::Argument(
+                    Words::argument("pixel_size_y")
+                        .and(" and ")
+                        .and_argument("height_unit")
+                        .and(" need ")
+                        .and_argument("pixel_size"),
+                ));
+            }
+            return Ok(None);
+        };
+        let dx = length("pixel_size", dx)?;
+        let dy = match self.pixel_size_y.as_deref() {
+            Some(v) => length("pixel_size_y", v)?,
+            None => dx,
+        };
+        let unit = self.height_unit.as_deref().ok_or_else(|| {
+            Error::Argument(
+                Words::argument("pixel_size")
+                    .and(" needs ")
+                    .and_argument("height_unit")
+                    .and(format!(" ({})", units::allowed())),
+            )
+        })?;
+        let z_unit = units::metres_per(unit).ok_or_else(|| {
+            Error::argument("height_unit", format!(" must be one of {}, got `{unit}`", units::allowed()))
+        })?;
+        Ok(Some(Calibration { dx, dy, z_unit }))
+    }
+
+    /// Read a topography file's bytes (`ext`: its extension, lower case) and describe it.
+    pub fn read(&self, bytes: &[u8], file: &str, ext: &str) -> Result<(HeightMap, Analysis)> {
+        let levelling = self.levelling()?;
+        let calibration = self.calibration()?;
+        let map = topography::from_bytes(bytes, file, ext, calibration)?;
+        let analysis = analyse(&map, levelling)?;
+        Ok((map, analysis))
     }
 }
 

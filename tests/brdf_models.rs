@@ -70,8 +70,9 @@ fn every_model_evaluates_finite_non_negative() {
     let materials = simple_materials();
     let models: std::collections::BTreeSet<_> = materials.iter().map(|m| m.json["model"].as_str().unwrap()).collect();
     // The measured tables other than MERL are evaluated by tests/measured_formats.rs (their synthetic files
-    // live in fixtures/materials/, not among the shipped recipes).
-    for m in recipe::MODELS.iter().filter(|m| !["paint", "rgl", "inplane-csv", "e1392"].contains(*m)) {
+    // live in fixtures/materials/, not among the shipped recipes), and measured topographies by
+    // tests/topography.rs (fixtures/topography/).
+    for m in recipe::MODELS.iter().filter(|m| !["paint", "rgl", "inplane-csv", "e1392", "topography"].contains(*m)) {
         assert!(models.contains(m), "no fixture for model {m}");
     }
     for m in &materials {

@@ -324,3 +324,24 @@ fn sheets_as_read_follow_their_schema() {
     let doc = glossmeter::report::to_json(&glossmeter::report::compare::SheetReadDoc::new(&sheet));
     assert_eq!(doc["sheet"], cmp["sheet"]);
 }
+
+#[test]
+fn topography_follows_its_schema() {
+    let s = schema("topography");
+    for file in ["fixtures/topography/gaussian.x3p", "fixtures/topography/gaussian-masked.x3p"] {
+        let (code, text) = gm(&["topography", file, "--format", "json"]);
+        assert_eq!(code, 0, "{file}");
+        let v: Value = serde_json::from_str(&text).unwrap();
+        assert_valid(&s, &v, file);
+    }
+    // A flat map has no skewness nor kurtosis: nulls, which the schema allows.
+    let flat = std::env::temp_dir().join(format!("glossmeter-schemas-flat-{}.csv", std::process::id()));
+    std::fs::write(&flat, "1 1 1\n1 1 1\n1 1 1\n").unwrap();
+    let (code, text) =
+        gm(&["topography", flat.to_str().unwrap(), "--format", "json", "--pixel-size", "1um", "--height-unit", "um"]);
+    assert_eq!(code, 0);
+    let v: Value = serde_json::from_str(&text).unwrap();
+    assert!(v["heights"]["ssk"].is_null());
+    assert_valid(&s, &v, "flat");
+    let _ = std::fs::remove_file(&flat);
+}

@@ -22,7 +22,8 @@
 //!   [`mixture::MixtureSurface`]), `phong.rs` ([`phong::Phong`]), `ward.rs` ([`ward::Ward`]),
 //!   `multilobe.rs` ([`multilobe::CookTorranceLobes`]), `halo.rs` (a Rayleigh–Rice scatter halo on a model's
 //!   mirror, [`halo::WithHalo`] over [`halo::Halo`]), `two_scale.rs` (a rough interface with that halo,
-//!   [`two_scale::RoughWithHalo`]) and `paint`, the paint model of Ďurikovič & Ágošton
+//!   [`two_scale::RoughWithHalo`]), `topography.rs` (the facets of a measured surface's own slopes,
+//!   [`topography::TopographySurface`]) and `paint`, the paint model of Ďurikovič & Ágošton
 //!   (2007) ([`paint::Paint`] built from a [`paint::PaintSpec`]);
 //! * `albedo.rs`: the directional albedo that resolves narrow lobes
 //!   ([`albedo::directional_albedo`], [`albedo::directional_albedo_to`]): a d/8 sphere's hemisphere
@@ -42,6 +43,7 @@ pub mod mixture;
 pub mod multilobe;
 pub mod paint;
 pub mod phong;
+pub mod topography;
 pub mod two_scale;
 pub mod ward;
 

@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use clap::{Parser, Subcommand, ValueEnum};
 
 use super::common::{ColourArgs, Format};
-use super::{compare, convergence, fit, pictures, profile, sweep};
+use super::{compare, convergence, fit, pictures, profile, sweep, topography};
 use crate::instrument::plan::PlanOptions;
 
 #[derive(Parser, Debug)]
@@ -35,6 +35,8 @@ pub enum OutputSchema {
     Convergence,
     /// A sheet as the one sheet reader reads it (the Python bindings' `read_sheet`).
     Sheet,
+    /// `topography --format json`.
+    Topography,
 }
 
 #[derive(Subcommand, Debug)]
@@ -96,7 +98,7 @@ pub enum Command {
         id: Option<String>,
     },
     /// Print the JSON Schema of the recipe format, or of an output (`--output-format
-    /// measure|compare|sweep|fit|profile|convergence`).
+    /// measure|compare|sweep|fit|profile|convergence|topography`).
     Schema {
         #[arg(long, value_enum)]
         output_format: Option<OutputSchema>,
@@ -116,6 +118,9 @@ pub enum Command {
     /// The goniophotometric profile about the 20° specular direction (Rhopoint IQ-class 512-pixel array):
     /// one row per pixel, angle and normalised reading with their error estimates (CSV or JSON).
     Profile(profile::ProfileArgs),
+    /// A measured surface topography (X3P, SDF, GSF or a text matrix): its height and slope parameters
+    /// (ISO 25178-2), slope distribution and PSD (docs/topography.md).
+    Topography(topography::TopographyArgs),
     /// Serve the virtual meter as a local web page and an HTTP API (docs/serve.md); prints the address and
     /// serves until stopped.
     #[cfg(feature = "serve")]

@@ -9,7 +9,7 @@
 //!   [`common::readings_status`], and [`common::pad_table`], through which every text table goes);
 //! * `mod.rs` (this): [`run`] runs a command line and dispatches it, [`exit_status`] maps an error to its status;
 //! * a file per subcommand, which parses its own arguments and formats its results: [`batch`] (`measure` of
-//!   many recipes), [`compare`], [`convergence`], [`fit`], [`pictures`] (`plot`), [`profile`], [`sweep`];
+//!   many recipes), [`compare`], [`convergence`], [`fit`], [`pictures`] (`plot`), [`profile`], [`sweep`], [`topography`];
 //! * the writers: [`format`](mod@format) the text tables of `measure` ([`format::table`],
 //!   [`format::envelope_table`]), [`output`] the files ([`output::OutputTarget`]: a new file whole or not at
 //!   all, never overwriting, or standard output), [`plot`] the pictures (PNG or SVG with an embedded font),
@@ -37,6 +37,7 @@ pub mod plot;
 pub mod profile;
 pub mod progress;
 pub mod sweep;
+pub mod topography;
 
 use crate::request::PlanRequest;
 use args::{Cli, Command, OutputSchema};
@@ -232,6 +233,7 @@ fn dispatch(cli: Cli, #[allow(unused_variables)] serve: Serve) -> Result<()> {
         Command::Plot(args) => pictures::run(args),
         Command::Profile(args) => profile::run(args),
         Command::Sweep(args) => sweep::run(args),
+        Command::Topography(args) => topography::run(args),
         #[cfg(feature = "serve")]
         Command::Serve(args) => serve(&args.request()),
         Command::Schema { output_format } => {
@@ -244,6 +246,7 @@ fn dispatch(cli: Cli, #[allow(unused_variables)] serve: Serve) -> Result<()> {
                 Some(OutputSchema::Profile) => crate::report::schema::profile(),
                 Some(OutputSchema::Convergence) => crate::report::schema::convergence(),
                 Some(OutputSchema::Sheet) => crate::report::schema::sheet(),
+                Some(OutputSchema::Topography) => crate::report::schema::topography(),
             };
             let text = serde_json::to_string_pretty(&schema)
                 .map_err(|e| Error::Numeric(format!("the schema does not serialise: {e}")))?;

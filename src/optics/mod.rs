@@ -19,6 +19,8 @@
 //!   ([`microfacet::Microfacet`], [`microfacet::Distribution`], [`microfacet::Shadowing`]);
 //! * `slope_mixture.rs` (on `microfacet.rs`): a mixture of slope populations, D = Σ wᵢ Dᵢ with the Smith
 //!   masking of the mixture, Λ = Σ wᵢ Λᵢ ([`slope_mixture::SlopeMixture`]);
+//! * `slope_table.rs` (on `microfacet.rs`): a measured slope distribution (a topography's cells) smoothed into
+//!   a normalised density, its D and the Gaussian-equivalent Smith Λ ([`slope_table::SlopeTable`]);
 //! * `scatter.rs`: smooth-surface (Rayleigh–Rice) scatter from a surface PSD, K-correlation or Gaussian
 //!   ([`scatter::Psd`], [`scatter::rayleigh_rice`], [`scatter::polarisation_factor`]);
 //! * `levelling.rs` (on the quadrature's Gauss–Legendre rule): the levelling of an applied texture by surface tension
@@ -36,5 +38,6 @@ pub mod levelling;
 pub mod microfacet;
 pub mod scatter;
 pub mod slope_mixture;
+pub mod slope_table;
 pub mod tabulated;
 pub mod thin_film;

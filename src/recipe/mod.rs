@@ -16,6 +16,8 @@
 //! * `paint.rs`: `"model": "paint"` recipes ([`paint::parse_paint`], [`paint::parse_paint_spec`]);
 //! * `measured.rs`: the measured tables' recipes, a path resolved against the recipe's directory
 //!   ([`measured::resolve`], [`measured::parse_merl`], [`measured::parse_rgl`], [`measured::parse_inplane`]);
+//! * `topography.rs`: `"model": "topography"`, the facets of a measured topography's own slopes
+//!   ([`topography::parse_topography`]; the file resolved as a measured table's);
 //! * `scatter.rs`: the `scatter` object (a Rayleigh–Rice halo on a smooth interface's mirror) of `paint`,
 //!   `cook-torrance-lobes` and `microfacet` recipes ([`scatter::parse_scatter`]);
 //! * `schema.rs`: the JSON Schema of the format, generated from the registry ([`schema::schema`]);
@@ -47,6 +49,7 @@ pub mod measured;
 pub mod paint;
 pub mod scatter;
 pub mod schema;
+pub mod topography;
 pub mod uncertainty;
 
 pub use crate::registry::{MAX_LOBES, MODELS};
@@ -211,6 +214,7 @@ pub fn parse_brdf(obj: &Obj) -> Result<Arc<dyn Brdf>> {
         "merl" => measured::parse_merl(obj)?,
         "rgl" => measured::parse_rgl(obj)?,
         "inplane-csv" | "e1392" => measured::parse_inplane(obj, model)?,
+        "topography" => topography::parse_topography(obj)?,
         other => return Err(obj.err("model", format!("unknown model {other:?}; {}", allowed()))),
     };
     Ok(brdf)

@@ -14,6 +14,7 @@
 //!   recipes, each reading's material;
 //! * [`compare`]: the predictions beside a sheet, as JSON and CSV;
 //! * [`fit`]: the fit's report as JSON;
+//! * [`topography`]: a measured topography's statistics as JSON (`glossmeter topography`);
 //! * [`schema`]: the JSON Schemas of the outputs, derived (`schemars`) from the document types: the structs
 //!   that the writers serialise ([`ReadingDoc`], [`measure::MeasureDoc`], [`compare::CompareDoc`],
 //!   [`fit::FitDoc`], ...), so a field cannot be written without being in its schema.
@@ -27,6 +28,7 @@ pub mod measure;
 pub mod pictures;
 pub mod profile;
 pub mod schema;
+pub mod topography;
 
 use crate::comparison::propagation::PredictionUncertainty;
 use crate::comparison::Drift;

@@ -1,6 +1,6 @@
 //! JSON Schemas (draft 2020-12) of the JSON outputs of `measure` (one recipe or many), `compare`, `fit`,
-//! `profile`, `convergence` and the JSON lines of `sweep`: the contract that scripts and CI rely on, printed by
-//! `glossmeter schema --output-format measure|compare|sweep|fit|profile|convergence`. Each is derived (`schemars`) from the types
+//! `profile`, `convergence`, `topography` and the JSON lines of `sweep`: the contract that scripts and CI rely on, printed by
+//! `glossmeter schema --output-format measure|compare|sweep|fit|profile|convergence|topography`. Each is derived (`schemars`) from the types
 //! the writers serialise, so the schema and the output cannot drift apart: a field exists in both or in
 //! neither, and its doc comment is its description. `tests/schemas.rs` validates real outputs against them
 //! with the `jsonschema` crate.
@@ -12,6 +12,7 @@ use super::convergence::ConvergenceDoc;
 use super::fit::FitOutput;
 use super::measure::MeasureOutput;
 use super::profile::ProfileDoc;
+use super::topography::TopographyDoc;
 use super::{to_json, SweepLineDoc};
 
 /// `measure --format json`: one recipe (`material`), or many (`materials`, and `material` on each reading).
@@ -48,4 +49,9 @@ pub fn convergence() -> Value {
 /// A sheet as the one sheet reader reads it (the Python bindings' `read_sheet`).
 pub fn sheet() -> Value {
     to_json(&schema_for!(SheetReadDoc))
+}
+
+/// `topography --format json`.
+pub fn topography() -> Value {
+    to_json(&schema_for!(TopographyDoc))
 }

@@ -590,8 +590,14 @@ mod tests {
     fn a_table_needs_the_data_directory() {
         let l = Limits::default();
         let ctx = Context { limits: &l, data_dir: None, cancel: &Cancel::default() };
-        let r = Request::parse(br#"{"recipe": {"model": "merl", "file": "x.binary"}}"#).unwrap();
-        let e = measure(&r, ctx).unwrap_err().to_string();
-        assert!(e.contains("--data-dir"), "{e}");
+        // A measured topography's file is a table path like any other (registry `…/file` entries).
+        for body in [
+            &br#"{"recipe": {"model": "merl", "file": "x.binary"}}"#[..],
+            br#"{"recipe": {"model": "topography", "file": "panel.x3p", "ior": 1.5}}"#,
+        ] {
+            let r = Request::parse(body).unwrap();
+            let e = measure(&r, ctx).unwrap_err().to_string();
+            assert!(e.contains("--data-dir"), "{e}");
+        }
     }
 }

@@ -4,7 +4,8 @@
 //! * the convergence chart of `glossmeter convergence --plot` ([`draw_sweep`], here): a log–log chart of the
 //!   actual error, solid line and filled points, and the estimated error, dashed, against the time per reading;
 //! * the in-plane BRDF section, readings against a recipe number and `compare`'s residuals ([`charts`]);
-//! * the goniophotometric profile ([`profile`]).
+//! * the goniophotometric profile ([`profile`]);
+//! * a measured topography's height map and radial PSD ([`topography`]).
 //!
 //! Fonts: a clean CI machine may have no system fonts, so the text is drawn with DejaVu Sans embedded in the
 //! binary (`assets/fonts/`, Bitstream Vera licence with public-domain DejaVu changes: `assets/fonts/LICENSE`)
@@ -20,6 +21,7 @@ use crate::{Error, Result};
 
 pub mod charts;
 pub mod profile;
+pub mod topography;
 
 /// What was drawn, for messages.
 #[derive(Clone, Debug, PartialEq)]

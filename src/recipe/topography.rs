@@ -1,0 +1,51 @@
+//! `"model": "topography"`: the facet term of a measured surface (`brdf::topography::TopographySurface`),
+//! from a topography file referenced by path as a measured table is (resolved against the recipe's directory,
+//! `measured::resolve`; the server confines it to its data directory like every registry `file` entry). The
+//! map is levelled, its cells' slopes smoothed into the facet distribution (docs/topography.md §The facet term
+//! of a measured surface).
+use std::sync::Arc;
+
+use super::measured::resolve;
+use crate::brdf::topography::TopographySurface;
+use crate::brdf::Brdf;
+use crate::input::json::Obj;
+use crate::optics::slope_table::SlopeTable;
+use crate::registry;
+use crate::topography::level::{level, Levelling};
+use crate::topography::slopes::slopes;
+use crate::{Error, Result};
+
+/// `{"model": "topography", "file": "…", "ior": n, "levelling": "plane"}`.
+pub fn parse_topography(obj: &Obj) -> Result<Arc<dyn Brdf>> {
+    obj.deny_unknown_in("topography")?;
+    let file = obj.str(&obj.param_key(&registry::TOPOGRAPHY_FILE))?;
+    if file.is_empty() {
+        return Err(obj.err("file", "empty path; expected the path of an .x3p, .sdf or .gsf topography"));
+    }
+    let ior = obj.param(&registry::TOPOGRAPHY_IOR)?;
+    let levelling = match obj.opt_str(&obj.param_key(&registry::TOPOGRAPHY_LEVELLING))? {
+        None => Levelling::Plane,
+        Some(s) => Levelling::parse(s).ok_or_else(|| {
+            obj.err("levelling", format!("unknown levelling {s:?}; allowed: {}", Levelling::allowed()))
+        })?,
+    };
+    let path = resolve(obj.file, file);
+    let wrap = |e: Error| match e {
+        Error::Io { file: f, source } => obj.err("file", format!("cannot read the topography {f}: {source}")),
+        other => {
+            let text = other.to_string();
+            let hint = if text.contains("no lateral calibration") && text.contains("plain height matrix") {
+                " (a recipe reads .x3p, .sdf and .gsf files, which carry their calibration)"
+            } else {
+                ""
+            };
+            obj.err("file", format!("not a topography this model reads: {text}{hint}"))
+        }
+    };
+    let map = crate::topography::load(&path, None).map_err(wrap)?;
+    let levelled = level(&map, levelling).map_err(wrap)?;
+    let s = slopes(&levelled.z, map.nx, map.ny, map.dx, map.dy, &map.file).map_err(wrap)?;
+    let table = SlopeTable::from_slopes(&s.sx, &s.sy).map_err(|m| obj.err("file", format!("{}: {m}", map.file)))?;
+    let source = format!("{}, levelling {}", map.file, levelling.name());
+    Ok(Arc::new(TopographySurface::new(table, ior, source)?))
+}

@@ -1,0 +1,94 @@
+//! Measured surface topographies as an input: height maps read from the files profilometers, confocal
+//! microscopes and interferometers write, levelled, and described by the ISO 25178-2 parameters, the slope
+//! distribution and the power spectral density (docs/topography.md). A topography is read the way every input
+//! is: within stated limits checked before anything is allocated ([`map`]), its units and calibration from
+//! the file, and every bad value an error naming the file and the field.
+//!
+//! The folder, one idea a file:
+//! * [`map`]: the height map ([`map::HeightMap`], metres, NaN for invalid points), its [`map::Format`] and the
+//!   limits ([`map::MAX_FILE_BYTES`], [`map::MAX_POINTS`]);
+//! * [`units`]: length units and lengths as files and users write them;
+//! * the readers, one per format: [`x3p`] (ISO 25178-72), [`sdf`] (ISO 25178-71, text and binary), [`gsf`]
+//!   (Gwyddion Simple Field), [`text`] (plain text and CSV matrices, with a [`text::Calibration`] given);
+//! * [`level`]: the reference surface removed (mean, plane, polynomial);
+//! * [`heights`]: Sq, Sa, Sp, Sv, Sz, Ssk, Sku;
+//! * [`slopes`]: the cells' slopes, Sdq, Sdr and the slope-angle histogram;
+//! * [`psd`]: the 2-D PSD and its radial average;
+//! * [`analysis`]: the one call that levels a map and computes all of it;
+//! * `mod.rs` (this): [`load`] and [`from_bytes`], which tell the format from the file's first bytes.
+pub mod analysis;
+pub mod gsf;
+pub mod heights;
+pub mod level;
+pub mod map;
+pub mod psd;
+pub mod sdf;
+pub mod slopes;
+pub mod text;
+pub mod units;
+pub mod x3p;
+
+use std::path::Path;
+
+use crate::{Error, Result};
+use map::{HeightMap, MAX_FILE_BYTES};
+use text::Calibration;
+
+/// Read a topography file (at most [`MAX_FILE_BYTES`]); `calibration` is used by a plain matrix only.
+pub fn load(path: &Path, calibration: Option<Calibration>) -> Result<HeightMap> {
+    let file = crate::input::name(path);
+    let bytes = crate::input::read_bytes_limited(path, "topography", MAX_FILE_BYTES)?;
+    let ext = path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase()).unwrap_or_default();
+    from_bytes(&bytes, &file, &ext, calibration)
+}
+
+/// The format of a file, from its first bytes: a zip archive is X3P, `Gwyddion Simple Field 1.0` GSF,
+/// `aISO`/`bISO` (or the older `aBCR`/`bBCR`) SDF, anything else a plain matrix. An extension that names a
+/// format the bytes are not is an error (a damaged file, or the wrong one).
+pub fn from_bytes(bytes: &[u8], file: &str, ext: &str, calibration: Option<Calibration>) -> Result<HeightMap> {
+    let is_sdf = bytes.len() >= 4 && matches!(bytes[0], b'a' | b'b') && matches!(&bytes[1..4], b"ISO" | b"BCR");
+    let not = |what: &str| {
+        Error::input(file, "", format!("a .{ext} file is {what}, but this one is not (damaged, or not that format)"))
+    };
+    if bytes.starts_with(b"PK\x03\x04") {
+        x3p::read(bytes, file)
+    } else if bytes.starts_with(gsf::MAGIC) {
+        gsf::read(bytes, file)
+    } else if is_sdf {
+        sdf::read(bytes, file)
+    } else {
+        match ext {
+            "x3p" => Err(not("a zip archive (ISO 25178-72)")),
+            "gsf" => Err(not("a Gwyddion Simple Field, beginning `Gwyddion Simple Field 1.0`")),
+            "sdf" => Err(not("an ISO 25178-71 file, beginning `aISO-1.0` or `bISO-1.0`")),
+            _ => {
+                let text = std::str::from_utf8(bytes).map_err(|e| {
+                    Error::input(
+                        file,
+                        "",
+                        format!(
+                            "not a topography this program reads: neither X3P, SDF, GSF nor a text matrix (invalid \
+                             UTF-8 at offset {})",
+                            e.valid_up_to()
+                        ),
+                    )
+                })?;
+                text::read(text, file, calibration)
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_format_is_told_from_the_bytes() {
+        let cal = Some(Calibration { dx: 1e-6, dy: 1e-6, z_unit: 1e-9 });
+        assert_eq!(from_bytes(b"1 2\n3 4\n", "t.txt", "txt", cal).unwrap().format, map::Format::Text);
+        let e = from_bytes(b"1 2\n3 4\n", "t.x3p", "x3p", cal).unwrap_err().to_string();
+        assert!(e.contains("zip archive"), "{e}");
+        assert!(from_bytes(&[0xff, 0xfe, 0], "t.bin", "bin", cal).unwrap_err().to_string().contains("UTF-8"));
+    }
+}

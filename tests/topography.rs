@@ -1,0 +1,306 @@
+//! Measured topographies (docs/topography.md): every reader on the fixtures of
+//! `tools/make_topography_fixtures.py`, against the statistics NumPy computed for them there
+//! (`fixtures/topography/expected.json`), and bad files refused with exit status 2, naming the file and the
+//! field.
+#![cfg(feature = "cli")]
+use std::path::{Path, PathBuf};
+
+use glossmeter::cli::run;
+use glossmeter::request::TopographyRequest;
+use glossmeter::topography::analysis::analyse;
+use glossmeter::topography::level::Levelling;
+use glossmeter::topography::map::Format;
+use glossmeter::topography::text::Calibration;
+use serde_json::Value;
+
+const DIR: &str = "fixtures/topography";
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("glossmeter-topography-test-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d.join(name)
+}
+
+fn expected(which: &str) -> Value {
+    let text = std::fs::read_to_string(format!("{DIR}/expected.json")).unwrap();
+    serde_json::from_str::<Value>(&text).unwrap()[which].clone()
+}
+
+/// The statistics glossmeter reads from a fixture, plane levelled.
+fn read(file: &str, calibration: Option<Calibration>) -> (Format, Value) {
+    let map = glossmeter::topography::load(Path::new(&format!("{DIR}/{file}")), calibration).unwrap();
+    let a = analyse(&map, Levelling::Plane).unwrap();
+    let v = serde_json::json!({
+        "sq_um": a.heights.sq * 1e6,
+        "sa_um": a.heights.sa * 1e6,
+        "sdq": a.slope_stats.sdq,
+        "psd_power_um2": a.psd.power() * 1e12,
+        "tilt_x": a.tilt[0],
+        "tilt_y": a.tilt[1],
+    });
+    (map.format, v)
+}
+
+fn close(got: &Value, want: &Value, rtol: f64, what: &str) {
+    for key in ["sq_um", "sa_um", "sdq", "psd_power_um2", "tilt_x", "tilt_y"] {
+        let (g, w) = (got[key].as_f64().unwrap(), want[key].as_f64().unwrap());
+        assert!((g - w).abs() <= rtol * w.abs(), "{what}: {key} = {g}, NumPy {w} (rtol {rtol})");
+    }
+}
+
+#[test]
+fn every_reader_agrees_with_numpy_on_the_same_surface() {
+    // f64 heights: X3P exactly; SDF and CSV through 17-digit decimals (nm and µm), so to a few ulps.
+    let cal = Some(Calibration { dx: 1e-6, dy: 1e-6, z_unit: 1e-6 });
+    for (file, format, calibration) in [
+        ("gaussian.x3p", Format::X3p, None),
+        ("gaussian-binary.sdf", Format::SdfBinary, None),
+        ("gaussian-text.sdf", Format::SdfText, None),
+        ("gaussian.csv", Format::Text, cal),
+    ] {
+        let (f, got) = read(file, calibration);
+        assert_eq!(f, format, "{file}");
+        close(&got, &expected("gaussian"), 1e-11, file);
+    }
+    // GSF holds f32: NumPy computed its statistics on the same f32 values.
+    close(&read("gaussian.gsf", None).1, &expected("gaussian_f32"), 1e-11, "gaussian.gsf");
+    // i16 nm data with three points masked: the mask is read (the statistics move) and matches NumPy's.
+    let (_, masked) = read("gaussian-masked.x3p", None);
+    close(&masked, &expected("gaussian_masked"), 1e-9, "gaussian-masked.x3p");
+    let map = glossmeter::topography::load(Path::new(&format!("{DIR}/gaussian-masked.x3p")), None).unwrap();
+    assert_eq!(map.nx * map.ny - map.valid(), 3);
+}
+
+#[test]
+fn the_command_prints_the_statistics_and_refuses_what_it_cannot_read() {
+    let out = tmp("gaussian.json");
+    let _ = std::fs::remove_file(&out);
+    let o = out.to_str().unwrap();
+    assert_eq!(run(["glossmeter", "topography", "fixtures/topography/gaussian.x3p", "--format", "json", "-o", o]), 0);
+    let doc: Value = serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
+    let want = expected("gaussian");
+    assert!((doc["heights"]["sq_um"].as_f64().unwrap() - want["sq_um"].as_f64().unwrap()).abs() < 1e-12);
+    assert!((doc["slopes"]["sdq"].as_f64().unwrap() - want["sdq"].as_f64().unwrap()).abs() < 1e-12);
+    assert_eq!(doc["map"]["format"], "x3p");
+    assert_eq!(doc["map"]["points_x"], 64);
+    // The radial PSD holds all the power: Σ S̄·count·Δfx·Δfy = Sq².
+    let (sx, sy) = (doc["psd"]["step_x_per_um"].as_f64().unwrap(), doc["psd"]["step_y_per_um"].as_f64().unwrap());
+    let power: f64 = doc["psd"]["radial"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|b| b["psd_nm2_um2"].as_f64().unwrap() * 1e-6 * b["count"].as_f64().unwrap() * sx * sy)
+        .sum();
+    let sq = doc["heights"]["sq_um"].as_f64().unwrap();
+    assert!((power - sq * sq).abs() < 1e-10 * sq * sq, "{power} {}", sq * sq);
+    // The histogram of slope angles sums to 1.
+    let total: f64 =
+        doc["slopes"]["angle_histogram"].as_array().unwrap().iter().map(|b| b["fraction"].as_f64().unwrap()).sum();
+    assert!((total - 1.0).abs() < 1e-12);
+    // The table, every format, and a text matrix with its calibration.
+    for file in ["gaussian.gsf", "gaussian-text.sdf", "gaussian-binary.sdf", "gaussian-masked.x3p"] {
+        assert_eq!(run(["glossmeter", "topography", &format!("{DIR}/{file}")]), 0, "{file}");
+    }
+    let csv = "fixtures/topography/gaussian.csv";
+    assert_eq!(run(["glossmeter", "topography", csv, "--pixel-size", "1um", "--height-unit", "um"]), 0);
+    // A text matrix without its calibration, and bad arguments: exit 2.
+    assert_eq!(run(["glossmeter", "topography", csv]), 2);
+    assert_eq!(run(["glossmeter", "topography", csv, "--pixel-size", "1um"]), 2);
+    assert_eq!(run(["glossmeter", "topography", csv, "--pixel-size", "1", "--height-unit", "um"]), 2);
+    assert_eq!(run(["glossmeter", "topography", csv, "--pixel-size", "1um", "--height-unit", "inch"]), 2);
+    assert_eq!(run(["glossmeter", "topography", "fixtures/topography/gaussian.x3p", "--levelling", "poly9"]), 2);
+    assert_eq!(run(["glossmeter", "topography", "fixtures/topography/missing.x3p"]), 2);
+    // The recipe of the same surface reads through the default panel.
+    assert_eq!(run(["glossmeter", "measure", "fixtures/topography/gaussian-panel.json"]), 0);
+}
+
+/// The error of reading `bytes` as `name`, and the command's exit status on the same file.
+fn refused(name: &str, bytes: &[u8], calibration: &[&str]) -> String {
+    let p = tmp(name);
+    std::fs::write(&p, bytes).unwrap();
+    let path = p.to_str().unwrap();
+    let mut args = vec!["glossmeter", "topography", path];
+    args.extend_from_slice(calibration);
+    assert_eq!(run(args), 2, "{name}");
+    let req = TopographyRequest {
+        pixel_size: calibration.get(1).map(|s| s.to_string()),
+        height_unit: calibration.get(3).map(|s| s.to_string()),
+        ..TopographyRequest::default()
+    };
+    let ext = name.rsplit('.').next().unwrap();
+    let e = req.read(bytes, path, ext).map(|_| ()).unwrap_err().to_string();
+    assert!(e.starts_with(path), "the message names the file: {e}");
+    e
+}
+
+#[test]
+fn bad_files_exit_2_naming_the_file_and_the_field() {
+    let cal = ["--pixel-size", "1um", "--height-unit", "nm"];
+    // Truncated files of every binary format.
+    let x3p = std::fs::read(format!("{DIR}/gaussian.x3p")).unwrap();
+    let e = refused("truncated.x3p", &x3p[..x3p.len() / 2], &[]);
+    assert!(e.contains("damaged or truncated"), "{e}");
+    let sdf = std::fs::read(format!("{DIR}/gaussian-binary.sdf")).unwrap();
+    let e = refused("truncated.sdf", &sdf[..sdf.len() - 9], &[]);
+    assert!(e.contains("field `NumPoints`") && e.contains("truncated"), "{e}");
+    let gsf = std::fs::read(format!("{DIR}/gaussian.gsf")).unwrap();
+    let e = refused("truncated.gsf", &gsf[..gsf.len() - 4], &[]);
+    assert!(e.contains("field `data`") && e.contains("truncated"), "{e}");
+    // Inconsistent dimensions: a ragged matrix; an SDF whose header says more points than it has.
+    let e = refused("ragged.csv", b"1 2 3\n4 5 6\n7 8\n", &cal);
+    assert!(e.contains("field `line 3`"), "{e}");
+    let text = std::fs::read_to_string(format!("{DIR}/gaussian-text.sdf")).unwrap();
+    let e = refused("wide.sdf", text.replace("NumPoints   = 64", "NumPoints   = 65").as_bytes(), &[]);
+    assert!(e.contains("field `NumPoints`"), "{e}");
+    // No lateral calibration.
+    let e = refused("nocal.sdf", text.replace("Xscale      = 1e-06", "Xscale      = 0").as_bytes(), &[]);
+    assert!(e.contains("field `Xscale`"), "{e}");
+    let header = String::from_utf8_lossy(&gsf[..200]).into_owned();
+    let at = header.find("XReal").unwrap();
+    let mut nocal = gsf.clone();
+    nocal[at..at + 5].copy_from_slice(b"XRexl");
+    let e = refused("nocal.gsf", &nocal, &[]);
+    assert!(e.contains("field `XReal`") && e.contains("lateral calibration"), "{e}");
+    // All invalid, and NaN heights where the format has no invalid marker.
+    let all_bad: String = "-32768 ".repeat(64 * 64);
+    let body = text.split("*\n").nth(1).unwrap();
+    let e = refused(
+        "allbad.sdf",
+        text.replace(body, &all_bad).replace("DataType    = 7", "DataType    = 5").as_bytes(),
+        &[],
+    );
+    assert!(e.contains("every point"), "{e}");
+    let e = refused("nan.csv", b"1 2\n3 NaN\n", &cal);
+    assert!(e.contains("field `line 2`") && e.contains("NaN"), "{e}");
+    // Absurd sizes: a header of 60000 × 60000 points, refused before anything is allocated; a height of 2 m.
+    let e = refused(
+        "huge.sdf",
+        text.replace("NumPoints   = 64", "NumPoints   = 60000")
+            .replace("NumProfiles = 64", "NumProfiles = 60000")
+            .as_bytes(),
+        &[],
+    );
+    assert!(e.contains("too large") && e.contains("field `NumPoints`"), "{e}");
+    let e = refused("tall.csv", b"1 2\n3 4\n", &["--pixel-size", "1um", "--height-unit", "m"]);
+    assert!(e.contains("|height|"), "{e}");
+    // Not a topography at all.
+    let e = refused("noise.x3p", b"this is not a zip", &[]);
+    assert!(e.contains("zip archive"), "{e}");
+}
+
+/// A periodic surface of `k` cosines of random direction, frequency and phase (SplitMix64, seeded), whose
+/// slopes are close to Gaussian (a sum of many independent terms), written as a GSF file of n × n points 1 µm
+/// apart, scaled to the rms slope `sdq`.
+fn random_cosines(path: &Path, n: usize, k: usize, sdq: f64, seed: u64) {
+    let mut state = seed;
+    let mut next = || {
+        state = state.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = state;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let terms: Vec<(f64, f64, f64)> = (0..k)
+        .map(|_| {
+            let (kx, ky) = ((next() * 25.0).floor() - 12.0, (next() * 25.0).floor() - 12.0);
+            let (kx, ky) = if kx == 0.0 && ky == 0.0 { (1.0, 0.0) } else { (kx, ky) };
+            (kx, ky, next() * 2.0 * std::f64::consts::PI)
+        })
+        .collect();
+    let mut z: Vec<f64> = Vec::with_capacity(n * n);
+    for j in 0..n {
+        for i in 0..n {
+            let t = |(kx, ky, ph): &(f64, f64, f64)| {
+                (2.0 * std::f64::consts::PI * (kx * i as f64 + ky * j as f64) / n as f64 + ph).cos()
+            };
+            z.push(terms.iter().map(t).sum::<f64>());
+        }
+    }
+    // Scale to the rms slope wanted (the cells' slopes, in units of 1 µm spacing).
+    let s = glossmeter::topography::slopes::slopes(&z, n, n, 1.0, 1.0, "s").unwrap().stats().sdq;
+    let mut b = b"Gwyddion Simple Field 1.0\n".to_vec();
+    b.extend_from_slice(
+        format!("XRes = {n}\nYRes = {n}\nXReal = {n}\nYReal = {n}\nXYUnits = um\nZUnits = um\n").as_bytes(),
+    );
+    let pad = 4 - b.len() % 4;
+    b.extend(std::iter::repeat_n(0u8, pad));
+    for v in &z {
+        b.extend_from_slice(&((v * sdq / s) as f32).to_le_bytes());
+    }
+    std::fs::write(path, b).unwrap();
+}
+
+#[test]
+fn the_facets_of_a_gaussian_slope_map_read_as_beckmann_of_the_same_rms_slope() {
+    use glossmeter::instrument::plan::PlanOptions;
+    use glossmeter::optics::slope_table::SlopeTable;
+    let map_path = tmp("cosines.gsf");
+    random_cosines(&map_path, 256, 400, 0.1, 41);
+    let recipe = tmp("cosines.json");
+    std::fs::write(&recipe, r#"{"model": "topography", "file": "cosines.gsf", "ior": 1.5, "levelling": "mean"}"#)
+        .unwrap();
+    let material = glossmeter::recipe::load_file(&recipe).unwrap();
+    // The same table, built here from the map, for its rms slope (the cells' Sdq widened by the kernel).
+    let map = glossmeter::topography::load(&map_path, None).unwrap();
+    let s = glossmeter::topography::slopes::slopes(&map.z, 256, 256, map.dx, map.dy, "m").unwrap();
+    let m = SlopeTable::from_slopes(&s.sx, &s.sy).unwrap().rms_slope();
+    assert!((m - 0.1).abs() < 0.01, "{m}");
+    let beckmann = glossmeter::recipe::parse_str(
+        &format!(r#"{{"model": "microfacet", "distribution": "beckmann", "roughness": {m}, "ior": 1.5}}"#),
+        "beckmann.json",
+    )
+    .unwrap();
+    let ids = ["astm-d523-20", "astm-d523-60", "astm-d523-85"];
+    let geos = glossmeter::resolve_geometries(&ids, &[] as &[&str]).unwrap();
+    let options = PlanOptions { rtol: 1e-5, ..PlanOptions::default() };
+    let a = glossmeter::measure(&material, &geos, &options).unwrap();
+    let b = glossmeter::measure(&beckmann, &geos, &options).unwrap();
+    for ((x, y), id) in a.iter().zip(&b).zip(ids) {
+        let (x, y) = (x.value.unwrap(), y.value.unwrap());
+        eprintln!("{id}: topography {x:.4} GU, Beckmann m = {m:.5} {y:.4} GU");
+        // The stated tolerance (docs/topography.md §The facet term of a measured surface): 3 % of the reading.
+        assert!((x - y).abs() < 0.03 * y, "{x} vs {y}");
+    }
+}
+
+#[test]
+fn a_topography_recipe_refuses_what_it_cannot_read() {
+    let dir = tmp("recipes");
+    std::fs::create_dir_all(&dir).unwrap();
+    let write = |name: &str, text: &str| {
+        let p = dir.join(name);
+        std::fs::write(&p, text).unwrap();
+        p
+    };
+    write("plain.csv", "1 2\n3 4\n");
+    let e = |text: &str| glossmeter::recipe::load_file(&write("r.json", text)).unwrap_err().to_string();
+    let csv = e(r#"{"model": "topography", "file": "plain.csv", "ior": 1.5}"#);
+    assert!(csv.contains("field `/file`") && csv.contains("carry their calibration"), "{csv}");
+    let missing = e(r#"{"model": "topography", "file": "none.x3p", "ior": 1.5}"#);
+    assert!(missing.contains("field `/file`") && missing.contains("cannot read"), "{missing}");
+    let x3p = std::fs::canonicalize(format!("{DIR}/gaussian.x3p")).unwrap();
+    let ok = format!(r#"{{"model": "topography", "file": "{}", "ior": 1.5}}"#, x3p.display());
+    assert!(glossmeter::recipe::load_file(&write("ok.json", &ok)).is_ok());
+    assert!(e(&ok.replace("1.5}", "1.5, \"levelling\": \"poly9\"}")).contains("field `/levelling`"));
+    assert!(e(&ok.replace("1.5}", "0.5}")).contains("field `/ior`"));
+    assert!(e(&ok.replace("1.5}", "1.5, \"roughness\": 0.1}")).contains("unknown field"));
+}
+
+#[test]
+fn the_picture_is_drawn_and_never_overwritten() {
+    let (svg, png) = (tmp("map.svg"), tmp("map.png"));
+    let _ = std::fs::remove_file(&svg);
+    let _ = std::fs::remove_file(&png);
+    let x3p = "fixtures/topography/gaussian-masked.x3p";
+    assert_eq!(run(["glossmeter", "topography", x3p, "--plot", svg.to_str().unwrap()]), 0);
+    let text = std::fs::read_to_string(&svg).unwrap();
+    assert!(text.contains("<svg") && text.contains("radial PSD"), "{}", &text[..200.min(text.len())]);
+    assert_eq!(run(["glossmeter", "topography", x3p, "--plot", png.to_str().unwrap()]), 0);
+    let img = image::open(&png).unwrap();
+    assert_eq!((img.width(), img.height()), (1200, 560));
+    // An existing picture is not replaced, and nothing is written.
+    let before = std::fs::read(&png).unwrap();
+    assert_eq!(run(["glossmeter", "topography", x3p, "--plot", png.to_str().unwrap()]), 2);
+    assert_eq!(std::fs::read(&png).unwrap(), before);
+    assert_eq!(run(["glossmeter", "topography", x3p, "--plot", "map.gif"]), 2);
+}
