@@ -767,6 +767,10 @@ pub fn generate_registry_recipe(rng: &mut Rng) -> String {
         let f = root().join("fixtures/materials/merl/lambert-tiny.binary");
         obj.insert("file".into(), json!(f.to_string_lossy()));
     }
+    if model == "topography" {
+        let f = root().join("fixtures/topography/gaussian.x3p");
+        obj.insert("file".into(), json!(f.to_string_lossy()));
+    }
     Value::Object(obj).to_string()
 }
 

@@ -144,7 +144,16 @@ fn check_shared_strings(zip: &mut Archive, file: &str) -> Result<()> {
                 }
                 return Ok(());
             }
-            Ok(Event::Eof) | Err(_) => return Ok(()),
+            Ok(Event::Eof) => return Ok(()),
+            // calamine's reader is more lenient than this one (it reads on past a mismatched end tag, expanding
+            // the repeats that follow), so what this reader cannot follow is refused, not waved through.
+            Err(e) => {
+                return Err(Error::input(
+                    file,
+                    "content.xml",
+                    format!("not well-formed XML at byte {}: {e}", r.error_position()),
+                ))
+            }
             _ => buf.clear(),
         }
     }
@@ -178,7 +187,16 @@ fn check_ods_extent(zip: &mut Archive, file: &str) -> Result<()> {
                 t.cell(count(&e, b"table:number-columns-repeated").unwrap_or(1), valued)
             }
             Ok(Event::End(e)) if e.name().as_ref() == b"table:table-row" => t.row_end(),
-            Ok(Event::Eof) | Err(_) => return Ok(()),
+            Ok(Event::Eof) => return Ok(()),
+            // calamine's reader is more lenient than this one (it reads on past a mismatched end tag, expanding
+            // the repeats that follow), so what this reader cannot follow is refused, not waved through.
+            Err(e) => {
+                return Err(Error::input(
+                    file,
+                    "content.xml",
+                    format!("not well-formed XML at byte {}: {e}", r.error_position()),
+                ))
+            }
             _ => {}
         }
         if let Some(m) = t.over() {
@@ -255,14 +273,28 @@ impl OdsTable {
         if self.before.saturating_add(self.area()) > MAX_CELLS {
             return Some(format!("a table's used range is {rows} rows × {} columns (repeats counted)", self.width));
         }
-        (self.before.saturating_add(self.stored) > MAX_CELLS)
-            .then(|| format!("a table stores {} cells (repeated columns counted)", self.stored))
+        // The row being read counts as it grows: one cell repeated 2³² times is over before its row ends.
+        let stored = self.stored.saturating_add(self.valued_end);
+        (self.before.saturating_add(stored) > MAX_CELLS)
+            .then(|| format!("a table stores {stored} cells (repeated columns counted)"))
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Found by the 10⁶-case fuzz run: a cell repeated 2³² − 1 times in a row whose end tag never comes
+    /// (calamine read on and expanded it for minutes) is over the limit while its row is read.
+    #[test]
+    fn a_row_is_counted_before_it_ends() {
+        let mut t = OdsTable::default();
+        t.row_start(1);
+        t.cell(1, true);
+        assert!(t.over().is_none());
+        t.cell(4_294_967_295, true);
+        assert!(t.over().unwrap().contains("4294967296 cells"), "{:?}", t.over());
+    }
 
     /// The review's 1.1 kB `.ods`: one valued row repeated 10⁶ times is over the limit; trailing empty rows
     /// repeated to the sheet's end (as LibreOffice writes them) count nothing.
