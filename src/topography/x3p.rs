@@ -158,17 +158,10 @@ pub fn read(bytes: &[u8], file: &str) -> Result<HeightMap> {
         }
     }
     let data_field = if main.data_list.is_some() { "Record3/DataList" } else { "Record3/DataLink/PointDataLink" };
-    let map =
-        HeightMap::new(file, Format::X3p, nx as usize, ny as usize, spacing[0], spacing[1], z, &field(data_field));
-    map.map_err(|e| match e {
-        // The scale is part of what a height's message should say.
-        Error::Input { file, field, message } if message.contains("|height|") => Error::input(
-            file,
-            field,
-            format!("{message} (CZ Increment {}, Offset {})", number(z_scale), number(z_offset)),
-        ),
-        other => other,
-    })
+    // The scale is part of what a height's message should say.
+    let note = format!(" (CZ Increment {}, Offset {})", number(z_scale), number(z_offset));
+    let (nx, ny) = (nx as usize, ny as usize);
+    HeightMap::with_height_note(file, Format::X3p, nx, ny, spacing[0], spacing[1], z, &field(data_field), &note)
 }
 
 /// The member `name`, inflated: exactly `size` bytes if `linked` (a data file whose size the grid fixes, named
