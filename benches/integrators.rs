@@ -32,7 +32,7 @@ use std::time::Instant;
 use glossmeter::brdf::{Brdf, Lobe, Tail, Term, TermKind};
 use glossmeter::instrument::geometry::{solid_angle_density, Axes, Stop};
 use glossmeter::instrument::method::{Chart, Flux, Method, Rule, Target};
-use glossmeter::instrument::plan::{Plan, PlanOptions, Reading};
+use glossmeter::instrument::plan::{Engine, Plan, PlanOptions, Reading};
 use glossmeter::instrument::standards::{self, StandardGeometry};
 use glossmeter::optics::fresnel::fr_dielectric;
 use glossmeter::spectrum::Sampling;
@@ -1025,9 +1025,9 @@ impl Brdf for Counting {
     }
 }
 
-fn count_evaluations(brdf: Arc<dyn Brdf>, opts: PlanOptions) -> usize {
+fn count_evaluations(brdf: Arc<dyn Brdf>, opts: PlanOptions, engine: Engine) -> usize {
     let c = Arc::new(Counting { inner: brdf, n: Default::default() });
-    let plan = Plan::compile(c.clone(), panel(), opts).expect("plan compiles");
+    let plan = Plan::compile_with_engine(c.clone(), panel(), opts, engine).expect("plan compiles");
     let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build().expect("pool");
     pool.install(|| plan.execute());
     c.n.load(std::sync::atomic::Ordering::Relaxed)
@@ -1040,8 +1040,8 @@ struct PanelRun {
     jobs: usize,
 }
 
-fn run_panel(brdf: Arc<dyn Brdf>, opts: PlanOptions, threads: usize) -> PanelRun {
-    let plan = Plan::compile(brdf, panel(), opts).expect("plan compiles");
+fn run_panel(brdf: Arc<dyn Brdf>, opts: PlanOptions, engine: Engine, threads: usize) -> PanelRun {
+    let plan = Plan::compile_with_engine(brdf, panel(), opts, engine).expect("plan compiles");
     let jobs = plan.jobs.len();
     // One thread by default: the time of the work itself, not of the parallel schedule.
     let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("pool");
@@ -1055,27 +1055,28 @@ fn b5(md: &mut String) {
     let _ = writeln!(md, "| recipe | plan options | integrals | specimen BRDF evaluations | time | runs | readings |");
     let _ = writeln!(md, "|---|---|---|---|---|---|---|");
     let default = PlanOptions { rtol: 1e-6, ..Default::default() };
-    let variants: Vec<(&str, &str, PlanOptions)> = vec![
-        ("cerulean-blue-c.json", "default (fold + share)", default.clone()),
+    let engine = Engine::default();
+    let variants: Vec<(&str, &str, Engine)> = vec![
+        ("cerulean-blue-c.json", "default (fold + share)", engine),
         (
             "cerulean-blue-c.json",
             "fold_in_material: false (per-sample paint, weighted in the integrand)",
-            PlanOptions { fold_in_material: false, ..default.clone() },
+            Engine { fold_in_material: false, ..engine },
         ),
-        ("cerulean-blue-c-literal.json", "default (narrow flake lobes)", default.clone()),
+        ("cerulean-blue-c-literal.json", "default (narrow flake lobes)", engine),
         (
             "cerulean-blue-c-literal.json",
             "fold_in_material: false (narrow flake lobes)",
-            PlanOptions { fold_in_material: false, ..default.clone() },
+            Engine { fold_in_material: false, ..engine },
         ),
-        ("cerulean-blue-c.json", "default, 2-thread pool", default.clone()),
-        ("cerulean-blue-c.json", "fold_spectral: false", PlanOptions { fold_spectral: false, ..default.clone() }),
-        ("cerulean-blue-c.json", "share_fluxes: false", PlanOptions { share_fluxes: false, ..default.clone() }),
-        ("cerulean-blue-b.json", "default (metallic flakes only)", default.clone()),
-        ("cerulean-blue-a.json", "default (no flakes)", default.clone()),
+        ("cerulean-blue-c.json", "default, 2-thread pool", engine),
+        ("cerulean-blue-c.json", "fold_spectral: false", Engine { fold_spectral: false, ..engine }),
+        ("cerulean-blue-c.json", "share_fluxes: false", Engine { share_fluxes: false, ..engine }),
+        ("cerulean-blue-b.json", "default (metallic flakes only)", engine),
+        ("cerulean-blue-a.json", "default (no flakes)", engine),
     ];
     let mut details: Vec<(&str, Vec<Reading>)> = Vec::new();
-    for (file, label, opts) in variants {
+    for (file, label, engine) in variants {
         let Some(brdf) = recipe(file) else {
             let _ = writeln!(md, "| {file} | {label} | – | – | – | – | recipe failed to load |");
             continue;
@@ -1083,8 +1084,8 @@ fn b5(md: &mut String) {
         let detail = label.starts_with("default (fold");
         match try_run(&format!("{file} {label}"), || {
             (
-                run_panel(brdf.clone(), opts.clone(), if label.contains("2-thread") { 2 } else { 1 }),
-                count_evaluations(brdf, opts),
+                run_panel(brdf.clone(), default.clone(), engine, if label.contains("2-thread") { 2 } else { 1 }),
+                count_evaluations(brdf, default.clone(), engine),
             )
         }) {
             Some((r, evals)) => {
@@ -1229,7 +1230,7 @@ fn b5_rules(md: &mut String) {
 fn tolerance_sweep(md: &mut String) {
     let Some(brdf) = recipe("cerulean-blue-c.json") else { return };
     let Some(reference) = try_run("cerulean-c rtol 1e-9", || {
-        run_panel(brdf.clone(), PlanOptions { rtol: 1e-9, ..Default::default() }, 1)
+        run_panel(brdf.clone(), PlanOptions { rtol: 1e-9, ..Default::default() }, Engine::default(), 1)
     }) else {
         return;
     };
@@ -1241,8 +1242,8 @@ fn tolerance_sweep(md: &mut String) {
     let _ = writeln!(md, "|---|---|---|---|---|");
     for rtol in [1e-3, 1e-4, 1e-5, 1e-6, 1e-7] {
         let opts = PlanOptions { rtol, ..Default::default() };
-        let r = run_panel(brdf.clone(), opts.clone(), 1);
-        let evals = count_evaluations(brdf.clone(), opts);
+        let r = run_panel(brdf.clone(), opts.clone(), Engine::default(), 1);
+        let evals = count_evaluations(brdf.clone(), opts, Engine::default());
         let (mut worst, mut ratio) = (0.0f64, 0.0f64);
         for (x, y) in r.readings.iter().zip(&reference.readings) {
             if let (Some(a), Some(b)) = (x.value, y.value) {

@@ -11,6 +11,7 @@
 //! the sweep-point rows (`sweep_points`).
 use std::time::Instant;
 
+use glossmeter::brdf::paint::{Paint, TableBuild};
 use glossmeter::optics::coat_albedo::CoatAlbedo;
 use glossmeter::optics::microfacet::{Distribution, Microfacet};
 
@@ -21,6 +22,15 @@ fn median(mut v: Vec<f64>) -> f64 {
 
 /// Sets one field of a recipe.
 type Setter = Box<dyn Fn(&mut serde_json::Value, f64)>;
+
+/// A sweep point's paint built from its recipe text as `Sweep::plan_point` builds it (the JSON read, the spec
+/// validated, the paint built), with the flake tables fitted as `build` says.
+fn build_paint(text: &str, build: TableBuild) -> Paint {
+    let json = glossmeter::input::json::parse_json(text, "bench.json").expect("json");
+    let obj = glossmeter::input::json::Obj::new("bench.json", "", &json).expect("object");
+    let spec = glossmeter::recipe::paint::parse_paint_spec(&obj).expect("recipe");
+    Paint::with_table_build(spec, build).expect("paint")
+}
 
 /// What one sweep point rebuilds (`docs/performance.md` §"Paint rebuilds in sweeps"): the recipe of a point is
 /// parsed and its paint built anew (`Sweep::plan_point` → `recipe::parse_str` → `Paint::new`), so the median time of
@@ -70,22 +80,20 @@ fn sweep_points() {
             // before `docs/model.md` §Evaluation cost "shared across samples"), one with the memo and the samples
             // fitted at once (after). A memo build is timed right after an untimed build of the other value in
             // the same mode (the memo then holds what a sweep's previous point left), the values alternating.
-            let modes = [(true, true), (false, true), (false, false)];
+            let modes = [(true, TableBuild::PerSample), (false, TableBuild::PerSample), (false, TableBuild::Shared)];
             let mut times: [Vec<f64>; 3] = Default::default();
             let mut work = [(0, 0); 3];
             let start = Instant::now();
             let mut i = 0;
             while start.elapsed().as_secs_f64() < 0.9 || times[2].len() < 6 {
-                for (m, &(cold, per_sample)) in modes.iter().enumerate() {
-                    glossmeter::brdf::paint::build_tables_per_sample(per_sample);
+                for (m, &(cold, build)) in modes.iter().enumerate() {
                     glossmeter::brdf::paint::forget_tables();
                     if !cold {
-                        let neighbour = glossmeter::recipe::parse_str(&texts[(i + 1) % 2], "bench.json");
-                        std::hint::black_box(neighbour.expect("recipe"));
+                        std::hint::black_box(build_paint(&texts[(i + 1) % 2], build));
                     }
                     let before = glossmeter::brdf::paint::table_work();
                     let t = Instant::now();
-                    let b = glossmeter::recipe::parse_str(&texts[i % 2], "bench.json").expect("recipe");
+                    let b = build_paint(&texts[i % 2], build);
                     let dt = t.elapsed().as_secs_f64();
                     let after = glossmeter::brdf::paint::table_work();
                     std::hint::black_box(b);
@@ -94,7 +102,6 @@ fn sweep_points() {
                 }
                 i += 1;
             }
-            glossmeter::brdf::paint::build_tables_per_sample(false);
             let n = times[2].len();
             let [cold, before, after] = times.map(median);
             println!(

@@ -13,6 +13,7 @@
 //! ```
 use std::path::Path;
 
+use crate::input::Source;
 use crate::instrument::plan::{Plan, PlanOptions, Reading};
 use crate::instrument::standards::{self, StandardGeometry};
 use crate::recipe::{self, Material};
@@ -35,6 +36,17 @@ pub fn resolve_geometries_or<S: AsRef<str>, P: AsRef<Path>>(
     files: &[P],
     defaults: &[&str],
 ) -> Result<Vec<StandardGeometry>> {
+    let files: Vec<Source> = files.iter().map(|f| Source::from(f.as_ref())).collect();
+    resolve_geometries_from(ids, &files, defaults)
+}
+
+/// [`resolve_geometries_or`] with the user geometry files as sources (a file, or standard input as a front end
+/// read it).
+pub fn resolve_geometries_from<S: AsRef<str>>(
+    ids: &[S],
+    files: &[Source],
+    defaults: &[&str],
+) -> Result<Vec<StandardGeometry>> {
     let mut out = Vec::new();
     if ids.is_empty() && files.is_empty() {
         for id in defaults {
@@ -45,7 +57,7 @@ pub fn resolve_geometries_or<S: AsRef<str>, P: AsRef<Path>>(
         out.push(standards::find(id.as_ref())?);
     }
     for f in files {
-        out.push(standards::load_file(f.as_ref())?);
+        out.push(standards::load_source(f)?);
     }
     Ok(out)
 }

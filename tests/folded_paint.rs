@@ -8,7 +8,7 @@ use std::sync::Arc;
 
 use glossmeter::brdf::Brdf;
 use glossmeter::colorimetry::weighting::Weighting;
-use glossmeter::instrument::plan::{Plan, PlanOptions};
+use glossmeter::instrument::plan::{Engine, Plan, PlanOptions};
 use glossmeter::instrument::standards;
 use glossmeter::Vec3;
 use serde_json::Value;
@@ -137,9 +137,8 @@ fn readings_with_and_without_folding_in_the_material_agree() {
     for name in PAINTS {
         let b = glossmeter::recipe::load_file(Path::new(&format!("fixtures/recipes/{name}.json"))).unwrap().brdf;
         let on = Plan::compile(b.clone(), panel.clone(), PlanOptions::default()).unwrap().execute();
-        let off = Plan::compile(b, panel.clone(), PlanOptions { fold_in_material: false, ..PlanOptions::default() })
-            .unwrap()
-            .execute();
+        let unfolded = Engine { fold_in_material: false, ..Engine::default() };
+        let off = Plan::compile_with_engine(b, panel.clone(), PlanOptions::default(), unfolded).unwrap().execute();
         for (a, z) in on.iter().zip(&off) {
             let (x, y) = (a.value.unwrap(), z.value.unwrap());
             let d = (x - y).abs();

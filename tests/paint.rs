@@ -1238,7 +1238,8 @@ fn smooth_is_claimed_only_for_the_physical_form_under_a_smooth_coat() {
 /// deviations and the split light's constants in round-trip form.
 #[test]
 fn flake_tables_built_for_all_samples_at_once_are_those_built_one_at_a_time() {
-    use glossmeter::brdf::paint::{build_tables_per_sample, forget_tables};
+    use glossmeter::brdf::paint::{forget_tables, TableBuild};
+    use glossmeter::recipe::paint::parse_paint_spec;
     let dir = format!("{}/fixtures/recipes", env!("CARGO_MANIFEST_DIR"));
     let (mut paints, mut pearls, mut tabled) = (0, 0, 0);
     for entry in std::fs::read_dir(&dir).unwrap() {
@@ -1255,14 +1256,12 @@ fn flake_tables_built_for_all_samples_at_once_are_those_built_one_at_a_time() {
                 let mut v = base.clone();
                 v["clear_coat"]["index"] = eta.into();
                 v["flake_light"] = light.into();
-                let build = |per_sample: bool| {
-                    build_tables_per_sample(per_sample);
+                let build = |how: TableBuild| {
                     forget_tables();
-                    let b = from_json(&v).unwrap();
-                    build_tables_per_sample(false);
-                    format!("{b:?}")
+                    let spec = parse_paint_spec(&Obj::new("test.json", "", &v).unwrap()).unwrap();
+                    format!("{:?}", Paint::with_table_build(spec, how).unwrap())
                 };
-                let (alone, together) = (build(true), build(false));
+                let (alone, together) = (build(TableBuild::PerSample), build(TableBuild::Shared));
                 tabled += together.contains("ChebTable") as usize;
                 assert!(alone == together, "{}, coat index {eta}, {light} light: the tables differ", path.display());
             }

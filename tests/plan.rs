@@ -6,7 +6,7 @@ use common::TestBeckmann;
 use std::sync::Arc;
 
 use glossmeter::brdf::Brdf;
-use glossmeter::instrument::plan::{Plan, PlanOptions, Planner, Reading};
+use glossmeter::instrument::plan::{Engine, Plan, PlanOptions, Planner, Reading};
 use glossmeter::instrument::standards::{self, StandardGeometry};
 use glossmeter::spectrum::Sampling;
 
@@ -20,6 +20,10 @@ fn fixture(name: &str) -> Arc<dyn Brdf> {
 
 fn run(brdf: Arc<dyn Brdf>, options: PlanOptions) -> Vec<Reading> {
     Plan::compile(brdf, panel(), options).unwrap().execute()
+}
+
+fn run_engine(brdf: Arc<dyn Brdf>, engine: Engine) -> Vec<Reading> {
+    Plan::compile_with_engine(brdf, panel(), PlanOptions::default(), engine).unwrap().execute()
 }
 
 fn bits(r: &Reading) -> (Option<u64>, u64, usize, bool) {
@@ -36,8 +40,8 @@ fn folding_and_sharing_switches_give_the_same_readings() {
     for name in ["cerulean-blue-c.json", "white-pearl-spectral.json", "rgb-lambert.json", "rough-conductor-ggx.json"] {
         let brdf = fixture(name);
         let base = run(brdf.clone(), PlanOptions::default());
-        let unshared = run(brdf.clone(), PlanOptions { share_fluxes: false, ..PlanOptions::default() });
-        let unfolded = run(brdf.clone(), PlanOptions { fold_spectral: false, ..PlanOptions::default() });
+        let unshared = run_engine(brdf.clone(), Engine { share_fluxes: false, ..Engine::default() });
+        let unfolded = run_engine(brdf.clone(), Engine { fold_spectral: false, ..Engine::default() });
         assert_eq!(base.len(), unshared.len());
         assert_eq!(base.len(), unfolded.len());
         for ((a, b), c) in base.iter().zip(&unshared).zip(&unfolded) {

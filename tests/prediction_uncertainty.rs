@@ -209,7 +209,7 @@ fn compare(sheet_file: &Path, recipes: &[(&str, PathBuf)]) -> Vec<comparison::Co
     let recipes = Recipes {
         default: None,
         dir: None,
-        per_sample: recipes.iter().map(|(s, p)| (s.to_string(), p.clone())).collect(),
+        per_sample: recipes.iter().map(|(s, p)| (s.to_string(), p.clone().into())).collect(),
     };
     comparison::compare_sheet(&sheet, &recipes, &VerdictRule::default(), &PlanOptions::default()).unwrap()
 }

@@ -280,7 +280,7 @@ fn template_text(py: Python<'_>, template: &Bound<'_, PyAny>) -> PyResult<(Strin
     };
     let path = if glossmeter::input::is_stdin(&path) { PathBuf::from(".").join(path) } else { path };
     let text = glossmeter::input::read_text(&path, "recipe").map_err(to_py_err)?;
-    Ok((text, glossmeter::input::name(&path)))
+    Ok((text, path.display().to_string()))
 }
 
 /// `shard=`: None (the whole sweep), "K/M" or (K, M): the K-th of M contiguous slices.

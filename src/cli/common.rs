@@ -44,9 +44,8 @@ impl ColourArgs {
 /// The verdict on a set of readings (docs/instrument.md §Exit statuses): an error (exit 1) if one has no
 /// finite value, or did not converge (unless allowed).
 pub fn readings_status(readings: &[crate::Reading], allow_unconverged: bool) -> Result<()> {
-    // The hue of a neutral colour has no value by definition, not by failure.
-    let neutral_hue = |r: &crate::Reading| r.note.as_deref().is_some_and(|p| p.starts_with(NEUTRAL_HUE));
-    let missing = readings.iter().filter(|r| r.value.is_none() && !neutral_hue(r)).count();
+    // The hue of a neutral colour has no value by definition, not by failure (`Reading::undefined`).
+    let missing = readings.iter().filter(|r| r.value.is_none() && !r.undefined()).count();
     if missing > 0 {
         return Err(Error::Numeric(format!(
             "{missing} of {} reading(s) have no finite value (see the notes in the output)",
@@ -63,8 +62,6 @@ pub fn readings_status(readings: &[crate::Reading], allow_unconverged: bool) -> 
     }
     Ok(())
 }
-
-pub use crate::instrument::plan::NEUTRAL_HUE;
 
 /// `--rtol` in (0, 1), checked before any work (`request::check_rtol`, written with the flag's name).
 pub fn check_rtol(rtol: f64) -> Result<()> {

@@ -6,7 +6,7 @@
 use std::path::PathBuf;
 
 use crate::cli::common::{pad_table, readings_status, ColourArgs};
-use crate::cli::output::OutputTarget;
+use crate::cli::output::{Existing, OutputTarget};
 use crate::comparison::sheet::{self, Sheet};
 use crate::comparison::{self, ColourDifference, Comparison, Drift, Recipes, Verdict, VerdictRule};
 use crate::report;
@@ -101,15 +101,15 @@ pub fn request(a: &CompareArgs) -> CompareRequest {
     }
 }
 
-pub fn run(a: CompareArgs) -> Result<()> {
+pub fn run(a: CompareArgs, existing: Existing) -> Result<()> {
     let request = request(&a);
     let rule = request.rule()?;
     let plan_options = request.plan.options()?;
     if let Some(p) = &a.plot {
-        crate::cli::plot::check_plot_path(p, "--plot")?;
+        crate::cli::plot::check_plot_path(p, "--plot", existing)?;
     }
     let max_de00 = request.max_de00()?;
-    let target = OutputTarget::new(a.output.as_deref(), "--output")?;
+    let target = OutputTarget::new(a.output.as_deref(), "--output", existing)?;
     let (default, sheet_path) = match a.paths.as_slice() {
         [s] => (None, s.clone()),
         [r, s] => (Some(r.clone()), s.clone()),
@@ -137,10 +137,17 @@ pub fn run(a: CompareArgs) -> Result<()> {
     crate::input::at_most_one_stdin(
         a.paths.iter().chain(&a.baseline).map(PathBuf::as_path).chain(per_sample.iter().map(|(_, f)| f.as_path())),
     )?;
-    let recipes = Recipes { default, dir: a.recipe_dir.clone(), per_sample };
     let options = request.sheet.options()?;
-    let baseline = a.baseline.as_deref().map(comparison::load_baseline).transpose()?;
-    let sheet = sheet::load(&sheet_path, &options)?;
+    // Standard input, if one of them is `-`, is read here, before any of them is parsed.
+    let mut stdin = crate::input::Stdin::default();
+    let default = default.map(|p| stdin.open_text(&p, "recipe")).transpose()?;
+    let per_sample =
+        per_sample.into_iter().map(|(s, p)| Ok((s, stdin.open_text(&p, "recipe")?))).collect::<Result<Vec<_>>>()?;
+    let baseline = a.baseline.as_deref().map(|p| stdin.open_text(p, "baseline")).transpose()?;
+    let sheet_source = stdin.open_text(&sheet_path, "sheet")?;
+    let recipes = Recipes { default, dir: a.recipe_dir.clone(), per_sample };
+    let baseline = baseline.as_ref().map(comparison::load_baseline_source).transpose()?;
+    let sheet = sheet::load_source(&sheet_source, &options)?;
     let mut cmp = comparison::compare_sheet(&sheet, &recipes, &rule, &plan_options)?;
     let des = comparison::colour_differences(&mut cmp, max_de00);
     let drift = match &baseline {
@@ -160,7 +167,7 @@ pub fn run(a: CompareArgs) -> Result<()> {
     };
     target.write(&text)?;
     if let Some(p) = &a.plot {
-        crate::cli::pictures::write_comparison(p, &cmp)?;
+        crate::cli::pictures::write_comparison(p, &cmp, existing)?;
     }
     let outside = cmp.iter().filter(|c| c.verdict == Verdict::Outside).count();
     let unchecked = cmp.iter().filter(|c| c.verdict.why_unchecked().is_some()).count();

@@ -4,7 +4,7 @@
 use std::path::PathBuf;
 
 use super::common::{pad_table, Format};
-use super::output::OutputTarget;
+use super::output::{Existing, OutputTarget};
 use super::plot;
 use crate::instrument::convergence::{self, ReferenceKind, Sweep};
 use crate::recipe::{self, Material};
@@ -59,18 +59,20 @@ pub fn request(a: &ConvergenceArgs) -> ConvergenceRequest {
     }
 }
 
-pub fn run(args: ConvergenceArgs) -> Result<()> {
+pub fn run(args: ConvergenceArgs, existing: Existing) -> Result<()> {
     // Every check that can fail cheaply comes before the (possibly long) sweep.
     let (tolerances, options) = request(&args).options()?;
-    let target = OutputTarget::new(args.output.as_deref(), "--output")?;
+    let target = OutputTarget::new(args.output.as_deref(), "--output", existing)?;
     if let Some(p) = &args.plot {
-        plot::check_plot_path(p, "--plot")?;
+        plot::check_plot_path(p, "--plot", existing)?;
         if args.output.as_deref() == Some(p.as_path()) {
             return Err(Error::Usage(format!("--plot and --output name the same file {}", p.display())));
         }
     }
-    let material = recipe::load_file(&args.recipe)?;
-    let geometries = crate::resolve_geometries_or(&args.geometries, &args.geometry_files, DEFAULT_GEOMETRIES)?;
+    let mut stdin = crate::input::Stdin::default();
+    let material = recipe::load_source(&stdin.open_text(&args.recipe, "recipe")?)?;
+    let files = stdin.open_text_all(&args.geometry_files, "geometry file")?;
+    let geometries = crate::api::resolve_geometries_from(&args.geometries, &files, DEFAULT_GEOMETRIES)?;
     let sweep = convergence::sweep(material.brdf.clone(), geometries, &tolerances, &options)?;
     let text = match args.format {
         Format::Table => table(&material, &sweep),
@@ -79,7 +81,7 @@ pub fn run(args: ConvergenceArgs) -> Result<()> {
     };
     if let Some(p) = &args.plot {
         let title = format!("{}: error vs time", material.name);
-        let s = plot::write_plot(&sweep, &title, p)?;
+        let s = plot::write_plot(&sweep, &title, p, existing)?;
         eprintln!(
             "plot: {} ({} series; errors below {:.1e} drawn at that floor: {} actual, {} estimated)",
             p.display(),

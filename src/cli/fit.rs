@@ -4,7 +4,7 @@
 use std::path::PathBuf;
 
 use crate::cli::common::Format;
-use crate::cli::output::{print, OutputTarget};
+use crate::cli::output::{print, Existing, OutputTarget};
 use crate::comparison::sheet;
 use crate::fit::{self, FitOptions, FitReport};
 use crate::request::{FitRequest, SheetRequest};
@@ -84,25 +84,27 @@ pub fn request(a: &FitArgs) -> FitRequest {
     }
 }
 
-pub fn run(a: FitArgs) -> Result<()> {
+pub fn run(a: FitArgs, existing: Existing) -> Result<()> {
     let request = request(&a);
     let options = request.options()?;
     // Refused before any work if it exists (or its directory does not); written whole or not at all.
-    let output = OutputTarget::new(a.output.as_deref(), "-o")?;
+    let output = OutputTarget::new(a.output.as_deref(), "-o", existing)?;
     crate::input::at_most_one_stdin(
         std::iter::once(&a.recipe).chain(&a.sheet).chain(&a.geometry_files).map(PathBuf::as_path),
     )?;
     let free = request.free()?;
+    let mut stdin = crate::input::Stdin::default();
     let sheet = match &a.sheet {
-        Some(s) => Some(sheet::load(s, &request.sheet.options()?)?),
+        Some(s) => Some(sheet::load_source(&stdin.open_text(s, "sheet")?, &request.sheet.options()?)?),
         None => None,
     };
     let (targets, notes) = request.targets(sheet.as_ref())?;
     for n in notes {
         eprintln!("note: {n}");
     }
-    let material = recipe::load_file(&a.recipe)?;
-    let geometries = crate::resolve_geometries_or::<&str, _>(&[], &a.geometry_files, &[])?;
+    let material = recipe::load_source(&stdin.open_text(&a.recipe, "recipe")?)?;
+    let files = stdin.open_text_all(&a.geometry_files, "geometry file")?;
+    let geometries = crate::api::resolve_geometries_from::<&str>(&[], &files, &[])?;
     let options = FitOptions { geometries, ..options };
     let report = match fit::fit(&material.json, &material.file, &free, &targets, &options) {
         Ok(report) => report,

@@ -22,7 +22,7 @@ use clap::Parser;
 
 use crate::instrument::plan::{Plan, PlanOptions};
 use crate::instrument::standards;
-use crate::{recipe, report, resolve_geometries, Error, Result};
+use crate::{recipe, report, Error, Result};
 
 pub mod args;
 pub mod batch;
@@ -79,9 +79,7 @@ where
             };
         }
     };
-    output::set_force(cli.force);
     let result = dispatch(cli, serve);
-    output::set_force(false);
     match result {
         Ok(()) => 0,
         // A reader that went away (`glossmeter standards | head -1`) is not an error: end quietly, as
@@ -105,6 +103,7 @@ pub fn exit_status(e: &Error) -> i32 {
 }
 
 fn dispatch(cli: Cli, #[allow(unused_variables)] serve: Serve) -> Result<()> {
+    let existing = output::Existing::from_force(cli.force);
     match cli.command {
         Command::Measure {
             recipes,
@@ -140,9 +139,12 @@ fn dispatch(cli: Cli, #[allow(unused_variables)] serve: Serve) -> Result<()> {
             crate::input::at_most_one_stdin(
                 recipes.iter().chain(&baseline).chain(&geometry_files).map(PathBuf::as_path),
             )?;
-            let target = OutputTarget::new(output.as_deref(), "--output")?;
-            let baseline_file = baseline.as_deref().map(crate::input::name);
-            let baseline = baseline.as_deref().map(crate::comparison::load_baseline).transpose()?;
+            let target = OutputTarget::new(output.as_deref(), "--output", existing)?;
+            // Standard input, if an input is `-`, is read once, when that input's turn comes.
+            let mut stdin = crate::input::Stdin::default();
+            let baseline = baseline.as_deref().map(|p| stdin.open_text(p, "baseline")).transpose()?;
+            let baseline_file = baseline.as_ref().map(crate::input::Source::name);
+            let baseline = baseline.as_ref().map(crate::comparison::load_baseline_source).transpose()?;
             if recipes.len() > 1 || recipes[0].is_dir() {
                 if explain {
                     return Err(Error::Usage("--explain takes one recipe".into()));
@@ -153,10 +155,11 @@ fn dispatch(cli: Cli, #[allow(unused_variables)] serve: Serve) -> Result<()> {
                     timing: !no_timing,
                     allow_unconverged,
                 };
-                return measure_batch(&recipes, &geometries, &geometry_files, &options, &batch, &target);
+                return measure_batch(&recipes, &geometries, &geometry_files, &options, &batch, &target, stdin);
             }
-            let material = recipe::load_file(&recipes[0])?;
-            let geos = resolve_geometries(&geometries, &geometry_files)?;
+            let material = recipe::load_source(&stdin.open_text(&recipes[0], "recipe")?)?;
+            let files = stdin.open_text_all(&geometry_files, "geometry file")?;
+            let geos = crate::api::resolve_geometries_from(&geometries, &files, crate::DEFAULT_PANEL)?;
             let plan = Plan::compile(material.brdf.clone(), geos.clone(), options.clone())?;
             let mut text = String::new();
             if explain {
@@ -227,13 +230,13 @@ fn dispatch(cli: Cli, #[allow(unused_variables)] serve: Serve) -> Result<()> {
             };
             print(&text)
         }
-        Command::Convergence(args) => convergence::run(args),
-        Command::Compare(args) => compare::run(args),
-        Command::Fit(args) => fit::run(args),
-        Command::Plot(args) => pictures::run(args),
-        Command::Profile(args) => profile::run(args),
-        Command::Sweep(args) => sweep::run(args),
-        Command::Topography(args) => topography::run(args),
+        Command::Convergence(args) => convergence::run(args, existing),
+        Command::Compare(args) => compare::run(args, existing),
+        Command::Fit(args) => fit::run(args, existing),
+        Command::Plot(args) => pictures::run(args, existing),
+        Command::Profile(args) => profile::run(args, existing),
+        Command::Sweep(args) => sweep::run(args, existing),
+        Command::Topography(args) => topography::run(args, existing),
         #[cfg(feature = "serve")]
         Command::Serve(args) => serve(&args.request()),
         Command::Schema { output_format } => {
@@ -301,10 +304,16 @@ fn measure_batch(
     options: &PlanOptions,
     how: &Batch,
     target: &OutputTarget,
+    mut stdin: crate::input::Stdin,
 ) -> Result<()> {
     let files = crate::batch::recipe_files(paths)?;
-    let materials = crate::batch::load_all(&files)?;
-    let geos = resolve_geometries(geometries, geometry_files)?;
+    // Every recipe is loaded before any work; the first bad one is the error.
+    let mut materials = Vec::with_capacity(files.len());
+    for f in &files {
+        materials.push(recipe::load_source(&stdin.open_text(f, "recipe")?)?);
+    }
+    let files = stdin.open_text_all(geometry_files, "geometry file")?;
+    let geos = crate::api::resolve_geometries_from(geometries, &files, crate::DEFAULT_PANEL)?;
     let runs = crate::batch::run_many(&materials, &geos, options)?;
     let evaluations: Vec<usize> = runs.iter().map(|e| e.evaluations()).collect();
     let readings: Vec<Vec<crate::Reading>> = runs.into_iter().map(|e| e.readings).collect();

@@ -9,10 +9,10 @@
 //! temporary file is removed when it is dropped. The target is checked before any work is done
 //! ([`OutputTarget::new`]), so a long computation is not wasted on a name that would be refused.
 //!
-//! `--force` ([`set_force`], for re-runs in a Makefile) lets an existing regular file be replaced: the new file
+//! `--force` ([`Existing::Replace`], for re-runs in a Makefile; the command line passes it to every writer as a
+//! value) lets an existing regular file be replaced: the new file
 //! is still written to a temporary file and renamed over the old one only when it is complete (`persist`, an
 //! atomic `rename(2)`), so a failed run leaves the old file as it was. A directory is never replaced.
-use std::cell::Cell;
 use std::fs::File;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -22,34 +22,42 @@ use crate::{Error, Result};
 /// How standard output is named in errors.
 pub const STDOUT: &str = "<stdout>";
 
-thread_local! {
-    /// `--force`: replace existing files (set by the command line for its run, on the thread that writes).
-    static FORCE: Cell<bool> = const { Cell::new(false) };
+/// What a written file does to an existing file of its name: refuse it (the default), or replace it whole
+/// (`--force`). A directory is refused either way.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Existing {
+    #[default]
+    Refuse,
+    Replace,
 }
 
-/// Whether the files this thread writes may replace existing ones (`--force`).
-pub fn set_force(force: bool) {
-    FORCE.with(|f| f.set(force));
+impl Existing {
+    /// `--force` given: [`Existing::Replace`].
+    pub fn from_force(force: bool) -> Existing {
+        if force {
+            Existing::Replace
+        } else {
+            Existing::Refuse
+        }
+    }
 }
 
-fn force() -> bool {
-    FORCE.with(Cell::get)
-}
-
-/// Standard output, or a file that must not exist yet.
+/// Standard output, or a file that must not exist yet (or may be replaced, [`Existing::Replace`]).
 #[derive(Clone, Debug)]
 pub struct OutputTarget {
     path: Option<PathBuf>,
+    existing: Existing,
 }
 
 impl OutputTarget {
-    /// `None` and `-` are standard output. A path is refused now if it exists or its directory does not.
-    pub fn new(path: Option<&Path>, option: &str) -> Result<OutputTarget> {
+    /// `None` and `-` are standard output. A path is refused now if it exists (unless `existing` replaces it)
+    /// or its directory does not.
+    pub fn new(path: Option<&Path>, option: &str, existing: Existing) -> Result<OutputTarget> {
         let path = path.filter(|p| p.as_os_str() != "-");
         if let Some(p) = path {
-            check_new_file(p, option)?;
+            check_new_file(p, option, existing)?;
         }
-        Ok(OutputTarget { path: path.map(Path::to_path_buf) })
+        Ok(OutputTarget { path: path.map(Path::to_path_buf), existing })
     }
 
     pub fn path(&self) -> Option<&Path> {
@@ -60,7 +68,7 @@ impl OutputTarget {
     pub fn write(&self, text: &str) -> Result<()> {
         match &self.path {
             None => print(text),
-            Some(p) => write_new_file(p, text.as_bytes()),
+            Some(p) => write_new_file(p, text.as_bytes(), self.existing),
         }
     }
 
@@ -80,7 +88,7 @@ impl OutputTarget {
                 body(&mut out)?;
                 out.flush().map_err(io)
             }
-            Some(p) => write_new_file_by(p, |f| {
+            Some(p) => write_new_file_by(p, self.existing, |f| {
                 let mut out = std::io::BufWriter::new(f);
                 body(&mut out)?;
                 out.flush().map_err(io)
@@ -89,13 +97,14 @@ impl OutputTarget {
     }
 }
 
-/// Refuse an existing path (never overwritten) and a path whose directory does not exist.
-pub fn check_new_file(p: &Path, option: &str) -> Result<()> {
+/// Refuse an existing path (unless `existing` replaces it; a directory always) and a path whose directory does
+/// not exist.
+pub fn check_new_file(p: &Path, option: &str, existing: Existing) -> Result<()> {
     if let Ok(meta) = p.symlink_metadata() {
         if meta.is_dir() {
             return Err(Error::Usage(format!("{option} {}: is a directory, not a file", p.display())));
         }
-        if !force() {
+        if existing == Existing::Refuse {
             return Err(Error::Usage(format!(
                 "{option} {}: already exists; glossmeter never overwrites a file (choose another name, or give \
                  --force to replace it)",
@@ -124,23 +133,24 @@ fn parent(p: &Path) -> &Path {
 }
 
 /// Write `bytes` to the new file `path`, atomically (see the module documentation).
-pub fn write_new_file(path: &Path, bytes: &[u8]) -> Result<()> {
-    write_new_file_with(path, bytes, |f, b| f.write_all(b))
+pub fn write_new_file(path: &Path, bytes: &[u8], existing: Existing) -> Result<()> {
+    write_new_file_with(path, bytes, existing, |f, b| f.write_all(b))
 }
 
 /// [`write_new_file`] with the writing step given, so that tests can make it fail like a full disk.
 pub fn write_new_file_with(
     path: &Path,
     bytes: &[u8],
+    existing: Existing,
     write: impl FnOnce(&mut File, &[u8]) -> std::io::Result<()>,
 ) -> Result<()> {
     let io = |source| Error::Io { file: path.display().to_string(), source };
-    write_new_file_by(path, |f| write(f, bytes).map_err(io))
+    write_new_file_by(path, existing, |f| write(f, bytes).map_err(io))
 }
 
 /// Create the new file `path` atomically with the contents `body` writes (see the module documentation):
 /// on any error of `body`, of the flush or of the link, no file is left behind.
-pub fn write_new_file_by(path: &Path, body: impl FnOnce(&mut File) -> Result<()>) -> Result<()> {
+pub fn write_new_file_by(path: &Path, existing: Existing, body: impl FnOnce(&mut File) -> Result<()>) -> Result<()> {
     let io = |source| Error::Io { file: path.display().to_string(), source };
     let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| "output".into());
     let prefix = format!(".{name}.glossmeter-");
@@ -154,7 +164,7 @@ pub fn write_new_file_by(path: &Path, body: impl FnOnce(&mut File) -> Result<()>
     // On an error here `tmp` is dropped, which removes the temporary file.
     body(tmp.as_file_mut())?;
     tmp.as_file_mut().flush().and_then(|_| tmp.as_file().sync_all()).map_err(io)?;
-    if force() {
+    if existing == Existing::Replace {
         if path.is_dir() {
             return Err(Error::Usage(format!("{}: is a directory, not a file", path.display())));
         }
@@ -197,13 +207,12 @@ mod tests {
         let d = dir("force");
         let p = d.join("readings.csv");
         std::fs::write(&p, "old").unwrap();
-        assert!(check_new_file(&p, "-o").unwrap_err().to_string().contains("--force"));
-        set_force(true);
-        check_new_file(&p, "-o").unwrap();
-        write_new_file(&p, b"new").unwrap();
+        assert!(check_new_file(&p, "-o", Existing::Refuse).unwrap_err().to_string().contains("--force"));
+        check_new_file(&p, "-o", Existing::Replace).unwrap();
+        write_new_file(&p, b"new", Existing::Replace).unwrap();
         assert_eq!(std::fs::read_to_string(&p).unwrap(), "new");
         // A write that fails half-way leaves the previous file as it was, and no temporary file.
-        let r = write_new_file_with(&p, b"0123456789", |f, b| {
+        let r = write_new_file_with(&p, b"0123456789", Existing::Replace, |f, b| {
             f.write_all(&b[..5])?;
             Err(std::io::Error::from(std::io::ErrorKind::StorageFull))
         });
@@ -211,9 +220,8 @@ mod tests {
         assert_eq!(std::fs::read_to_string(&p).unwrap(), "new");
         assert_eq!(entries(&d), ["readings.csv"]);
         // A directory is never replaced.
-        assert!(check_new_file(&d, "-o").unwrap_err().to_string().contains("directory"));
-        set_force(false);
-        assert!(check_new_file(&p, "-o").is_err());
+        assert!(check_new_file(&d, "-o", Existing::Replace).unwrap_err().to_string().contains("directory"));
+        assert!(check_new_file(&p, "-o", Existing::Refuse).is_err());
     }
 
     #[test]
@@ -221,7 +229,7 @@ mod tests {
         let d = dir("full");
         let p = d.join("readings.json");
         // A disk that fills after half the bytes: the old `BufWriter` path left a 0-byte file and exit 0.
-        let r = write_new_file_with(&p, b"0123456789", |f, b| {
+        let r = write_new_file_with(&p, b"0123456789", Existing::Refuse, |f, b| {
             f.write_all(&b[..5])?;
             Err(std::io::Error::from(std::io::ErrorKind::StorageFull))
         });
@@ -234,14 +242,14 @@ mod tests {
     fn an_existing_file_is_never_overwritten_even_if_it_appears_during_the_run() {
         let d = dir("race");
         let p = d.join("out.txt");
-        assert!(OutputTarget::new(Some(&p), "-o").is_ok());
+        assert!(OutputTarget::new(Some(&p), "-o", Existing::Refuse).is_ok());
         std::fs::write(&p, "user data").unwrap();
-        assert!(OutputTarget::new(Some(&p), "-o").is_err(), "checked before the work");
-        let e = write_new_file(&p, b"new").unwrap_err().to_string();
+        assert!(OutputTarget::new(Some(&p), "-o", Existing::Refuse).is_err(), "checked before the work");
+        let e = write_new_file(&p, b"new", Existing::Refuse).unwrap_err().to_string();
         assert!(e.contains("already exists"), "{e}");
         assert_eq!(std::fs::read_to_string(&p).unwrap(), "user data");
         assert_eq!(entries(&d), vec!["out.txt".to_string()]);
-        write_new_file(&d.join("fresh.txt"), b"whole").unwrap();
+        write_new_file(&d.join("fresh.txt"), b"whole", Existing::Refuse).unwrap();
         assert_eq!(std::fs::read_to_string(d.join("fresh.txt")).unwrap(), "whole");
     }
 
@@ -250,7 +258,7 @@ mod tests {
     fn a_written_file_has_the_permissions_of_a_created_one() {
         use std::os::unix::fs::PermissionsExt;
         let d = dir("mode");
-        write_new_file(&d.join("ours.txt"), b"x").unwrap();
+        write_new_file(&d.join("ours.txt"), b"x", Existing::Refuse).unwrap();
         std::fs::File::create(d.join("plain.txt")).unwrap();
         let mode = |n: &str| std::fs::metadata(d.join(n)).unwrap().permissions().mode() & 0o777;
         assert_eq!(mode("ours.txt"), mode("plain.txt"));
@@ -258,7 +266,8 @@ mod tests {
 
     #[test]
     fn a_missing_directory_is_refused_before_the_work() {
-        let e = OutputTarget::new(Some(Path::new("/nonexistent-dir-glossmeter/x.json")), "-o").unwrap_err();
+        let e = OutputTarget::new(Some(Path::new("/nonexistent-dir-glossmeter/x.json")), "-o", Existing::Refuse)
+            .unwrap_err();
         assert!(e.to_string().contains("does not exist"), "{e}");
     }
 }

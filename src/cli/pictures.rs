@@ -4,7 +4,9 @@
 //! `compare`'s comparison).
 use std::path::{Path, PathBuf};
 
+use crate::cli::output::Existing;
 use crate::comparison::Comparison;
+use crate::input::Stdin;
 use crate::report::pictures::charts::{draw_comparison, draw_sections, draw_vs_parameter, section, Residual, Section};
 pub use crate::report::pictures::charts::{section_svg, vs_parameter_svg};
 use crate::request::{self, PlanRequest, VsParameterRequest};
@@ -74,8 +76,8 @@ pub fn request(a: &PlotArgs) -> VsParameterRequest {
     }
 }
 
-pub fn run(a: PlotArgs) -> Result<()> {
-    super::plot::check_plot_path(&a.output, "--output")?;
+pub fn run(a: PlotArgs, existing: Existing) -> Result<()> {
+    super::plot::check_plot_path(&a.output, "--output", existing)?;
     if let Some(rtol) = a.rtol {
         request::check_rtol(rtol)?;
     }
@@ -85,7 +87,7 @@ pub fn run(a: PlotArgs) -> Result<()> {
             if a.vary.is_some() {
                 return Err(Error::Usage("--vary belongs to --kind gloss-vs-parameter".into()));
             }
-            let material = recipe::load_file(&a.recipe)?;
+            let material = recipe::load_source(&Stdin::default().open_text(&a.recipe, "recipe")?)?;
             let panels: Vec<Section> = geos.iter().filter_map(|g| section(material.brdf.as_ref(), g)).collect();
             if panels.is_empty() {
                 return Err(Error::Usage(
@@ -93,13 +95,17 @@ pub fn run(a: PlotArgs) -> Result<()> {
                 ));
             }
             let h = 420 * panels.len() as u32;
-            crate::render_plot!(&a.output, "--output", (1000, h), |root| draw_sections(root, &material.name, &panels))?;
+            crate::render_plot!(&a.output, "--output", existing, (1000, h), |root| draw_sections(
+                root,
+                &material.name,
+                &panels
+            ))?;
         }
         PlotKind::GlossVsParameter => {
-            let file = crate::input::name(&a.recipe);
-            let text = crate::input::read_text(&a.recipe, "recipe")?;
+            let source = Stdin::default().open_text(&a.recipe, "recipe")?;
+            let (file, text) = (source.name(), source.text("recipe")?);
             let v = request(&a).read(&text, &file, geos)?;
-            crate::render_plot!(&a.output, "--output", (1000, 640), |root| draw_vs_parameter(
+            crate::render_plot!(&a.output, "--output", existing, (1000, 640), |root| draw_vs_parameter(
                 root, &v.name, &v.label, v.log, &v.series
             ))?;
         }
@@ -113,7 +119,7 @@ pub fn run(a: PlotArgs) -> Result<()> {
 /// uncertainty + the prediction's error estimate, the verdict's threshold) as a band ±A about 0; each point
 /// coloured by its verdict (ok green, outside red, unchecked grey) and the verdict written beside it. The legend,
 /// beside the chart, names every row.
-pub fn write_comparison(path: &Path, cmp: &[Comparison]) -> Result<()> {
+pub fn write_comparison(path: &Path, cmp: &[Comparison], existing: Existing) -> Result<()> {
     let mut rows: Vec<Residual> = Vec::new();
     let mut names: Vec<&str> = Vec::new();
     for c in cmp {
@@ -135,5 +141,5 @@ pub fn write_comparison(path: &Path, cmp: &[Comparison]) -> Result<()> {
     }
     let name = if names.len() == 1 { names[0].to_string() } else { format!("{} materials", names.len()) };
     let h = 640.max(120 + 42 * rows.len().min(40) as u32);
-    crate::render_plot!(path, "--plot", (1100, h), |root| draw_comparison(root, &name, &rows))
+    crate::render_plot!(path, "--plot", existing, (1100, h), |root| draw_comparison(root, &name, &rows))
 }

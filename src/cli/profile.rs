@@ -5,7 +5,7 @@
 use std::path::PathBuf;
 
 use super::common::readings_status;
-use super::output::OutputTarget;
+use super::output::{Existing, OutputTarget};
 use crate::instrument::profile::{self, Profile};
 use crate::recipe::{self, Material};
 use crate::report::pictures::profile::draw;
@@ -68,18 +68,19 @@ pub fn request(a: &ProfileArgs) -> ProfileRequest {
     }
 }
 
-pub fn run(args: ProfileArgs) -> Result<()> {
+pub fn run(args: ProfileArgs, existing: Existing) -> Result<()> {
     let (options, budget) = request(&args).options()?;
-    let target = OutputTarget::new(args.output.as_deref(), "--output")?;
+    let target = OutputTarget::new(args.output.as_deref(), "--output", existing)?;
     if let Some(p) = &args.plot {
-        super::plot::check_plot_path(p, "--plot")?;
+        super::plot::check_plot_path(p, "--plot", existing)?;
         if args.output.as_deref() == Some(p.as_path()) {
             return Err(Error::Usage(format!("--plot and --output name the same file {}", p.display())));
         }
     }
-    let material = recipe::load_file(&args.recipe)?;
+    let mut stdin = crate::input::Stdin::default();
+    let material = recipe::load_source(&stdin.open_text(&args.recipe, "recipe")?)?;
     let g = match &args.geometry_file {
-        Some(f) => crate::instrument::standards::load_file(f)?,
+        Some(f) => crate::instrument::standards::load_source(&stdin.open_text(f, "geometry file")?)?,
         None => crate::instrument::standards::find(args.geometry.as_deref().unwrap_or(DEFAULT_GEOMETRY))?,
     };
     // Checked before any work: the geometry must have a profile array.
@@ -91,7 +92,7 @@ pub fn run(args: ProfileArgs) -> Result<()> {
     };
     if let Some(p) = &args.plot {
         let title = format!("{}: {} profile", material.name, prof.geometry);
-        crate::render_plot!(p, "--plot", (1000, 640), |root| draw(root, &prof, &title))?;
+        crate::render_plot!(p, "--plot", existing, (1000, 640), |root| draw(root, &prof, &title))?;
         eprintln!("plot: {} ({} pixels)", p.display(), prof.rows.len());
     }
     target.write(&text)?;

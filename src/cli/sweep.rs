@@ -4,7 +4,7 @@
 use std::io::IsTerminal;
 use std::path::PathBuf;
 
-use crate::cli::output::OutputTarget;
+use crate::cli::output::{Existing, OutputTarget};
 use crate::instrument::plan::PlanOptions;
 use crate::request::{PlanRequest, SweepRequest};
 use crate::sweep;
@@ -67,15 +67,15 @@ pub fn request(a: &SweepArgs) -> SweepRequest {
     }
 }
 
-pub fn run(a: SweepArgs) -> Result<()> {
+pub fn run(a: SweepArgs, existing: Existing) -> Result<()> {
     let request = request(&a);
     // Every check that needs no file comes before any work.
     request.plan.options()?;
     request.axes()?;
     let (k, m) = a.shard.as_deref().map(sweep::parse_shard).transpose()?.unwrap_or((1, 1));
-    let target = OutputTarget::new(a.output.as_deref(), "--output")?;
-    let file = crate::input::name(&a.template);
-    let text = crate::input::read_text(&a.template, "recipe")?;
+    let target = OutputTarget::new(a.output.as_deref(), "--output", existing)?;
+    let template = crate::input::Stdin::default().open_text(&a.template, "recipe")?;
+    let (file, text) = (template.name(), template.text("recipe")?);
     let geos = resolve_geometries(&a.geometries, &[] as &[&str])?;
     let s = request.sweep(&text, &file, geos)?;
     let range = s.shard(k, m);

@@ -7,7 +7,7 @@
 use std::path::PathBuf;
 
 use super::common::pad_table;
-use super::output::OutputTarget;
+use super::output::{Existing, OutputTarget};
 use crate::report::pictures::topography::draw;
 use crate::report::topography::TopographyDoc;
 use crate::request::TopographyRequest;
@@ -58,20 +58,20 @@ pub fn request(a: &TopographyArgs) -> TopographyRequest {
     }
 }
 
-pub fn run(args: TopographyArgs) -> Result<()> {
+pub fn run(args: TopographyArgs, existing: Existing) -> Result<()> {
     let req = request(&args);
     // The arguments are checked before the file is read.
     req.levelling()?;
     req.calibration()?;
-    let target = OutputTarget::new(args.output.as_deref(), "--output")?;
+    let target = OutputTarget::new(args.output.as_deref(), "--output", existing)?;
     if let Some(p) = &args.plot {
-        super::plot::check_plot_path(p, "--plot")?;
+        super::plot::check_plot_path(p, "--plot", existing)?;
         if args.output.as_deref() == Some(p.as_path()) {
             return Err(Error::Usage(format!("--plot and --output name the same file {}", p.display())));
         }
     }
-    let file = crate::input::name(&args.file);
-    let bytes = crate::input::read_bytes_limited(&args.file, "topography", MAX_FILE_BYTES)?;
+    let source = crate::input::Stdin::default().open(&args.file, "topography", MAX_FILE_BYTES)?;
+    let (file, bytes) = (source.name(), source.bytes_limited("topography", MAX_FILE_BYTES)?);
     let ext = args.file.extension().map(|e| e.to_string_lossy().to_ascii_lowercase()).unwrap_or_default();
     let (map, analysis) = req.read(&bytes, &file, &ext)?;
     let doc = TopographyDoc::new(&map, &analysis);
@@ -81,7 +81,7 @@ pub fn run(args: TopographyArgs) -> Result<()> {
     };
     if let Some(p) = &args.plot {
         let title = format!("{} ({}, levelling {})", map.file, map.format.name(), doc.levelling);
-        crate::render_plot!(p, "--plot", (1200, 560), |root| draw(root, &map, &analysis, &doc, &title))?;
+        crate::render_plot!(p, "--plot", existing, (1200, 560), |root| draw(root, &map, &analysis, &doc, &title))?;
         eprintln!("plot: {} ({} × {} points)", p.display(), map.nx, map.ny);
     }
     target.write(&text)

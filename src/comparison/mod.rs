@@ -51,6 +51,7 @@ use rayon::prelude::*;
 use self::propagation::PredictionUncertainty;
 use self::sheet::{Layout, Sheet, SheetOptions, SheetRow};
 use crate::error::Words;
+use crate::input::Source;
 use crate::instrument::plan::{Plan, PlanOptions, Reading};
 use crate::instrument::standards::{self, StandardGeometry};
 use crate::recipe::{self, Material};
@@ -134,8 +135,8 @@ pub fn group_rows(rows: &[SheetRow]) -> Vec<Group> {
 
 /// A sheet read as targets, for callers other than `compare` (`fit --sheet`): every (sample, geometry,
 /// reading) with its values, the largest stated uncertainty, the statistics and the lines they came from.
-pub fn read_targets(path: &Path, options: &SheetOptions) -> Result<(Sheet, Vec<Group>)> {
-    let sheet = sheet::load(path, options)?;
+pub fn read_targets(source: &Source, options: &SheetOptions) -> Result<(Sheet, Vec<Group>)> {
+    let sheet = sheet::load_source(source, options)?;
     let groups = group_rows(&sheet.rows);
     Ok((sheet, groups))
 }
@@ -480,17 +481,17 @@ pub fn judge(
 }
 
 /// Where each sample's recipe comes from: `--recipe SAMPLE=FILE` first, then `DIR/<sample>.json`, then the
-/// one recipe given for all samples.
+/// one recipe given for all samples (each a file, or standard input as the front end read it).
 #[derive(Clone, Debug, Default)]
 pub struct Recipes {
-    pub default: Option<PathBuf>,
+    pub default: Option<Source>,
     pub dir: Option<PathBuf>,
-    pub per_sample: Vec<(String, PathBuf)>,
+    pub per_sample: Vec<(String, Source)>,
 }
 
 impl Recipes {
-    /// The recipe file of a sample, or None.
-    pub fn path_of(&self, sample: &str) -> Option<PathBuf> {
+    /// The recipe of a sample, or None.
+    pub fn source_of(&self, sample: &str) -> Option<Source> {
         if let Some((_, p)) = self.per_sample.iter().find(|(s, _)| s == sample) {
             return Some(p.clone());
         }
@@ -504,7 +505,7 @@ impl Recipes {
             if plain {
                 let p = d.join(format!("{sample}.json"));
                 if p.is_file() {
-                    return Some(p);
+                    return Some(Source::File(p));
                 }
             }
         }
@@ -524,9 +525,9 @@ pub fn compare_sheet(
     let groups = group_rows(&sheet.rows);
     let geometries = sheet_geometries(sheet)?;
     // Recipes per sample, in order of first appearance.
-    let mut samples: Vec<(String, PathBuf)> = Vec::new();
+    let mut samples: Vec<(String, Source)> = Vec::new();
     for sample in distinct_samples(&groups) {
-        let Some(p) = recipes.path_of(sample) else {
+        let Some(p) = recipes.source_of(sample) else {
             let row = sheet.rows.iter().find(|r| r.sample == sample).expect("sample from rows");
             let where_ = match &recipes.dir {
                 Some(d) => format!("no {}/{}.json", d.display(), sample),
@@ -542,10 +543,10 @@ pub fn compare_sheet(
         };
         samples.push((sample.to_string(), p));
     }
-    let mut paths: Vec<PathBuf> = samples.iter().map(|(_, p)| p.clone()).collect();
+    let mut paths: Vec<Source> = samples.iter().map(|(_, p)| p.clone()).collect();
     paths.sort();
     paths.dedup();
-    let materials: Vec<Material> = paths.iter().map(|p| recipe::load_file(p)).collect::<Result<_>>()?;
+    let materials: Vec<Material> = paths.iter().map(recipe::load_source).collect::<Result<_>>()?;
     let of_sample: Vec<(String, usize)> =
         samples.iter().map(|(s, p)| (s.clone(), paths.binary_search(p).expect("path listed"))).collect();
     judge_all(sheet, groups, geometries, &materials, &of_sample, rule, options)
@@ -681,9 +682,14 @@ pub struct BaselineEntry {
 
 /// Read a baseline file: the JSON of `measure` (one or many recipes) or of `compare`.
 pub fn load_baseline(path: &Path) -> Result<Vec<BaselineEntry>> {
-    let file = crate::input::name(path);
+    load_baseline_source(&path.into())
+}
+
+/// [`load_baseline`] of a source (a file, or standard input as a front end read it).
+pub fn load_baseline_source(source: &Source) -> Result<Vec<BaselineEntry>> {
+    let file = source.name();
     // Read as every JSON input is: the size limit, a BOM, duplicate keys refused.
-    let text = crate::input::read_text(path, "baseline")?;
+    let text = source.text("baseline")?;
     let doc = crate::input::json::parse_json(&text, &file)?;
     let entries = parse_baseline(&doc, &file)?;
     if entries.is_empty() {

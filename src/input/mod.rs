@@ -4,16 +4,18 @@
 //! own header in `measured::merl`.)
 //!
 //! The folder:
-//! * `mod.rs` (this): [`read_text`] and [`read_bytes`] with the text limit [`MAX_TEXT_BYTES`], and their
-//!   `_limited` forms ([`read_text_limited`], [`read_bytes_limited`]) that the measured tables use with
-//!   [`MAX_TABLE_BYTES`]; the path `-` is standard input ([`is_stdin`], named [`STDIN`] in messages), which
-//!   one input of a run may be (docs/instrument.md §Standard input and output);
+//! * `mod.rs` (this): a [`Source`], a file or bytes already read, read as text ([`Source::text`]) or bytes
+//!   ([`Source::bytes`]) with the text limit [`MAX_TEXT_BYTES`], or with the limit given (`_limited`: the
+//!   measured tables use [`MAX_TABLE_BYTES`]); [`read_text`] and its kin for a file's path. Standard input is
+//!   a source a front end opens ([`Stdin::open`]: the argument `-`, named [`STDIN`] in messages, which one
+//!   input of a run may be, docs/instrument.md §Standard input and output) and hands to the readers: no
+//!   reader knows `-`;
 //! * `json.rs`: a JSON document read with errors that name the file and the field's JSON Pointer
 //!   ([`json::parse_json`], which refuses duplicate keys, [`json::Obj`] and its typed accessors, [`json::kind`],
 //!   [`json::show`]); every recipe and geometry-file parser reads through it.
 use std::io::Read;
-use std::path::Path;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 use crate::{Error, Result};
 
@@ -30,18 +32,10 @@ pub const MAX_TABLE_BYTES: u64 = 256 * 1024 * 1024;
 /// How standard input is named in messages (the path `-`).
 pub const STDIN: &str = "<stdin>";
 
-/// Whether a path is `-`, standard input (a file named `-` is still reachable as `./-`).
+/// Whether a command-line argument is `-`, standard input (a file named `-` is still reachable as `./-`). Only
+/// front ends ask: a reader is handed a [`Source`], and the path `-` is a file of that name to it.
 pub fn is_stdin(path: &Path) -> bool {
     path.as_os_str() == "-"
-}
-
-/// A path as messages name it: the path as given, or [`STDIN`] for `-`.
-pub fn name(path: &Path) -> String {
-    if is_stdin(path) {
-        STDIN.into()
-    } else {
-        path.display().to_string()
-    }
 }
 
 /// Refuse, before any reading, a run that names `-` for two inputs (standard input can be read once).
@@ -56,61 +50,151 @@ pub fn at_most_one_stdin<'a>(paths: impl IntoIterator<Item = &'a Path>) -> Resul
     Ok(())
 }
 
-/// Set when standard input has been read: it can be read once, so a second `-` is an error, not an empty file.
-static STDIN_READ: AtomicBool = AtomicBool::new(false);
-
-/// Read a UTF-8 text file of at most [`MAX_TEXT_BYTES`]; `what` names the kind of file in messages.
-pub fn read_text(path: &Path, what: &str) -> Result<String> {
-    read_text_limited(path, what, MAX_TEXT_BYTES)
+/// An input as a front end hands it to a reader: a file the reader opens, or bytes the front end has already
+/// read (standard input, [`Stdin::open`]) with the name messages give them.
+#[derive(Clone, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Source {
+    /// A file, by its path as given.
+    File(PathBuf),
+    /// Bytes already read (at most a reader's limit + 1, so that the reader still refuses a larger input), and
+    /// their name in messages ([`STDIN`]).
+    Read { name: String, bytes: Arc<[u8]> },
 }
 
-/// The bytes of a file of at most [`MAX_TEXT_BYTES`] (for sheets, whose encoding is decided after reading).
-pub fn read_bytes(path: &Path, what: &str) -> Result<Vec<u8>> {
-    read_bytes_limited(path, what, MAX_TEXT_BYTES)
+impl From<&Path> for Source {
+    fn from(p: &Path) -> Source {
+        Source::File(p.to_path_buf())
+    }
 }
 
-/// The bytes of a file of at most `limit` bytes; a larger one (or an endless one, `/dev/zero`) is refused
-/// after reading `limit` + 1 bytes, naming the file and the limit.
-pub fn read_bytes_limited(path: &Path, what: &str, limit: u64) -> Result<Vec<u8>> {
-    let file = name(path);
-    let io = |source| Error::Io { file: file.clone(), source };
-    let mut bytes = Vec::new();
-    if is_stdin(path) {
-        if STDIN_READ.swap(true, Ordering::SeqCst) {
+impl From<PathBuf> for Source {
+    fn from(p: PathBuf) -> Source {
+        Source::File(p)
+    }
+}
+
+impl Source {
+    /// The source as messages name it: the path as given, or the name of bytes read ([`STDIN`]).
+    pub fn name(&self) -> String {
+        match self {
+            Source::File(p) => p.display().to_string(),
+            Source::Read { name, .. } => name.clone(),
+        }
+    }
+
+    /// The file's path (None for bytes already read).
+    pub fn path(&self) -> Option<&Path> {
+        match self {
+            Source::File(p) => Some(p),
+            Source::Read { .. } => None,
+        }
+    }
+
+    /// The bytes of the source, of at most [`MAX_TEXT_BYTES`] (for sheets, whose encoding is decided after
+    /// reading).
+    pub fn bytes(&self, what: &str) -> Result<Vec<u8>> {
+        self.bytes_limited(what, MAX_TEXT_BYTES)
+    }
+
+    /// The source as UTF-8 text of at most [`MAX_TEXT_BYTES`]; `what` names the kind of file in messages.
+    pub fn text(&self, what: &str) -> Result<String> {
+        self.text_limited(what, MAX_TEXT_BYTES)
+    }
+
+    /// The bytes of the source, of at most `limit` bytes; a larger one (or an endless one, `/dev/zero`) is
+    /// refused after reading `limit` + 1 bytes, naming the file and the limit.
+    pub fn bytes_limited(&self, what: &str, limit: u64) -> Result<Vec<u8>> {
+        let file = self.name();
+        let bytes = match self {
+            Source::File(path) => {
+                let io = |source| Error::Io { file: file.clone(), source };
+                let mut bytes = Vec::new();
+                let f = std::fs::File::open(path).map_err(io)?;
+                f.take(limit + 1).read_to_end(&mut bytes).map_err(io)?;
+                bytes
+            }
+            Source::Read { bytes, .. } => bytes.to_vec(),
+        };
+        if bytes.len() as u64 > limit {
+            return Err(Error::input(
+                &file,
+                "",
+                format!("larger than {} MiB, the limit for a {what} (is this the right file?)", limit / (1024 * 1024)),
+            ));
+        }
+        Ok(bytes)
+    }
+
+    /// [`Source::text`] with the limit given.
+    pub fn text_limited(&self, what: &str, limit: u64) -> Result<String> {
+        let bytes = self.bytes_limited(what, limit)?;
+        String::from_utf8(bytes).map_err(|e| {
+            Error::input(
+                self.name(),
+                "",
+                format!(
+                    "not UTF-8 text (invalid byte at offset {}); a {what} is JSON or CSV text",
+                    e.utf8_error().valid_up_to()
+                ),
+            )
+        })
+    }
+}
+
+/// Standard input as a front end opens it: a value the front end owns for one run (never a flag of the
+/// process), which reads standard input for the first `-` and refuses a second (it can be read once).
+#[derive(Debug, Default)]
+pub struct Stdin {
+    read: bool,
+}
+
+impl Stdin {
+    /// The source of a command-line argument: a file, or for `-` standard input read now (at most `limit` + 1
+    /// bytes: the reader, which has the same limit, refuses more), named [`STDIN`]. `what` names the kind of
+    /// input in the message refusing a second `-`.
+    pub fn open(&mut self, path: &Path, what: &str, limit: u64) -> Result<Source> {
+        if !is_stdin(path) {
+            return Ok(Source::File(path.to_path_buf()));
+        }
+        if std::mem::replace(&mut self.read, true) {
             return Err(Error::Usage(format!(
                 "`-` (standard input) is given for a second input (a {what}): standard input can be read once, so \
                  at most one input may be `-`"
             )));
         }
-        std::io::stdin().lock().take(limit + 1).read_to_end(&mut bytes).map_err(io)?;
-    } else {
-        let f = std::fs::File::open(path).map_err(io)?;
-        f.take(limit + 1).read_to_end(&mut bytes).map_err(io)?;
+        let mut bytes = Vec::new();
+        std::io::stdin()
+            .lock()
+            .take(limit + 1)
+            .read_to_end(&mut bytes)
+            .map_err(|source| Error::Io { file: STDIN.into(), source })?;
+        Ok(Source::Read { name: STDIN.into(), bytes: bytes.into() })
     }
-    if bytes.len() as u64 > limit {
-        return Err(Error::input(
-            &file,
-            "",
-            format!("larger than {} MiB, the limit for a {what} (is this the right file?)", limit / (1024 * 1024)),
-        ));
+
+    /// [`Stdin::open`] of a text input ([`MAX_TEXT_BYTES`]: recipes, sheets, geometry files, baselines).
+    pub fn open_text(&mut self, path: &Path, what: &str) -> Result<Source> {
+        self.open(path, what, MAX_TEXT_BYTES)
     }
-    Ok(bytes)
+
+    /// [`Stdin::open_text`] of every path, in order.
+    pub fn open_text_all(&mut self, paths: &[PathBuf], what: &str) -> Result<Vec<Source>> {
+        paths.iter().map(|p| self.open_text(p, what)).collect()
+    }
+}
+
+/// Read the UTF-8 text file `path` of at most [`MAX_TEXT_BYTES`]; `what` names the kind of file in messages.
+pub fn read_text(path: &Path, what: &str) -> Result<String> {
+    Source::from(path).text(what)
+}
+
+/// The bytes of the file `path`, of at most `limit` bytes ([`Source::bytes_limited`]).
+pub fn read_bytes_limited(path: &Path, what: &str, limit: u64) -> Result<Vec<u8>> {
+    Source::from(path).bytes_limited(what, limit)
 }
 
 /// [`read_text`] with the limit given.
 pub fn read_text_limited(path: &Path, what: &str, limit: u64) -> Result<String> {
-    let file = name(path);
-    let bytes = read_bytes_limited(path, what, limit)?;
-    String::from_utf8(bytes).map_err(|e| {
-        Error::input(
-            &file,
-            "",
-            format!(
-                "not UTF-8 text (invalid byte at offset {}); a {what} is JSON or CSV text",
-                e.utf8_error().valid_up_to()
-            ),
-        )
-    })
+    Source::from(path).text_limited(what, limit)
 }
 
 #[cfg(test)]
@@ -140,6 +224,25 @@ mod tests {
             let e = e.to_string();
             assert!(e.contains("/dev/zero") && e.contains("larger than 256 MiB"), "{e}");
         }
+    }
+
+    /// Standard input is the front end's: a reader given the path `-` opens a file of that name, and the bytes
+    /// a front end read are held to the reader's limit and named `<stdin>`; a second `-` is refused.
+    #[test]
+    fn standard_input_is_a_source_the_front_end_opens() {
+        let dash = Path::new("-");
+        if !dash.exists() {
+            let e = Source::from(dash).text("recipe").unwrap_err();
+            assert!(matches!(&e, Error::Io { file, .. } if file == "-"), "{e}");
+        }
+        let read = Source::Read { name: STDIN.into(), bytes: vec![b'x'; 3].into() };
+        assert_eq!(read.text_limited("recipe", 3).unwrap(), "xxx");
+        let e = read.text_limited("recipe", 2).unwrap_err().to_string();
+        assert!(e.contains(STDIN) && e.contains("larger than 0 MiB, the limit for a recipe"), "{e}");
+        let mut stdin = Stdin { read: true };
+        assert_eq!(stdin.open_text(Path::new("r.json"), "recipe").unwrap(), Source::File("r.json".into()));
+        let e = stdin.open_text(dash, "geometry file").unwrap_err().to_string();
+        assert!(e.contains("`-` (standard input) is given for a second input (a geometry file)"), "{e}");
     }
 
     #[test]

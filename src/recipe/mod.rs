@@ -77,9 +77,12 @@ pub struct Material {
 
 /// Read and validate a recipe file. I/O errors name the file.
 pub fn load_file(path: &std::path::Path) -> Result<Material> {
-    let file = crate::input::name(path);
-    let text = crate::input::read_text(path, "recipe")?;
-    parse_str(&text, &file)
+    load_source(&path.into())
+}
+
+/// [`load_file`] of a source (a file, or standard input as a front end read it).
+pub fn load_source(source: &crate::input::Source) -> Result<Material> {
+    parse_str(&source.text("recipe")?, &source.name())
 }
 
 /// Validate recipe text; `file` names it in messages.

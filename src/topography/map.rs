@@ -117,6 +117,23 @@ impl HeightMap {
         z: Vec<f64>,
         field: &str,
     ) -> Result<HeightMap> {
+        HeightMap::with_height_note(file, format, nx, ny, dx, dy, z, field, "")
+    }
+
+    /// [`HeightMap::new`], with `note` added to the message refusing a height (what a format says of its
+    /// heights' scale: X3P's increment and offset).
+    #[allow(clippy::too_many_arguments)]
+    pub fn with_height_note(
+        file: &str,
+        format: Format,
+        nx: usize,
+        ny: usize,
+        dx: f64,
+        dy: f64,
+        z: Vec<f64>,
+        field: &str,
+        note: &str,
+    ) -> Result<HeightMap> {
         let n = check_dimensions(file, field, nx as u64, ny as u64)?;
         check_spacing(file, field, dx)?;
         check_spacing(file, field, dy)?;
@@ -129,7 +146,7 @@ impl HeightMap {
                 field,
                 format!(
                     "the height at point ({}, {}) is {} m; allowed: |height| ≤ {} m (a larger value is a scale or unit \
-                     error)",
+                     error){note}",
                     k % nx,
                     k / nx,
                     number(z[k]),

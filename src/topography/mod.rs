@@ -36,7 +36,7 @@ use text::Calibration;
 
 /// Read a topography file (at most [`MAX_FILE_BYTES`]); `calibration` is used by a plain matrix only.
 pub fn load(path: &Path, calibration: Option<Calibration>) -> Result<HeightMap> {
-    let file = crate::input::name(path);
+    let file = path.display().to_string();
     let bytes = crate::input::read_bytes_limited(path, "topography", MAX_FILE_BYTES)?;
     let ext = path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase()).unwrap_or_default();
     from_bytes(&bytes, &file, &ext, calibration)

@@ -158,17 +158,10 @@ pub fn read(bytes: &[u8], file: &str) -> Result<HeightMap> {
         }
     }
     let data_field = if main.data_list.is_some() { "Record3/DataList" } else { "Record3/DataLink/PointDataLink" };
-    let map =
-        HeightMap::new(file, Format::X3p, nx as usize, ny as usize, spacing[0], spacing[1], z, &field(data_field));
-    map.map_err(|e| match e {
-        // The scale is part of what a height's message should say.
-        Error::Input { file, field, message } if message.contains("|height|") => Error::input(
-            file,
-            field,
-            format!("{message} (CZ Increment {}, Offset {})", number(z_scale), number(z_offset)),
-        ),
-        other => other,
-    })
+    // The scale is part of what a height's message should say.
+    let note = format!(" (CZ Increment {}, Offset {})", number(z_scale), number(z_offset));
+    let (nx, ny) = (nx as usize, ny as usize);
+    HeightMap::with_height_note(file, Format::X3p, nx, ny, spacing[0], spacing[1], z, &field(data_field), &note)
 }
 
 /// The member `name`, inflated: exactly `size` bytes if `linked` (a data file whose size the grid fixes, named
@@ -338,6 +331,10 @@ pub(crate) mod tests {
         assert!(e(main_xml(2, 2, "0", "D", LINK), &data).contains("lateral calibration"));
         let nan: Vec<u8> = [f64::NAN; 4].iter().flat_map(|v| v.to_le_bytes()).collect();
         assert!(e(ok.clone(), &nan).contains("every point"));
+        // A height beyond the limit: the message says the scale it was read with (CZ's increment, offset).
+        let far: Vec<u8> = [1.0, 2.0, 3.0, 2e9f64].iter().flat_map(|v| v.to_le_bytes()).collect();
+        let m = e(ok.clone(), &far);
+        assert!(m.contains("the height at point (1, 1)") && m.contains("error) (CZ Increment 1e-9, Offset 0)"), "{m}");
         assert!(read(b"PK\x03\x04 truncated", "t.x3p").unwrap_err().to_string().contains("damaged or truncated"));
         let full = zip_of(&[("main.xml", ok.as_bytes()), ("bindata/data.bin", &data)]);
         assert!(read(&full[..full.len() / 2], "t.x3p").is_err());

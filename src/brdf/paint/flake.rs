@@ -14,7 +14,7 @@ use crate::quadrature::gauss_legendre;
 use num_complex::Complex64;
 use std::cell::Cell;
 use std::f64::consts::PI;
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::atomic::{AtomicU64, Ordering};
 
 /// Largest accepted deviation of a flake-reflectance table from the direct evaluation (absolute, on a
 /// reflectance ≤ 1): far below any tolerance a reading is asked for.
@@ -290,9 +290,17 @@ impl FlakeTerm {
     /// [`FlakeTerm::grid`]) and, for the split flake light, its constants ([`FlakeTerm::split_constants`]) —
     /// taken from the process's [`Memo`] when a build before had the same inputs to the bit (what a sweep point
     /// that varies an area ratio, a spread, the primer or the coat's roughness meets), else computed and kept.
-    pub(super) fn prepare(&mut self, k_mix: &[f64], s_mix: &[f64], depth_mm: f64, wavelengths_nm: &[f64]) {
+    /// `build` says how tables the memo does not have are fitted (the bits are the same either way).
+    pub(super) fn prepare(
+        &mut self,
+        k_mix: &[f64],
+        s_mix: &[f64],
+        depth_mm: f64,
+        wavelengths_nm: &[f64],
+        build: TableBuild,
+    ) {
         let key = self.key(k_mix, s_mix, depth_mm, wavelengths_nm);
-        let made = TABLES.get_or_make(key, || self.compute(k_mix, s_mix, depth_mm, wavelengths_nm));
+        let made = TABLES.get_or_make(key, || self.compute(k_mix, s_mix, depth_mm, wavelengths_nm, build));
         self.table = made.table.clone();
         self.grid = made.grid.clone();
         self.depth = made.depth.clone();
@@ -300,8 +308,15 @@ impl FlakeTerm {
     }
 
     /// What [`FlakeTerm::prepare`] computes when the memo does not have it, counted in [`table_work`].
-    fn compute(&self, k_mix: &[f64], s_mix: &[f64], depth_mm: f64, wavelengths_nm: &[f64]) -> Prepared {
-        let per_sample = PER_SAMPLE.load(Ordering::Relaxed);
+    fn compute(
+        &self,
+        k_mix: &[f64],
+        s_mix: &[f64],
+        depth_mm: f64,
+        wavelengths_nm: &[f64],
+        build: TableBuild,
+    ) -> Prepared {
+        let per_sample = build == TableBuild::PerSample;
         let work = Work::default();
         let mut t = self.clone();
         t.tabulate(wavelengths_nm, per_sample, &work);
@@ -361,14 +376,17 @@ struct Prepared {
     diffuse: Vec<f64>,
 }
 
-/// Build the flake tables one sample at a time (`true`: the engine before `docs/model.md` §Evaluation cost
-/// "shared across samples", what `benches/paint_build.rs` times as "before") or all samples at once (`false`,
-/// the default). The tables are the same bits either way (`tests/paint.rs`), so the memo serves both.
-pub fn build_tables_per_sample(on: bool) {
-    PER_SAMPLE.store(on, Ordering::Relaxed);
+/// How a paint's flake tables are fitted ([`super::Paint::with_table_build`]): all samples at once
+/// ([`TableBuild::Shared`], what [`super::Paint::new`] does) or one sample at a time
+/// ([`TableBuild::PerSample`]: the engine before `docs/model.md` §Evaluation cost "shared across samples", what
+/// `benches/paint_build.rs` times as "before"). The tables are the same bits either way (`tests/paint.rs`), so
+/// the memo serves both.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum TableBuild {
+    #[default]
+    Shared,
+    PerSample,
 }
-
-static PER_SAMPLE: AtomicBool = AtomicBool::new(false);
 static STACK_SETUPS: AtomicU64 = AtomicU64::new(0);
 static STACK_WAVELENGTHS: AtomicU64 = AtomicU64::new(0);
 

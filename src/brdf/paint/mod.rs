@@ -53,7 +53,7 @@ mod hemisphere;
 mod memo;
 mod spec;
 
-pub use flake::{build_tables_per_sample, forget_tables, table_work, TABLE_TOLERANCE};
+pub use flake::{forget_tables, table_work, TableBuild, TABLE_TOLERANCE};
 pub use hemisphere::{
     diffuse_fresnel_reflectance, hemispherical_mean, internal_diffuse_reflectance, DIFFUSE_FRESNEL_NODES,
 };
@@ -108,6 +108,12 @@ pub struct Paint {
 impl Paint {
     /// Validate `spec` and precompute everything that does not depend on direction.
     pub fn new(spec: PaintSpec) -> Result<Paint> {
+        Paint::with_table_build(spec, TableBuild::Shared)
+    }
+
+    /// [`Paint::new`] with the flake tables fitted as `build` says ([`TableBuild`]: the same bits either way;
+    /// `benches/paint_build.rs` compares the two builds' times).
+    pub fn with_table_build(spec: PaintSpec, build: TableBuild) -> Result<Paint> {
         let n = spec.sampling.len();
         if n == 0 || n > MAX_SAMPLES {
             return Err(usage(format!("{n} spectral samples; a paint takes 1 to {MAX_SAMPLES}")));
@@ -217,7 +223,7 @@ impl Paint {
                 diffuse: vec![0.0; n],
                 split,
             };
-            term.prepare(&k_mix, &s_mix, depth, &spec.sampling.wavelengths_nm);
+            term.prepare(&k_mix, &s_mix, depth, &spec.sampling.wavelengths_nm, build);
             term
         };
         let metallic = spec.metallic.as_ref().filter(|m| m.area_ratio > 0.0).map(|m| {

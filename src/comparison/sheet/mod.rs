@@ -157,11 +157,14 @@ impl Sheet {
     }
 }
 
-/// Read a sheet file (or `-`, standard input): its bytes, then [`from_bytes`].
+/// Read a sheet file: its bytes, then [`from_bytes`].
 pub fn load(path: &Path, options: &SheetOptions) -> Result<Sheet> {
-    let file = crate::input::name(path);
-    let bytes = crate::input::read_bytes(path, "sheet")?;
-    from_bytes(&bytes, &file, options)
+    load_source(&path.into(), options)
+}
+
+/// [`load`] of a source (a file, or standard input as a front end read it).
+pub fn load_source(source: &crate::input::Source, options: &SheetOptions) -> Result<Sheet> {
+    from_bytes(&source.bytes("sheet")?, &source.name(), options)
 }
 
 /// The one entry point of every front end (command line, server, Python): a sheet's bytes, a workbook if they

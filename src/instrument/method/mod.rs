@@ -231,7 +231,7 @@ pub enum Projection {
     /// table per flake term instead of n); the default. Otherwise the same as `Fold`.
     FoldInMaterial,
     /// After: the cubature integrates the n samples and the weighting is applied to the results
-    /// (kept to measure what folding saves; `PlanOptions::fold_spectral`).
+    /// (kept to measure what folding saves; `plan::Engine::fold_spectral`).
     Separate,
 }
 

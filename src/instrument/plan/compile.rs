@@ -19,7 +19,7 @@ use crate::instrument::standards::{self, StandardGeometry};
 use crate::spectrum::Sampling;
 use crate::{Error, Result};
 
-use super::{shape, Job, Plan, PlanOptions, PlannedReading, MIN_RTOL, SPECIMEN_SHARE, STANDARD_SHARE};
+use super::{shape, Engine, Job, Plan, PlanOptions, PlannedReading, MIN_RTOL, SPECIMEN_SHARE, STANDARD_SHARE};
 
 /// Why `rtol` is not a relative tolerance (a number in (0, 1)), if it is not: the words after its name, which
 /// [`Planner::compile`] calls "the relative tolerance (rtol)" and the command line `--rtol`.
@@ -110,6 +110,17 @@ impl Planner {
         geometries: Vec<StandardGeometry>,
         options: PlanOptions,
     ) -> Result<Plan> {
+        self.compile_with_engine(material, geometries, options, Engine::default())
+    }
+
+    /// [`Planner::compile`] with an engine variant ([`Engine`]: benches and tests).
+    pub fn compile_with_engine(
+        &self,
+        material: Arc<dyn Brdf>,
+        geometries: Vec<StandardGeometry>,
+        options: PlanOptions,
+        engine: Engine,
+    ) -> Result<Plan> {
         if let Some(why) = rtol_refusal(options.rtol) {
             return Err(Error::Usage(format!("the relative tolerance (rtol) {why}")));
         }
@@ -146,7 +157,7 @@ impl Planner {
         let mut readings: Vec<PlannedReading> = Vec::new();
         let mut index: HashMap<JobKey, usize> = HashMap::new();
         for (g, reported) in &queue {
-            add_geometry(g, *reported, colour, options.share_fluxes, &mut drafts, &mut readings, &mut index)?;
+            add_geometry(g, *reported, colour, engine.share_fluxes, &mut drafts, &mut readings, &mut index)?;
         }
         resolve_composites(&mut readings)?;
 
@@ -169,7 +180,7 @@ impl Planner {
             (0..drafts.len()).filter(|&j| drafts[j].aperture.target == Target::Standard).collect();
         let std_methods: Vec<Method> = std_idx.iter().map(|&j| standard_method(&drafts[j])).collect();
         let std_drafts: Vec<&Draft> = std_idx.iter().map(|&j| &drafts[j]).collect();
-        let std_flux = self.standard_fluxes(&std_drafts, &std_methods, &options);
+        let std_flux = self.standard_fluxes(&std_drafts, &std_methods, &options, engine);
         // Absolute floor per geometry angle: 1e-4·rtol of the largest standard flux at that angle, i.e.
         // 0.01·rtol GU on a gloss reading; it only matters for fluxes that are (nearly) zero. A colour flux's
         // floor is 1e-4·rtol of the perfect diffuser's Y flux (100·white), 0.01·rtol on X, Y, Z; a flux that
@@ -195,7 +206,7 @@ impl Planner {
         // Step 1b: the specimen's methods, from the material's facts read once.
         let terms = material.terms();
         let facts = MaterialFacts::of(material.as_ref());
-        let projection = match (options.fold_spectral, options.fold_in_material) {
+        let projection = match (engine.fold_spectral, engine.fold_in_material) {
             (false, _) => Projection::Separate,
             (true, false) => Projection::Fold,
             (true, true) => Projection::FoldInMaterial,
@@ -235,6 +246,7 @@ impl Planner {
             twins: material.coarser(),
             material,
             options,
+            engine,
             geometries: queue.into_iter().map(|(g, _)| g).collect(),
             jobs,
             readings,
@@ -276,9 +288,15 @@ impl Planner {
     /// under one lock, and only the fluxes it lacks are computed, in parallel (in a batch every plan after
     /// the first finds them all, and then hands nothing to the pool). With sharing off, always computed (the
     /// ablation measures what sharing saves).
-    fn standard_fluxes(&self, drafts: &[&Draft], methods: &[Method], options: &PlanOptions) -> Vec<Flux> {
+    fn standard_fluxes(
+        &self,
+        drafts: &[&Draft],
+        methods: &[Method],
+        options: &PlanOptions,
+        engine: Engine,
+    ) -> Vec<Flux> {
         let compute = |d: &Draft, m: &Method| m.execute(&d.scale.standard());
-        if !options.share_fluxes {
+        if !engine.share_fluxes {
             return drafts.par_iter().zip(methods).map(|(d, m)| compute(d, m)).collect();
         }
         let keys: Vec<StandardKey> = drafts
@@ -431,6 +449,17 @@ impl Plan {
     pub fn compile(material: Arc<dyn Brdf>, geometries: Vec<StandardGeometry>, options: PlanOptions) -> Result<Plan> {
         Planner::new()?.compile(material, geometries, options)
     }
+
+    /// [`Plan::compile`] with an engine variant ([`Engine`]), for the benches and tests that measure what an
+    /// optimisation saves.
+    pub fn compile_with_engine(
+        material: Arc<dyn Brdf>,
+        geometries: Vec<StandardGeometry>,
+        options: PlanOptions,
+        engine: Engine,
+    ) -> Result<Plan> {
+        Planner::new()?.compile_with_engine(material, geometries, options, engine)
+    }
 }
 
 #[cfg(test)]
@@ -467,9 +496,13 @@ mod tests {
         let plan = Plan::compile(grey(), geometries(&ids), PlanOptions::default()).unwrap();
         let shared: Vec<&Job> = plan.jobs.iter().filter(|j| j.used_by.len() == 2).collect();
         assert!(!shared.is_empty(), "{:?}", plan.jobs.iter().map(|j| &j.used_by).collect::<Vec<_>>());
-        let unshared =
-            Plan::compile(grey(), geometries(&ids), PlanOptions { share_fluxes: false, ..PlanOptions::default() })
-                .unwrap();
+        let unshared = Plan::compile_with_engine(
+            grey(),
+            geometries(&ids),
+            PlanOptions::default(),
+            Engine { share_fluxes: false, ..Engine::default() },
+        )
+        .unwrap();
         assert!(unshared.jobs.len() > plan.jobs.len());
         assert!(unshared.jobs.iter().all(|j| j.used_by.len() == 1));
     }

@@ -155,7 +155,7 @@ impl Plan {
             n_std,
             uses,
             self.readings.len(),
-            if self.options.share_fluxes {
+            if self.engine.share_fluxes {
                 "; each distinct integral computed once and shared"
             } else {
                 "; sharing off"

@@ -57,7 +57,8 @@ mod readings;
 pub use cancel::Cancel;
 pub use compile::{rtol_refusal, Planner};
 pub use readings::{
-    colour_value, colour_xyz, haze_index_value, neutral_chroma, reading_value, NEUTRAL_CHROMA_FLOOR, NEUTRAL_HUE,
+    colour_value, colour_xyz, haze_index_value, neutral_chroma, reading_value, NeutralHue, NEUTRAL_CHROMA_FLOOR,
+    NEUTRAL_HUE,
 };
 
 /// Share of a reading's relative tolerance given to each specimen flux and to the gloss standard's flux. A
@@ -107,21 +108,13 @@ pub const DATA_RESOLVED: f64 = 2.0;
 /// end (`crate::request`), and of [`PlanOptions::default`].
 pub const DEFAULT_RTOL: f64 = 1e-6;
 
-/// Knobs of the planner. The defaults are what `measure` uses; the others exist to measure what each
-/// optimisation saves (`docs/performance.md`).
+/// What a front end asks of a plan: the tolerance, the budgets, the colour conditions and the stop signal.
+/// Every field is a user's choice; the engine's own switches, kept to measure what each optimisation saves,
+/// are [`Engine`]'s, which only benches and tests set.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PlanOptions {
     /// Relative tolerance of every reading.
     pub rtol: f64,
-    /// Apply the spectral weighting in the integrand (k components) rather than after integrating every
-    /// sample (n components).
-    pub fold_spectral: bool,
-    /// With `fold_spectral`, let a material that can sum a luminous-only flux's samples itself do so
-    /// (`Brdf::eval_batch_folded`: the paint's folded flake tables); off, the integrand weights the n
-    /// samples the material returns (kept to measure what it saves, `docs/performance.md`).
-    pub fold_in_material: bool,
-    /// Compute each distinct flux once.
-    pub share_fluxes: bool,
     /// Evaluation budget per flux integral (deterministic: a reading that hits it is the same bits on every
     /// machine).
     pub max_evals: usize,
@@ -148,15 +141,35 @@ impl Default for PlanOptions {
     fn default() -> Self {
         PlanOptions {
             rtol: DEFAULT_RTOL,
-            fold_spectral: true,
-            fold_in_material: true,
-            share_fluxes: true,
             max_evals: DEFAULT_MAX_EVALS,
             max_seconds: None,
             colour: Conditions::default(),
             rtol_from_data: true,
             cancel: Cancel::default(),
         }
+    }
+}
+
+/// The planner's optimisations, each of which can be turned off to measure what it saves
+/// (`docs/performance.md`; the readings agree to rounding, `tests/plan.rs`, `tests/folded_paint.rs`). Every
+/// front end compiles with the default, all on ([`Plan::compile`]); a bench or a test that compares builds
+/// the variant it compares ([`Plan::compile_with_engine`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Engine {
+    /// Apply the spectral weighting in the integrand (k components) rather than after integrating every
+    /// sample (n components).
+    pub fold_spectral: bool,
+    /// With `fold_spectral`, let a material that can sum a luminous-only flux's samples itself do so
+    /// (`Brdf::eval_batch_folded`: the paint's folded flake tables); off, the integrand weights the n
+    /// samples the material returns.
+    pub fold_in_material: bool,
+    /// Compute each distinct flux once.
+    pub share_fluxes: bool,
+}
+
+impl Default for Engine {
+    fn default() -> Self {
+        Engine { fold_spectral: true, fold_in_material: true, share_fluxes: true }
     }
 }
 
@@ -189,8 +202,9 @@ pub struct PlannedReading {
     pub reported: bool,
 }
 
-/// A computed reading. `value` is None when no finite value exists (then `problem` says why): a NaN or
-/// an infinity is never reported as a reading.
+/// A computed reading. `value` is None when no finite value exists (then `problem` says why), or when none is
+/// defined (the hue of a neutral colour: then `note` says why, [`Reading::undefined`]): a NaN or an infinity is
+/// never reported as a reading.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Reading {
     pub geometry: String,
@@ -211,6 +225,14 @@ pub struct Reading {
     /// §Data uncertainty of measured tables). None for a model (no data) and when there is no value.
     /// Separate from `error_estimate`, the numerical error of the integration.
     pub data_uncertainty: Option<f64>,
+}
+
+impl Reading {
+    /// Whether the reading has no value by definition, not by failure: no value and no problem (the hue of a
+    /// neutral colour, [`NeutralHue`], whose note says why). It changes no exit status.
+    pub fn undefined(&self) -> bool {
+        self.value.is_none() && self.problem.is_none()
+    }
 }
 
 /// One execution of a plan ([`Plan::run`]): the readings, and the flux of every integral of the plan.
@@ -257,6 +279,8 @@ fn shape(m: &dyn Brdf) -> Shape {
 pub struct Plan {
     pub material: Arc<dyn Brdf>,
     pub options: PlanOptions,
+    /// The engine it was compiled with ([`Engine::default`] but in benches and tests).
+    pub engine: Engine,
     pub geometries: Vec<StandardGeometry>,
     pub jobs: Vec<Job>,
     pub readings: Vec<PlannedReading>,

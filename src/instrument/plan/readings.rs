@@ -148,6 +148,32 @@ pub fn colour_xyz(
     (xyz.map(|x| x / white), err.map(|e| e / white))
 }
 
+/// The hue of a neutral colour, undefined by definition (not a failure): its chroma, at or below the floor
+/// [`neutral_chroma`] gives (docs/colour.md §Neutral colours). Its `Display` is the reading's note, which
+/// starts with [`NEUTRAL_HUE`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NeutralHue {
+    pub chroma: f64,
+    pub floor: f64,
+}
+
+impl std::fmt::Display for NeutralHue {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{NEUTRAL_HUE} (C*ab = {:.2e} ≤ {:.2e}, a chroma the integration cannot tell from 0): the hue angle is \
+             undefined",
+            self.chroma, self.floor
+        )
+    }
+}
+
+/// Why a direct reading has no value: undefined by definition (the hue of a neutral colour), or a problem.
+enum NoValue {
+    NeutralHue(NeutralHue),
+    Problem(String),
+}
+
 /// A colour quantity and its error bound from X, Y, Z (`docs/colour.md`: L*, a*, b* by intervals, C*ab and
 /// hab from the a*b* box). Err for the hue of a neutral colour (C*ab = 0), which is undefined.
 pub fn colour_value(
@@ -155,7 +181,7 @@ pub fn colour_value(
     xyz: [f64; 3],
     err: [f64; 3],
     white: [f64; 3],
-) -> std::result::Result<(f64, f64), String> {
+) -> std::result::Result<(f64, f64), NeutralHue> {
     let lab = cielab::xyz_to_lab(xyz, white);
     let le = cielab::lab_errors(xyz, err, white);
     let lch = cielab::lab_to_lch(lab);
@@ -170,14 +196,7 @@ pub fn colour_value(
         ColourQuantity::C => (lch.c, ec),
         ColourQuantity::H => match lch.h {
             Some(h) if lch.c > neutral_chroma(ec) => (h, eh),
-            _ => {
-                return Err(format!(
-                    "{NEUTRAL_HUE} (C*ab = {:.2e} ≤ {:.2e}, a chroma the integration cannot tell from 0): the \
-                     hue angle is undefined",
-                    lch.c,
-                    neutral_chroma(ec)
-                ))
-            }
+            _ => return Err(NeutralHue { chroma: lch.c, floor: neutral_chroma(ec) }),
         },
     })
 }
@@ -204,7 +223,7 @@ fn direct_value(
     jobs: &[Job],
     white_point: Option<(Conditions, [f64; 3])>,
     spread: &dyn Fn(&Flux, usize, bool) -> f64,
-) -> std::result::Result<(f64, f64), String> {
+) -> std::result::Result<(f64, f64), NoValue> {
     let specimen = |rx: &str| {
         let j = r.specimen_jobs[rx];
         let c = component_of(r, jobs, j);
@@ -222,11 +241,11 @@ fn direct_value(
                 (flux[j].value[c], spread(&flux[j], c, false))
             });
             match white_point {
-                Some((c, w)) if c == cond => colour_value(*quantity, xyz, err, w),
-                _ => Err("no white point for these colour conditions".into()),
+                Some((c, w)) if c == cond => colour_value(*quantity, xyz, err, w).map_err(NoValue::NeutralHue),
+                _ => Err(NoValue::Problem("no white point for these colour conditions".into())),
             }
         }
-        _ => reading_value(&r.spec, &specimen, &standard),
+        _ => reading_value(&r.spec, &specimen, &standard).map_err(NoValue::Problem),
     }
 }
 
@@ -280,14 +299,14 @@ fn compute_reading(
         Ok((v, _)) => problem_reading(r, no_finite_value(v)),
         // The hue of a neutral colour has no value by definition, not by failure: null, with the reason as
         // its note, converged as its fluxes are (it changes no exit status).
-        Err(why) if why.starts_with(NEUTRAL_HUE) => Reading {
+        Err(NoValue::NeutralHue(hue)) => Reading {
             value: None,
             error_estimate: 0.0,
             problem: None,
-            note: Some(why),
+            note: Some(hue.to_string()),
             ..valued_reading(r, (0.0, 0.0), evaluations, seconds, converged)
         },
-        Err(why) => problem_reading(r, why),
+        Err(NoValue::Problem(why)) => problem_reading(r, why),
     }
 }
 

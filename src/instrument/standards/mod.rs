@@ -189,8 +189,13 @@ pub fn builtin_all() -> Result<Vec<StandardGeometry>> {
 /// Load a user geometry file (same format as the builtin ones: a gloss geometry, or a colour geometry when it
 /// has a `kind`, `docs/colour.md`).
 pub fn load_file(path: &Path) -> Result<StandardGeometry> {
-    let name = crate::input::name(path);
-    let text = crate::input::read_text(path, "geometry file")?;
+    load_source(&path.into())
+}
+
+/// [`load_file`] of a source (a file, or standard input as a front end read it).
+pub fn load_source(source: &crate::input::Source) -> Result<StandardGeometry> {
+    let name = source.name();
+    let text = source.text("geometry file")?;
     let is_colour = parse_json(&text, &name).map(|v| colour::is_colour_spec(&v)).unwrap_or(false);
     let g = if is_colour { colour::parse(&text, &name)? } else { parse(&text, &name)? };
     check_user(&g, &builtin_all()?)?;
