@@ -1083,7 +1083,7 @@ pub const APPLICATION: Param = p(
     "",
     NONE,
     Opt("none: the coat's `roughness` and `scatter` as given"),
-    "how the coat was applied and dried; its levelled texture gives the coat's facets and halo (not with `roughness` or `scatter`; docs/model.md §From the cured spectrum to the coat)",
+    "how the coat was applied and dried; its levelled texture gives the coat's facets, Beckmann α = the cured Sdq (not with `roughness` or `scatter`; docs/model.md §From the cured spectrum to the coat)",
 );
 pub const APP_TEXTURE: Param = p(
     "/clear_coat/application/texture",
