@@ -238,3 +238,34 @@ fn the_command_line_reads_levelled_recipes_and_refuses_bad_ones() {
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// `sweep` varies the application's numbers like any other parameter (one vary grammar): the DOI of the
+/// poorly levelling film rises with film build and flash-off time and falls as the later viscosity rises.
+#[test]
+fn sweep_varies_film_build_flash_off_and_viscosity() {
+    let exe = env!("CARGO_BIN_EXE_glossmeter");
+    let dir = std::env::temp_dir().join(format!("glossmeter-levelling-sweep-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let template = dir.join("template.json");
+    std::fs::write(&template, with_application(application(3000.0, 60.0, 20.0, 100.0)).to_string()).unwrap();
+    let doi_along = |vary: &str| -> Vec<f64> {
+        let out = std::process::Command::new(exe)
+            .args(["sweep", template.to_str().unwrap(), "--vary", vary, "-g", "astm-e430-30"])
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{vary}: {}", String::from_utf8_lossy(&out.stderr));
+        let text = String::from_utf8(out.stdout).unwrap();
+        let mut lines = text.lines();
+        let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+        let col = header.iter().position(|h| *h == "astm-e430-30 doi (DOI)").unwrap_or_else(|| panic!("{header:?}"));
+        lines.map(|l| l.split(',').nth(col).unwrap().parse().unwrap()).collect()
+    };
+    let rising = |v: &[f64]| v.windows(2).all(|w| w[1] > w[0]);
+    let by_build = doi_along("/clear_coat/application/wet_film_um=15..30:4");
+    let by_flash = doi_along("/clear_coat/application/flash_off_s=0..60:4");
+    let by_eta = doi_along("/clear_coat/application/viscosity/1/eta_pa_s=100..1000:4");
+    assert!(by_build.len() == 4 && rising(&by_build), "{by_build:?}");
+    assert!(by_flash.len() == 4 && rising(&by_flash), "{by_flash:?}");
+    assert!(by_eta.len() == 4 && by_eta.windows(2).all(|w| w[1] < w[0]), "{by_eta:?}");
+    std::fs::remove_dir_all(&dir).ok();
+}
