@@ -164,6 +164,12 @@ fn bad_applications_name_their_pointer() {
         ),
         (json!({"viscosity": [{"t_s": 5, "eta_pa_s": 1}]}), "/clear_coat/application/viscosity/0/t_s"),
         (json!({"viscosity": []}), "/clear_coat/application/viscosity"),
+        // A levelling integral beyond double precision: a film the model cannot integrate.
+        (
+            json!({"wet_film_um": 10000, "surface_tension_mn_m": 1000, "flash_off_s": 0,
+                   "viscosity": [{"t_s": 0, "eta_pa_s": 1e-300}, {"t_s": 1e7, "eta_pa_s": 1e-300}]}),
+            "/clear_coat/application/viscosity",
+        ),
         (
             json!({"texture": {"psd": "gaussian", "rms_roughness_nm": 0, "correlation_length_um": 50}}),
             "/clear_coat/application/texture/rms_roughness_nm",

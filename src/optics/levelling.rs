@@ -397,6 +397,19 @@ mod tests {
     }
 
     #[test]
+    fn cured_k_correlation_keeps_v_squared_sigma_squared_without_levelling() {
+        // L = 0: the cured PSD is v²·S_a, whose σ² is v²σ_a² (the table plus the closed-form tail); levelling
+        // takes heights and more of the slopes.
+        let applied = Psd::k_correlation(800.0, 150.0, 2.5);
+        let bare = CuredPsd::new(applied, 0.4, 0.0);
+        let ms = bare.band_ms(0.0, f64::INFINITY);
+        assert!((ms / (0.4f64 * 800.0).powi(2) - 1.0).abs() < 1e-9, "{ms}");
+        let levelled = CuredPsd::new(applied, 0.4, 1e9);
+        assert!(levelled.band_ms(0.0, f64::INFINITY) < ms);
+        assert!(levelled.slope_ms() < bare.slope_ms() && levelled.slope_ms() > 0.0);
+    }
+
+    #[test]
     fn bad_applications_name_the_field() {
         let good = film(vec![(0.0, 0.3), (60.0, 3.0)], 30.0);
         assert!(good.validate().is_ok());

@@ -186,14 +186,26 @@ pub fn parse_levelled_paint(root: &Obj, coat: &Obj, app: &Obj, mut spec: PaintSp
         }
     }
     let (application, applied) = parse_application(app)?;
+    if !application.levelling_integral_um4().is_finite() {
+        return Err(Error::input(
+            app.file,
+            app.field(&app.param_key(&reg::APP_VISCOSITY)),
+            "the levelling integral L = γ∫h³/η dt overflows double precision: the viscosities are too small for \
+             this film and time (allowed: a table whose L is finite, e.g. viscosities of mPa·s and above)",
+        ));
+    }
     let lc = level(&application, applied);
     if !(lc.roughness <= 1.0) {
+        let sdq = if lc.roughness.is_finite() {
+            crate::error::number(lc.roughness)
+        } else {
+            "beyond double precision".to_string()
+        };
         return Err(coat.err(
             "application",
             format!(
-                "the cured texture's rms slope Sdq is {} (the coat's Beckmann α), beyond the coat's facet model \
-                 (allowed: at most 1); a smoother texture or more levelling is needed",
-                crate::error::number(lc.roughness)
+                "the cured texture's rms slope Sdq is {sdq} (the coat's Beckmann α), beyond the coat's facet model \
+                 (allowed: at most 1); a smoother texture or more levelling is needed"
             ),
         ));
     }
