@@ -230,6 +230,10 @@ function template(ptr, recipe) {
   return null;
 }
 
+function blockId(ptr) {
+  return ptr.slice(1).replace(/[^A-Za-z0-9]/g, "_");
+}
+
 function fieldId(ptr) {
   return "f" + ptr.replace(/[^A-Za-z0-9]/g, "_");
 }
@@ -287,7 +291,7 @@ function buildBlocks() {
     const name = label(b.pointer, r);
     if (b.type === "array of objects") {
       const one = name.replace(/s$/, "").replace(/^.* · /, "");
-      const add = el("button", { type: "button", id: "add" + fieldId(b.pointer), text: `add a ${one}` });
+      const add = el("button", { type: "button", id: "add-" + blockId(b.pointer), text: `add a ${one}` });
       add.addEventListener("click", () => {
         const t = template(b.pointer, r);
         if (!t) return status(`no shipped ${r.model} recipe has a ${one} to start from; add it in the raw JSON`);
@@ -306,12 +310,16 @@ function buildBlocks() {
       });
     } else if (!b.required && parentOf(b.pointer) === "") {
       const has = v !== undefined;
-      const btn = el("button", { type: "button", id: (has ? "remove" : "add") + fieldId(b.pointer), text: `${has ? "remove" : "add"} ${name}` });
+      const btn = el("button", { type: "button", id: (has ? "remove-" : "add-") + blockId(b.pointer), text: `${has ? "remove" : "add"} ${name}` });
       btn.addEventListener("click", () => {
         if (has) setAt(r, b.pointer, undefined);
         else {
           const t = template(b.pointer, r);
           if (!t) return status(`no shipped ${r.model} recipe has ${name} to start from; add it in the raw JSON`);
+          // Flakes lie inside the pigmented layer (their depth at most its thickness): a template's depth
+          // deeper than this recipe's layer is put at the layer's middle.
+          const x = getAt(r, "/pigmented_layer/thickness_mm");
+          if (typeof t.depth_mm === "number" && typeof x === "number" && t.depth_mm > x) t.depth_mm = x / 2;
           setAt(r, b.pointer, t);
         }
         edited();
@@ -393,6 +401,7 @@ function setRecipe(r, saved = true) {
   buildForm();
   recipeChanged();
   if (saved) markSaved();
+  $("saved-list").value = "";
 }
 
 /// Another model: the fields the two models share are kept, and every required block or field of the new
@@ -405,12 +414,15 @@ function modelChanged() {
   for (const p of state.registry.parameters) {
     if (!p.models.includes(model) || p.pointer.split("/").length !== 2 || p.pointer === "/model") continue;
     const v = getAt(old, p.pointer);
-    if (v !== undefined && (p.type === "number" || !p.numeric || typeof v === "number")) setAt(r, p.pointer, v);
+    const before = entryOf(p.pointer, old.model);
+    if (v !== undefined && before && before.type === p.type) setAt(r, p.pointer, v);
   }
   const first = state.fixtures.map((f) => JSON.parse(f.recipe)).find((f) => f.model === model);
   const filled = [];
   for (const p of state.registry.parameters) {
-    if (!p.models.includes(model) || !p.required || p.pointer.split("/").length !== 2 || getAt(r, p.pointer) !== undefined) continue;
+    // Required, or one of a group of which one must be given (its default says "give …").
+    const needed = p.required || /\bgive\b/.test(String(p.default));
+    if (!p.models.includes(model) || !needed || p.pointer.split("/").length !== 2 || getAt(r, p.pointer) !== undefined) continue;
     const v = first ? getAt(first, p.pointer) : undefined;
     if (v !== undefined) {
       setAt(r, p.pointer, JSON.parse(JSON.stringify(v)));
@@ -502,6 +514,7 @@ function loadBrowser() {
   if (!r) return;
   if (unsaved() && !confirm("Your edits are not saved. Load the saved recipe anyway?")) return;
   setRecipe(JSON.parse(JSON.stringify(r)));
+  $("saved-list").value = name;
   status(`loaded “${name}” from this browser`);
 }
 
@@ -586,14 +599,14 @@ function geometryOf(id) {
   return state.geometries.find((g) => g.id === id) || { id, title: id, standards: [], assumed: [] };
 }
 
-/// What the numerical error means beside the displayed step, in words.
+/// What the numerical error means beside the displayed step: [short words, the full sentence].
 function errorWords(r) {
-  if (r.value === null) return r.problem || "no value";
+  if (r.value === null) return [r.problem || "no value", r.problem || "no value"];
   const e = r.error_estimate, step = stepOf(r.unit), u = r.unit ? " " + r.unit : "";
-  if (!(e >= 0)) return "";
-  if (e < step / 20) return `exact to the digit shown (computing error ${e.toExponential(0)}${u}, far below the display step ${step}${u})`;
-  if (e < step / 2) return `the last digit may be off by one (computing error ${e.toPrecision(1)}${u})`;
-  return `NOT exact to the digit shown: the computation is only good to ${e.toPrecision(2)}${u}`;
+  if (!(e >= 0)) return ["", ""];
+  if (e < step / 20) return ["exact to the digit shown", `computing error ${e.toExponential(0)}${u}, far below the display step ${step}${u}`];
+  if (e < step / 2) return ["last digit ±1", `the last digit may be off by one: computing error ${e.toPrecision(1)}${u} (display step ${step}${u})`];
+  return [`NOT exact: good to ${e.toPrecision(2)}${u}`, `the computation is only good to ${e.toPrecision(2)}${u}, more than half the display step ${step}${u}`];
 }
 
 /// The geometry's assumed numbers (no retrieved source states them), in words, with the reason on hover.
@@ -618,15 +631,19 @@ function showReadings(doc) {
   body.replaceChildren();
   const ref = state.pinned && state.pinned.doc ? new Map(state.pinned.doc.readings.map((r) => [readingKey(r), r])) : null;
   $("readings").classList.toggle("pinned", !!ref);
+  let last = null;
   for (const r of doc.readings) {
     const g = geometryOf(r.geometry);
     const v = el("td", { class: "num value", text: display(r.value, r.unit) });
     v.dataset.value = r.value === null ? "" : String(r.value);
     v.title = r.value === null ? "no value" : `computed: ${r.value}`;
-    const pu = (doc.prediction_uncertainty || []).find((u) => u.geometry === r.geometry && u.name === r.name);
-    const how = errorWords(r) + (pu && pu.standard_uncertainty !== undefined ? `; from the recipe's stated uncertainties ± ${display(pu.standard_uncertainty, r.unit)} ${r.unit}` : "");
-    const tr = el("tr", { "data-geometry": r.geometry, "data-name": r.name },
-      el("td", { class: "instrument", title: `${g.id}: ${(g.standards || []).join(", ")}`, text: g.title }),
+    const [short, long] = errorWords(r);
+    const pu = r.prediction_uncertainty;
+    const stated = typeof pu === "number" ? `; from the recipe's stated uncertainties: standard uncertainty ${pu.toPrecision(2)} ${r.unit}` : "";
+    const first = r.geometry !== last;
+    last = r.geometry;
+    const tr = el("tr", { "data-geometry": r.geometry, "data-name": r.name, class: first ? "first" : "more" },
+      el("td", { class: "instrument", title: `${g.id}: ${(g.standards || []).join(", ")}`, text: first ? g.title : "" }),
       el("td", { text: r.name }),
       v,
       el("td", { class: "unit", text: r.unit }));
@@ -640,7 +657,7 @@ function showReadings(doc) {
       diff.dataset.value = dv === null ? "" : String(dv);
       tr.append(ref_td, diff);
     }
-    tr.append(el("td", { class: "note" + (r.converged ? "" : " warn"), text: how + (r.note ? `; ${r.note}` : "") }), el("td", {}, assumedBox(g)));
+    tr.append(el("td", { class: "note" + (r.converged ? "" : " warn"), title: long + stated, text: short + stated + (r.note ? `; ${r.note}` : "") }), el("td", {}, first ? assumedBox(g) : ""));
     body.append(tr);
   }
   showColours(doc);
