@@ -5,6 +5,7 @@ that had none, every model switch giving readings, pigments and flakes added in 
 compares what the page shows with what `glossmeter` itself computes, so that a wrong number fails it."""
 import json
 import math
+import os
 import re
 import subprocess
 import time
@@ -202,6 +203,9 @@ def test_pin_a_reference_and_compare_another_recipe(browser, tmp_path):
         assert float(shown) == float(displayed(x - y, a[k]["unit"])), (k, shown, x - y)
     heads = [th.text for th in d.find_elements(By.CSS_SELECTOR, "#readings thead th")]
     assert "reference" in heads and "difference" in heads
+    shots = os.environ.get("GLOSSMETER_SCREENSHOTS")
+    if shots:
+        d.save_screenshot(os.path.join(shots, "serve-pin.png"))
     d.find_element(By.ID, "unpin").click()
     assert not d.find_elements(By.CSS_SELECTOR, "#readings tbody td.ref")
     assert console_errors(d) == []
@@ -262,6 +266,10 @@ def test_a_sweep_and_a_fit_of_the_clear_coat_roughness_on_a_paint_that_had_none(
     for c in charts:
         n = len([r for r in cli[0]["readings"] if r["unit"] == c.get_attribute("data-unit")])
         assert len(c.find_elements(By.CSS_SELECTOR, "polyline.series")) == n
+    shots = os.environ.get("GLOSSMETER_SCREENSHOTS")
+    if shots:
+        d.execute_script("document.getElementById('tabs').scrollIntoView()")
+        d.save_screenshot(os.path.join(shots, "serve-sweep.png"))
     d.find_element(By.ID, "sweep-csv").click()
     WebDriverWait(d, WAIT).until(lambda d: (tmp_path / "sweep.csv").exists())
     lines = (tmp_path / "sweep.csv").read_text().splitlines()

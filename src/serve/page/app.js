@@ -1005,9 +1005,14 @@ function drawSweep(ptr, what) {
       const c = COLOURS[i % COLOURS.length];
       g.append(svg("polyline", { points: s.pts.map(([x, y]) => `${sx(x).toFixed(1)},${sy(y).toFixed(1)}`).join(" "), fill: "none", stroke: c, "stroke-width": 2, class: "series" }));
       for (const [x, y] of s.pts) g.append(svg("circle", { cx: sx(x).toFixed(1), cy: sy(y).toFixed(1), r: 2.5, fill: c }));
-      g.append(svg("text", { x: L + 6, y: T - 8 + 0 * i, dx: i * 150, "font-size": 11, fill: c, text: `${geometryOf(s.geometry).title.replace(/^(\S+ \S+).*?(\d+°)?$/, (m, a, b) => a + (b ? " " + b : ""))} ${s.name}` }));
     });
-    box.append(el("figure", {}, g, el("figcaption", { text: `${unit || "colour"}: ${series.map((s) => s.geometry + " " + s.name).join(", ")}` })));
+    const cap = el("figcaption", { class: "legend" });
+    series.forEach((s, i) => {
+      const key = el("span", { class: "key" });
+      key.style.background = COLOURS[i % COLOURS.length];
+      cap.append(el("span", { class: "item" }, key, `${geometryOf(s.geometry).title}: ${s.name}`));
+    });
+    box.append(el("figure", {}, g, cap));
   }
 }
 
