@@ -334,3 +334,20 @@ def test_pigments_and_flakes_are_added_in_the_editor(browser, tmp_path):
     assert d.find_element(By.ID, "measure-error").text == ""
     assert_page_is_cli(d, tmp_path)
     assert console_errors(d) == []
+
+
+def test_a_nested_optional_block_is_added_and_removed(browser, tmp_path):
+    d = browser
+    wait_current(d)
+    choose_fixture(d, "solid-white")
+    assert "scatter" not in raw(d)["clear_coat"]
+    d.find_element(By.ID, "add-clear_coat_scatter").click()
+    WebDriverWait(d, WAIT).until(lambda d: "scatter" in raw(d)["clear_coat"])
+    # Its numbers are fields of the editor now, and the readings are measure's.
+    assert field(d, "/clear_coat/scatter/rms_roughness_nm").get_attribute("value")
+    wait_current(d)
+    assert d.find_element(By.ID, "measure-error").text == ""
+    assert_page_is_cli(d, tmp_path)
+    d.find_element(By.ID, "remove-clear_coat_scatter").click()
+    WebDriverWait(d, WAIT).until(lambda d: "scatter" not in raw(d)["clear_coat"])
+    assert console_errors(d) == []

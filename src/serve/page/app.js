@@ -308,7 +308,7 @@ function buildBlocks() {
         });
         box.append(rm);
       });
-    } else if (!b.required && parentOf(b.pointer) === "") {
+    } else if (!b.required && (parentOf(b.pointer) === "" || getAt(r, parentOf(b.pointer)) !== undefined)) {
       const has = v !== undefined;
       const btn = el("button", { type: "button", id: (has ? "remove-" : "add-") + blockId(b.pointer), text: `${has ? "remove" : "add"} ${name}` });
       btn.addEventListener("click", () => {
