@@ -1053,7 +1053,7 @@ async function compare() {
     for (const c of doc.comparisons) {
       const cls = c.verdict === "ok" ? "ok" : c.verdict === "OUTSIDE" ? "bad" : "warn";
       tbody.append(el("tr", {},
-        el("td", { text: c.sample }), el("td", { text: c.geometry }), el("td", { text: c.reading }),
+        el("td", { text: c.sample }), el("td", { text: geometryOf(c.geometry).title, title: c.geometry }), el("td", { text: c.reading }),
         el("td", { class: "num", text: String(c.n) }), el("td", { class: "num", text: shown(c.mean, 1e-3) }),
         el("td", { class: "num", text: shown(c.predicted, 1e-3) }), el("td", { class: "num", text: shown(c.difference, 1e-3) }),
         el("td", { class: "num", text: c.allowance ? shown(c.allowance.total, 1e-3) : "—" }),
@@ -1080,6 +1080,12 @@ async function compareDownload(format) {
 }
 
 // ---- fit --------------------------------------------------------------------------------------------
+
+/// The unit of a reading the readings table shows (null: not shown there).
+function unitOf(geometry, name) {
+  const r = state.doc && state.doc.readings.find((x) => x.geometry === geometry && x.name === name);
+  return r ? r.unit : null;
+}
 
 function buildFitChoices() {
   const box = $("fit-free");
@@ -1144,7 +1150,7 @@ async function fit() {
     for (const t of doc.targets) {
       const tr = el("tr", { "data-geometry": t.geometry, "data-name": t.name }, el("td", { text: `${geometryOf(t.geometry).title}: ${t.name}`, title: t.geometry }),
         el("td", { class: "num", text: String(t.measured) }),
-        el("td", { class: "num", text: String(t.uncertainty) }), el("td", { class: "num predicted", text: display(t.predicted, t.unit || "GU") }),
+        el("td", { class: "num", text: String(t.uncertainty) }), el("td", { class: "num predicted", text: unitOf(t.geometry, t.name) === null ? Number(t.predicted).toPrecision(4) : display(t.predicted, unitOf(t.geometry, t.name)) }),
         el("td", { class: "num", text: Number(t.residual).toPrecision(2) }));
       tr.querySelector(".predicted").dataset.value = String(t.predicted);
       tb.append(tr);
