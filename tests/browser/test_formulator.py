@@ -286,7 +286,7 @@ def test_a_sweep_and_a_fit_of_the_clear_coat_roughness_on_a_paint_that_had_none(
     row = box.find_element(By.XPATH, "..")
     assert (row.find_element(By.CLASS_NAME, "lo").get_attribute("value"), row.find_element(By.CLASS_NAME, "hi").get_attribute("value")) == ("0", "1")
     box.click()
-    type_into(d.find_element(By.ID, "fit-targets"), f"astm-d523-20/gloss={target:.6f}±0.01")
+    type_into(d.find_element(By.ID, "fit-targets"), f"astm-d523-20/gloss={target:.6f}±0,01".replace(".", ",", 1))
     d.find_element(By.ID, "fit-go").click()
     WebDriverWait(d, WAIT).until(lambda d: d.find_element(By.ID, "fit-verdict").text or d.find_element(By.ID, "fit-error").text)
     assert d.find_element(By.ID, "fit-error").text == ""

@@ -1132,7 +1132,8 @@ async function fit() {
       body.sheet = state.sheet;
       if ($("fit-sample").value.trim()) body.sample = $("fit-sample").value.trim();
     } else {
-      body.target = $("fit-targets").value.split("\n").map((s) => s.trim()).filter((s) => s);
+      // A decimal comma between digits is a decimal point (`85,2±0,5`); the geometry ids have none.
+      body.target = $("fit-targets").value.split("\n").map((s) => s.trim().replace(/(\d),(\d)/g, "$1.$2")).filter((s) => s);
     }
     status("fitting…");
     $("fit-go").disabled = true;
