@@ -703,7 +703,7 @@ function showColours(doc) {
   const lab = labOf(doc);
   const ref = state.pinned && state.pinned.doc ? labOf(state.pinned.doc) : null;
   if (!lab && !ref) {
-    box.append(el("p", { class: "hint", text: "Tick a colour geometry (ASTM E2194, ASTM E308…) under Geometries to see the colour." }));
+    box.append(el("p", { class: "hint", text: "Tick a colour geometry under Geometries (ASTM E2194 or E2539 multi-angle, the d/8 sphere) to see the colour; it needs a spectral recipe (one with wavelengths_nm)." }));
     return;
   }
   if (lab) box.append(swatch(lab, "this recipe (" + geometryOf(lab.geometry).title + ")"));
