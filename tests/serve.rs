@@ -130,6 +130,45 @@ fn measure_gives_the_bits_of_the_command_line() {
     }
 }
 
+/// Objects of a geometry file with `"status": "assumed"` and a number for `value`.
+fn assumed_in(v: &Value) -> usize {
+    match v {
+        Value::Object(o) => {
+            usize::from(o.get("status") == Some(&json!("assumed")) && o.get("value").is_some_and(Value::is_number))
+                + o.values().map(assumed_in).sum::<usize>()
+        }
+        Value::Array(a) => a.iter().map(assumed_in).sum(),
+        _ => 0,
+    }
+}
+
+#[test]
+fn the_geometries_name_their_instrument_and_their_assumed_numbers() {
+    let addr = default_server();
+    let geos = request(addr, "GET", "/api/geometries", b"", &[]).json();
+    let mut checked = 0;
+    for g in geos["geometries"].as_array().unwrap() {
+        let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("standards");
+        let name = format!("{}.json", g["id"].as_str().unwrap());
+        let path = [dir.join(&name), dir.join("colour").join(&name)].into_iter().find(|p| p.exists()).unwrap();
+        let text = std::fs::read_to_string(&path).unwrap();
+        let file: Value = serde_json::from_str(&text).unwrap();
+        assert_eq!(g["title"], file["title"], "{path:?}");
+        assert_eq!(g["standards"], file["standards"], "{path:?}");
+        let assumed = g["assumed"].as_array().unwrap();
+        assert_eq!(assumed.len(), assumed_in(&file), "{path:?}");
+        for a in assumed {
+            let at = file.pointer(a["pointer"].as_str().unwrap()).unwrap_or_else(|| panic!("{path:?}: {a}"));
+            assert_eq!(at["status"], "assumed", "{a}");
+            assert_eq!(at["value"], a["value"], "{a}");
+            assert_eq!(at["source"], a["source"], "{a}");
+        }
+        checked += 1;
+    }
+    assert_eq!(checked, geos["geometries"].as_array().unwrap().len());
+    assert!(checked >= 20, "{checked} geometry files checked");
+}
+
 #[test]
 fn the_endpoints_answer_on_the_command_lines_documents() {
     let addr = default_server();

@@ -552,22 +552,58 @@ fn finite(x: f64) -> Value {
     }
 }
 
-/// `GET /api/geometries`: the shipped geometries (id, the line of `glossmeter standards`, whether it is in
-/// the default panel, whether it has a profile array).
+/// `GET /api/geometries`: the shipped geometries (id, the instrument's title and standards as the geometry
+/// file names them, the line of `glossmeter standards`, whether it is in the default panel, whether it has a
+/// profile array, and every number of the file whose status is `assumed`, with its JSON Pointer and reason).
 pub fn geometries_doc() -> Result<Reply> {
     let all = standards::builtin_all()?;
     let list: Vec<Value> = all
         .iter()
         .map(|g| {
+            let mut assumed = Vec::new();
+            assumed_numbers(&g.spec, &mut String::new(), &mut assumed);
             json!({
                 "id": g.geometry.id,
+                "title": g.spec.get("title").and_then(Value::as_str).unwrap_or(&g.geometry.id),
+                "standards": g.spec.get("standards").cloned().unwrap_or_else(|| json!([])),
                 "line": standards::list_line_any(g),
                 "default": crate::api::DEFAULT_PANEL.contains(&g.geometry.id.as_str()),
                 "profile": standards::profile::of(g).is_ok(),
+                "assumed": assumed,
             })
         })
         .collect();
     Ok(Reply::json(&json!({"geometries": list})))
+}
+
+/// The sourced numbers of a geometry file (`{"value", "source", "status"}`) whose
+/// status is `assumed` (docs/instrument.md §2.1 Sourced numbers): `{pointer, value, source}` in document order.
+fn assumed_numbers(v: &Value, at: &mut String, out: &mut Vec<Value>) {
+    let len = at.len();
+    match v {
+        Value::Object(o) => {
+            if o.get("status").and_then(Value::as_str) == Some("assumed") {
+                if let Some(x) = o.get("value").filter(|x| x.is_number()) {
+                    out.push(json!({"pointer": at.clone(), "value": x, "source": o.get("source")}));
+                }
+            }
+            for (k, x) in o {
+                at.push('/');
+                at.push_str(&k.replace('~', "~0").replace('/', "~1"));
+                assumed_numbers(x, at, out);
+                at.truncate(len);
+            }
+        }
+        Value::Array(a) => {
+            for (i, x) in a.iter().enumerate() {
+                at.push('/');
+                at.push_str(&i.to_string());
+                assumed_numbers(x, at, out);
+                at.truncate(len);
+            }
+        }
+        _ => {}
+    }
 }
 
 #[cfg(test)]

@@ -24,6 +24,7 @@ pub const FIXTURES: &[(&str, &str)] = &[
     ("cerulean-blue-b-literal", include_str!("../../fixtures/recipes/cerulean-blue-b-literal.json")),
     ("cerulean-blue-b", include_str!("../../fixtures/recipes/cerulean-blue-b.json")),
     ("cerulean-blue-c-literal", include_str!("../../fixtures/recipes/cerulean-blue-c-literal.json")),
+    ("clear-coat-haze", include_str!("../../fixtures/recipes/clear-coat-haze.json")),
     ("conductor-example", include_str!("../../fixtures/recipes/conductor-example.json")),
     ("conductor-rgb-example", include_str!("../../fixtures/recipes/conductor-rgb-example.json")),
     ("cook-torrance-lobes", include_str!("../../fixtures/recipes/cook-torrance-lobes.json")),
