@@ -33,13 +33,15 @@ pub fn parse_topography(obj: &Obj) -> Result<Arc<dyn Brdf>> {
     let wrap = |e: Error| match e {
         Error::Io { file: f, source } => obj.err("file", format!("cannot read the topography {f}: {source}")),
         other => {
-            let text = other.to_string();
-            let hint = if text.contains("no lateral calibration") && text.contains("plain height matrix") {
-                " (a recipe reads .x3p, .sdf and .gsf files, which carry their calibration)"
-            } else {
-                ""
-            };
-            obj.err("file", format!("not a topography this model reads: {text}{hint}"))
+            // A recipe gives no calibration, so a plain matrix (a file announcing none of the calibrated formats)
+            // cannot be read by one: the error says which files can.
+            let named = path
+                .extension()
+                .is_some_and(|e| ["x3p", "gsf", "sdf"].iter().any(|f| e.to_string_lossy().eq_ignore_ascii_case(f)));
+            let plain = !named && !crate::topography::announces_calibrated_format(&head(&path));
+            let hint =
+                if plain { " (a recipe reads .x3p, .sdf and .gsf files, which carry their calibration)" } else { "" };
+            obj.err("file", format!("not a topography this model reads: {other}{hint}"))
         }
     };
     let map = crate::topography::load(&path, None).map_err(wrap)?;
@@ -48,4 +50,14 @@ pub fn parse_topography(obj: &Obj) -> Result<Arc<dyn Brdf>> {
     let table = SlopeTable::from_slopes(&s.sx, &s.sy).map_err(|m| obj.err("file", format!("{}: {m}", map.file)))?;
     let source = format!("{}, levelling {}", map.file, levelling.name());
     Ok(Arc::new(TopographySurface::new(table, ior, source)?))
+}
+
+/// A file's first bytes (fewer if it is shorter or cannot be read; only a message depends on them).
+fn head(path: &std::path::Path) -> Vec<u8> {
+    use std::io::Read;
+    let mut head = Vec::with_capacity(16);
+    if let Ok(f) = std::fs::File::open(path) {
+        let _ = f.take(16).read_to_end(&mut head);
+    }
+    head
 }

@@ -42,11 +42,20 @@ pub fn load(path: &Path, calibration: Option<Calibration>) -> Result<HeightMap> 
     from_bytes(&bytes, &file, &ext, calibration)
 }
 
+fn is_sdf(bytes: &[u8]) -> bool {
+    bytes.len() >= 4 && matches!(bytes[0], b'a' | b'b') && matches!(&bytes[1..4], b"ISO" | b"BCR")
+}
+
+/// Whether a file's first bytes announce one of the calibrated formats (X3P, GSF, SDF; [`from_bytes`]) rather
+/// than a plain matrix, whose calibration only its caller can give (docs/topography.md §Plain text matrices).
+pub fn announces_calibrated_format(head: &[u8]) -> bool {
+    head.starts_with(b"PK\x03\x04") || head.starts_with(gsf::MAGIC) || is_sdf(head)
+}
+
 /// The format of a file, from its first bytes: a zip archive is X3P, `Gwyddion Simple Field 1.0` GSF,
 /// `aISO`/`bISO` (or the older `aBCR`/`bBCR`) SDF, anything else a plain matrix. An extension that names a
 /// format the bytes are not is an error (a damaged file, or the wrong one).
 pub fn from_bytes(bytes: &[u8], file: &str, ext: &str, calibration: Option<Calibration>) -> Result<HeightMap> {
-    let is_sdf = bytes.len() >= 4 && matches!(bytes[0], b'a' | b'b') && matches!(&bytes[1..4], b"ISO" | b"BCR");
     let not = |what: &str| {
         Error::input(file, "", format!("a .{ext} file is {what}, but this one is not (damaged, or not that format)"))
     };
@@ -54,7 +63,7 @@ pub fn from_bytes(bytes: &[u8], file: &str, ext: &str, calibration: Option<Calib
         x3p::read(bytes, file)
     } else if bytes.starts_with(gsf::MAGIC) {
         gsf::read(bytes, file)
-    } else if is_sdf {
+    } else if is_sdf(bytes) {
         sdf::read(bytes, file)
     } else {
         match ext {

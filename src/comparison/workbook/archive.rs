@@ -72,10 +72,15 @@ fn check_member(zip: &mut Archive, i: usize, file: &str, total: u64) -> Result<u
     let mut n = 0u64;
     let mut buf = vec![0u8; 64 << 10];
     loop {
-        let k = m.read(&mut buf).map_err(|e| match e.to_string().contains("checksum") {
-            true => corrupt("does not match the CRC-32 the archive records (bad CRC)".into()),
-            false => corrupt(format!("cannot be decompressed ({e})")),
-        })?;
+        let k = match m.read(&mut buf) {
+            Ok(k) => k,
+            // The zip crate compares the CRC-32 once the member's last byte is out: an error after every declared
+            // byte arrived, with a hash that differs from the record, is a bad CRC (decided by the numbers).
+            Err(_) if n == declared && hasher.clone().finalize() != m.crc32() => {
+                return Err(corrupt("does not match the CRC-32 the archive records (bad CRC)".into()))
+            }
+            Err(e) => return Err(corrupt(format!("cannot be decompressed ({e})"))),
+        };
         if k == 0 {
             break;
         }
