@@ -239,35 +239,41 @@ fn dispatch(cli: Cli, #[allow(unused_variables)] serve: Serve) -> Result<()> {
         Command::Topography(args) => topography::run(args, existing),
         #[cfg(feature = "serve")]
         Command::Serve(args) => serve(&args.request()),
-        Command::Schema { output_format } => {
-            let schema = match output_format {
-                None => recipe::schema::schema(),
-                Some(OutputSchema::Measure) => crate::report::schema::measure(),
-                Some(OutputSchema::Compare) => crate::report::schema::compare(),
-                Some(OutputSchema::Sweep) => crate::report::schema::sweep(),
-                Some(OutputSchema::Fit) => crate::report::schema::fit(),
-                Some(OutputSchema::Profile) => crate::report::schema::profile(),
-                Some(OutputSchema::Convergence) => crate::report::schema::convergence(),
-                Some(OutputSchema::Sheet) => crate::report::schema::sheet(),
-                Some(OutputSchema::Topography) => crate::report::schema::topography(),
-            };
-            let text = serde_json::to_string_pretty(&schema)
-                .map_err(|e| Error::Numeric(format!("the schema does not serialise: {e}")))?;
-            print(&(text + "\n"))
-        }
+        Command::Schema { output_format } => print(&schema_text(output_format)?),
         Command::Completions { shell } => {
             let mut bytes = Vec::new();
             clap_complete::generate(shell, &mut <Cli as clap::CommandFactory>::command(), "glossmeter", &mut bytes);
             print(&String::from_utf8_lossy(&bytes))
         }
-        Command::Man => {
-            let mut bytes = Vec::new();
-            clap_mangen::Man::new(<Cli as clap::CommandFactory>::command())
-                .render(&mut bytes)
-                .map_err(|e| Error::Io { file: STDOUT.into(), source: e })?;
-            print(&String::from_utf8_lossy(&bytes))
-        }
+        Command::Man => print(&man_page()?),
     }
+}
+
+/// `glossmeter schema`: the recipe format's JSON Schema, or an output document's.
+fn schema_text(output_format: Option<OutputSchema>) -> Result<String> {
+    let schema = match output_format {
+        None => recipe::schema::schema(),
+        Some(OutputSchema::Measure) => crate::report::schema::measure(),
+        Some(OutputSchema::Compare) => crate::report::schema::compare(),
+        Some(OutputSchema::Sweep) => crate::report::schema::sweep(),
+        Some(OutputSchema::Fit) => crate::report::schema::fit(),
+        Some(OutputSchema::Profile) => crate::report::schema::profile(),
+        Some(OutputSchema::Convergence) => crate::report::schema::convergence(),
+        Some(OutputSchema::Sheet) => crate::report::schema::sheet(),
+        Some(OutputSchema::Topography) => crate::report::schema::topography(),
+    };
+    let text = serde_json::to_string_pretty(&schema)
+        .map_err(|e| Error::Numeric(format!("the schema does not serialise: {e}")))?;
+    Ok(text + "\n")
+}
+
+/// `glossmeter man`: the manual page, from the same argument definitions as `--help`.
+fn man_page() -> Result<String> {
+    let mut bytes = Vec::new();
+    clap_mangen::Man::new(<Cli as clap::CommandFactory>::command())
+        .render(&mut bytes)
+        .map_err(|e| Error::Io { file: STDOUT.into(), source: e })?;
+    Ok(String::from_utf8_lossy(&bytes).into_owned())
 }
 
 /// Exit status 1 when a baseline reading moved.
