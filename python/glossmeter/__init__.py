@@ -45,8 +45,10 @@ from ._glossmeter import (
 )
 from ._types import (
     Allowance,
+    AllowancePart,
     Baseline,
     BrdfFunction,
+    BudgetLine,
     ColourDifference,
     CompareReport,
     CompareSummary,
@@ -92,9 +94,11 @@ if TYPE_CHECKING:
 __all__ = [
     "DEFAULT_GEOMETRIES",
     "Allowance",
+    "AllowancePart",
     "Arrays",
     "Baseline",
     "BrdfFunction",
+    "BudgetLine",
     "ColourDifference",
     "CompareReport",
     "CompareSummary",

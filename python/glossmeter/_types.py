@@ -66,6 +66,18 @@ class Envelope(TypedDict):
     varied: List[EnvelopeVariation]
 
 
+class BudgetLine(TypedDict):
+    """One line of a prediction's uncertainty budget (docs/instrument.md §The prediction's uncertainty): a
+    number of the recipe (its JSON Pointer), its stated standard uncertainty, the reading's sensitivity to it
+    and its contribution |∂y/∂x|·u(x), with how the sensitivity was differenced."""
+
+    pointer: str
+    u: float
+    sensitivity: float
+    contribution: float
+    difference: Literal["central", "forward", "backward"]
+
+
 class Reading(_ReadingRequired, total=False):
     """One reading, with the fields of ``glossmeter measure --format json`` (``value`` and ``error_estimate``
     are None when there is no finite value, and ``problem`` says why; ``seconds`` is left out with
@@ -81,6 +93,10 @@ class Reading(_ReadingRequired, total=False):
     envelope_max: Optional[float]
     envelope: Optional[Envelope]
     envelope_cut: bool
+    #: With a recipe's ``uncertainty`` block: the prediction's standard uncertainty u_pred, in its unit.
+    prediction_uncertainty: float
+    #: With ``prediction_uncertainty``: each stated number's share of it.
+    uncertainty_budget: List[BudgetLine]
 
 
 Readings = List[Reading]
@@ -139,14 +155,35 @@ class Sheet(TypedDict):
     rows: List[SheetRow]
 
 
+class AllowancePart(TypedDict):
+    """One part of an allowance, named, with its formula (``k·√(s²/n + u_pred²)``, ...) and value."""
+
+    name: Literal["statistical", "statistical and prediction uncertainty", "stated", "numerical"]
+    formula: str
+    value: float
+
+
 class Allowance(TypedDict):
+    """The allowed difference: total = random + stated + prediction (docs/instrument.md §The prediction's
+    uncertainty)."""
+
     statistical: float
+    prediction_uncertainty: float
+    random: float
     stated: float
     prediction: float
     total: float
+    parts: List[AllowancePart]
 
 
-class Comparison(TypedDict):
+class _ComparisonOptional(TypedDict, total=False):
+    #: With a recipe's ``uncertainty`` block: the prediction's standard uncertainty u_pred.
+    prediction_uncertainty: float
+    #: With ``prediction_uncertainty``: each stated number's share of it.
+    uncertainty_budget: List[BudgetLine]
+
+
+class Comparison(_ComparisonOptional):
     """One compared (sample, reading) of ``compare``."""
 
     sample: str
