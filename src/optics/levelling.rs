@@ -12,6 +12,7 @@
 //! * the dry film keeps the resin: with the solids spread evenly through the film's depth (no
 //!   surface-tension gradients), a texture frozen at the end of flow dries to `volume_solids` of its wet
 //!   amplitude, so the cured PSD is S_cured(f) = v²·S_applied(f)·exp(−(32π⁴/3)·f⁴·L).
+use crate::optics::scatter::Psd;
 use crate::quadrature::gauss_legendre;
 use std::f64::consts::PI;
 
@@ -199,6 +200,135 @@ pub fn psd_transfer(volume_solids: f64, l_um4: f64, f_per_um: f64) -> f64 {
     volume_solids * volume_solids * amplitude_transfer(l_um4, f_per_um).powi(2)
 }
 
+/// Gauss–Legendre points per piece of a cured PSD's radial moments (the integrand, smooth in ln f, is
+/// integrated over pieces of ln f no wider than [`LEVELLED_STEP`]).
+const LEVELLED_NODES: usize = 16;
+/// The width in ln f of one piece of a cured PSD's moment table.
+const LEVELLED_STEP: f64 = 0.125;
+/// The PSD factor exp(−x) below which the cured spectrum is taken as zero: exp(−745) is below the smallest
+/// subnormal double.
+const LEVELLED_UNDERFLOW: f64 = 745.0;
+
+/// A surface texture's PSD as applied ([`Psd::KCorrelation`] or [`Psd::Gaussian`]) after the film's levelling
+/// (docs/model.md §Levelling of the applied texture): S_c(f) = v²·S_a(f)·exp(−(32π⁴/3)·f⁴·L). Its
+/// radial moments M_j(ρ) = ∫₀^ρ (2πf)^j S_c(f) f df (j = 0: heights, j = 2: slopes) over the whole cured spectrum are tabulated at construction, on knots a [`LEVELLED_STEP`] apart in ln f,
+/// by Gauss–Legendre quadrature in ln f; between knots a moment adds one more such piece.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CuredPsd {
+    /// The texture as applied (a K-correlation or Gaussian PSD).
+    pub applied: Psd,
+    /// Volume solids v: the dry film keeps v of the wet texture's amplitude.
+    pub volume_solids: f64,
+    /// The levelling integral L, µm⁴.
+    pub l_um4: f64,
+    f_min: f64,
+    f_max: f64,
+    knots: Vec<f64>,
+    m0: Vec<f64>,
+    m2: Vec<f64>,
+}
+
+impl CuredPsd {
+    /// The cured PSD of `applied` after a levelling integral `l_um4` at volume solids `v`.
+    pub fn new(applied: Psd, v: f64, l_um4: f64) -> CuredPsd {
+        let f_e = if l_um4 > 0.0 { levelled_frequency(l_um4) } else { f64::INFINITY };
+        let knee = applied.knee();
+        let f_min = 1e-6 * knee.min(f_e);
+        // Beyond f_max the factor exp(−(32π⁴/3) f⁴ L) underflows; without levelling the table stops 10⁸ knees
+        // out and the height moment adds the applied PSD's closed-form tail.
+        let f_max =
+            if l_um4 > 0.0 { (LEVELLED_UNDERFLOW / (32.0 * PI.powi(4) / 3.0 * l_um4)).powf(0.25) } else { 1e8 * knee }
+                .max(2.0 * f_min);
+        let span = (f_max / f_min).ln();
+        let n = ((span / LEVELLED_STEP).ceil() as usize).clamp(1, 4000);
+        let step = span / n as f64;
+        let mut l = CuredPsd {
+            applied,
+            volume_solids: v,
+            l_um4,
+            f_min,
+            f_max,
+            knots: Vec::with_capacity(n + 1),
+            m0: Vec::with_capacity(n + 1),
+            m2: Vec::with_capacity(n + 1),
+        };
+        let s0 = l.cured(0.0);
+        let (mut a0, mut a2) = (s0 * f_min * f_min / 2.0, 4.0 * PI * PI * s0 * f_min.powi(4) / 4.0);
+        let mut prev = f_min;
+        for i in 0..=n {
+            let f = if i == n { f_max } else { f_min * (i as f64 * step).exp() };
+            if i > 0 {
+                a0 += l.piece(0, prev, f);
+                a2 += l.piece(2, prev, f);
+            }
+            l.knots.push(f);
+            l.m0.push(a0);
+            l.m2.push(a2);
+            prev = f;
+        }
+        l
+    }
+
+    /// S_c(f), nm²·µm², over the whole spectrum (no band limit).
+    pub fn cured(&self, f: f64) -> f64 {
+        psd_transfer(self.volume_solids, self.l_um4, f) * self.applied.s2(f)
+    }
+
+    /// ∫ over [a, b] of (2πf)^j S_c(f) f df by one Gauss–Legendre piece in ln f.
+    fn piece(&self, j: i32, a: f64, b: f64) -> f64 {
+        if !(b > a) {
+            return 0.0;
+        }
+        let (x, w) = gauss_legendre(LEVELLED_NODES);
+        let (ua, ub) = (a.ln(), b.ln());
+        let (mid, half) = (0.5 * (ua + ub), 0.5 * (ub - ua));
+        let mut sum = 0.0;
+        for (xi, wi) in x.iter().zip(&w) {
+            let f = (mid + half * xi).exp();
+            sum += wi * (2.0 * PI * f).powi(j) * self.cured(f) * f * f;
+        }
+        sum * half
+    }
+
+    /// M_j(ρ) = ∫₀^ρ (2πf)^j S_c(f) f df over the whole cured spectrum, j = 0 (nm²) or 2 (nm²/µm²). For ρ
+    /// beyond the table without levelling, M_0 adds the applied PSD's closed-form tail; M_2 is only asked
+    /// below the table's end.
+    pub fn moment(&self, j: i32, rho: f64) -> f64 {
+        let s0 = self.cured(0.0);
+        if rho <= self.f_min {
+            return match j {
+                0 => s0 * rho * rho / 2.0,
+                _ => 4.0 * PI * PI * s0 * rho.powi(4) / 4.0,
+            };
+        }
+        let tab = if j == 0 { &self.m0 } else { &self.m2 };
+        let last = self.knots.len() - 1;
+        if rho >= self.f_max {
+            let tail = if j == 0 && self.l_um4 == 0.0 {
+                let v2 = self.volume_solids * self.volume_solids;
+                v2 * (self.applied.radial_cumulative(rho) - self.applied.radial_cumulative(self.f_max)).max(0.0)
+            } else {
+                0.0
+            };
+            return tab[last] + tail;
+        }
+        let i = self.knots.partition_point(|&k| k <= rho).saturating_sub(1).min(last);
+        tab[i] + self.piece(j, self.knots[i], rho)
+    }
+
+    /// The mean-square height (nm²) of the band [a, b] of the cured spectrum: 2π(M_0(b) − M_0(a)).
+    pub fn band_ms(&self, a: f64, b: f64) -> f64 {
+        (2.0 * PI * (self.moment(0, b) - self.moment(0, a))).max(0.0)
+    }
+
+    /// The mean-square slope ⟨|∇h|²⟩ = Sdq² of the whole cured spectrum, ∫∫ (2π|f|)² S_c d²f = 2π·M_2(∞), in
+    /// nm²/µm² (10⁻⁶ rad²). Without levelling (L = 0) the table ends 10⁸ knees out, where a K-correlation
+    /// texture with C ≤ 3, whose slopes diverge, has grown past any facet model.
+    pub fn slope_ms(&self) -> f64 {
+        2.0 * PI * self.moment(2, self.f_max)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -264,6 +394,19 @@ mod tests {
         }
         let fe = thin.levelled_frequency_per_um();
         assert!((thin.amplitude_transfer(fe) - (-1f64).exp()).abs() < 1e-12);
+    }
+
+    #[test]
+    fn cured_k_correlation_keeps_v_squared_sigma_squared_without_levelling() {
+        // L = 0: the cured PSD is v²·S_a, whose σ² is v²σ_a² (the table plus the closed-form tail); levelling
+        // takes heights and more of the slopes.
+        let applied = Psd::k_correlation(800.0, 150.0, 2.5);
+        let bare = CuredPsd::new(applied, 0.4, 0.0);
+        let ms = bare.band_ms(0.0, f64::INFINITY);
+        assert!((ms / (0.4f64 * 800.0).powi(2) - 1.0).abs() < 1e-9, "{ms}");
+        let levelled = CuredPsd::new(applied, 0.4, 1e9);
+        assert!(levelled.band_ms(0.0, f64::INFINITY) < ms);
+        assert!(levelled.slope_ms() < bare.slope_ms() && levelled.slope_ms() > 0.0);
     }
 
     #[test]

@@ -747,7 +747,40 @@ fn registry_object(
             _ => {}
         }
     }
+    levelling_rules(prefix, &mut obj, rng);
     obj
+}
+
+/// A paint coat's `application` and the rules across its fields (docs/recipe-format.md §A coat from its
+/// application): it excludes `roughness` and `scatter` (half the coats keep it, without them); its viscosity
+/// table starts at 0 s, its times increase and its viscosity does not fall; a Gaussian texture has no `c`.
+fn levelling_rules(prefix: &str, obj: &mut serde_json::Map<String, serde_json::Value>, rng: &mut Rng) {
+    use serde_json::json;
+    match prefix {
+        "/clear_coat" if obj.contains_key("application") => {
+            if rng.chance(0.5) {
+                for k in ["roughness", "scatter", "distribution"] {
+                    obj.remove(k);
+                }
+            } else {
+                obj.remove("application");
+            }
+        }
+        "/clear_coat/application" => {
+            if let Some(serde_json::Value::Array(points)) = obj.get_mut("viscosity") {
+                let mut etas: Vec<f64> = points.iter().filter_map(|p| p["eta_pa_s"].as_f64()).collect();
+                etas.sort_by(f64::total_cmp);
+                for (i, (p, eta)) in points.iter_mut().zip(etas).enumerate() {
+                    p["t_s"] = json!(60.0 * i as f64);
+                    p["eta_pa_s"] = json!(eta);
+                }
+            }
+        }
+        "/clear_coat/application/texture" if obj.get("psd").and_then(|v| v.as_str()) == Some("gaussian") => {
+            obj.remove("c");
+        }
+        _ => {}
+    }
 }
 
 /// A recipe built from the registry: a random model and its fields in their ranges (cross-field rules such
