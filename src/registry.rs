@@ -741,6 +741,7 @@ pub const EXACTLY_ONE: &[(&str, &str, &str)] = &[
     ("/metallic_flakes", "spread_deg", "spread_slope"),
     ("/pearlescent_flakes", "spread_deg", "spread_slope"),
     ("", "roughness", "populations"),
+    ("/clear_coat/application/texture", "psd", "file"),
 ];
 
 pub const METALLIC: Param =
@@ -1100,7 +1101,7 @@ pub const APP_TEXTURE_PSD: Param = p(
     Type::Choice(&["k-correlation", "gaussian"]),
     "",
     NONE,
-    Req,
+    Opt("give this or file"),
     "the applied texture's PSD: Church–Takacs K-correlation (ABC) or Gaussian",
 );
 pub const APP_TEXTURE_SIGMA: Param = p(
@@ -1109,7 +1110,7 @@ pub const APP_TEXTURE_SIGMA: Param = p(
     Type::Number,
     "nm",
     Some(TEXTURE_SIGMA_RANGE),
-    Req,
+    Opt("required with psd"),
     "rms height of the wet texture as applied (all frequencies)",
 );
 pub const APP_TEXTURE_ELL: Param = p(
@@ -1118,7 +1119,7 @@ pub const APP_TEXTURE_ELL: Param = p(
     Type::Number,
     "µm",
     Some(TEXTURE_ELL_RANGE),
-    Req,
+    Opt("required with psd"),
     "correlation length ℓ of the applied texture: B = 2πℓ (K-correlation), exp(−r²/ℓ²) autocovariance (Gaussian)",
 );
 pub const APP_TEXTURE_C: Param = p(
@@ -1129,6 +1130,24 @@ pub const APP_TEXTURE_C: Param = p(
     Some(SCATTER_C_RANGE),
     Opt("2 (exponential autocovariance)"),
     "K-correlation exponent C of the applied texture; k-correlation only",
+);
+pub const APP_TEXTURE_FILE: Param = p(
+    "/clear_coat/application/texture/file",
+    PAINT,
+    Type::Text,
+    "",
+    NONE,
+    Opt("give this or psd"),
+    "a measured topography of the texture as applied (.x3p, .sdf or .gsf), relative to the recipe's directory: its own 2-D PSD is levelled, over the map's band (docs/model.md §From the cured spectrum to the coat)",
+);
+pub const APP_TEXTURE_LEVELLING: Param = p(
+    "/clear_coat/application/texture/levelling",
+    PAINT,
+    Type::Choice(&["mean", "plane", "poly2", "poly3", "poly4", "poly5"]),
+    "",
+    NONE,
+    Opt("\"plane\"; with file"),
+    "the reference surface removed from the measured texture before its PSD is taken",
 );
 pub const APP_TEXTURE_NOTES: Param =
     p("/clear_coat/application/texture/notes", PAINT, Type::Notes, "", NONE, Opt("none"), "free text");
@@ -1167,6 +1186,15 @@ pub const APP_FLASH_OFF: Param = p(
     Some(Range::closed(0.0, 1e7)),
     Opt("0 (the film at its dry thickness from the start)"),
     "flash-off time: the film thins linearly from wet to dry over it",
+);
+pub const APP_SURFACE_TENSION_GRADIENT: Param = p(
+    "/clear_coat/application/surface_tension_gradient_mn_m_per_um",
+    PAINT,
+    Type::Number,
+    "mN/m per µm",
+    Some(Range::closed(-1000.0, 1000.0)),
+    Opt("0 (a uniform surface tension)"),
+    "γ' = dγ/dh: the wet film's surface tension per µm of local thickness above the mean (Overdiep's surface-tension gradient); positive works against levelling (docs/model.md §Levelling of the applied texture)",
 );
 pub const APP_VISCOSITY: Param = p(
     "/clear_coat/application/viscosity",
@@ -1283,11 +1311,14 @@ pub static PARAMS: &[&Param] = &[
     &APP_TEXTURE_SIGMA,
     &APP_TEXTURE_ELL,
     &APP_TEXTURE_C,
+    &APP_TEXTURE_FILE,
+    &APP_TEXTURE_LEVELLING,
     &APP_TEXTURE_NOTES,
     &APP_WET_FILM,
     &APP_VOLUME_SOLIDS,
     &APP_SURFACE_TENSION,
     &APP_FLASH_OFF,
+    &APP_SURFACE_TENSION_GRADIENT,
     &APP_VISCOSITY,
     &APP_VISCOSITY_T,
     &APP_VISCOSITY_ETA,

@@ -4,7 +4,7 @@
 //! example recipes read through the default panel.
 use glossmeter::instrument::plan::{PlanOptions, Reading};
 use glossmeter::instrument::standards;
-use glossmeter::optics::levelling::{Application, CuredPsd, ViscosityPoint};
+use glossmeter::optics::levelling::{Application, CuredPsd, Flow, ViscosityPoint};
 use glossmeter::optics::scatter::Psd;
 use glossmeter::{api, recipe};
 use serde_json::{json, Value};
@@ -68,7 +68,7 @@ fn gaussian_cured_moments_match_their_closed_forms() {
     for (sigma, ell, v, l) in
         [(500.0, 100.0, 0.5, 0.0), (500.0, 100.0, 0.5, 1.0e6), (2000.0, 40.0, 0.3, 2.0e5), (800.0, 300.0, 0.8, 3.0e8)]
     {
-        let cured = CuredPsd::new(Psd::Gaussian { sigma, ell }, v, l);
+        let cured = CuredPsd::new(Psd::Gaussian { sigma, ell }, v, Flow { l_um4: l, m_um2: 0.0 });
         let (sq2, sdq2) = gaussian_closed_form(sigma, ell, v, l);
         let got_sq2 = cured.band_ms(0.0, f64::INFINITY);
         let got_sdq2 = cured.slope_ms();
@@ -109,6 +109,7 @@ fn film_build_and_viscosity_move_gloss_haze_and_doi_as_the_levelling_gives() {
             surface_tension_mn_m: 30.0,
             flash_off_s: 20.0,
             viscosity: vec![ViscosityPoint { t_s: 0.0, eta_pa_s: eta }, ViscosityPoint { t_s: 60.0, eta_pa_s: eta }],
+            surface_tension_gradient_mn_m_per_um: 0.0,
         };
         gaussian_closed_form(sigma, ell, 0.5, a.levelling_integral_um4()).1.sqrt() * 1e-3
     };
@@ -182,6 +183,10 @@ fn bad_applications_name_their_pointer() {
             json!({"texture": {"psd": "lorentz", "rms_roughness_nm": 10, "correlation_length_um": 50}}),
             "/clear_coat/application/texture/psd",
         ),
+        // A surface-tension gradient outside its range, or one that grows the texture beyond the linear model.
+        (json!({"surface_tension_gradient_mn_m_per_um": 5000}), "/clear_coat/application/surface_tension_gradient_mn_m_per_um"),
+        (json!({"surface_tension_gradient_mn_m_per_um": "high"}), "/clear_coat/application/surface_tension_gradient_mn_m_per_um"),
+        (json!({"surface_tension_gradient_mn_m_per_um": 900}), "/clear_coat/application/surface_tension_gradient_mn_m_per_um"),
     ];
     for (patch, pointer) in cases {
         let mut app = application(3000.0, 60.0, 20.0, 100.0);
@@ -211,6 +216,107 @@ fn bad_applications_name_their_pointer() {
             other => panic!("{key}: expected an input error, got {other:?}"),
         }
     }
+}
+
+/// A surface-tension gradient (docs/model.md §Levelling of the applied texture, Overdiep's term) moves the readings
+/// the way its sign says: γ' > 0 works against levelling (rougher cured coat: lower 20° gloss and DOI, more haze),
+/// γ' < 0 helps it. The gradient is chosen so that the largest growth is 4× (within the linear model's 10×).
+#[test]
+fn a_surface_tension_gradient_moves_the_readings_by_its_sign() {
+    let (sigma, ell, wet, eta) = (3000.0, 60.0, 40.0, 1.0);
+    let film = |g: f64| Application {
+        wet_film_um: wet,
+        volume_solids: 0.5,
+        surface_tension_mn_m: 30.0,
+        flash_off_s: 20.0,
+        viscosity: vec![ViscosityPoint { t_s: 0.0, eta_pa_s: eta }, ViscosityPoint { t_s: 60.0, eta_pa_s: eta }],
+        surface_tension_gradient_mn_m_per_um: g,
+    };
+    // The growth's exponent is quadratic in γ': ln growth(γ') = γ'²·ln growth(1).
+    let g = (4f64.ln() / film(1.0).largest_growth().ln()).sqrt();
+    assert!((film(g).largest_growth() / 4.0 - 1.0).abs() < 1e-9);
+    let readings = |g: f64| {
+        let mut app = application(sigma, ell, wet, eta);
+        app["surface_tension_gradient_mn_m_per_um"] = g.into();
+        let rs = read(&with_application(app));
+        (value(&rs, "astm-d523-20", "gloss"), value(&rs, "iso-13803-20", "haze"), value(&rs, "astm-e430-30", "doi"))
+    };
+    let (against, plain, with) = (readings(g), readings(0.0), readings(-g));
+    assert!(against.0 < plain.0 && plain.0 < with.0, "20° gloss: {against:?} {plain:?} {with:?}");
+    assert!(against.1 > plain.1 && plain.1 > with.1, "haze: {against:?} {plain:?} {with:?}");
+    assert!(against.2 < plain.2 && plain.2 < with.2, "DOI: {against:?} {plain:?} {with:?}");
+}
+
+/// A Gwyddion Simple Field of `z` (µm), `n` × `n` points `dx_um` apart, for a recipe's measured texture.
+fn write_gsf(path: &std::path::Path, n: usize, dx_um: f64, z: impl Fn(usize, usize) -> f64) {
+    let side = n as f64 * dx_um;
+    let mut bytes = format!(
+        "Gwyddion Simple Field 1.0\nXRes = {n}\nYRes = {n}\nXReal = {side}\nYReal = {side}\nXYUnits = um\nZUnits = um\n"
+    )
+    .into_bytes();
+    bytes.extend(std::iter::repeat(0u8).take(4 - bytes.len() % 4));
+    for j in 0..n {
+        for i in 0..n {
+            bytes.extend((z(i, j) as f32).to_le_bytes());
+        }
+    }
+    std::fs::write(path, bytes).unwrap();
+}
+
+/// A measured texture (docs/model.md §From the cured spectrum to the coat) is levelled mode by mode: a map that is
+/// one sinusoid of amplitude a and wavelength Λ cures to the rms slope v·T(1/Λ)·(2π/Λ)·a/√2 (T the amplitude
+/// transfer), so the coat reads as the same paint given that α as its roughness. A map and a PSD together, a map
+/// that levels flat and a missing file are refused at their pointers.
+#[test]
+fn a_measured_texture_levels_mode_by_mode() {
+    let dir = std::env::temp_dir().join(format!("glossmeter-measured-texture-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (n, dx, periods, a) = (64, 10.0, 4.0, 1.0);
+    let lambda = n as f64 * dx / periods;
+    let wave = dir.join("wave.gsf");
+    write_gsf(&wave, n, dx, |i, _| a * (2.0 * PI * periods * i as f64 / n as f64).cos());
+    // η chosen so that the wave keeps half its amplitude: L ∝ 1/η at constant η.
+    let film = |eta: f64| Application {
+        wet_film_um: 20.0,
+        volume_solids: 0.5,
+        surface_tension_mn_m: 30.0,
+        flash_off_s: 20.0,
+        viscosity: vec![ViscosityPoint { t_s: 0.0, eta_pa_s: eta }, ViscosityPoint { t_s: 60.0, eta_pa_s: eta }],
+        surface_tension_gradient_mn_m_per_um: 0.0,
+    };
+    let l_target = 2f64.ln() / (16.0 * PI.powi(4) / 3.0 * lambda.powi(-4));
+    let eta = film(1.0).levelling_integral_um4() / l_target;
+    let t = film(eta).amplitude_transfer(1.0 / lambda);
+    assert!((t - 0.5).abs() < 1e-9, "{t}");
+    let alpha = 0.5 * t * 2.0 * PI / lambda * a / 2f64.sqrt();
+    let mut app = application(1.0, 1.0, 20.0, eta);
+    app["texture"] = json!({"file": wave.to_str().unwrap(), "levelling": "mean"});
+    let measured = read(&with_application(app.clone()));
+    let mut explicit = black();
+    explicit["clear_coat"]["roughness"] = json!(alpha);
+    let given = read(&explicit);
+    for (m, g) in measured.iter().zip(&given) {
+        let (m, g) = (m.value.unwrap(), g.value.unwrap());
+        assert!((m - g).abs() <= 1e-5 * g.abs().max(1.0), "{m} vs {g} (α = {alpha})");
+    }
+    // Refused: both a PSD and a file; a flat map; a file that is not there.
+    let mut both = app.clone();
+    both["texture"]["psd"] = json!("gaussian");
+    let flat = dir.join("flat.gsf");
+    write_gsf(&flat, 8, 1.0, |_, _| 0.25);
+    let mut level = app.clone();
+    level["texture"]["file"] = json!(flat.to_str().unwrap());
+    let mut missing = app.clone();
+    missing["texture"]["file"] = json!(dir.join("none.x3p").to_str().unwrap());
+    for (case, pointer) in [(both, "file"), (level, "file"), (missing, "file")] {
+        match recipe::parse_str(&with_application(case).to_string(), "coat.json") {
+            Err(glossmeter::Error::Input { field, message, .. }) => {
+                assert_eq!(field, format!("/clear_coat/application/texture/{pointer}"), "{message}")
+            }
+            other => panic!("expected an input error at texture/{pointer}, got {other:?}"),
+        }
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 /// The command line: a bad application exits 2 naming the file and the pointer; the shipped examples read

@@ -6,11 +6,14 @@
 use crate::brdf::annotated::Annotated;
 use crate::brdf::paint::{Paint, PaintSpec};
 use crate::brdf::Brdf;
+use super::topography::levelled_map;
 use crate::input::json::{kind, Obj};
-use crate::optics::levelling::{levelled_frequency, Application, CuredPsd, ViscosityPoint};
+use crate::optics::levelling::{levelled_frequency, Application, CuredPsd, Flow, ViscosityPoint};
 use crate::optics::microfacet::{Distribution, Microfacet};
+use crate::optics::levelling::psd_transfer;
 use crate::optics::scatter::Psd;
 use crate::registry as reg;
+use crate::topography::psd::{psd as map_psd, Psd2};
 use crate::{Error, Result};
 use serde_json::Value;
 use std::f64::consts::PI;
@@ -23,47 +26,73 @@ const PAINT: &str = "paint";
 pub const BANDS_MM: [(&str, f64, f64); 6] =
     [("du", 0.0, 0.1), ("Wa", 0.1, 0.3), ("Wb", 0.3, 1.0), ("Wc", 1.0, 3.0), ("Wd", 3.0, 10.0), ("We", 10.0, 30.0)];
 
+/// The applicator's texture as applied (wet): an analytic isotropic PSD, or a measured topography's own 2-D PSD.
+#[derive(Clone, Debug)]
+pub enum Texture {
+    Analytic(Psd),
+    Measured {
+        /// The levelled map's 2-D PSD (1/m, m⁴).
+        psd: Psd2,
+        /// The file and its levelling, for the note.
+        source: String,
+    },
+}
+
+/// The cured texture: the applied one after the flow, kept at v of its amplitude.
+#[derive(Clone, Debug)]
+pub enum Cured {
+    /// An analytic texture's cured spectrum, over all frequencies.
+    Analytic(CuredPsd),
+    /// A measured texture's grid spectrum, each mode multiplied by the PSD transfer: over the map's band only
+    /// (from 1/(its size) to its Nyquist frequency).
+    Measured { psd: Psd2, volume_solids: f64, flow: Flow, source: String },
+}
+
+impl Cured {
+    /// The mean-square height (nm²) of the band [a, b] (1/µm), cured (`cured`) or as applied.
+    fn band_ms(&self, a: f64, b: f64, cured: bool) -> f64 {
+        match self {
+            Cured::Analytic(c) if cured => c.band_ms(a, b),
+            Cured::Analytic(c) => (2.0 * PI * (c.applied.radial_cumulative(b) - c.applied.radial_cumulative(a))).max(0.0),
+            Cured::Measured { psd, volume_solids, flow, .. } => {
+                let w = |f: f64| if cured { psd_transfer(*volume_solids, *flow, f * 1e-6) } else { 1.0 };
+                // 1/µm → 1/m; m² → nm².
+                psd.weighted_moment(0, a * 1e6, b * 1e6, w) * 1e18
+            }
+        }
+    }
+
+    /// The cured mean-square slope, nm²/µm² (10⁻⁶ rad²).
+    fn slope_ms(&self) -> f64 {
+        match self {
+            Cured::Analytic(c) => c.slope_ms(),
+            Cured::Measured { psd, volume_solids, flow, .. } => {
+                psd.weighted_moment(2, 0.0, f64::INFINITY, |f| psd_transfer(*volume_solids, *flow, f * 1e-6)) * 1e6
+            }
+        }
+    }
+}
+
 /// What a coat's application gives: the levelling, the cured spectrum and the facets' roughness.
 #[derive(Clone, Debug)]
 pub struct LevelledCoat {
     pub application: Application,
-    /// The texture as applied.
-    pub applied: Psd,
-    /// The levelling integral L, µm⁴.
-    pub l_um4: f64,
-    /// The cured spectrum.
-    pub cured: CuredPsd,
+    /// The flow's integrals: L (µm⁴), which levels, and the surface-tension gradient's M (µm²).
+    pub flow: Flow,
+    /// The cured texture (with the applied one).
+    pub cured: Cured,
     /// The facets' Beckmann α: the cured spectrum's rms slope Sdq; 0 below the smooth limit.
     pub roughness: f64,
 }
 
-/// Read the `application` object `o` (at `/clear_coat/application`) into the application and the applied PSD.
-pub fn parse_application(o: &Obj) -> Result<(Application, Psd)> {
+/// Read the `application` object `o` (at `/clear_coat/application`) into the application and the applied texture.
+pub fn parse_application(o: &Obj) -> Result<(Application, Texture)> {
     o.deny_unknown_in(PAINT)?;
     notes(o)?;
     let t = o.obj("texture")?;
     t.deny_unknown_in(PAINT)?;
     notes(&t)?;
-    let psd_key = t.param_key(&reg::APP_TEXTURE_PSD);
-    let sigma = t.param(&reg::APP_TEXTURE_SIGMA)?;
-    let ell = t.param(&reg::APP_TEXTURE_ELL)?;
-    let c = t.opt_param(&reg::APP_TEXTURE_C)?;
-    let applied = match t.str(&psd_key)? {
-        "k-correlation" => Psd::k_correlation(sigma, ell, c.unwrap_or(2.0)),
-        "gaussian" => {
-            if c.is_some() {
-                return Err(t.err(
-                    "c",
-                    "a K-correlation parameter; a Gaussian texture takes rms_roughness_nm and correlation_length_um",
-                ));
-            }
-            Psd::Gaussian { sigma, ell }
-        }
-        other => {
-            return Err(t.err(&psd_key, format!("unknown PSD {other:?}; allowed: \"k-correlation\", \"gaussian\"")))
-        }
-    };
-    let key = o.param_key(&reg::APP_VISCOSITY);
+    let applied = parse_texture(&t)?;    let key = o.param_key(&reg::APP_VISCOSITY);
     let mut viscosity = Vec::new();
     for (i, v) in o.array(&key)?.iter().enumerate() {
         let p = Obj::new(o.file, o.element(&key, i), v)?;
@@ -77,30 +106,85 @@ pub fn parse_application(o: &Obj) -> Result<(Application, Psd)> {
         surface_tension_mn_m: o.param(&reg::APP_SURFACE_TENSION)?,
         flash_off_s: o.opt_param(&reg::APP_FLASH_OFF)?.unwrap_or(0.0),
         viscosity,
+        surface_tension_gradient_mn_m_per_um: o.opt_param(&reg::APP_SURFACE_TENSION_GRADIENT)?.unwrap_or(0.0),
     };
-    // The model's own checks (order of the table, the viscosity not falling, a rise it resolves) name the
-    // field relative to the block: "viscosity/1/eta_pa_s: ...".
-    app.validate().map_err(|m| {
-        let field = m.split(':').next().unwrap_or("").trim();
-        Error::input(o.file, format!("{}/{}", o.path, field), m.clone())
-    })?;
+    // The model's own checks (order of the table, the viscosity not falling, a rise it resolves, a gradient
+    // the linear model holds for) name the field relative to the block.
+    app.validate().map_err(|e| Error::input(o.file, format!("{}/{}", o.path, e.field), e.to_string()))?;
     Ok((app, applied))
+}
+
+/// The `texture` object: a PSD (`psd` with its numbers) or a measured topography (`file`, `levelling`), exactly one.
+fn parse_texture(t: &Obj) -> Result<Texture> {
+    let psd_key = t.param_key(&reg::APP_TEXTURE_PSD);
+    let file_key = t.param_key(&reg::APP_TEXTURE_FILE);
+    match (t.get(&psd_key).is_some(), t.get(&file_key).is_some()) {
+        (true, true) => {
+            return Err(t.err(&file_key, "give either `psd` (an analytic texture) or `file` (a measured one), not both"))
+        }
+        (false, false) => {
+            return Err(t.err(
+                &psd_key,
+                "missing required field: the texture is a PSD (`psd`: \"k-correlation\" or \"gaussian\", with its \
+                 rms_roughness_nm and correlation_length_um) or a measured topography (`file`)",
+            ))
+        }
+        (false, true) => {
+            for key in ["rms_roughness_nm", "correlation_length_um", "c"] {
+                if t.get(key).is_some() {
+                    return Err(t.err(key, "a PSD's number; a measured texture (`file`) takes its heights from the map"));
+                }
+            }
+            let (map, levelled, how) = levelled_map(t, &reg::APP_TEXTURE_FILE, &reg::APP_TEXTURE_LEVELLING)?;
+            let psd = map_psd(&levelled.z, map.nx, map.ny, map.dx, map.dy);
+            if !(psd.weighted_moment(0, 0.0, f64::INFINITY, |_| 1.0) > 0.0) {
+                return Err(t.err(&file_key, format!("{}: the levelled map is flat: a texture with no energy", map.file)));
+            }
+            return Ok(Texture::Measured { psd, source: format!("{}, levelling {}", map.file, how.name()) });
+        }
+        (true, false) => {
+            if t.get(&t.param_key(&reg::APP_TEXTURE_LEVELLING)).is_some() {
+                return Err(t.err("levelling", "the levelling of a measured texture (`file`); a PSD has none"));
+            }
+        }
+    }
+    let sigma = t.param(&reg::APP_TEXTURE_SIGMA)?;
+    let ell = t.param(&reg::APP_TEXTURE_ELL)?;
+    let c = t.opt_param(&reg::APP_TEXTURE_C)?;
+    Ok(Texture::Analytic(match t.str(&psd_key)? {
+        "k-correlation" => Psd::k_correlation(sigma, ell, c.unwrap_or(2.0)),
+        "gaussian" => {
+            if c.is_some() {
+                return Err(t.err(
+                    "c",
+                    "a K-correlation parameter; a Gaussian texture takes rms_roughness_nm and correlation_length_um",
+                ));
+            }
+            Psd::Gaussian { sigma, ell }
+        }
+        other => {
+            return Err(t.err(&psd_key, format!("unknown PSD {other:?}; allowed: \"k-correlation\", \"gaussian\"")))
+        }
+    }))
 }
 
 /// Level the applied texture (docs/model.md §From the cured spectrum to the coat): the facets' α is the
 /// cured spectrum's rms slope, Sdq = (∫∫ (2π|f|)² S_c d²f)^{1/2}.
-pub fn level(app: &Application, applied: Psd) -> LevelledCoat {
-    let l_um4 = app.levelling_integral_um4();
-    let cured = CuredPsd::new(applied, app.volume_solids, l_um4);
+pub fn level(app: &Application, applied: Texture) -> LevelledCoat {
+    let flow = app.flow();
+    let cured = match applied {
+        Texture::Analytic(psd) => Cured::Analytic(CuredPsd::new(psd, app.volume_solids, flow)),
+        Texture::Measured { psd, source } => Cured::Measured { psd, volume_solids: app.volume_solids, flow, source },
+    };
     let alpha = cured.slope_ms().sqrt() * 1e-3;
     let roughness = if alpha >= Microfacet::SMOOTH_THRESHOLD { alpha } else { 0.0 };
-    LevelledCoat { application: app.clone(), applied, l_um4, cured, roughness }
+    LevelledCoat { application: app.clone(), flow, cured, roughness }
 }
 
 impl LevelledCoat {
     /// The cured rms height Sq, nm.
     pub fn sq_nm(&self) -> f64 {
-        self.cured.band_ms(0.0, f64::INFINITY).sqrt()
+        self.cured.band_ms(0.0, f64::INFINITY, true).sqrt()
     }
 
     /// The cured rms slope Sdq (rad) over the whole spectrum.
@@ -116,9 +200,8 @@ impl LevelledCoat {
                 // Surface wavelengths Λ in [lo, hi] mm are frequencies f in [1/hi, 1/lo] per µm·10⁻³.
                 let f_lo = 1e-3 / hi_mm;
                 let f_hi = if lo_mm > 0.0 { 1e-3 / lo_mm } else { f64::INFINITY };
-                let applied =
-                    (2.0 * PI * (self.applied.radial_cumulative(f_hi) - self.applied.radial_cumulative(f_lo))).max(0.0);
-                (name, applied.sqrt(), self.cured.band_ms(f_lo, f_hi).sqrt())
+                let applied = self.cured.band_ms(f_lo, f_hi, false);
+                (name, applied.sqrt(), self.cured.band_ms(f_lo, f_hi, true).sqrt())
             })
             .collect()
     }
@@ -127,17 +210,36 @@ impl LevelledCoat {
     /// levelled spectrum band by band.
     pub fn note(&self) -> String {
         let e = crate::error::number;
-        let fe = levelled_frequency(self.l_um4);
+        let fe = levelled_frequency(self.flow.l_um4);
+        let gradient = if self.flow.m_um2 != 0.0 {
+            format!(
+                ", surface-tension gradient γ' = {} mN/m per µm: M = {} µm², largest growth ×{}",
+                e(self.application.surface_tension_gradient_mn_m_per_um),
+                e(sig(self.flow.m_um2)),
+                e(sig(self.application.largest_growth()))
+            )
+        } else {
+            String::new()
+        };
         let bands: Vec<String> =
             self.bands().iter().map(|(n, a, c)| format!("{n} {} → {} nm", e(sig(*a)), e(sig(*c)))).collect();
+        let texture = match &self.cured {
+            Cured::Measured { source, psd, .. } => format!(
+                "; the applied texture measured ({source}; surface wavelengths {}–{} mm, the map's band)",
+                e(sig(1e3 / (0.5 * (psd.nx as f64 * psd.dfx).min(psd.ny as f64 * psd.dfy)))),
+                e(sig(1e3 / psd.dfx.min(psd.dfy)))
+            ),
+            Cured::Analytic(_) => String::new(),
+        };
         format!(
-            "coat levelled from its application (docs/model.md §From the cured spectrum to the coat): wet film {} µm, \
-             dry {} µm, L = {} µm⁴, amplitude 1/e at Λ = {} µm; cured Sq = {} nm, Sdq = {} rad: the coat's facets, \
+            "coat levelled from its application (docs/model.md §From the cured spectrum to the coat){texture}: wet film {} µm, \
+             dry {} µm, L = {} µm⁴, amplitude 1/e at Λ = {} µm{}; cured Sq = {} nm, Sdq = {} rad: the coat's facets, \
              Beckmann α = {}; band rms applied → cured: {}",
             e(self.application.wet_film_um),
             e(sig(self.application.dry_film_um())),
-            e(sig(self.l_um4)),
+            e(sig(self.flow.l_um4)),
             e(sig(1.0 / fe)),
+            gradient,
             e(sig(self.sq_nm())),
             e(sig(self.sdq())),
             e(sig(self.roughness)),

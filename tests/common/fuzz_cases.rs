@@ -753,7 +753,7 @@ fn registry_object(
 
 /// A paint coat's `application` and the rules across its fields (docs/recipe-format.md §A coat from its
 /// application): it excludes `roughness` and `scatter` (half the coats keep it, without them); its viscosity
-/// table starts at 0 s, its times increase and its viscosity does not fall; a Gaussian texture has no `c`.
+/// table starts at 0 s, its times increase and its viscosity does not fall; its texture is a PSD or a map.
 fn levelling_rules(prefix: &str, obj: &mut serde_json::Map<String, serde_json::Value>, rng: &mut Rng) {
     use serde_json::json;
     match prefix {
@@ -776,8 +776,22 @@ fn levelling_rules(prefix: &str, obj: &mut serde_json::Map<String, serde_json::V
                 }
             }
         }
-        "/clear_coat/application/texture" if obj.get("psd").and_then(|v| v.as_str()) == Some("gaussian") => {
-            obj.remove("c");
+        // A measured texture (`file`) is the shipped map, with none of a PSD's numbers; a PSD has its two numbers
+        // (optional in the registry only because a map replaces them) and no levelling; a Gaussian one no `c`.
+        "/clear_coat/application/texture" if obj.contains_key("file") => {
+            let f = root().join("fixtures/topography/gaussian.x3p");
+            obj.insert("file".into(), json!(f.to_string_lossy()));
+            for k in ["rms_roughness_nm", "correlation_length_um", "c"] {
+                obj.remove(k);
+            }
+        }
+        "/clear_coat/application/texture" => {
+            obj.remove("levelling");
+            obj.entry("rms_roughness_nm").or_insert(json!(2000.0));
+            obj.entry("correlation_length_um").or_insert(json!(200.0));
+            if obj.get("psd").and_then(|v| v.as_str()) == Some("gaussian") {
+                obj.remove("c");
+            }
         }
         _ => {}
     }
