@@ -184,9 +184,18 @@ fn bad_applications_name_their_pointer() {
             "/clear_coat/application/texture/psd",
         ),
         // A surface-tension gradient outside its range, or one that grows the texture beyond the linear model.
-        (json!({"surface_tension_gradient_mn_m_per_um": 5000}), "/clear_coat/application/surface_tension_gradient_mn_m_per_um"),
-        (json!({"surface_tension_gradient_mn_m_per_um": "high"}), "/clear_coat/application/surface_tension_gradient_mn_m_per_um"),
-        (json!({"surface_tension_gradient_mn_m_per_um": 900}), "/clear_coat/application/surface_tension_gradient_mn_m_per_um"),
+        (
+            json!({"surface_tension_gradient_mn_m_per_um": 5000}),
+            "/clear_coat/application/surface_tension_gradient_mn_m_per_um",
+        ),
+        (
+            json!({"surface_tension_gradient_mn_m_per_um": "high"}),
+            "/clear_coat/application/surface_tension_gradient_mn_m_per_um",
+        ),
+        (
+            json!({"surface_tension_gradient_mn_m_per_um": 900}),
+            "/clear_coat/application/surface_tension_gradient_mn_m_per_um",
+        ),
     ];
     for (patch, pointer) in cases {
         let mut app = application(3000.0, 60.0, 20.0, 100.0);
@@ -223,7 +232,7 @@ fn bad_applications_name_their_pointer() {
 /// γ' < 0 helps it. The gradient is chosen so that the largest growth is 4× (within the linear model's 10×).
 #[test]
 fn a_surface_tension_gradient_moves_the_readings_by_its_sign() {
-    let (sigma, ell, wet, eta) = (3000.0, 60.0, 40.0, 1.0);
+    let (sigma, ell, wet, eta) = (3000.0, 60.0, 40.0, 1000.0);
     let film = |g: f64| Application {
         wet_film_um: wet,
         volume_solids: 0.5,
@@ -232,8 +241,11 @@ fn a_surface_tension_gradient_moves_the_readings_by_its_sign() {
         viscosity: vec![ViscosityPoint { t_s: 0.0, eta_pa_s: eta }, ViscosityPoint { t_s: 60.0, eta_pa_s: eta }],
         surface_tension_gradient_mn_m_per_um: g,
     };
-    // The growth's exponent is quadratic in γ': ln growth(γ') = γ'²·ln growth(1).
-    let g = (4f64.ln() / film(1.0).largest_growth().ln()).sqrt();
+    // The growth's exponent is quadratic in γ': ln growth(γ') = (γ'/γ₀)²·ln growth(γ₀).
+    let g0 = 1e-3;
+    let ln0 = film(g0).largest_growth().ln();
+    assert!(ln0.is_finite() && ln0 > 0.0, "{ln0}");
+    let g = g0 * (4f64.ln() / ln0).sqrt();
     assert!((film(g).largest_growth() / 4.0 - 1.0).abs() < 1e-9);
     let readings = |g: f64| {
         let mut app = application(sigma, ell, wet, eta);
@@ -254,7 +266,7 @@ fn write_gsf(path: &std::path::Path, n: usize, dx_um: f64, z: impl Fn(usize, usi
         "Gwyddion Simple Field 1.0\nXRes = {n}\nYRes = {n}\nXReal = {side}\nYReal = {side}\nXYUnits = um\nZUnits = um\n"
     )
     .into_bytes();
-    bytes.extend(std::iter::repeat(0u8).take(4 - bytes.len() % 4));
+    bytes.extend(std::iter::repeat_n(0u8, 4 - bytes.len() % 4));
     for j in 0..n {
         for i in 0..n {
             bytes.extend((z(i, j) as f32).to_le_bytes());

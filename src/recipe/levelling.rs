@@ -3,14 +3,14 @@
 //! The applied texture's PSD is levelled (`optics::levelling`) and the cured spectrum's slopes become the coat's
 //! facets (Beckmann α = its rms slope Sdq). Why the whole cured spectrum is facets and none of it a
 //! Rayleigh–Rice halo: docs/model.md §From the cured spectrum to the coat.
+use super::topography::levelled_map;
 use crate::brdf::annotated::Annotated;
 use crate::brdf::paint::{Paint, PaintSpec};
 use crate::brdf::Brdf;
-use super::topography::levelled_map;
 use crate::input::json::{kind, Obj};
+use crate::optics::levelling::psd_transfer;
 use crate::optics::levelling::{levelled_frequency, Application, CuredPsd, Flow, ViscosityPoint};
 use crate::optics::microfacet::{Distribution, Microfacet};
-use crate::optics::levelling::psd_transfer;
 use crate::optics::scatter::Psd;
 use crate::registry as reg;
 use crate::topography::psd::{psd as map_psd, Psd2};
@@ -53,7 +53,9 @@ impl Cured {
     fn band_ms(&self, a: f64, b: f64, cured: bool) -> f64 {
         match self {
             Cured::Analytic(c) if cured => c.band_ms(a, b),
-            Cured::Analytic(c) => (2.0 * PI * (c.applied.radial_cumulative(b) - c.applied.radial_cumulative(a))).max(0.0),
+            Cured::Analytic(c) => {
+                (2.0 * PI * (c.applied.radial_cumulative(b) - c.applied.radial_cumulative(a))).max(0.0)
+            }
             Cured::Measured { psd, volume_solids, flow, .. } => {
                 let w = |f: f64| if cured { psd_transfer(*volume_solids, *flow, f * 1e-6) } else { 1.0 };
                 // 1/µm → 1/m; m² → nm².
@@ -92,7 +94,8 @@ pub fn parse_application(o: &Obj) -> Result<(Application, Texture)> {
     let t = o.obj("texture")?;
     t.deny_unknown_in(PAINT)?;
     notes(&t)?;
-    let applied = parse_texture(&t)?;    let key = o.param_key(&reg::APP_VISCOSITY);
+    let applied = parse_texture(&t)?;
+    let key = o.param_key(&reg::APP_VISCOSITY);
     let mut viscosity = Vec::new();
     for (i, v) in o.array(&key)?.iter().enumerate() {
         let p = Obj::new(o.file, o.element(&key, i), v)?;
@@ -132,13 +135,19 @@ fn parse_texture(t: &Obj) -> Result<Texture> {
         (false, true) => {
             for key in ["rms_roughness_nm", "correlation_length_um", "c"] {
                 if t.get(key).is_some() {
-                    return Err(t.err(key, "a PSD's number; a measured texture (`file`) takes its heights from the map"));
+                    return Err(
+                        t.err(key, "a PSD's number; a measured texture (`file`) takes its heights from the map")
+                    );
                 }
             }
             let (map, levelled, how) = levelled_map(t, &reg::APP_TEXTURE_FILE, &reg::APP_TEXTURE_LEVELLING)?;
             let psd = map_psd(&levelled.z, map.nx, map.ny, map.dx, map.dy);
-            if !(psd.weighted_moment(0, 0.0, f64::INFINITY, |_| 1.0) > 0.0) {
-                return Err(t.err(&file_key, format!("{}: the levelled map is flat: a texture with no energy", map.file)));
+            // Flat: the levelled rms height is at the rounding of the heights (the mean taken from a constant).
+            let scale = map.z.iter().filter(|z| z.is_finite()).fold(0.0f64, |m, z| m.max(z.abs()));
+            if !(psd.weighted_moment(0, 0.0, f64::INFINITY, |_| 1.0).sqrt() > 1e-12 * scale) {
+                return Err(
+                    t.err(&file_key, format!("{}: the levelled map is flat: a texture with no energy", map.file))
+                );
             }
             return Ok(Texture::Measured { psd, source: format!("{}, levelling {}", map.file, how.name()) });
         }
