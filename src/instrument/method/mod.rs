@@ -53,7 +53,7 @@ pub use delta::{
     DELTA_SAFETY, DELTA_TAIL_SAFETY, DELTA_T_ORDERS,
 };
 pub use design::{
-    delta_rule, lobe_rule, polar_rule, smooth_rule, LobesAt, DELTA_GATE, LOBE_REACH, POLAR_GRAZING, POLAR_REACH,
+    delta_rule, lobe_rule, polar_rule, smooth_rule, DELTA_GATE, LOBE_REACH, POLAR_GRAZING, POLAR_REACH,
     POLAR_REACH_GRAZING, TENSOR_MAX_WIDTH_V, TENSOR_MIN_WIDTH, TENSOR_MIN_WIDTH_U,
 };
 pub use execute::{deadline_after, LATE_START_SHARE};
