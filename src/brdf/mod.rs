@@ -328,8 +328,9 @@ pub trait Brdf: Send + Sync + std::fmt::Debug {
 
     /// What the model tells the planner about itself, in one value ([`Hints`]: its terms, kinks, seams,
     /// reciprocity and smoothness). A model states only what differs from [`Hints::new`]'s defaults; a
-    /// wrapper forwards or edits this one value. It is read once per plan (`instrument::method::MaterialFacts`)
-    /// and must not change over the model's life.
+    /// wrapper forwards or edits this one value. The planner reads it once per plan
+    /// (`instrument::method::MaterialFacts`), the executor once per integral (for [`Hints::smooth`]), so it
+    /// must not change over the model's life.
     fn hints(&self) -> Hints;
 
     /// The same measured table read on about every second sample along each of its axes (its two *coarse
@@ -382,4 +383,62 @@ pub(crate) fn per_sample(what: &str, values: &[f64], sampling: &Sampling) -> Res
         return Err(Error::Usage(format!("{what}: {v} is not a finite number")));
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::sync::Arc;
+
+    fn delta() -> Term {
+        Term { label: "mirror".into(), kind: TermKind::Delta }
+    }
+
+    #[test]
+    fn hints_default_to_no_kinks_no_seams_reciprocal_not_smooth_and_each_builder_sets_its_field_alone() {
+        let h = Hints::new(vec![delta()]);
+        assert_eq!((h.kinks.len(), h.seams.len(), h.reciprocal, h.smooth), (0, 0, true, false));
+        let k = vec![Kink::Incidence { cos: 0.5 }];
+        assert_eq!(h.clone().with_kinks(k.clone()), Hints { kinks: k, ..h.clone() });
+        assert_eq!(h.clone().with_seams(vec![0.25]), Hints { seams: vec![0.25], ..h.clone() });
+        assert_eq!(h.clone().with_reciprocal(false), Hints { reciprocal: false, ..h.clone() });
+        assert_eq!(h.clone().with_smooth(true), Hints { smooth: true, ..h.clone() });
+        assert!(h.has_delta() && !h.has_regular() && !h.has_diffuse() && h.lobes().is_empty());
+    }
+
+    #[test]
+    fn the_horizon_guard_zeroes_a_pair_at_or_below_the_horizon_or_not_a_number_and_leaves_others() {
+        let up = Vec3::new(0.0, 0.0, 1.0);
+        for below in [Vec3::new(1.0, 0.0, 0.0), Vec3::new(0.6, 0.0, -0.8), Vec3::new(0.0, 0.0, f64::NAN)] {
+            for (wi, wo) in [(up, below), (below, up)] {
+                let mut out = [7.0; 2];
+                assert!(!above_horizon(wi, wo) && below_horizon(wi, wo, &mut out) && out == [0.0; 2]);
+            }
+        }
+        let mut out = [7.0; 2];
+        assert!(above_horizon(up, up) && !below_horizon(up, up, &mut out) && out == [7.0; 2]);
+    }
+
+    /// A wrapper forwards the one value: the annotated model's hints are the inner model's, every field.
+    #[test]
+    fn a_wrapper_forwards_the_whole_hints() {
+        // An index below 1 has a critical angle: a kink.
+        let inner: Arc<dyn Brdf> = Arc::new(dielectric::SmoothDielectric::new(0.8));
+        let wrapped = annotated::Annotated { inner: inner.clone(), note: "note".into() };
+        let h = inner.hints();
+        assert!(!h.kinks.is_empty() && h.smooth, "the test needs a model with kinks that is smooth: {h:?}");
+        assert_eq!(wrapped.hints(), h);
+    }
+
+    /// Every model zeroes the regular part below the horizon, Lambert's constant included.
+    #[test]
+    fn a_model_is_zero_below_the_horizon() {
+        let l = lambert::Lambert::new(vec![0.5], Sampling::grey()).unwrap();
+        let (up, down) = (Vec3::new(0.0, 0.0, 1.0), Vec3::new(0.6, 0.0, -0.8));
+        let mut out = [7.0];
+        l.eval(up, down, &mut out);
+        assert_eq!(out, [0.0]);
+        l.eval(up, up, &mut out);
+        assert_eq!(out, [0.5 / std::f64::consts::PI]);
+    }
 }
