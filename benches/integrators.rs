@@ -29,7 +29,7 @@ use std::path::Path;
 use std::sync::Arc;
 use std::time::Instant;
 
-use glossmeter::brdf::{Brdf, Lobe, Tail, Term, TermKind};
+use glossmeter::brdf::{Brdf, Hints, Lobe, Tail, Term, TermKind};
 use glossmeter::instrument::geometry::{solid_angle_density, Axes, Stop};
 use glossmeter::instrument::method::{Chart, Flux, Method, Rule, Target};
 use glossmeter::instrument::plan::{Engine, Plan, PlanOptions, Reading};
@@ -100,8 +100,8 @@ impl Brdf for BenchLambert {
     fn eval(&self, _: Vec3, _: Vec3, out: &mut [f64]) {
         out[0] = self.albedo / std::f64::consts::PI;
     }
-    fn terms(&self) -> Vec<Term> {
-        vec![Term { label: "lambert".into(), kind: TermKind::Diffuse }]
+    fn hints(&self) -> Hints {
+        Hints::new(vec![Term { label: "lambert".into(), kind: TermKind::Diffuse }])
     }
     fn describe(&self) -> String {
         format!("Lambert albedo {}", self.albedo)
@@ -169,9 +169,9 @@ impl Brdf for BenchMicrofacet {
         let g = 1.0 / (1.0 + self.lambda(wi) + self.lambda(wo));
         out[0] = fr_dielectric(wi.dot(h).clamp(0.0, 1.0), self.n) * d * g / (4.0 * wi.z * wo.z);
     }
-    fn terms(&self) -> Vec<Term> {
+    fn hints(&self) -> Hints {
         let label = format!("{:?} {}", self.dist, self.alpha);
-        vec![Term {
+        Hints::new(vec![Term {
             label: label.clone(),
             kind: TermKind::Lobe(Lobe {
                 slope_width: self.alpha,
@@ -179,7 +179,7 @@ impl Brdf for BenchMicrofacet {
                 label,
                 tail: if self.dist == Dist::Ggx { Tail::InverseQuartic } else { Tail::Gaussian },
             }),
-        }]
+        }])
     }
     fn describe(&self) -> String {
         format!("{:?} α = {}, n = {}", self.dist, self.alpha, self.n)
@@ -931,8 +931,9 @@ impl Brdf for Recording {
         self.seen.lock().expect("lock").push(x);
         self.inner.eval(wi, wo, out)
     }
-    fn terms(&self) -> Vec<Term> {
-        self.inner.terms()
+    /// The inner model's terms only (no kinks, not smooth: the defaults), as the recorded histogram was made.
+    fn hints(&self) -> Hints {
+        Hints::new(self.inner.hints().terms)
     }
     fn describe(&self) -> String {
         self.inner.describe()
@@ -1014,11 +1015,11 @@ impl Brdf for Counting {
         self.n.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         self.inner.delta_reflectance(wi, out)
     }
-    fn terms(&self) -> Vec<Term> {
-        self.inner.terms()
-    }
-    fn is_reciprocal(&self) -> bool {
-        self.inner.is_reciprocal()
+    /// The inner model's terms and reciprocity only (no kinks, not smooth: the defaults), as the bench's
+    /// recorded counts were made.
+    fn hints(&self) -> Hints {
+        let h = self.inner.hints();
+        Hints::new(h.terms).with_reciprocal(h.reciprocal)
     }
     fn describe(&self) -> String {
         self.inner.describe()

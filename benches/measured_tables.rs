@@ -18,7 +18,7 @@
 //!
 //! Plain `main` (harness = false). `cargo bench --bench measured_tables [FILTER]`: only the rows whose table
 //! name contains FILTER; the table goes to stdout.
-use glossmeter::brdf::{Brdf, Tail, Term, TermKind};
+use glossmeter::brdf::{Brdf, Hints, Tail, TermKind};
 use glossmeter::instrument::plan::{Plan, PlanOptions};
 use glossmeter::measured::merl::{Interpolation, MerlBrdf};
 use glossmeter::spectrum::Sampling;
@@ -44,28 +44,16 @@ impl Brdf for AtResolution {
     fn eval_batch(&self, wi: &[Vec3], wo: &[Vec3], out: &mut [f64]) {
         self.table.eval_batch(wi, wo, out)
     }
-    fn terms(&self) -> Vec<Term> {
-        let mut terms = self.table.terms();
-        for t in &mut terms {
+    fn hints(&self) -> Hints {
+        let mut h = self.table.hints();
+        for t in &mut h.terms {
             if let TermKind::Lobe(l) = &mut t.kind {
                 if let Tail::Table { resolution, .. } = l.tail {
                     l.slope_width = resolution;
                 }
             }
         }
-        terms
-    }
-    fn kinks(&self) -> Vec<glossmeter::brdf::Kink> {
-        self.table.kinks()
-    }
-    fn seams(&self) -> Vec<f64> {
-        self.table.seams()
-    }
-    fn is_reciprocal(&self) -> bool {
-        self.table.is_reciprocal()
-    }
-    fn smooth(&self) -> bool {
-        self.table.smooth()
+        h
     }
     fn coarser(&self) -> Vec<Arc<dyn Brdf>> {
         if self.twins {

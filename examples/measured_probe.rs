@@ -6,7 +6,7 @@
 //! trilinear) of the engine's own GGX on n = 1.5, written in memory. The overrides replace the lobe the
 //! table states (its width, its tail) or state a diffuse term instead, to measure what the planner would do
 //! with that description; the values are the table's own.
-use glossmeter::brdf::{Brdf, Lobe, Tail, Term, TermKind};
+use glossmeter::brdf::{Brdf, Hints, Lobe, Tail, Term, TermKind};
 use glossmeter::instrument::method::Method;
 use glossmeter::instrument::standards;
 use glossmeter::spectrum::Sampling;
@@ -29,8 +29,8 @@ impl Brdf for Override {
     fn eval_batch(&self, wi: &[Vec3], wo: &[Vec3], out: &mut [f64]) {
         self.inner.eval_batch(wi, wo, out)
     }
-    fn terms(&self) -> Vec<Term> {
-        self.terms.clone()
+    fn hints(&self) -> Hints {
+        Hints::new(self.terms.clone())
     }
     fn describe(&self) -> String {
         self.inner.describe()
@@ -104,7 +104,7 @@ fn main() {
             .map(|d| format!("{d}°:{:.3e}", at(*d, &mut f) / f0))
             .collect();
         println!("{r}: f(spec) = {f0:.4e}; in-plane f(θi + δ)/f(spec): {}", shape.join(" "));
-        let terms = brdf.terms();
+        let terms = brdf.hints().terms;
         let brdf: Arc<dyn Brdf> = if width.is_some() || diffuse || tail != Tail::Unknown {
             let kind = if diffuse {
                 TermKind::Diffuse

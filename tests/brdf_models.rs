@@ -6,7 +6,7 @@ use glossmeter::brdf::lambert::Lambert;
 use glossmeter::brdf::multilobe::{CookTorranceLobes, CtLobe};
 use glossmeter::brdf::phong::{Phong, PhongVariant};
 use glossmeter::brdf::ward::Ward;
-use glossmeter::brdf::{Brdf, TermKind};
+use glossmeter::brdf::{Brdf, Hints, TermKind};
 use glossmeter::optics::microfacet::{Distribution, Microfacet, Shadowing};
 use glossmeter::recipe;
 use glossmeter::spectrum::Sampling;
@@ -87,14 +87,14 @@ fn every_model_evaluates_finite_non_negative() {
                 assert!(r.iter().all(|x| (0.0..=1.0).contains(x)), "{}: R_δ = {r:?}", m.file);
             }
         }
-        assert!(!m.brdf.describe().is_empty() && !m.brdf.terms().is_empty());
+        assert!(!m.brdf.describe().is_empty() && !m.brdf.hints().terms.is_empty());
     }
 }
 
 #[test]
 fn reciprocity() {
     for m in simple_materials() {
-        assert!(m.brdf.is_reciprocal(), "{} claims non-reciprocal", m.file);
+        assert!(m.brdf.hints().reciprocal, "{} claims non-reciprocal", m.file);
         for &wi in &grid() {
             for &wo in &grid() {
                 let (a, b) = (eval(m.brdf.as_ref(), wi, wo), eval(m.brdf.as_ref(), wo, wi));
@@ -135,7 +135,7 @@ fn lambert_albedo_is_rho() {
 fn smooth_dielectric_albedo_is_fresnel() {
     for n in [1.0, 1.5, 1.567, 2.4] {
         let b = SmoothDielectric::new(n);
-        assert_eq!(b.terms().iter().map(|t| &t.kind).collect::<Vec<_>>(), vec![&TermKind::Delta]);
+        assert_eq!(b.hints().terms.iter().map(|t| &t.kind).collect::<Vec<_>>(), vec![&TermKind::Delta]);
         for t in [0.0, 20.0, 60.0, 85.0] {
             let wi = dir(t, 0.0);
             let (a, err) = directional_albedo(&b, wi);
@@ -159,7 +159,7 @@ fn microfacet_delta_limit() {
     for dist in [Distribution::Beckmann, Distribution::Ggx] {
         for shadowing in [Shadowing::SmithHeightCorrelated, Shadowing::SmithSeparable, Shadowing::VCavity] {
             let b = microfacet(dist, 1e-4, 1.5, shadowing);
-            assert!(matches!(b.terms()[0].kind, TermKind::Lobe(_)));
+            assert!(matches!(b.hints().terms[0].kind, TermKind::Lobe(_)));
             for t in [0.0, 20.0, 60.0, 85.0] {
                 let wi = dir(t, 0.0);
                 let (a, err) = directional_albedo(&b, wi);
@@ -200,8 +200,8 @@ fn microfacet_smooth_switch_is_continuous() {
     for dist in [Distribution::Beckmann, Distribution::Ggx] {
         let below = microfacet(dist, 0.99 * t, 1.5, Shadowing::SmithHeightCorrelated);
         let above = microfacet(dist, 1.01 * t, 1.5, Shadowing::SmithHeightCorrelated);
-        assert_eq!(below.terms()[0].kind, TermKind::Delta);
-        assert!(matches!(above.terms()[0].kind, TermKind::Lobe(_)));
+        assert_eq!(below.hints().terms[0].kind, TermKind::Delta);
+        assert!(matches!(above.hints().terms[0].kind, TermKind::Lobe(_)));
         for th in [0.0, 45.0, 80.0] {
             let (a, _) = directional_albedo(&below, dir(th, 0.0));
             let (b, err) = directional_albedo(&above, dir(th, 0.0));
@@ -265,7 +265,7 @@ fn cook_torrance_lobes_linearity_and_smooth_limit() {
         assert!((a[0] - b[0] - 0.3).abs() < 1e-8 + e1 + e2, "{t}°: {} vs {} + 0.3", a[0], b[0]);
     }
     let smooth = CookTorranceLobes::new(vec![0.0], vec![lobe(0.25, 1.0, 0.0)], sh, Sampling::grey()).unwrap();
-    assert_eq!(smooth.terms()[0].kind, TermKind::Delta);
+    assert_eq!(smooth.hints().terms[0].kind, TermKind::Delta);
     let (a, _) = directional_albedo(&smooth, dir(40.0, 0.0));
     assert!((a[0] - 0.25).abs() < 1e-15);
 }
@@ -282,7 +282,7 @@ fn terms_are_honest() {
     let l: Arc<dyn Brdf> = Arc::new(Lambert::new(vec![0.5], Sampling::grey()).unwrap());
     assert!(l.lobes().is_empty() && !l.has_delta());
     let w: Arc<dyn Brdf> = Arc::new(Ward::new(vec![0.0], vec![0.1], 0.05, Sampling::grey()).unwrap());
-    assert_eq!(w.terms().len(), 1, "no diffuse term when ρd = 0");
+    assert_eq!(w.hints().terms.len(), 1, "no diffuse term when ρd = 0");
     assert_eq!(w.lobes()[0].slope_width, 0.05);
 }
 
@@ -341,14 +341,14 @@ impl Brdf for WardDur2006 {
         let tan2 = (h.x * h.x + h.y * h.y) / (h.z * h.z);
         out[0] = (-tan2 / a2).exp() / (4.0 * PI * a2 * wi.z * wo.z);
     }
-    fn terms(&self) -> Vec<glossmeter::brdf::Term> {
+    fn hints(&self) -> Hints {
         let lobe = glossmeter::brdf::Lobe {
             slope_width: self.alpha,
             medium_eta: 1.0,
             label: "Ward–Dür 2006".into(),
             tail: glossmeter::brdf::Tail::Gaussian,
         };
-        vec![glossmeter::brdf::Term { label: "Ward–Dür 2006".into(), kind: TermKind::Lobe(lobe) }]
+        Hints::new(vec![glossmeter::brdf::Term { label: "Ward–Dür 2006".into(), kind: TermKind::Lobe(lobe) }])
     }
     fn describe(&self) -> String {
         "Ward–Dür 2006".into()
@@ -382,7 +382,7 @@ fn lobes_under_a_clear_coat() {
     let text = r#"{"model": "cook-torrance-lobes", "kd": 0.2, "lobes": [{"ks": 0.3, "r": 0.9, "m": 0.2}]"#;
     let bare = recipe::parse_str(&format!("{text}}}"), "bare.json").unwrap();
     let coated = recipe::parse_str(&format!(r#"{text}, "clear_coat": {{"index": 1.5}}}}"#), "coat.json").unwrap();
-    assert_eq!(coated.brdf.terms()[0].label, "clear coat (Fresnel, delta)");
+    assert_eq!(coated.brdf.hints().terms[0].label, "clear coat (Fresnel, delta)");
     for (ti, to, po) in [(20.0, 20.0, 180.0), (60.0, 45.0, 150.0), (85.0, 80.0, 180.0)] {
         let (wi, wo) = (dir(ti, 0.0), dir(to, po));
         let tt = (1.0 - fresnel_closed_form(wi.z, 1.5)) * (1.0 - fresnel_closed_form(wo.z, 1.5));
@@ -391,7 +391,7 @@ fn lobes_under_a_clear_coat() {
         let mut d = [0.0];
         assert!(coated.brdf.delta_reflectance(wi, &mut d));
         assert!((d[0] - fresnel_closed_form(wi.z, 1.5)).abs() < 1e-12);
-        assert!(coated.brdf.is_reciprocal());
+        assert!(coated.brdf.hints().reciprocal);
     }
     let bad = recipe::parse_str(&format!(r#"{text}, "clear_coat": {{"index": 2.5}}}}"#), "bad.json").unwrap_err();
     assert!(bad.to_string().contains("/clear_coat/index"), "{bad}");

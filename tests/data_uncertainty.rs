@@ -2,7 +2,7 @@
 //! tables): tables of analytic BRDFs, read through the instrument, must lie within their stated data
 //! uncertainty (plus the two numerical errors) of the analytic reading, at several resolutions and in the
 //! MERL, RGL and in-plane forms; and a default run of a table converges at the tolerance its data sets.
-use glossmeter::brdf::{Brdf, Tail, Term, TermKind};
+use glossmeter::brdf::{Brdf, Hints, Tail, TermKind};
 use glossmeter::instrument::plan::{Plan, PlanOptions, Reading};
 use glossmeter::instrument::standards;
 use glossmeter::measured::merl::{Interpolation, MerlBrdf};
@@ -173,15 +173,16 @@ impl Brdf for AtResolution {
     fn eval_batch(&self, wi: &[Vec3], wo: &[Vec3], out: &mut [f64]) {
         self.0.eval_batch(wi, wo, out)
     }
-    fn terms(&self) -> Vec<Term> {
-        let mut terms = self.0.terms();
+    /// The table's terms with the lobe at the resolution, and the defaults otherwise.
+    fn hints(&self) -> Hints {
+        let mut terms = self.0.hints().terms;
         for t in &mut terms {
             if let TermKind::Lobe(l) = &mut t.kind {
                 let Tail::Table { resolution, .. } = l.tail else { panic!("not a table's lobe: {l:?}") };
                 l.slope_width = resolution;
             }
         }
-        terms
+        Hints::new(terms)
     }
     fn describe(&self) -> String {
         self.0.describe()

@@ -4,7 +4,7 @@
 //! integration of the mirror overlap.
 use std::sync::Arc;
 
-use glossmeter::brdf::{Brdf, Term, TermKind};
+use glossmeter::brdf::{Brdf, Hints, Term, TermKind};
 use glossmeter::instrument::geometry::Axes;
 use glossmeter::instrument::method::Method;
 use glossmeter::instrument::plan::{Plan, PlanOptions, Reading};
@@ -26,8 +26,8 @@ impl Brdf for TestLambert {
     fn eval(&self, _: Vec3, _: Vec3, out: &mut [f64]) {
         out[0] = self.0 / std::f64::consts::PI;
     }
-    fn terms(&self) -> Vec<Term> {
-        vec![Term { label: "lambert".into(), kind: TermKind::Diffuse }]
+    fn hints(&self) -> Hints {
+        Hints::new(vec![Term { label: "lambert".into(), kind: TermKind::Diffuse }])
     }
     fn describe(&self) -> String {
         "test lambert".into()
@@ -51,8 +51,8 @@ impl Brdf for TestMirror {
         };
         true
     }
-    fn terms(&self) -> Vec<Term> {
-        vec![Term { label: "mirror".into(), kind: TermKind::Delta }]
+    fn hints(&self) -> Hints {
+        Hints::new(vec![Term { label: "mirror".into(), kind: TermKind::Delta }])
     }
     fn describe(&self) -> String {
         "test mirror".into()

@@ -1,5 +1,5 @@
 //! Bounded work (`docs/instrument.md` §Quadrature, "Kinks"): a Fresnel critical angle inside the stops is a kink of the
-//! integrand, and the plan puts it on partition boundaries (`Brdf::kinks`, `instrument::aperture::kinked_position`).
+//! integrand, and the plan puts it on partition boundaries (`Hints::kinks`, `instrument::aperture::kinked_position`).
 //! The reproducer, `{"model":"microfacet","distribution":"beckmann","roughness":1e-7,"ior":[0.3375,0.0]}` at
 //! 20° (θc = 19.72°, inside the 20° stops), ran 18 s to the 50 M budget without converging.
 //!
@@ -82,11 +82,15 @@ fn the_critical_angle_lies_inside_the_20_degree_stops() {
     let theta_c = N.asin();
     let half = g.source.p[1].atan();
     assert!(g.theta - half < theta_c && theta_c < g.theta + half, "θc {theta_c} vs 20° ± {half}");
-    assert_eq!(reproducer().kinks().len(), 1);
+    assert_eq!(reproducer().hints().kinks.len(), 1);
     assert!(recipe(r#"{"model":"microfacet","distribution":"beckmann","roughness":1e-7,"ior":[0.3375,0.1]}"#)
-        .kinks()
+        .hints()
+        .kinks
         .is_empty());
-    assert!(recipe(r#"{"model":"microfacet","distribution":"beckmann","roughness":0.1,"ior":1.5}"#).kinks().is_empty());
+    assert!(recipe(r#"{"model":"microfacet","distribution":"beckmann","roughness":0.1,"ior":1.5}"#)
+        .hints()
+        .kinks
+        .is_empty());
 }
 
 /// The delta limits (the microfacet model below its smooth threshold, and the smooth conductor) against the

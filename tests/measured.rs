@@ -5,7 +5,7 @@
 // Channels index several parallel arrays (values, scales, expected values) at once.
 #![allow(clippy::needless_range_loop)]
 
-use glossmeter::brdf::{Brdf, TermKind};
+use glossmeter::brdf::{Brdf, Hints, TermKind};
 use glossmeter::instrument::plan::{Plan, PlanOptions};
 use glossmeter::instrument::standards;
 use glossmeter::measured::merl::{fold_phi_d, half_diff, Interpolation, MerlBrdf, MERL_DIMS, MERL_SCALE};
@@ -199,7 +199,7 @@ fn lambertian_table_reads_rho_over_pi_with_both_lookups() {
         assert!(desc.contains("0 invalid"), "{desc}");
         // Every cell the same per channel: a constant BRDF, stated as a diffuse term (`docs/instrument.md` §Quadrature,
         // "Measured tables": the plain chart, 57 evaluations at D523 20°/60°/85°, instead of splits at the resolution).
-        let terms = m.brdf.terms();
+        let terms = m.brdf.hints().terms;
         assert_eq!(terms.len(), 1);
         assert_eq!(terms[0].kind, TermKind::Diffuse, "{terms:?}");
         assert!(terms[0].label.contains("every cell the same value per channel"), "{}", terms[0].label);
@@ -220,7 +220,7 @@ fn lambertian_table_reads_rho_over_pi_with_both_lookups() {
     });
     let m = MerlBrdf::load(&bumped, Interpolation::Trilinear).unwrap();
     assert!(!m.is_flat());
-    match &m.terms()[0].kind {
+    match &m.hints().terms[0].kind {
         TermKind::Lobe(l) => {
             assert_eq!((l.medium_eta, l.label.as_str()), (1.0, "measured (MERL)"));
             // The bump is far from the specular scan: the lobe never falls to half, its half width is infinite
@@ -508,14 +508,14 @@ impl Brdf for LobeFn {
         let hd = half_diff(wi, wo);
         out.fill(Self::f(hd.theta_h, hd.theta_d));
     }
-    fn terms(&self) -> Vec<glossmeter::brdf::Term> {
+    fn hints(&self) -> Hints {
         let l = glossmeter::brdf::Lobe {
             slope_width: 0.1,
             medium_eta: 1.0,
             label: "lobe".into(),
             tail: glossmeter::brdf::Tail::Unknown,
         };
-        vec![glossmeter::brdf::Term { label: "lobe".into(), kind: TermKind::Lobe(l) }]
+        Hints::new(vec![glossmeter::brdf::Term { label: "lobe".into(), kind: TermKind::Lobe(l) }])
     }
     fn describe(&self) -> String {
         "analytic lobe".into()

@@ -282,13 +282,13 @@ fn fixtures_load_and_evaluate_finite_non_negative_values() {
         let mut d = [f64::NAN; 3];
         assert!(b.delta_reflectance(dir(60.0, 0.0), &mut d), "{name}: a smooth coat has a delta");
         assert!((d[0] - fresnel_r(60f64.to_radians().cos(), 1.5)).abs() < 1e-12, "{name}: delta = coat Fresnel");
-        assert!(b.is_reciprocal());
+        assert!(b.hints().reciprocal);
     }
 }
 
 #[test]
 fn fixture_terms_list_only_what_the_recipe_has() {
-    let labels = |n: &str| load(n).terms().into_iter().map(|t| t.label).collect::<Vec<_>>();
+    let labels = |n: &str| load(n).hints().terms.into_iter().map(|t| t.label).collect::<Vec<_>>();
     assert_eq!(labels("cerulean-blue-a"), ["clear coat (Fresnel, delta)", "pigmented layer (Kubelka–Munk, diffuse)"]);
     assert_eq!(
         labels("cerulean-blue-b"),
@@ -433,7 +433,7 @@ fn rough_coat_white_furnace_and_reciprocity() {
             let p = Paint::new(spec).unwrap();
             assert!(!p.delta_reflectance(dir(30.0, 0.0), &mut [0.0; 3]));
             assert_eq!(
-                p.terms()[0].kind,
+                p.hints().terms[0].kind,
                 TermKind::Lobe(glossmeter::brdf::Lobe {
                     slope_width: alpha,
                     medium_eta: 1.0,
@@ -645,7 +645,7 @@ proptest! {
     fn random_recipes_conserve_energy(r in random_spec(), ti in 0f64..89.5) {
         let eta = r.spec.coat.index;
         let p = Paint::new(r.spec).unwrap();
-        let width = p.terms().iter().filter_map(|t| match &t.kind { TermKind::Lobe(l) => Some(l.slope_width), _ => None })
+        let width = p.hints().terms.iter().filter_map(|t| match &t.kind { TermKind::Lobe(l) => Some(l.slope_width), _ => None })
             .fold(0.05, f64::min);
         let (a, err) = albedo_interior(&p, eta, dir(ti, 0.0), width, 1e-6);
         for v in &a {
@@ -661,7 +661,7 @@ proptest! {
     fn random_recipes_are_reciprocal(r in random_spec(), ti in 0f64..89.9, pi in 0f64..360.0,
                                      to in 0f64..89.9, po in 0f64..360.0, near in any::<bool>()) {
         let p = Paint::new(r.spec).unwrap();
-        prop_assert!(p.is_reciprocal());
+        prop_assert!(p.hints().reciprocal);
         let wi = dir(ti, pi);
         // Half of the cases close to the specular direction, where the flake lobes are.
         let wo = if near { dir(ti + 0.01 * (to - 45.0) / 45.0, pi + 180.0 + 0.02 * (po - 180.0) / 180.0) } else { dir(to, po) };
@@ -806,7 +806,7 @@ fn paper_eq1_normalisation_is_four_times_the_energy_normalised_lobe() {
     let phys = Paint::new(spec.clone()).unwrap();
     spec.form = Form::PaperEq1;
     let paper = Paint::new(spec).unwrap();
-    assert!(!paper.is_reciprocal());
+    assert!(!paper.hints().reciprocal);
     let m = 2f64.to_radians().tan();
     let wi = dir(0.0, 0.0);
     let rho0 = fresnel_r(1.0, 1.5);
@@ -862,8 +862,8 @@ fn flake_delta_switch_is_continuous_and_is_eq5_corrected() {
         Paint::new(spec).unwrap()
     };
     let smooth = build(1e-6, Form::Physical);
-    assert!(smooth.terms().iter().filter(|t| t.kind == TermKind::Delta).count() == 3);
-    assert!(!smooth.terms().iter().any(|t| matches!(t.kind, TermKind::Diffuse)), "Am + Ap = 1: no body");
+    assert!(smooth.hints().terms.iter().filter(|t| t.kind == TermKind::Delta).count() == 3);
+    assert!(!smooth.hints().terms.iter().any(|t| matches!(t.kind, TermKind::Diffuse)), "Am + Ap = 1: no body");
     for ti in [0.0, 40.0, 75.0] {
         let wi = dir(ti, 0.0);
         let mut d = [0.0; 3];
@@ -920,9 +920,9 @@ fn split_flake_light_delta_weight_and_diffuse_part() {
     };
     let split = build(FlakeLight::Split, 1e-6);
     let paper = build(FlakeLight::PaperEq5, 1e-6);
-    let labels: Vec<String> = split.terms().into_iter().map(|t| t.label).collect();
+    let labels: Vec<String> = split.hints().terms.into_iter().map(|t| t.label).collect();
     assert!(labels.iter().any(|l| l.contains("scattered by the pigment") && l.starts_with("metallic")), "{labels:?}");
-    assert!(!paper.terms().iter().any(|t| t.label.contains("scattered")));
+    assert!(!paper.hints().terms.iter().any(|t| t.label.contains("scattered")));
     for ti in [0.0, 40.0, 75.0] {
         let wi = dir(ti, 0.0);
         let ct_in = refract_in(wi, 1.5).z;
@@ -962,7 +962,7 @@ fn split_flake_light_delta_weight_and_diffuse_part() {
         Paint::new(spec).unwrap()
     };
     let (c1, c2) = (clear(FlakeLight::Split), clear(FlakeLight::PaperEq5));
-    assert_eq!(c1.terms().len(), c2.terms().len());
+    assert_eq!(c1.hints().terms.len(), c2.hints().terms.len());
     for (ti, to, po) in [(20.0, 20.0, 180.0), (60.0, 50.0, 170.0), (10.0, 70.0, 30.0)] {
         let (f1, f2) = (eval(&c1, dir(ti, 0.0), dir(to, po)), eval(&c2, dir(ti, 0.0), dir(to, po)));
         for j in 0..3 {
@@ -994,7 +994,7 @@ fn zero_area_ratio_builds_no_flake_terms() {
     v["pearlescent_flakes"]["area_ratio"] = json!(0.0);
     let b = from_json(&v).unwrap();
     let a = load("cerulean-blue-a");
-    assert_eq!(b.terms(), a.terms());
+    assert_eq!(b.hints().terms, a.hints().terms);
     for (ti, to) in [(20.0, 20.0), (60.0, 30.0)] {
         let (wi, wo) = (dir(ti, 0.0), dir(to, 180.0));
         assert_eq!(eval(&*b, wi, wo), eval(&*a, wi, wo));
@@ -1216,18 +1216,18 @@ fn realistic_paints_read_in_the_real_meter_ranges() {
 
 #[test]
 fn smooth_is_claimed_only_for_the_physical_form_under_a_smooth_coat() {
-    // `Brdf::smooth` lets the integrator check and shrink its region estimates (docs/accuracy.md §5.1). The
+    // `Hints::smooth` lets the integrator check and shrink its region estimates (docs/accuracy.md §5.1). The
     // physical form under a smooth coat is analytic in the exterior directions; the rough coat's E(μ) table
     // and the printed Eq. (1)'s V-cavity G are not, and must keep the calibrated estimate.
     for name in ["cerulean-blue-b-literal", "cerulean-blue-c-literal", "white-pearl-spectral"] {
-        assert!(load(name).smooth(), "{name}: physical form, smooth coat");
+        assert!(load(name).hints().smooth, "{name}: physical form, smooth coat");
     }
-    assert!(!load("semigloss-white").smooth(), "semigloss-white: rough clear coat");
+    assert!(!load("semigloss-white").hints().smooth, "semigloss-white: rough clear coat");
     let mut spec = rgb_spec(1.5, 0.1, [0.5; 3], [0.0; 3], [0.0; 3]);
     spec.metallic = Some(MetallicFlakes { n: vec![0.05; 3], k: vec![4.0; 3], ..metal(2.0, 1.0, 0.0) });
-    assert!(Paint::new(spec.clone()).unwrap().smooth());
+    assert!(Paint::new(spec.clone()).unwrap().hints().smooth);
     spec.form = Form::PaperEq1;
-    assert!(!Paint::new(spec).unwrap().smooth(), "paper Eq. (1): V-cavity G");
+    assert!(!Paint::new(spec).unwrap().hints().smooth, "paper Eq. (1): V-cavity G");
 }
 
 /// The flake tables built for all samples at once (`docs/model.md` §Evaluation cost: the film stack's angles

@@ -154,7 +154,7 @@ fn halos_are_reciprocal() {
     ];
     for text in texts {
         let m = recipe::parse_str(text, "t.json").unwrap();
-        assert!(m.brdf.is_reciprocal());
+        assert!(m.brdf.hints().reciprocal);
         let n = m.brdf.sampling().len();
         let (mut a, mut b) = (vec![0.0; n], vec![0.0; n]);
         for (wi, wo) in

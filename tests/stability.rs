@@ -856,7 +856,7 @@ fn narrow_flakes_and_smooth_switches() {
         recipe(&metallic_recipe(spread(t * (1.0 + 1e-4)), 0.4)),
         recipe(&metallic_recipe(spread(t * (1.0 - 1e-4)), 0.4)),
     );
-    let kinds = |b: &Arc<dyn Brdf>| b.terms().iter().filter(|t| matches!(t.kind, TermKind::Lobe(_))).count();
+    let kinds = |b: &Arc<dyn Brdf>| b.hints().terms.iter().filter(|t| matches!(t.kind, TermKind::Lobe(_))).count();
     assert_eq!((kinds(&above), kinds(&below)), (1, 0), "the two sides must be on either side of the switch");
     for (a, b) in run(&above, &gs, RTOL).iter().zip(&run(&below, &gs, RTOL)) {
         check_gap(test, "flake smooth switch slope 1e-7(1±1e-4)", a, b, RTOL, 0.0, &mut fails);
@@ -902,7 +902,8 @@ fn area_ratios_zero_and_one() {
     let full = recipe(&metallic_recipe(0.25, 1.0));
     // The flakes' scattered light (split flake light) is a diffuse term of its own; the pigmented layer's body
     // term is what A = 1 removes.
-    let has_body = full.terms().iter().any(|t| t.kind == TermKind::Diffuse && t.label.starts_with("pigmented layer"));
+    let has_body =
+        full.hints().terms.iter().any(|t| t.kind == TermKind::Diffuse && t.label.starts_with("pigmented layer"));
     if !stab(test, "metallic A=1: no body term", has_body as u8 as f64, 0.0, 0.0, 0.0, !has_body) {
         fails.push("A = 1 still has a diffuse body term".into());
     }

@@ -2,7 +2,7 @@
 //!
 //! Why: the integrator splits its lobe variables at multiples of each lobe's width so that a lobe of any
 //! width is seen by the first samples (`docs/instrument.md` §Quadrature). A model in Rust states its widths in
-//! `Brdf::terms`; a Python function does not, and adaptive cubature over the apertures would silently return
+//! `Hints::terms`; a Python function does not, and adaptive cubature over the apertures would silently return
 //! ≈ 0 for a lobe narrower than its first sample spacing. So, when the caller gives no hint, we probe f along a
 //! geometric ladder of deviations from the specular direction (in the plane of measurement and across it, at
 //! the centre of the source aperture of every angle measured) and take the smallest deviation at which f has

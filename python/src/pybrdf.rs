@@ -10,7 +10,7 @@
 //! exception is raised, as itself, when the measurement returns.
 use std::sync::Mutex;
 
-use glossmeter::brdf::{Brdf, Lobe, Tail, Term, TermKind};
+use glossmeter::brdf::{Brdf, Hints, Lobe, Tail, Term, TermKind};
 use glossmeter::colorimetry::weighting::Weighting;
 use glossmeter::instrument::plan::{Plan, PlanOptions, Target};
 use glossmeter::spectrum::Sampling;
@@ -223,13 +223,10 @@ impl Brdf for PyBrdf {
         }
     }
 
-    fn terms(&self) -> Vec<Term> {
-        self.terms.clone()
-    }
-
-    fn is_reciprocal(&self) -> bool {
-        // Unknown for a user's function; nothing in the plan relies on it.
-        false
+    /// The terms the user stated; reciprocity is unknown for a user's function (nothing in the plan relies
+    /// on it), so not claimed.
+    fn hints(&self) -> Hints {
+        Hints::new(self.terms.clone()).with_reciprocal(false)
     }
 
     fn describe(&self) -> String {
@@ -248,8 +245,8 @@ impl Brdf for Placeholder {
     fn eval(&self, _wi: Vec3, _wo: Vec3, out: &mut [f64]) {
         out.fill(0.0);
     }
-    fn terms(&self) -> Vec<Term> {
-        vec![Term { label: "placeholder".into(), kind: TermKind::Diffuse }]
+    fn hints(&self) -> Hints {
+        Hints::new(vec![Term { label: "placeholder".into(), kind: TermKind::Diffuse }])
     }
     fn describe(&self) -> String {
         "placeholder".into()

@@ -17,7 +17,7 @@
 //! provided no panel straddles a kink or a seam of the integrand, where |K15 − G7| is of the order of the
 //! error itself and was measured 1–5× below it (a rough coat's E(μ) seams at normal incidence). So the radial
 //! partition also breaks, along each azimuth, where the outgoing cosine crosses one of the model's seams
-//! ([`Brdf::seams`]: cos θo = μk at r = (a + √(a² + c² − μk²))/(c + μk)) and where ωi·h crosses a
+//! ([`Hints::seams`](super::Hints::seams): cos θo = μk at r = (a + √(a² + c² − μk²))/(c + μk)) and where ωi·h crosses a
 //! half-angle kink ([`Kink::HalfAngle`]: (a r + c)/√(1 + r²) = k, the roots of
 //! (a² − k²) r² + 2ac r + c² − k² = 0 with a r + c > 0).
 use super::{Brdf, Kink, TermKind};
@@ -49,7 +49,8 @@ pub fn directional_albedo_to(brdf: &dyn Brdf, wi: Vec3, tolerance: f64) -> (Vec<
     } else {
         total.fill(0.0);
     }
-    let terms = brdf.terms();
+    let hints = brdf.hints();
+    let terms = &hints.terms;
     if terms.iter().all(|t| t.kind == TermKind::Delta) {
         return (total, 0.0);
     }
@@ -65,7 +66,7 @@ pub fn directional_albedo_to(brdf: &dyn Brdf, wi: Vec3, tolerance: f64) -> (Vec<
     let c = wi.z;
     let phi_i = wi.y.atan2(wi.x);
 
-    let extra = Breaks { seams: brdf.seams(), half_angle: half_angle_kinks(brdf) };
+    let extra = Breaks { seams: hints.seams.clone(), half_angle: half_angle_kinks(&hints.kinks) };
     let inner_tol = tolerance / (4.0 * PI);
     let mut fval = vec![0.0; n];
     // The outer integrand carries the inner error estimate as an extra component, so that its integral over
@@ -128,10 +129,10 @@ impl Breaks {
     }
 }
 
-fn half_angle_kinks(brdf: &dyn Brdf) -> Vec<f64> {
-    brdf.kinks()
-        .into_iter()
-        .filter_map(|k| match k {
+fn half_angle_kinks(kinks: &[Kink]) -> Vec<f64> {
+    kinks
+        .iter()
+        .filter_map(|k| match *k {
             Kink::HalfAngle { cos } => Some(cos),
             Kink::Incidence { .. } => None,
         })

@@ -2,7 +2,7 @@
 //! only [`Brdf::describe`] adds the note. The recipe parser wraps a paint whose coat was derived from its
 //! application (docs/model.md §From the cured spectrum to the coat) so that `--explain` shows the cured
 //! spectrum, Sq and Sdq beside the model they produced.
-use super::{Brdf, Kink, Term};
+use super::{Brdf, Hints};
 use crate::spectrum::Sampling;
 use crate::Vec3;
 use std::sync::Arc;
@@ -33,20 +33,8 @@ impl Brdf for Annotated {
     fn delta_reflectance(&self, wi: Vec3, out: &mut [f64]) -> bool {
         self.inner.delta_reflectance(wi, out)
     }
-    fn terms(&self) -> Vec<Term> {
-        self.inner.terms()
-    }
-    fn kinks(&self) -> Vec<Kink> {
-        self.inner.kinks()
-    }
-    fn seams(&self) -> Vec<f64> {
-        self.inner.seams()
-    }
-    fn is_reciprocal(&self) -> bool {
-        self.inner.is_reciprocal()
-    }
-    fn smooth(&self) -> bool {
-        self.inner.smooth()
+    fn hints(&self) -> Hints {
+        self.inner.hints()
     }
     fn coarser(&self) -> Vec<Arc<dyn Brdf>> {
         self.inner.coarser()

@@ -2,7 +2,7 @@
 //! reflectance of a complex index n + ik (Born & Wolf, *Principles of Optics* §14.2; pbrt-v4 `FrConductor`).
 //! A rough conductor is [`super::dielectric::MicrofacetSurface`] with [`super::dielectric::Ior::Conductor`].
 use super::dielectric::Ior;
-use super::{Brdf, Kink, Term, TermKind};
+use super::{Brdf, Hints, Term, TermKind};
 use crate::optics::fresnel::critical_cosine_complex;
 use crate::spectrum::Sampling;
 use crate::Vec3;
@@ -41,18 +41,11 @@ impl Brdf for SmoothConductor {
         true
     }
 
-    fn terms(&self) -> Vec<Term> {
-        vec![Term { label: "specular reflection (conductor Fresnel)".into(), kind: TermKind::Delta }]
-    }
-
-    /// A real index below 1 (k = 0) has a critical angle.
-    fn kinks(&self) -> Vec<Kink> {
-        super::fresnel_kinks(self.ior.iter().map(|e| critical_cosine_complex(*e)), true)
-    }
-
-    /// Analytic everywhere but on its reported kinks (`Brdf::smooth`).
-    fn smooth(&self) -> bool {
-        true
+    /// A real index below 1 (k = 0) has a critical angle, its kink; analytic everywhere else (`Hints::smooth`).
+    fn hints(&self) -> Hints {
+        Hints::new(vec![Term { label: "specular reflection (conductor Fresnel)".into(), kind: TermKind::Delta }])
+            .with_kinks(super::fresnel_kinks(self.ior.iter().map(|e| critical_cosine_complex(*e)), true))
+            .with_smooth(true)
     }
 
     fn describe(&self) -> String {

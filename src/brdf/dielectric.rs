@@ -10,7 +10,7 @@
 //!   Smith height-correlated (Heitz 2014 Eq. 99, default) or the V-cavity G of Cook & Torrance (1982). Below
 //!   [`Microfacet::SMOOTH_THRESHOLD`] the lobe is replaced by its delta limit R(θi) = F(cos θi) (D → δ(h − n),
 //!   G → 1, ωi·h → cos θi), so the directional albedo is continuous across the switch.
-use super::{Brdf, Kink, Lobe, Term, TermKind};
+use super::{above_horizon, Brdf, Hints, Lobe, Term, TermKind};
 use crate::optics::fresnel::{critical_cosine, critical_cosine_complex, fr_conductor, fr_dielectric};
 use crate::optics::microfacet::{Distribution, Microfacet, Shadowing};
 use crate::spectrum::Sampling;
@@ -107,17 +107,11 @@ impl Brdf for SmoothDielectric {
         true
     }
 
-    fn terms(&self) -> Vec<Term> {
-        vec![Term { label: "specular reflection (Fresnel)".into(), kind: TermKind::Delta }]
-    }
-
-    fn kinks(&self) -> Vec<Kink> {
-        super::fresnel_kinks([critical_cosine(self.ior)], true)
-    }
-
-    /// Analytic everywhere but on its reported kinks (`Brdf::smooth`).
-    fn smooth(&self) -> bool {
-        true
+    /// Analytic everywhere but on the kink of its critical angle (`Hints::smooth`).
+    fn hints(&self) -> Hints {
+        Hints::new(vec![Term { label: "specular reflection (Fresnel)".into(), kind: TermKind::Delta }])
+            .with_kinks(super::fresnel_kinks([critical_cosine(self.ior)], true))
+            .with_smooth(true)
     }
 
     fn describe(&self) -> String {
@@ -180,10 +174,10 @@ pub(crate) fn describe_shadowing(s: Shadowing) -> &'static str {
     }
 }
 
-/// D(h)·G/(4 cos θi cos θo) and ωi·h for a microfacet lobe, or None when either direction is at or below
-/// the horizon (the regular part is zero there).
+/// D(h)·G/(4 cos θi cos θo) and ωi·h for a microfacet lobe, or None when the pair is not
+/// [`above_horizon`] (the regular part is zero there).
 pub(crate) fn microfacet_factor(facets: &Microfacet, shadowing: Shadowing, wi: Vec3, wo: Vec3) -> Option<(f64, f64)> {
-    if wi.z <= 0.0 || wo.z <= 0.0 {
+    if !above_horizon(wi, wo) {
         return None;
     }
     let h = (wi + wo).normalize();
@@ -226,27 +220,20 @@ impl Brdf for MicrofacetSurface {
         true
     }
 
-    fn terms(&self) -> Vec<Term> {
-        if self.facets.effectively_smooth() {
-            vec![Term {
-                label: "specular reflection (smooth limit of the microfacet lobe)".into(),
-                kind: TermKind::Delta,
-            }]
+    /// The Fresnel factor F(ωi·h) of every index below 1 kinks at its critical angle (in cos θi in the
+    /// smooth limit). Smooth with a Smith G; the V-cavity G is a min() of three terms, a kink it does not
+    /// report.
+    fn hints(&self) -> Hints {
+        let smooth_limit = self.facets.effectively_smooth();
+        let term = if smooth_limit {
+            Term { label: "specular reflection (smooth limit of the microfacet lobe)".into(), kind: TermKind::Delta }
         } else {
             let label = format!("microfacet lobe ({})", describe_facets(&self.facets));
-            vec![Term { label: label.clone(), kind: TermKind::Lobe(Lobe::of_facets(&self.facets, 1.0, label)) }]
-        }
-    }
-
-    /// The Fresnel factor F(ωi·h) of every index below 1 kinks at its critical angle (in cos θi in the
-    /// smooth limit).
-    fn kinks(&self) -> Vec<Kink> {
-        super::fresnel_kinks(self.ior.iter().map(Ior::critical_cosine), self.facets.effectively_smooth())
-    }
-
-    /// Smooth with a Smith G; the V-cavity G is a min() of three terms, a kink it does not report.
-    fn smooth(&self) -> bool {
-        self.shadowing != Shadowing::VCavity
+            Term { label: label.clone(), kind: TermKind::Lobe(Lobe::of_facets(&self.facets, 1.0, label)) }
+        };
+        Hints::new(vec![term])
+            .with_kinks(super::fresnel_kinks(self.ior.iter().map(Ior::critical_cosine), smooth_limit))
+            .with_smooth(self.shadowing != Shadowing::VCavity)
     }
 
     fn describe(&self) -> String {

@@ -9,7 +9,7 @@
 //! The halo's hemispherical integral is R·g to first order in the halo's angular width (Q·cos θs ≈ R·cos θi
 //! over the halo; `tests/scatter.rs` measures the difference), so the mirror, the halo and what the inner
 //! model puts under the interface (T = 1 − R, unchanged) conserve energy to that order.
-use super::{Brdf, Kink, Lobe, Tail, Term, TermKind};
+use super::{above_horizon, Brdf, Hints, Lobe, Tail, Term, TermKind};
 use crate::optics::scatter::{polarisation, polarisation_factor, rayleigh_rice, rayleigh_rice_with_q, Psd};
 use crate::spectrum::Sampling;
 use crate::{Error, Result, Vec3};
@@ -122,6 +122,17 @@ impl Halo {
         }
     }
 
+    /// The hints of a model `inner` with this halo added ([`WithHalo`], [`super::two_scale::RoughWithHalo`]):
+    /// the inner model's, with the halo's term after its own. The halo is reciprocal (Q and S₂(|f|) are
+    /// symmetric in ωi, ωo) and analytic in the upper hemispheres (a real ε > 1 has no critical angle from
+    /// outside; a conductor's ε none at all), so the whole keeps the inner model's kinks, seams, reciprocity
+    /// and smoothness.
+    pub fn over(&self, inner: Hints) -> Hints {
+        let mut h = inner;
+        h.terms.push(self.term());
+        h
+    }
+
     pub fn describe(&self) -> String {
         let e = crate::error::number;
         match self.psd {
@@ -169,7 +180,7 @@ impl Brdf for WithHalo {
 
     fn eval(&self, wi: Vec3, wo: Vec3, out: &mut [f64]) {
         self.inner.eval(wi, wo, out);
-        if wi.z > 0.0 && wo.z > 0.0 {
+        if above_horizon(wi, wo) {
             self.halo.add(wi, wo, out);
         }
     }
@@ -178,7 +189,7 @@ impl Brdf for WithHalo {
         self.inner.eval_batch(wi, wo, out);
         let n = self.sampling().len();
         for ((a, b), o) in wi.iter().zip(wo).zip(out.chunks_exact_mut(n)) {
-            if a.z > 0.0 && b.z > 0.0 {
+            if above_horizon(*a, *b) {
                 self.halo.add(*a, *b, o);
             }
         }
@@ -194,7 +205,7 @@ impl Brdf for WithHalo {
         }
         let mut h = vec![0.0; self.halo.eps.len()];
         for ((a, b), o) in wi.iter().zip(wo).zip(out.iter_mut()) {
-            if a.z > 0.0 && b.z > 0.0 {
+            if above_horizon(*a, *b) {
                 h.fill(0.0);
                 self.halo.add(*a, *b, &mut h);
                 *o += w.iter().zip(&h).map(|(w, h)| w * h).sum::<f64>();
@@ -211,29 +222,8 @@ impl Brdf for WithHalo {
         true
     }
 
-    fn terms(&self) -> Vec<Term> {
-        let mut t = self.inner.terms();
-        t.push(self.halo.term());
-        t
-    }
-
-    fn kinks(&self) -> Vec<Kink> {
-        self.inner.kinks()
-    }
-
-    fn seams(&self) -> Vec<f64> {
-        self.inner.seams()
-    }
-
-    /// The halo is reciprocal (Q and S₂(|f|) are symmetric in ωi, ωo), so the whole is if the inner model is.
-    fn is_reciprocal(&self) -> bool {
-        self.inner.is_reciprocal()
-    }
-
-    /// The halo is analytic in the upper hemispheres (a real ε > 1 has no critical angle from outside; a
-    /// conductor's ε none at all), so the whole is smooth if the inner model is.
-    fn smooth(&self) -> bool {
-        self.inner.smooth()
+    fn hints(&self) -> Hints {
+        self.halo.over(self.inner.hints())
     }
 
     fn describe(&self) -> String {

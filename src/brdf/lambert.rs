@@ -3,7 +3,7 @@
 //! Source: J. H. Lambert, *Photometria* (1760); in modern form e.g. Pharr, Jakob & Humphreys, *Physically
 //! Based Rendering* 4th ed. (pbrt-v4) §9.2 `DiffuseBxDF`. Its directional albedo ∫ f cos θo dωo = ρ for every
 //! incident direction (the closed form checked in `tests/brdf_models.rs`).
-use super::{Brdf, Term, TermKind};
+use super::{below_horizon, Brdf, Hints, Term, TermKind};
 use crate::spectrum::Sampling;
 use crate::Vec3;
 use std::f64::consts::PI;
@@ -29,19 +29,18 @@ impl Brdf for Lambert {
         &self.sampling
     }
 
-    fn eval(&self, _wi: Vec3, _wo: Vec3, out: &mut [f64]) {
+    fn eval(&self, wi: Vec3, wo: Vec3, out: &mut [f64]) {
+        if below_horizon(wi, wo, out) {
+            return;
+        }
         for (o, r) in out.iter_mut().zip(&self.albedo) {
             *o = r / PI;
         }
     }
 
-    fn terms(&self) -> Vec<Term> {
-        vec![Term { label: "Lambertian".into(), kind: TermKind::Diffuse }]
-    }
-
-    /// Analytic everywhere but on its reported kinks (`Brdf::smooth`).
-    fn smooth(&self) -> bool {
-        true
+    /// Analytic everywhere (`Hints::smooth`).
+    fn hints(&self) -> Hints {
+        Hints::new(vec![Term { label: "Lambertian".into(), kind: TermKind::Diffuse }]).with_smooth(true)
     }
 
     fn describe(&self) -> String {

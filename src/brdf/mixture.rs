@@ -6,7 +6,7 @@
 //! population is a lobe for the planner, of its own width and tail. Every population is rough (roughness ≥
 //! [`Microfacet::SMOOTH_THRESHOLD`]; the recipe refuses a delta population).
 use super::dielectric::{check_iors, describe_facets, describe_iors, describe_shadowing, Ior};
-use super::{Brdf, Kink, Lobe, Term, TermKind};
+use super::{below_horizon, Brdf, Hints, Lobe, Term, TermKind};
 use crate::optics::microfacet::{Microfacet, Shadowing};
 use crate::optics::slope_mixture::SlopeMixture;
 use crate::spectrum::Sampling;
@@ -56,8 +56,7 @@ impl Brdf for MixtureSurface {
     /// As `MicrofacetSurface::eval` (the same operations in the same order, so one population gives the same
     /// bits), with the mixture's D and G.
     fn eval(&self, wi: Vec3, wo: Vec3, out: &mut [f64]) {
-        if wi.z <= 0.0 || wo.z <= 0.0 {
-            out.fill(0.0);
+        if below_horizon(wi, wo, out) {
             return;
         }
         let h = (wi + wo).normalize();
@@ -74,10 +73,13 @@ impl Brdf for MixtureSurface {
         }
     }
 
-    /// One lobe per population, of its width and tail (the planner splits at each).
-    fn terms(&self) -> Vec<Term> {
+    /// One lobe per population, of its width and tail (the planner splits at each). The Fresnel factor
+    /// F(ωi·h) of every index below 1 kinks at its critical angle. Smooth with a Smith G; the V-cavity G's
+    /// min() is a kink it does not report.
+    fn hints(&self) -> Hints {
         let n = self.facets.populations.len();
-        self.facets
+        let terms = self
+            .facets
             .populations
             .iter()
             .enumerate()
@@ -90,17 +92,10 @@ impl Brdf for MixtureSurface {
                 );
                 Term { label: label.clone(), kind: TermKind::Lobe(Lobe::of_facets(m, 1.0, label)) }
             })
-            .collect()
-    }
-
-    /// The Fresnel factor F(ωi·h) of every index below 1 kinks at its critical angle.
-    fn kinks(&self) -> Vec<Kink> {
-        super::fresnel_kinks(self.ior.iter().map(Ior::critical_cosine), false)
-    }
-
-    /// Smooth with a Smith G; the V-cavity G's min() is a kink it does not report.
-    fn smooth(&self) -> bool {
-        self.shadowing != Shadowing::VCavity
+            .collect();
+        Hints::new(terms)
+            .with_kinks(super::fresnel_kinks(self.ior.iter().map(Ior::critical_cosine), false))
+            .with_smooth(self.shadowing != Shadowing::VCavity)
     }
 
     fn describe(&self) -> String {

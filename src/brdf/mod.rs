@@ -7,14 +7,19 @@
 //!
 //! Conventions (all models): local frame with the specimen normal along +z and the plane of measurement x–z;
 //! `wi` points from the surface towards the source, `wo` towards the receptor; both are unit vectors with
-//! z > 0. `eval` returns the *regular* part of f_r in sr⁻¹ (no cosine factor); a delta component is reported
-//! separately by [`Brdf::delta_reflectance`].
+//! z > 0. `eval` returns the *regular* part of f_r in sr⁻¹ (no cosine factor), zero for a pair not
+//! [`above_horizon`] (every model guards with [`below_horizon`], the one copy of the guard); a delta component
+//! is reported separately by [`Brdf::delta_reflectance`].
+//!
+//! The contract has two halves. Evaluation: `sampling`, `eval`, `eval_batch` and its batched contract, `folds`
+//! and `eval_batch_folded`, `delta_reflectance`. The planner's hints, one value: `hints` returns [`Hints`] (the
+//! terms, kinks, seams, reciprocity and smoothness), so a wrapper forwards or edits one thing. Beside them
+//! `coarser` (a measured table's coarse twins, models built on demand, not a fact) and `describe`.
 //!
 //! The folder:
-//! * `mod.rs` (this): the contract, [`Brdf`] (`sampling`, `eval`, `eval_batch` and its batched contract,
-//!   `folds` and `eval_batch_folded`, `delta_reflectance`, `terms`, `kinks`, `seams`, `is_reciprocal`,
-//!   `smooth`, `describe`), what a model tells the integrator ([`Term`], [`TermKind`], [`Lobe`], [`Tail`],
-//!   [`Kink`]) and [`mirror`];
+//! * `mod.rs` (this): the contract, [`Brdf`] and [`Hints`], what a model tells the integrator ([`Term`],
+//!   [`TermKind`], [`Lobe`], [`Tail`], [`Kink`]), the horizon guard ([`above_horizon`], [`below_horizon`]) and
+//!   [`mirror`];
 //! * the models, one per file, each over the optics it cites: `lambert.rs` ([`lambert::Lambert`]),
 //!   `dielectric.rs` (the smooth dielectric [`dielectric::SmoothDielectric`] and the rough interface of a
 //!   dielectric or a conductor [`dielectric::MicrofacetSurface`], with its [`dielectric::Ior`]), `conductor.rs`
@@ -167,13 +172,116 @@ pub enum TermKind {
     Lobe(Lobe),
 }
 
+/// What a model tells the planner about itself, apart from its values ([`Brdf::hints`]): one value, so that a
+/// wrapper forwards (or edits) one thing. [`Hints::new`] takes the terms, which every model has, and gives the
+/// defaults of the rest (no kinks, no seams, reciprocal, not smooth); a model states only what differs, with
+/// the `with_*` builders.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Hints {
+    /// The terms of the model (delta, diffuse, lobes) in evaluation order. The integrator uses the lobes to
+    /// place its splits and the delta flag to add the analytic part; `--explain` prints them.
+    pub terms: Vec<Term>,
+    /// The kinks of the model's terms (see [`Kink`]), in increasing order of their cosine within each kind:
+    /// none by default. A model whose value has a discontinuous derivative inside the upper hemisphere must
+    /// report it, or the integrator refines around it to its budget.
+    pub kinks: Vec<Kink>,
+    /// The cosines at which the regular part, as a function of cos θi or of cos θo, has a seam: a point where
+    /// a tabulated factor of one direction changes piece or is held constant (the rough coat's E(μ),
+    /// `optics::coat_albedo`), so that its value or derivative jumps by more than rounding. Sorted, in (0, 1);
+    /// none by default. The directional albedo (`brdf::albedo`) puts them on its panel boundaries: a
+    /// Gauss–Kronrod panel across a seam underestimates its own error (docs/accuracy.md §The estimate property,
+    /// over generated recipes).
+    pub seams: Vec<f64>,
+    /// Whether f_r(ωi, ωo) = f_r(ωo, ωi) holds for this model (Helmholtz reciprocity); true by default.
+    pub reciprocal: bool,
+    /// Whether the model's value is smooth (analytic formulas, no min/max, clamp, table or interpolation
+    /// seam — short of a table of a smooth function verified far below any tolerance, as a paint's flake
+    /// reflectances within 10⁻¹²) everywhere in the upper hemispheres except on the kinks it reports
+    /// ([`Hints::kinks`]). False by default. A smooth model lets the integrator trust its region estimates further
+    /// (`quadrature::Options::checked`, `docs/accuracy.md` §5): on a model with a kink it does not report
+    /// (the V-cavity G's min, a table's seams) the null rules and the parent–children check both miss the
+    /// kink, and the deeper estimates fell below the actual error at rtol 10⁻⁷ and 10⁻⁸.
+    pub smooth: bool,
+}
+
+impl Hints {
+    /// The hints of a model with these terms and the defaults of everything else: no kinks, no seams,
+    /// reciprocal, not smooth.
+    pub fn new(terms: Vec<Term>) -> Hints {
+        Hints { terms, kinks: Vec::new(), seams: Vec::new(), reciprocal: true, smooth: false }
+    }
+
+    /// With these kinks ([`Hints::kinks`]).
+    pub fn with_kinks(self, kinks: Vec<Kink>) -> Hints {
+        Hints { kinks, ..self }
+    }
+
+    /// With these seams ([`Hints::seams`]).
+    pub fn with_seams(self, seams: Vec<f64>) -> Hints {
+        Hints { seams, ..self }
+    }
+
+    /// Reciprocal or not ([`Hints::reciprocal`]).
+    pub fn with_reciprocal(self, reciprocal: bool) -> Hints {
+        Hints { reciprocal, ..self }
+    }
+
+    /// Smooth or not ([`Hints::smooth`]).
+    pub fn with_smooth(self, smooth: bool) -> Hints {
+        Hints { smooth, ..self }
+    }
+
+    /// The lobes among the terms.
+    pub fn lobes(&self) -> Vec<Lobe> {
+        self.terms
+            .iter()
+            .filter_map(|t| match &t.kind {
+                TermKind::Lobe(l) => Some(l.clone()),
+                _ => None,
+            })
+            .collect()
+    }
+
+    /// Whether the model has a delta term.
+    pub fn has_delta(&self) -> bool {
+        self.terms.iter().any(|t| t.kind == TermKind::Delta)
+    }
+
+    /// Whether `eval` can be non-zero (the model has a diffuse or lobe term).
+    pub fn has_regular(&self) -> bool {
+        self.terms.iter().any(|t| t.kind != TermKind::Delta)
+    }
+
+    /// Whether the model has a diffuse term.
+    pub fn has_diffuse(&self) -> bool {
+        self.terms.iter().any(|t| t.kind == TermKind::Diffuse)
+    }
+}
+
+/// Whether both directions are above the horizon (z > 0; a NaN is not): the regular part of every model is
+/// zero elsewhere (the conventions above). The horizon guard, written once for every model and wrapper.
+#[inline]
+pub fn above_horizon(wi: Vec3, wo: Vec3) -> bool {
+    wi.z > 0.0 && wo.z > 0.0
+}
+
+/// The horizon guard of an `eval`: true, with `out` zeroed, when the pair is not [`above_horizon`].
+#[inline]
+pub fn below_horizon(wi: Vec3, wo: Vec3, out: &mut [f64]) -> bool {
+    let below = !above_horizon(wi, wo);
+    if below {
+        out.fill(0.0);
+    }
+    below
+}
+
 /// A reflectance model. Implementations must be pure: the same arguments give the same bits.
 pub trait Brdf: Send + Sync + std::fmt::Debug {
     /// The spectral samples this model evaluates.
     fn sampling(&self) -> &Sampling;
 
     /// Regular part of f_r(ωi, ωo) in sr⁻¹, one value per spectral sample, written to `out`
-    /// (`out.len() == self.sampling().len()`).
+    /// (`out.len() == self.sampling().len()`); zeros for a pair not [`above_horizon`] ([`below_horizon`]).
     fn eval(&self, wi: Vec3, wo: Vec3, out: &mut [f64]);
 
     /// The regular part at many direction pairs in one call (the integrator hands over a whole quadrature
@@ -182,9 +290,8 @@ pub trait Brdf: Send + Sync + std::fmt::Debug {
     /// * `wi.len() == wo.len() == m` and `out.len() == m · n` with n = `self.sampling().len()`, point-major:
     ///   the n sample values of pair i go to `out[i*n..(i+1)*n]`;
     /// * every one of the m · n outputs must be written, zeros included (the buffer is reused between calls
-    ///   and its contents on entry are unspecified); a pair with `wi.z <= 0` or `wo.z <= 0` gets zeros, as
-    ///   from [`Brdf::eval`] (the instrument passes only pairs above the horizon, but a model must not rely
-    ///   on it);
+    ///   and its contents on entry are unspecified); a pair not [`above_horizon`] gets zeros, as from
+    ///   [`Brdf::eval`] (the instrument passes only pairs above the horizon, but a model must not rely on it);
     /// * the values must be the same bits as m calls of [`Brdf::eval`]: the integrator's sums, and so every
     ///   reading, must not depend on how the points were batched.
     ///
@@ -219,47 +326,19 @@ pub trait Brdf: Send + Sync + std::fmt::Debug {
         false
     }
 
-    /// The terms of the model (delta, diffuse, lobes) in evaluation order. The integrator uses the lobes to
-    /// place its splits and the delta flag to add the analytic part; `--explain` prints them.
-    fn terms(&self) -> Vec<Term>;
-
-    /// The kinks of the model's terms (see [`Kink`]), in increasing order of their cosine within each kind:
-    /// none by default. A model whose value has a discontinuous derivative inside the upper hemisphere must
-    /// report it, or the integrator refines around it to its budget.
-    fn kinks(&self) -> Vec<Kink> {
-        Vec::new()
-    }
-
-    /// The cosines at which the regular part, as a function of cos θi or of cos θo, has a seam: a point where
-    /// a tabulated factor of one direction changes piece or is held constant (the rough coat's E(μ),
-    /// `optics::coat_albedo`), so that its value or derivative jumps by more than rounding. Sorted, in (0, 1);
-    /// none by default. The directional albedo (`brdf::albedo`) puts them on its panel boundaries: a
-    /// Gauss–Kronrod panel across a seam underestimates its own error (docs/accuracy.md §The estimate property, over generated recipes).
-    fn seams(&self) -> Vec<f64> {
-        Vec::new()
-    }
-
-    /// Whether f_r(ωi, ωo) = f_r(ωo, ωi) holds for this model (Helmholtz reciprocity).
-    fn is_reciprocal(&self) -> bool {
-        true
-    }
-
-    /// Whether the model's value is smooth (analytic formulas, no min/max, clamp, table or interpolation
-    /// seam — short of a table of a smooth function verified far below any tolerance, as a paint's flake
-    /// reflectances within 10⁻¹²) everywhere in the upper hemispheres except on the kinks it reports
-    /// ([`Brdf::kinks`]). False by default. A smooth model lets the integrator trust its region estimates further
-    /// (`quadrature::Options::checked`, `docs/accuracy.md` §5): on a model with a kink it does not report
-    /// (the V-cavity G's min, a table's seams) the null rules and the parent–children check both miss the
-    /// kink, and the deeper estimates fell below the actual error at rtol 10⁻⁷ and 10⁻⁸.
-    fn smooth(&self) -> bool {
-        false
-    }
+    /// What the model tells the planner about itself, in one value ([`Hints`]: its terms, kinks, seams,
+    /// reciprocity and smoothness). A model states only what differs from [`Hints::new`]'s defaults; a
+    /// wrapper forwards or edits this one value. The planner reads it once per plan
+    /// (`instrument::method::MaterialFacts`), the executor once per integral (for [`Hints::smooth`]), so it
+    /// must not change over the model's life.
+    fn hints(&self) -> Hints;
 
     /// The same measured table read on about every second sample along each of its axes (its two *coarse
     /// twins*, on the even samples and on the odd ones), from which the planner estimates a reading's data
     /// (resolution) uncertainty: the larger difference of the readings through a twin and through the table
     /// (`docs/accuracy.md` §Data uncertainty of measured tables). Empty for a model that is not a table (the
-    /// default) and for a twin itself.
+    /// default) and for a twin itself. Not one of the [`Hints`]: the twins are models built on demand, each a
+    /// copy of the table, which a plan asks for once.
     fn coarser(&self) -> Vec<std::sync::Arc<dyn Brdf>> {
         Vec::new()
     }
@@ -269,24 +348,19 @@ pub trait Brdf: Send + Sync + std::fmt::Debug {
 }
 
 impl dyn Brdf + '_ {
-    /// The lobes among [`Brdf::terms`].
+    /// The lobes among the model's terms ([`Hints::lobes`]).
     pub fn lobes(&self) -> Vec<Lobe> {
-        self.terms()
-            .into_iter()
-            .filter_map(|t| match t.kind {
-                TermKind::Lobe(l) => Some(l),
-                _ => None,
-            })
-            .collect()
+        self.hints().lobes()
     }
 
+    /// Whether the model has a delta term ([`Hints::has_delta`]).
     pub fn has_delta(&self) -> bool {
-        self.terms().iter().any(|t| t.kind == TermKind::Delta)
+        self.hints().has_delta()
     }
 
-    /// True if `eval` can be non-zero (the model has a diffuse or lobe term).
+    /// True if `eval` can be non-zero (the model has a diffuse or lobe term; [`Hints::has_regular`]).
     pub fn has_regular(&self) -> bool {
-        self.terms().iter().any(|t| t.kind != TermKind::Delta)
+        self.hints().has_regular()
     }
 }
 
@@ -309,4 +383,62 @@ pub(crate) fn per_sample(what: &str, values: &[f64], sampling: &Sampling) -> Res
         return Err(Error::Usage(format!("{what}: {v} is not a finite number")));
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::sync::Arc;
+
+    fn delta() -> Term {
+        Term { label: "mirror".into(), kind: TermKind::Delta }
+    }
+
+    #[test]
+    fn hints_default_to_no_kinks_no_seams_reciprocal_not_smooth_and_each_builder_sets_its_field_alone() {
+        let h = Hints::new(vec![delta()]);
+        assert_eq!((h.kinks.len(), h.seams.len(), h.reciprocal, h.smooth), (0, 0, true, false));
+        let k = vec![Kink::Incidence { cos: 0.5 }];
+        assert_eq!(h.clone().with_kinks(k.clone()), Hints { kinks: k, ..h.clone() });
+        assert_eq!(h.clone().with_seams(vec![0.25]), Hints { seams: vec![0.25], ..h.clone() });
+        assert_eq!(h.clone().with_reciprocal(false), Hints { reciprocal: false, ..h.clone() });
+        assert_eq!(h.clone().with_smooth(true), Hints { smooth: true, ..h.clone() });
+        assert!(h.has_delta() && !h.has_regular() && !h.has_diffuse() && h.lobes().is_empty());
+    }
+
+    #[test]
+    fn the_horizon_guard_zeroes_a_pair_at_or_below_the_horizon_or_not_a_number_and_leaves_others() {
+        let up = Vec3::new(0.0, 0.0, 1.0);
+        for below in [Vec3::new(1.0, 0.0, 0.0), Vec3::new(0.6, 0.0, -0.8), Vec3::new(0.0, 0.0, f64::NAN)] {
+            for (wi, wo) in [(up, below), (below, up)] {
+                let mut out = [7.0; 2];
+                assert!(!above_horizon(wi, wo) && below_horizon(wi, wo, &mut out) && out == [0.0; 2]);
+            }
+        }
+        let mut out = [7.0; 2];
+        assert!(above_horizon(up, up) && !below_horizon(up, up, &mut out) && out == [7.0; 2]);
+    }
+
+    /// A wrapper forwards the one value: the annotated model's hints are the inner model's, every field.
+    #[test]
+    fn a_wrapper_forwards_the_whole_hints() {
+        // An index below 1 has a critical angle: a kink.
+        let inner: Arc<dyn Brdf> = Arc::new(dielectric::SmoothDielectric::new(0.8));
+        let wrapped = annotated::Annotated { inner: inner.clone(), note: "note".into() };
+        let h = inner.hints();
+        assert!(!h.kinks.is_empty() && h.smooth, "the test needs a model with kinks that is smooth: {h:?}");
+        assert_eq!(wrapped.hints(), h);
+    }
+
+    /// Every model zeroes the regular part below the horizon, Lambert's constant included.
+    #[test]
+    fn a_model_is_zero_below_the_horizon() {
+        let l = lambert::Lambert::new(vec![0.5], Sampling::grey()).unwrap();
+        let (up, down) = (Vec3::new(0.0, 0.0, 1.0), Vec3::new(0.6, 0.0, -0.8));
+        let mut out = [7.0];
+        l.eval(up, down, &mut out);
+        assert_eq!(out, [0.0]);
+        l.eval(up, up, &mut out);
+        assert_eq!(out, [0.5 / std::f64::consts::PI]);
+    }
 }

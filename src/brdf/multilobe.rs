@@ -19,7 +19,7 @@
 //! becomes a delta of weight Ksₖ·Fₖ(cos θi), continuous with the rough lobe.
 use super::dielectric::{describe_facets, describe_shadowing, microfacet_factor};
 use super::lambert::fmt_values;
-use super::{Brdf, Lobe, Term, TermKind};
+use super::{below_horizon, Brdf, Hints, Lobe, Term, TermKind};
 use crate::optics::fresnel::fr_dielectric;
 use crate::optics::microfacet::{Microfacet, Shadowing};
 use crate::spectrum::Sampling;
@@ -83,8 +83,7 @@ impl Brdf for CookTorranceLobes {
     }
 
     fn eval(&self, wi: Vec3, wo: Vec3, out: &mut [f64]) {
-        if wi.z <= 0.0 || wo.z <= 0.0 {
-            out.fill(0.0);
+        if below_horizon(wi, wo, out) {
             return;
         }
         for (o, kd) in out.iter_mut().zip(&self.kd) {
@@ -127,7 +126,9 @@ impl Brdf for CookTorranceLobes {
         true
     }
 
-    fn terms(&self) -> Vec<Term> {
+    /// Smooth with a Smith G and no clear coat (the V-cavity G's min() is a kink it does not report; a coat
+    /// is not claimed).
+    fn hints(&self) -> Hints {
         let mut t = Vec::new();
         if self.clear_coat.is_some() {
             t.push(Term { label: "clear coat (Fresnel, delta)".into(), kind: TermKind::Delta });
@@ -143,13 +144,7 @@ impl Brdf for CookTorranceLobes {
                 t.push(Term { label: label.clone(), kind: TermKind::Lobe(Lobe::of_facets(&lobe.facets, 1.0, label)) });
             }
         }
-        t
-    }
-
-    /// Smooth with a Smith G and no clear coat (the V-cavity G's min() is a kink it does not report; a coat
-    /// is not claimed).
-    fn smooth(&self) -> bool {
-        self.shadowing != Shadowing::VCavity && self.clear_coat.is_none()
+        Hints::new(t).with_smooth(self.shadowing != Shadowing::VCavity && self.clear_coat.is_none())
     }
 
     fn describe(&self) -> String {

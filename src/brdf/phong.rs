@@ -17,7 +17,7 @@
 //! m = √(2/(n + 2)) (Walter et al. 2007, §5.2, αp = 2αb⁻² − 2); the Phong lobe in r·ωo is about twice as
 //! narrow in the half-vector (the angle to the mirror is ≈ 2θh near normal incidence), m ≈ ½√(2/(n + 2)).
 use super::lambert::fmt_values;
-use super::{mirror, Brdf, Lobe, Term, TermKind};
+use super::{below_horizon, mirror, Brdf, Hints, Lobe, Term, TermKind};
 use crate::spectrum::Sampling;
 use crate::Vec3;
 use std::f64::consts::PI;
@@ -92,8 +92,7 @@ impl Brdf for Phong {
     }
 
     fn eval(&self, wi: Vec3, wo: Vec3, out: &mut [f64]) {
-        if wi.z <= 0.0 || wo.z <= 0.0 {
-            out.fill(0.0);
+        if below_horizon(wi, wo, out) {
             return;
         }
         let c = match self.variant {
@@ -106,7 +105,8 @@ impl Brdf for Phong {
         }
     }
 
-    fn terms(&self) -> Vec<Term> {
+    /// max(0, c)ⁿ has n − 1 continuous derivatives at c = 0: smooth enough for the degree-7 rule from n = 8.
+    fn hints(&self) -> Hints {
         let mut t = Vec::new();
         if self.kd.iter().any(|&k| k > 0.0) {
             t.push(Term { label: "Lambertian".into(), kind: TermKind::Diffuse });
@@ -121,12 +121,7 @@ impl Brdf for Phong {
                 tail: super::Tail::Gaussian,
             }),
         });
-        t
-    }
-
-    /// max(0, c)ⁿ has n − 1 continuous derivatives at c = 0: smooth enough for the degree-7 rule from n = 8.
-    fn smooth(&self) -> bool {
-        self.exponent >= 8.0
+        Hints::new(t).with_smooth(self.exponent >= 8.0)
     }
 
     fn describe(&self) -> String {

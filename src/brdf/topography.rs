@@ -9,7 +9,7 @@
 //! α of the slopes, of unknown tail (a measured density is no Gaussian nor GGX, so no shaped rule applies:
 //! the adaptive partition integrates it).
 use super::dielectric::Ior;
-use super::{fresnel_kinks, Brdf, Kink, Lobe, Tail, Term, TermKind};
+use super::{below_horizon, fresnel_kinks, Brdf, Hints, Lobe, Tail, Term, TermKind};
 use crate::optics::microfacet::{g_with_lambda, Shadowing};
 use crate::optics::slope_table::SlopeTable;
 use crate::spectrum::Sampling;
@@ -41,8 +41,7 @@ impl Brdf for TopographySurface {
     }
 
     fn eval(&self, wi: Vec3, wo: Vec3, out: &mut [f64]) {
-        if wi.z <= 0.0 || wo.z <= 0.0 {
-            out.fill(0.0);
+        if below_horizon(wi, wo, out) {
             return;
         }
         let h = (wi + wo).normalize();
@@ -57,15 +56,12 @@ impl Brdf for TopographySurface {
         out.fill(f);
     }
 
-    fn terms(&self) -> Vec<Term> {
+    fn hints(&self) -> Hints {
         let label = format!("measured facets ({} slopes, rms {:.4})", self.slopes.samples, self.slopes.rms_slope());
         let lobe =
             Lobe { slope_width: self.slopes.width(), medium_eta: 1.0, label: label.clone(), tail: Tail::Unknown };
-        vec![Term { label, kind: TermKind::Lobe(lobe) }]
-    }
-
-    fn kinks(&self) -> Vec<Kink> {
-        fresnel_kinks([Ior::Dielectric(self.ior).critical_cosine()], false)
+        Hints::new(vec![Term { label, kind: TermKind::Lobe(lobe) }])
+            .with_kinks(fresnel_kinks([Ior::Dielectric(self.ior).critical_cosine()], false))
     }
 
     fn describe(&self) -> String {

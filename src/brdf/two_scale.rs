@@ -16,7 +16,7 @@
 //! slopes: for slope widths far below the halo's angular width (orange peel ~0.1°, the halo ~1° and more)
 //! the convolution changes it to second order in their ratio.
 use super::halo::Halo;
-use super::{Brdf, Kink, Term};
+use super::{above_horizon, Brdf, Hints};
 use crate::optics::tabulated::ChebTable;
 use crate::spectrum::Sampling;
 use crate::{Error, Result, Vec3};
@@ -65,7 +65,7 @@ impl Brdf for RoughWithHalo {
 
     fn eval(&self, wi: Vec3, wo: Vec3, out: &mut [f64]) {
         self.inner.eval(wi, wo, out);
-        if wi.z > 0.0 && wo.z > 0.0 {
+        if above_horizon(wi, wo) {
             for (k, o) in out.iter_mut().enumerate() {
                 *o *= self.keep(k, wi, wo);
             }
@@ -83,30 +83,12 @@ impl Brdf for RoughWithHalo {
         true
     }
 
-    fn terms(&self) -> Vec<Term> {
-        let mut t = self.inner.terms();
-        t.push(self.halo.term());
-        t
-    }
-
-    fn kinks(&self) -> Vec<Kink> {
-        self.inner.kinks()
-    }
-
-    fn seams(&self) -> Vec<f64> {
-        self.inner.seams()
-    }
-
-    /// The factor depends on ωi and ωo symmetrically and the halo is reciprocal, so the whole is if the
-    /// facets are.
-    fn is_reciprocal(&self) -> bool {
-        self.inner.is_reciprocal()
-    }
-
-    /// g is analytic in cos θ̄ (the PSD integrated over a disc whose radius moves smoothly; its table within
-    /// 1e-13, far below any tolerance), the halo analytic in the upper hemispheres; smooth if the facets are.
-    fn smooth(&self) -> bool {
-        self.inner.smooth()
+    /// The facets' hints with the halo's term (`Halo::over`): the factor 1 − g depends on ωi and ωo
+    /// symmetrically, so the whole is reciprocal if the facets are, and g is analytic in cos θ̄ (the PSD
+    /// integrated over a disc whose radius moves smoothly; its table within 1e-13, far below any tolerance),
+    /// so the whole is smooth if the facets are.
+    fn hints(&self) -> Hints {
+        self.halo.over(self.inner.hints())
     }
 
     fn describe(&self) -> String {

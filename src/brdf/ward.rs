@@ -18,7 +18,7 @@
 //!   ρs ∫₀¹ (1 − t²)(2t/α²) e^(−t²/α²) dt = ρs·(1 − α²(1 − e^(−1/α²))),
 //! checked in `tests/brdf_models.rs`. The lobe is Beckmann-shaped in the half vector: slope width α.
 use super::lambert::fmt_values;
-use super::{Brdf, Lobe, Term, TermKind};
+use super::{below_horizon, Brdf, Hints, Lobe, Term, TermKind};
 use crate::spectrum::Sampling;
 use crate::Vec3;
 use std::f64::consts::PI;
@@ -58,8 +58,7 @@ impl Brdf for Ward {
     }
 
     fn eval(&self, wi: Vec3, wo: Vec3, out: &mut [f64]) {
-        if wi.z <= 0.0 || wo.z <= 0.0 {
-            out.fill(0.0);
+        if below_horizon(wi, wo, out) {
             return;
         }
         let h = wi + wo;
@@ -71,7 +70,8 @@ impl Brdf for Ward {
         }
     }
 
-    fn terms(&self) -> Vec<Term> {
+    /// Analytic everywhere (`Hints::smooth`).
+    fn hints(&self) -> Hints {
         let mut t = Vec::new();
         if self.rho_d.iter().any(|&k| k > 0.0) {
             t.push(Term { label: "Lambertian".into(), kind: TermKind::Diffuse });
@@ -81,12 +81,7 @@ impl Brdf for Ward {
             label: label.clone(),
             kind: TermKind::Lobe(Lobe { slope_width: self.alpha, medium_eta: 1.0, label, tail: super::Tail::Gaussian }),
         });
-        t
-    }
-
-    /// Analytic everywhere but on its reported kinks (`Brdf::smooth`).
-    fn smooth(&self) -> bool {
-        true
+        Hints::new(t).with_smooth(true)
     }
 
     fn describe(&self) -> String {

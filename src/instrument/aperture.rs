@@ -36,6 +36,30 @@ pub fn lobe_widths_uv(lobe: &Lobe, theta: f64) -> [f64; 2] {
     [2.0 * m * eta * ct / c, 2.0 * m * eta * ct]
 }
 
+/// A material's lobes at one geometry angle θ with their widths there, computed once per design for the
+/// chart ([`choose_chart`]), the split points ([`lobe_splits`]) and the rule choosers
+/// (`method::design`): each lobe's [`lobe_widths_uv`] and, for a measured table's lobe, the widths of its
+/// first ring ([`table_pole_widths`]); with whether a diffuse term lies under them (the choosers' gate).
+#[derive(Clone, Debug)]
+pub struct LobesAt<'a> {
+    pub lobes: &'a [Lobe],
+    /// [`lobe_widths_uv`] of each lobe at θ.
+    pub widths: Vec<[f64; 2]>,
+    /// [`table_pole_widths`] of each lobe at θ (None but for a table's lobe).
+    pub poles: Vec<Option<[f64; 2]>>,
+    pub has_diffuse: bool,
+    pub theta: f64,
+}
+
+impl<'a> LobesAt<'a> {
+    /// `lobes` at θ, over a diffuse term or not.
+    pub fn new(lobes: &'a [Lobe], theta: f64, has_diffuse: bool) -> LobesAt<'a> {
+        let widths = lobes.iter().map(|l| lobe_widths_uv(l, theta)).collect();
+        let poles = lobes.iter().map(|l| table_pole_widths(l, theta)).collect();
+        LobesAt { lobes, widths, poles, has_diffuse, theta }
+    }
+}
+
 /// The variables (chart) of a regular part's integrand: a part's chart is chosen per integral by
 /// [`choose_chart`] (plain or lobe); a shaped rule may integrate in another one (the tensor rule's
 /// `PlainPLobeQ`). The map from a chart's point to the two directions and its Jacobian is
@@ -55,16 +79,15 @@ pub enum Chart {
     PlainPLobeQ,
 }
 
-/// Choose the chart of the regular part for these (clipped) stops and lobes at angle θ.
-pub fn choose_chart(lobes: &[Lobe], theta: f64, source: Stop, receptor: Stop) -> Chart {
+/// Choose the chart of the regular part for these (clipped) stops and these lobes at their angle θ.
+pub fn choose_chart(l: &LobesAt, source: Stop, receptor: Stop) -> Chart {
     let range_u = (source.p[1] - source.p[0]) + (receptor.p[1] - receptor.p[0]);
     let range_v = (source.q[1] - source.q[0]) + (receptor.q[1] - receptor.q[0]);
-    let wide = |l: &Lobe| {
-        let w = lobe_widths_uv(l, theta);
-        let pole = table_pole_widths(l, theta).unwrap_or(w);
+    let wide = |(&w, pole): (&[f64; 2], &Option<[f64; 2]>)| {
+        let pole = pole.unwrap_or(w);
         w[0] >= range_u && w[1] >= range_v && pole[0] >= range_u && pole[1] >= range_v
     };
-    if lobes.iter().all(wide) {
+    if l.widths.iter().zip(&l.poles).all(wide) {
         Chart::Plain
     } else {
         Chart::Lobe
@@ -81,14 +104,15 @@ pub fn mirror_overlap(source: Stop, receptor: Stop) -> Option<([f64; 2], [f64; 2
     (hi[0] > lo[0] && hi[1] > lo[1]).then_some((lo, hi))
 }
 
-/// The split points of the lobe chart on each axis (u, then v), from the stops and the lobes.
-pub fn lobe_splits(lobes: &[Lobe], theta: f64, source: Stop, receptor: Stop) -> [Vec<f64>; 2] {
+/// The split points of the lobe chart on each axis (u, then v), from the stops and the lobes at their angle.
+pub fn lobe_splits(l: &LobesAt, source: Stop, receptor: Stop) -> [Vec<f64>; 2] {
     let ap = AxisMap { s: source.p, r: receptor.p };
     let aq = AxisMap { s: source.q, r: receptor.q };
-    let widths: Vec<[f64; 2]> = lobes.iter().map(|l| seen_widths(l, theta, ap, aq)).collect();
+    let lobes = l.lobes;
+    let widths: Vec<[f64; 2]> = lobes.iter().zip(&l.widths).map(|(lobe, &w)| seen_from(lobe, w, ap, aq)).collect();
     let mut up = ap.splits(&widths.iter().zip(lobes).map(|(w, l)| (w[0], l.tail.is_heavy())).collect::<Vec<_>>());
     let mut uq = aq.splits(&widths.iter().zip(lobes).map(|(w, l)| (w[1], l.tail.is_heavy())).collect::<Vec<_>>());
-    for pole in lobes.iter().filter_map(|l| table_pole_widths(l, theta)) {
+    for &pole in l.poles.iter().flatten() {
         // The cusp is at the pole alone (u = v = 0, inside the first ring): a receptor whose range on the
         // other axis stays a ring's width away from 0 never meets it (an E430 or ISO 13803 receptor off the
         // specular direction), and that axis takes no pole splits.
@@ -132,7 +156,11 @@ pub fn table_pole_widths(lobe: &Lobe, theta: f64) -> Option<[f64; 2]> {
 /// nearest point (an E430 haze receptor 2° off specular sees a GGX α = 0.003 lobe 5.3 times wider across the
 /// plane of incidence than the specular receptor does; `docs/instrument.md` §Quadrature).
 pub fn seen_widths(lobe: &Lobe, theta: f64, ap: AxisMap, aq: AxisMap) -> [f64; 2] {
-    let w = lobe_widths_uv(lobe, theta);
+    seen_from(lobe, lobe_widths_uv(lobe, theta), ap, aq)
+}
+
+/// [`seen_widths`] from the lobe's widths `w` at θ ([`lobe_widths_uv`], computed by the caller).
+fn seen_from(lobe: &Lobe, w: [f64; 2], ap: AxisMap, aq: AxisMap) -> [f64; 2] {
     if lobe.tail != Tail::InverseQuartic || !(w[0] > 0.0 && w[1] > 0.0 && w[0].is_finite() && w[1].is_finite()) {
         return w;
     }
@@ -515,15 +543,18 @@ mod tests {
     fn the_chart_is_plain_only_when_every_lobe_covers_the_range() {
         let s = Stop { p: [-0.01, 0.01], q: [-0.02, 0.02] };
         let theta = 0.35;
-        assert_eq!(choose_chart(&[], theta, s, s), Chart::Plain);
+        assert_eq!(choose_chart(&LobesAt::new(&[], theta, false), s, s), Chart::Plain);
         // Range in u: 0.04, in v: 0.08; a lobe of slope width m is ≈ 2m wide.
-        assert_eq!(choose_chart(&[lobe(0.5, 1.0, false)], theta, s, s), Chart::Plain);
-        assert_eq!(choose_chart(&[lobe(1e-3, 1.0, false)], theta, s, s), Chart::Lobe);
-        assert_eq!(choose_chart(&[lobe(0.5, 1.0, false), lobe(1e-3, 1.0, true)], theta, s, s), Chart::Lobe);
+        assert_eq!(choose_chart(&LobesAt::new(&[lobe(0.5, 1.0, false)], theta, false), s, s), Chart::Plain);
+        assert_eq!(choose_chart(&LobesAt::new(&[lobe(1e-3, 1.0, false)], theta, false), s, s), Chart::Lobe);
+        assert_eq!(
+            choose_chart(&LobesAt::new(&[lobe(0.5, 1.0, false), lobe(1e-3, 1.0, true)], theta, false), s, s),
+            Chart::Lobe
+        );
         // Wide enough in u but not in v (0.03: 2m = 0.06 ≥ 0.04/cos θ... but 2m cos θ < 0.08).
         let w = lobe_widths_uv(&lobe(0.03, 1.0, false), theta);
         assert!(w[0] >= 0.04 && w[1] < 0.08);
-        assert_eq!(choose_chart(&[lobe(0.03, 1.0, false)], theta, s, s), Chart::Lobe);
+        assert_eq!(choose_chart(&LobesAt::new(&[lobe(0.03, 1.0, false)], theta, false), s, s), Chart::Lobe);
     }
 
     #[test]
@@ -533,7 +564,7 @@ mod tests {
         let theta = 0.0;
         let has = |v: &[f64], x: f64| v.iter().any(|y| (y - x).abs() <= 1e-15);
         // A Gaussian lobe 2e-4 wide in u: 0, ±w, ±3w, ±10w, and no further.
-        let [u, v] = lobe_splits(&[lobe(1e-4, 1.0, false)], theta, src, rec);
+        let [u, v] = lobe_splits(&LobesAt::new(&[lobe(1e-4, 1.0, false)], theta, false), src, rec);
         let w = 2e-4;
         for k in [0.0, 1.0, 3.0, 10.0, -1.0, -3.0, -10.0] {
             assert!(has(&u, k * w), "{k}w missing from {u:?}");
@@ -545,10 +576,11 @@ mod tests {
         }
         assert!(u.windows(2).all(|p| p[0] < p[1]), "sorted, no duplicates");
         // A heavy tail goes on to the end of the range.
-        let [uh, _] = lobe_splits(&[lobe(1e-4, 1.0, true)], theta, src, rec);
+        let [uh, _] = lobe_splits(&LobesAt::new(&[lobe(1e-4, 1.0, true)], theta, false), src, rec);
         assert!(has(&uh, 30.0 * w) && has(&uh, 100.0 * w) && has(&uh, -100.0 * w), "{uh:?}");
         // Lobes within 3× of a narrower one share its splits.
-        let [u2, _] = lobe_splits(&[lobe(1e-4, 1.0, false), lobe(2.5e-4, 1.0, false)], theta, src, rec);
+        let [u2, _] =
+            lobe_splits(&LobesAt::new(&[lobe(1e-4, 1.0, false), lobe(2.5e-4, 1.0, false)], theta, false), src, rec);
         assert_eq!(u2, u);
         // v gets the same treatment with the perpendicular width (2m cos θ = 2m here).
         assert!(has(&v, 10.0 * w) && has(&v, -10.0 * w));
@@ -572,20 +604,26 @@ mod tests {
         let ring = table_pole_widths(&table, theta).unwrap();
         let has = |v: &[f64], x: f64| v.iter().any(|y| (y - x).abs() <= 1e-15);
         // On the specular receptor both axes reach the pole: the ring is cut on both.
-        let [u, v] =
-            lobe_splits(std::slice::from_ref(&table), theta, src, Stop { p: [-0.002, 0.002], q: [-0.01, 0.01] });
+        let [u, v] = lobe_splits(
+            &LobesAt::new(std::slice::from_ref(&table), theta, false),
+            src,
+            Stop { p: [-0.002, 0.002], q: [-0.01, 0.01] },
+        );
         assert!(has(&u, ring[0]) && has(&u, -ring[0]) && has(&v, ring[1]) && has(&v, -ring[1]), "{u:?} {v:?}");
         // 0.03 off specular on p: u never comes within a ring of 0, so v has no ring splits (its lobe splits at
         // 0 and ± the lobe widths remain); u's range holds no pole to split at.
-        let [u, v] =
-            lobe_splits(std::slice::from_ref(&table), theta, src, Stop { p: [0.028, 0.032], q: [-0.01, 0.01] });
+        let [u, v] = lobe_splits(
+            &LobesAt::new(std::slice::from_ref(&table), theta, false),
+            src,
+            Stop { p: [0.028, 0.032], q: [-0.01, 0.01] },
+        );
         assert!(!has(&v, ring[1]) && !has(&v, -ring[1]), "{v:?}");
         let w = lobe_widths_uv(&table, theta);
         assert!(has(&v, 0.0) && has(&v, w[1]) && has(&v, -w[1]), "{v:?}");
         assert!(u.iter().all(|&x| x >= 0.026), "{u:?}");
         // A u-range that starts inside the ring (half a ring from 0) still reaches the pole.
         let rec = Stop { p: [0.002 + 0.5 * ring[0], 0.01], q: [-0.01, 0.01] };
-        let [_, v] = lobe_splits(&[table], theta, src, rec);
+        let [_, v] = lobe_splits(&LobesAt::new(&[table], theta, false), src, rec);
         assert!(has(&v, ring[1]), "{v:?}");
     }
 

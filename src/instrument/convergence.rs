@@ -176,7 +176,7 @@ pub fn validate_tolerances(tolerances: &[f64]) -> Result<()> {
 /// value that is the same (to 1e-14 relative) for a set of quite different direction pairs — its luminous
 /// f_r = ρ_lum/π; otherwise None.
 pub fn lambertian_value(brdf: &dyn Brdf) -> Option<f64> {
-    let terms = brdf.terms();
+    let terms = brdf.hints().terms;
     if terms.len() != 1 || terms[0].kind != TermKind::Diffuse {
         return None;
     }

@@ -10,7 +10,8 @@
 //!   ([`geometry::Stop`]), [`geometry::solid_angle_density`], a compiled [`geometry::Geometry`] and its
 //!   [`geometry::Integral`]s (aperture, sphere hemisphere, specular port);
 //! * `aperture.rs`: questions about one aperture integral: [`aperture::clip`], [`aperture::mirror_overlap`],
-//!   the [`aperture::Chart`] ([`aperture::choose_chart`]), [`aperture::lobe_widths_uv`],
+//!   the [`aperture::Chart`] ([`aperture::choose_chart`]), [`aperture::lobe_widths_uv`], a material's lobes at
+//!   one angle with their widths there ([`aperture::LobesAt`]),
 //!   [`aperture::seen_widths`], [`aperture::lobe_splits`], [`aperture::lobe_boxes`], the kinks that cross the stops
 //!   ([`aperture::delta_kinks`], [`aperture::regular_kinks`], [`aperture::regular_kinks_between`],
 //!   [`aperture::kinked_position`]) and

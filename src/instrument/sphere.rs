@@ -18,7 +18,7 @@ use std::f64::consts::PI;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use crate::brdf::albedo::directional_albedo;
-use crate::brdf::{Brdf, Kink, Term, TermKind};
+use crate::brdf::{Brdf, Hints};
 use crate::instrument::aperture::lobe_widths_uv;
 use crate::quadrature::{integrate, pointwise, Options};
 use crate::spectrum::Sampling;
@@ -49,17 +49,11 @@ impl Brdf for Transposed<'_> {
         // The mirror pair is symmetric: R_δ of the mirror direction of wi, which has the same polar angle.
         self.0.delta_reflectance(crate::brdf::mirror(wi), out)
     }
-    fn terms(&self) -> Vec<Term> {
-        self.0.terms()
-    }
-    fn seams(&self) -> Vec<f64> {
-        // Seams are in the cosine of either direction, so the transposition keeps them.
-        self.0.seams()
-    }
-    fn kinks(&self) -> Vec<Kink> {
-        // ωi·h = ωo·h: a half-angle kink is symmetric; the delta term's kink is in the polar angle of ωi,
-        // which the mirror pair shares.
-        self.0.kinks()
+    /// The model's own: seams are in the cosine of either direction, so the transposition keeps them; a
+    /// half-angle kink is symmetric (ωi·h = ωo·h) and the delta term's kink is in the polar angle of ωi, which
+    /// the mirror pair shares; reciprocity and smoothness are kept by an exchange of the arguments.
+    fn hints(&self) -> Hints {
+        self.0.hints()
     }
     fn describe(&self) -> String {
         format!("transposed {}", self.0.describe())
@@ -90,7 +84,7 @@ pub fn port_reflectance(brdf: &dyn Brdf, viewing: f64, beta: f64, rtol: f64, max
     if !brdf.delta_reflectance(axis, &mut delta) {
         delta.fill(0.0);
     }
-    if !brdf.terms().iter().any(|t| t.kind != TermKind::Delta) {
+    if !brdf.has_regular() {
         return PerSample { value: delta, error: vec![0.0; n], evaluations: 0, converged: true };
     }
     let tmax = beta.tan();

@@ -39,7 +39,7 @@
 //! when Q is a product of a function of θh and one of θd (a constant; F(θd)·D(θh)), and the specular row
 //! Q(0, ·) carrying the θd dependence.
 use super::table::{file_name, reflection_half_diff, Nodes, Resolution, Table, TableAxis};
-use crate::brdf::{Brdf, Lobe, Term, TermKind};
+use crate::brdf::{Brdf, Hints, Lobe, Term, TermKind};
 use crate::spectrum::Sampling;
 use crate::{Error, Result, Vec3};
 use std::f64::consts::FRAC_PI_2;
@@ -383,7 +383,7 @@ impl InPlaneBrdf {
 
     /// Whether the table is a constant BRDF as evaluated: every value the same (to `table::FLAT_RTOL`, the
     /// rounding of a file of f·cos θo) and the `f` extension
-    /// ([`Brdf::terms`] then states a diffuse term, integrated in the plain chart).
+    /// ([`Hints::terms`] then states a diffuse term, integrated in the plain chart).
     pub fn is_flat(&self) -> bool {
         self.flat && self.off_plane == OffPlane::Brdf
     }
@@ -559,17 +559,17 @@ impl Brdf for InPlaneBrdf {
         };
     }
 
-    fn terms(&self) -> Vec<Term> {
+    fn hints(&self) -> Hints {
         if self.is_flat() {
-            return vec![Term {
+            return Hints::new(vec![Term {
                 label: format!(
                     "measured in-plane table ({}): every value the same (to 1e-9), a constant BRDF",
                     self.format
                 ),
                 kind: TermKind::Diffuse,
-            }];
+            }]);
         }
-        vec![Term {
+        Hints::new(vec![Term {
             label: format!("measured in-plane table ({}, isotropic (θh, θd) extension)", self.format),
             kind: TermKind::Lobe(Lobe {
                 slope_width: self.half_width,
@@ -577,7 +577,7 @@ impl Brdf for InPlaneBrdf {
                 label: format!("measured ({})", self.format),
                 tail: crate::brdf::Tail::Table { half_width: self.half_width, resolution: self.resolution_slope() },
             }),
-        }]
+        }])
     }
 
     fn coarser(&self) -> Vec<std::sync::Arc<dyn Brdf>> {

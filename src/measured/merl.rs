@@ -21,7 +21,7 @@
 //! of the data.
 use super::table::{file_name, floor_index, reflection_half_diff, Edge, Resolution, Table, TableAxis};
 pub use super::table::{fold_phi_d, half_diff, HalfDiff};
-use crate::brdf::{Brdf, Lobe, Term, TermKind};
+use crate::brdf::{Brdf, Hints, Lobe, Term, TermKind};
 use crate::spectrum::Sampling;
 use crate::{Error, Result, Vec3};
 use std::f64::consts::{FRAC_PI_2, PI};
@@ -200,7 +200,7 @@ impl MerlBrdf {
         m
     }
 
-    /// Whether every cell is valid and the same per channel, to `table::FLAT_RTOL` (a constant BRDF: [`Brdf::terms`] then states a
+    /// Whether every cell is valid and the same per channel, to `table::FLAT_RTOL` (a constant BRDF: [`Hints::terms`] then states a
     /// diffuse term, so the plan integrates it in the plain chart instead of splitting at the resolution).
     pub fn is_flat(&self) -> bool {
         self.flat
@@ -321,17 +321,17 @@ impl Brdf for MerlBrdf {
         out.copy_from_slice(&v);
     }
 
-    fn terms(&self) -> Vec<Term> {
+    fn hints(&self) -> Hints {
         let lookup = self.interpolation.name();
         if self.flat {
-            return vec![Term {
+            return Hints::new(vec![Term {
                 label: format!(
                     "measured table (MERL, {lookup} lookup): every cell the same value per channel (to 1e-9)"
                 ),
                 kind: TermKind::Diffuse,
-            }];
+            }]);
         }
-        vec![Term {
+        Hints::new(vec![Term {
             label: format!("measured table (MERL, {lookup} lookup)"),
             kind: TermKind::Lobe(Lobe {
                 slope_width: self.half_width,
@@ -339,7 +339,7 @@ impl Brdf for MerlBrdf {
                 label: "measured (MERL)".to_string(),
                 tail: crate::brdf::Tail::Table { half_width: self.half_width, resolution: self.resolution_slope() },
             }),
-        }]
+        }])
     }
 
     fn coarser(&self) -> Vec<std::sync::Arc<dyn Brdf>> {

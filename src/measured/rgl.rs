@@ -27,7 +27,7 @@
 //! grid, every parameter linear between its values (clamped), exactly as `PiecewiseLinear2D`; the
 //! arithmetic here is f64 on the files' f32 values.
 use super::table::{elevation, Edge, Resolution, TableAxis};
-use crate::brdf::{Brdf, Lobe, Term, TermKind};
+use crate::brdf::{below_horizon, Brdf, Hints, Lobe, Term, TermKind};
 use crate::spectrum::Sampling;
 use crate::{Error, Result, Vec3};
 use std::f64::consts::{FRAC_PI_2, PI};
@@ -612,10 +612,10 @@ impl Brdf for RglBrdf {
     }
 
     fn eval(&self, wi: Vec3, wo: Vec3, out: &mut [f64]) {
-        out.fill(0.0);
-        if !(wi.z > 0.0 && wo.z > 0.0) {
+        if below_horizon(wi, wo, out) {
             return;
         }
+        out.fill(0.0);
         // pbrt's ωo (the table's parameter direction) is our source direction ωi.
         let wm = wi + wo;
         if !(wm.length_squared() > 0.0) {
@@ -643,8 +643,9 @@ impl Brdf for RglBrdf {
         }
     }
 
-    fn terms(&self) -> Vec<Term> {
-        vec![Term {
+    /// Not reciprocal: the evaluation singles out the parameter direction, and the data need not be.
+    fn hints(&self) -> Hints {
+        Hints::new(vec![Term {
             label: "measured table (RGL .bsdf, pbrt-v4 evaluation)".into(),
             kind: TermKind::Lobe(Lobe {
                 slope_width: self.half_width,
@@ -652,12 +653,8 @@ impl Brdf for RglBrdf {
                 label: "measured (RGL)".into(),
                 tail: crate::brdf::Tail::Table { half_width: self.half_width, resolution: self.resolution_slope() },
             }),
-        }]
-    }
-
-    fn is_reciprocal(&self) -> bool {
-        // The evaluation singles out the parameter direction; the data need not be reciprocal.
-        false
+        }])
+        .with_reciprocal(false)
     }
 
     fn coarser(&self) -> Vec<std::sync::Arc<dyn Brdf>> {

@@ -363,8 +363,7 @@ pub fn half_diff(wi: Vec3, wo: Vec3) -> HalfDiff {
 /// so below either horizon the BRDF is 0 (`out` zeroed, `None`); above both, the half/difference angles of
 /// the pair, the coordinates the lookup starts from.
 pub fn reflection_half_diff(wi: Vec3, wo: Vec3, out: &mut [f64]) -> Option<HalfDiff> {
-    if !(wi.z > 0.0 && wo.z > 0.0) {
-        out.fill(0.0);
+    if crate::brdf::below_horizon(wi, wo, out) {
         return None;
     }
     Some(half_diff(wi, wo))

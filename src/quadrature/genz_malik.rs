@@ -20,7 +20,7 @@ pub struct Options {
     pub max_shrink: f64,
     /// Whether a split box's children have their estimates scaled from their parent's check
     /// ([`child_scale`]); only for an integrand that is smooth inside every box (a material that says
-    /// `Brdf::smooth`), `docs/accuracy.md` §5.
+    /// `Hints::smooth`), `docs/accuracy.md` §5.
     pub checked: bool,
 }
 

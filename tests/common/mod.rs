@@ -1,6 +1,6 @@
 //! Test helpers shared by the integration tests.
 #![allow(dead_code)]
-use glossmeter::brdf::{Brdf, Lobe, Term, TermKind};
+use glossmeter::brdf::{Brdf, Hints, Lobe, Term, TermKind};
 use glossmeter::optics::fresnel::fr_dielectric;
 use glossmeter::spectrum::Sampling;
 use glossmeter::Vec3;
@@ -36,8 +36,8 @@ impl Brdf for TestBeckmann {
         let f = fr_dielectric(wi.dot(h).clamp(0.0, 1.0), self.n) * d * g / (4.0 * wi.z * wo.z);
         out.iter_mut().for_each(|o| *o = f);
     }
-    fn terms(&self) -> Vec<Term> {
-        vec![Term {
+    fn hints(&self) -> Hints {
+        Hints::new(vec![Term {
             label: "beckmann".into(),
             kind: TermKind::Lobe(Lobe {
                 slope_width: self.m,
@@ -45,7 +45,7 @@ impl Brdf for TestBeckmann {
                 label: "beckmann".into(),
                 tail: glossmeter::brdf::Tail::Gaussian,
             }),
-        }]
+        }])
     }
     fn describe(&self) -> String {
         format!("test beckmann m = {}", self.m)

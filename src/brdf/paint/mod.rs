@@ -63,7 +63,7 @@ pub use spec::{
     PigmentedLayer, Spread,
 };
 
-use super::{Brdf, Lobe, Term, TermKind};
+use super::{above_horizon, Brdf, Hints, Lobe, Term, TermKind};
 use crate::colorimetry::weighting::Weighting;
 use crate::optics::coat_albedo::{CoatAlbedo, OutOfTable, ALPHA_BREAKS, ETA_MAX, ETA_MIN};
 use crate::optics::fresnel::{fr_dielectric, fresnel_dielectric, refract_into};
@@ -293,7 +293,7 @@ impl Paint {
     /// over the samples once where they do not depend on direction (`docs/model.md` §Folded evaluation). It
     /// equals Σ_j w_j·eval_j to rounding (the summation order differs; `tests/paint.rs` bounds the difference).
     fn eval_folded(&self, fo: &Folded, wi: Vec3, wo: Vec3) -> f64 {
-        if wi.z.is_nan() || wo.z.is_nan() || wi.z <= 0.0 || wo.z <= 0.0 {
+        if !above_horizon(wi, wo) {
             return 0.0;
         }
         let eta = self.spec.coat.index;
@@ -450,6 +450,86 @@ impl Paint {
     }
 }
 
+/// The paint's hints (`Brdf::hints`), one fact each.
+impl Paint {
+    /// The terms in evaluation order (the coat, the body, the split flake light, the flakes).
+    fn terms(&self) -> Vec<Term> {
+        let mut t = Vec::new();
+        match &self.rough_coat {
+            None => t.push(Term { label: "clear coat (Fresnel, delta)".into(), kind: TermKind::Delta }),
+            Some(mf) => t.push(Term {
+                label: "clear coat (rough, microfacet)".into(),
+                kind: TermKind::Lobe(Lobe::of_facets(mf, 1.0, "clear coat".into())),
+            }),
+        }
+        if self.body_weight > 0.0 {
+            t.push(Term { label: "pigmented layer (Kubelka–Munk, diffuse)".into(), kind: TermKind::Diffuse });
+        }
+        let medium = match self.spec.form {
+            Form::Physical => self.spec.coat.index,
+            Form::PaperEq1 => 1.0,
+        };
+        for fl in self.flakes().filter(|f| f.split && f.diffuse.iter().any(|&d| d > 0.0)) {
+            t.push(Term {
+                label: format!("{}, light scattered by the pigment above them (diffuse)", fl.label),
+                kind: TermKind::Diffuse,
+            });
+        }
+        for fl in self.flakes() {
+            let kind = if fl.smooth {
+                TermKind::Delta
+            } else {
+                TermKind::Lobe(Lobe {
+                    slope_width: fl.facets.alpha,
+                    medium_eta: medium,
+                    label: fl.label.into(),
+                    tail: super::Tail::Gaussian,
+                })
+            };
+            t.push(Term { label: fl.label.into(), kind });
+        }
+        t
+    }
+
+    /// Smooth in the physical form under a smooth (delta) coat: Fresnel T(θ) of the air → coat interface
+    /// (η ≥ 1.3, so refraction into the coat never meets total internal reflection and ωi', ωo' are analytic
+    /// in ωi, ωo over the whole upper hemisphere: the interior critical angle bounds which interior directions
+    /// are reached, it is no cutoff in the exterior directions the instrument integrates over), the
+    /// Kubelka–Munk body (a constant), the split light's τ = exp(−εX'/μ') (μ' ≥ √(1 − 1/η²)), and the flake
+    /// lobes' Beckmann D with the Smith height-correlated G (erfc, no min). The flake reflectances are read
+    /// from piecewise Chebyshev tables of smooth functions verified within `TABLE_TOLERANCE` (10⁻¹²) of the
+    /// direct evaluation, so a seam is a jump of at most ~2·10⁻¹², far below the tolerances a reading is asked
+    /// for. Not smooth: a rough coat (E(μ) from a table held constant below μ₀, measured dishonest when
+    /// checked, `docs/accuracy.md` §5.1) and the paper's Eq. (1) form (V-cavity G, a min()).
+    ///
+    /// Nor is a flake whose reflectance ρ kinks at a critical angle of total internal reflection (mica below
+    /// the resin's index, `FlakeTerm::rho_kinks`): its table fit fails on the kink, and the direct ρ the lobe
+    /// then evaluates is not smooth at the local cosine μc, which is no [`Kink`] of the exterior directions.
+    fn smooth(&self) -> bool {
+        self.spec.form == Form::Physical
+            && self.rough_coat.is_none()
+            && self.flakes().all(|f| (0..f.cover.len()).all(|k| f.rho_kinks(k).is_empty()))
+    }
+
+    /// The rough coat's E(μ) (`optics::coat_albedo`) changes Chebyshev piece at its μ breaks and is held at
+    /// E(μ₀) below μ₀: the coat transmittance 1 − E(μ) of both directions seams there.
+    fn seams(&self) -> Vec<f64> {
+        if self.coat_albedo.is_none() {
+            return Vec::new();
+        }
+        crate::optics::coat_albedo::BREAKS.iter().copied().filter(|&c| c > 0.0 && c < 1.0).collect()
+    }
+
+    /// Physical: T(θi)T(θo) symmetric, f' symmetric (h' and ωi'·h' = ωo'·h' are). Paper Eq. 1 applies τ(θi)
+    /// once, which breaks the symmetry whenever anything lies under the coat.
+    fn is_reciprocal(&self) -> bool {
+        match self.spec.form {
+            Form::Physical => true,
+            Form::PaperEq1 => self.body_weight == 0.0 && self.metallic.is_none() && self.pearlescent.is_none(),
+        }
+    }
+}
+
 impl Brdf for Paint {
     fn sampling(&self) -> &Sampling {
         &self.spec.sampling
@@ -459,7 +539,7 @@ impl Brdf for Paint {
         let n = self.spec.sampling.len();
         let out = &mut out[..n];
         out.fill(0.0);
-        if wi.z.is_nan() || wo.z.is_nan() || wi.z <= 0.0 || wo.z <= 0.0 {
+        if !above_horizon(wi, wo) {
             return;
         }
         let eta = self.spec.coat.index;
@@ -592,80 +672,11 @@ impl Brdf for Paint {
         true
     }
 
-    fn terms(&self) -> Vec<Term> {
-        let mut t = Vec::new();
-        match &self.rough_coat {
-            None => t.push(Term { label: "clear coat (Fresnel, delta)".into(), kind: TermKind::Delta }),
-            Some(mf) => t.push(Term {
-                label: "clear coat (rough, microfacet)".into(),
-                kind: TermKind::Lobe(Lobe::of_facets(mf, 1.0, "clear coat".into())),
-            }),
-        }
-        if self.body_weight > 0.0 {
-            t.push(Term { label: "pigmented layer (Kubelka–Munk, diffuse)".into(), kind: TermKind::Diffuse });
-        }
-        let medium = match self.spec.form {
-            Form::Physical => self.spec.coat.index,
-            Form::PaperEq1 => 1.0,
-        };
-        for fl in self.flakes().filter(|f| f.split && f.diffuse.iter().any(|&d| d > 0.0)) {
-            t.push(Term {
-                label: format!("{}, light scattered by the pigment above them (diffuse)", fl.label),
-                kind: TermKind::Diffuse,
-            });
-        }
-        for fl in self.flakes() {
-            let kind = if fl.smooth {
-                TermKind::Delta
-            } else {
-                TermKind::Lobe(Lobe {
-                    slope_width: fl.facets.alpha,
-                    medium_eta: medium,
-                    label: fl.label.into(),
-                    tail: super::Tail::Gaussian,
-                })
-            };
-            t.push(Term { label: fl.label.into(), kind });
-        }
-        t
-    }
-
-    /// Smooth in the physical form under a smooth (delta) coat: Fresnel T(θ) of the air → coat interface
-    /// (η ≥ 1.3, so refraction into the coat never meets total internal reflection and ωi', ωo' are analytic
-    /// in ωi, ωo over the whole upper hemisphere: the interior critical angle bounds which interior directions
-    /// are reached, it is no cutoff in the exterior directions the instrument integrates over), the
-    /// Kubelka–Munk body (a constant), the split light's τ = exp(−εX'/μ') (μ' ≥ √(1 − 1/η²)), and the flake
-    /// lobes' Beckmann D with the Smith height-correlated G (erfc, no min). The flake reflectances are read
-    /// from piecewise Chebyshev tables of smooth functions verified within `TABLE_TOLERANCE` (10⁻¹²) of the
-    /// direct evaluation, so a seam is a jump of at most ~2·10⁻¹², far below the tolerances a reading is asked
-    /// for. Not smooth: a rough coat (E(μ) from a table held constant below μ₀, measured dishonest when
-    /// checked, `docs/accuracy.md` §5.1) and the paper's Eq. (1) form (V-cavity G, a min()).
-    ///
-    /// Nor is a flake whose reflectance ρ kinks at a critical angle of total internal reflection (mica below
-    /// the resin's index, `FlakeTerm::rho_kinks`): its table fit fails on the kink, and the direct ρ the lobe
-    /// then evaluates is not smooth at the local cosine μc, which is no [`Kink`] of the exterior directions.
-    fn smooth(&self) -> bool {
-        self.spec.form == Form::Physical
-            && self.rough_coat.is_none()
-            && self.flakes().all(|f| (0..f.cover.len()).all(|k| f.rho_kinks(k).is_empty()))
-    }
-
-    /// The rough coat's E(μ) (`optics::coat_albedo`) changes Chebyshev piece at its μ breaks and is held at
-    /// E(μ₀) below μ₀: the coat transmittance 1 − E(μ) of both directions seams there.
-    fn seams(&self) -> Vec<f64> {
-        if self.coat_albedo.is_none() {
-            return Vec::new();
-        }
-        crate::optics::coat_albedo::BREAKS.iter().copied().filter(|&c| c > 0.0 && c < 1.0).collect()
-    }
-
-    fn is_reciprocal(&self) -> bool {
-        // Physical: T(θi)T(θo) symmetric, f' symmetric (h' and ωi'·h' = ωo'·h' are). Paper Eq. 1 applies
-        // τ(θi) once, which breaks the symmetry whenever anything lies under the coat.
-        match self.spec.form {
-            Form::Physical => true,
-            Form::PaperEq1 => self.body_weight == 0.0 && self.metallic.is_none() && self.pearlescent.is_none(),
-        }
+    fn hints(&self) -> Hints {
+        Hints::new(self.terms())
+            .with_seams(self.seams())
+            .with_reciprocal(self.is_reciprocal())
+            .with_smooth(self.smooth())
     }
 
     fn describe(&self) -> String {

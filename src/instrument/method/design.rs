@@ -8,11 +8,11 @@ use super::gauss::TENSOR_MAX_LEVEL;
 use super::gauss::{tensor_boxes, LOBE_LEVELS};
 use super::polar::{POLAR_LEVELS, TAIL_LEVELS};
 use super::{Aperture, DeltaPart, Design, MaterialFacts, Method, Projection, RegularPart, Rule, Target};
-use crate::brdf::{Brdf, Lobe, Tail};
+use crate::brdf::{Brdf, Tail};
 use crate::colorimetry::weighting::Weighting;
 use crate::instrument::aperture::{
-    choose_chart, clip, delta_kinks, lobe_boxes, lobe_splits, lobe_widths_uv, mirror_overlap, regular_kinks,
-    regular_kinks_between, AxisMap, Chart, DELTA_SHARE,
+    choose_chart, clip, delta_kinks, lobe_boxes, lobe_splits, mirror_overlap, regular_kinks, regular_kinks_between,
+    AxisMap, Chart, LobesAt, DELTA_SHARE,
 };
 use crate::instrument::geometry::{Integral, Stop};
 use crate::quadrature::{tensor, Cell, Refine};
@@ -100,16 +100,18 @@ impl Method {
                 } else {
                     regular_kinks_between(&facts.kinks, a.theta + a.viewing, src, rec)
                 };
+                // The lobes' widths at this angle, once for the chart, the splits and every rule chooser.
+                let l = LobesAt::new(&facts.lobes, a.theta, facts.has_diffuse);
                 let chart = if !on_mirror_axis {
                     Chart::Plain
                 } else if kinks.is_empty() {
-                    choose_chart(&facts.lobes, a.theta, src, rec)
+                    choose_chart(&l, src, rec)
                 } else {
                     Chart::Lobe
                 };
                 let (splits, boxes) = match chart {
                     Chart::Lobe | Chart::PlainPLobeQ => {
-                        let splits = lobe_splits(&facts.lobes, a.theta, src, rec);
+                        let splits = lobe_splits(&l, src, rec);
                         let boxes = kinked_boxes(lobe_boxes(&splits), kinks.len());
                         (splits, boxes)
                     }
@@ -133,15 +135,11 @@ impl Method {
                 };
                 let share = 1.0 - DELTA_SHARE;
                 let rule = match chart {
-                    Chart::Lobe if kinks.is_empty() && on_mirror_axis => {
-                        // The lobes' widths at this angle, once for every chooser.
-                        let l = LobesAt::new(facts, a.theta);
-                        delta_rule(&l, src, rec, share * d.rtol)
-                            .or_else(|| lobe_rule(&l, src, rec))
-                            .or_else(|| polar_rule(&l, src, rec))
-                            .or_else(|| smooth_rule(&l, src, rec))
-                            .unwrap_or(Rule::GenzMalik75)
-                    }
+                    Chart::Lobe if kinks.is_empty() && on_mirror_axis => delta_rule(&l, src, rec, share * d.rtol)
+                        .or_else(|| lobe_rule(&l, src, rec))
+                        .or_else(|| polar_rule(&l, src, rec))
+                        .or_else(|| smooth_rule(&l, src, rec))
+                        .unwrap_or(Rule::GenzMalik75),
                     _ => Rule::GenzMalik75,
                 };
                 Some(RegularPart {
@@ -280,25 +278,6 @@ pub fn polar_rule(l: &LobesAt, src: Stop, rec: Stop) -> Option<Rule> {
         return None;
     }
     Some(Rule::LobePolar { width, u, v, levels: [1; 9] })
-}
-
-/// What the rule choosers read about a material's lobes at one geometry angle θ: the lobes, their widths
-/// in (u, v) there (`aperture::lobe_widths_uv`, computed once per design for every chooser) and whether a
-/// diffuse term lies under them.
-#[derive(Clone, Debug)]
-pub struct LobesAt<'a> {
-    pub lobes: &'a [Lobe],
-    pub widths: Vec<[f64; 2]>,
-    pub has_diffuse: bool,
-    pub theta: f64,
-}
-
-impl<'a> LobesAt<'a> {
-    /// The lobes of `facts` at θ.
-    pub fn new(facts: &'a MaterialFacts, theta: f64) -> LobesAt<'a> {
-        let widths = facts.lobes.iter().map(|l| lobe_widths_uv(l, theta)).collect();
-        LobesAt { lobes: &facts.lobes, widths, has_diffuse: facts.has_diffuse, theta }
-    }
 }
 
 /// The initial boxes of a lobe chart with `kinks` kinks: every box cut on t_p into kinks + 1 equal pieces

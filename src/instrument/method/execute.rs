@@ -199,7 +199,7 @@ impl Method {
             }
         };
         let mut flux = Flux::zero(k);
-        let smooth = brdf.smooth();
+        let smooth = brdf.hints().smooth;
 
         // 1. The delta part: source points whose mirror (−p, −q) lies in the receptor.
         if let Some(part) = &self.delta {

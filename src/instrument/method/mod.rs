@@ -53,7 +53,7 @@ pub use delta::{
     DELTA_SAFETY, DELTA_TAIL_SAFETY, DELTA_T_ORDERS,
 };
 pub use design::{
-    delta_rule, lobe_rule, polar_rule, smooth_rule, LobesAt, DELTA_GATE, LOBE_REACH, POLAR_GRAZING, POLAR_REACH,
+    delta_rule, lobe_rule, polar_rule, smooth_rule, DELTA_GATE, LOBE_REACH, POLAR_GRAZING, POLAR_REACH,
     POLAR_REACH_GRAZING, TENSOR_MAX_WIDTH_V, TENSOR_MIN_WIDTH, TENSOR_MIN_WIDTH_U,
 };
 pub use execute::{deadline_after, LATE_START_SHARE};
@@ -64,7 +64,7 @@ pub use shape::{Integrand, Outcome, RuleRun, ShapedRule};
 #[cfg(doc)]
 use crate::instrument::aperture::DELTA_SHARE;
 
-use crate::brdf::{Brdf, Kink, Lobe, TermKind};
+use crate::brdf::{Brdf, Hints, Kink, Lobe};
 use crate::colorimetry::weighting::Weighting;
 pub use crate::instrument::aperture::Chart;
 use crate::instrument::geometry::{Integral, Stop};
@@ -145,7 +145,7 @@ impl std::hash::Hash for Aperture {
 #[derive(Clone, Debug, PartialEq)]
 pub struct MaterialFacts {
     pub lobes: Vec<Lobe>,
-    /// The material's kinks (`Brdf::kinks`).
+    /// The material's kinks (`Hints::kinks`).
     pub kinks: Vec<Kink>,
     /// Whether the material has a delta term, a regular (diffuse or lobe) term, and a diffuse one.
     pub has_delta: bool,
@@ -156,13 +156,17 @@ pub struct MaterialFacts {
 impl MaterialFacts {
     /// The facts of `brdf`'s terms and kinks.
     pub fn of(brdf: &dyn Brdf) -> MaterialFacts {
-        let terms = brdf.terms();
+        MaterialFacts::from_hints(&brdf.hints())
+    }
+
+    /// The facts of a material's hints ([`Brdf::hints`], read once by the caller).
+    pub fn from_hints(hints: &Hints) -> MaterialFacts {
         MaterialFacts {
-            lobes: brdf.lobes(),
-            kinks: brdf.kinks(),
-            has_delta: terms.iter().any(|t| t.kind == TermKind::Delta),
-            has_regular: terms.iter().any(|t| t.kind != TermKind::Delta),
-            has_diffuse: terms.iter().any(|t| t.kind == TermKind::Diffuse),
+            lobes: hints.lobes(),
+            kinks: hints.kinks.clone(),
+            has_delta: hints.has_delta(),
+            has_regular: hints.has_regular(),
+            has_diffuse: hints.has_diffuse(),
         }
     }
 

@@ -19,7 +19,7 @@ use crate::instrument::standards::{self, StandardGeometry};
 use crate::spectrum::Sampling;
 use crate::{Error, Result};
 
-use super::{shape, Engine, Job, Plan, PlanOptions, PlannedReading, MIN_RTOL, SPECIMEN_SHARE, STANDARD_SHARE};
+use super::{Engine, Job, Plan, PlanOptions, PlannedReading, Shape, MIN_RTOL, SPECIMEN_SHARE, STANDARD_SHARE};
 
 /// Why `rtol` is not a relative tolerance (a number in (0, 1)), if it is not: the words after its name, which
 /// [`Planner::compile`] calls "the relative tolerance (rtol)" and the command line `--rtol`.
@@ -204,8 +204,8 @@ impl Planner {
         };
 
         // Step 1b: the specimen's methods, from the material's facts read once.
-        let terms = material.terms();
-        let facts = MaterialFacts::of(material.as_ref());
+        let hints = material.hints();
+        let facts = MaterialFacts::from_hints(&hints);
         let projection = match (engine.fold_spectral, engine.fold_in_material) {
             (false, _) => Projection::Separate,
             (true, false) => Projection::Fold,
@@ -236,7 +236,7 @@ impl Planner {
             };
             jobs.push(Job { method, scale: d.scale, used_by: d.used_by.clone() });
         }
-        let shape = shape(material.as_ref());
+        let shape = Shape::of(material.sampling(), &hints.terms);
         let white_point = match weighting.parts.iter().any(|(k, _)| matches!(k, WeightingKind::Xyz(_))) {
             true => Some((options.colour, crate::colorimetry::weights(material.sampling(), options.colour)?.white)),
             false => None,
@@ -251,7 +251,7 @@ impl Planner {
             jobs,
             readings,
             weighting,
-            terms,
+            terms: hints.terms,
             shape,
             standard_flux,
         })

@@ -261,17 +261,19 @@ struct Shape {
     kinds: Vec<u8>,
 }
 
-fn shape(m: &dyn Brdf) -> Shape {
-    let kinds = m
-        .terms()
-        .iter()
-        .map(|t| match t.kind {
-            TermKind::Delta => 0,
-            TermKind::Diffuse => 1,
-            TermKind::Lobe(_) => 2,
-        })
-        .collect();
-    Shape { sampling: m.sampling().clone(), kinds }
+impl Shape {
+    /// The shape of a material of this sampling and these terms.
+    fn of(sampling: &Sampling, terms: &[Term]) -> Shape {
+        let kinds = terms
+            .iter()
+            .map(|t| match t.kind {
+                TermKind::Delta => 0,
+                TermKind::Diffuse => 1,
+                TermKind::Lobe(_) => 2,
+            })
+            .collect();
+        Shape { sampling: sampling.clone(), kinds }
+    }
 }
 
 /// The compiled plan.
@@ -305,7 +307,7 @@ impl Plan {
     /// The split points stay those of the material the plan was compiled for: right for a nearby material
     /// (a fitter's step, a sweep's neighbour); for a very different one compile a new plan.
     pub fn with_material(&self, material: Arc<dyn Brdf>) -> Result<Plan> {
-        let s = shape(material.as_ref());
+        let s = Shape::of(material.sampling(), &material.hints().terms);
         if s != self.shape {
             return Err(Error::Usage(format!(
                 "the plan was compiled for a material of another shape ({} samples, terms {:?}); this one has {} \
