@@ -176,7 +176,7 @@ impl ChebTable {
     ) -> Vec<Option<ChebTable>> {
         let kinks: Vec<f64> = kinks.iter().copied().filter(|&c| c > a && c < b).collect();
         let segs = segments(a, b, &kinks);
-        if pieces % segs.len().max(1) != 0 {
+        if !pieces.is_multiple_of(segs.len().max(1)) {
             return vec![None; which.len()];
         }
         ChebTable::fit_pieces(&mut f, which, a, b, &segs, pieces, tol)
