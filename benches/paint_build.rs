@@ -121,9 +121,71 @@ fn sweep_points() {
     println!();
 }
 
+/// What a coat-index sweep point costs at every coat index from 1.3 to 1.8 (`docs/performance.md` §"Coat-index
+/// points from 1.3 to 1.8"): each shipped paint with flakes, its coat index set to η, built with an empty memo
+/// (a coat-index point always misses it: every flake table depends on η), the median of the build times; beside it
+/// the ratio to the cost at η = 1.5 and whether every flake is read from its tables (`Paint::flake_tables`) or
+/// evaluated directly. `PAINT_BUILD=coat`.
+fn coat_index_points() {
+    println!("### A coat-index sweep point from 1.3 to 1.8: building the paint with its coat index set to η\n");
+    let fixtures = [
+        "cerulean-blue-b-literal",
+        "cerulean-blue-c",
+        "cerulean-blue-c-literal",
+        "white-pearl",
+        "white-pearl-spectral",
+        "blue-metallic-spectral",
+        "silver-metallic",
+    ];
+    let etas: Vec<f64> = (0..=25).map(|i| ((130 + 2 * i) as f64) / 100.0).collect();
+    print!("| fixture | η = 1.5 |");
+    for e in &etas {
+        print!(" {e:.2} |");
+    }
+    println!(" worst / η = 1.5 | builds timed each |");
+    println!("|---|---|{}---|---|", "---|".repeat(etas.len()));
+    for f in fixtures {
+        let Ok(text) = std::fs::read_to_string(format!("fixtures/recipes/{f}.json")) else { continue };
+        let Ok(base) = serde_json::from_str::<serde_json::Value>(&text) else { continue };
+        let time_at = |eta: f64| -> (f64, usize, bool) {
+            let mut v = base.clone();
+            v["clear_coat"]["index"] = eta.into();
+            let t = serde_json::to_string(&v).expect("json");
+            let mut times = vec![];
+            let mut tabulated = true;
+            let start = Instant::now();
+            while start.elapsed().as_secs_f64() < 0.25 || times.len() < 3 {
+                glossmeter::brdf::paint::forget_tables();
+                let t0 = Instant::now();
+                let p = build_paint(&t, TableBuild::Shared);
+                times.push(t0.elapsed().as_secs_f64());
+                tabulated &= p.flake_tables().iter().all(|(_, d)| d.is_some());
+                std::hint::black_box(p);
+            }
+            (median(times.clone()), times.len(), tabulated)
+        };
+        let (at_15, _, _) = time_at(1.5);
+        print!("| {f} | {:.3} ms |", at_15 * 1e3);
+        let mut worst: f64 = 0.0;
+        let mut fewest = usize::MAX;
+        for &e in &etas {
+            let (t, n, tabulated) = time_at(e);
+            worst = worst.max(t / at_15);
+            fewest = fewest.min(n);
+            print!(" {:.3}{} |", t * 1e3, if tabulated { "" } else { " (direct)" });
+        }
+        println!(" {worst:.2}× | ≥ {fewest} |");
+    }
+    println!("\n(ms a build; \"(direct)\": a flake evaluated directly, no table met 10⁻¹²)\n");
+}
+
 fn main() {
     if std::env::var("PAINT_BUILD").is_ok_and(|v| v == "sweep") {
         sweep_points();
+        return;
+    }
+    if std::env::var("PAINT_BUILD").is_ok_and(|v| v == "coat") {
+        coat_index_points();
         return;
     }
     let base: serde_json::Value =

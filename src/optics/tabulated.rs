@@ -13,6 +13,20 @@
 //! nodes, stored as Chebyshev coefficients c_k = (2/N) Σ_j f(x_j) cos(πk(j + ½)/N) (c₀ halved) and
 //! evaluated by Clenshaw's recurrence (Trefethen, *Approximation Theory and Approximation Practice*, 2013,
 //! ch. 3–4; Press et al., *Numerical Recipes* §5.8).
+//!
+//! A function that is continuous but kinks like √|x − c| at known points c (a reflectance at a critical angle
+//! of total internal reflection) converges only algebraically under one interpolant across c, so no table of
+//! at most `MAX_PIECES` pieces meets a tolerance of 10⁻¹². For it the table is cut at every kink and midway
+//! between two, and each segment that ends on a kink c is tabulated in s ∈ [0, 1] with x = c + h·s² (h the
+//! signed distance from c to the segment's other end), which turns √|x − c| into the smooth |h|^½·s: the
+//! substitution the hemispherical mean already uses (`brdf::paint::hemispherical_mean`; `docs/model.md`
+//! §Evaluation cost, "Tables cut at the kinks"). Each segment has the same number of equal pieces in s.
+//!
+//! At the kink: the function's own value within a few ulp of c is ill-conditioned (√ of a rounding error: a
+//! Fresnel reflectance at the computed critical cosine is off by ~10⁻⁸ when the computed c is an ulp on the
+//! other side of where the function's own arithmetic puts the edge), so the check points of a segment that
+//! ends on a kink leave out the kink itself (s = 0); the table's value there is the limit of both segments.
+//! Interpolation nodes never fall on it (Chebyshev–Gauss nodes are interior).
 
 /// Interpolation nodes per piece (degree N − 1).
 pub const N: usize = 16;
@@ -27,8 +41,47 @@ pub struct ChebTable {
     pieces: usize,
     /// pieces × N coefficients.
     coeffs: Vec<f64>,
+    /// Empty: `pieces` equal pieces of [a, b]. Otherwise the segments cut at the kinks ([`Segment`], in
+    /// increasing x), each of `pieces / segments.len()` equal pieces in s.
+    segments: Vec<Segment>,
     /// Largest |table − f| found at the check points.
     pub max_error: f64,
+}
+
+/// A segment of a table cut at kinks: x = from + h·s², s ∈ [0, 1], `from` a kink; it covers [lo, hi].
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Segment {
+    from: f64,
+    h: f64,
+    lo: f64,
+    hi: f64,
+}
+
+impl Segment {
+    /// x at s.
+    #[inline]
+    fn x(&self, s: f64) -> f64 {
+        self.from + self.h * s * s
+    }
+
+    /// s at x (clamped into [0, 1]).
+    #[inline]
+    fn s(&self, x: f64) -> f64 {
+        ((x - self.from) / self.h).max(0.0).sqrt().min(1.0)
+    }
+}
+
+/// The segments of [a, b] cut at `kinks` (sorted, distinct, inside (a, b)) and midway between two: from each
+/// kink down to the cut below it and up to the cut above it. Empty without kinks.
+fn segments(a: f64, b: f64, kinks: &[f64]) -> Vec<Segment> {
+    let mut out = Vec::with_capacity(2 * kinks.len());
+    for (i, &c) in kinks.iter().enumerate() {
+        let below = if i == 0 { a } else { 0.5 * (kinks[i - 1] + c) };
+        let above = if i + 1 == kinks.len() { b } else { 0.5 * (c + kinks[i + 1]) };
+        out.push(Segment { from: c, h: below - c, lo: below, hi: c });
+        out.push(Segment { from: c, h: above - c, lo: c, hi: above });
+    }
+    out
 }
 
 impl ChebTable {
@@ -51,17 +104,38 @@ impl ChebTable {
     /// stack's angles and interface amplitudes, the same for every wavelength) is done once. A function whose
     /// table is met leaves `which` at the next piece count.
     pub fn fit_each(
-        mut f: impl FnMut(f64, &[usize], &mut [f64]),
+        f: impl FnMut(f64, &[usize], &mut [f64]),
         count: usize,
         a: f64,
         b: f64,
         tol: f64,
     ) -> Vec<Option<ChebTable>> {
+        ChebTable::fit_each_kinked(f, count, a, b, &[], tol)
+    }
+
+    /// [`ChebTable::fit`] of a function that kinks at `kinks` (sorted, distinct; those outside (a, b) are
+    /// ignored): the table cut there (module doc). Without kinks, `fit` itself.
+    pub fn fit_kinked(f: impl Fn(f64) -> f64, a: f64, b: f64, kinks: &[f64], tol: f64) -> Option<ChebTable> {
+        ChebTable::fit_each_kinked(|x, _, v| v[0] = f(x), 1, a, b, kinks, tol).pop().flatten()
+    }
+
+    /// [`ChebTable::fit_each`] of functions that all kink at `kinks` ([`ChebTable::fit_kinked`]). The piece
+    /// counts tried are those of `fit_each` (8, 16, …), shared among the segments (at least one each).
+    pub fn fit_each_kinked(
+        mut f: impl FnMut(f64, &[usize], &mut [f64]),
+        count: usize,
+        a: f64,
+        b: f64,
+        kinks: &[f64],
+        tol: f64,
+    ) -> Vec<Option<ChebTable>> {
+        let kinks: Vec<f64> = kinks.iter().copied().filter(|&c| c > a && c < b).collect();
+        let segs = segments(a, b, &kinks);
         let mut out = vec![None; count];
         let mut which: Vec<usize> = (0..count).collect();
-        let mut pieces = 8;
+        let mut pieces = 8usize.next_multiple_of(segs.len().max(1));
         while !which.is_empty() && pieces <= MAX_PIECES {
-            let fits = ChebTable::fit_pieces(&mut f, &which, a, b, pieces, tol);
+            let fits = ChebTable::fit_pieces(&mut f, &which, a, b, &segs, pieces, tol);
             let mut missed = Vec::new();
             for (&i, fit) in which.iter().zip(fits) {
                 match fit {
@@ -79,14 +153,33 @@ impl ChebTable {
     /// [`ChebTable::fit_with_pieces`] of the functions `which` of `f` at once (as [`ChebTable::fit_each`]):
     /// one result per entry of `which`.
     pub fn fit_each_with_pieces(
-        mut f: impl FnMut(f64, &[usize], &mut [f64]),
+        f: impl FnMut(f64, &[usize], &mut [f64]),
         which: &[usize],
         a: f64,
         b: f64,
         pieces: usize,
         tol: f64,
     ) -> Vec<Option<ChebTable>> {
-        ChebTable::fit_pieces(&mut f, which, a, b, pieces, tol)
+        ChebTable::fit_each_kinked_with_pieces(f, which, a, b, &[], pieces, tol)
+    }
+
+    /// [`ChebTable::fit_each_with_pieces`] of functions that kink at `kinks` ([`ChebTable::fit_kinked`]);
+    /// `pieces` counts the pieces of all segments (a multiple of their number, as [`ChebTable::pieces`] gives).
+    pub fn fit_each_kinked_with_pieces(
+        mut f: impl FnMut(f64, &[usize], &mut [f64]),
+        which: &[usize],
+        a: f64,
+        b: f64,
+        kinks: &[f64],
+        pieces: usize,
+        tol: f64,
+    ) -> Vec<Option<ChebTable>> {
+        let kinks: Vec<f64> = kinks.iter().copied().filter(|&c| c > a && c < b).collect();
+        let segs = segments(a, b, &kinks);
+        if !pieces.is_multiple_of(segs.len().max(1)) {
+            return vec![None; which.len()];
+        }
+        ChebTable::fit_pieces(&mut f, which, a, b, &segs, pieces, tol)
             .into_iter()
             .map(|fit| match fit {
                 Fit::Met(t) => Some(t),
@@ -101,6 +194,7 @@ impl ChebTable {
         which: &[usize],
         a: f64,
         b: f64,
+        segments: &[Segment],
         pieces: usize,
         tol: f64,
     ) -> Vec<Fit> {
@@ -114,14 +208,22 @@ impl ChebTable {
         });
         let m = which.len();
         let width = (b - a) / pieces as f64;
+        // Piece p's variable: x itself on [a, b] (no segments), else s of its segment, and x at a value of it.
+        let per = pieces / segments.len().max(1);
+        let (sw, seg) = (1.0 / per as f64, |p: usize| segments[p / per]);
+        let range = |p: usize| match segments.is_empty() {
+            true => (a + p as f64 * width, a + (p + 1) as f64 * width),
+            false => ((p % per) as f64 * sw, (p % per + 1) as f64 * sw),
+        };
+        let to_x = |p: usize, u: f64| if segments.is_empty() { u } else { seg(p).x(u) };
         let mut coeffs: Vec<Vec<f64>> = (0..m).map(|_| Vec::with_capacity(pieces * N)).collect();
         let mut finite = vec![true; m];
         let mut vals = vec![[0.0; N]; m];
         let mut at = vec![0.0; m];
         for p in 0..pieces {
-            let (lo, hi) = (a + p as f64 * width, a + (p + 1) as f64 * width);
+            let (lo, hi) = range(p);
             for (j, x) in nodes.iter().enumerate() {
-                f(0.5 * (lo + hi) + 0.5 * (hi - lo) * x, which, &mut at);
+                f(to_x(p, 0.5 * (lo + hi) + 0.5 * (hi - lo) * x), which, &mut at);
                 for ((v, fin), y) in vals.iter_mut().zip(&mut finite).zip(&at) {
                     v[j] = *y;
                     *fin &= y.is_finite();
@@ -137,13 +239,21 @@ impl ChebTable {
                 }
             }
         }
-        let tables: Vec<ChebTable> =
-            coeffs.into_iter().map(|coeffs| ChebTable { a, b, pieces, coeffs, max_error: 0.0 }).collect();
+        let tables: Vec<ChebTable> = coeffs
+            .into_iter()
+            .map(|coeffs| ChebTable { a, b, pieces, coeffs, segments: segments.to_vec(), max_error: 0.0 })
+            .collect();
         let mut worst = vec![0.0f64; m];
         for p in 0..pieces {
-            let (lo, hi) = (a + p as f64 * width, a + (p + 1) as f64 * width);
+            let (lo, hi) = range(p);
             for j in 0..=N {
-                let x = 0.5 * (lo + hi) + 0.5 * (hi - lo) * (std::f64::consts::PI * j as f64 / N as f64).cos();
+                // Not at a kink itself (s = 0, the first piece's lower end): there the function's own value is
+                // ill-conditioned, not the table's (module doc, "At the kink").
+                if !segments.is_empty() && p % per == 0 && j == N {
+                    continue;
+                }
+                let u = 0.5 * (lo + hi) + 0.5 * (hi - lo) * (std::f64::consts::PI * j as f64 / N as f64).cos();
+                let x = to_x(p, u);
                 f(x, which, &mut at);
                 for ((w, t), y) in worst.iter_mut().zip(&tables).zip(&at) {
                     *w = w.max((t.eval(x) - y).abs());
@@ -173,17 +283,36 @@ impl ChebTable {
 
     /// Whether `other` has the same interval and pieces (so one [`ChebTable::locate`] serves both).
     pub fn same_grid(&self, other: &ChebTable) -> bool {
-        self.a == other.a && self.b == other.b && self.pieces == other.pieces
+        self.a == other.a && self.b == other.b && self.pieces == other.pieces && self.segments == other.segments
     }
 
-    /// The piece of x (clamped into [a, b]) and x's position t ∈ [−1, 1] in it.
+    /// Whether the table is cut at kinks ([`ChebTable::fit_kinked`]).
+    pub fn kinked(&self) -> bool {
+        !self.segments.is_empty()
+    }
+
+    /// The piece of x (clamped into [a, b]) and x's position t ∈ [−1, 1] in it (in s on a segment at a kink).
     #[inline]
     pub fn locate(&self, x: f64) -> (usize, f64) {
         let x = x.clamp(self.a, self.b);
+        if !self.segments.is_empty() {
+            return self.locate_on_segments(x);
+        }
         let width = (self.b - self.a) / self.pieces as f64;
         let p = (((x - self.a) / width) as usize).min(self.pieces - 1);
         let lo = self.a + p as f64 * width;
         (p, 2.0 * (x - lo) / width - 1.0)
+    }
+
+    /// [`ChebTable::locate`] on a table cut at kinks: the segment holding x (the last whose lower end is ≤ x),
+    /// s there, and the piece of s.
+    fn locate_on_segments(&self, x: f64) -> (usize, f64) {
+        let i = self.segments.iter().rposition(|g| g.lo <= x).unwrap_or(0);
+        let per = self.pieces / self.segments.len();
+        let s = self.segments[i].s(x);
+        let width = 1.0 / per as f64;
+        let p = ((s / width) as usize).min(per - 1);
+        (i * per + p, 2.0 * (s - p as f64 * width) / width - 1.0)
     }
 
     /// The N Chebyshev coefficients of piece `p`.
@@ -214,7 +343,14 @@ impl ChebTable {
             }
         }
         let max_error = tables.iter().zip(weights).map(|(t, w)| w.abs() * t.max_error).sum::<f64>();
-        Some(ChebTable { a: first.a, b: first.b, pieces: first.pieces, coeffs, max_error })
+        Some(ChebTable {
+            a: first.a,
+            b: first.b,
+            pieces: first.pieces,
+            coeffs,
+            segments: first.segments.clone(),
+            max_error,
+        })
     }
 }
 
@@ -356,6 +492,36 @@ mod tests {
         );
         let none = ChebTable::fit_each_with_pieces(|_, _, _| unreachable!(), &[], 0.0, 1.0, 8, 1e-12);
         assert!(none.is_empty() && calls.get() > 0);
+    }
+
+    /// A function that kinks like √|x − c| (a dielectric's Fresnel reflectance at its critical cosine, seen from
+    /// the denser side) defeats every uniform table, and the table cut at the kink meets the tolerance with as
+    /// few pieces as a smooth function (also at two kinks, one near an end), and reproduces it off its nodes.
+    #[test]
+    fn tables_cut_at_kinks_meet_the_tolerance_where_uniform_ones_cannot() {
+        use crate::optics::fresnel::{critical_cosine_complex, fr_dielectric};
+        let eta = 1.58 / 1.8;
+        let c = critical_cosine_complex(num_complex::Complex64::new(eta, 0.0)).unwrap();
+        let f = |x: f64| fr_dielectric(x, eta);
+        assert!(ChebTable::fit(f, 0.0, 1.0, 1e-12).is_none());
+        let t = ChebTable::fit_kinked(f, 0.0, 1.0, &[c], 1e-12).unwrap();
+        assert!(t.kinked() && t.max_error <= 1e-12 && t.pieces() <= 16, "{} pieces", t.pieces());
+        let two = |x: f64| (x - 0.3).abs().sqrt() * (2.0 * x).cos() + (x - 0.97).abs().sqrt();
+        let t2 = ChebTable::fit_kinked(two, 0.0, 1.0, &[0.3, 0.97], 1e-12).unwrap();
+        assert_eq!(t2.segments.len(), 4);
+        for i in 0..=4999 {
+            let x = i as f64 / 4999.0;
+            assert!((t.eval(x) - f(x)).abs() < 2e-12, "x = {x}");
+            assert!((t2.eval(x) - two(x)).abs() < 2e-12, "x = {x}");
+        }
+        // Kinks outside (a, b) are no kinks: the uniform table, to the bit.
+        let smooth = |x: f64| (3.0 * x).sin();
+        let plain = ChebTable::fit(smooth, 0.0, 1.0, 1e-12);
+        assert_eq!(plain, ChebTable::fit_kinked(smooth, 0.0, 1.0, &[0.0, 1.0], 1e-12));
+        // Tables cut at the same kinks share a grid and combine; cut elsewhere, they do not.
+        let sum = ChebTable::combine(&[t.clone(), t.clone()], &[1.0, 0.5]).unwrap();
+        assert!((sum.eval(0.5 * c) - 1.5 * f(0.5 * c)).abs() < 4e-12);
+        assert!(ChebTable::combine(&[t, t2], &[1.0, 1.0]).is_none());
     }
 
     #[test]

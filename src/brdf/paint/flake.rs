@@ -202,21 +202,14 @@ impl FlakeTerm {
                 );
             }
         } else {
-            let bits = |k: &[f64]| k.iter().map(|c| c.to_bits()).collect::<Vec<u64>>();
-            let mut done = vec![false; n];
-            for j in 0..n {
-                if done[j] {
-                    continue;
-                }
-                let group: Vec<usize> = (j..n).filter(|&i| !done[i] && bits(&kinks[i]) == bits(&kinks[j])).collect();
+            for group in same_kinks(&kinks) {
                 let means = hemispherical_means(
                     |mu, out| self.rho_each(mu, &group, wavelengths_nm, out, work),
                     group.len(),
-                    &kinks[j],
+                    &kinks[group[0]],
                 );
                 for (&i, m) in group.iter().zip(means) {
                     rho_d[i] = m;
-                    done[i] = true;
                 }
             }
         }
@@ -236,10 +229,13 @@ impl FlakeTerm {
             .collect();
     }
 
-    /// Build the per-sample tables; all or none. `per_sample`: each sample's table fitted alone (the engine
-    /// before), else all at once ([`ChebTable::fit_each`], the same tables to the bit).
+    /// Build the per-sample tables; all or none. Each is cut at its ρ's kinks ([`FlakeTerm::rho_kinks`],
+    /// [`ChebTable::fit_kinked`]; without kinks the uniform table of before). `per_sample`: each sample's table
+    /// fitted alone (the engine before), else all samples with the same kinks at once
+    /// ([`ChebTable::fit_each_kinked`], the same tables to the bit).
     fn tabulate(&mut self, wavelengths_nm: &[f64], per_sample: bool, work: &Work) {
         let n = self.cover.len();
+        let kinks: Vec<Vec<f64>> = (0..n).map(|k| self.rho_kinks(k)).collect();
         self.table = if per_sample {
             (0..n)
                 .map(|k| {
@@ -247,19 +243,34 @@ impl FlakeTerm {
                         work.count(1, 1);
                         self.reflectance_direct(k, c, wavelengths_nm[k])
                     };
-                    ChebTable::fit(f, 0.0, 1.0, TABLE_TOLERANCE)
+                    ChebTable::fit_kinked(f, 0.0, 1.0, &kinks[k], TABLE_TOLERANCE)
                 })
                 .collect()
         } else {
-            let f = |c, which: &[usize], out: &mut [f64]| self.reflectance_each(c, which, wavelengths_nm, out, work);
-            ChebTable::fit_each(f, n, 0.0, 1.0, TABLE_TOLERANCE).into_iter().collect()
+            let mut tables = vec![None; n];
+            for group in same_kinks(&kinks) {
+                let f = |c, which: &[usize], out: &mut [f64]| {
+                    let which: Vec<usize> = which.iter().map(|&i| group[i]).collect();
+                    self.reflectance_each(c, &which, wavelengths_nm, out, work)
+                };
+                let fits = ChebTable::fit_each_kinked(f, group.len(), 0.0, 1.0, &kinks[group[0]], TABLE_TOLERANCE);
+                for (&k, t) in group.iter().zip(fits) {
+                    tables[k] = t;
+                }
+            }
+            tables.into_iter().collect()
         };
     }
 
     /// The tables on one grid ([`FlakeTerm::grid`]): a table with fewer pieces than the most among them is
     /// fitted again at that count (alone, or all such at once as in [`FlakeTerm::tabulate`]).
+    /// Samples whose ρ kinks at different cosines have tables cut differently, which share no grid: None.
     fn on_one_grid(&self, wavelengths_nm: &[f64], per_sample: bool, work: &Work) -> Option<Vec<ChebTable>> {
         let t = self.table.as_ref()?;
+        let kinks = self.rho_kinks(0);
+        if (1..t.len()).any(|k| bits(&self.rho_kinks(k)) != bits(&kinks)) {
+            return None;
+        }
         let pieces = t.iter().map(ChebTable::pieces).max()?;
         if per_sample {
             return t
@@ -267,22 +278,27 @@ impl FlakeTerm {
                 .enumerate()
                 .map(|(k, tk)| match tk.pieces() == pieces {
                     true => Some(tk.clone()),
-                    false => ChebTable::fit_with_pieces(
-                        |c| {
+                    false => ChebTable::fit_each_kinked_with_pieces(
+                        |c, _, v| {
                             work.count(1, 1);
-                            self.reflectance_direct(k, c, wavelengths_nm[k])
+                            v[0] = self.reflectance_direct(k, c, wavelengths_nm[k])
                         },
+                        &[0],
                         0.0,
                         1.0,
+                        &kinks,
                         pieces,
                         TABLE_TOLERANCE,
-                    ),
+                    )
+                    .pop()
+                    .flatten(),
                 })
                 .collect();
         }
         let refit: Vec<usize> = (0..t.len()).filter(|&k| t[k].pieces() != pieces).collect();
         let f = |c, which: &[usize], out: &mut [f64]| self.reflectance_each(c, which, wavelengths_nm, out, work);
-        let mut again = ChebTable::fit_each_with_pieces(f, &refit, 0.0, 1.0, pieces, TABLE_TOLERANCE).into_iter();
+        let mut again =
+            ChebTable::fit_each_kinked_with_pieces(f, &refit, 0.0, 1.0, &kinks, pieces, TABLE_TOLERANCE).into_iter();
         t.iter().map(|tk| if tk.pieces() == pieces { Some(tk.clone()) } else { again.next().flatten() }).collect()
     }
 
@@ -299,7 +315,8 @@ impl FlakeTerm {
         wavelengths_nm: &[f64],
         build: TableBuild,
     ) {
-        let key = self.key(k_mix, s_mix, depth_mm, wavelengths_nm);
+        let mut key = self.key(k_mix, s_mix, depth_mm, wavelengths_nm);
+        key.push((build == TableBuild::Direct) as u64);
         let made = TABLES.get_or_make(key, || self.compute(k_mix, s_mix, depth_mm, wavelengths_nm, build));
         self.table = made.table.clone();
         self.grid = made.grid.clone();
@@ -319,8 +336,10 @@ impl FlakeTerm {
         let per_sample = build == TableBuild::PerSample;
         let work = Work::default();
         let mut t = self.clone();
-        t.tabulate(wavelengths_nm, per_sample, &work);
-        t.grid = t.on_one_grid(wavelengths_nm, per_sample, &work);
+        if build != TableBuild::Direct {
+            t.tabulate(wavelengths_nm, per_sample, &work);
+            t.grid = t.on_one_grid(wavelengths_nm, per_sample, &work);
+        }
         if t.split {
             t.split_constants(k_mix, s_mix, depth_mm, wavelengths_nm, per_sample, &work);
         }
@@ -358,6 +377,28 @@ impl FlakeTerm {
     }
 }
 
+/// The bits of a list of cosines.
+fn bits(k: &[f64]) -> Vec<u64> {
+    k.iter().map(|c| c.to_bits()).collect()
+}
+
+/// The samples grouped by their kinks (the same to the bit), each group in increasing order, the groups in
+/// the order of their first sample.
+fn same_kinks(kinks: &[Vec<f64>]) -> Vec<Vec<usize>> {
+    let n = kinks.len();
+    let mut done = vec![false; n];
+    let mut groups = Vec::new();
+    for j in 0..n {
+        if done[j] {
+            continue;
+        }
+        let group: Vec<usize> = (j..n).filter(|&i| !done[i] && bits(&kinks[i]) == bits(&kinks[j])).collect();
+        group.iter().for_each(|&i| done[i] = true);
+        groups.push(group);
+    }
+    groups
+}
+
 /// The flake terms' tables kept between paint builds ([`FlakeTerm::prepare`]).
 static TABLES: Memo<Prepared> = Memo::new();
 
@@ -379,13 +420,16 @@ struct Prepared {
 /// How a paint's flake tables are fitted ([`super::Paint::with_table_build`]): all samples at once
 /// ([`TableBuild::Shared`], what [`super::Paint::new`] does) or one sample at a time
 /// ([`TableBuild::PerSample`]: the engine before `docs/model.md` §Evaluation cost "shared across samples", what
-/// `benches/paint_build.rs` times as "before"). The tables are the same bits either way (`tests/paint.rs`), so
-/// the memo serves both.
+/// `benches/paint_build.rs` times as "before"), or none fitted ([`TableBuild::Direct`]). The tables are the
+/// same bits either way (`tests/paint.rs`), so the memo serves both; `Direct` has entries of its own.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum TableBuild {
     #[default]
     Shared,
     PerSample,
+    /// No tables: every flake reflectance evaluated directly (the reference the tables are checked against,
+    /// `tests/paint.rs`; not the same bits, and far slower).
+    Direct,
 }
 static STACK_SETUPS: AtomicU64 = AtomicU64::new(0);
 static STACK_WAVELENGTHS: AtomicU64 = AtomicU64::new(0);

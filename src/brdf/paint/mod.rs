@@ -112,7 +112,8 @@ impl Paint {
     }
 
     /// [`Paint::new`] with the flake tables fitted as `build` says ([`TableBuild`]: the same bits either way;
-    /// `benches/paint_build.rs` compares the two builds' times).
+    /// `benches/paint_build.rs` compares the two builds' times), or with none ([`TableBuild::Direct`]: every
+    /// flake reflectance evaluated directly, the reference the tables are checked against).
     pub fn with_table_build(spec: PaintSpec, build: TableBuild) -> Result<Paint> {
         let n = spec.sampling.len();
         if n == 0 || n > MAX_SAMPLES {
@@ -285,6 +286,19 @@ impl Paint {
         }
     }
 
+    /// Per flake term (metallic first): its label, whether its reflectance is read from verified tables
+    /// (`docs/model.md` §Evaluation cost) for every sample and on one grid for the folded evaluation, and the
+    /// largest deviation found at the tables' check points (None where the flake is evaluated directly).
+    pub fn flake_tables(&self) -> Vec<(&'static str, Option<f64>)> {
+        self.flakes()
+            .map(|f| {
+                let on_grid = f.table.is_some() && f.grid.is_some();
+                let worst = f.table.iter().flatten().map(|t| t.max_error).fold(0.0, f64::max);
+                (f.label, on_grid.then_some(worst))
+            })
+            .collect()
+    }
+
     fn flakes(&self) -> impl Iterator<Item = &FlakeTerm> {
         self.metallic.iter().chain(self.pearlescent.iter())
     }
@@ -387,7 +401,7 @@ impl Paint {
                             if lobe[m] > 0.0 {
                                 let r = match &mff.grid {
                                     Some(g) => dot(g[j].piece(located[m].0), &bases[m]),
-                                    None => mfl.reflectance_direct(j, cos_local, self.lambda(j)),
+                                    None => mfl.reflectance(j, cos_local, self.lambda(j)),
                                 };
                                 lobe_sum[m] += att * r;
                             }
@@ -503,8 +517,9 @@ impl Paint {
     /// checked, `docs/accuracy.md` §5.1) and the paper's Eq. (1) form (V-cavity G, a min()).
     ///
     /// Nor is a flake whose reflectance ρ kinks at a critical angle of total internal reflection (mica below
-    /// the resin's index, `FlakeTerm::rho_kinks`): its table fit fails on the kink, and the direct ρ the lobe
-    /// then evaluates is not smooth at the local cosine μc, which is no [`Kink`] of the exterior directions.
+    /// the resin's index, `FlakeTerm::rho_kinks`): its table is cut there (`docs/model.md` §Evaluation cost,
+    /// "Tables cut at the kinks") and so reproduces the kink, ρ is not smooth at the local cosine μc, which is
+    /// no [`Kink`] of the exterior directions.
     fn smooth(&self) -> bool {
         self.spec.form == Form::Physical
             && self.rough_coat.is_none()
@@ -709,8 +724,9 @@ impl Brdf for Paint {
         for fl in self.flakes() {
             let table = match &fl.table {
                 Some(t) => format!(
-                    ", reflectance tabulated ({} pieces, max deviation {:.0e})",
+                    ", reflectance tabulated ({} pieces{}, max deviation {:.0e})",
                     t[0].pieces(),
+                    if t[0].kinked() { " cut at the critical cosine" } else { "" },
                     t.iter().map(|x| x.max_error).fold(0.0, f64::max)
                 ),
                 None => String::new(),
