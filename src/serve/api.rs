@@ -569,11 +569,65 @@ pub fn geometries_doc() -> Result<Reply> {
                 "line": standards::list_line_any(g),
                 "default": crate::api::DEFAULT_PANEL.contains(&g.geometry.id.as_str()),
                 "profile": standards::profile::of(g).is_ok(),
+                "colour": g.geometry.is_colour(),
                 "assumed": assumed,
             })
         })
         .collect();
     Ok(Reply::json(&json!({"geometries": list})))
+}
+
+/// The models whose recipe names a table file (`/file`), with the file name endings each reads.
+pub const TABLE_MODELS: &[(&str, &[&str])] = &[
+    ("merl", &[".binary"]),
+    ("rgl", &[".bsdf"]),
+    ("inplane-csv", &[".csv"]),
+    ("e1392", &[".txt"]),
+    ("topography", &[".x3p", ".sdf", ".gsf"]),
+];
+
+/// `GET /api/tables`: the table files a recipe may name on this server, per model (docs/serve.md §The page:
+/// switching to a table model fills `/file` with the first): every file of the data directory (four folders
+/// deep at most, 200 files at most, in path order) whose name ends as the model's tables do, named by its path
+/// relative to the directory, each resolved as a recipe's path is ([`table_path`]: a link out of the
+/// directory is not listed). Without `--data-dir`, `"data_dir": false` and no files.
+pub fn tables_doc(data_dir: Option<&Path>) -> Reply {
+    let mut found: Vec<String> = Vec::new();
+    if let Some(root) = data_dir {
+        walk_tables(root, root, 0, &mut found);
+    }
+    found.sort();
+    found.truncate(200);
+    let models: Vec<Value> = TABLE_MODELS
+        .iter()
+        .map(|(model, ends)| {
+            let files: Vec<&String> = found.iter().filter(|f| ends.iter().any(|e| f.ends_with(e))).collect();
+            json!({"model": model, "extensions": ends, "files": files})
+        })
+        .collect();
+    Reply::json(&json!({"data_dir": data_dir.is_some(), "models": models}))
+}
+
+fn walk_tables(root: &Path, dir: &Path, depth: usize, out: &mut Vec<String>) {
+    let Ok(entries) = std::fs::read_dir(dir) else { return };
+    let mut entries: Vec<_> = entries.flatten().map(|e| e.path()).collect();
+    entries.sort();
+    for p in entries.into_iter().take(1000) {
+        let Ok(rel) = p.strip_prefix(root) else { continue };
+        let Some(rel) = rel.to_str().map(str::to_string) else { continue };
+        if p.is_dir() {
+            if depth < 3 {
+                walk_tables(root, &p, depth + 1, out);
+            }
+        } else if TABLE_MODELS.iter().any(|(_, ends)| ends.iter().any(|e| rel.ends_with(e)))
+            && table_path(Some(root), &rel, RECIPE, "/file").is_ok()
+        {
+            out.push(rel);
+        }
+        if out.len() >= 1000 {
+            return;
+        }
+    }
 }
 
 /// The sourced numbers of a geometry file (`{"value", "source", "status"}`) whose
