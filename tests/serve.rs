@@ -621,5 +621,28 @@ fn an_rgb_recipe_is_refused_colour_as_the_command_line_refuses_it() {
     assert!(cli.contains(why), "the command line says the same: {cli}");
     let a = request(addr, "POST", "/api/measure", &with_recipe(&text, json!({"geometries": ["astm-d523-60"]})), &[]);
     assert_eq!(a.status, 200, "{}", a.body);
-    assert_eq!(a.json()["readings"], cli_measure_json("fixtures/recipes/rgb-lambert.json", &["astm-d523-60"])["readings"]);
+    let gloss = cli_measure_json("fixtures/recipes/rgb-lambert.json", &["astm-d523-60"]);
+    assert_eq!(a.json()["readings"], gloss["readings"]);
+    assert!(a.json().get("refused").is_none());
+    // `omit_refused_colour` (the page's): the refused colour geometries left out and the refusal in the
+    // document, the other readings the same bits.
+    let body = json!({"geometries": ["astm-d523-60", "d8-sci", "astm-e2194-45"], "omit_refused_colour": true});
+    let a = request(addr, "POST", "/api/measure", &with_recipe(&text, body), &[]);
+    assert_eq!(a.status, 200, "{}", a.body);
+    let doc = a.json();
+    assert_eq!(doc["readings"], gloss["readings"]);
+    assert_eq!(doc["evaluations"], gloss["evaluations"]);
+    assert_eq!(doc["refused"]["geometries"], json!(["d8-sci", "astm-e2194-45"]));
+    let m = doc["refused"]["message"].as_str().unwrap();
+    assert!(m.starts_with("d8-sci, astm-e2194-45: ") && m.ends_with(why), "{m}");
+    let only = json!({"geometries": ["d8-sci"], "omit_refused_colour": true});
+    let doc = request(addr, "POST", "/api/measure", &with_recipe(&text, only), &[]).json();
+    assert_eq!((doc["readings"].clone(), doc["refused"]["geometries"].clone()), (json!([]), json!(["d8-sci"])));
+    // A spectral recipe is not touched by the option: the same document as without it.
+    let spectral = fixture("white-pearl-spectral");
+    let with = json!({"geometries": ["d8-sci"], "omit_refused_colour": true});
+    let a = request(addr, "POST", "/api/measure", &with_recipe(&spectral, with), &[]).json();
+    let b = request(addr, "POST", "/api/measure", &with_recipe(&spectral, json!({"geometries": ["d8-sci"]})), &[]).json();
+    assert_eq!(a, b);
+    assert!(a["readings"].as_array().unwrap().iter().any(|r| r["name"] == "L*"));
 }

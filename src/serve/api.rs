@@ -215,14 +215,38 @@ fn plan_options(o: &Obj, ctx: Context, default_rtol: f64) -> Result<PlanOptions>
 }
 
 fn timing(o: &Obj) -> Result<bool> {
-    match o.get("timing") {
+    flag(o, "timing")
+}
+
+/// A true/false field, false when absent.
+fn flag(o: &Obj, key: &str) -> Result<bool> {
+    match o.get(key) {
         None => Ok(false),
         Some(Value::Bool(b)) => Ok(*b),
-        Some(v) => Err(o.err("timing", format!("expected true or false, got {}", kind(v)))),
+        Some(v) => Err(o.err(key, format!("expected true or false, got {}", kind(v)))),
     }
 }
 
-const MEASURE_FIELDS: &[&str] = &["recipe", "geometries", "rtol", "max_evals", "illuminant", "observer", "timing"];
+const MEASURE_FIELDS: &[&str] =
+    &["recipe", "geometries", "rtol", "max_evals", "illuminant", "observer", "timing", "omit_refused_colour"];
+
+/// With `omit_refused_colour`: the colour geometries among `geos` that the library refuses for this material
+/// (its samples define no X, Y, Z: an RGB recipe, docs/colour.md) are taken out, and the refusal is kept,
+/// `{"geometries": [ids], "message": the library's message}`, for the document's `refused`.
+fn omit_refused_colour(
+    material: &Material,
+    geos: Vec<StandardGeometry>,
+    options: &PlanOptions,
+) -> (Vec<StandardGeometry>, Option<Value>) {
+    let Err(e) = crate::colorimetry::weights(material.brdf.sampling(), options.colour) else { return (geos, None) };
+    let (colour, rest): (Vec<_>, Vec<_>) = geos.into_iter().partition(|g| g.geometry.is_colour());
+    if colour.is_empty() {
+        return (rest, None);
+    }
+    let ids: Vec<&str> = colour.iter().map(|g| g.geometry.id.as_str()).collect();
+    let message = format!("{}: {}", ids.join(", "), e.naming(&|a| format!("`{a}`")));
+    (rest, Some(json!({"geometries": ids, "message": message})))
+}
 
 /// A profile's evaluation budget on this server: the command line's, each part held to the server's per-integral
 /// limit and the whole profile to ten times it (docs/serve.md §Safety).
@@ -242,16 +266,27 @@ pub fn measure(req: &Request, ctx: Context) -> Result<Reply> {
     let options = plan_options(&o, ctx, DEFAULT_RTOL)?;
     let geos = geometries(&o, ctx, crate::api::DEFAULT_PANEL)?;
     let timing = timing(&o)?;
+    let omit = flag(&o, "omit_refused_colour")?;
     let material = material(req, ctx)?;
-    let plan = Plan::compile(material.brdf.clone(), geos, options)?;
-    let run = plan.run();
-    let evaluations = run.evaluations();
-    // The recipe's stated uncertainties propagated to each reading (nothing is run without them).
-    let uncertainties =
-        crate::comparison::propagation::propagate(&material, &plan.geometries, &plan.options, &run.readings)?;
-    let doc =
-        report::measure::json_doc(&material, &run.readings, timing, evaluations).with_uncertainties(&uncertainties);
-    Ok(Reply::json(&report::to_json(&doc)))
+    let (geos, refused) = if omit { omit_refused_colour(&material, geos, &options) } else { (geos, None) };
+    let mut doc = if geos.is_empty() {
+        // Every geometry asked for was a refused colour one: no reading, the refusal says why.
+        report::to_json(&report::measure::json_doc(&material, &[], timing, 0))
+    } else {
+        let plan = Plan::compile(material.brdf.clone(), geos, options)?;
+        let run = plan.run();
+        let evaluations = run.evaluations();
+        // The recipe's stated uncertainties propagated to each reading (nothing is run without them).
+        let uncertainties =
+            crate::comparison::propagation::propagate(&material, &plan.geometries, &plan.options, &run.readings)?;
+        let doc = report::measure::json_doc(&material, &run.readings, timing, evaluations)
+            .with_uncertainties(&uncertainties);
+        report::to_json(&doc)
+    };
+    if let Some(r) = refused {
+        doc["refused"] = r;
+    }
+    Ok(Reply::json(&doc))
 }
 
 /// `POST /api/explain`: the measurement plan of `measure --explain`, as text in `{"plan": …}`.

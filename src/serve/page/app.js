@@ -422,6 +422,9 @@ function modelChanged() {
     if (!p.models.includes(model) || p.pointer.split("/").length !== 2 || p.pointer === "/model") continue;
     const v = getAt(old, p.pointer);
     const before = entryOf(p.pointer, old.model);
+    // Another model's table is kept only when this model reads its kind of file.
+    const t = p.pointer === "/file" ? tableOf(model) : null;
+    if (t && !(typeof v === "string" && t.extensions.some((e) => v.endsWith(e)))) continue;
     if (v !== undefined && before && before.type === p.type) setAt(r, p.pointer, v);
   }
   const first = state.fixtures.map((f) => JSON.parse(f.recipe)).find((f) => f.model === model);
@@ -584,21 +587,10 @@ function recipeChanged() {
 }
 
 /// The measure document of `recipe` through `geos`. A colour geometry the library refuses for this recipe (an
-/// RGB recipe has no spectrum, so no X, Y, Z: docs/colour.md) is left out, the others are read, and the
-/// document says which and why (`refused`: {geometries, message}, the library's message): the refusal is
-/// known colour-only when the same recipe reads without the colour geometries.
+/// RGB recipe has no spectrum, so no X, Y, Z: docs/colour.md) is left out by the server, the others are read,
+/// and the document says which and why (`refused`: {geometries, message}, the library's message).
 async function measureDoc(recipe, geos, signal) {
-  try {
-    return await (await post("/api/measure", { recipe, geometries: geos }, signal)).json();
-  } catch (e) {
-    const colour = geos.filter((id) => geometryOf(id).colour);
-    if (e.status !== 400 || !colour.length) throw e;
-    const rest = geos.filter((id) => !geometryOf(id).colour);
-    const doc = await (await post("/api/measure", { recipe, geometries: rest.length ? rest : ["astm-d523-60"] }, signal)).json();
-    if (!rest.length) doc.readings = [];
-    doc.refused = { geometries: colour, message: e.message };
-    return doc;
-  }
+  return (await post("/api/measure", { recipe, geometries: geos, omit_refused_colour: true }, signal)).json();
 }
 
 /// In place of the readings: what the recipe still needs (no request is sent).
@@ -856,6 +848,11 @@ function setHeaders() {
 const pictureSoon = debounce(picture, 600);
 
 async function picture() {
+  const missing = missingRequired(state.recipe);
+  if (missing.length) {
+    $("picture-error").textContent = `set ${missing.map((m) => m.pointer).join(", ")} first (see the readings)`;
+    return;
+  }
   const seq = ++state.pictureSeq;
   if (state.pictureAbort) state.pictureAbort.abort();
   const ctl = new AbortController();
