@@ -177,7 +177,7 @@ fn every_unit_and_colour_get_an_axis_of_their_own() {
     let args = [
         "glossmeter",
         "plot",
-        "fixtures/recipes/cerulean-blue-c.json",
+        "fixtures/recipes/blue-metallic-spectral.json",
         "--kind",
         "gloss-vs-parameter",
         "--vary",

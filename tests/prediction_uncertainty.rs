@@ -333,9 +333,27 @@ fn the_command_line_reports_the_allowances_parts() {
     assert_eq!(
         head,
         [
-            "line", "sample", "material", "geometry", "reading", "n", "mean", "std", "min", "max", "predicted",
-            "error_estimate", "difference", "allowance", "verdict", "note", "prediction_uncertainty",
-            "allowance_statistical", "allowance_random", "allowance_stated", "allowance_prediction"
+            "line",
+            "sample",
+            "material",
+            "geometry",
+            "reading",
+            "n",
+            "mean",
+            "std",
+            "min",
+            "max",
+            "predicted",
+            "error_estimate",
+            "difference",
+            "allowance",
+            "verdict",
+            "note",
+            "prediction_uncertainty",
+            "allowance_statistical",
+            "allowance_random",
+            "allowance_stated",
+            "allowance_prediction"
         ]
     );
     let col = |name: &str| head.iter().position(|h| *h == name).unwrap();
@@ -375,7 +393,9 @@ fn the_command_line_reports_the_allowances_parts() {
     // numbers rounded to the display step.
     let (_, table) = gm(&with);
     for c in doc["comparisons"].as_array().unwrap() {
-        let shown = |v: &Value, step: f64| format!("{:.*}", if step < 0.05 { 2 } else { 1 }, (v.as_f64().unwrap() / step + 0.5).floor() * step);
+        let shown = |v: &Value, step: f64| {
+            format!("{:.*}", if step < 0.05 { 2 } else { 1 }, (v.as_f64().unwrap() / step + 0.5).floor() * step)
+        };
         let line = table
             .lines()
             .find(|l| l.contains(c["sample"].as_str().unwrap()) && l.contains(c["geometry"].as_str().unwrap()))

@@ -566,9 +566,8 @@ fn the_tables_of_the_data_directory_are_listed_per_model() {
     let addr = start(ServeOptions { data_dir: Some(data.clone()), ..ServeOptions::default() });
     let doc = request(addr, "GET", "/api/tables", b"", &[]).json();
     assert_eq!(doc["data_dir"], true);
-    let files = |model: &str| {
-        doc["models"].as_array().unwrap().iter().find(|m| m["model"] == model).unwrap()["files"].clone()
-    };
+    let files =
+        |model: &str| doc["models"].as_array().unwrap().iter().find(|m| m["model"] == model).unwrap()["files"].clone();
     assert_eq!(files("merl"), json!(["merl/lambert-tiny.binary"]), "the link out is not listed: {doc}");
     assert_eq!(files("inplane-csv"), json!(["inplane/beckmann.csv"]));
     assert_eq!(files("rgl"), json!([]));
@@ -607,7 +606,13 @@ fn an_rgb_recipe_is_refused_colour_as_the_command_line_refuses_it() {
     }
     assert!(colour.iter().any(|id| id.contains("e2194")) && !colour.contains(&"astm-d523-60"), "{colour:?}");
     let text = fixture("rgb-lambert");
-    let a = request(addr, "POST", "/api/measure", &with_recipe(&text, json!({"geometries": ["astm-d523-60", "d8-sci"]})), &[]);
+    let a = request(
+        addr,
+        "POST",
+        "/api/measure",
+        &with_recipe(&text, json!({"geometries": ["astm-d523-60", "d8-sci"]})),
+        &[],
+    );
     assert_eq!(a.status, 400, "{}", a.body);
     let e = a.json()["error"].as_str().unwrap().to_string();
     assert!(e.contains("d8-sci") && e.contains("wavelengths_nm") && e.contains("RGB"), "{e}");
@@ -642,7 +647,8 @@ fn an_rgb_recipe_is_refused_colour_as_the_command_line_refuses_it() {
     let spectral = fixture("white-pearl-spectral");
     let with = json!({"geometries": ["d8-sci"], "omit_refused_colour": true});
     let a = request(addr, "POST", "/api/measure", &with_recipe(&spectral, with), &[]).json();
-    let b = request(addr, "POST", "/api/measure", &with_recipe(&spectral, json!({"geometries": ["d8-sci"]})), &[]).json();
+    let b =
+        request(addr, "POST", "/api/measure", &with_recipe(&spectral, json!({"geometries": ["d8-sci"]})), &[]).json();
     assert_eq!(a, b);
     assert!(a["readings"].as_array().unwrap().iter().any(|r| r["name"] == "L*"));
 }

@@ -315,7 +315,8 @@ fn measure<'py>(
     guarded(|| {
         let list = PyList::empty(py);
         for (i, r) in readings.iter().enumerate() {
-            let doc = report::ReadingDoc::new(r, timing).with_uncertainty(uncertainties.get(i).and_then(Option::as_ref));
+            let doc =
+                report::ReadingDoc::new(r, timing).with_uncertainty(uncertainties.get(i).and_then(Option::as_ref));
             list.append(from_json(py, &report::to_json(&doc))?)?;
         }
         Ok(list)

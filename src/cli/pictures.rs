@@ -107,9 +107,9 @@ pub fn run(a: PlotArgs, existing: Existing) -> Result<()> {
             let source = Stdin::default().open_text(&a.recipe, "recipe")?;
             let (file, text) = (source.name(), source.text("recipe")?);
             let v = request(&a).read(&text, &file, geos)?;
-            crate::render_plot!(&a.output, "--output", existing, vs_parameter_size(&v.series), |root| draw_vs_parameter(
-                root, &v.name, &v.label, v.log, &v.series
-            ))?;
+            crate::render_plot!(&a.output, "--output", existing, vs_parameter_size(&v.series), |root| {
+                draw_vs_parameter(root, &v.name, &v.label, v.log, &v.series)
+            })?;
         }
     }
     eprintln!("plot: {}", a.output.display());

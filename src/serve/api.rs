@@ -279,8 +279,8 @@ pub fn measure(req: &Request, ctx: Context) -> Result<Reply> {
         // The recipe's stated uncertainties propagated to each reading (nothing is run without them).
         let uncertainties =
             crate::comparison::propagation::propagate(&material, &plan.geometries, &plan.options, &run.readings)?;
-        let doc = report::measure::json_doc(&material, &run.readings, timing, evaluations)
-            .with_uncertainties(&uncertainties);
+        let doc =
+            report::measure::json_doc(&material, &run.readings, timing, evaluations).with_uncertainties(&uncertainties);
         report::to_json(&doc)
     };
     if let Some(r) = refused {

@@ -73,7 +73,7 @@ def test_an_rgb_recipe_says_in_place_why_it_has_no_colour(browser, tmp_path):
 def test_colour_gets_its_own_axes_in_the_sweep(browser, tmp_path):
     d = browser
     wait_current(d)
-    choose_fixture(d, "cerulean-blue-c")
+    choose_fixture(d, "blue-metallic-spectral")
     tick_only(d, ["astm-d523-60", "astm-e2194-45"])
     wait_current(d)
     recipe = raw(d)
