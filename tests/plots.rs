@@ -167,3 +167,66 @@ fn compare_and_convergence_plots() {
     );
     check_png(&p);
 }
+
+/// Readings of several units never share an axis (docs/instrument.md §Pictures): a gloss-vs-parameter picture of
+/// gloss, haze, DOI and colour readings has one chart per unit, colour's CIELAB and X, Y, Z each their own; a
+/// residual chart of a gloss, haze and DOI sheet too. Readings of one unit keep the one chart.
+#[test]
+fn every_unit_and_colour_get_an_axis_of_their_own() {
+    let p = tmp("units.svg");
+    let args = [
+        "glossmeter",
+        "plot",
+        "fixtures/recipes/blue-metallic-spectral.json",
+        "--kind",
+        "gloss-vs-parameter",
+        "--vary",
+        "/clear_coat/index=1.45..1.55",
+        "--points",
+        "2",
+        "-g",
+        "astm-d523-60",
+        "-g",
+        "astm-e430-30",
+        "-g",
+        "astm-e2194-45",
+        "-o",
+        p.to_str().unwrap(),
+    ];
+    assert_eq!(run(args), 0);
+    let svg = std::fs::read_to_string(&p).unwrap();
+    for axis in [
+        "reading (GU)",
+        "reading (HU)",
+        "reading (DOI)",
+        "colour: L*, a*, b*, C* (no unit)",
+        "colour: X, Y, Z (no unit)",
+        "reading (°)",
+    ] {
+        assert!(svg.contains(axis), "no axis {axis:?}");
+    }
+    assert!(!svg.contains("unit in the legend"), "no shared axis");
+    let p = tmp("one-unit.svg");
+    let one = ["glossmeter", "plot", "fixtures/recipes/cerulean-blue-c.json", "--kind", "gloss-vs-parameter"];
+    let rest = ["--vary", "/clear_coat/index=1.45..1.55", "--points", "2", "-o", p.to_str().unwrap()];
+    assert_eq!(run(one.iter().chain(&rest).copied()), 0);
+    let svg = std::fs::read_to_string(&p).unwrap();
+    assert!(svg.contains("reading (GU)") && svg.contains("height=\"640\""), "one unit, one chart as before");
+    let p = tmp("residual-units.svg");
+    let args = [
+        "glossmeter",
+        "compare",
+        "fixtures/recipes/glass-n1.5.json",
+        "fixtures/sheets/rhopoint-iq.csv",
+        "--tolerance",
+        "1",
+        "--plot",
+        p.to_str().unwrap(),
+    ];
+    run(args);
+    let svg = std::fs::read_to_string(&p).unwrap();
+    for axis in ["predicted − measured (GU)", "predicted − measured (HU)", "predicted − measured (DOI)"] {
+        assert!(svg.contains(axis), "no axis {axis:?}");
+    }
+    assert!(!svg.contains("predicted − measured (GU, "), "no shared axis");
+}

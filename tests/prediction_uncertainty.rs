@@ -324,6 +324,93 @@ fn the_command_line_reports_the_allowances_parts() {
         assert_eq!(c["prediction_uncertainty"], a["prediction_uncertainty"]);
         assert_eq!(c["verdict"], "ok");
     }
+    // The CSV has the allowance's parts as columns (docs/instrument.md §The prediction's uncertainty), each
+    // the JSON's number to ten significant digits, the columns before them as they were.
+    let (code, csv) = gm(&[&with[..], &["--format", "csv"]].concat());
+    assert_eq!(code, 0);
+    let mut lines = csv.lines();
+    let head: Vec<&str> = lines.next().unwrap().split(',').collect();
+    assert_eq!(
+        head,
+        [
+            "line",
+            "sample",
+            "material",
+            "geometry",
+            "reading",
+            "n",
+            "mean",
+            "std",
+            "min",
+            "max",
+            "predicted",
+            "error_estimate",
+            "difference",
+            "allowance",
+            "verdict",
+            "note",
+            "prediction_uncertainty",
+            "allowance_statistical",
+            "allowance_random",
+            "allowance_stated",
+            "allowance_prediction"
+        ]
+    );
+    let col = |name: &str| head.iter().position(|h| *h == name).unwrap();
+    let rows: Vec<Vec<String>> = lines.map(|l| l.split(',').map(String::from).collect()).collect();
+    assert_eq!(rows.len(), doc["comparisons"].as_array().unwrap().len());
+    for (r, c) in rows.iter().zip(doc["comparisons"].as_array().unwrap()) {
+        let a = &c["allowance"];
+        for (column, json) in [
+            ("prediction_uncertainty", &c["prediction_uncertainty"]),
+            ("allowance_statistical", &a["statistical"]),
+            ("allowance_random", &a["random"]),
+            ("allowance_stated", &a["stated"]),
+            ("allowance_prediction", &a["prediction"]),
+            ("allowance", &a["total"]),
+        ] {
+            let (x, y): (f64, f64) = (r[col(column)].parse().unwrap(), json.as_f64().unwrap());
+            assert!((x - y).abs() <= 1e-9 * y.abs(), "{column}: {x} vs {y}");
+        }
+        assert!(r[col("prediction_uncertainty")].parse::<f64>().unwrap() > 0.0);
+    }
+    // Without the blocks the part columns are there, the prediction's uncertainty empty.
+    let (_, csv) = gm(&[
+        "compare",
+        sheet,
+        "--recipe",
+        "Black 2K=fixtures/recipes/solid-black.json",
+        "--recipe",
+        "Satin white=fixtures/recipes/semigloss-white.json",
+        "--format",
+        "csv",
+    ]);
+    let row: Vec<&str> = csv.lines().nth(1).unwrap().split(',').collect();
+    assert_eq!(row.len(), head.len());
+    assert_eq!(row[col("prediction_uncertainty")], "");
+    assert_eq!(row[col("allowance_random")], row[col("allowance_statistical")], "{csv}");
+    // The table shows each reading as the instrument displays it (0.1 GU, the spread 0.01 GU): the JSON's
+    // numbers rounded to the display step.
+    let (_, table) = gm(&with);
+    for c in doc["comparisons"].as_array().unwrap() {
+        let shown = |v: &Value, step: f64| {
+            format!("{:.*}", if step < 0.05 { 2 } else { 1 }, (v.as_f64().unwrap() / step + 0.5).floor() * step)
+        };
+        let line = table
+            .lines()
+            .find(|l| l.contains(c["sample"].as_str().unwrap()) && l.contains(c["geometry"].as_str().unwrap()))
+            .unwrap_or_else(|| panic!("{table}"));
+        let want = [
+            format!("{} ± {}", shown(&c["mean"], 0.1), shown(&c["std"], 0.01)),
+            shown(&c["predicted"], 0.1),
+            shown(&c["difference"], 0.1),
+            shown(&c["allowance"]["total"], 0.1),
+        ];
+        for w in &want {
+            assert!(line.contains(&format!(" {w} ")), "{w} not in {line:?}");
+        }
+        assert!(!line.contains(&format!("{:.3}", c["predicted"].as_f64().unwrap())), "{line}");
+    }
     let (code, table) = gm(&["measure", "fixtures/uncertainty/solid-black.json", "-g", "astm-d523-20", "--no-timing"]);
     assert_eq!(code, 0);
     assert!(

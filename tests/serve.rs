@@ -548,3 +548,107 @@ fn a_table_s_tolerance_is_chosen_as_the_command_line_chooses_it() {
     assert_eq!(given.json()["readings"], cli(Some("1e-4"))["readings"]);
     assert_ne!(from_data.json()["readings"], given.json()["readings"]);
 }
+
+/// The table files a recipe may name (`GET /api/tables`, which the page fills a table model's `/file` from):
+/// the data directory's files each table model reads, relative to it, a link out of it not listed; none
+/// without `--data-dir`. The first listed file reads as `measure` reads it.
+#[test]
+fn the_tables_of_the_data_directory_are_listed_per_model() {
+    let root = scratch("tables");
+    let data = root.join("data");
+    std::fs::create_dir_all(data.join("merl")).unwrap();
+    std::fs::create_dir_all(data.join("inplane")).unwrap();
+    std::fs::copy("fixtures/materials/merl/lambert-tiny.binary", data.join("merl/lambert-tiny.binary")).unwrap();
+    std::fs::copy("fixtures/materials/inplane/beckmann.csv", data.join("inplane/beckmann.csv")).unwrap();
+    std::fs::copy("fixtures/materials/merl/lambert-tiny.binary", root.join("outside.binary")).unwrap();
+    #[cfg(unix)]
+    std::os::unix::fs::symlink(root.join("outside.binary"), data.join("link.binary")).unwrap();
+    let addr = start(ServeOptions { data_dir: Some(data.clone()), ..ServeOptions::default() });
+    let doc = request(addr, "GET", "/api/tables", b"", &[]).json();
+    assert_eq!(doc["data_dir"], true);
+    let files =
+        |model: &str| doc["models"].as_array().unwrap().iter().find(|m| m["model"] == model).unwrap()["files"].clone();
+    assert_eq!(files("merl"), json!(["merl/lambert-tiny.binary"]), "the link out is not listed: {doc}");
+    assert_eq!(files("inplane-csv"), json!(["inplane/beckmann.csv"]));
+    assert_eq!(files("rgl"), json!([]));
+    assert!(!doc.to_string().contains(&root.display().to_string()), "no server path: {doc}");
+    let a = post(addr, "/api/measure", &json!({"recipe": {"model": "merl", "file": "merl/lambert-tiny.binary"}}));
+    assert_eq!(a.status, 200, "{}", a.body);
+    let cli = std::process::Command::new(env!("CARGO_BIN_EXE_glossmeter"))
+        .args(["measure", "--format", "json", "--no-timing", "fixtures/recipes/merl-lambert-tiny.json"])
+        .output()
+        .unwrap();
+    let cli: Value = serde_json::from_slice(&cli.stdout).unwrap();
+    assert_eq!(a.json()["readings"], cli["readings"]);
+    let bare = request(default_server(), "GET", "/api/tables", b"", &[]).json();
+    assert_eq!(bare["data_dir"], false);
+    assert!(bare["models"].as_array().unwrap().iter().all(|m| m["files"] == json!([])), "{bare}");
+    std::fs::remove_dir_all(&root).unwrap();
+}
+
+/// An RGB recipe through a colour geometry: the library's refusal (docs/colour.md: three R, G, B values are no
+/// spectrum), 400 with the command line's message naming the geometry and `wavelengths_nm`, while the same
+/// recipe reads without the colour geometry; `/api/geometries` marks the colour geometries, so that the page
+/// can leave them out and say why in place (docs/serve.md §The page).
+#[test]
+fn an_rgb_recipe_is_refused_colour_as_the_command_line_refuses_it() {
+    let addr = default_server();
+    let geos = request(addr, "GET", "/api/geometries", b"", &[]).json();
+    let colour: Vec<&str> = geos["geometries"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|g| g["colour"] == true)
+        .map(|g| g["id"].as_str().unwrap())
+        .collect();
+    for id in ["d8-sci", "d8-sce"] {
+        assert!(colour.contains(&id), "{colour:?}");
+    }
+    assert!(colour.iter().any(|id| id.contains("e2194")) && !colour.contains(&"astm-d523-60"), "{colour:?}");
+    let text = fixture("rgb-lambert");
+    let a = request(
+        addr,
+        "POST",
+        "/api/measure",
+        &with_recipe(&text, json!({"geometries": ["astm-d523-60", "d8-sci"]})),
+        &[],
+    );
+    assert_eq!(a.status, 400, "{}", a.body);
+    let e = a.json()["error"].as_str().unwrap().to_string();
+    assert!(e.contains("d8-sci") && e.contains("wavelengths_nm") && e.contains("RGB"), "{e}");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_glossmeter"))
+        .args(["measure", "fixtures/recipes/rgb-lambert.json", "-g", "astm-d523-60", "-g", "d8-sci"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let cli = String::from_utf8_lossy(&out.stderr);
+    let why = e.split_once("colour readings").unwrap().1;
+    assert!(cli.contains(why), "the command line says the same: {cli}");
+    let a = request(addr, "POST", "/api/measure", &with_recipe(&text, json!({"geometries": ["astm-d523-60"]})), &[]);
+    assert_eq!(a.status, 200, "{}", a.body);
+    let gloss = cli_measure_json("fixtures/recipes/rgb-lambert.json", &["astm-d523-60"]);
+    assert_eq!(a.json()["readings"], gloss["readings"]);
+    assert!(a.json().get("refused").is_none());
+    // `omit_refused_colour` (the page's): the refused colour geometries left out and the refusal in the
+    // document, the other readings the same bits.
+    let body = json!({"geometries": ["astm-d523-60", "d8-sci", "astm-e2194-45"], "omit_refused_colour": true});
+    let a = request(addr, "POST", "/api/measure", &with_recipe(&text, body), &[]);
+    assert_eq!(a.status, 200, "{}", a.body);
+    let doc = a.json();
+    assert_eq!(doc["readings"], gloss["readings"]);
+    assert_eq!(doc["evaluations"], gloss["evaluations"]);
+    assert_eq!(doc["refused"]["geometries"], json!(["d8-sci", "astm-e2194-45"]));
+    let m = doc["refused"]["message"].as_str().unwrap();
+    assert!(m.starts_with("d8-sci, astm-e2194-45: ") && m.ends_with(why), "{m}");
+    let only = json!({"geometries": ["d8-sci"], "omit_refused_colour": true});
+    let doc = request(addr, "POST", "/api/measure", &with_recipe(&text, only), &[]).json();
+    assert_eq!((doc["readings"].clone(), doc["refused"]["geometries"].clone()), (json!([]), json!(["d8-sci"])));
+    // A spectral recipe is not touched by the option: the same document as without it.
+    let spectral = fixture("white-pearl-spectral");
+    let with = json!({"geometries": ["d8-sci"], "omit_refused_colour": true});
+    let a = request(addr, "POST", "/api/measure", &with_recipe(&spectral, with), &[]).json();
+    let b =
+        request(addr, "POST", "/api/measure", &with_recipe(&spectral, json!({"geometries": ["d8-sci"]})), &[]).json();
+    assert_eq!(a, b);
+    assert!(a["readings"].as_array().unwrap().iter().any(|r| r["name"] == "L*"));
+}

@@ -11,6 +11,7 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::PathBuf;
 use std::sync::{Arc, OnceLock};
 
+use glossmeter::comparison::propagation::propagate;
 use glossmeter::instrument::plan::{PlanOptions, Reading};
 use glossmeter::instrument::standards::{self as stds, StandardGeometry};
 use glossmeter::recipe::{self, Material};
@@ -306,8 +307,20 @@ fn measure<'py>(
     let timing = args::flag("timing", timing, true)?;
     let material = guarded(|| load_recipe(py, recipe))?;
     let geos = guarded(|| load_geometries(py, geometries))?;
-    let readings = run_plan(py, material.brdf.clone(), geos, options, false)?;
-    guarded(|| readings_to_py(py, &readings, timing))
+    let readings = run_plan(py, material.brdf.clone(), geos.clone(), options.clone(), false)?;
+    // The recipe's stated uncertainties propagated to each reading, as `measure --format json` gives them
+    // (docs/instrument.md §The prediction's uncertainty; nothing is run without an `uncertainty` block).
+    let uncertainties =
+        py.detach(|| guarded(|| propagate(&material, &geos, &options, &readings).map_err(to_py_err)))?;
+    guarded(|| {
+        let list = PyList::empty(py);
+        for (i, r) in readings.iter().enumerate() {
+            let doc =
+                report::ReadingDoc::new(r, timing).with_uncertainty(uncertainties.get(i).and_then(Option::as_ref));
+            list.append(from_json(py, &report::to_json(&doc))?)?;
+        }
+        Ok(list)
+    })
 }
 
 /// standards() -> list[dict]: every shipped geometry, as in `standards/*.json` (with the provenance of

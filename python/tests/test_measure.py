@@ -174,3 +174,25 @@ def test_a_huge_or_tiny_number_in_a_refusal_is_short():
             glossmeter.measure_brdf(f, lobes=[bad], geometries=["astm-d523-60"])
         msg = str(e.value)
         assert "slope width" in msg and "0000000000" not in msg and len(msg) < 300, msg
+
+
+def test_a_recipe_with_stated_uncertainties_gets_the_cli_prediction_uncertainty():
+    """A recipe's `uncertainty` block gives every reading `prediction_uncertainty` and `uncertainty_budget`,
+    as `glossmeter measure --format json` does (docs/python.md §measure); a recipe without one gives neither."""
+    path = ROOT / "fixtures" / "uncertainty" / "semigloss-white.json"
+    stated = {p for p in json.loads(path.read_text())["uncertainty"]}
+    readings = glossmeter.measure(path, geometries=["astm-d523-20", "astm-d523-60"], timing=False)
+    for r in readings:
+        assert r["prediction_uncertainty"] > 0, r
+        budget = r["uncertainty_budget"]
+        assert {b["pointer"] for b in budget} == stated
+        # u_pred² is the sum of the squared contributions (docs/instrument.md §The prediction's uncertainty).
+        assert abs(sum(b["contribution"] ** 2 for b in budget) ** 0.5 - r["prediction_uncertainty"]) <= 1e-12 * r["prediction_uncertainty"]
+    plain = glossmeter.measure(RECIPES / "semigloss-white.json", geometries=["astm-d523-60"], timing=False)
+    assert "prediction_uncertainty" not in plain[0] and "uncertainty_budget" not in plain[0]
+    exe = cli_binary()
+    if exe is None:
+        pytest.skip("the release CLI is not built (cargo build --release); .ci/run builds it first")
+    out = subprocess.run([exe, "measure", str(path), "-g", "astm-d523-20", "-g", "astm-d523-60", "--format", "json",
+                          "--no-timing"], capture_output=True, text=True, check=True)
+    assert json.loads(out.stdout)["readings"] == readings

@@ -194,8 +194,21 @@ pub fn run(a: CompareArgs, existing: Existing) -> Result<()> {
     readings_status(&predicted, a.allow_unconverged)
 }
 
-fn fmt(v: Option<f64>) -> String {
-    v.filter(|x| x.is_finite()).map(|x| format!("{x:.3}")).unwrap_or_else(|| "—".into())
+/// A reading's number as its instrument displays it: rounded to the display step of its unit
+/// (`report::display_step`: 0.1 GU, HU, DOI; 0.01 for colour coordinates), "—" without one.
+fn fmt(v: Option<f64>, step: f64) -> String {
+    v.filter(|x| x.is_finite()).map(|x| crate::report::displayed(x, step)).unwrap_or_else(|| "—".into())
+}
+
+/// The display step of a comparison's row: that of the predicted reading's unit; a row without a prediction
+/// takes the step its reading's name implies (a colour coordinate 0.01, else 0.1).
+fn step_of(c: &Comparison) -> f64 {
+    let unit = match &c.predicted {
+        Some(p) => p.unit.as_str(),
+        None if ["X", "Y", "Z", "L*", "a*", "b*", "C*"].contains(&c.group.reading.as_str()) => "",
+        None => "GU",
+    };
+    crate::report::display_step(unit)
 }
 
 /// Counts of the verdicts, for the summary line.
@@ -244,16 +257,20 @@ fn table(sheet: &Sheet, cmp: &[Comparison], rule: &VerdictRule, drift: &[Drift],
         if !materials.contains(&material) {
             materials.push(material);
         }
+        // Readings, differences and allowances as the instrument displays them; the standard deviation of the
+        // sheet's readings one digit finer (docs/instrument.md §Sheets). CSV and JSON keep every digit.
+        let step = step_of(c);
+        let mean = fmt(Some(s.mean), step);
         rows.push(vec![
             c.group.sample.clone(),
             c.group.geometry.clone(),
             c.group.reading.clone(),
             s.n.to_string(),
-            if s.n > 1 { format!("{:.3} ± {:.3}", s.mean, s.std) } else { format!("{:.3}", s.mean) },
-            fmt(v),
+            if s.n > 1 { format!("{mean} ± {}", fmt(Some(s.std), step / 10.0)) } else { mean },
+            fmt(v, step),
             p.filter(|p| p.value.is_some()).map(|p| format!("{:.1e}", p.error_estimate)).unwrap_or("—".into()),
-            fmt(c.difference()),
-            fmt(c.allowance.map(|a| a.total())),
+            fmt(c.difference(), step),
+            fmt(c.allowance.map(|a| a.total()), step),
             c.verdict.label().into(),
         ]);
         let why = match &c.verdict {

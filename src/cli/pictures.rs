@@ -7,7 +7,9 @@ use std::path::{Path, PathBuf};
 use crate::cli::output::Existing;
 use crate::comparison::Comparison;
 use crate::input::Stdin;
-use crate::report::pictures::charts::{draw_comparison, draw_sections, draw_vs_parameter, section, Residual, Section};
+use crate::report::pictures::charts::{
+    comparison_height, draw_comparison, draw_sections, draw_vs_parameter, section, vs_parameter_size, Residual, Section,
+};
 pub use crate::report::pictures::charts::{section_svg, vs_parameter_svg};
 use crate::request::{self, PlanRequest, VsParameterRequest};
 use crate::{recipe, Error, Result};
@@ -105,9 +107,9 @@ pub fn run(a: PlotArgs, existing: Existing) -> Result<()> {
             let source = Stdin::default().open_text(&a.recipe, "recipe")?;
             let (file, text) = (source.name(), source.text("recipe")?);
             let v = request(&a).read(&text, &file, geos)?;
-            crate::render_plot!(&a.output, "--output", existing, (1000, 640), |root| draw_vs_parameter(
-                root, &v.name, &v.label, v.log, &v.series
-            ))?;
+            crate::render_plot!(&a.output, "--output", existing, vs_parameter_size(&v.series), |root| {
+                draw_vs_parameter(root, &v.name, &v.label, v.log, &v.series)
+            })?;
         }
     }
     eprintln!("plot: {}", a.output.display());
@@ -140,6 +142,6 @@ pub fn write_comparison(path: &Path, cmp: &[Comparison], existing: Existing) -> 
         return Err(Error::Numeric("nothing to plot: no row has a prediction with a value".into()));
     }
     let name = if names.len() == 1 { names[0].to_string() } else { format!("{} materials", names.len()) };
-    let h = 640.max(120 + 42 * rows.len().min(40) as u32);
+    let h = comparison_height(&rows);
     crate::render_plot!(path, "--plot", existing, (1100, h), |root| draw_comparison(root, &name, &rows))
 }

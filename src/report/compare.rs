@@ -382,6 +382,13 @@ pub fn csv(cmp: &[Comparison]) -> Result<String> {
         "allowance",
         "verdict",
         "note",
+        // The allowance's parts (docs/instrument.md §The prediction's uncertainty), after the columns that
+        // were there before them: u_pred, k·s/√n, k·√(s²/n + u_pred²), the stated uncertainty, e_P.
+        "prediction_uncertainty",
+        "allowance_statistical",
+        "allowance_random",
+        "allowance_stated",
+        "allowance_prediction",
     ];
     // Numbers to their precision (docs/instrument.md §Numbers in text); the JSON keeps every digit.
     let e = |v: Option<f64>| v.map(super::measured).unwrap_or_default();
@@ -410,6 +417,11 @@ pub fn csv(cmp: &[Comparison]) -> Result<String> {
                 Verdict::NotPredicted(why) => format!("not predicted: {why}"),
                 v => v.why_unchecked().map(|w| format!("not checked: {w}")).unwrap_or_default(),
             },
+            e(c.prediction_uncertainty.as_ref().map(|u| u.u)),
+            e(c.allowance.map(|a| a.statistical)),
+            e(c.allowance.map(|a| a.random)),
+            e(c.allowance.map(|a| a.stated)),
+            e(c.allowance.map(|a| a.prediction)),
         ]
     });
     csv_text(&head, rows)

@@ -49,6 +49,34 @@ pub fn decimals(error: f64) -> usize {
     }
 }
 
+/// The step a reading of `unit` is displayed in by the instrument that reads it (docs/instrument.md §Numbers
+/// in text): 0.1 for gloss, haze (linear and log) and DOI (`GU`, `HU`, `HU(log)`, `DOI`: the one-decimal
+/// display of gloss, haze and DOI meters) and for the hue angle (`°`); 0.01 for the colour coordinates X, Y, Z,
+/// L*, a*, b*, C* (unit `""`: the two-decimal CIELAB display of spectrophotometers) and any other unit. A
+/// display convention, not a number of any standard; the page of `glossmeter serve` rounds by the same table.
+pub fn display_step(unit: &str) -> f64 {
+    match unit {
+        "GU" | "HU" | "HU(log)" | "DOI" | "°" => 0.1,
+        _ => 0.01,
+    }
+}
+
+/// `v` as the instrument displays it: rounded to the multiple of `step` nearest it (a half up, as the page's
+/// `Math.round`), with the step's decimals; `-0.0` is `0.0`; a value of 10¹⁵ or more in scientific notation
+/// ([`shown`]).
+pub fn displayed(v: f64, step: f64) -> String {
+    let d = (-step.log10()).round().max(0.0) as usize;
+    if !v.is_finite() || v.abs() >= 1e15 {
+        return shown(v, d);
+    }
+    let s = format!("{:.d$}", (v / step + 0.5).floor() * step);
+    if s.starts_with('-') && s[1..].bytes().all(|b| b == b'0' || b == b'.') {
+        s[1..].to_string()
+    } else {
+        s
+    }
+}
+
 /// A number for CSV: the shortest digits that read back to the same double, plain decimals in
 /// [10⁻¹⁵, 10¹⁵) (never `1e2`) and scientific notation outside it (`1e300`, not 301 digits; every CSV reader
 /// takes both; `docs/instrument.md` §Numbers in text).
@@ -572,5 +600,16 @@ mod tests {
             let (pv, pe): (f64, f64) = (vs.parse().unwrap(), es.parse().unwrap());
             assert!(pe >= e && (pv - v).abs() <= pe - e + 1e-15 * v.abs(), "{v} {e}: {vs} {es}");
         }
+    }
+
+    #[test]
+    fn readings_are_displayed_in_their_units_step() {
+        assert_eq!(displayed(89.14, display_step("GU")), "89.1");
+        assert_eq!(displayed(89.15000001, display_step("GU")), "89.2");
+        assert_eq!(displayed(-0.04, display_step("HU")), "0.0");
+        assert_eq!(displayed(-0.06, display_step("DOI")), "-0.1");
+        assert_eq!(displayed(52.345678, display_step("")), "52.35");
+        assert_eq!(displayed(231.26, display_step("°")), "231.3");
+        assert_eq!(displayed(2e20, 0.1), "2.000e20");
     }
 }

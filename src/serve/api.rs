@@ -215,14 +215,38 @@ fn plan_options(o: &Obj, ctx: Context, default_rtol: f64) -> Result<PlanOptions>
 }
 
 fn timing(o: &Obj) -> Result<bool> {
-    match o.get("timing") {
+    flag(o, "timing")
+}
+
+/// A true/false field, false when absent.
+fn flag(o: &Obj, key: &str) -> Result<bool> {
+    match o.get(key) {
         None => Ok(false),
         Some(Value::Bool(b)) => Ok(*b),
-        Some(v) => Err(o.err("timing", format!("expected true or false, got {}", kind(v)))),
+        Some(v) => Err(o.err(key, format!("expected true or false, got {}", kind(v)))),
     }
 }
 
-const MEASURE_FIELDS: &[&str] = &["recipe", "geometries", "rtol", "max_evals", "illuminant", "observer", "timing"];
+const MEASURE_FIELDS: &[&str] =
+    &["recipe", "geometries", "rtol", "max_evals", "illuminant", "observer", "timing", "omit_refused_colour"];
+
+/// With `omit_refused_colour`: the colour geometries among `geos` that the library refuses for this material
+/// (its samples define no X, Y, Z: an RGB recipe, docs/colour.md) are taken out, and the refusal is kept,
+/// `{"geometries": [ids], "message": the library's message}`, for the document's `refused`.
+fn omit_refused_colour(
+    material: &Material,
+    geos: Vec<StandardGeometry>,
+    options: &PlanOptions,
+) -> (Vec<StandardGeometry>, Option<Value>) {
+    let Err(e) = crate::colorimetry::weights(material.brdf.sampling(), options.colour) else { return (geos, None) };
+    let (colour, rest): (Vec<_>, Vec<_>) = geos.into_iter().partition(|g| g.geometry.is_colour());
+    if colour.is_empty() {
+        return (rest, None);
+    }
+    let ids: Vec<&str> = colour.iter().map(|g| g.geometry.id.as_str()).collect();
+    let message = format!("{}: {}", ids.join(", "), e.naming(&|a| format!("`{a}`")));
+    (rest, Some(json!({"geometries": ids, "message": message})))
+}
 
 /// A profile's evaluation budget on this server: the command line's, each part held to the server's per-integral
 /// limit and the whole profile to ten times it (docs/serve.md §Safety).
@@ -242,16 +266,27 @@ pub fn measure(req: &Request, ctx: Context) -> Result<Reply> {
     let options = plan_options(&o, ctx, DEFAULT_RTOL)?;
     let geos = geometries(&o, ctx, crate::api::DEFAULT_PANEL)?;
     let timing = timing(&o)?;
+    let omit = flag(&o, "omit_refused_colour")?;
     let material = material(req, ctx)?;
-    let plan = Plan::compile(material.brdf.clone(), geos, options)?;
-    let run = plan.run();
-    let evaluations = run.evaluations();
-    // The recipe's stated uncertainties propagated to each reading (nothing is run without them).
-    let uncertainties =
-        crate::comparison::propagation::propagate(&material, &plan.geometries, &plan.options, &run.readings)?;
-    let doc =
-        report::measure::json_doc(&material, &run.readings, timing, evaluations).with_uncertainties(&uncertainties);
-    Ok(Reply::json(&report::to_json(&doc)))
+    let (geos, refused) = if omit { omit_refused_colour(&material, geos, &options) } else { (geos, None) };
+    let mut doc = if geos.is_empty() {
+        // Every geometry asked for was a refused colour one: no reading, the refusal says why.
+        report::to_json(&report::measure::json_doc(&material, &[], timing, 0))
+    } else {
+        let plan = Plan::compile(material.brdf.clone(), geos, options)?;
+        let run = plan.run();
+        let evaluations = run.evaluations();
+        // The recipe's stated uncertainties propagated to each reading (nothing is run without them).
+        let uncertainties =
+            crate::comparison::propagation::propagate(&material, &plan.geometries, &plan.options, &run.readings)?;
+        let doc =
+            report::measure::json_doc(&material, &run.readings, timing, evaluations).with_uncertainties(&uncertainties);
+        report::to_json(&doc)
+    };
+    if let Some(r) = refused {
+        doc["refused"] = r;
+    }
+    Ok(Reply::json(&doc))
 }
 
 /// `POST /api/explain`: the measurement plan of `measure --explain`, as text in `{"plan": …}`.
@@ -569,11 +604,65 @@ pub fn geometries_doc() -> Result<Reply> {
                 "line": standards::list_line_any(g),
                 "default": crate::api::DEFAULT_PANEL.contains(&g.geometry.id.as_str()),
                 "profile": standards::profile::of(g).is_ok(),
+                "colour": g.geometry.is_colour(),
                 "assumed": assumed,
             })
         })
         .collect();
     Ok(Reply::json(&json!({"geometries": list})))
+}
+
+/// The models whose recipe names a table file (`/file`), with the file name endings each reads.
+pub const TABLE_MODELS: &[(&str, &[&str])] = &[
+    ("merl", &[".binary"]),
+    ("rgl", &[".bsdf"]),
+    ("inplane-csv", &[".csv"]),
+    ("e1392", &[".txt"]),
+    ("topography", &[".x3p", ".sdf", ".gsf"]),
+];
+
+/// `GET /api/tables`: the table files a recipe may name on this server, per model (docs/serve.md §The page:
+/// switching to a table model fills `/file` with the first): every file of the data directory (four folders
+/// deep at most, 200 files at most, in path order) whose name ends as the model's tables do, named by its path
+/// relative to the directory, each resolved as a recipe's path is ([`table_path`]: a link out of the
+/// directory is not listed). Without `--data-dir`, `"data_dir": false` and no files.
+pub fn tables_doc(data_dir: Option<&Path>) -> Reply {
+    let mut found: Vec<String> = Vec::new();
+    if let Some(root) = data_dir {
+        walk_tables(root, root, 0, &mut found);
+    }
+    found.sort();
+    found.truncate(200);
+    let models: Vec<Value> = TABLE_MODELS
+        .iter()
+        .map(|(model, ends)| {
+            let files: Vec<&String> = found.iter().filter(|f| ends.iter().any(|e| f.ends_with(e))).collect();
+            json!({"model": model, "extensions": ends, "files": files})
+        })
+        .collect();
+    Reply::json(&json!({"data_dir": data_dir.is_some(), "models": models}))
+}
+
+fn walk_tables(root: &Path, dir: &Path, depth: usize, out: &mut Vec<String>) {
+    let Ok(entries) = std::fs::read_dir(dir) else { return };
+    let mut entries: Vec<_> = entries.flatten().map(|e| e.path()).collect();
+    entries.sort();
+    for p in entries.into_iter().take(1000) {
+        let Ok(rel) = p.strip_prefix(root) else { continue };
+        let Some(rel) = rel.to_str().map(str::to_string) else { continue };
+        if p.is_dir() {
+            if depth < 3 {
+                walk_tables(root, &p, depth + 1, out);
+            }
+        } else if TABLE_MODELS.iter().any(|(_, ends)| ends.iter().any(|e| rel.ends_with(e)))
+            && table_path(Some(root), &rel, RECIPE, "/file").is_ok()
+        {
+            out.push(rel);
+        }
+        if out.len() >= 1000 {
+            return;
+        }
+    }
 }
 
 /// The sourced numbers of a geometry file (`{"value", "source", "status"}`) whose

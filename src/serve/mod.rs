@@ -242,6 +242,10 @@ fn router(shared: Arc<Shared>, guard: Arc<Guard>) -> Router {
             get(|| async { api::geometries_doc().map_or_else(|e| error(StatusCode::BAD_REQUEST, &e), reply) }),
         )
         .route("/api/fixtures", get(|| async { fixtures() }))
+        .route(
+            "/api/tables",
+            get(|State(s): State<Arc<Shared>>| async move { reply(api::tables_doc(s.data_dir.as_deref())) }),
+        )
         .route("/api/measure", post(|State(s): State<Arc<Shared>>, r: Request| work(s, r, api::measure)))
         .route("/api/explain", post(|State(s): State<Arc<Shared>>, r: Request| work(s, r, api::explain)))
         .route("/api/plot", post(|State(s): State<Arc<Shared>>, r: Request| work(s, r, api::plot)))

@@ -167,14 +167,79 @@ pub fn draw_sections<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, name: &st
     Ok(())
 }
 
-/// Readings against the parameter: x on a log axis when the values are log-spaced (drawn as log10 x with the
-/// ticks labelled in x), the legend beside the chart.
+/// The axis a reading is drawn on (docs/instrument.md §Pictures): one per unit (GU, HU, HU(log), DOI, the hue
+/// angle's °), and colour's unitless coordinates on two of their own, CIELAB (L*, a*, b*, C*) and the
+/// tristimulus values (X, Y, Z), never beside a unit's. `unit` and `name` are the reading's.
+pub fn axis_of(unit: &str, name: &str) -> String {
+    match (unit, name) {
+        ("", "X" | "Y" | "Z") => "X, Y, Z".into(),
+        ("", _) => "L*, a*, b*, C*".into(),
+        (u, _) => u.into(),
+    }
+}
+
+/// The axis of a series labelled `GEOMETRY READING (UNIT)` ([`axis_of`]).
+fn series_axis(label: &str) -> String {
+    let (head, unit) = match (label.rfind(" ("), label.strip_suffix(')')) {
+        (Some(i), Some(_)) => (&label[..i], &label[i + 2..label.len() - 1]),
+        _ => (label, ""),
+    };
+    axis_of(unit, head.split_once(' ').map_or(head, |(_, n)| n))
+}
+
+/// The axes of `keys` in order of first appearance, each with the indices that are drawn on it.
+fn by_axis(keys: impl Iterator<Item = String>) -> Vec<(String, Vec<usize>)> {
+    let mut out: Vec<(String, Vec<usize>)> = Vec::new();
+    for (i, k) in keys.enumerate() {
+        match out.iter_mut().find(|(a, _)| *a == k) {
+            Some((_, v)) => v.push(i),
+            None => out.push((k, vec![i])),
+        }
+    }
+    out
+}
+
+/// The picture size of [`draw_vs_parameter`]: 1000 × 640, and 360 pixels a panel when the readings need more
+/// than one axis.
+pub fn vs_parameter_size(series: &[(String, Vec<(f64, f64)>)]) -> (u32, u32) {
+    match by_axis(series.iter().map(|s| series_axis(&s.0))).len() {
+        0 | 1 => (1000, 640),
+        n => (1000, 360 * n as u32),
+    }
+}
+
+/// Readings against the parameter, one chart per axis ([`axis_of`]: a unit, or colour's CIELAB or X, Y, Z)
+/// stacked with the same x axis, so that GU, HU, DOI and colour never share a scale.
 pub fn draw_vs_parameter<DB: DrawingBackend>(
     root: DrawingArea<DB, Shift>,
     name: &str,
     label: &str,
     log: bool,
     series: &[(String, Vec<(f64, f64)>)],
+) -> Result<()> {
+    let axes = by_axis(series.iter().map(|s| series_axis(&s.0)));
+    if axes.len() <= 1 {
+        return draw_vs_parameter_panel(root, name, label, log, series, None);
+    }
+    root.fill(&WHITE).map_err(plot_err)?;
+    for (area, (axis, members)) in root.split_evenly((axes.len(), 1)).into_iter().zip(&axes) {
+        let part: Vec<(String, Vec<(f64, f64)>)> = members.iter().map(|&i| series[i].clone()).collect();
+        draw_vs_parameter_panel(area, name, label, log, &part, Some(axis))?;
+    }
+    root.present().map_err(plot_err)?;
+    Ok(())
+}
+
+/// One chart of readings against the parameter: x on a log axis when the values are log-spaced (drawn as log10
+/// x with the ticks labelled in x), the legend beside the chart; `axis` names the y axis of one panel of
+/// several (None: the whole picture, named by the series' unit).
+fn draw_vs_parameter_panel<DB: DrawingBackend>(
+    root: DrawingArea<DB, Shift>,
+    name: &str,
+    label: &str,
+    log: bool,
+    series: &[(String, Vec<(f64, f64)>)],
+    axis: Option<&str>,
 ) -> Result<()> {
     root.fill(&WHITE).map_err(plot_err)?;
     let fx = |x: f64| if log { x.log10() } else { x };
@@ -188,10 +253,19 @@ pub fn draw_vs_parameter<DB: DrawingBackend>(
     let mut units: Vec<&str> =
         series.iter().filter_map(|s| s.0.rsplit_once('(').map(|(_, u)| u.trim_end_matches(')'))).collect();
     units.dedup();
-    let y_desc =
-        if units.len() == 1 { format!("reading ({})", units[0]) } else { "reading (unit in the legend)".into() };
+    let y_desc = match axis {
+        Some(a) if a.contains('*') || a.starts_with('X') => format!("colour: {a} (no unit)"),
+        Some(a) => format!("reading ({a})"),
+        None if units.len() == 1 => format!("reading ({})", units[0]),
+        None => "reading (unit in the legend)".into(),
+    };
+    let what = label.split(',').next().unwrap_or(label);
+    let caption = match axis {
+        Some(a) => format!("{name}: readings against {what}: {a}"),
+        None => format!("{name}: readings against {what}"),
+    };
     let mut chart = ChartBuilder::on(&chart_area)
-        .caption(format!("{name}: readings against {}", label.split(',').next().unwrap_or(label)), ("sans-serif", 18))
+        .caption(caption, ("sans-serif", 18))
         .margin(12)
         .x_label_area_size(45)
         .y_label_area_size(70)
@@ -216,11 +290,14 @@ pub fn draw_vs_parameter<DB: DrawingBackend>(
     let spacing = if log { "values spaced logarithmically" } else { "values spaced evenly" };
     legend.push((Mark::Dot(BLACK.to_rgba()), format!("a computed reading ({spacing})")));
     super::draw_side_legend(&legend_area, "readings", &legend, 13)?;
-    root.present().map_err(plot_err)?;
+    if axis.is_none() {
+        root.present().map_err(plot_err)?;
+    }
     Ok(())
 }
 
 /// One row of the residual chart.
+#[derive(Clone)]
 pub struct Residual {
     /// `SAMPLE GEOMETRY READING`.
     pub label: String,
@@ -240,7 +317,51 @@ fn verdict_colour(v: &str) -> RGBAColor {
     }
 }
 
+/// The axis of a residual row ([`axis_of`], by its unit and its reading, the last word of its label).
+fn residual_axis(r: &Residual) -> String {
+    axis_of(&r.unit, r.label.rsplit_once(' ').map_or(r.label.as_str(), |(_, n)| n))
+}
+
+/// The picture height of [`draw_comparison`] for `rows`: one panel per axis, each tall enough for its legend.
+pub fn comparison_height(rows: &[Residual]) -> u32 {
+    let axes = by_axis(rows.iter().map(residual_axis));
+    if axes.len() <= 1 {
+        return 640.max(120 + 42 * rows.len().min(40) as u32);
+    }
+    axes.iter().map(|(_, m)| panel_height(m.len())).sum()
+}
+
+/// The height of one panel of several in the residual chart: room for its legend's rows, at least 360.
+fn panel_height(rows: usize) -> u32 {
+    (120 + 42 * rows.min(40) as u32).max(360)
+}
+
+/// `compare --plot`: the residuals, one chart per axis ([`axis_of`]: a unit, or colour's CIELAB or X, Y, Z),
+/// stacked, so that GU, HU, DOI and colour never share a scale.
 pub fn draw_comparison<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, name: &str, rows: &[Residual]) -> Result<()> {
+    let axes = by_axis(rows.iter().map(residual_axis));
+    if axes.len() <= 1 {
+        return draw_comparison_panel(root, name, rows, None);
+    }
+    root.fill(&WHITE).map_err(plot_err)?;
+    let mut rest = root.clone();
+    for (k, (axis, members)) in axes.iter().enumerate() {
+        let part: Vec<Residual> = members.iter().map(|&i| rows[i].clone()).collect();
+        let (area, below) =
+            if k + 1 < axes.len() { rest.split_vertically(panel_height(members.len())) } else { (rest.clone(), rest) };
+        draw_comparison_panel(area, name, &part, Some(axis))?;
+        rest = below;
+    }
+    root.present().map_err(plot_err)?;
+    Ok(())
+}
+
+fn draw_comparison_panel<DB: DrawingBackend>(
+    root: DrawingArea<DB, Shift>,
+    name: &str,
+    rows: &[Residual],
+    axis: Option<&str>,
+) -> Result<()> {
     root.fill(&WHITE).map_err(plot_err)?;
     // Symmetric about 0, wide enough for every residual and every band; within ±1e307 (a residual of 1e308
     // made the axis infinite and plotters' key points loop); what lies beyond is clipped.
@@ -257,7 +378,13 @@ pub fn draw_comparison<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, name: &
     units.sort();
     units.dedup();
     let mut chart = ChartBuilder::on(&chart_area)
-        .caption(format!("{name}: predicted − measured, with the allowance"), ("sans-serif", 18))
+        .caption(
+            match axis {
+                Some(a) => format!("{name}: predicted − measured, with the allowance: {a}"),
+                None => format!("{name}: predicted − measured, with the allowance"),
+            },
+            ("sans-serif", 18),
+        )
         .margin(12)
         .x_label_area_size(45)
         .y_label_area_size(80)
@@ -266,7 +393,11 @@ pub fn draw_comparison<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, name: &
     chart
         .configure_mesh()
         .x_desc("row of the comparison (named in the legend)")
-        .y_desc(format!("predicted − measured ({})", units.join(", ")))
+        .y_desc(match axis {
+            Some(a) if a.contains('*') || a.starts_with('X') => format!("predicted − measured, colour: {a} (no unit)"),
+            Some(a) => format!("predicted − measured ({a})"),
+            None => format!("predicted − measured ({})", units.join(", ")),
+        })
         .x_labels(n.min(20) + 1)
         .x_label_formatter(&|x| {
             let k = x.round();
@@ -315,7 +446,9 @@ pub fn draw_comparison<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, name: &
         legend.push((Mark::Dot(BLACK.to_rgba()), format!("… and {} more rows (in the table)", n - 40)));
     }
     super::draw_side_legend(&legend_area, "rows and verdicts", &legend, 12)?;
-    root.present().map_err(plot_err)?;
+    if axis.is_none() {
+        root.present().map_err(plot_err)?;
+    }
     Ok(())
 }
 
@@ -338,5 +471,5 @@ pub fn vs_parameter_svg(name: &str, label: &str, log: bool, series: &[(String, V
     if series.iter().all(|s| s.1.is_empty()) {
         return Err(Error::Numeric("no reading has a value over the range".into()));
     }
-    super::to_svg((1000, 640), |root| draw_vs_parameter(root, name, label, log, series))
+    super::to_svg(vs_parameter_size(series), |root| draw_vs_parameter(root, name, label, log, series))
 }

@@ -21,6 +21,7 @@ const state = {
   doc: null, // the current recipe's measure document
   pinned: null, // {name, recipe, geometries, doc}: the reference
   savedText: "", // the recipe as last saved or loaded (JSON)
+  tables: { data_dir: false, models: [] }, // /api/tables: the table files a recipe may name, per model
 };
 
 // ---- small helpers ----------------------------------------------------------------------------------
@@ -259,6 +260,12 @@ function buildForm() {
     } else if (p.number) {
       input = numberInput({ id, placeholder: p.required ? "required" : `default ${p.default}` });
       input.value = typeof v === "number" ? String(v) : "";
+    } else if (tableOf(r.model) && ptr === "/file") {
+      // A table model's file: the tables of the server's data directory that the model reads (/api/tables).
+      const t = tableOf(r.model);
+      input = el("input", { id, type: "text", list: id + "-tables", placeholder: tablePlaceholder(t) });
+      input.value = typeof v === "string" ? v : "";
+      form.append(el("datalist", { id: id + "-tables" }, ...t.files.map((f) => el("option", { value: f }))));
     } else {
       // Colours, spectra, arrays, indices, text: the JSON of the value (text fields: the string).
       const text = p.numeric || typeof v !== "string" ? (v === undefined ? "" : JSON.stringify(v)) : v;
@@ -415,6 +422,9 @@ function modelChanged() {
     if (!p.models.includes(model) || p.pointer.split("/").length !== 2 || p.pointer === "/model") continue;
     const v = getAt(old, p.pointer);
     const before = entryOf(p.pointer, old.model);
+    // Another model's table is kept only when this model reads its kind of file.
+    const t = p.pointer === "/file" ? tableOf(model) : null;
+    if (t && !(typeof v === "string" && t.extensions.some((e) => v.endsWith(e)))) continue;
     if (v !== undefined && before && before.type === p.type) setAt(r, p.pointer, v);
   }
   const first = state.fixtures.map((f) => JSON.parse(f.recipe)).find((f) => f.model === model);
@@ -431,8 +441,42 @@ function modelChanged() {
   }
   // A model whose roughness and populations are alternatives: the shipped recipe's choice.
   if (first && first.populations && r.roughness === undefined && r.populations === undefined) r.populations = first.populations;
+  // A table model: the first table of the server's data directory that it reads (no shipped recipe names
+  // one there); none: the field and the readings say what is needed and where it may come from.
+  const t = tableOf(model);
+  let words = filled.length ? `${model}: ${filled.join(", ")} filled from the shipped recipe “${first.name || ""}”` : `${model}`;
+  if (t && r.file === undefined && t.files.length) {
+    r.file = t.files[0];
+    words = `${model}: file “${r.file}”, the first of the ${t.files.length} ${t.extensions.join(" or ")} table(s) in the server's data directory`;
+  } else if (t && r.file === undefined) words = `${model}: ${tablePlaceholder(t)}`;
   setRecipe(r, false);
-  status(filled.length ? `${model}: ${filled.join(", ")} filled from the shipped recipe “${first.name || ""}”` : `${model}`);
+  status(words);
+}
+
+/// The table files of a table model (`{model, extensions, files}` of /api/tables), or null.
+function tableOf(model) {
+  return state.tables.models.find((m) => m.model === model) || null;
+}
+
+function tablePlaceholder(t) {
+  const kind = `a ${t.extensions.join(" or ")} table`;
+  if (t.files.length) return `${kind} in the server's data directory: ${t.files.join(", ")}`;
+  return state.tables.data_dir
+    ? `${kind} in the server's data directory (it holds none: put one there)`
+    : `${kind} in the server's data directory: this server has none (start it with glossmeter serve --data-dir DIR)`;
+}
+
+/// The required top-level fields the recipe does not set, with what each allows (a switch of model to one no
+/// shipped recipe fills, a table model without a table): shown in place of the readings, not as an error.
+function missingRequired(r) {
+  if (!state.registry || !r.model || !state.registry.models.includes(r.model)) return [];
+  return state.registry.parameters
+    .filter((p) => p.models.includes(r.model) && p.required && p.pointer !== "/model" && p.pointer.split("/").length === 2 && getAt(r, p.pointer) === undefined)
+    .map((p) => {
+      const t = tableOf(r.model);
+      const allowed = t && p.pointer === "/file" ? tablePlaceholder(t) : `${p.type}${p.range ? " " + p.range.text : ""}${p.unit ? " (" + p.unit + ")" : ""}: ${p.description}`;
+      return { pointer: p.pointer, text: `${label(p.pointer, r)}: ${allowed}` };
+    });
 }
 
 // ---- save and load ----------------------------------------------------------------------------------
@@ -542,16 +586,39 @@ function recipeChanged() {
   unsavedChanged();
 }
 
+/// The measure document of `recipe` through `geos`. A colour geometry the library refuses for this recipe (an
+/// RGB recipe has no spectrum, so no X, Y, Z: docs/colour.md) is left out by the server, the others are read,
+/// and the document says which and why (`refused`: {geometries, message}, the library's message).
+async function measureDoc(recipe, geos, signal) {
+  return (await post("/api/measure", { recipe, geometries: geos, omit_refused_colour: true }, signal)).json();
+}
+
+/// In place of the readings: what the recipe still needs (no request is sent).
+function showMissing(missing) {
+  state.doc = null;
+  const body = $("readings").querySelector("tbody");
+  const ul = el("ul", {}, ...missing.map((m) => el("li", { "data-pointer": m.pointer, text: m.text })));
+  const cols = $("readings").querySelectorAll("thead th").length || 6;
+  body.replaceChildren(el("tr", { class: "missing" }, el("td", { colspan: cols }, el("p", { text: `To read this ${state.recipe.model} recipe, set:` }), ul)));
+  $("colours").replaceChildren();
+  $("measure-error").textContent = "";
+  $("readings").classList.remove("stale");
+  $("readings").setAttribute("aria-busy", "false");
+  $("readings-state").textContent = "needs a value";
+  status(`${state.recipe.model}: ${missing.map((m) => m.pointer).join(", ")} to set`);
+}
+
 async function measure() {
   const seq = ++state.measureSeq;
   if (state.measureAbort) state.measureAbort.abort();
+  const missing = missingRequired(state.recipe);
+  if (missing.length) return showMissing(missing);
   const ctl = new AbortController();
   state.measureAbort = ctl;
   markStale("computing…");
   status("measuring…");
   try {
-    const r = await post("/api/measure", { recipe: state.recipe, geometries: chosenGeometries() }, ctl.signal);
-    const doc = await r.json();
+    const doc = await measureDoc(state.recipe, chosenGeometries(), ctl.signal);
     if (seq !== state.measureSeq) return; // a newer request is under way: never show this one as current
     state.doc = doc;
     showReadings(doc);
@@ -660,6 +727,16 @@ function showReadings(doc) {
     tr.append(el("td", { class: "note" + (r.converged ? "" : " warn"), title: long + stated, text: short + stated + (r.note ? `; ${r.note}` : "") }), el("td", {}, first ? assumedBox(g) : ""));
     body.append(tr);
   }
+  // The colour geometries the library refused for this recipe: a row each, saying why, in place.
+  for (const id of doc.refused ? doc.refused.geometries : []) {
+    const g = geometryOf(id);
+    const tr = el("tr", { "data-geometry": id, "data-name": "", class: "first refused" },
+      el("td", { class: "instrument", title: `${g.id}: ${(g.standards || []).join(", ")}`, text: g.title }),
+      el("td", { text: "colour" }), el("td", { class: "num value", "data-value": "", text: "—" }), el("td", { class: "unit" }));
+    if (ref) tr.append(el("td", { class: "num ref", text: "—" }), el("td", { class: "num diff", text: "—" }));
+    tr.append(el("td", { class: "note warn", title: doc.refused.message, text: "no colour: " + refusalWords(doc.refused.message) }), el("td", {}, assumedBox(g)));
+    body.append(tr);
+  }
   showColours(doc);
   $("readings").classList.remove("stale");
   $("readings").setAttribute("aria-busy", "false");
@@ -697,12 +774,25 @@ function swatch(lab, caption) {
   return el("figure", { class: "colour" }, s, el("figcaption", { text: `${caption}: L* ${lab.L.toFixed(2)}, a* ${lab.a.toFixed(2)}, b* ${lab.b.toFixed(2)}` }));
 }
 
+/// The library's refusal without the geometry ids it starts with (the row names the instrument).
+function refusalWords(message) {
+  return message.replace(/^(recipe: )?[a-z0-9-]+(, [a-z0-9-]+)*: (?=colour)/, "");
+}
+
 function showColours(doc) {
   const box = $("colours");
   box.replaceChildren();
+  if (doc.refused) {
+    const spectral = (state.fixtures || []).filter((f) => JSON.parse(f.recipe).wavelengths_nm).map((f) => f.name);
+    box.append(el("p", { id: "colour-refused", class: "warn" },
+      `No colour for this recipe through ${doc.refused.geometries.map((id) => geometryOf(id).title).join(", ")}: ${refusalWords(doc.refused.message)}. ` +
+        `Its other readings are shown. Colour needs a spectral recipe: give it "wavelengths_nm" with a value per wavelength` +
+        (spectral.length ? `, or start from a shipped spectral one (${spectral.join(", ")}).` : ".")));
+  }
   const lab = labOf(doc);
   const ref = state.pinned && state.pinned.doc ? labOf(state.pinned.doc) : null;
   if (!lab && !ref) {
+    if (doc.refused) return;
     box.append(el("p", { class: "hint", text: "Tick a colour geometry under Geometries (ASTM E2194 or E2539 multi-angle, the d/8 sphere) to see the colour; it needs a spectral recipe (one with wavelengths_nm)." }));
     return;
   }
@@ -737,7 +827,7 @@ async function remeasurePinned() {
   if (!state.pinned || JSON.stringify(state.pinned.geometries) === JSON.stringify(chosenGeometries())) return;
   const geos = chosenGeometries();
   try {
-    const doc = await (await post("/api/measure", { recipe: state.pinned.recipe, geometries: geos })).json();
+    const doc = await measureDoc(state.pinned.recipe, geos);
     if (state.pinned) Object.assign(state.pinned, { doc, geometries: geos });
     if (state.doc) showReadings(state.doc);
   } catch (e) {
@@ -758,6 +848,11 @@ function setHeaders() {
 const pictureSoon = debounce(picture, 600);
 
 async function picture() {
+  const missing = missingRequired(state.recipe);
+  if (missing.length) {
+    $("picture-error").textContent = `set ${missing.map((m) => m.pointer).join(", ")} first (see the readings)`;
+    return;
+  }
   const seq = ++state.pictureSeq;
   if (state.pictureAbort) state.pictureAbort.abort();
   const ctl = new AbortController();
@@ -867,7 +962,9 @@ async function sweep() {
     return;
   }
   const p = entryOf(ptr, state.recipe.model);
-  const geos = chosenGeometries();
+  // The colour geometries the library refused for this recipe (the readings say why) are not swept.
+  const refused = state.doc && state.doc.refused ? state.doc.refused.geometries : [];
+  const geos = chosenGeometries().filter((id) => !refused.includes(id));
   const body = { recipe: recipeWith(ptr, p).recipe, vary: [`${ptr}=${lo}..${hi}:${n}`], geometries: geos };
   const thead = $("sweep-rows").querySelector("thead"), tbody = $("sweep-rows").querySelector("tbody");
   tbody.replaceChildren();
@@ -966,15 +1063,24 @@ function ticks(lo, hi, n) {
 
 const COLOURS = ["#1f5fbf", "#b3261e", "#116329", "#8a5a00", "#6f42c1", "#0a7d8c", "#c2185b", "#57606a"];
 
-/// One chart per unit (GU, HU, DOI, …): the readings of that unit against the varied number.
+/// The axis a reading is drawn on: its unit (GU, HU, HU(log), DOI, ° of the hue angle); colour's unitless
+/// coordinates on two axes of their own, CIELAB (L*, a*, b*, C*) and X, Y, Z (as the command line's pictures,
+/// `report::pictures::charts::axis_of`).
+function axisOf(unit, name) {
+  if (unit !== "") return unit;
+  return ["X", "Y", "Z"].includes(name) ? "X, Y, Z" : "L*, a*, b*, C*";
+}
+
+/// One chart per axis (GU, HU, DOI, …, CIELAB, X Y Z): the readings on it against the varied number.
 function drawSweep(ptr, what) {
   const rows = state.sweepRows.filter((r) => r.readings);
   const box = $("sweep-charts");
   box.replaceChildren();
   if (!rows.length) return;
-  const units = [...new Set(rows[0].readings.map((r) => r.unit))];
-  for (const unit of units) {
-    const series = rows[0].readings.filter((r) => r.unit === unit).map((r) => ({ geometry: r.geometry, name: r.name, pts: [] }));
+  const axes = [...new Set(rows[0].readings.map((r) => axisOf(r.unit, r.name)))];
+  for (const axis of axes) {
+    const unit = rows[0].readings.find((r) => axisOf(r.unit, r.name) === axis).unit;
+    const series = rows[0].readings.filter((r) => axisOf(r.unit, r.name) === axis).map((r) => ({ geometry: r.geometry, name: r.name, pts: [] }));
     for (const row of rows) {
       for (const s of series) {
         const x = row.readings.find((y) => y.geometry === s.geometry && y.name === s.name);
@@ -988,8 +1094,9 @@ function drawSweep(ptr, what) {
     if (x1 === x0) [x0, x1] = [x0 - 1, x1 + 1];
     const W = 520, H = 260, L = 58, R = 12, T = 24, B = 40;
     const sx = (x) => L + ((x - x0) / (x1 - x0)) * (W - L - R), sy = (y) => H - B - ((y - y0) / (y1 - y0)) * (H - T - B);
-    const g = svg("svg", { viewBox: `0 0 ${W} ${H}`, width: W, height: H, role: "img", class: "chart", "data-unit": unit || "colour" });
-    g.append(svg("title", { text: `${unit || "colour"} against ${what}` }));
+    const colour = unit === "" ? `colour: ${axis} (no unit)` : null;
+    const g = svg("svg", { viewBox: `0 0 ${W} ${H}`, width: W, height: H, role: "img", class: "chart", "data-unit": axis });
+    g.append(svg("title", { text: `${colour || axis} against ${what}` }));
     g.append(svg("rect", { x: L, y: T, width: W - L - R, height: H - T - B, fill: "none", stroke: "#d0d7de" }));
     for (const t of ticks(x0, x1, 6)) {
       g.append(svg("line", { x1: sx(t), x2: sx(t), y1: H - B, y2: H - B + 4, stroke: "#57606a" }));
@@ -1000,7 +1107,7 @@ function drawSweep(ptr, what) {
       g.append(svg("text", { x: L - 6, y: sy(t) + 4, "text-anchor": "end", "font-size": 11, text: String(t) }));
     }
     g.append(svg("text", { x: (L + W - R) / 2, y: H - 6, "text-anchor": "middle", "font-size": 12, text: what }));
-    g.append(svg("text", { x: 14, y: (T + H - B) / 2, "text-anchor": "middle", "font-size": 12, transform: `rotate(-90 14 ${(T + H - B) / 2})`, text: unit || "L*, a*, b*" }));
+    g.append(svg("text", { x: 14, y: (T + H - B) / 2, "text-anchor": "middle", "font-size": 12, transform: `rotate(-90 14 ${(T + H - B) / 2})`, text: colour || axis }));
     series.forEach((s, i) => {
       const c = COLOURS[i % COLOURS.length];
       g.append(svg("polyline", { points: s.pts.map(([x, y]) => `${sx(x).toFixed(1)},${sy(y).toFixed(1)}`).join(" "), fill: "none", stroke: c, "stroke-width": 2, class: "series" }));
@@ -1216,8 +1323,9 @@ function setupTabs() {
 
 async function start() {
   $("params").addEventListener("submit", (e) => e.preventDefault());
-  const [reg, geos, fix] = await Promise.all(["/api/registry", "/api/geometries", "/api/fixtures"].map((p) => fetch(p).then((r) => r.json())));
+  const [reg, geos, fix, tables] = await Promise.all(["/api/registry", "/api/geometries", "/api/fixtures", "/api/tables"].map((p) => fetch(p).then((r) => r.json())));
   state.registry = reg;
+  state.tables = tables;
   state.geometries = geos.geometries;
   for (const m of reg.models) $("model").append(el("option", { value: m, text: m }));
   const box = $("geometries");
