@@ -741,6 +741,7 @@ pub const EXACTLY_ONE: &[(&str, &str, &str)] = &[
     ("/metallic_flakes", "spread_deg", "spread_slope"),
     ("/pearlescent_flakes", "spread_deg", "spread_slope"),
     ("", "roughness", "populations"),
+    ("/clear_coat/application/texture", "psd", "file"),
 ];
 
 pub const METALLIC: Param =
@@ -1070,6 +1071,160 @@ pub const MICROFACET_SCATTER: ScatterParams = scatter_params!(
     "the interface (smooth: on its mirror; rough: the two-scale surface of slopes and halo, brdf/two_scale.rs)"
 );
 
+/// The applied texture's rms height, nm: above 0 (a texture with no energy has nothing to level) up to
+/// 100 µm (beyond any applicator's texture on a film of at most 10 mm).
+pub const TEXTURE_SIGMA_RANGE: Range = Range { lo: 0.0, lo_closed: false, hi: 1e5, hi_closed: true };
+/// The applied texture's correlation length, µm: 0.01 µm to 100 mm.
+pub const TEXTURE_ELL_RANGE: Range = Range::closed(0.01, 1e5);
+
+pub const APPLICATION: Param = p(
+    "/clear_coat/application",
+    PAINT,
+    Type::Object,
+    "",
+    NONE,
+    Opt("none: the coat's `roughness` and `scatter` as given"),
+    "how the coat was applied and dried; its levelled texture gives the coat's facets, Beckmann α = the cured Sdq (not with `roughness` or `scatter`; docs/model.md §From the cured spectrum to the coat)",
+);
+pub const APP_TEXTURE: Param = p(
+    "/clear_coat/application/texture",
+    PAINT,
+    Type::Object,
+    "",
+    NONE,
+    Req,
+    "the applicator's texture as applied (wet), an isotropic PSD",
+);
+pub const APP_TEXTURE_PSD: Param = p(
+    "/clear_coat/application/texture/psd",
+    PAINT,
+    Type::Choice(&["k-correlation", "gaussian"]),
+    "",
+    NONE,
+    Opt("give this or file"),
+    "the applied texture's PSD: Church–Takacs K-correlation (ABC) or Gaussian",
+);
+pub const APP_TEXTURE_SIGMA: Param = p(
+    "/clear_coat/application/texture/rms_roughness_nm",
+    PAINT,
+    Type::Number,
+    "nm",
+    Some(TEXTURE_SIGMA_RANGE),
+    Opt("required with psd"),
+    "rms height of the wet texture as applied (all frequencies)",
+);
+pub const APP_TEXTURE_ELL: Param = p(
+    "/clear_coat/application/texture/correlation_length_um",
+    PAINT,
+    Type::Number,
+    "µm",
+    Some(TEXTURE_ELL_RANGE),
+    Opt("required with psd"),
+    "correlation length ℓ of the applied texture: B = 2πℓ (K-correlation), exp(−r²/ℓ²) autocovariance (Gaussian)",
+);
+pub const APP_TEXTURE_C: Param = p(
+    "/clear_coat/application/texture/c",
+    PAINT,
+    Type::Number,
+    "",
+    Some(SCATTER_C_RANGE),
+    Opt("2 (exponential autocovariance)"),
+    "K-correlation exponent C of the applied texture; k-correlation only",
+);
+pub const APP_TEXTURE_FILE: Param = p(
+    "/clear_coat/application/texture/file",
+    PAINT,
+    Type::Text,
+    "",
+    NONE,
+    Opt("give this or psd"),
+    "a measured topography of the texture as applied (.x3p, .sdf or .gsf), relative to the recipe's directory: its own 2-D PSD is levelled, over the map's band (docs/model.md §From the cured spectrum to the coat)",
+);
+pub const APP_TEXTURE_LEVELLING: Param = p(
+    "/clear_coat/application/texture/levelling",
+    PAINT,
+    Type::Choice(&["mean", "plane", "poly2", "poly3", "poly4", "poly5"]),
+    "",
+    NONE,
+    Opt("\"plane\"; with file"),
+    "the reference surface removed from the measured texture before its PSD is taken",
+);
+pub const APP_TEXTURE_NOTES: Param =
+    p("/clear_coat/application/texture/notes", PAINT, Type::Notes, "", NONE, Opt("none"), "free text");
+pub const APP_WET_FILM: Param = p(
+    "/clear_coat/application/wet_film_um",
+    PAINT,
+    Type::Number,
+    "µm",
+    Some(Range { lo: 0.0, lo_closed: false, hi: 10_000.0, hi_closed: true }),
+    Req,
+    "wet film thickness as applied (film build)",
+);
+pub const APP_VOLUME_SOLIDS: Param = p(
+    "/clear_coat/application/volume_solids",
+    PAINT,
+    Type::Number,
+    "",
+    Some(Range { lo: 0.0, lo_closed: false, hi: 1.0, hi_closed: true }),
+    Req,
+    "volume solids v: dry film = v × wet film",
+);
+pub const APP_SURFACE_TENSION: Param = p(
+    "/clear_coat/application/surface_tension_mn_m",
+    PAINT,
+    Type::Number,
+    "mN/m",
+    Some(Range { lo: 0.0, lo_closed: false, hi: 1000.0, hi_closed: true }),
+    Req,
+    "surface tension γ of the wet film",
+);
+pub const APP_FLASH_OFF: Param = p(
+    "/clear_coat/application/flash_off_s",
+    PAINT,
+    Type::Number,
+    "s",
+    Some(Range::closed(0.0, 1e7)),
+    Opt("0 (the film at its dry thickness from the start)"),
+    "flash-off time: the film thins linearly from wet to dry over it",
+);
+pub const APP_SURFACE_TENSION_GRADIENT: Param = p(
+    "/clear_coat/application/surface_tension_gradient_mn_m_per_um",
+    PAINT,
+    Type::Number,
+    "mN/m per µm",
+    Some(Range::closed(-1000.0, 1000.0)),
+    Opt("0 (a uniform surface tension)"),
+    "γ' = dγ/dh: the wet film's surface tension per µm of local thickness above the mean (Overdiep's surface-tension gradient); positive works against levelling (docs/model.md §Levelling of the applied texture)",
+);
+pub const APP_VISCOSITY: Param = p(
+    "/clear_coat/application/viscosity",
+    PAINT,
+    Type::Objects,
+    "",
+    NONE,
+    Req,
+    "the wet film's viscosity against time, {t_s, eta_pa_s}: from t = 0, times increasing, viscosity not falling; ln η linear between points; the last time ends the flow",
+);
+pub const APP_VISCOSITY_T: Param = p(
+    "/clear_coat/application/viscosity/*/t_s",
+    PAINT,
+    Type::Number,
+    "s",
+    Some(Range::closed(0.0, 1e7)),
+    Req,
+    "time since application",
+);
+pub const APP_VISCOSITY_ETA: Param = p(
+    "/clear_coat/application/viscosity/*/eta_pa_s",
+    PAINT,
+    Type::Number,
+    "Pa·s",
+    Some(Range { lo: 0.0, lo_closed: false, hi: 1e15, hi_closed: true }),
+    Req,
+    "low-shear viscosity of the wet film at that time",
+);
+pub const APP_NOTES: Param = p("/clear_coat/application/notes", PAINT, Type::Notes, "", NONE, Opt("none"), "free text");
+
 /// Every entry, in the order of the docs table (descriptive fields first, then model by model).
 pub static PARAMS: &[&Param] = &[
     &MODEL,
@@ -1150,6 +1305,24 @@ pub static PARAMS: &[&Param] = &[
     &PAINT_SCATTER.a,
     &PAINT_SCATTER.b,
     &PAINT_SCATTER.notes,
+    &APPLICATION,
+    &APP_TEXTURE,
+    &APP_TEXTURE_PSD,
+    &APP_TEXTURE_SIGMA,
+    &APP_TEXTURE_ELL,
+    &APP_TEXTURE_C,
+    &APP_TEXTURE_FILE,
+    &APP_TEXTURE_LEVELLING,
+    &APP_TEXTURE_NOTES,
+    &APP_WET_FILM,
+    &APP_VOLUME_SOLIDS,
+    &APP_SURFACE_TENSION,
+    &APP_FLASH_OFF,
+    &APP_SURFACE_TENSION_GRADIENT,
+    &APP_VISCOSITY,
+    &APP_VISCOSITY_T,
+    &APP_VISCOSITY_ETA,
+    &APP_NOTES,
     &LAYER,
     &LAYER_THICKNESS,
     &LAYER_PRIMER,

@@ -24,6 +24,7 @@ fn application(v: &Value) -> Application {
             .iter()
             .map(|p| ViscosityPoint { t_s: p[0].as_f64().unwrap(), eta_pa_s: p[1].as_f64().unwrap() })
             .collect(),
+        surface_tension_gradient_mn_m_per_um: v["surface_tension_gradient_mn_m_per_um"].as_f64().unwrap_or(0.0),
     }
 }
 
@@ -56,6 +57,45 @@ fn small_textures_level_as_the_linear_model_says_and_the_difference_grows_as_the
     }
 }
 
+/// The surface-tension gradient's Marangoni term (docs/model.md §Levelling of the applied texture) against the full
+/// equation with the Marangoni flux: at ε = 10⁻³ the linear transfer exp(−(16π⁴/3)f⁴L + 4π²f²M) agrees to the
+/// same second-order difference as without it, for γ' of both signs, and M agrees with SciPy's quad.
+#[test]
+fn a_surface_tension_gradient_moves_the_transfer_as_the_full_equation_does() {
+    let f = fixture();
+    let base = &f["application"];
+    let runs = f["gradient"].as_array().expect("the gradient block");
+    assert!(runs.len() >= 6, "the fixture holds {} gradient runs", runs.len());
+    let mut signs = (0, 0);
+    for r in runs {
+        let g = r["surface_tension_gradient_mn_m_per_um"].as_f64().unwrap();
+        let mut v = base.clone();
+        v["surface_tension_gradient_mn_m_per_um"] = g.into();
+        let app = application(&v);
+        app.validate().unwrap();
+        let m = app.gradient_integral_um2();
+        let reference = r["gradient_integral_um2"].as_f64().unwrap();
+        assert!((m / reference - 1.0).abs() < 1e-11, "γ' {g}: M = {m} µm², SciPy {reference}");
+        let lambda = r["wavelength_um"].as_f64().unwrap();
+        let linear = app.amplitude_transfer(1.0 / lambda);
+        let nonlinear = r["nonlinear_ratio"].as_f64().unwrap();
+        let rel = nonlinear / linear - 1.0;
+        assert!(rel.abs() < 1e-5, "γ' {g}, Λ = {lambda} µm: nonlinear/linear − 1 = {rel:e}");
+        // The gradient's sign moves the transfer the way the flux says, against the same film without it.
+        let mut plain = app.clone();
+        plain.surface_tension_gradient_mn_m_per_um = 0.0;
+        let without = plain.amplitude_transfer(1.0 / lambda);
+        if g > 0.0 {
+            assert!(nonlinear > without, "γ' {g} > 0 levels less: {nonlinear} vs {without}");
+            signs.0 += 1;
+        } else {
+            assert!(nonlinear < without, "γ' {g} < 0 levels more: {nonlinear} vs {without}");
+            signs.1 += 1;
+        }
+    }
+    assert!(signs.0 > 0 && signs.1 > 0, "both signs of γ' are in the fixture");
+}
+
 #[test]
 fn a_thicker_film_a_thinner_paint_and_a_longer_open_time_each_level_more() {
     let base = Application {
@@ -68,6 +108,7 @@ fn a_thicker_film_a_thinner_paint_and_a_longer_open_time_each_level_more() {
             ViscosityPoint { t_s: 60.0, eta_pa_s: 3.0 },
             ViscosityPoint { t_s: 600.0, eta_pa_s: 300.0 },
         ],
+        surface_tension_gradient_mn_m_per_um: 0.0,
     };
     let l0 = base.levelling_integral_um4();
     let mut thick = base.clone();

@@ -25,6 +25,8 @@
 //!   [`two_scale::RoughWithHalo`]), `topography.rs` (the facets of a measured surface's own slopes,
 //!   [`topography::TopographySurface`]) and `paint`, the paint model of Ďurikovič & Ágošton
 //!   (2007) ([`paint::Paint`] built from a [`paint::PaintSpec`]);
+//! * `annotated.rs`: a model with a note on where its parameters came from ([`annotated::Annotated`], the
+//!   inner model's bits, its description and the note);
 //! * `albedo.rs`: the directional albedo that resolves narrow lobes
 //!   ([`albedo::directional_albedo`], [`albedo::directional_albedo_to`]): a d/8 sphere's hemisphere
 //!   reading (`instrument::sphere`) and the tests' white furnace.
@@ -35,6 +37,7 @@ use crate::spectrum::Sampling;
 use crate::{Error, Result, Vec3};
 
 pub mod albedo;
+pub mod annotated;
 pub mod conductor;
 pub mod dielectric;
 pub mod halo;

@@ -11,7 +11,12 @@
 //!   a(T)/a(0) = exp(−(16π⁴/3)·f⁴·L), L = ∫₀ᵀ γ h(t)³/η(t) dt (the levelling integral);
 //! * the dry film keeps the resin: with the solids spread evenly through the film's depth (no
 //!   surface-tension gradients), a texture frozen at the end of flow dries to `volume_solids` of its wet
-//!   amplitude, so the cured PSD is S_cured(f) = v²·S_applied(f)·exp(−(32π⁴/3)·f⁴·L).
+//!   amplitude, so the cured PSD is S_cured(f) = v²·S_applied(f)·exp(−(32π⁴/3)·f⁴·L);
+//! * a surface tension that varies along the surface drives a Marangoni flux h²∂γ/∂x/(2η) beside the capillary
+//!   one (the lubrication equation, Oron, Davis & Bankoff 1997); with γ = γ₀ + γ'·(h − h̄) (Overdiep 1986: the
+//!   solvent leaves crests and troughs at different fractions) a mode gains da/dt = +γ'h²k²/(2η)·a, so the
+//!   transfer becomes exp(−(16π⁴/3)·f⁴·L + 4π²·f²·M), M = ∫₀ᵀ γ'h(t)²/(2η(t)) dt (the gradient integral).
+use crate::optics::scatter::Psd;
 use crate::quadrature::gauss_legendre;
 use std::f64::consts::PI;
 
@@ -39,7 +44,33 @@ pub struct Application {
     /// The viscosity against time, from t = 0, times increasing, viscosities not decreasing; between points
     /// ln η is linear in t. The last point ends the flow (the gel point, or the end of the open time).
     pub viscosity: Vec<ViscosityPoint>,
+    /// γ' = dγ/dh, mN/m per µm: how the surface tension of the wet film changes with the local thickness above
+    /// the mean (Overdiep's surface-tension gradient); 0 without one. Positive works against levelling.
+    pub surface_tension_gradient_mn_m_per_um: f64,
 }
+
+/// A field of an [`Application`] that is not allowed: its path relative to the application block (`wet_film_um`,
+/// `viscosity/1/eta_pa_s`) and what is allowed.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Invalid {
+    pub field: String,
+    pub message: String,
+}
+
+impl std::fmt::Display for Invalid {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}: {}", self.field, self.message)
+    }
+}
+
+fn invalid(field: impl Into<String>, message: impl Into<String>) -> Invalid {
+    Invalid { field: field.into(), message: message.into() }
+}
+
+/// The largest growth of a mode's amplitude that the surface-tension gradient may give: the linear model holds
+/// while the texture stays below a tenth of the film (within 1 % of the full equation, docs/model.md §Levelling
+/// of the applied texture), so a texture that starts at a hundredth of it may grow tenfold at most.
+pub const MAX_GROWTH: f64 = 10.0;
 
 /// Gauss–Legendre points per sub-interval of the levelling integral. On a sub-interval the integrand is a
 /// cubic in t times exp(−b t) with |b|·Δt ≤ 1 (`MAX_LOG_STEP`), which 16 points integrate to rounding.
@@ -52,52 +83,85 @@ const MAX_PIECES: usize = 100_000;
 
 impl Application {
     /// Check every field, naming it and what is allowed.
-    pub fn validate(&self) -> Result<(), String> {
-        let positive = |name: &str, v: f64, unit: &str| -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), Invalid> {
+        let positive = |name: &str, v: f64, unit: &str| -> Result<(), Invalid> {
             if !(v > 0.0) || !v.is_finite() {
-                return Err(format!("{name}: must be a finite number > 0 {unit} (got {v})"));
+                return Err(invalid(name, format!("must be a finite number > 0 {unit} (got {v})")));
             }
             Ok(())
         };
         positive("wet_film_um", self.wet_film_um, "µm")?;
         if !(self.wet_film_um <= 10_000.0) {
-            return Err(format!("wet_film_um: at most 10 000 µm (got {})", self.wet_film_um));
+            return Err(invalid("wet_film_um", format!("at most 10 000 µm (got {})", self.wet_film_um)));
         }
         if !(self.volume_solids > 0.0 && self.volume_solids <= 1.0) {
-            return Err(format!("volume_solids: must be in (0, 1] (got {})", self.volume_solids));
+            return Err(invalid("volume_solids", format!("must be in (0, 1] (got {})", self.volume_solids)));
         }
         positive("surface_tension_mn_m", self.surface_tension_mn_m, "mN/m")?;
         if !(self.flash_off_s >= 0.0) || !self.flash_off_s.is_finite() {
-            return Err(format!("flash_off_s: must be a finite number ≥ 0 s (got {})", self.flash_off_s));
+            return Err(invalid("flash_off_s", format!("must be a finite number ≥ 0 s (got {})", self.flash_off_s)));
+        }
+        if !self.surface_tension_gradient_mn_m_per_um.is_finite() {
+            return Err(invalid(
+                "surface_tension_gradient_mn_m_per_um",
+                format!("must be a finite number (got {})", self.surface_tension_gradient_mn_m_per_um),
+            ));
         }
         if self.viscosity.is_empty() {
-            return Err("viscosity: needs at least one point {t_s, eta_pa_s}".into());
+            return Err(invalid("viscosity", "needs at least one point {t_s, eta_pa_s}"));
         }
         let mut log_span = 0.0;
         for (i, p) in self.viscosity.iter().enumerate() {
             positive(&format!("viscosity/{i}/eta_pa_s"), p.eta_pa_s, "Pa·s")?;
             if !(p.t_s >= 0.0) || !p.t_s.is_finite() {
-                return Err(format!("viscosity/{i}/t_s: must be a finite number ≥ 0 s (got {})", p.t_s));
+                return Err(invalid(
+                    format!("viscosity/{i}/t_s"),
+                    format!("must be a finite number ≥ 0 s (got {})", p.t_s),
+                ));
             }
             if i == 0 && p.t_s != 0.0 {
-                return Err(format!("viscosity/0/t_s: the table starts at application, t = 0 s (got {})", p.t_s));
+                return Err(invalid(
+                    "viscosity/0/t_s",
+                    format!("the table starts at application, t = 0 s (got {})", p.t_s),
+                ));
             }
             if i > 0 {
                 let q = self.viscosity[i - 1];
                 if !(p.t_s > q.t_s) {
-                    return Err(format!("viscosity/{i}/t_s: times must increase (got {} after {})", p.t_s, q.t_s));
+                    return Err(invalid(
+                        format!("viscosity/{i}/t_s"),
+                        format!("times must increase (got {} after {})", p.t_s, q.t_s),
+                    ));
                 }
                 if p.eta_pa_s < q.eta_pa_s {
-                    return Err(format!(
-                        "viscosity/{i}/eta_pa_s: a drying film's viscosity does not fall (got {} after {} Pa·s)",
-                        p.eta_pa_s, q.eta_pa_s
+                    return Err(invalid(
+                        format!("viscosity/{i}/eta_pa_s"),
+                        format!(
+                            "a drying film's viscosity does not fall (got {} after {} Pa·s)",
+                            p.eta_pa_s, q.eta_pa_s
+                        ),
                     ));
                 }
                 log_span += (p.eta_pa_s / q.eta_pa_s).ln();
             }
         }
         if log_span / MAX_LOG_STEP > MAX_PIECES as f64 / 2.0 {
-            return Err(format!("viscosity: rises by e^{log_span:.0}, beyond what the model resolves (e^50 000)"));
+            return Err(invalid(
+                "viscosity",
+                format!("rises by e^{log_span:.0}, beyond what the model resolves (e^50 000)"),
+            ));
+        }
+        let growth = self.largest_growth();
+        if !(growth <= MAX_GROWTH) {
+            return Err(invalid(
+                "surface_tension_gradient_mn_m_per_um",
+                format!(
+                    "the gradient grows the texture by up to {}× (at Λ = {} µm) before the flow ends, beyond the \
+                     linear model (allowed: a growth of at most {MAX_GROWTH}×; a smaller gradient, or more levelling)",
+                    crate::error::number(growth),
+                    crate::error::number(1.0 / self.fastest_growing_frequency_per_um()),
+                ),
+            ));
         }
         Ok(())
     }
@@ -136,13 +200,29 @@ impl Application {
         v[v.len() - 1].eta_pa_s
     }
 
-    /// The levelling integral L = ∫₀ᵀ γ h³/η dt in µm⁴, T the end of flow.
+    /// The levelling integral L = ∫₀ᵀ γ h³/η dt in µm⁴, T the end of flow. γ/η in (N/m)/(Pa·s) = m/s, times
+    /// h³ in µm³ and dt in s, is 10⁶ µm⁴ per unit.
+    pub fn levelling_integral_um4(&self) -> f64 {
+        let gamma = self.surface_tension_mn_m * 1e-3;
+        self.over_the_flow(|w, t| w * gamma * self.thickness_um(t).powi(3) / self.viscosity_pa_s(t)) * 1e6
+    }
+
+    /// The gradient integral M = ∫₀ᵀ γ' h²/(2η) dt in µm²: γ' in mN/m per µm is 10³ Pa, and Pa·µm²/(Pa·s) over
+    /// dt in s is µm², so 10³ µm² per unit. 0 without a gradient.
+    pub fn gradient_integral_um2(&self) -> f64 {
+        let g = self.surface_tension_gradient_mn_m_per_um;
+        if g == 0.0 {
+            return 0.0;
+        }
+        self.over_the_flow(|w, t| w * g * self.thickness_um(t).powi(2) / (2.0 * self.viscosity_pa_s(t))) * 1e3
+    }
+
+    /// ∫₀ᵀ of an integrand given as `term(weight, t)` (the weight multiplied in first).
     ///
     /// The breakpoints (the table's times and the end of the flash-off) cut [0, T] into intervals on which h
     /// is linear and ln η linear; each is split so that ln η changes by at most `MAX_LOG_STEP` per piece, and
-    /// each piece takes `NODES` Gauss–Legendre points. γ/η in (N/m)/(Pa·s) = m/s, times h³ in µm³ and dt in
-    /// s, is 10⁶ µm⁴ per unit.
-    pub fn levelling_integral_um4(&self) -> f64 {
+    /// each piece takes `NODES` Gauss–Legendre points.
+    fn over_the_flow(&self, term: impl Fn(f64, f64) -> f64) -> f64 {
         let end = self.end_of_flow_s();
         let mut cuts: Vec<f64> = self.viscosity.iter().map(|p| p.t_s).collect();
         if self.flash_off_s > 0.0 && self.flash_off_s < end {
@@ -151,7 +231,6 @@ impl Application {
         cuts.sort_by(f64::total_cmp);
         cuts.dedup();
         let (x, w) = gauss_legendre(NODES);
-        let gamma = self.surface_tension_mn_m * 1e-3;
         let mut sum = 0.0;
         for pair in cuts.windows(2) {
             let (a, b) = (pair[0], pair[1]);
@@ -162,17 +241,46 @@ impl Application {
                 let (lo, hi) = (a + k as f64 * step, a + (k + 1) as f64 * step);
                 let (mid, half) = (0.5 * (lo + hi), 0.5 * (hi - lo));
                 for (xi, wi) in x.iter().zip(&w) {
-                    let t = mid + half * xi;
-                    sum += wi * half * gamma * self.thickness_um(t).powi(3) / self.viscosity_pa_s(t);
+                    sum += term(wi * half, mid + half * xi);
                 }
             }
         }
-        sum * 1e6
+        sum
     }
 
-    /// The wet surface's amplitude transfer at spatial frequency f (1/µm): a(T)/a(0) = exp(−(16π⁴/3) f⁴ L).
+    /// The flow's two integrals, L (µm⁴) and M (µm²).
+    pub fn flow(&self) -> Flow {
+        Flow { l_um4: self.levelling_integral_um4(), m_um2: self.gradient_integral_um2() }
+    }
+
+    /// The largest amplitude transfer over all frequencies: exp(B²/(4A)) with A = (16π⁴/3)L, B = 4π²M when
+    /// the gradient works against levelling (M > 0), else 1 (at f → 0); infinite when nothing levels (L = 0).
+    pub fn largest_growth(&self) -> f64 {
+        let flow = self.flow();
+        if !(flow.m_um2 > 0.0) {
+            return 1.0;
+        }
+        let (a, b) = (16.0 * PI.powi(4) / 3.0 * flow.l_um4, 4.0 * PI * PI * flow.m_um2);
+        if !(a > 0.0) {
+            return f64::INFINITY;
+        }
+        (b * b / (4.0 * a)).exp()
+    }
+
+    /// The frequency of the largest growth, f² = B/(2A) (1/µm); 0 without a gradient against levelling.
+    pub fn fastest_growing_frequency_per_um(&self) -> f64 {
+        let flow = self.flow();
+        let (a, b) = (16.0 * PI.powi(4) / 3.0 * flow.l_um4, 4.0 * PI * PI * flow.m_um2);
+        if !(b > 0.0 && a > 0.0) {
+            return 0.0;
+        }
+        (b / (2.0 * a)).sqrt()
+    }
+
+    /// The wet surface's amplitude transfer at spatial frequency f (1/µm): a(T)/a(0) = exp(−(16π⁴/3) f⁴ L +
+    /// 4π² f² M).
     pub fn amplitude_transfer(&self, f_per_um: f64) -> f64 {
-        amplitude_transfer(self.levelling_integral_um4(), f_per_um)
+        self.flow().amplitude_transfer(f_per_um)
     }
 
     /// The frequency (1/µm) whose amplitude the levelling takes down by 1/e: f_e = (3/(16π⁴ L))^{1/4}.
@@ -181,10 +289,20 @@ impl Application {
     }
 }
 
-/// exp(−(16π⁴/3) f⁴ L): the amplitude left of a mode of spatial frequency f (1/µm) after a levelling
-/// integral L (µm⁴).
-pub fn amplitude_transfer(l_um4: f64, f_per_um: f64) -> f64 {
-    (-(16.0 * PI.powi(4) / 3.0) * f_per_um.powi(4) * l_um4).exp()
+/// The two integrals of a film's flow: L = ∫γh³/η dt (µm⁴), which levels, and M = ∫γ'h²/(2η) dt (µm²), the
+/// surface-tension gradient's, which works against levelling when positive.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Flow {
+    pub l_um4: f64,
+    pub m_um2: f64,
+}
+
+impl Flow {
+    /// The amplitude left of a mode of spatial frequency f (1/µm): exp(−(16π⁴/3) f⁴ L + 4π² f² M).
+    pub fn amplitude_transfer(&self, f_per_um: f64) -> f64 {
+        (-(16.0 * PI.powi(4) / 3.0) * f_per_um.powi(4) * self.l_um4 + 4.0 * PI * PI * f_per_um.powi(2) * self.m_um2)
+            .exp()
+    }
 }
 
 /// (3/(16π⁴ L))^{1/4}: the spatial frequency (1/µm) levelled to 1/e of its amplitude by L (µm⁴); infinite
@@ -193,10 +311,141 @@ pub fn levelled_frequency(l_um4: f64) -> f64 {
     (3.0 / (16.0 * PI.powi(4) * l_um4)).powf(0.25)
 }
 
-/// The cured PSD's factor at spatial frequency f (1/µm): v²·exp(−(32π⁴/3) f⁴ L), for a PSD of the applied
-/// texture's heights (docs/model.md §Levelling of the applied texture).
-pub fn psd_transfer(volume_solids: f64, l_um4: f64, f_per_um: f64) -> f64 {
-    volume_solids * volume_solids * amplitude_transfer(l_um4, f_per_um).powi(2)
+/// The cured PSD's factor at spatial frequency f (1/µm): v²·exp(2·(−(16π⁴/3) f⁴ L + 4π² f² M)), for a PSD of
+/// the applied texture's heights (docs/model.md §Levelling of the applied texture).
+pub fn psd_transfer(volume_solids: f64, flow: Flow, f_per_um: f64) -> f64 {
+    volume_solids * volume_solids * flow.amplitude_transfer(f_per_um).powi(2)
+}
+
+/// Gauss–Legendre points per piece of a cured PSD's radial moments (the integrand, smooth in ln f, is
+/// integrated over pieces of ln f no wider than [`LEVELLED_STEP`]).
+const LEVELLED_NODES: usize = 16;
+/// The width in ln f of one piece of a cured PSD's moment table.
+const LEVELLED_STEP: f64 = 0.125;
+/// The PSD factor exp(−x) below which the cured spectrum is taken as zero: exp(−745) is below the smallest
+/// subnormal double.
+const LEVELLED_UNDERFLOW: f64 = 745.0;
+
+/// A surface texture's PSD as applied ([`Psd::KCorrelation`] or [`Psd::Gaussian`]) after the film's levelling
+/// (docs/model.md §Levelling of the applied texture): S_c(f) = v²·S_a(f)·exp(2·(−(16π⁴/3)·f⁴·L + 4π²·f²·M)).
+/// Its radial moments M_j(ρ) = ∫₀^ρ (2πf)^j S_c(f) f df (j = 0: heights, j = 2: slopes) over the whole cured
+/// spectrum are tabulated at construction, on knots a [`LEVELLED_STEP`] apart in ln f, by Gauss–Legendre
+/// quadrature in ln f; between knots a moment adds one more such piece.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CuredPsd {
+    /// The texture as applied (a K-correlation or Gaussian PSD).
+    pub applied: Psd,
+    /// Volume solids v: the dry film keeps v of the wet texture's amplitude.
+    pub volume_solids: f64,
+    /// The flow's integrals L (µm⁴) and M (µm²).
+    pub flow: Flow,
+    f_min: f64,
+    f_max: f64,
+    knots: Vec<f64>,
+    m0: Vec<f64>,
+    m2: Vec<f64>,
+}
+
+impl CuredPsd {
+    /// The cured PSD of `applied` after a flow `flow` at volume solids `v`.
+    pub fn new(applied: Psd, v: f64, flow: Flow) -> CuredPsd {
+        let l_um4 = flow.l_um4;
+        let f_e = if l_um4 > 0.0 { levelled_frequency(l_um4) } else { f64::INFINITY };
+        let knee = applied.knee();
+        let f_min = 1e-6 * knee.min(f_e);
+        // Beyond f_max the factor exp(−(32π⁴/3) f⁴ L) underflows; without levelling the table stops 10⁸ knees
+        // out and the height moment adds the applied PSD's closed-form tail.
+        let f_max =
+            if l_um4 > 0.0 { (LEVELLED_UNDERFLOW / (32.0 * PI.powi(4) / 3.0 * l_um4)).powf(0.25) } else { 1e8 * knee }
+                .max(2.0 * f_min);
+        let span = (f_max / f_min).ln();
+        let n = ((span / LEVELLED_STEP).ceil() as usize).clamp(1, 4000);
+        let step = span / n as f64;
+        let mut l = CuredPsd {
+            applied,
+            volume_solids: v,
+            flow,
+            f_min,
+            f_max,
+            knots: Vec::with_capacity(n + 1),
+            m0: Vec::with_capacity(n + 1),
+            m2: Vec::with_capacity(n + 1),
+        };
+        let s0 = l.cured(0.0);
+        let (mut a0, mut a2) = (s0 * f_min * f_min / 2.0, 4.0 * PI * PI * s0 * f_min.powi(4) / 4.0);
+        let mut prev = f_min;
+        for i in 0..=n {
+            let f = if i == n { f_max } else { f_min * (i as f64 * step).exp() };
+            if i > 0 {
+                a0 += l.piece(0, prev, f);
+                a2 += l.piece(2, prev, f);
+            }
+            l.knots.push(f);
+            l.m0.push(a0);
+            l.m2.push(a2);
+            prev = f;
+        }
+        l
+    }
+
+    /// S_c(f), nm²·µm², over the whole spectrum (no band limit).
+    pub fn cured(&self, f: f64) -> f64 {
+        psd_transfer(self.volume_solids, self.flow, f) * self.applied.s2(f)
+    }
+
+    /// ∫ over [a, b] of (2πf)^j S_c(f) f df by one Gauss–Legendre piece in ln f.
+    fn piece(&self, j: i32, a: f64, b: f64) -> f64 {
+        if !(b > a) {
+            return 0.0;
+        }
+        let (x, w) = gauss_legendre(LEVELLED_NODES);
+        let (ua, ub) = (a.ln(), b.ln());
+        let (mid, half) = (0.5 * (ua + ub), 0.5 * (ub - ua));
+        let mut sum = 0.0;
+        for (xi, wi) in x.iter().zip(&w) {
+            let f = (mid + half * xi).exp();
+            sum += wi * (2.0 * PI * f).powi(j) * self.cured(f) * f * f;
+        }
+        sum * half
+    }
+
+    /// M_j(ρ) = ∫₀^ρ (2πf)^j S_c(f) f df over the whole cured spectrum, j = 0 (nm²) or 2 (nm²/µm²). For ρ
+    /// beyond the table without levelling, M_0 adds the applied PSD's closed-form tail; M_2 is only asked
+    /// below the table's end.
+    pub fn moment(&self, j: i32, rho: f64) -> f64 {
+        let s0 = self.cured(0.0);
+        if rho <= self.f_min {
+            return match j {
+                0 => s0 * rho * rho / 2.0,
+                _ => 4.0 * PI * PI * s0 * rho.powi(4) / 4.0,
+            };
+        }
+        let tab = if j == 0 { &self.m0 } else { &self.m2 };
+        let last = self.knots.len() - 1;
+        if rho >= self.f_max {
+            let tail = if j == 0 && self.flow.l_um4 == 0.0 {
+                let v2 = self.volume_solids * self.volume_solids;
+                v2 * (self.applied.radial_cumulative(rho) - self.applied.radial_cumulative(self.f_max)).max(0.0)
+            } else {
+                0.0
+            };
+            return tab[last] + tail;
+        }
+        let i = self.knots.partition_point(|&k| k <= rho).saturating_sub(1).min(last);
+        tab[i] + self.piece(j, self.knots[i], rho)
+    }
+
+    /// The mean-square height (nm²) of the band [a, b] of the cured spectrum: 2π(M_0(b) − M_0(a)).
+    pub fn band_ms(&self, a: f64, b: f64) -> f64 {
+        (2.0 * PI * (self.moment(0, b) - self.moment(0, a))).max(0.0)
+    }
+
+    /// The mean-square slope ⟨|∇h|²⟩ = Sdq² of the whole cured spectrum, ∫∫ (2π|f|)² S_c d²f = 2π·M_2(∞), in
+    /// nm²/µm² (10⁻⁶ rad²). Without levelling (L = 0) the table ends 10⁸ knees out, where a K-correlation
+    /// texture with C ≤ 3, whose slopes diverge, has grown past any facet model.
+    pub fn slope_ms(&self) -> f64 {
+        2.0 * PI * self.moment(2, self.f_max)
+    }
 }
 
 #[cfg(test)]
@@ -210,6 +459,7 @@ mod tests {
             surface_tension_mn_m: 30.0,
             flash_off_s: flash,
             viscosity: viscosity.into_iter().map(|(t_s, eta_pa_s)| ViscosityPoint { t_s, eta_pa_s }).collect(),
+            surface_tension_gradient_mn_m_per_um: 0.0,
         }
     }
 
@@ -267,26 +517,79 @@ mod tests {
     }
 
     #[test]
+    fn cured_k_correlation_keeps_v_squared_sigma_squared_without_levelling() {
+        // L = 0: the cured PSD is v²·S_a, whose σ² is v²σ_a² (the table plus the closed-form tail); levelling
+        // takes heights and more of the slopes.
+        let applied = Psd::k_correlation(800.0, 150.0, 2.5);
+        let bare = CuredPsd::new(applied, 0.4, Flow { l_um4: 0.0, m_um2: 0.0 });
+        let ms = bare.band_ms(0.0, f64::INFINITY);
+        assert!((ms / (0.4f64 * 800.0).powi(2) - 1.0).abs() < 1e-9, "{ms}");
+        let levelled = CuredPsd::new(applied, 0.4, Flow { l_um4: 1e9, m_um2: 0.0 });
+        assert!(levelled.band_ms(0.0, f64::INFINITY) < ms);
+        assert!(levelled.slope_ms() < bare.slope_ms() && levelled.slope_ms() > 0.0);
+    }
+
+    #[test]
     fn bad_applications_name_the_field() {
         let good = film(vec![(0.0, 0.3), (60.0, 3.0)], 30.0);
         assert!(good.validate().is_ok());
         let mut a = good.clone();
         a.wet_film_um = -1.0;
-        assert!(a.validate().unwrap_err().starts_with("wet_film_um"));
+        assert!(a.validate().unwrap_err().field == "wet_film_um");
         let mut a = good.clone();
         a.volume_solids = 0.0;
-        assert!(a.validate().unwrap_err().starts_with("volume_solids"));
+        assert!(a.validate().unwrap_err().field == "volume_solids");
         let mut a = good.clone();
         a.surface_tension_mn_m = f64::NAN;
-        assert!(a.validate().unwrap_err().starts_with("surface_tension_mn_m"));
+        assert!(a.validate().unwrap_err().field == "surface_tension_mn_m");
         let mut a = good.clone();
         a.viscosity[1].eta_pa_s = 0.1;
-        assert!(a.validate().unwrap_err().starts_with("viscosity/1/eta_pa_s"), "{:?}", a.validate());
+        assert!(a.validate().unwrap_err().field == "viscosity/1/eta_pa_s", "{:?}", a.validate());
         let mut a = good.clone();
         a.viscosity[1].t_s = 0.0;
-        assert!(a.validate().unwrap_err().starts_with("viscosity/1/t_s"));
-        let mut a = good;
+        assert!(a.validate().unwrap_err().field == "viscosity/1/t_s");
+        let mut a = good.clone();
         a.viscosity[0].t_s = 5.0;
-        assert!(a.validate().unwrap_err().starts_with("viscosity/0/t_s"));
+        assert!(a.validate().unwrap_err().field == "viscosity/0/t_s");
+        let mut a = good;
+        a.surface_tension_gradient_mn_m_per_um = 1e6;
+        assert_eq!(a.validate().unwrap_err().field, "surface_tension_gradient_mn_m_per_um");
+    }
+
+    #[test]
+    fn a_gradient_at_constant_viscosity_and_thickness_adds_its_closed_form() {
+        // v = 1, η and h constant over T: M = γ'h²T/(2η) exactly, and a mode's rate is
+        // −γh³k⁴/(3η) + γ'h²k²/(2η) (SI: γ' in N/m per m).
+        let mut a = film(vec![(0.0, 0.5), (120.0, 0.5)], 0.0);
+        a.volume_solids = 1.0;
+        a.surface_tension_gradient_mn_m_per_um = 0.02;
+        let m = a.gradient_integral_um2();
+        let exact = 0.02 * 60f64.powi(2) * 120.0 / (2.0 * 0.5) * 1e3;
+        assert!((m / exact - 1.0).abs() < 1e-14, "{m} vs {exact}");
+        let (h, eta, gamma, g) = (60e-6f64, 0.5, 30e-3, 0.02 * 1e3);
+        for lambda_um in [2000.0f64, 5000.0, 20000.0] {
+            let k = 2.0 * PI / (lambda_um * 1e-6);
+            let rate = -gamma * h.powi(3) * k.powi(4) / (3.0 * eta) + g * h * h * k * k / (2.0 * eta);
+            let got = a.amplitude_transfer(1.0 / lambda_um);
+            assert!((got / (rate * 120.0).exp() - 1.0).abs() < 1e-12, "Λ {lambda_um}: {got}");
+        }
+        // The largest growth is exp(B²/4A) at f² = B/2A.
+        let f = a.fastest_growing_frequency_per_um();
+        let top = a.amplitude_transfer(f);
+        assert!((top / a.largest_growth() - 1.0).abs() < 1e-12);
+        for x in [0.9, 1.1] {
+            assert!(a.amplitude_transfer(f * x) < top);
+        }
+        // A gradient of the other sign levels faster at every frequency.
+        let mut b = a.clone();
+        b.surface_tension_gradient_mn_m_per_um = -0.02;
+        let mut plain = a.clone();
+        plain.surface_tension_gradient_mn_m_per_um = 0.0;
+        for f in [1e-4, 2e-4, 5e-4] {
+            assert!(plain.amplitude_transfer(f) > 1e-300, "f {f} underflows");
+            assert!(b.amplitude_transfer(f) < plain.amplitude_transfer(f));
+            assert!(a.amplitude_transfer(f) > plain.amplitude_transfer(f));
+        }
+        assert_eq!(plain.largest_growth(), 1.0);
     }
 }

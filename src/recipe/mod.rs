@@ -13,6 +13,8 @@
 //!   interfaces, Phong, Ward, the Cook–Torrance lobes), [`META_FIELDS`];
 //! * `fields.rs`: the registry-driven reading of a parameter (`Obj::param`, `opt_param`, `param_array`,
 //!   `param_key`, `deny_unknown_in`, [`fields::param_number`]) on `input::json`'s reader;
+//! * `levelling.rs`: a paint coat's `application` block, levelled into the coat's facets and halo
+//!   ([`levelling::parse_levelled_paint`], [`levelling::level`]);
 //! * `paint.rs`: `"model": "paint"` recipes ([`paint::parse_paint`], [`paint::parse_paint_spec`]);
 //! * `measured.rs`: the measured tables' recipes, a path resolved against the recipe's directory
 //!   ([`measured::resolve`], [`measured::parse_merl`], [`measured::parse_rgl`], [`measured::parse_inplane`]);
@@ -45,6 +47,7 @@ use serde_json::Value;
 use std::sync::Arc;
 
 pub mod fields;
+pub mod levelling;
 pub mod measured;
 pub mod paint;
 pub mod scatter;

@@ -30,6 +30,9 @@ const PAINT: &str = "paint";
 pub fn parse_paint(obj: &Obj) -> Result<Arc<dyn Brdf>> {
     let spec = parse_paint_spec(obj)?;
     let coat = obj.obj("clear_coat")?;
+    if let Some(app) = coat.opt_obj("application")? {
+        return crate::recipe::levelling::parse_levelled_paint(obj, &coat, &app, spec);
+    }
     let scatter = coat.opt_obj("scatter")?;
     if scatter.is_some() && spec.coat.roughness >= Microfacet::SMOOTH_THRESHOLD {
         return Err(coat.err(

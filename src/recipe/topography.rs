@@ -10,26 +10,38 @@ use crate::brdf::topography::TopographySurface;
 use crate::brdf::Brdf;
 use crate::input::json::Obj;
 use crate::optics::slope_table::SlopeTable;
-use crate::registry;
-use crate::topography::level::{level, Levelling};
+use crate::registry::{self, Param};
+use crate::topography::level::{level, Levelled, Levelling};
+use crate::topography::map::HeightMap;
 use crate::topography::slopes::slopes;
 use crate::{Error, Result};
 
 /// `{"model": "topography", "file": "…", "ior": n, "levelling": "plane"}`.
 pub fn parse_topography(obj: &Obj) -> Result<Arc<dyn Brdf>> {
     obj.deny_unknown_in("topography")?;
-    let file = obj.str(&obj.param_key(&registry::TOPOGRAPHY_FILE))?;
-    if file.is_empty() {
+    let ior = obj.param(&registry::TOPOGRAPHY_IOR)?;
+    let (map, levelled, levelling) = levelled_map(obj, &registry::TOPOGRAPHY_FILE, &registry::TOPOGRAPHY_LEVELLING)?;
+    let wrap = |e: Error| obj.err("file", format!("not a topography this model reads: {e}"));
+    let s = slopes(&levelled.z, map.nx, map.ny, map.dx, map.dy, &map.file).map_err(wrap)?;
+    let table = SlopeTable::from_slopes(&s.sx, &s.sy).map_err(|m| obj.err("file", format!("{}: {m}", map.file)))?;
+    let source = format!("{}, levelling {}", map.file, levelling.name());
+    Ok(Arc::new(TopographySurface::new(table, ior, source)?))
+}
+
+/// The topography that `obj`'s `file` entry names (resolved against the recipe's directory), levelled as its
+/// `levelling` entry says (the plane when absent): the map, its levelled heights and the levelling.
+pub fn levelled_map(obj: &Obj, file: &Param, levelling: &Param) -> Result<(HeightMap, Levelled, Levelling)> {
+    let name = obj.str(&obj.param_key(file))?;
+    if name.is_empty() {
         return Err(obj.err("file", "empty path; expected the path of an .x3p, .sdf or .gsf topography"));
     }
-    let ior = obj.param(&registry::TOPOGRAPHY_IOR)?;
-    let levelling = match obj.opt_str(&obj.param_key(&registry::TOPOGRAPHY_LEVELLING))? {
+    let how = match obj.opt_str(&obj.param_key(levelling))? {
         None => Levelling::Plane,
         Some(s) => Levelling::parse(s).ok_or_else(|| {
             obj.err("levelling", format!("unknown levelling {s:?}; allowed: {}", Levelling::allowed()))
         })?,
     };
-    let path = resolve(obj.file, file);
+    let path = resolve(obj.file, name);
     let wrap = |e: Error| match e {
         Error::Io { file: f, source } => obj.err("file", format!("cannot read the topography {f}: {source}")),
         other => {
@@ -45,11 +57,8 @@ pub fn parse_topography(obj: &Obj) -> Result<Arc<dyn Brdf>> {
         }
     };
     let map = crate::topography::load(&path, None).map_err(wrap)?;
-    let levelled = level(&map, levelling).map_err(wrap)?;
-    let s = slopes(&levelled.z, map.nx, map.ny, map.dx, map.dy, &map.file).map_err(wrap)?;
-    let table = SlopeTable::from_slopes(&s.sx, &s.sy).map_err(|m| obj.err("file", format!("{}: {m}", map.file)))?;
-    let source = format!("{}, levelling {}", map.file, levelling.name());
-    Ok(Arc::new(TopographySurface::new(table, ior, source)?))
+    let levelled = level(&map, how).map_err(wrap)?;
+    Ok((map, levelled, how))
 }
 
 /// A file's first bytes (fewer if it is shorter or cannot be read; only a message depends on them).

@@ -95,6 +95,23 @@ impl Psd2 {
         (sum * self.dfx * self.dfy).sqrt()
     }
 
+    /// Σ w(|f|)·(2π|f|)^j·S(f)·Δfₓ·Δf_y over the grid frequencies with lo ≤ |f| < hi (1/m): the power (j = 0,
+    /// m²) or the mean-square slope (j = 2, rad²) of that band of the map, each mode weighted by w (a filter's
+    /// power transfer, 1 for the map itself).
+    pub fn weighted_moment(&self, j: i32, lo: f64, hi: f64, w: impl Fn(f64) -> f64) -> f64 {
+        let mut sum = 0.0;
+        for ky in 0..self.ny {
+            for kx in 0..self.nx {
+                let (fx, fy) = self.frequency(kx, ky);
+                let f = fx.hypot(fy);
+                if f >= lo && f < hi {
+                    sum += w(f) * (2.0 * PI * f).powi(j) * self.s[ky * self.nx + kx];
+                }
+            }
+        }
+        sum * self.dfx * self.dfy
+    }
+
     /// The radial (azimuthal) average: annuli of width Δf = max(Δfₓ, Δf_y) centred on multiples of Δf, each
     /// the mean of S over the grid frequencies in it. For an isotropic surface it estimates S(|f|), with
     /// ∫₀^∞ 2πf S(f) df = Sq²; on the grid, Σ S̄·count·Δfₓ·Δf_y = Sq² exactly. Annuli beyond the smaller Nyquist
@@ -146,6 +163,14 @@ mod tests {
         let radial = p.radial();
         let total: f64 = radial.iter().map(|b| b.s * b.count as f64).sum::<f64>() * p.dfx * p.dfy;
         assert!((total - sq2).abs() < 1e-12 * sq2);
+        // The weighted moments: unit weight gives the power and the slope; a band that excludes the peak, 0; a
+        // weight scales the peak's power by its value at the peak's frequency.
+        let f = fx.hypot(fy);
+        assert!((p.weighted_moment(0, 0.0, f64::INFINITY, |_| 1.0) - sq2).abs() < 1e-12 * sq2);
+        assert!((p.weighted_moment(2, 0.0, f64::INFINITY, |_| 1.0).sqrt() - slope).abs() < 1e-10 * slope);
+        assert!(p.weighted_moment(0, 0.0, 0.5 * f, |_| 1.0) < 1e-12 * sq2);
+        let w = p.weighted_moment(0, 0.5 * f, 2.0 * f, |g| if (g - f).abs() < 1e-9 * f { 0.25 } else { 0.0 });
+        assert!((w - 0.25 * sq2).abs() < 1e-12 * sq2, "{w}");
     }
 
     #[test]

@@ -747,7 +747,54 @@ fn registry_object(
             _ => {}
         }
     }
+    levelling_rules(prefix, &mut obj, rng);
     obj
+}
+
+/// A paint coat's `application` and the rules across its fields (docs/recipe-format.md §A coat from its
+/// application): it excludes `roughness` and `scatter` (half the coats keep it, without them); its viscosity
+/// table starts at 0 s, its times increase and its viscosity does not fall; its texture is a PSD or a map.
+fn levelling_rules(prefix: &str, obj: &mut serde_json::Map<String, serde_json::Value>, rng: &mut Rng) {
+    use serde_json::json;
+    match prefix {
+        "/clear_coat" if obj.contains_key("application") => {
+            if rng.chance(0.5) {
+                for k in ["roughness", "scatter", "distribution"] {
+                    obj.remove(k);
+                }
+            } else {
+                obj.remove("application");
+            }
+        }
+        "/clear_coat/application" => {
+            if let Some(serde_json::Value::Array(points)) = obj.get_mut("viscosity") {
+                let mut etas: Vec<f64> = points.iter().filter_map(|p| p["eta_pa_s"].as_f64()).collect();
+                etas.sort_by(f64::total_cmp);
+                for (i, (p, eta)) in points.iter_mut().zip(etas).enumerate() {
+                    p["t_s"] = json!(60.0 * i as f64);
+                    p["eta_pa_s"] = json!(eta);
+                }
+            }
+        }
+        // A measured texture (`file`) is the shipped map, with none of a PSD's numbers; a PSD has its two numbers
+        // (optional in the registry only because a map replaces them) and no levelling; a Gaussian one no `c`.
+        "/clear_coat/application/texture" if obj.contains_key("file") => {
+            let f = root().join("fixtures/topography/gaussian.x3p");
+            obj.insert("file".into(), json!(f.to_string_lossy()));
+            for k in ["rms_roughness_nm", "correlation_length_um", "c"] {
+                obj.remove(k);
+            }
+        }
+        "/clear_coat/application/texture" => {
+            obj.remove("levelling");
+            obj.entry("rms_roughness_nm").or_insert(json!(2000.0));
+            obj.entry("correlation_length_um").or_insert(json!(200.0));
+            if obj.get("psd").and_then(|v| v.as_str()) == Some("gaussian") {
+                obj.remove("c");
+            }
+        }
+        _ => {}
+    }
 }
 
 /// A recipe built from the registry: a random model and its fields in their ranges (cross-field rules such

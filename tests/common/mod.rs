@@ -58,6 +58,15 @@ impl Brdf for TestBeckmann {
 pub fn every_fixture_reading(
     options: &glossmeter::instrument::plan::PlanOptions,
 ) -> Vec<(String, glossmeter::instrument::plan::Reading)> {
+    fixture_readings(options, |_| true)
+}
+
+/// [`every_fixture_reading`] of the recipes whose file stem `keep` accepts.
+#[allow(dead_code)]
+pub fn fixture_readings(
+    options: &glossmeter::instrument::plan::PlanOptions,
+    keep: impl Fn(&str) -> bool,
+) -> Vec<(String, glossmeter::instrument::plan::Reading)> {
     use glossmeter::instrument::plan::Plan;
     use glossmeter::instrument::standards;
     use glossmeter::spectrum::SamplingKind;
@@ -72,8 +81,11 @@ pub fn every_fixture_reading(
     recipes.sort();
     let mut out = Vec::new();
     for path in recipes {
-        let m = glossmeter::recipe::load_file(&path).unwrap();
         let stem = path.file_stem().unwrap().to_string_lossy().into_owned();
+        if !keep(&stem) {
+            continue;
+        }
+        let m = glossmeter::recipe::load_file(&path).unwrap();
         let geos = if m.brdf.sampling().kind == SamplingKind::Rgb { &gloss } else { &all };
         let plan = Plan::compile(m.brdf.clone(), geos.clone(), options.clone()).unwrap();
         for r in plan.execute() {

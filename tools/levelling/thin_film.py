@@ -2,9 +2,11 @@
 """The full (nonlinear) thin-film equation on a periodic 1-D profile, as an independent check of the linear
 levelling model of src/optics/levelling.rs (docs/model.md §Levelling of the applied texture).
 
-    ∂h/∂t = −∂/∂x [ γ h³ /(3 η(t)) · ∂³h/∂x³ ] − E(t)
+    ∂h/∂t = −∂/∂x [ γ h³ /(3 η(t)) · ∂³h/∂x³ + h² γ'(∂h/∂x)/(2 η(t)) ] − E(t)
 
-h(x, t) the film thickness (µm), x in µm over one wavelength Λ (periodic), γ the surface tension, η(t) the
+h(x, t) the film thickness (µm), x in µm over one wavelength Λ (periodic), γ the surface tension, γ' = dγ/dh the
+surface-tension gradient (a Marangoni flux h²∂γ/∂x/(2η), ∂γ/∂x = γ'∂h/∂x; 10³ µm²/s per (mN/m/µm)·µm²/(Pa·s)),
+η(t) the
 viscosity (ln η linear between table points), E(t) a uniform evaporation rate that thins the film linearly from
 wet to v·wet over the flash-off (zero after it). γ/(3η) in (N/m)/(Pa·s) is 10⁶ µm/s.
 
@@ -12,6 +14,9 @@ Derivatives are spectral (FFT) on N points; time by SciPy's Radau (stiff), rtol 
 amplitude transfer is exp(−(k⁴/3)·∫ γ h̄³/η dt), h̄ the mean thickness; the first Fourier mode of the
 nonlinear solution is compared with it for initial amplitudes ε·h_wet, ε from 1e-3 to 0.3. The levelling
 integral is computed here independently with scipy.integrate.quad.
+
+The second block, "gradient", repeats the small-amplitude runs with γ' ≠ 0 (of both signs) against the linear
+transfer exp(−(k⁴/3)·L + (k²)·M), M = ∫ γ'h̄²/(2η) dt by quad.
 
 Run by hand (numpy, scipy from PyPI):  python3 tools/levelling/thin_film.py > fixtures/reference/levelling-thin-film.json
 """
@@ -31,6 +36,8 @@ CASES = {
 }
 WAVELENGTHS_UM = [2500.0, 4000.0, 6000.0]
 EPSILONS = [1e-3, 1e-2, 0.1, 0.3]
+#: γ' (mN/m per µm) of the gradient block: against levelling (+) and with it (−).
+GRADIENTS = [0.005, -0.005]
 N = 64
 
 
@@ -62,8 +69,23 @@ def levelling_integral(c):
     return total * 1e6
 
 
+def gradient_integral(c):
+    g = c.get("surface_tension_gradient_mn_m_per_um", 0.0)
+    end = c["viscosity"][-1][0]
+    pts = sorted({p[0] for p in c["viscosity"]} | {c["flash_off_s"]})
+    f = lambda t: g * thickness(t, c) ** 2 / (2 * viscosity(t, c["viscosity"]))
+    total = 0.0
+    for a, b in zip(pts[:-1], pts[1:]):
+        if b > end:
+            break
+        v, _ = quad(f, a, b, epsabs=0, epsrel=1e-13, limit=200)
+        total += v
+    return total * 1e3
+
+
 def run(c, lam, eps):
     gamma = c["surface_tension_mn_m"] * 1e-3
+    grad = c.get("surface_tension_gradient_mn_m_per_um", 0.0)
     x = np.arange(N) * lam / N
     k = 2 * np.pi * np.fft.fftfreq(N, d=lam / N)
     wet, dry, flash = c["wet_film_um"], c["volume_solids"] * c["wet_film_um"], c["flash_off_s"]
@@ -73,7 +95,9 @@ def run(c, lam, eps):
     def rhs(t, h):
         hk = np.fft.fft(h)
         h3x = np.real(np.fft.ifft((1j * k) ** 3 * hk))
-        flux = gamma * 1e6 / (3 * viscosity(t, c["viscosity"])) * h**3 * h3x
+        hx = np.real(np.fft.ifft(1j * k * hk))
+        eta = viscosity(t, c["viscosity"])
+        flux = gamma * 1e6 / (3 * eta) * h**3 * h3x + grad * 1e3 / (2 * eta) * h**2 * hx
         dflux = np.real(np.fft.ifft(1j * k * np.fft.fft(flux)))
         e = rate if t < flash else 0.0
         return -dflux - e
@@ -96,12 +120,25 @@ def main():
                          "mean_thickness_um": mean})
             print(f"Λ={lam} ε={eps}: nonlinear {ratio:.10g} linear {lin:.10g} ({ratio / lin - 1:+.2e})",
                   file=sys.stderr)
+    gradient = []
+    for g in GRADIENTS:
+        c = dict(CASES, surface_tension_gradient_mn_m_per_um=g)
+        M = gradient_integral(c)
+        for lam in WAVELENGTHS_UM:
+            ratio, _ = run(c, lam, 1e-3)
+            f = 1 / lam
+            lin = float(np.exp(-(16 * np.pi**4 / 3) * f**4 * L + 4 * np.pi**2 * f**2 * M))
+            gradient.append({"surface_tension_gradient_mn_m_per_um": g, "gradient_integral_um2": M,
+                             "wavelength_um": lam, "epsilon": 1e-3, "nonlinear_ratio": ratio, "linear_ratio": lin})
+            print(f"γ'={g} Λ={lam}: nonlinear {ratio:.10g} linear {lin:.10g} ({ratio / lin - 1:+.2e})",
+                  file=sys.stderr)
     out = {
         "provenance": "tools/levelling/thin_film.py, run by hand: the full thin-film equation, spectral in x "
                       f"(N = {N}), SciPy Radau rtol 1e-10; numpy {np.__version__}, scipy {scipy.__version__}",
         "application": CASES,
         "levelling_integral_um4": L,
         "runs": rows,
+        "gradient": gradient,
     }
     print(json.dumps(out, indent=1))
 
