@@ -81,8 +81,10 @@ class BudgetLine(TypedDict):
 class Reading(_ReadingRequired, total=False):
     """One reading, with the fields of ``glossmeter measure --format json`` (``value`` and ``error_estimate``
     are None when there is no finite value, and ``problem`` says why; ``seconds`` is left out with
-    ``timing=False``). The ``envelope`` fields are the command line's ``--envelope``, which ``measure`` here
-    does not compute: they are in the type because they are in the document's schema."""
+    ``timing=False``). The ``envelope`` fields are the command line's ``--envelope``, and
+    ``prediction_uncertainty`` / ``uncertainty_budget`` the command line's for a recipe with an ``uncertainty``
+    block; ``measure`` here computes neither yet: they are in the type because they are in the document's
+    schema."""
 
     seconds: float
     problem: str
