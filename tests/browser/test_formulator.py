@@ -9,6 +9,7 @@ import os
 import re
 import subprocess
 import time
+import urllib.request
 
 from selenium.webdriver.common.by import By
 from selenium.webdriver.common.keys import Keys
@@ -350,4 +351,19 @@ def test_a_nested_optional_block_is_added_and_removed(browser, tmp_path):
     assert_page_is_cli(d, tmp_path)
     d.find_element(By.ID, "remove-clear_coat_scatter").click()
     WebDriverWait(d, WAIT).until(lambda d: "scatter" not in raw(d)["clear_coat"])
+    assert console_errors(d) == []
+
+
+def test_an_element_of_a_numeric_array_is_swept_over_the_arrays_range(browser, server):
+    """`/albedo/0` takes the range of the registry's `/albedo` entry (0..1), not an open guess around the value."""
+    d = browser
+    wait_current(d)
+    choose_fixture(d, "rgb-lambert")
+    d.find_element(By.ID, "tab-sweep").click()
+    Select(d.find_element(By.ID, "sweep-path")).select_by_value("/albedo/0")
+    lo, hi = (d.find_element(By.ID, k).get_attribute("value") for k in ("sweep-lo", "sweep-hi"))
+    with urllib.request.urlopen(server.rstrip("/") + "/api/registry") as r:
+        reg = json.load(r)
+    albedo = next(p for p in reg["parameters"] if p["pointer"] == "/albedo" and "lambert" in p["models"])
+    assert (float(lo), float(hi)) == (albedo["range"]["lo"], albedo["range"]["hi"]) == (0, 1), (lo, hi)
     assert console_errors(d) == []

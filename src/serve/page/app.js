@@ -186,9 +186,13 @@ function label(ptr, recipe) {
 
 // ---- the recipe editor ------------------------------------------------------------------------------
 
+/// The registry entry of `ptr`: array elements of objects match the entry's `*`, and an element of a numeric
+/// array (`/albedo/0`) takes the array's entry, whose range bounds each element.
 function entryOf(ptr, model) {
   const pattern = ptr.replace(/\/\d+(?=\/|$)/g, "/*");
-  return state.registry.parameters.find((q) => q.models.includes(model) && (q.pointer === pattern || q.pointer === ptr));
+  const array = ptr.replace(/\/\d+$/, "");
+  const of = (want) => state.registry.parameters.find((q) => q.models.includes(model) && q.pointer === want);
+  return of(ptr) || of(pattern) || (array !== ptr && of(array.replace(/\/\d+(?=\/|$)/g, "/*"))) || undefined;
 }
 
 /// The fields the editor shows for the recipe: every registry entry of its model whose parent object is in
