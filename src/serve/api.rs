@@ -303,7 +303,8 @@ pub fn explain(req: &Request, ctx: Context) -> Result<Reply> {
     })))
 }
 
-/// `POST /api/plot`: an SVG picture drawn by the command line's code: `kind` `section` (the in-plane BRDF
+/// `POST /api/plot`: an SVG picture drawn by the library's pictures (`report::pictures`, the same drawing as
+/// the command line's): `kind` `section` (the in-plane BRDF
 /// section with the apertures, `plot --kind section`), `profile` (the goniophotometric profile of
 /// `geometry`, default rspec-20, `profile --plot`) or `gloss-vs-parameter` (`vary` PATH=LO..HI over `points`
 /// values, `plot --kind gloss-vs-parameter`).
