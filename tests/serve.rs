@@ -189,7 +189,7 @@ fn the_endpoints_answer_on_the_command_lines_documents() {
     let a = request(addr, "POST", "/api/explain", &with_recipe(&glass, json!({"geometries": ["astm-d523-60"]})), &[]);
     assert_eq!(a.status, 200, "{}", a.body);
     assert!(a.json()["plan"].as_str().unwrap().contains("astm-d523-60"));
-    // plot: SVG from the command line's drawing code.
+    // plot: SVG from the library's pictures (the drawing the command line uses).
     for kind in [
         json!({"kind": "section"}),
         json!({"kind": "profile"}),

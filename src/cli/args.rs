@@ -7,7 +7,7 @@ use clap::{Parser, Subcommand, ValueEnum};
 
 use super::common::{ColourArgs, Format};
 use super::{compare, convergence, fit, pictures, profile, sweep, topography};
-use crate::instrument::plan::PlanOptions;
+use crate::instrument::plan::{PlanOptions, DATA_MAX_RTOL, DEFAULT_RTOL};
 
 #[derive(Parser, Debug)]
 #[command(
@@ -57,10 +57,12 @@ pub enum Command {
         /// A user geometry file in the standards format (repeatable).
         #[arg(long = "geometry-file")]
         geometry_files: Vec<PathBuf>,
-        /// Relative tolerance of every reading (default 1e-6; for a measured table, by default a quarter of
-        /// each integral's data uncertainty, never tighter than 1e-6 nor looser than 1e-2: given here, it is
-        /// used as given, for tables too).
-        #[arg(long)]
+        // The help is written from the one default tolerance and the data's loosest, not copies of their values.
+        #[arg(long, help = format!(
+            "Relative tolerance of every reading (default {DEFAULT_RTOL:e}; for a measured table, by default a \
+             quarter of each integral's data uncertainty, never tighter than {DEFAULT_RTOL:e} nor looser than \
+             {DATA_MAX_RTOL:e}: given here, it is used as given, for tables too)"
+        ))]
         rtol: Option<f64>,
         #[arg(long, value_enum, default_value_t = Format::Table)]
         format: Format,

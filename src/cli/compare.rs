@@ -9,6 +9,7 @@ use crate::cli::common::{pad_table, readings_status, ColourArgs};
 use crate::cli::output::{Existing, OutputTarget};
 use crate::comparison::sheet::{self, Sheet};
 use crate::comparison::{self, ColourDifference, Comparison, Drift, Recipes, Verdict, VerdictRule};
+use crate::instrument::plan::DEFAULT_RTOL;
 use crate::report;
 use crate::report::junit;
 use crate::request::{CompareRequest, SheetRequest};
@@ -50,7 +51,7 @@ pub struct CompareArgs {
     #[arg(long = "ignore-column", value_name = "HEADER")]
     pub ignore_columns: Vec<String>,
     /// Standard errors of the mean allowed for repeated readings (k·s/√n).
-    #[arg(short = 'k', long = "k", default_value_t = 2.0)]
+    #[arg(short = 'k', long = "k", default_value_t = crate::request::DEFAULT_K)]
     pub k: f64,
     /// Allowed |predicted − measured| in the reading's unit, for rows without an `uncertainty`: a number for
     /// every reading, or per reading (repeatable): `gloss=2`, `haze=5`, `astm-e430-30/doi=3` (the most specific
@@ -60,9 +61,12 @@ pub struct CompareArgs {
     /// A previous `measure` or `compare` JSON: fail any prediction that moved by more than both error estimates.
     #[arg(long, value_name = "PREVIOUS.json")]
     pub baseline: Option<PathBuf>,
-    /// Relative tolerance of the predictions (default 1e-6; for a measured table, by default a quarter of each
-    /// integral's data uncertainty, never tighter than 1e-6: given here, it is used as given, tables too).
-    #[arg(long)]
+    // The help is written from the one default tolerance, not a copy of its value.
+    #[arg(long, help = format!(
+        "Relative tolerance of the predictions (default {DEFAULT_RTOL:e}; for a measured table, by default a \
+         quarter of each integral's data uncertainty, never tighter than {DEFAULT_RTOL:e}: given here, it is used \
+         as given, tables too)"
+    ))]
     pub rtol: Option<f64>,
     #[arg(long, value_enum, default_value_t = CompareFormat::Table)]
     pub format: CompareFormat,

@@ -39,10 +39,10 @@ pub struct ConvergenceArgs {
     pub output: Option<PathBuf>,
     /// Repeat each execution until this many milliseconds have elapsed (or --max-repetitions), and report
     /// the minimum time per execution.
-    #[arg(long, default_value_t = 20.0)]
+    #[arg(long, default_value_t = ConvergenceRequest::default().min_time_ms)]
     pub min_time_ms: f64,
     /// At most this many timed executions per tolerance.
-    #[arg(long, default_value_t = 50)]
+    #[arg(long, default_value_t = ConvergenceRequest::default().max_repetitions)]
     pub max_repetitions: usize,
     /// Compare with a run at 1/100 of the tightest tolerance even when a closed form exists.
     #[arg(long)]

@@ -36,7 +36,7 @@ pub struct PlotArgs {
     #[arg(long)]
     pub vary: Option<String>,
     /// For gloss-vs-parameter: how many values.
-    #[arg(long, default_value_t = 9)]
+    #[arg(long, default_value_t = request::PLOT_POINTS)]
     pub points: usize,
     /// For gloss-vs-parameter: how the values are spaced. `auto`: logarithmically when the range spans a
     /// decade or more (LO > 0 and HI ≥ 10·LO, as a roughness range does), else evenly.

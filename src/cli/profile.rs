@@ -6,6 +6,7 @@ use std::path::PathBuf;
 
 use super::common::readings_status;
 use super::output::{Existing, OutputTarget};
+use crate::instrument::plan::DEFAULT_RTOL;
 use crate::instrument::profile::{self, Profile};
 use crate::recipe::{self, Material};
 use crate::report::pictures::profile::draw;
@@ -42,9 +43,11 @@ pub struct ProfileArgs {
     /// Write the CSV/JSON to this new file instead of stdout (refuses to overwrite).
     #[arg(long, short = 'o')]
     pub output: Option<PathBuf>,
-    /// Relative tolerance of every pixel's reading (default 1e-6; for a measured table, by default a quarter of
-    /// each integral's data uncertainty, as in `measure`: given here, it is used as given).
-    #[arg(long)]
+    // The help is written from the one default tolerance, not a copy of its value.
+    #[arg(long, help = format!(
+        "Relative tolerance of every pixel's reading (default {DEFAULT_RTOL:e}; for a measured table, by default \
+         a quarter of each integral's data uncertainty, as in `measure`: given here, it is used as given)"
+    ))]
     pub rtol: Option<f64>,
     /// Exit 0 even if a pixel did not converge within its budget (it is still marked in the output).
     #[arg(long)]

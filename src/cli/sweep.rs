@@ -5,7 +5,7 @@ use std::io::IsTerminal;
 use std::path::PathBuf;
 
 use crate::cli::output::{Existing, OutputTarget};
-use crate::instrument::plan::PlanOptions;
+use crate::instrument::plan::{PlanOptions, DEFAULT_RTOL};
 use crate::request::{PlanRequest, SweepRequest};
 use crate::sweep;
 use crate::{resolve_geometries, Error, Result};
@@ -40,9 +40,11 @@ pub struct SweepArgs {
     pub shard: Option<String>,
     #[arg(long, value_enum, default_value_t = SweepFormat::Csv)]
     pub format: SweepFormat,
-    /// Relative tolerance of every reading (default 1e-6; for a measured table, by default a quarter of each
-    /// integral's data uncertainty, as in `measure`: given here, it is used as given).
-    #[arg(long)]
+    // The help is written from the one default tolerance, not a copy of its value.
+    #[arg(long, help = format!(
+        "Relative tolerance of every reading (default {DEFAULT_RTOL:e}; for a measured table, by default a \
+         quarter of each integral's data uncertainty, as in `measure`: given here, it is used as given)"
+    ))]
     pub rtol: Option<f64>,
     /// Leave the per-point wall time out (then the output is reproducible byte for byte).
     #[arg(long)]

@@ -20,8 +20,8 @@ use crate::instrument::standards::{self, StandardGeometry};
 use crate::recipe::{self, Material};
 use crate::registry::{self, Type};
 use crate::request::{
-    CompareRequest, FitRequest, PlanRequest, SheetRequest, Spacing, SweepRequest, VsParameterRequest, DEFAULT_K,
-    PLOT_GEOMETRIES, PLOT_RTOL,
+    CompareRequest, FitRequest, PlanRequest, ProfileRequest, SheetRequest, Spacing, SweepRequest, VsParameterRequest,
+    DEFAULT_K, PLOT_GEOMETRIES, PLOT_RTOL,
 };
 use crate::sweep::Sweep;
 use crate::{report, Error, Result};
@@ -248,14 +248,15 @@ fn omit_refused_colour(
     (rest, Some(json!({"geometries": ids, "message": message})))
 }
 
-/// A profile's evaluation budget on this server: the command line's, each part held to the server's per-integral
+/// A profile request on this server: the command line's budget, each part held to the server's per-integral
 /// limit and the whole profile to ten times it (docs/serve.md §Safety).
-fn profile_budget(ctx: Context) -> crate::instrument::profile::Budget {
-    let d = crate::instrument::profile::Budget::default();
-    crate::instrument::profile::Budget {
-        per_part: d.per_part.min(ctx.limits.max_evals),
-        total: d.total.min(ctx.limits.max_evals.saturating_mul(10)),
-    }
+fn profile_request(o: &Obj, ctx: Context) -> Result<ProfileRequest> {
+    let d = ProfileRequest::default();
+    Ok(ProfileRequest {
+        plan: plan_request(o, ctx)?,
+        max_evals: d.max_evals.min(ctx.limits.max_evals),
+        max_total_evals: d.max_total_evals.min(ctx.limits.max_evals.saturating_mul(10)),
+    })
 }
 
 /// `POST /api/measure`: the document of `glossmeter measure --format json` (with `--no-timing` unless
@@ -303,7 +304,8 @@ pub fn explain(req: &Request, ctx: Context) -> Result<Reply> {
     })))
 }
 
-/// `POST /api/plot`: an SVG picture drawn by the command line's code: `kind` `section` (the in-plane BRDF
+/// `POST /api/plot`: an SVG picture drawn by the library's pictures (`report::pictures`, the same drawing as
+/// the command line's): `kind` `section` (the in-plane BRDF
 /// section with the apertures, `plot --kind section`), `profile` (the goniophotometric profile of
 /// `geometry`, default rspec-20, `profile --plot`) or `gloss-vs-parameter` (`vary` PATH=LO..HI over `points`
 /// values, `plot --kind gloss-vs-parameter`).
@@ -329,12 +331,15 @@ pub fn plot(req: &Request, ctx: Context) -> Result<Reply> {
             crate::report::pictures::charts::section_svg(&material(req, ctx)?, &geos)?
         }
         "profile" => {
-            let options = plan_options(&o, ctx, DEFAULT_RTOL)?;
+            // Each field's refusal under its own name first, then the one request's options.
+            plan_options(&o, ctx, DEFAULT_RTOL)?;
+            let (options, budget) = profile_request(&o, ctx)?.options().map_err(|e| at_field(&o, e))?;
+            let options = PlanOptions { cancel: ctx.cancel.clone(), ..options };
             let id = o.opt_str("geometry")?.unwrap_or(crate::request::PROFILE_GEOMETRY);
             let g = standards::find(id).map_err(|e| o.err("geometry", e.to_string()))?;
             standards::profile::of(&g).map_err(|e| o.err("geometry", e.to_string()))?;
             let m = material(req, ctx)?;
-            let prof = crate::instrument::profile::measure(m.brdf.clone(), &g, options, profile_budget(ctx))?;
+            let prof = crate::instrument::profile::measure(m.brdf.clone(), &g, options, budget)?;
             crate::report::pictures::profile::svg(&prof, &format!("{}: {} profile", m.name, prof.geometry))?
         }
         "gloss-vs-parameter" => {
