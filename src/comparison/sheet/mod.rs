@@ -218,15 +218,16 @@ pub fn parse(text: &str, file: &str, options: &SheetOptions) -> Result<Sheet> {
 fn parse_at(text: &str, file: &str, options: &SheetOptions, place: &Place) -> Result<Sheet> {
     let mut metadata: Vec<(usize, (String, String))> =
         text.lines().enumerate().filter_map(|(i, l)| metadata_line(l).map(|m| (i + 1, m))).collect();
-    let content = || text.lines().filter(|l| !l.trim().is_empty() && !l.trim_start().starts_with('#'));
-    let Some(first_line) = content().next() else {
+    let is_content = |l: &&str| !l.trim().is_empty() && !l.trim_start().starts_with('#');
+    let content = || text.lines().filter(is_content);
+    let Some((first_at, first_line)) = text.lines().enumerate().find(|(_, l)| is_content(l)) else {
         return Err(Error::input(file, "", "the sheet is empty (no header line)"));
     };
     // A JSON file given where a sheet goes (`compare RECIPE RECIPE`): say so, not "unrecognised column '{'".
     if first_line.trim_start_matches('\u{feff}').trim_start().starts_with(['{', '[']) {
         return Err(Error::input(
             file,
-            "",
+            place.line(first_at + 1),
             "this is a JSON file (a recipe?), not an instrument sheet: `compare` takes [RECIPE] SHEET, the sheet \
              being a CSV or a workbook (.xlsx, .xlsm, .xlsb, .xls, .ods) of readings (docs/instrument.md §Sheets)",
         ));
@@ -359,6 +360,13 @@ fn parse_at(text: &str, file: &str, options: &SheetOptions, place: &Place) -> Re
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_json_file_given_as_a_sheet_is_named_at_its_first_content_line() {
+        let o = SheetOptions::default();
+        let e = parse("# title\n\n  {\"model\": \"glass\"}\n", "r.json", &o).unwrap_err().to_string();
+        assert!(e.contains("r.json") && e.contains("line 3") && e.contains("not an instrument sheet"), "{e}");
+    }
 
     #[test]
     fn colour_layout_and_colour_quantities() {
