@@ -17,7 +17,7 @@ use crate::{Error, Result};
 /// recursive, sub-directories left out), sorted by name. A `*.json` entry that cannot be read, a dangling
 /// symbolic link or a link loop, stays in the list, so that loading it is the error naming it: a recipe moved
 /// away behind a link never drops out of a batch without a word.
-pub fn recipe_files(paths: &[PathBuf]) -> Result<Vec<PathBuf>> {
+pub(crate) fn recipe_files(paths: &[PathBuf]) -> Result<Vec<PathBuf>> {
     let mut out = vec![];
     for p in paths {
         if p.is_dir() {
@@ -58,7 +58,7 @@ pub fn measure_many(
 
 /// [`measure_many`] keeping each material's execution (its readings and the fluxes of its plan, for the
 /// plan's evaluation count).
-pub fn run_many(
+pub(crate) fn run_many(
     materials: &[Material],
     geometries: &[StandardGeometry],
     options: &PlanOptions,

@@ -76,7 +76,7 @@ impl Words {
     }
 
     /// These words, then an argument.
-    pub fn and_argument(mut self, name: &'static str) -> Words {
+    pub(crate) fn and_argument(mut self, name: &'static str) -> Words {
         let start = self.text.len();
         self.text.push_str(&format!("`{name}`"));
         self.arguments.push((start..self.text.len(), name));
@@ -85,7 +85,7 @@ impl Words {
 
     /// The argument these words begin with, and the words after it (`` `rtol` must be … `` → `rtol` and
     /// ` must be …`), so that a front end can name the argument apart (the server: as the field of its body).
-    pub fn leading_argument(&self) -> Option<(&'static str, Words)> {
+    pub(crate) fn leading_argument(&self) -> Option<(&'static str, Words)> {
         let (span, name) = self.arguments.first()?;
         if span.start != 0 {
             return None;

@@ -11,8 +11,8 @@
 use crate::{Error, Result};
 
 /// The CIE tables shipped under `standards/cie/`, embedded.
-pub const ILLUMINANT_C_CSV: &str = include_str!("../standards/cie/illuminant-c.csv");
-pub const YBAR_CSV: &str = include_str!("../standards/cie/cie1931-ybar.csv");
+pub(crate) const ILLUMINANT_C_CSV: &str = include_str!("../standards/cie/illuminant-c.csv");
+pub(crate) const YBAR_CSV: &str = include_str!("../standards/cie/cie1931-ybar.csv");
 
 /// Luminance weights of the RGB samples. The samples *are* the CIE 1931 RGB primaries ([`RGB_WAVELENGTHS_NM`]),
 /// so they are weighted by those primaries' luminances: the Y row of the CIE 1931 RGB→XYZ matrix,
@@ -20,7 +20,7 @@ pub const YBAR_CSV: &str = include_str!("../standards/cie/cie1931-ybar.csv");
 /// Wright–Guild's primaries, Wyszecki & Stiles, *Color Science*, 2nd ed., §3.3.2). They sum to 1, so a grey
 /// material's reading does not depend on them. (Earlier these were the sRGB / BT.709 weights
 /// 0.2126/0.7152/0.0722, which belong to different primaries; `docs/model.md` §Spectral gives the effect.)
-pub const RGB_LUMINANCE_WEIGHTS: [f64; 3] = [0.17697, 0.81240, 0.01063];
+pub(crate) const RGB_LUMINANCE_WEIGHTS: [f64; 3] = [0.17697, 0.81240, 0.01063];
 
 /// Relative radiant powers of the CIE 1931 RGB primaries that match the equal-energy white, 72.0962 : 1.3791 : 1
 /// (Wyszecki & Stiles, *Color Science*, 2nd ed., §3.3.2). Their products with ȳ at the primaries' wavelengths
@@ -29,7 +29,7 @@ pub const CIE_RGB_RADIANT_POWER_RATIOS: [f64; 3] = [72.0962, 1.3791, 1.0];
 
 /// Wavelengths at which an RGB material's wavelength-dependent optics (thin-film interference) are evaluated:
 /// the CIE 1931 RGB primaries 700 nm, 546.1 nm and 435.8 nm (CIE 15:2004 §3.1 / Wright–Guild primaries).
-pub const RGB_WAVELENGTHS_NM: [f64; 3] = [700.0, 546.1, 435.8];
+pub(crate) const RGB_WAVELENGTHS_NM: [f64; 3] = [700.0, 546.1, 435.8];
 
 /// How a material is sampled in wavelength.
 #[derive(Clone, Debug, PartialEq)]
@@ -108,7 +108,7 @@ fn cie_tables() -> Result<&'static (Table, Table)> {
 }
 
 /// The wavelengths a spectral grid may use: those of the CIE 1931 ȳ table (`standards/cie/cie1931-ybar.csv`).
-pub const SPECTRAL_RANGE_NM: (f64, f64) = (360.0, 830.0);
+pub(crate) const SPECTRAL_RANGE_NM: (f64, f64) = (360.0, 830.0);
 
 /// Illuminant C at `lam`. CIE 15:2004 Table T.1 tabulates C only to 780 nm; from 780 to 830 nm its 780 nm
 /// value is held. This cannot move a luminous weight by more than about 2e-5 of the total: ȳ there is at
@@ -174,7 +174,7 @@ pub fn parse_table(text: &str, file: &str) -> Result<Vec<(f64, f64)>> {
 /// Parse a CSV table `wavelength_nm,v1,…,vn` with `ncols` value columns: the one format of every table under
 /// `standards/cie/` (`#` lines are provenance, a line starting with `wavelength` is the header). Wavelengths must
 /// increase strictly; every value must be a finite number.
-pub fn parse_columns(text: &str, file: &str, ncols: usize) -> Result<Vec<(f64, Vec<f64>)>> {
+pub(crate) fn parse_columns(text: &str, file: &str, ncols: usize) -> Result<Vec<(f64, Vec<f64>)>> {
     let mut rows = Vec::new();
     for (i, line) in text.lines().enumerate() {
         let line = line.trim();

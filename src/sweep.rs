@@ -134,7 +134,7 @@ fn unit(bits: u64) -> f64 {
 /// A keyed pseudo-random permutation of 0..n, evaluated at i without storing it: a 4-round balanced Feistel
 /// network on the smallest even number of bits covering n, with cycle walking (re-encrypt until the result
 /// is below n; it terminates because the network is a bijection of a domain smaller than 4n).
-pub fn permute(i: u64, n: u64, key: u64) -> u64 {
+pub(crate) fn permute(i: u64, n: u64, key: u64) -> u64 {
     assert!(i < n);
     let bits = (64 - (n - 1).leading_zeros()).max(2);
     let half = bits.div_ceil(2);
@@ -349,7 +349,7 @@ impl Sweep {
     /// every integral: each integral completes the share of its point that its expected evaluation count is of
     /// the point's (a point whose recipe is invalid counts whole once planned). The rows still come in index
     /// order at the end of each chunk; only the count moves within it. The results are the same bits.
-    pub fn run_reporting(
+    pub(crate) fn run_reporting(
         &self,
         range: Range<u64>,
         mut sink: impl FnMut(PointResult) -> Result<()>,
@@ -435,7 +435,7 @@ impl Sweep {
 
     /// The CSV header: index, one column per parameter, value and error of every reading, problem (and
     /// seconds when timed).
-    pub fn csv_header(&self, timing: bool) -> String {
+    pub(crate) fn csv_header(&self, timing: bool) -> String {
         let mut h: Vec<String> = vec!["index".into()];
         h.extend(self.axes.iter().map(|a| a.path.clone()));
         for (g, n, u) in self.columns() {
@@ -489,7 +489,7 @@ impl Sweep {
     }
 
     /// One JSON line ([`Sweep::line_doc`]).
-    pub fn jsonl_row(&self, r: &PointResult, timing: bool) -> String {
+    pub(crate) fn jsonl_row(&self, r: &PointResult, timing: bool) -> String {
         report::to_json(&self.line_doc(r, timing)).to_string() + "\n"
     }
 

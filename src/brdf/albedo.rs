@@ -26,7 +26,7 @@ use crate::Vec3;
 use std::f64::consts::PI;
 
 /// Absolute tolerance of the albedo integral (albedos are ≤ 1).
-pub const ALBEDO_TOLERANCE: f64 = 1e-9;
+pub(crate) const ALBEDO_TOLERANCE: f64 = 1e-9;
 
 /// Directional albedo of `brdf` for the incident direction `wi` (unit, z > 0), per spectral sample, with an
 /// error estimate (absolute, max over samples). Includes the delta reflectance. Returns zeros for wi at or

@@ -9,7 +9,7 @@ use std::sync::Arc;
 
 /// `inner`, described with `note` after its own description.
 #[derive(Clone, Debug)]
-pub struct Annotated {
+pub(crate) struct Annotated {
     pub inner: Arc<dyn Brdf>,
     pub note: String,
 }

@@ -10,7 +10,7 @@ use num_complex::Complex64;
 
 /// A smooth conductor with a complex index per spectral sample.
 #[derive(Clone, Debug, PartialEq)]
-pub struct SmoothConductor {
+pub(crate) struct SmoothConductor {
     /// n + ik (k ≥ 0) per spectral sample, relative to air.
     pub ior: Vec<Complex64>,
     pub sampling: Sampling,

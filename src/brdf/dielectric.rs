@@ -39,7 +39,7 @@ impl Ior {
 
     /// The cosine of the critical angle, if the index has one (a real index below 1, as a dielectric or as a
     /// conductor with k = 0).
-    pub fn critical_cosine(&self) -> Option<f64> {
+    pub(crate) fn critical_cosine(&self) -> Option<f64> {
         match *self {
             Ior::Dielectric(n) => critical_cosine(n),
             Ior::Conductor(eta) => critical_cosine_complex(eta),

@@ -54,7 +54,7 @@ impl Halo {
     }
 
     /// The largest rms roughness (nm) the theory is used for with this sampling.
-    pub fn sigma_max(sampling: &Sampling) -> f64 {
+    pub(crate) fn sigma_max(sampling: &Sampling) -> f64 {
         let lambda_min = sampling.wavelengths_nm.iter().copied().fold(f64::INFINITY, f64::min);
         crate::optics::scatter::MAX_PHASE * lambda_min / (4.0 * std::f64::consts::PI)
     }
@@ -91,7 +91,7 @@ impl Halo {
     }
 
     /// Take the halo's light from a mirror: out[k] −= R(θi)·g(θi) (first order, docs/optics.md §8).
-    pub fn take_from_mirror(&self, wi: Vec3, out: &mut [f64]) {
+    pub(crate) fn take_from_mirror(&self, wi: Vec3, out: &mut [f64]) {
         if wi.z > 0.0 {
             let c = wi.z.min(1.0);
             for (k, o) in out.iter_mut().enumerate() {
@@ -153,7 +153,7 @@ impl Halo {
 
 /// A model with a scatter halo on its top interface's mirror.
 #[derive(Clone, Debug)]
-pub struct WithHalo {
+pub(crate) struct WithHalo {
     pub inner: Arc<dyn Brdf>,
     pub halo: Halo,
 }

@@ -42,7 +42,7 @@ use crate::spectrum::Sampling;
 use crate::{Error, Result, Vec3};
 
 pub mod albedo;
-pub mod annotated;
+pub(crate) mod annotated;
 pub mod conductor;
 pub mod dielectric;
 pub mod halo;
@@ -52,7 +52,7 @@ pub mod multilobe;
 pub mod paint;
 pub mod phong;
 pub mod topography;
-pub mod two_scale;
+pub(crate) mod two_scale;
 pub mod ward;
 
 /// A glossy lobe centred on the specular direction (half vector along the normal, or, for a lobe formed
@@ -104,7 +104,7 @@ pub enum Tail {
 
 impl Tail {
     /// Whether the tail falls off slower than a Gaussian (split out to the ends of the range).
-    pub fn is_heavy(self) -> bool {
+    pub(crate) fn is_heavy(self) -> bool {
         self != Tail::Gaussian
     }
 }
@@ -113,7 +113,7 @@ impl Lobe {
     /// The lobe of a microfacet distribution formed in a medium of index `medium_eta`: its width is the
     /// roughness, its tail the distribution's own (GGX: `Tail::InverseQuartic`, Beckmann: `Tail::Gaussian`). (It lives here rather than on
     /// `Microfacet` because `optics` sits below `brdf` and knows nothing of lobes.)
-    pub fn of_facets(facets: &Microfacet, medium_eta: f64, label: String) -> Lobe {
+    pub(crate) fn of_facets(facets: &Microfacet, medium_eta: f64, label: String) -> Lobe {
         let tail = match facets.distribution {
             Distribution::Ggx => Tail::InverseQuartic,
             Distribution::Beckmann => Tail::Gaussian,
@@ -212,12 +212,12 @@ impl Hints {
     }
 
     /// With these kinks ([`Hints::kinks`]).
-    pub fn with_kinks(self, kinks: Vec<Kink>) -> Hints {
+    pub(crate) fn with_kinks(self, kinks: Vec<Kink>) -> Hints {
         Hints { kinks, ..self }
     }
 
     /// With these seams ([`Hints::seams`]).
-    pub fn with_seams(self, seams: Vec<f64>) -> Hints {
+    pub(crate) fn with_seams(self, seams: Vec<f64>) -> Hints {
         Hints { seams, ..self }
     }
 
@@ -227,7 +227,7 @@ impl Hints {
     }
 
     /// Smooth or not ([`Hints::smooth`]).
-    pub fn with_smooth(self, smooth: bool) -> Hints {
+    pub(crate) fn with_smooth(self, smooth: bool) -> Hints {
         Hints { smooth, ..self }
     }
 
@@ -253,7 +253,7 @@ impl Hints {
     }
 
     /// Whether the model has a diffuse term.
-    pub fn has_diffuse(&self) -> bool {
+    pub(crate) fn has_diffuse(&self) -> bool {
         self.terms.iter().any(|t| t.kind == TermKind::Diffuse)
     }
 }
@@ -261,13 +261,13 @@ impl Hints {
 /// Whether both directions are above the horizon (z > 0; a NaN is not): the regular part of every model is
 /// zero elsewhere (the conventions above). The horizon guard, written once for every model and wrapper.
 #[inline]
-pub fn above_horizon(wi: Vec3, wo: Vec3) -> bool {
+pub(crate) fn above_horizon(wi: Vec3, wo: Vec3) -> bool {
     wi.z > 0.0 && wo.z > 0.0
 }
 
 /// The horizon guard of an `eval`: true, with `out` zeroed, when the pair is not [`above_horizon`].
 #[inline]
-pub fn below_horizon(wi: Vec3, wo: Vec3, out: &mut [f64]) -> bool {
+pub(crate) fn below_horizon(wi: Vec3, wo: Vec3, out: &mut [f64]) -> bool {
     let below = !above_horizon(wi, wo);
     if below {
         out.fill(0.0);

@@ -27,7 +27,7 @@ use crate::Vec3;
 use std::f64::consts::PI;
 
 /// Schlick's Fresnel approximation F = F0 + (1 − F0)(1 − cos θ)⁵ (Schlick 1994 Eq. 15).
-pub fn schlick_fresnel(f0: f64, cos_theta: f64) -> f64 {
+pub(crate) fn schlick_fresnel(f0: f64, cos_theta: f64) -> f64 {
     let m = (1.0 - cos_theta.clamp(0.0, 1.0)).powi(5);
     f0 + (1.0 - f0) * m
 }
@@ -66,7 +66,7 @@ impl CookTorranceLobes {
     }
 
     /// Put a smooth clear coat of index `index` on top (docs/recipe-format.md §cook-torrance-lobes).
-    pub fn with_clear_coat(mut self, index: f64) -> Self {
+    pub(crate) fn with_clear_coat(mut self, index: f64) -> Self {
         self.clear_coat = Some(index);
         self
     }

@@ -70,7 +70,7 @@ impl Phong {
     }
 
     /// Equivalent Beckmann rms slope of the lobe, for the integrator's splits.
-    pub fn equivalent_slope_width(&self) -> f64 {
+    pub(crate) fn equivalent_slope_width(&self) -> f64 {
         let m = (2.0 / (self.exponent + 2.0)).sqrt();
         match self.variant {
             PhongVariant::BlinnPhong => m,

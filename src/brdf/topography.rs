@@ -16,7 +16,7 @@ use crate::spectrum::Sampling;
 use crate::Vec3;
 
 #[derive(Clone, Debug, PartialEq)]
-pub struct TopographySurface {
+pub(crate) struct TopographySurface {
     pub slopes: SlopeTable,
     /// The index beneath the surface (real: a dielectric).
     pub ior: f64,

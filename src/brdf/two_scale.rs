@@ -24,7 +24,7 @@ use std::sync::Arc;
 
 /// A rough interface (a regular lobe, no mirror) with the scatter halo of its micro-roughness.
 #[derive(Clone, Debug)]
-pub struct RoughWithHalo {
+pub(crate) struct RoughWithHalo {
     pub inner: Arc<dyn Brdf>,
     pub halo: Halo,
     /// g(cos θ̄) per sample as a verified piecewise Chebyshev table on [0, 1] (`optics::tabulated`; within

@@ -27,7 +27,7 @@ pub struct Lch {
 const DELTA: f64 = 6.0 / 29.0;
 
 /// CIELAB's f(t): t^(1/3) above δ³, t/(3δ²) + 4/29 below.
-pub fn lab_f(t: f64) -> f64 {
+pub(crate) fn lab_f(t: f64) -> f64 {
     if t > DELTA * DELTA * DELTA {
         t.cbrt()
     } else {
@@ -50,7 +50,7 @@ fn f_change(t: f64, e: f64) -> f64 {
 }
 
 /// Error bounds of L*, a*, b* from absolute error bounds of X, Y, Z.
-pub fn lab_errors(xyz: [f64; 3], err: [f64; 3], white: [f64; 3]) -> [f64; 3] {
+pub(crate) fn lab_errors(xyz: [f64; 3], err: [f64; 3], white: [f64; 3]) -> [f64; 3] {
     let d: Vec<f64> = (0..3).map(|i| f_change(xyz[i] / white[i], err[i] / white[i])).collect();
     [116.0 * d[1], 500.0 * (d[0] + d[1]), 200.0 * (d[1] + d[2])]
 }
@@ -64,7 +64,7 @@ pub fn lab_to_lch(lab: Lab) -> Lch {
 
 /// Error bounds of C*ab and hab (degrees) for a*, b* known to within (ea, eb): the point moves by at most
 /// r = hypot(ea, eb), so C changes by at most r and the hue by at most asin(r / C) (180° if r ≥ C).
-pub fn lch_errors(lab: Lab, ea: f64, eb: f64) -> (f64, f64) {
+pub(crate) fn lch_errors(lab: Lab, ea: f64, eb: f64) -> (f64, f64) {
     let r = ea.hypot(eb);
     let c = lab.a.hypot(lab.b);
     let eh = if r < c { (r / c).asin().to_degrees() } else { 180.0 };
@@ -77,7 +77,7 @@ pub fn ciede2000(lab1: Lab, lab2: Lab) -> f64 {
 }
 
 /// CIEDE2000 ΔE00 with parametric factors [kL, kC, kH] (Sharma et al. 2005, Eqs. 1–21).
-pub fn ciede2000_k(lab1: Lab, lab2: Lab, k: [f64; 3]) -> f64 {
+pub(crate) fn ciede2000_k(lab1: Lab, lab2: Lab, k: [f64; 3]) -> f64 {
     let pow7 = |x: f64| x.powi(7);
     let c_ab = 0.5 * (lab1.a.hypot(lab1.b) + lab2.a.hypot(lab2.b)); // Eq. 2–3
     let g = 0.5 * (1.0 - (pow7(c_ab) / (pow7(c_ab) + pow7(25.0))).sqrt()); // Eq. 4

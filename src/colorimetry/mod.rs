@@ -43,16 +43,16 @@ pub mod weighting;
 pub use cielab::{ciede2000, lab_to_lch, xyz_to_lab, Lab, Lch};
 
 /// CIE 1931 2° colour-matching functions, 1 nm, 360–830 nm.
-pub const CIE1931_2DEG_CSV: &str = include_str!("../../standards/cie/cie1931-2deg-xyz.csv");
+pub(crate) const CIE1931_2DEG_CSV: &str = include_str!("../../standards/cie/cie1931-2deg-xyz.csv");
 /// CIE 1964 10° colour-matching functions, 1 nm, 360–830 nm.
-pub const CIE1964_10DEG_CSV: &str = include_str!("../../standards/cie/cie1964-10deg-xyz.csv");
-pub const ILLUMINANT_D65_CSV: &str = include_str!("../../standards/cie/illuminant-d65.csv");
-pub const ILLUMINANT_D50_CSV: &str = include_str!("../../standards/cie/illuminant-d50.csv");
-pub const ILLUMINANT_A_CSV: &str = include_str!("../../standards/cie/illuminant-a.csv");
+pub(crate) const CIE1964_10DEG_CSV: &str = include_str!("../../standards/cie/cie1964-10deg-xyz.csv");
+pub(crate) const ILLUMINANT_D65_CSV: &str = include_str!("../../standards/cie/illuminant-d65.csv");
+pub(crate) const ILLUMINANT_D50_CSV: &str = include_str!("../../standards/cie/illuminant-d50.csv");
+pub(crate) const ILLUMINANT_A_CSV: &str = include_str!("../../standards/cie/illuminant-a.csv");
 
 /// First and last wavelength of the summation, nm (1 nm steps).
-pub const SUM_START_NM: u32 = 360;
-pub const SUM_END_NM: u32 = 780;
+pub(crate) const SUM_START_NM: u32 = 360;
+pub(crate) const SUM_END_NM: u32 = 780;
 
 /// A CIE standard colorimetric observer.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -219,7 +219,7 @@ fn hat(wl: &[f64], lam: f64) -> [(usize, f64); 2] {
 }
 
 /// Weights for samples at `wavelengths_nm` (strictly increasing; one wavelength = wavelength-flat).
-pub fn weights_for_grid(wavelengths_nm: &[f64], c: Conditions) -> Result<Weights> {
+pub(crate) fn weights_for_grid(wavelengths_nm: &[f64], c: Conditions) -> Result<Weights> {
     if wavelengths_nm.is_empty() || wavelengths_nm.windows(2).any(|w| !(w[1] > w[0])) {
         return Err(Error::Usage("colour weights need a strictly increasing, non-empty wavelength grid".into()));
     }
@@ -254,7 +254,7 @@ pub fn weights(sampling: &Sampling, c: Conditions) -> Result<Weights> {
 }
 
 /// Why an RGB material has no colour readings.
-pub const RGB_REFUSAL: &str =
+pub(crate) const RGB_REFUSAL: &str =
     "colour readings need a spectral (or grey) material: an RGB material's three samples are \
      linear R, G, B values whose optics are evaluated at 700, 546.1 and 435.8 nm, not a reflectance spectrum, so \
      they define no X, Y, Z; give the recipe \"wavelengths_nm\" with one value per wavelength";

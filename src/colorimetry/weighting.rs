@@ -36,7 +36,7 @@ pub struct Weighting {
 
 impl Weighting {
     /// The rows of one kind for this sampling.
-    pub fn rows_of(kind: WeightingKind, sampling: &Sampling) -> Result<Vec<Vec<f64>>> {
+    pub(crate) fn rows_of(kind: WeightingKind, sampling: &Sampling) -> Result<Vec<Vec<f64>>> {
         Ok(match kind {
             WeightingKind::Luminous => vec![match sampling.kind {
                 SamplingKind::Grey => vec![1.0; sampling.len()],
@@ -88,7 +88,7 @@ impl Weighting {
     }
 
     /// An error bound of component c from per-sample error bounds: Σ_j |W[c][j]| e_j.
-    pub fn component_error(&self, c: usize, errors: &[f64]) -> f64 {
+    pub(crate) fn component_error(&self, c: usize, errors: &[f64]) -> f64 {
         self.rows[c].iter().zip(errors).map(|(w, e)| w.abs() * e).sum()
     }
 

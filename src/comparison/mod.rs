@@ -100,7 +100,7 @@ pub struct Group {
 }
 
 /// Rows grouped by (sample, geometry, reading), in order of first appearance.
-pub fn group_rows(rows: &[SheetRow]) -> Vec<Group> {
+pub(crate) fn group_rows(rows: &[SheetRow]) -> Vec<Group> {
     let mut index: HashMap<(&str, &str, &str), usize> = HashMap::new();
     let mut groups: Vec<Group> = Vec::new();
     for r in rows {
@@ -203,7 +203,7 @@ impl ReadingTolerance {
 
 /// One `--tolerance` argument: a plain number (`2`, every reading without a more specific one) or `KEY=VALUE`
 /// ([`ReadingTolerance`]). Returns (None, plain) or (Some(entry), _).
-pub fn parse_tolerance(text: &str) -> Result<(Option<ReadingTolerance>, f64)> {
+pub(crate) fn parse_tolerance(text: &str) -> Result<(Option<ReadingTolerance>, f64)> {
     let bad = |why: String| Error::argument("tolerance", format!(" {text:?}: {why}"));
     let number = |v: &str| -> Result<f64> {
         let x: f64 = v.trim().parse().map_err(|_| bad(format!("`{}` is not a number", v.trim())))?;
@@ -263,7 +263,7 @@ impl VerdictRule {
 
     /// The rule of `--tolerance` arguments ([`parse_tolerance`]), each a plain number (at most one) or
     /// `KEY=VALUE` (at most one per key).
-    pub fn with_tolerances(k: f64, arguments: &[String]) -> Result<VerdictRule> {
+    pub(crate) fn with_tolerances(k: f64, arguments: &[String]) -> Result<VerdictRule> {
         let mut rule = VerdictRule { k, ..VerdictRule::default() };
         for a in arguments {
             match parse_tolerance(a)? {
@@ -287,7 +287,7 @@ impl VerdictRule {
     /// The tolerance of a reading of `geometry` with this name and quantity: the most specific entry of
     /// `per_reading` that names it (geometry and reading, then the reading's name, then its quantity), else
     /// the plain `tolerance`.
-    pub fn tolerance_for(&self, geometry: &str, name: &str, quantity: &str) -> Option<f64> {
+    pub(crate) fn tolerance_for(&self, geometry: &str, name: &str, quantity: &str) -> Option<f64> {
         self.per_reading
             .iter()
             .filter_map(|t| t.names(geometry, name, quantity).map(|rank| (rank, t.value)))
@@ -395,7 +395,7 @@ impl Verdict {
         matches!(self, Verdict::Outside | Verdict::NoValue(_) | Verdict::NoAllowance)
     }
     /// Why the row could not be checked, if it could not.
-    pub fn why_unchecked(&self) -> Option<String> {
+    pub(crate) fn why_unchecked(&self) -> Option<String> {
         match self {
             Verdict::NoValue(why) => Some(format!("the prediction has no value ({why})")),
             Verdict::NoAllowance => {
@@ -429,7 +429,7 @@ impl Comparison {
 
 /// The verdict of one group against the readings of its material and their prediction uncertainties
 /// (`uncertainties[i]` of `readings[i]`; an empty slice when the recipe states none).
-pub fn judge(
+pub(crate) fn judge(
     group: Group,
     material: &Material,
     readings: &[Reading],
@@ -494,7 +494,7 @@ pub struct Recipes {
 
 impl Recipes {
     /// The recipe of a sample, or None.
-    pub fn source_of(&self, sample: &str) -> Option<Source> {
+    pub(crate) fn source_of(&self, sample: &str) -> Option<Source> {
         if let Some((_, p)) = self.per_sample.iter().find(|(s, _)| s == sample) {
             return Some(p.clone());
         }

@@ -30,7 +30,7 @@ impl Statistic {
 /// The words of statistics headers (normalised as the sheet reader normalises headers: lower case, letters and
 /// digits only), longest first so that `stddev` is not read as `std` + `dev`. `x̄` normalises to `x`, which is
 /// not taken (it is also an axis); `s` and `r` alone are too short to be sure of.
-pub const STATISTIC_WORDS: &[(&str, Statistic)] = &[
+pub(crate) const STATISTIC_WORDS: &[(&str, Statistic)] = &[
     ("standarddeviation", Statistic::Std),
     ("average", Statistic::Mean),
     ("minimum", Statistic::Min),
@@ -95,7 +95,7 @@ impl Series {
 }
 
 /// The decimals a number was written with (`89.13` → 2, `1.5e-3` → 4, `90` → 0).
-pub fn written_decimals(text: &str) -> i32 {
+pub(crate) fn written_decimals(text: &str) -> i32 {
     let t = text.trim().replace(',', ".");
     let (mantissa, exponent) = match t.find(['e', 'E']) {
         Some(i) => (&t[..i], t[i + 1..].parse::<i32>().unwrap_or(0)),

@@ -73,7 +73,7 @@ use problem::{describe_point, u_of_t, Forward, Mode, Problem};
 
 /// The largest Gauss–Newton step, in standard uncertainties of the targets, that may remain at a fit called
 /// converged (an independent check of the solver's own stopping rule; see [`fit`]).
-pub const STEP_TOLERANCE: f64 = 0.01;
+pub(crate) const STEP_TOLERANCE: f64 = 0.01;
 
 /// Fit the free parameters of `recipe` (the JSON of a recipe file named `file`) to the targets.
 /// Bad arguments (paths, bounds, starts, targets, counts) are usage errors, [`Error::Argument`] where they

@@ -40,7 +40,7 @@ impl<'a> Obj<'a> {
     }
 
     /// Refuse any key not in `allowed` (typos must not be silently ignored).
-    pub fn deny_unknown(&self, allowed: &[&str]) -> Result<()> {
+    pub(crate) fn deny_unknown(&self, allowed: &[&str]) -> Result<()> {
         for k in self.map.keys() {
             if !allowed.contains(&k.as_str()) {
                 if k.is_empty() {
@@ -70,7 +70,7 @@ impl<'a> Obj<'a> {
         Obj::new(self.file, self.field(key), self.required(key)?)
     }
 
-    pub fn opt_obj(&self, key: &str) -> Result<Option<Obj<'a>>> {
+    pub(crate) fn opt_obj(&self, key: &str) -> Result<Option<Obj<'a>>> {
         self.get(key).map(|v| Obj::new(self.file, self.field(key), v)).transpose()
     }
 
@@ -79,7 +79,7 @@ impl<'a> Obj<'a> {
         v.as_str().ok_or_else(|| self.err(key, format!("expected a string, got {}", kind(v))))
     }
 
-    pub fn opt_str(&self, key: &str) -> Result<Option<&'a str>> {
+    pub(crate) fn opt_str(&self, key: &str) -> Result<Option<&'a str>> {
         match self.get(key) {
             None => Ok(None),
             Some(v) => v.as_str().map(Some).ok_or_else(|| self.err(key, format!("expected a string, got {}", kind(v)))),
@@ -92,7 +92,7 @@ impl<'a> Obj<'a> {
         number(self.file, &self.field(key), v, lo, hi, what)
     }
 
-    pub fn opt_num(&self, key: &str, lo: f64, hi: f64, what: &str) -> Result<Option<f64>> {
+    pub(crate) fn opt_num(&self, key: &str, lo: f64, hi: f64, what: &str) -> Result<Option<f64>> {
         self.get(key).map(|v| number(self.file, &self.field(key), v, lo, hi, what)).transpose()
     }
 

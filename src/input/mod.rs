@@ -23,14 +23,14 @@ pub mod json;
 
 /// The largest text input file: 16 MiB. A recipe or a geometry file is a few kB; a sheet of 16 MiB holds
 /// some 300 000 readings.
-pub const MAX_TEXT_BYTES: u64 = 16 * 1024 * 1024;
+pub(crate) const MAX_TEXT_BYTES: u64 = 16 * 1024 * 1024;
 
 /// The largest measured table (RGL `.bsdf`, in-plane CSV, ASTM E1392 text): 256 MiB. A MERL-resolution
 /// isotropic table is 34 MB (90 × 90 × 180 × 3 doubles); RGL files of measured materials are 1–60 MB.
-pub const MAX_TABLE_BYTES: u64 = 256 * 1024 * 1024;
+pub(crate) const MAX_TABLE_BYTES: u64 = 256 * 1024 * 1024;
 
 /// How standard input is named in messages (the path `-`).
-pub const STDIN: &str = "<stdin>";
+pub(crate) const STDIN: &str = "<stdin>";
 
 /// Whether a command-line argument is `-`, standard input (a file named `-` is still reachable as `./-`). Only
 /// front ends ask: a reader is handed a [`Source`], and the path `-` is a file of that name to it.
@@ -39,7 +39,7 @@ pub fn is_stdin(path: &Path) -> bool {
 }
 
 /// Refuse, before any reading, a run that names `-` for two inputs (standard input can be read once).
-pub fn at_most_one_stdin<'a>(paths: impl IntoIterator<Item = &'a Path>) -> Result<()> {
+pub(crate) fn at_most_one_stdin<'a>(paths: impl IntoIterator<Item = &'a Path>) -> Result<()> {
     if paths.into_iter().filter(|p| is_stdin(p)).count() > 1 {
         return Err(Error::Usage(
             "`-` (standard input) is given for a second input: standard input can be read once, so at most one \
@@ -103,7 +103,7 @@ impl Source {
 
     /// The bytes of the source, of at most `limit` bytes; a larger one (or an endless one, `/dev/zero`) is
     /// refused after reading `limit` + 1 bytes, naming the file and the limit.
-    pub fn bytes_limited(&self, what: &str, limit: u64) -> Result<Vec<u8>> {
+    pub(crate) fn bytes_limited(&self, what: &str, limit: u64) -> Result<Vec<u8>> {
         let file = self.name();
         let bytes = match self {
             Source::File(path) => {
@@ -126,7 +126,7 @@ impl Source {
     }
 
     /// [`Source::text`] with the limit given.
-    pub fn text_limited(&self, what: &str, limit: u64) -> Result<String> {
+    pub(crate) fn text_limited(&self, what: &str, limit: u64) -> Result<String> {
         let bytes = self.bytes_limited(what, limit)?;
         String::from_utf8(bytes).map_err(|e| {
             Error::input(
@@ -144,7 +144,7 @@ impl Source {
 /// Standard input as a front end opens it: a value the front end owns for one run (never a flag of the
 /// process), which reads standard input for the first `-` and refuses a second (it can be read once).
 #[derive(Debug, Default)]
-pub struct Stdin {
+pub(crate) struct Stdin {
     read: bool,
 }
 
@@ -172,12 +172,12 @@ impl Stdin {
     }
 
     /// [`Stdin::open`] of a text input ([`MAX_TEXT_BYTES`]: recipes, sheets, geometry files, baselines).
-    pub fn open_text(&mut self, path: &Path, what: &str) -> Result<Source> {
+    pub(crate) fn open_text(&mut self, path: &Path, what: &str) -> Result<Source> {
         self.open(path, what, MAX_TEXT_BYTES)
     }
 
     /// [`Stdin::open_text`] of every path, in order.
-    pub fn open_text_all(&mut self, paths: &[PathBuf], what: &str) -> Result<Vec<Source>> {
+    pub(crate) fn open_text_all(&mut self, paths: &[PathBuf], what: &str) -> Result<Vec<Source>> {
         paths.iter().map(|p| self.open_text(p, what)).collect()
     }
 }
@@ -188,12 +188,12 @@ pub fn read_text(path: &Path, what: &str) -> Result<String> {
 }
 
 /// The bytes of the file `path`, of at most `limit` bytes ([`Source::bytes_limited`]).
-pub fn read_bytes_limited(path: &Path, what: &str, limit: u64) -> Result<Vec<u8>> {
+pub(crate) fn read_bytes_limited(path: &Path, what: &str, limit: u64) -> Result<Vec<u8>> {
     Source::from(path).bytes_limited(what, limit)
 }
 
 /// [`read_text`] with the limit given.
-pub fn read_text_limited(path: &Path, what: &str, limit: u64) -> Result<String> {
+pub(crate) fn read_text_limited(path: &Path, what: &str, limit: u64) -> Result<String> {
     Source::from(path).text_limited(what, limit)
 }
 

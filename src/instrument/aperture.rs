@@ -21,7 +21,7 @@ use crate::instrument::geometry::{Axes, Stop};
 /// Fraction of a flux's tolerance given to its delta part. The delta part is a smooth 2-D integral that
 /// converges to near machine precision in a few hundred evaluations, so it is asked for much more than its
 /// half and the expensive 4-D regular part gets the rest.
-pub const DELTA_SHARE: f64 = 0.01;
+pub(crate) const DELTA_SHARE: f64 = 0.01;
 
 /// Width in u (in-plane) and v (perpendicular) of a lobe at geometry angle θ.
 /// A facet/flake tilt δ inside a medium of index η turns the internal reflected ray by 2δ; leaving the
@@ -80,7 +80,7 @@ pub enum Chart {
 }
 
 /// Choose the chart of the regular part for these (clipped) stops and these lobes at their angle θ.
-pub fn choose_chart(l: &LobesAt, source: Stop, receptor: Stop) -> Chart {
+pub(crate) fn choose_chart(l: &LobesAt, source: Stop, receptor: Stop) -> Chart {
     let range_u = (source.p[1] - source.p[0]) + (receptor.p[1] - receptor.p[0]);
     let range_v = (source.q[1] - source.q[0]) + (receptor.q[1] - receptor.q[0]);
     let wide = |(&w, pole): (&[f64; 2], &Option<[f64; 2]>)| {
@@ -98,7 +98,7 @@ pub fn choose_chart(l: &LobesAt, source: Stop, receptor: Stop) -> Chart {
 /// lies in the receptor, as (lower, upper) corners; None if it is empty (the receptor does not see the
 /// mirror image of the source, so an ideal-mirror term contributes nothing). The one place this is computed
 /// (the independent reference in `instrument/reference.rs` keeps its own on purpose).
-pub fn mirror_overlap(source: Stop, receptor: Stop) -> Option<([f64; 2], [f64; 2])> {
+pub(crate) fn mirror_overlap(source: Stop, receptor: Stop) -> Option<([f64; 2], [f64; 2])> {
     let lo = [source.p[0].max(-receptor.p[1]), source.q[0].max(-receptor.q[1])];
     let hi = [source.p[1].min(-receptor.p[0]), source.q[1].min(-receptor.q[0])];
     (hi[0] > lo[0] && hi[1] > lo[1]).then_some((lo, hi))
@@ -140,7 +140,7 @@ pub fn lobe_splits(l: &LobesAt, source: Stop, receptor: Stop) -> [Vec<f64>; 2] {
 /// sampled in √θh or u_θ = √(2θ/π), so the interpolant is linear in √θh in the first cell; an in-plane table's
 /// is linear in |θh|): the lobe chart splits at 0 and ± these widths, so that the cusp sits in the corners of
 /// boxes a ring wide (`docs/instrument.md` §Quadrature, *Measured tables*). None for a lobe of a model.
-pub fn table_pole_widths(lobe: &Lobe, theta: f64) -> Option<[f64; 2]> {
+pub(crate) fn table_pole_widths(lobe: &Lobe, theta: f64) -> Option<[f64; 2]> {
     match lobe.tail {
         Tail::Table { resolution, .. } => {
             Some(lobe_widths_uv(&Lobe { slope_width: resolution, ..lobe.clone() }, theta))
@@ -272,7 +272,7 @@ fn stop_radius(stop: Stop) -> f64 {
 /// The kinks of the delta part that may cross the source box `src` (the mirror overlap) at geometry angle θ:
 /// the cosines of the critical angles θc within θ ± the box's angular radius (a bound: θi of a direction
 /// through the box differs from θ by at most the angle between it and the source axis), in increasing order.
-pub fn delta_kinks(kinks: &[Kink], theta: f64, src: Stop) -> Vec<f64> {
+pub(crate) fn delta_kinks(kinks: &[Kink], theta: f64, src: Stop) -> Vec<f64> {
     let a = stop_radius(src);
     let mut c: Vec<f64> = kinks
         .iter()
@@ -291,13 +291,13 @@ pub fn delta_kinks(kinks: &[Kink], theta: f64, src: Stop) -> Vec<f64> {
 /// half-angle kinks ωi·h = c whose angle between ωi and ωo, 2·acos c, lies within 2θ ± (the stops' angular
 /// radii) (the triangle inequality on the sphere: the angle between ωi and ωo differs from the axes' 2θ by
 /// at most the two directions' angles from their axes), in increasing order.
-pub fn regular_kinks(kinks: &[Kink], theta: f64, src: Stop, rec: Stop) -> Vec<f64> {
+pub(crate) fn regular_kinks(kinks: &[Kink], theta: f64, src: Stop, rec: Stop) -> Vec<f64> {
     regular_kinks_between(kinks, 2.0 * theta, src, rec)
 }
 
 /// [`regular_kinks`] for stops whose axes are `axes_angle` apart (2θ on the mirror axis; θ + the viewing
 /// angle for a receptor off it, in the plane on the other side of the normal).
-pub fn regular_kinks_between(kinks: &[Kink], axes_angle: f64, src: Stop, rec: Stop) -> Vec<f64> {
+pub(crate) fn regular_kinks_between(kinks: &[Kink], axes_angle: f64, src: Stop, rec: Stop) -> Vec<f64> {
     let theta = 0.5 * axes_angle.abs();
     let a = stop_radius(src) + stop_radius(rec);
     let mut c: Vec<f64> = kinks
@@ -316,7 +316,7 @@ pub fn regular_kinks_between(kinks: &[Kink], axes_angle: f64, src: Stop, rec: St
 /// The root in [lo, hi] of an increasing function g (value and derivative), by Newton's method kept inside
 /// a bracket (bisection when a step leaves it); lo when g(lo) ≥ 0, hi when g(hi) ≤ 0 (no crossing).
 /// Deterministic: the same arguments give the same bits.
-pub fn increasing_root(g: impl Fn(f64) -> (f64, f64), lo: f64, hi: f64) -> f64 {
+pub(crate) fn increasing_root(g: impl Fn(f64) -> (f64, f64), lo: f64, hi: f64) -> f64 {
     let (g_lo, _) = g(lo);
     if !(g_lo < 0.0) {
         return lo;
@@ -390,7 +390,7 @@ pub fn kinked_position(t: f64, lo: f64, hi: f64, cuts: usize, root: impl Fn(usiz
 /// normalised N/√(AB) with N = cos 2θ (1 + p_s p_r) + sin 2θ (p_s − p_r) + q_s q_r, A = 1 + p_s² + q_s²,
 /// B = 1 + p_r² + q_r² (the product of the two unnormalised directions, `geometry::Axes`); it increases with
 /// p_s along a constant u (the two directions close up), at the rate N′ = cos 2θ (p_r − p_s) + 2 sin 2θ.
-pub fn half_angle_kink_point(axes: &Axes, dot: f64, u: f64, qs: f64, qr: f64, lo: f64, hi: f64) -> f64 {
+pub(crate) fn half_angle_kink_point(axes: &Axes, dot: f64, u: f64, qs: f64, qr: f64, lo: f64, hi: f64) -> f64 {
     let (c2, s2) = ((2.0 * axes.theta).cos(), (2.0 * axes.theta).sin());
     increasing_root(
         |ps| {
@@ -437,7 +437,7 @@ pub fn plain_kink_point(axes: &Axes, dot: f64, qs: f64, wo: crate::Vec3, lo: f64
 /// The position p of the source-stop point on the critical-angle kink cos θi = `cos` (the delta part's kink,
 /// [`Kink::Incidence`]) at fixed q, within [lo, hi]: cos θi = (cos θ + p sin θ)/√(1 + p² + q²), increasing in
 /// p (towards the normal) at the rate (sin θ (1 + q²) − p cos θ)/(1 + p² + q²)^{3/2}.
-pub fn incidence_kink_point(axes: &Axes, cos: f64, q: f64, lo: f64, hi: f64) -> f64 {
+pub(crate) fn incidence_kink_point(axes: &Axes, cos: f64, q: f64, lo: f64, hi: f64) -> f64 {
     let (c, s) = (axes.theta.cos(), axes.theta.sin());
     increasing_root(
         |p| {

@@ -49,7 +49,7 @@ use crate::{Error, Result, Vec3};
 pub const DEFAULT_TOLERANCES: [f64; 9] = [1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10];
 
 /// How much tighter than the tightest tolerance of the sweep the reference run is.
-pub const REFERENCE_FACTOR: f64 = 100.0;
+pub(crate) const REFERENCE_FACTOR: f64 = 100.0;
 
 /// Knobs of a sweep.
 #[derive(Clone, Debug, PartialEq)]
@@ -237,7 +237,7 @@ fn closed_form_reading(r: &PlannedReading, flux: &[f64], done: &[Option<f64>]) -
 
 /// Closed-form references for every reported reading of `plan` (Lambertian material of luminous value
 /// `f_lum`), in the order of `plan.execute()`.
-pub fn closed_form_references(plan: &Plan, f_lum: f64) -> Vec<ReferenceValue> {
+pub(crate) fn closed_form_references(plan: &Plan, f_lum: f64) -> Vec<ReferenceValue> {
     let flux: Vec<f64> = plan.jobs.iter().map(|j| closed_form_flux(j, f_lum)).collect();
     let mut done: Vec<Option<f64>> = Vec::with_capacity(plan.readings.len());
     for r in &plan.readings {

@@ -14,7 +14,7 @@ use crate::{Error, Result};
 use serde_json::Value;
 
 /// Largest number of variations read at all 2^k corners.
-pub const MAX_CORNER_VARIATIONS: usize = 6;
+pub(crate) const MAX_CORNER_VARIATIONS: usize = 6;
 
 /// One number of a geometry that the standard (or the uncertainty of an assumption) lets vary.
 #[derive(Clone, Debug, PartialEq)]
@@ -31,7 +31,7 @@ pub struct Variation {
 }
 
 /// The variations of a geometry specification, in document order.
-pub fn variations(spec: &Value) -> Vec<Variation> {
+pub(crate) fn variations(spec: &Value) -> Vec<Variation> {
     let mut out = Vec::new();
     walk(spec, String::new(), &mut out);
     out
@@ -84,7 +84,7 @@ fn walk(v: &Value, pointer: String, out: &mut Vec<Variation>) {
 }
 
 /// The values every variant gives each variation (one vector per variant, in `variations` order).
-pub fn variant_values(vars: &[Variation]) -> Vec<Vec<f64>> {
+pub(crate) fn variant_values(vars: &[Variation]) -> Vec<Vec<f64>> {
     let k = vars.len();
     if k == 0 {
         return Vec::new();

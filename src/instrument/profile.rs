@@ -41,7 +41,7 @@ pub const DEFAULT_PIXEL_EVALS: usize = 100_000;
 /// 512-pixel profile spends (1.5·10⁶, the literal Cerulean (c) paint, measured). A profile that cannot converge
 /// (a constant 10³⁰⁸ table ran 8 minutes with the measurement's 2·10⁶ per part on each of 512 pixels) then
 /// ends after about 2·10⁷ evaluations, its pixels marked not converged.
-pub const DEFAULT_TOTAL_EVALS: usize = 20_000_000;
+pub(crate) const DEFAULT_TOTAL_EVALS: usize = 20_000_000;
 
 /// The evaluation budget of a profile: per part of each pixel's integral, and over all the pixels.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -143,7 +143,7 @@ impl Scale {
     }
 
     /// Reflectance at cos θ of the gloss standard rescaled to read 100: R_standard(θ)·100/value.
-    pub fn standard_reflectance(&self, cos_theta: f64) -> f64 {
+    pub(crate) fn standard_reflectance(&self, cos_theta: f64) -> f64 {
         self.standard().reflectance(cos_theta)
     }
 

@@ -62,7 +62,7 @@ impl Brdf for Transposed<'_> {
 
 /// ∫_H f(ωi, ω_v) cos θi dωi per sample, ω_v at `viewing` radians from the normal in the x–z plane (delta
 /// included). The error bound is the albedo integrator's (absolute, the same for every sample).
-pub fn hemisphere_reflectance(brdf: &dyn Brdf, viewing: f64) -> PerSample {
+pub(crate) fn hemisphere_reflectance(brdf: &dyn Brdf, viewing: f64) -> PerSample {
     let n = brdf.sampling().len();
     let wv = Vec3::new(viewing.sin(), 0.0, viewing.cos());
     let t = Transposed(brdf, AtomicUsize::new(0));
@@ -73,7 +73,7 @@ pub fn hemisphere_reflectance(brdf: &dyn Brdf, viewing: f64) -> PerSample {
 /// Reflectance into the specular port per sample: the delta reflectance (its mirror direction is the port's
 /// axis) plus ∫_cone f(ω, ω_v) cos θ dω over the cone of half-angle `beta` about the mirror of the viewing
 /// direction.
-pub fn port_reflectance(brdf: &dyn Brdf, viewing: f64, beta: f64, rtol: f64, max_evals: usize) -> PerSample {
+pub(crate) fn port_reflectance(brdf: &dyn Brdf, viewing: f64, beta: f64, rtol: f64, max_evals: usize) -> PerSample {
     let n = brdf.sampling().len();
     let (sv, cv) = viewing.sin_cos();
     let wv = Vec3::new(sv, 0.0, cv);

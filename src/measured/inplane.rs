@@ -47,7 +47,7 @@ use std::path::Path;
 
 /// What the value column holds.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Quantity {
+pub(crate) enum Quantity {
     /// f_r in sr⁻¹.
     Brdf,
     /// f_r·cos θo in sr⁻¹ (the "cosine-corrected BRDF" of ASTM E1392).
@@ -283,7 +283,7 @@ pub struct InPlaneBrdf {
 
 impl InPlaneBrdf {
     /// Build the table from points (any order). Errors name the file and the line of the offending point.
-    pub fn from_points(
+    pub(crate) fn from_points(
         file: &str,
         format: &'static str,
         mut points: Vec<Point>,
@@ -421,7 +421,7 @@ impl InPlaneBrdf {
 
     /// f_r·cos θi·cos θo at an in-plane pair, interpolated as that product between rows (the quantity the
     /// `f-cos-cos` and `microfacet` extensions take to be smooth).
-    pub fn in_plane_cos_cos(&self, theta_i: f64, theta_o: f64) -> f64 {
+    pub(crate) fn in_plane_cos_cos(&self, theta_i: f64, theta_o: f64) -> f64 {
         self.interpolate(theta_i, theta_o, Row::CosCos)
     }
 
@@ -661,7 +661,7 @@ pub fn parse_csv(text: &str, file: &str) -> Result<InPlaneBrdf> {
 }
 
 /// Read an in-plane CSV file.
-pub fn load_csv(path: &Path) -> Result<InPlaneBrdf> {
+pub(crate) fn load_csv(path: &Path) -> Result<InPlaneBrdf> {
     let file = path.display().to_string();
     let text = crate::input::read_text_limited(path, "table", crate::input::MAX_TABLE_BYTES)?;
     parse_csv(&text, &file)

@@ -33,7 +33,7 @@ pub const MERL_DIMS: [usize; 3] = [90, 90, 180];
 /// The per-channel scales applied on lookup (MERL `RED_SCALE`, `GREEN_SCALE`, `BLUE_SCALE`).
 pub const MERL_SCALE: [f64; 3] = [1.0 / 1500.0, 1.15 / 1500.0, 1.66 / 1500.0];
 /// Largest dimension accepted from a header (a guard against nonsense headers; MERL uses ≤ 180).
-pub const MAX_DIM: usize = 4096;
+pub(crate) const MAX_DIM: usize = 4096;
 /// Size of the header in bytes.
 const HEADER_BYTES: usize = 12;
 

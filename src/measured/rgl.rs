@@ -34,7 +34,7 @@ use std::f64::consts::{FRAC_PI_2, PI};
 use std::path::Path;
 
 /// The magic bytes at the start of a tensor file.
-pub const MAGIC: &[u8; 12] = b"tensor_file\0";
+pub(crate) const MAGIC: &[u8; 12] = b"tensor_file\0";
 /// The largest number of fields or rank accepted (a guard against nonsense headers).
 const MAX_FIELDS: u32 = 1024;
 const MAX_RANK: u16 = 16;
@@ -395,12 +395,12 @@ struct Corners {
 }
 
 /// pbrt-v4 `MeasuredBxDF::theta2u`.
-pub fn theta2u(theta: f64) -> f64 {
+pub(crate) fn theta2u(theta: f64) -> f64 {
     (theta * (2.0 / PI)).max(0.0).sqrt()
 }
 
 /// pbrt-v4 `MeasuredBxDF::phi2u`.
-pub fn phi2u(phi: f64) -> f64 {
+pub(crate) fn phi2u(phi: f64) -> f64 {
     phi * (1.0 / (2.0 * PI)) + 0.5
 }
 

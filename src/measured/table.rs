@@ -30,7 +30,7 @@ pub enum Resolution {
 
 impl Resolution {
     /// The two coarse twins.
-    pub const TWINS: [Resolution; 2] = [Resolution::Coarse, Resolution::Shifted];
+    pub(crate) const TWINS: [Resolution; 2] = [Resolution::Coarse, Resolution::Shifted];
 
     /// A table's coarse twins, `at(r)` being the table read at resolution r: both [`Resolution::TWINS`] for a
     /// table at its own resolution, none for a twin (twins have no twins).
@@ -109,7 +109,7 @@ impl TableAxis {
 
     /// [`TableAxis::linear`] at a [`Resolution`]: for a twin, the two neighbouring nodes of the twin and the
     /// weight of the second, in the same coordinate `u`.
-    pub fn linear_at(&self, u: f64, res: Resolution) -> (usize, usize, f64) {
+    pub(crate) fn linear_at(&self, u: f64, res: Resolution) -> (usize, usize, f64) {
         if res == Resolution::Own {
             return self.linear(u);
         }
@@ -181,7 +181,7 @@ impl TableAxis {
     }
 
     /// The smallest spacing between neighbouring samples (in the axis' coordinate); infinite for one sample.
-    pub fn min_spacing(&self) -> f64 {
+    pub(crate) fn min_spacing(&self) -> f64 {
         match &self.nodes {
             Nodes::Index(n) if *n > 1 => 1.0,
             Nodes::Values(v) if v.len() > 1 => v.windows(2).map(|w| w[1] - w[0]).fold(f64::INFINITY, f64::min),
@@ -191,7 +191,7 @@ impl TableAxis {
 }
 
 /// ⌊u⌋ clamped to 0..n−1 (NaN → 0), as MERL's index functions.
-pub fn floor_index(u: f64, n: usize) -> usize {
+pub(crate) fn floor_index(u: f64, n: usize) -> usize {
     if !(u > 0.0) {
         return 0;
     }
@@ -281,7 +281,7 @@ impl Table {
     }
 
     /// [`Table::nearest`] at a [`Resolution`] (a twin: its sample at or below each axis' floor).
-    pub fn nearest_at(&self, coords: &[f64], res: Resolution, out: &mut [f64]) {
+    pub(crate) fn nearest_at(&self, coords: &[f64], res: Resolution, out: &mut [f64]) {
         let mut o = 0;
         for (k, a) in self.axes.iter().enumerate() {
             let i = res.floor(a.floor(coords[k]));
@@ -297,7 +297,7 @@ impl Table {
     }
 
     /// [`Table::linear`] at a [`Resolution`] (`Coarse`: on every second sample of each axis).
-    pub fn linear_at(&self, coords: &[f64], res: Resolution, out: &mut [f64]) {
+    pub(crate) fn linear_at(&self, coords: &[f64], res: Resolution, out: &mut [f64]) {
         out.fill(0.0);
         let pairs: Vec<(usize, usize, f64)> = self.axes.iter().zip(coords).map(|(a, &u)| a.linear_at(u, res)).collect();
         self.accumulate(&pairs, 0, 0, None, out);
@@ -362,7 +362,7 @@ pub fn half_diff(wi: Vec3, wo: Vec3) -> HalfDiff {
 /// The preamble every tabulated BRDF's `eval` shares (MERL, in-plane tables): a table holds reflection only,
 /// so below either horizon the BRDF is 0 (`out` zeroed, `None`); above both, the half/difference angles of
 /// the pair, the coordinates the lookup starts from.
-pub fn reflection_half_diff(wi: Vec3, wo: Vec3, out: &mut [f64]) -> Option<HalfDiff> {
+pub(crate) fn reflection_half_diff(wi: Vec3, wo: Vec3, out: &mut [f64]) -> Option<HalfDiff> {
     if crate::brdf::below_horizon(wi, wo, out) {
         return None;
     }
@@ -391,7 +391,7 @@ pub fn fold_phi_d(phi_d: f64) -> f64 {
 }
 
 /// The polar angle of a unit vector, accurate near the pole: 2·asin(|d − z|/2) (Mitsuba 3's `elevation`).
-pub fn elevation(d: Vec3) -> f64 {
+pub(crate) fn elevation(d: Vec3) -> f64 {
     let dist = (d.x * d.x + d.y * d.y + (d.z - 1.0) * (d.z - 1.0)).sqrt();
     2.0 * (0.5 * dist).min(1.0).asin()
 }
@@ -399,7 +399,7 @@ pub fn elevation(d: Vec3) -> f64 {
 /// How far apart (relative) a table's values may be and the table still count as flat, a constant BRDF
 /// stated as a diffuse term (`docs/instrument.md` §Quadrature, "Measured tables"): a file written with 13 significant
 /// digits of f·cos θo and divided by cos θo at load differs from a constant in the last bits only.
-pub const FLAT_RTOL: f64 = 1e-9;
+pub(crate) const FLAT_RTOL: f64 = 1e-9;
 
 /// Whether `values` are all finite and within [`FLAT_RTOL`] of one another (relative to the largest).
 pub fn is_flat(values: impl IntoIterator<Item = f64>) -> bool {
@@ -415,9 +415,9 @@ pub fn is_flat(values: impl IntoIterator<Item = f64>) -> bool {
 }
 
 /// The angle of incidence at which [`specular_half_width`] scans a table (the D523 20° geometry's).
-pub const HALF_WIDTH_THETA_I_DEG: f64 = 20.0;
+pub(crate) const HALF_WIDTH_THETA_I_DEG: f64 = 20.0;
 /// The largest half-vector tilt [`specular_half_width`] scans, degrees.
-pub const HALF_WIDTH_MAX_TILT_DEG: f64 = 40.0;
+pub(crate) const HALF_WIDTH_MAX_TILT_DEG: f64 = 40.0;
 /// The scan's step in the half-vector tilt, degrees (then bisection to rounding).
 const HALF_WIDTH_STEP_DEG: f64 = 0.02;
 
@@ -429,7 +429,7 @@ const HALF_WIDTH_STEP_DEG: f64 = 0.02;
 /// bisected; the result is tan τ of the nearer side. Infinite when f_r at the specular pair is not positive
 /// or does not fall to half within [`HALF_WIDTH_MAX_TILT_DEG`] (a flat or retro-reflecting table).
 /// Deterministic: computed once when a table is loaded.
-pub fn specular_half_width(eval: impl Fn(Vec3, Vec3, &mut [f64]), samples: usize) -> f64 {
+pub(crate) fn specular_half_width(eval: impl Fn(Vec3, Vec3, &mut [f64]), samples: usize) -> f64 {
     let ti = HALF_WIDTH_THETA_I_DEG.to_radians();
     let wi = Vec3::new(-ti.sin(), 0.0, ti.cos());
     let mut out = vec![0.0; samples];

@@ -258,12 +258,12 @@ struct Table {
 }
 
 /// The bytes of `assets/coat-albedo-table.bin` (format: [`parse_table`]).
-pub const TABLE_BYTES: &[u8] = include_bytes!("../../assets/coat-albedo-table.bin");
+pub(crate) const TABLE_BYTES: &[u8] = include_bytes!("../../assets/coat-albedo-table.bin");
 /// Its first eight bytes.
 pub const TABLE_MAGIC: &[u8; 8] = b"GMCOAT01";
 
 /// Rows of the table, in its order.
-pub const TABLE_ROWS: usize = DISTRIBUTIONS.len() * (ALPHA_BREAKS.len() - 1) * PIECES * ALPHA_NODES * ETA_NODES;
+pub(crate) const TABLE_ROWS: usize = DISTRIBUTIONS.len() * (ALPHA_BREAKS.len() - 1) * PIECES * ALPHA_NODES * ETA_NODES;
 
 fn row_index(dist: usize, ap: usize, mp: usize, ka: usize, ke: usize) -> usize {
     (((dist * (ALPHA_BREAKS.len() - 1) + ap) * PIECES + mp) * ALPHA_NODES + ka) * ETA_NODES + ke

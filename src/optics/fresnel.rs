@@ -46,7 +46,7 @@ pub struct Amplitudes {
 /// cos θt = √(1 − sin²θt) taken on the forward (positive) branch. `None` when sin²θt > 1 (beyond the
 /// critical angle; only possible for η < 1). At exactly the critical angle the result is `Some(0.0)`.
 /// `cos_i` is clamped to [0, 1] to absorb rounding in callers' dot products.
-pub fn cos_transmitted(cos_i: f64, eta: f64) -> Option<f64> {
+pub(crate) fn cos_transmitted(cos_i: f64, eta: f64) -> Option<f64> {
     let c = cos_i.clamp(0.0, 1.0);
     // 1 − c² = (1 − c)(1 + c): no cancellation near normal incidence.
     let sin2_t = (1.0 - c) * (1.0 + c) / (eta * eta);
@@ -62,14 +62,14 @@ pub fn cos_transmitted(cos_i: f64, eta: f64) -> Option<f64> {
 /// critical angle). The reflectance is continuous there but its derivative is not: just above cos θc,
 /// 1 − R ∝ √(cos θi − cos θc)·…, since cos θt = √(1 − sin²θi/η²) vanishes like a square root. A quadrature
 /// needs this point on a boundary of its partition (`brdf::Kink`).
-pub fn critical_cosine(eta: f64) -> Option<f64> {
+pub(crate) fn critical_cosine(eta: f64) -> Option<f64> {
     (eta > 0.0 && eta < 1.0).then(|| ((1.0 - eta) * (1.0 + eta)).sqrt())
 }
 
 /// The critical cosine of a conductor index n + ik: the same as [`critical_cosine`] when k = 0 (the index is
 /// then a real index below 1 and the Fresnel reflectance has the same kink); `None` when k > 0 (n̂ cos θt
 /// never vanishes and the reflectance is smooth, however sharp its knee is for a small k).
-pub fn critical_cosine_complex(eta: Complex64) -> Option<f64> {
+pub(crate) fn critical_cosine_complex(eta: Complex64) -> Option<f64> {
     if eta.im == 0.0 {
         critical_cosine(eta.re)
     } else {
@@ -143,7 +143,7 @@ pub fn fr_conductor(cos_i: f64, eta: Complex64) -> f64 {
 /// principal and honours signed zero (√(−a − 0i) = −i√a, the growing branch), so the branch is fixed
 /// after the root: negate if Im < 0, or Im = 0 and Re < 0 (the decaying-wave branch, Im ≥ 0 under n + ik: Byrnes, "Multilayer optical calculations", arXiv:1603.02720, App. D).
 /// If n₂ = 0 the cosine is undefined; the function then returns NaN (not a physical medium).
-pub fn complex_cos_transmitted(n1: Complex64, cos1: Complex64, n2: Complex64) -> Complex64 {
+pub(crate) fn complex_cos_transmitted(n1: Complex64, cos1: Complex64, n2: Complex64) -> Complex64 {
     let one = Complex64::new(1.0, 0.0);
     let sin2 = (one - cos1) * (one + cos1);
     let n2cos2 = forward_sqrt(n2 * n2 - n1 * n1 * sin2);
@@ -183,7 +183,7 @@ pub fn amplitudes(n1: Complex64, cos1: Complex64, n2: Complex64, cos2: Complex64
 /// 1/η and keeps its azimuth, w′ = (w_x/η, w_y/η, cos θt), cos θt = √(1 − (w_x² + w_y²)/η²). The
 /// tangential part is taken from the components (not from 1 − w_z²) so that near-normal directions keep
 /// full relative precision. `w` is assumed to be a unit vector; the result is then a unit vector.
-pub fn refract_into(w: Vec3, eta: f64) -> Option<Vec3> {
+pub(crate) fn refract_into(w: Vec3, eta: f64) -> Option<Vec3> {
     let sin2_t = (w.x * w.x + w.y * w.y) / (eta * eta);
     if sin2_t > 1.0 {
         return None;

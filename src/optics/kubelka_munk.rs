@@ -133,7 +133,12 @@ pub fn mix(pigments: impl IntoIterator<Item = (f64, f64, f64)>) -> (f64, f64) {
 /// Errors (with the reason) when the data cannot come from a Kubelka–Munk layer: non-finite input, X ≤ 0,
 /// g ∉ (0, 1], R_b ≤ 0 (no scattering information), R_w ≤ R_b, R_w > 1, r0 + t > 1 (more light out than
 /// in), or r0 ≥ R∞(a) (the layer would be thicker than infinite).
-pub fn invert_white_black(r_over_white: f64, r_over_black: f64, white_bg: f64, x: f64) -> Result<(f64, f64), String> {
+pub(crate) fn invert_white_black(
+    r_over_white: f64,
+    r_over_black: f64,
+    white_bg: f64,
+    x: f64,
+) -> Result<(f64, f64), String> {
     let (rw, r0, g) = (r_over_white, r_over_black, white_bg);
     if ![rw, r0, g, x].iter().all(|v| v.is_finite()) {
         return Err(format!(

@@ -70,7 +70,7 @@ fn invalid(field: impl Into<String>, message: impl Into<String>) -> Invalid {
 /// The largest growth of a mode's amplitude that the surface-tension gradient may give: the linear model holds
 /// while the texture stays below a tenth of the film (within 1 % of the full equation, docs/model.md §Levelling
 /// of the applied texture), so a texture that starts at a hundredth of it may grow tenfold at most.
-pub const MAX_GROWTH: f64 = 10.0;
+pub(crate) const MAX_GROWTH: f64 = 10.0;
 
 /// Gauss–Legendre points per sub-interval of the levelling integral. On a sub-interval the integrand is a
 /// cubic in t times exp(−b t) with |b|·Δt ≤ 1 (`MAX_LOG_STEP`), which 16 points integrate to rounding.
@@ -167,12 +167,12 @@ impl Application {
     }
 
     /// Dry film thickness, µm: v × wet.
-    pub fn dry_film_um(&self) -> f64 {
+    pub(crate) fn dry_film_um(&self) -> f64 {
         self.volume_solids * self.wet_film_um
     }
 
     /// The time flow ends, s: the viscosity table's last time.
-    pub fn end_of_flow_s(&self) -> f64 {
+    pub(crate) fn end_of_flow_s(&self) -> f64 {
         self.viscosity.last().map_or(0.0, |p| p.t_s)
     }
 
@@ -186,7 +186,7 @@ impl Application {
     }
 
     /// Viscosity at time t, Pa·s: ln η linear between the table's points, its ends held beyond them.
-    pub fn viscosity_pa_s(&self, t: f64) -> f64 {
+    pub(crate) fn viscosity_pa_s(&self, t: f64) -> f64 {
         let v = &self.viscosity;
         if t <= v[0].t_s {
             return v[0].eta_pa_s;
@@ -249,7 +249,7 @@ impl Application {
     }
 
     /// The flow's two integrals, L (µm⁴) and M (µm²).
-    pub fn flow(&self) -> Flow {
+    pub(crate) fn flow(&self) -> Flow {
         Flow { l_um4: self.levelling_integral_um4(), m_um2: self.gradient_integral_um2() }
     }
 
@@ -268,7 +268,7 @@ impl Application {
     }
 
     /// The frequency of the largest growth, f² = B/(2A) (1/µm); 0 without a gradient against levelling.
-    pub fn fastest_growing_frequency_per_um(&self) -> f64 {
+    pub(crate) fn fastest_growing_frequency_per_um(&self) -> f64 {
         let flow = self.flow();
         let (a, b) = (16.0 * PI.powi(4) / 3.0 * flow.l_um4, 4.0 * PI * PI * flow.m_um2);
         if !(b > 0.0 && a > 0.0) {
@@ -307,13 +307,13 @@ impl Flow {
 
 /// (3/(16π⁴ L))^{1/4}: the spatial frequency (1/µm) levelled to 1/e of its amplitude by L (µm⁴); infinite
 /// for L = 0.
-pub fn levelled_frequency(l_um4: f64) -> f64 {
+pub(crate) fn levelled_frequency(l_um4: f64) -> f64 {
     (3.0 / (16.0 * PI.powi(4) * l_um4)).powf(0.25)
 }
 
 /// The cured PSD's factor at spatial frequency f (1/µm): v²·exp(2·(−(16π⁴/3) f⁴ L + 4π² f² M)), for a PSD of
 /// the applied texture's heights (docs/model.md §Levelling of the applied texture).
-pub fn psd_transfer(volume_solids: f64, flow: Flow, f_per_um: f64) -> f64 {
+pub(crate) fn psd_transfer(volume_solids: f64, flow: Flow, f_per_um: f64) -> f64 {
     volume_solids * volume_solids * flow.amplitude_transfer(f_per_um).powi(2)
 }
 
@@ -412,7 +412,7 @@ impl CuredPsd {
     /// M_j(ρ) = ∫₀^ρ (2πf)^j S_c(f) f df over the whole cured spectrum, j = 0 (nm²) or 2 (nm²/µm²). For ρ
     /// beyond the table without levelling, M_0 adds the applied PSD's closed-form tail; M_2 is only asked
     /// below the table's end.
-    pub fn moment(&self, j: i32, rho: f64) -> f64 {
+    pub(crate) fn moment(&self, j: i32, rho: f64) -> f64 {
         let s0 = self.cured(0.0);
         if rho <= self.f_min {
             return match j {

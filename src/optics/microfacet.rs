@@ -59,7 +59,7 @@ impl Microfacet {
         }
     }
 
-    pub fn effectively_smooth(&self) -> bool {
+    pub(crate) fn effectively_smooth(&self) -> bool {
         self.alpha < Self::SMOOTH_THRESHOLD
     }
 
@@ -180,7 +180,7 @@ impl Microfacet {
 /// G(ωi, ωo) for the half vector `h` from a Λ as it enters G ([`Microfacet::g`]'s forms; a slope mixture
 /// passes its Λ = Σ wᵢ Λᵢ, docs/optics.md §4.1). The V-cavity form does not use Λ.
 #[inline]
-pub fn g_with_lambda(wi: Vec3, wo: Vec3, h: Vec3, shadowing: Shadowing, lambda: impl Fn(Vec3) -> f64) -> f64 {
+pub(crate) fn g_with_lambda(wi: Vec3, wo: Vec3, h: Vec3, shadowing: Shadowing, lambda: impl Fn(Vec3) -> f64) -> f64 {
     let len = h.length();
     if !positive(len) || !positive(wi.z) || !positive(wo.z) {
         return 0.0;

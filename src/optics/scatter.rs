@@ -22,7 +22,7 @@ use std::f64::consts::PI;
 /// from a Gaussian surface's 1 − exp(−g) by less than g²/2 ≤ 3.1 % of the mirror, and far less at the
 /// angles and wavelengths that matter (at 20° and 560 nm, σ = 10 nm: g = 0.045, 0.1 %; docs/optics.md
 /// §Validity).
-pub const MAX_PHASE: f64 = 0.5;
+pub(crate) const MAX_PHASE: f64 = 0.5;
 
 /// Points of the periodic trapezoid rule over the azimuth ψ of the propagating disc ([`Psd::band_limited`]):
 /// the integrand is analytic and periodic, so the rule converges geometrically (checked against 4096 points
@@ -65,7 +65,7 @@ impl Psd {
 
     /// The frequency (1/µm) at which the PSD has fallen markedly from its level at 0: 1/B (the K-correlation's
     /// knee) or 1/(πℓ) (the Gaussian's e⁻¹ point).
-    pub fn knee(&self) -> f64 {
+    pub(crate) fn knee(&self) -> f64 {
         match *self {
             Psd::KCorrelation { b, .. } => 1.0 / b,
             Psd::Gaussian { ell, .. } => 1.0 / (PI * ell),
@@ -84,7 +84,7 @@ impl Psd {
     }
 
     /// P(ρ) = ∫₀^ρ S₂(f) f df (nm²), closed form; 2π·P(∞) = σ².
-    pub fn radial_cumulative(&self, rho: f64) -> f64 {
+    pub(crate) fn radial_cumulative(&self, rho: f64) -> f64 {
         match *self {
             Psd::KCorrelation { a, b, c } => {
                 let k = a * b * gamma_ratio((c + 1.0) / 2.0, c / 2.0) / (2.0 * PI.sqrt());
@@ -124,7 +124,7 @@ fn gamma_ratio(x: f64, y: f64) -> f64 {
 /// relative permittivity ε (Stover 2012, Ch. 5; Elson & Bennett 1979; Church, Jenkinson & Zavada 1979), at incidence
 /// θi, scatter θs and scatter azimuth φs from the plane of incidence (φs = 0 forward, the specular side).
 /// At the specular direction (θs = θi, φs = 0) Q is the Fresnel reflectance (R_s + R_p)/2.
-pub fn polarisation_factor(eps: Complex64, cos_i: f64, cos_s: f64, cos_phi: f64, sin_phi: f64) -> f64 {
+pub(crate) fn polarisation_factor(eps: Complex64, cos_i: f64, cos_s: f64, cos_phi: f64, sin_phi: f64) -> f64 {
     let (ci, cs) = (cos_i.clamp(0.0, 1.0), cos_s.clamp(0.0, 1.0));
     let (si, ss) = ((1.0 - ci * ci).max(0.0).sqrt(), (1.0 - cs * cs).max(0.0).sqrt());
     let qi = (eps - si * si).sqrt();
@@ -159,7 +159,7 @@ pub fn polarisation(eps: Complex64, wi: [f64; 3], wo: [f64; 3]) -> f64 {
 
 /// [`rayleigh_rice`] given its polarisation factor `q` (the same bits as [`rayleigh_rice`] with
 /// `q = polarisation(eps, wi, wo)`); zero below the horizon.
-pub fn rayleigh_rice_with_q(psd: &Psd, q: f64, lambda_nm: f64, wi: [f64; 3], wo: [f64; 3]) -> f64 {
+pub(crate) fn rayleigh_rice_with_q(psd: &Psd, q: f64, lambda_nm: f64, wi: [f64; 3], wo: [f64; 3]) -> f64 {
     if !(wi[2] > 0.0 && wo[2] > 0.0) {
         return 0.0;
     }

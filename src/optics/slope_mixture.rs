@@ -29,7 +29,7 @@ impl SlopeMixture {
 
     /// Λ(ω) = Σ wᵢ Λᵢ(ω) (Heitz 2014 Eq. 72 is linear in the slope distribution); each Λᵢ as it enters G
     /// (`Microfacet::lambda_in_g`: 0 where 1 + Λᵢ rounds to 1), +∞ at or below the horizon.
-    pub fn lambda_in_g(&self, w: Vec3) -> f64 {
+    pub(crate) fn lambda_in_g(&self, w: Vec3) -> f64 {
         self.populations.iter().fold(0.0, |s, (wt, m)| s + wt * m.lambda_in_g(w))
     }
 

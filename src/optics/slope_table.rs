@@ -20,7 +20,7 @@ use super::microfacet::{Distribution, Microfacet};
 use crate::Vec3;
 
 /// The most nodes along each axis of the table.
-pub const MAX_NODES: usize = 513;
+pub(crate) const MAX_NODES: usize = 513;
 
 /// A smoothed, normalised 2-D slope density.
 #[derive(Clone, Debug, PartialEq)]
@@ -139,7 +139,7 @@ impl SlopeTable {
     }
 
     /// The slope density P₂₂(x̃, ỹ), per unit slope² (0 outside the table).
-    pub fn p22(&self, x: f64, y: f64) -> f64 {
+    pub(crate) fn p22(&self, x: f64, y: f64) -> f64 {
         let (tx, ty) = ((x - self.first) / self.step, (y - self.first) / self.step);
         let last = (self.nodes - 1) as f64;
         if !(tx > -2.0 && ty > -2.0 && tx < last + 2.0 && ty < last + 2.0) {
@@ -183,7 +183,7 @@ impl SlopeTable {
 
     /// The Gaussian-equivalent α along the azimuth of ω: √2·σ_φ (for ω along the normal, the mean of the two
     /// axes').
-    pub fn alpha_along(&self, w: Vec3) -> f64 {
+    pub(crate) fn alpha_along(&self, w: Vec3) -> f64 {
         let r2 = w.x * w.x + w.y * w.y;
         let [xx, xy, yy] = self.moments;
         let var =

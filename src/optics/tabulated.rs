@@ -103,7 +103,7 @@ impl ChebTable {
     /// `f(x, which, values)` setting `values[i]` = f_{which[i]}(x), so that work they share at one x (a film
     /// stack's angles and interface amplitudes, the same for every wavelength) is done once. A function whose
     /// table is met leaves `which` at the next piece count.
-    pub fn fit_each(
+    pub(crate) fn fit_each(
         f: impl FnMut(f64, &[usize], &mut [f64]),
         count: usize,
         a: f64,
@@ -115,13 +115,13 @@ impl ChebTable {
 
     /// [`ChebTable::fit`] of a function that kinks at `kinks` (sorted, distinct; those outside (a, b) are
     /// ignored): the table cut there (module doc). Without kinks, `fit` itself.
-    pub fn fit_kinked(f: impl Fn(f64) -> f64, a: f64, b: f64, kinks: &[f64], tol: f64) -> Option<ChebTable> {
+    pub(crate) fn fit_kinked(f: impl Fn(f64) -> f64, a: f64, b: f64, kinks: &[f64], tol: f64) -> Option<ChebTable> {
         ChebTable::fit_each_kinked(|x, _, v| v[0] = f(x), 1, a, b, kinks, tol).pop().flatten()
     }
 
     /// [`ChebTable::fit_each`] of functions that all kink at `kinks` ([`ChebTable::fit_kinked`]). The piece
     /// counts tried are those of `fit_each` (8, 16, …), shared among the segments (at least one each).
-    pub fn fit_each_kinked(
+    pub(crate) fn fit_each_kinked(
         mut f: impl FnMut(f64, &[usize], &mut [f64]),
         count: usize,
         a: f64,
@@ -165,7 +165,7 @@ impl ChebTable {
 
     /// [`ChebTable::fit_each_with_pieces`] of functions that kink at `kinks` ([`ChebTable::fit_kinked`]);
     /// `pieces` counts the pieces of all segments (a multiple of their number, as [`ChebTable::pieces`] gives).
-    pub fn fit_each_kinked_with_pieces(
+    pub(crate) fn fit_each_kinked_with_pieces(
         mut f: impl FnMut(f64, &[usize], &mut [f64]),
         which: &[usize],
         a: f64,
@@ -282,7 +282,7 @@ impl ChebTable {
     }
 
     /// Whether `other` has the same interval and pieces (so one [`ChebTable::locate`] serves both).
-    pub fn same_grid(&self, other: &ChebTable) -> bool {
+    pub(crate) fn same_grid(&self, other: &ChebTable) -> bool {
         self.a == other.a && self.b == other.b && self.pieces == other.pieces && self.segments == other.segments
     }
 
@@ -293,7 +293,7 @@ impl ChebTable {
 
     /// The piece of x (clamped into [a, b]) and x's position t ∈ [−1, 1] in it (in s on a segment at a kink).
     #[inline]
-    pub fn locate(&self, x: f64) -> (usize, f64) {
+    pub(crate) fn locate(&self, x: f64) -> (usize, f64) {
         let x = x.clamp(self.a, self.b);
         if !self.segments.is_empty() {
             return self.locate_on_segments(x);
@@ -331,7 +331,7 @@ impl ChebTable {
     /// The table Σ_j w_j T_j of tables on one grid: its coefficients are the weighted sums of theirs (the
     /// interpolant is linear in the coefficients), so it interpolates Σ_j w_j f_j with a deviation of at most
     /// Σ_j |w_j|·(T_j's deviation) plus rounding, which `max_error` states. None if the grids differ.
-    pub fn combine(tables: &[ChebTable], weights: &[f64]) -> Option<ChebTable> {
+    pub(crate) fn combine(tables: &[ChebTable], weights: &[f64]) -> Option<ChebTable> {
         let first = tables.first()?;
         if tables.len() != weights.len() || tables.iter().any(|t| !t.same_grid(first)) {
             return None;
@@ -365,7 +365,7 @@ enum Fit {
 /// [−1, 1], |T_k| ≤ 1): with them, Σ_k c_k T_k(t) of several coefficient sets at one t is one dot product
 /// each ([`dot`]), where Clenshaw's recurrence would be run once per set.
 #[inline]
-pub fn basis(t: f64) -> [f64; N] {
+pub(crate) fn basis(t: f64) -> [f64; N] {
     let mut b = [0.0; N];
     basis_into(t, &mut b);
     b
@@ -373,7 +373,7 @@ pub fn basis(t: f64) -> [f64; N] {
 
 /// T_0(t) … T_{n−1}(t) into `out` (n = its length), by the recurrence T_k = 2t T_{k−1} − T_{k−2}.
 #[inline]
-pub fn basis_into(t: f64, out: &mut [f64]) {
+pub(crate) fn basis_into(t: f64, out: &mut [f64]) {
     let n = out.len();
     if n > 0 {
         out[0] = 1.0;
@@ -427,7 +427,7 @@ pub fn dot(c: &[f64; N], basis: &[f64; N]) -> f64 {
 
 /// Σ_k c_k T_k(t) by Clenshaw's recurrence: b_k = c_k + 2t b_{k+1} − b_{k+2}; f = c_0 + t b_1 − b_2.
 #[inline]
-pub fn clenshaw(c: &[f64; N], t: f64) -> f64 {
+pub(crate) fn clenshaw(c: &[f64; N], t: f64) -> f64 {
     let (mut b1, mut b2) = (0.0, 0.0);
     for &ck in c[1..].iter().rev() {
         let b0 = ck + 2.0 * t * b1 - b2;

@@ -177,7 +177,7 @@ pub fn stack(n_in: f64, layers: &[FilmLayer], n_out: Complex64, cos_i: f64, wave
 /// medium's cos θ, every interface's amplitudes r, t) is computed once for all of them; per wavelength only
 /// the layers' phases e^{iφⱼ} (once per distinct layer: a stack that repeats a layer, as the pearl's
 /// TiO₂/mica/TiO₂ does, computes its phase once) and the recursions remain (`docs/model.md` §Evaluation cost).
-pub fn stack_spectrum(
+pub(crate) fn stack_spectrum(
     n_in: f64,
     layers: &[FilmLayer],
     n_out: Complex64,

@@ -160,7 +160,7 @@ pub struct Cell<const D: usize> {
 
 impl<const D: usize> Cell<D> {
     /// The box [lo, hi] as a cell; None if it is degenerate (a zero or negative width on some axis).
-    pub fn from_box(lo: &[f64; D], hi: &[f64; D]) -> Option<Cell<D>> {
+    pub(crate) fn from_box(lo: &[f64; D], hi: &[f64; D]) -> Option<Cell<D>> {
         let mut c = [0.0; D];
         let mut h = [0.0; D];
         for k in 0..D {
@@ -315,7 +315,7 @@ const MAX_SMALL: usize = 8;
 
 /// The calibration of [`calibrated`]: the error of the reported I₇ is taken as `CALIBRATION`·r·N₁ when the
 /// null rules fall by r per step, never less than N₁/`MAX_SHRINK`.
-pub const CALIBRATION: f64 = 3.0;
+pub(crate) const CALIBRATION: f64 = 3.0;
 pub const MAX_SHRINK: f64 = 8.0;
 /// The shrink limit on the lobe chart of a smooth material (`Options::max_shrink`, `docs/accuracy.md` §5).
 pub const MAX_SHRINK_LOBE: f64 = 16.0;
@@ -348,7 +348,7 @@ pub fn calibrated(n1: f64, n2: f64, n3: f64, abs7: f64, max_shrink: f64) -> f64 
 
 /// How far below the decay of the null rules N₁ may fall on a box the refinement never split before it is
 /// taken for a cancellation ([`unsplit_estimate`]).
-pub const CANCELLATION: f64 = 8.0;
+pub(crate) const CANCELLATION: f64 = 8.0;
 
 /// The estimate of a box the refinement never split (no calibrated shrink, `docs/accuracy.md` §5.2): N₁,
 /// unless N₁ lies more than [`CANCELLATION`] times below what the decay of the two coarser null rules predicts
@@ -367,7 +367,7 @@ pub fn unsplit_estimate(n1: f64, n2: f64, n3: f64) -> f64 {
 /// 1 400–8 000× below the prediction; at 8 (as for unsplit boxes) 240 golden readings moved (+2.5 % of the
 /// golden set's evaluations) and an rtol-10⁻¹⁰ reference of `tests/estimates.rs` no longer converged within its budget, at
 /// 64 110 moved (+0.4 %) and every test of the estimate held.
-pub const SPLIT_CANCELLATION: f64 = 64.0;
+pub(crate) const SPLIT_CANCELLATION: f64 = 64.0;
 
 /// The N₁ a split box's calibrated estimate ([`calibrated`]) and its checked floors start from: N₁, or the
 /// prediction N₂·min(1, N₂/N₃) when N₁ lies more than [`SPLIT_CANCELLATION`] times below it. On GGX α = 0.0015
@@ -394,11 +394,11 @@ fn chance_free(n1: f64, n2: f64, n3: f64, factor: f64) -> f64 {
 
 /// The parent's check ([`child_scale`]): the children's estimates shrink only where the parent's estimate
 /// covered `CHECK_MARGIN` times its actual error.
-pub const CHECK_MARGIN: f64 = 4.0;
+pub(crate) const CHECK_MARGIN: f64 = 4.0;
 /// The most one check shrinks the children's estimates (a factor on their calibrated estimates).
-pub const CHECK_SHRINK: f64 = 8.0;
+pub(crate) const CHECK_SHRINK: f64 = 8.0;
 /// The most a checked box's estimate may shrink below N₁ in all.
-pub const CHECKED_MAX_SHRINK: f64 = 32.0;
+pub(crate) const CHECKED_MAX_SHRINK: f64 = 32.0;
 
 /// A cell's estimate from its calibrated one and its scale: base·scale, kept within
 /// [N₁/[`CHECKED_MAX_SHRINK`], N₁] (and exactly the calibrated estimate at scale 1).
@@ -420,7 +420,7 @@ fn scaled(n1: f64, base: f64, scale: f64) -> f64 {
 /// DCUHRE family (Berntsen, Espelid & Genz 1991 use successive null rules; this uses successive
 /// refinements), with constants chosen on this project's integrals (`docs/accuracy.md` §5). 1 when nothing is
 /// known (every component exact and zero).
-pub fn child_scale(parent_value: &[f64], parent_error: &[f64], a: &[f64], b: &[f64]) -> f64 {
+pub(crate) fn child_scale(parent_value: &[f64], parent_error: &[f64], a: &[f64], b: &[f64]) -> f64 {
     let (mut m, mut any): (f64, bool) = (0.0, false);
     for c in 0..parent_value.len() {
         let d = (parent_value[c] - (a[c] + b[c])).abs();

@@ -23,7 +23,7 @@ use super::Options;
 
 /// The Gauss–Legendre orders an axis steps through (index = level). Level 0 (the midpoint) is only ever the
 /// lower rule of level 1's difference; no axis is reported below level 1 (2 points).
-pub const ORDERS: [usize; 12] = [1, 2, 3, 4, 6, 8, 12, 16, 20, 24, 32, 48];
+pub(crate) const ORDERS: [usize; 12] = [1, 2, 3, 4, 6, 8, 12, 16, 20, 24, 32, 48];
 
 /// The result of [`integrate`]: the value Q(n) and the estimate per component, the final levels and
 /// the evaluations spent.
@@ -59,7 +59,7 @@ impl Rules {
 const CHUNK: usize = 512;
 
 /// The number of points of one box at these levels.
-pub fn points_per_box<const D: usize>(levels: [usize; D]) -> usize {
+pub(crate) fn points_per_box<const D: usize>(levels: [usize; D]) -> usize {
     levels.iter().map(|&l| ORDERS[l]).product()
 }
 
@@ -122,7 +122,7 @@ fn tensor_sum<const D: usize, F: FnMut(&[[f64; D]], &mut [f64])>(
 /// `genz_malik::calibrated`, with the same constants): when the differences fall by r = d/d_prev with
 /// 3·r < 1 the orders are in their asymptotic range and the error of the reported (higher) rule is taken as
 /// 3·r·d, but never below d/`max_shrink`; otherwise d itself.
-pub fn calibrate(d: f64, d_prev: f64, max_shrink: f64) -> f64 {
+pub(crate) fn calibrate(d: f64, d_prev: f64, max_shrink: f64) -> f64 {
     use super::genz_malik::CALIBRATION;
     if !(d_prev > 0.0) {
         return d;
@@ -139,12 +139,12 @@ pub fn calibrate(d: f64, d_prev: f64, max_shrink: f64) -> f64 {
 /// the boxes' differences cancel in the sum (|Σ d_b| < ½ Σ |d_b|): the ratios of such a sum are not those of
 /// one rule's asymptotics (a critical-angle conductor at D523 85° has the differences of three boxes cancel
 /// to 1 % and an actual error of d/2.9; `docs/accuracy.md` §5.2). Otherwise `genz_malik::MAX_SHRINK`.
-pub const SIGNED_MAX_SHRINK: f64 = 2.0;
+pub(crate) const SIGNED_MAX_SHRINK: f64 = 2.0;
 
 /// The most raises a run may make ([`Path`]).
-pub const MAX_STEPS: usize = 64;
+pub(crate) const MAX_STEPS: usize = 64;
 /// The most boxes the rule takes (a step stores its box in six bits; 63 is every box).
-pub const MAX_BOXES: usize = 63;
+pub(crate) const MAX_BOXES: usize = 63;
 /// A step that raised the axis on every box (shared orders).
 const ALL: usize = 63;
 

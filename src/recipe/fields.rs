@@ -9,7 +9,7 @@ use serde_json::Value;
 
 impl Obj<'_> {
     /// Refuse any key that the registry does not list at this object's pointer for `model`.
-    pub fn deny_unknown_in(&self, model: &str) -> Result<()> {
+    pub(crate) fn deny_unknown_in(&self, model: &str) -> Result<()> {
         let allowed = registry::children(model, &self.path);
         let allowed: Vec<&str> = allowed.iter().map(String::as_str).collect();
         self.deny_unknown(&allowed)
@@ -24,20 +24,20 @@ impl Obj<'_> {
     }
 
     /// A required number of the registry entry `p`, within its range.
-    pub fn param(&self, p: &Param) -> Result<f64> {
+    pub(crate) fn param(&self, p: &Param) -> Result<f64> {
         let key = self.key_of(p);
         let v = self.required(&key)?;
         param_number(self.file, &self.field(&key), v, p)
     }
 
     /// An optional number of the registry entry `p`.
-    pub fn opt_param(&self, p: &Param) -> Result<Option<f64>> {
+    pub(crate) fn opt_param(&self, p: &Param) -> Result<Option<f64>> {
         let key = self.key_of(p);
         self.get(&key).map(|v| param_number(self.file, &self.field(&key), v, p)).transpose()
     }
 
     /// The array of numbers of entry `p`, each within its range; of length `len` if given.
-    pub fn param_array(&self, p: &Param, len: Option<usize>) -> Result<Vec<f64>> {
+    pub(crate) fn param_array(&self, p: &Param, len: Option<usize>) -> Result<Vec<f64>> {
         let key = self.key_of(p);
         let a = self.array(&key)?;
         if let Some(n) = len {
@@ -49,13 +49,13 @@ impl Obj<'_> {
     }
 
     /// The registry entry `p` as a key of this object (for values read by hand, e.g. colours).
-    pub fn param_key(&self, p: &Param) -> String {
+    pub(crate) fn param_key(&self, p: &Param) -> String {
         self.key_of(p)
     }
 }
 
 /// Check that `v` is a finite number in the range of registry entry `p` (message from its description).
-pub fn param_number(file: &str, path: &str, v: &Value, p: &Param) -> Result<f64> {
+pub(crate) fn param_number(file: &str, path: &str, v: &Value, p: &Param) -> Result<f64> {
     let range = p.range();
     let allowed = range.describe();
     let allowed = allowed.trim_start_matches("in ");

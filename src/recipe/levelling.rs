@@ -23,7 +23,7 @@ const PAINT: &str = "paint";
 
 /// The wave-scan-like bands of the spectrum that `--explain` lists, by surface wavelength in mm (the bands of
 /// BYK-Gardner's wave-scan: du below 0.1 mm, Wa 0.1–0.3, Wb 0.3–1, Wc 1–3, Wd 3–10, We 10–30 mm).
-pub const BANDS_MM: [(&str, f64, f64); 6] =
+pub(crate) const BANDS_MM: [(&str, f64, f64); 6] =
     [("du", 0.0, 0.1), ("Wa", 0.1, 0.3), ("Wb", 0.3, 1.0), ("Wc", 1.0, 3.0), ("Wd", 3.0, 10.0), ("We", 10.0, 30.0)];
 
 /// The applicator's texture as applied (wet): an analytic isotropic PSD, or a measured topography's own 2-D PSD.
@@ -88,7 +88,7 @@ pub struct LevelledCoat {
 }
 
 /// Read the `application` object `o` (at `/clear_coat/application`) into the application and the applied texture.
-pub fn parse_application(o: &Obj) -> Result<(Application, Texture)> {
+pub(crate) fn parse_application(o: &Obj) -> Result<(Application, Texture)> {
     o.deny_unknown_in(PAINT)?;
     notes(o)?;
     let t = o.obj("texture")?;
@@ -192,7 +192,7 @@ pub fn level(app: &Application, applied: Texture) -> LevelledCoat {
 
 impl LevelledCoat {
     /// The cured rms height Sq, nm.
-    pub fn sq_nm(&self) -> f64 {
+    pub(crate) fn sq_nm(&self) -> f64 {
         self.cured.band_ms(0.0, f64::INFINITY, true).sqrt()
     }
 
@@ -202,7 +202,7 @@ impl LevelledCoat {
     }
 
     /// The rms height (nm) of the applied and the cured texture in each of [`BANDS_MM`].
-    pub fn bands(&self) -> Vec<(&'static str, f64, f64)> {
+    pub(crate) fn bands(&self) -> Vec<(&'static str, f64, f64)> {
         BANDS_MM
             .iter()
             .map(|&(name, lo_mm, hi_mm)| {
@@ -269,7 +269,7 @@ fn sig(x: f64) -> f64 {
 /// A paint whose coat is given by its application (`app`, the block at `/clear_coat/application` of the
 /// coat object `coat`): `spec` as read, its coat's roughness the levelled texture's Sdq. An explicit `roughness`, `scatter` or a `distribution` other than Beckmann
 /// beside it is refused.
-pub fn parse_levelled_paint(root: &Obj, coat: &Obj, app: &Obj, mut spec: PaintSpec) -> Result<Arc<dyn Brdf>> {
+pub(crate) fn parse_levelled_paint(root: &Obj, coat: &Obj, app: &Obj, mut spec: PaintSpec) -> Result<Arc<dyn Brdf>> {
     for key in ["roughness", "scatter"] {
         if coat.get(key).is_some() {
             return Err(coat.err(

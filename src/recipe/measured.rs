@@ -25,7 +25,7 @@ pub fn resolve(recipe_file: &str, file: &str) -> PathBuf {
 }
 
 /// `{"model": "merl", "file": "…", "interpolation": "nearest" | "trilinear"}`.
-pub fn parse_merl(obj: &Obj) -> Result<Arc<dyn Brdf>> {
+pub(crate) fn parse_merl(obj: &Obj) -> Result<Arc<dyn Brdf>> {
     obj.deny_unknown_in("merl")?;
     let file = obj.str(&obj.param_key(&registry::MERL_FILE))?;
     if file.is_empty() {
@@ -48,7 +48,7 @@ pub fn parse_merl(obj: &Obj) -> Result<Arc<dyn Brdf>> {
 }
 
 /// `{"model": "rgl", "file": "…"}`: an RGL material database `.bsdf` tensor file.
-pub fn parse_rgl(obj: &Obj) -> Result<Arc<dyn Brdf>> {
+pub(crate) fn parse_rgl(obj: &Obj) -> Result<Arc<dyn Brdf>> {
     obj.deny_unknown_in("rgl")?;
     let file = obj.str(&obj.param_key(&registry::RGL_FILE))?;
     if file.is_empty() {
@@ -64,7 +64,7 @@ pub fn parse_rgl(obj: &Obj) -> Result<Arc<dyn Brdf>> {
 
 /// `{"model": "inplane-csv", "file": "…"}` and `{"model": "e1392", "file": "…"}`: in-plane goniometer tables
 /// with the isotropic (θh, θd) extension (`measured::inplane`).
-pub fn parse_inplane(obj: &Obj, model: &str) -> Result<Arc<dyn Brdf>> {
+pub(crate) fn parse_inplane(obj: &Obj, model: &str) -> Result<Arc<dyn Brdf>> {
     obj.deny_unknown_in(model)?;
     let what = if model == "e1392" { "an ASTM E1392 text table" } else { "an in-plane CSV table" };
     let entry = if model == "e1392" { &registry::E1392_FILE } else { &registry::INPLANE_FILE };

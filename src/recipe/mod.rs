@@ -109,7 +109,7 @@ pub fn parse_str(text: &str, file: &str) -> Result<Material> {
 }
 
 /// Validate the root object of a recipe into its BRDF.
-pub fn parse_brdf(obj: &Obj) -> Result<Arc<dyn Brdf>> {
+pub(crate) fn parse_brdf(obj: &Obj) -> Result<Arc<dyn Brdf>> {
     let allowed = || format!("allowed: {}", MODELS.iter().map(|m| format!("\"{m}\"")).collect::<Vec<_>>().join(", "));
     let model = match obj.get("model") {
         None => return Err(obj.err("model", format!("missing required field; {}", allowed()))),

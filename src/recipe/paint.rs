@@ -20,9 +20,9 @@ use std::sync::Arc;
 
 /// Default TiO2 index: anatase, ordinary/extraordinary 2.56/2.49 at 589 nm (CRC Handbook of Chemistry and
 /// Physics, "Physical constants of inorganic compounds"); rutile is ≈ 2.6–2.9 (Devore, JOSA 41, 416, 1951).
-pub const DEFAULT_TIO2_INDEX: f64 = 2.5;
+pub(crate) const DEFAULT_TIO2_INDEX: f64 = 2.5;
 /// Default mica (muscovite) index: n ≈ 1.55–1.61 (CRC Handbook); Pfaff & Reynders, Chem. Rev. 99, 1963 (1999).
-pub const DEFAULT_MICA_INDEX: f64 = 1.58;
+pub(crate) const DEFAULT_MICA_INDEX: f64 = 1.58;
 
 const PAINT: &str = "paint";
 

@@ -18,7 +18,7 @@ use num_complex::Complex64;
 
 /// Read the scatter object `o` of a `model` recipe (entries `params`) into the halo of an interface of
 /// index `index` (one per sample of `sampling`).
-pub fn parse_scatter(
+pub(crate) fn parse_scatter(
     o: &Obj,
     params: &ScatterParams,
     model: &str,

@@ -17,7 +17,7 @@ use crate::topography::slopes::slopes;
 use crate::{Error, Result};
 
 /// `{"model": "topography", "file": "…", "ior": n, "levelling": "plane"}`.
-pub fn parse_topography(obj: &Obj) -> Result<Arc<dyn Brdf>> {
+pub(crate) fn parse_topography(obj: &Obj) -> Result<Arc<dyn Brdf>> {
     obj.deny_unknown_in("topography")?;
     let ior = obj.param(&registry::TOPOGRAPHY_IOR)?;
     let (map, levelled, levelling) = levelled_map(obj, &registry::TOPOGRAPHY_FILE, &registry::TOPOGRAPHY_LEVELLING)?;
@@ -30,7 +30,7 @@ pub fn parse_topography(obj: &Obj) -> Result<Arc<dyn Brdf>> {
 
 /// The topography that `obj`'s `file` entry names (resolved against the recipe's directory), levelled as its
 /// `levelling` entry says (the plane when absent): the map, its levelled heights and the levelling.
-pub fn levelled_map(obj: &Obj, file: &Param, levelling: &Param) -> Result<(HeightMap, Levelled, Levelling)> {
+pub(crate) fn levelled_map(obj: &Obj, file: &Param, levelling: &Param) -> Result<(HeightMap, Levelled, Levelling)> {
     let name = obj.str(&obj.param_key(file))?;
     if name.is_empty() {
         return Err(obj.err("file", "empty path; expected the path of an .x3p, .sdf or .gsf topography"));

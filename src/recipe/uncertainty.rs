@@ -21,7 +21,7 @@ use serde_json::Value;
 pub const KEY: &str = "uncertainty";
 
 /// At most this many numbers may carry an uncertainty (each costs two runs of the plan).
-pub const MAX_STATED: usize = 64;
+pub(crate) const MAX_STATED: usize = 64;
 
 /// One number of the recipe with its standard uncertainty.
 #[derive(Clone, Debug, PartialEq)]
@@ -38,7 +38,7 @@ pub struct Stated {
 
 /// The numbers of the recipe `json` (of `model`) that a numeric registry entry governs, as concrete pointers in
 /// document order (the block itself left out): what an `uncertainty` key may name.
-pub fn candidates(json: &Value, model: &str) -> Vec<String> {
+pub(crate) fn candidates(json: &Value, model: &str) -> Vec<String> {
     fn walk(v: &Value, at: String, model: &str, out: &mut Vec<String>) {
         match v {
             Value::Number(_) if registry::lookup(model, &at).is_some_and(|e| e.ty.is_numeric()) => out.push(at),

@@ -179,7 +179,7 @@ pub fn json(r: &FitReport, timing: bool) -> Value {
 /// The document of a fit that could not run to a report (its start or its final point has no finite
 /// readings): the failure, and what was asked, so that `fit --format json` always writes a document
 /// (docs/inverse.md §Verdicts and exit statuses).
-pub fn failure_json(free: &[FreeParameter], targets: &[TargetReading], failure: &str) -> Value {
+pub(crate) fn failure_json(free: &[FreeParameter], targets: &[TargetReading], failure: &str) -> Value {
     super::to_json(&FitFailureDoc {
         converged: false,
         failure: failure.into(),

@@ -140,7 +140,7 @@ fn without_testsuites_skipped(xml: String) -> String {
 }
 
 /// One case per baseline check.
-pub fn baseline_suite(drift: &[Drift]) -> TestSuite {
+pub(crate) fn baseline_suite(drift: &[Drift]) -> TestSuite {
     let mut suite = TestSuite::new("baseline");
     for d in drift {
         let msg = format!(

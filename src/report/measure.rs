@@ -57,7 +57,7 @@ pub fn json_doc(material: &Material, readings: &[Reading], timing: bool, evaluat
 impl MeasureDoc {
     /// Add the tolerance envelope to each reading (`None` where the standard data give no tolerance, or where
     /// the wall-clock limit cut the envelope: then `"envelope_cut": true`).
-    pub fn with_envelope(mut self, envelopes: &Envelopes) -> MeasureDoc {
+    pub(crate) fn with_envelope(mut self, envelopes: &Envelopes) -> MeasureDoc {
         self.readings = self
             .readings
             .into_iter()
@@ -71,7 +71,7 @@ impl MeasureDoc {
     }
 
     /// Add each reading's prediction uncertainty (`uncertainties[i]` of reading i; `comparison::propagation`).
-    pub fn with_uncertainties(mut self, uncertainties: &[Option<PredictionUncertainty>]) -> MeasureDoc {
+    pub(crate) fn with_uncertainties(mut self, uncertainties: &[Option<PredictionUncertainty>]) -> MeasureDoc {
         self.readings = self
             .readings
             .into_iter()
@@ -82,7 +82,7 @@ impl MeasureDoc {
     }
 
     /// Add the baseline checks (when a baseline was given).
-    pub fn with_baseline(mut self, drift: Option<&[Drift]>, file: Option<String>) -> MeasureDoc {
+    pub(crate) fn with_baseline(mut self, drift: Option<&[Drift]>, file: Option<String>) -> MeasureDoc {
         if let (Some(d), Some(file)) = (drift, file) {
             self.baseline = Some(BaselineDoc::new(file, d));
         }
@@ -186,7 +186,7 @@ pub enum MeasureOutput {
 
 /// The JSON of `measure` for many recipes: `materials` (each with its plan's `evaluations`) and `readings`,
 /// each reading with its `material` and `file`, and the sum of the evaluations.
-pub fn batch_json_doc(
+pub(crate) fn batch_json_doc(
     materials: &[Material],
     readings: &[Vec<Reading>],
     timing: bool,
@@ -222,7 +222,7 @@ pub fn batch_json_doc(
 impl BatchDoc {
     /// Add each reading's prediction uncertainty: `per_material[m][i]` of material m's reading i, as
     /// `comparison::propagation::propagate` gives them (one per reading, in the order of [`batch_json_doc`]).
-    pub fn with_uncertainties(mut self, per_material: &[Vec<Option<PredictionUncertainty>>]) -> BatchDoc {
+    pub(crate) fn with_uncertainties(mut self, per_material: &[Vec<Option<PredictionUncertainty>>]) -> BatchDoc {
         let flat: Vec<Option<&PredictionUncertainty>> =
             per_material.iter().flat_map(|v| v.iter().map(Option::as_ref)).collect();
         for (i, r) in self.readings.iter_mut().enumerate() {
@@ -232,7 +232,7 @@ impl BatchDoc {
     }
 
     /// Add the baseline checks (when a baseline was given).
-    pub fn with_baseline(mut self, drift: Option<&[Drift]>, file: Option<String>) -> BatchDoc {
+    pub(crate) fn with_baseline(mut self, drift: Option<&[Drift]>, file: Option<String>) -> BatchDoc {
         if let (Some(d), Some(file)) = (drift, file) {
             self.baseline = Some(BaselineDoc::new(file, d));
         }
@@ -246,7 +246,7 @@ impl BatchDoc {
 }
 
 /// The CSV of `measure` with `material` and `file` columns in front.
-pub fn batch_csv(materials: &[Material], readings: &[Vec<Reading>], timing: bool) -> Result<String> {
+pub(crate) fn batch_csv(materials: &[Material], readings: &[Vec<Reading>], timing: bool) -> Result<String> {
     let err = |e: csv::Error| Error::Io { file: "<csv>".into(), source: std::io::Error::other(e) };
     let mut head: Option<Vec<String>> = None;
     let mut rows = vec![];

@@ -54,7 +54,7 @@ pub fn decimals(error: f64) -> usize {
 /// display of gloss, haze and DOI meters) and for the hue angle (`°`); 0.01 for the colour coordinates X, Y, Z,
 /// L*, a*, b*, C* (unit `""`: the two-decimal CIELAB display of spectrophotometers) and any other unit. A
 /// display convention, not a number of any standard; the page of `glossmeter serve` rounds by the same table.
-pub fn display_step(unit: &str) -> f64 {
+pub(crate) fn display_step(unit: &str) -> f64 {
     match unit {
         "GU" | "HU" | "HU(log)" | "DOI" | "°" => 0.1,
         _ => 0.01,
@@ -64,7 +64,7 @@ pub fn display_step(unit: &str) -> f64 {
 /// `v` as the instrument displays it: rounded to the multiple of `step` nearest it (a half up, as the page's
 /// `Math.round`), with the step's decimals; `-0.0` is `0.0`; a value of 10¹⁵ or more in scientific notation
 /// ([`shown`]).
-pub fn displayed(v: f64, step: f64) -> String {
+pub(crate) fn displayed(v: f64, step: f64) -> String {
     let d = (-step.log10()).round().max(0.0) as usize;
     if !v.is_finite() || v.abs() >= 1e15 {
         return shown(v, d);
@@ -101,7 +101,7 @@ pub fn measured(v: f64) -> String {
 
 /// An error estimate alone for text (JUnit messages): two significant digits, rounded up (a printed estimate is
 /// never below the computed one); plain in [10⁻³, 10⁶), else `3.6e-11`.
-pub fn error_text(e: f64) -> String {
+pub(crate) fn error_text(e: f64) -> String {
     if !(e.is_finite() && e > 0.0) {
         return plain(e);
     }
@@ -114,7 +114,7 @@ pub fn error_text(e: f64) -> String {
 /// its last printed digit), so that the printed estimate still covers the printed value's error. Both are plain
 /// decimals in [10⁻¹⁵, 10¹⁵) as [`plain`]: `89.14 ± 3.5763209946461607e-11` prints `89.1400000000000` and
 /// `0.000000000036`. A zero or non-finite estimate leaves the value at [`measured`].
-pub fn with_error(v: f64, e: f64) -> (String, String) {
+pub(crate) fn with_error(v: f64, e: f64) -> (String, String) {
     match rounded(v, e) {
         Some((value, up)) => (value, plain_two_digits(up)),
         None => (measured(v), if e.is_finite() { plain(e) } else { String::new() }),
@@ -122,7 +122,7 @@ pub fn with_error(v: f64, e: f64) -> (String, String) {
 }
 
 /// [`with_error`] for text (JUnit messages): the estimate as [`error_text`] writes it (`3.6e-11`).
-pub fn with_error_text(v: f64, e: f64) -> (String, String) {
+pub(crate) fn with_error_text(v: f64, e: f64) -> (String, String) {
     match rounded(v, e) {
         Some((value, up)) => (value, two_digits_up(up)),
         None => (measured(v), if e.is_finite() { plain(e) } else { String::new() }),
@@ -371,7 +371,7 @@ impl ReadingDoc {
     }
 
     /// With the tolerance envelope of `measure --envelope` (`None`: the standard data give no tolerance).
-    pub fn with_envelope(mut self, e: Option<&Envelope>, cut: bool) -> ReadingDoc {
+    pub(crate) fn with_envelope(mut self, e: Option<&Envelope>, cut: bool) -> ReadingDoc {
         self.envelope_cut = cut.then_some(true);
         self.envelope_min = Some(e.map(|e| e.min));
         self.envelope_max = Some(e.map(|e| e.max));
@@ -553,7 +553,10 @@ pub struct SweepLineDoc {
 
 /// CSV text in memory: the header, then one record per row (quoted where the csv crate must). Every CSV that
 /// the command line writes (measure, many recipes, compare, convergence, profile) goes through here.
-pub fn csv_text<R: IntoIterator<Item = String>>(header: &[&str], rows: impl IntoIterator<Item = R>) -> Result<String> {
+pub(crate) fn csv_text<R: IntoIterator<Item = String>>(
+    header: &[&str],
+    rows: impl IntoIterator<Item = R>,
+) -> Result<String> {
     let err = |e: csv::Error| Error::Io { file: "<csv>".into(), source: std::io::Error::other(e) };
     let mut w = csv::Writer::from_writer(vec![]);
     w.write_record(header).map_err(err)?;

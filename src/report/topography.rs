@@ -9,8 +9,8 @@ use crate::topography::analysis::Analysis;
 use crate::topography::map::HeightMap;
 
 /// Width of the slope-angle histogram's bins, degrees, and their number (the last takes every steeper cell).
-pub const ANGLE_BIN_DEG: f64 = 1.0;
-pub const ANGLE_BINS: usize = 45;
+pub(crate) const ANGLE_BIN_DEG: f64 = 1.0;
+pub(crate) const ANGLE_BINS: usize = 45;
 
 /// The map as read.
 #[derive(Clone, Debug, Serialize, JsonSchema)]

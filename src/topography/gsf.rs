@@ -8,7 +8,7 @@ use crate::error::number;
 use crate::{Error, Result};
 
 /// The magic line.
-pub const MAGIC: &[u8] = b"Gwyddion Simple Field 1.0\n";
+pub(crate) const MAGIC: &[u8] = b"Gwyddion Simple Field 1.0\n";
 
 /// The longest header read: 64 KiB (a real header is a few hundred bytes).
 const MAX_HEADER: usize = 64 * 1024;

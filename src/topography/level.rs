@@ -7,7 +7,7 @@ use super::map::HeightMap;
 use crate::{Error, Result};
 
 /// The highest polynomial degree allowed.
-pub const MAX_DEGREE: u32 = 5;
+pub(crate) const MAX_DEGREE: u32 = 5;
 
 /// What is removed from the heights.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -5,22 +5,22 @@ use crate::error::number;
 use crate::{Error, Result};
 
 /// The largest file read as a topography: 256 MiB (a 4096 × 4096 map of doubles is 128 MiB).
-pub const MAX_FILE_BYTES: u64 = 256 * 1024 * 1024;
+pub(crate) const MAX_FILE_BYTES: u64 = 256 * 1024 * 1024;
 
 /// The most points a map may have: 2²⁴ = 16 777 216 (4096 × 4096). Its heights take 128 MiB and its
 /// spectrum 256 MiB of complex numbers.
-pub const MAX_POINTS: usize = 1 << 24;
+pub(crate) const MAX_POINTS: usize = 1 << 24;
 
 /// The smallest map: 2 points each way (a 2 × 2 map has one cell, one slope).
-pub const MIN_SIDE: usize = 2;
+pub(crate) const MIN_SIDE: usize = 2;
 
 /// The lateral spacings allowed, metres: 10⁻¹² (below any instrument's sampling) to 1 m (a 4096-point map
 /// of 1 m pixels is 4 km wide).
-pub const PIXEL_RANGE_M: (f64, f64) = (1e-12, 1.0);
+pub(crate) const PIXEL_RANGE_M: (f64, f64) = (1e-12, 1.0);
 
 /// The largest |height| allowed after scaling, metres: 1 m. A coating's topography spans micrometres; a value
 /// beyond a metre is a scale or unit error.
-pub const MAX_ABS_HEIGHT_M: f64 = 1.0;
+pub(crate) const MAX_ABS_HEIGHT_M: f64 = 1.0;
 
 /// The file formats read (docs/topography.md §Formats).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -68,7 +68,7 @@ pub struct HeightMap {
 
 /// Check a map's dimensions against the limits before anything of that size is allocated; `field` names
 /// where the dimensions were read.
-pub fn check_dimensions(file: &str, field: &str, nx: u64, ny: u64) -> Result<usize> {
+pub(crate) fn check_dimensions(file: &str, field: &str, nx: u64, ny: u64) -> Result<usize> {
     let allowed = format!("allowed: at least {MIN_SIDE} points each way and at most {MAX_POINTS} points in all");
     if nx < MIN_SIDE as u64 || ny < MIN_SIDE as u64 {
         return Err(Error::input(
@@ -84,7 +84,7 @@ pub fn check_dimensions(file: &str, field: &str, nx: u64, ny: u64) -> Result<usi
 }
 
 /// Check a lateral spacing (metres) read from `field`.
-pub fn check_spacing(file: &str, field: &str, d: f64) -> Result<f64> {
+pub(crate) fn check_spacing(file: &str, field: &str, d: f64) -> Result<f64> {
     let (lo, hi) = PIXEL_RANGE_M;
     if d.is_finite() && (lo..=hi).contains(&d) {
         Ok(d)
@@ -123,7 +123,7 @@ impl HeightMap {
     /// [`HeightMap::new`], with `note` added to the message refusing a height (what a format says of its
     /// heights' scale: X3P's increment and offset).
     #[allow(clippy::too_many_arguments)]
-    pub fn with_height_note(
+    pub(crate) fn with_height_note(
         file: &str,
         format: Format,
         nx: usize,

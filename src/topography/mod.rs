@@ -48,7 +48,7 @@ fn is_sdf(bytes: &[u8]) -> bool {
 
 /// Whether a file's first bytes announce one of the calibrated formats (X3P, GSF, SDF; [`from_bytes`]) rather
 /// than a plain matrix, whose calibration only its caller can give (docs/topography.md §Plain text matrices).
-pub fn announces_calibrated_format(head: &[u8]) -> bool {
+pub(crate) fn announces_calibrated_format(head: &[u8]) -> bool {
     head.starts_with(b"PK\x03\x04") || head.starts_with(gsf::MAGIC) || is_sdf(head)
 }
 

@@ -98,7 +98,7 @@ impl Psd2 {
     /// Σ w(|f|)·(2π|f|)^j·S(f)·Δfₓ·Δf_y over the grid frequencies with lo ≤ |f| < hi (1/m): the power (j = 0,
     /// m²) or the mean-square slope (j = 2, rad²) of that band of the map, each mode weighted by w (a filter's
     /// power transfer, 1 for the map itself).
-    pub fn weighted_moment(&self, j: i32, lo: f64, hi: f64, w: impl Fn(f64) -> f64) -> f64 {
+    pub(crate) fn weighted_moment(&self, j: i32, lo: f64, hi: f64, w: impl Fn(f64) -> f64) -> f64 {
         let mut sum = 0.0;
         for ky in 0..self.ny {
             for kx in 0..self.nx {

@@ -9,7 +9,7 @@ use crate::{Error, Result};
 /// The binary header: version (8), manufacturer (10), creation and modification dates (12 each), NumPoints and
 /// NumProfiles (u16 each), Xscale, Yscale, Zscale, Zresolution (f64 each), Compression, DataType, CheckType
 /// (u8 each): 81 bytes, little-endian.
-pub const BINARY_HEADER: usize = 8 + 10 + 12 + 12 + 2 + 2 + 4 * 8 + 3;
+pub(crate) const BINARY_HEADER: usize = 8 + 10 + 12 + 12 + 2 + 2 + 4 * 8 + 3;
 
 /// The data types (the `DataType` field), with their size in bytes and the value that marks an invalid point
 /// (as Gwyddion's reader of the format takes it: the type's extreme for 16- and 32-bit integers, NaN for

@@ -25,7 +25,7 @@ pub fn hemispherical_mean(f: impl Fn(f64) -> f64, kinks: &[f64]) -> f64 {
 /// [`hemispherical_mean`] of `count` functions with the same kinks at once: `f(μ, values)` sets every
 /// function's value at μ (so what they share at one μ is computed once), and each mean is summed in the same
 /// order, to the same bits, as [`hemispherical_mean`] sums it alone.
-pub fn hemispherical_means(mut f: impl FnMut(f64, &mut [f64]), count: usize, kinks: &[f64]) -> Vec<f64> {
+pub(crate) fn hemispherical_means(mut f: impl FnMut(f64, &mut [f64]), count: usize, kinks: &[f64]) -> Vec<f64> {
     let (x, w) = gauss_legendre(DIFFUSE_FRESNEL_NODES);
     let mut at = vec![0.0; count];
     let mut sums = vec![0.0; count];

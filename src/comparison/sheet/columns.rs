@@ -5,7 +5,7 @@ use super::*;
 /// A reading column an instrument writes, and the glossmeter reading it stands for. `not_predicted` is set for
 /// readings whose formula is not public (they are reported as "not predicted", never dropped).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ReadingColumn {
+pub(crate) struct ReadingColumn {
     /// Normalised header names (lower case, only letters and digits; see [`normalise`]).
     pub names: &'static [&'static str],
     /// The geometry id and the reading (a reading name or a quantity of that geometry).
@@ -20,7 +20,7 @@ pub(super) const NOT_PUBLIC: &str = "the maker's formula is not public";
 
 /// Header aliases of the readings other than plain gloss (for gloss see [`gloss_angle`]). To add a reading
 /// (e.g. colour columns), add a row; the docs table in docs/instrument.md §Sheets lists the same rows.
-pub const READING_COLUMNS: &[ReadingColumn] = &[
+pub(crate) const READING_COLUMNS: &[ReadingColumn] = &[
     ReadingColumn {
         names: &["haze", "hu", "haze20", "20haze", "hazehu"],
         geometry: IQ,
@@ -114,10 +114,10 @@ pub const READING_COLUMNS: &[ReadingColumn] = &[
 pub const IQ: &str = "rhopoint-iq-20";
 
 /// Columns that say which sample a row is.
-pub const SAMPLE_COLUMNS: &[&str] =
+pub(crate) const SAMPLE_COLUMNS: &[&str] =
     &["sample", "samplename", "sampleid", "specimen", "name", "id", "panel", "probe", "probenname", "muster"];
 /// Columns kept by the reader but not compared (bookkeeping that instruments add to each row).
-pub const INFO_COLUMNS: &[&str] = &[
+pub(crate) const INFO_COLUMNS: &[&str] = &[
     "date",
     "datum",
     "time",
@@ -139,19 +139,19 @@ pub const INFO_COLUMNS: &[&str] = &[
     "lot",
 ];
 /// The long layout's columns.
-pub const GEOMETRY_COLUMNS: &[&str] = &["geometry", "geometryid"];
-pub const QUANTITY_COLUMNS: &[&str] = &["quantity", "reading", "readingname"];
-pub const VALUE_COLUMNS: &[&str] = &["value", "measured", "measurement"];
-pub const UNCERTAINTY_COLUMNS: &[&str] = &["uncertainty", "u", "unc"];
+pub(crate) const GEOMETRY_COLUMNS: &[&str] = &["geometry", "geometryid"];
+pub(crate) const QUANTITY_COLUMNS: &[&str] = &["quantity", "reading", "readingname"];
+pub(crate) const VALUE_COLUMNS: &[&str] = &["value", "measured", "measurement"];
+pub(crate) const UNCERTAINTY_COLUMNS: &[&str] = &["uncertainty", "u", "unc"];
 /// The colour layout's columns (normalised) and the readings they give: L*, a*, b*.
-pub const LAB_COLUMNS: &[(&[&str], &str)] =
+pub(crate) const LAB_COLUMNS: &[(&[&str], &str)] =
     &[(&["l", "lstar", "cielabl"], "L*"), (&["a", "astar", "cielaba"], "a*"), (&["b", "bstar", "cielabb"], "b*")];
 /// A colour reading as a long-layout `quantity` (lower-cased) and its reading name.
 pub(super) const COLOUR_QUANTITIES: &[(&str, &str)] =
     &[("x", "X"), ("y", "Y"), ("z", "Z"), ("l*", "L*"), ("a*", "a*"), ("b*", "b*"), ("c*", "C*"), ("h", "h")];
 
 /// The gloss angles instruments write, and the shipped geometry read at each.
-pub const GLOSS_ANGLES: &[(&str, &str)] = &[
+pub(crate) const GLOSS_ANGLES: &[(&str, &str)] = &[
     ("20", "astm-d523-20"),
     ("45", "astm-d2457-45"),
     ("60", "astm-d523-60"),
@@ -161,7 +161,7 @@ pub const GLOSS_ANGLES: &[(&str, &str)] = &[
 
 /// A header as the alias tables spell it: without parenthesised units, lower case, only letters and
 /// digits, without a trailing `deg`/`degree(s)`. `Gloss 60° (GU)` → `gloss60`, `HU_LOG` → `hulog`.
-pub fn normalise(header: &str) -> String {
+pub(crate) fn normalise(header: &str) -> String {
     let mut s = String::new();
     let mut depth = 0usize;
     for c in header.chars() {
@@ -183,7 +183,7 @@ pub fn normalise(header: &str) -> String {
 }
 
 /// The gloss geometry of a header such as `20`, `20°`, `G60`, `Gloss 85°`, `60 gloss`, `GU 20`.
-pub fn gloss_angle(normalised: &str) -> Option<&'static str> {
+pub(crate) fn gloss_angle(normalised: &str) -> Option<&'static str> {
     let mut h = normalised;
     for p in ["gloss", "gu", "g"] {
         if let Some(t) = h.strip_prefix(p) {

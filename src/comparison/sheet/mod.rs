@@ -31,7 +31,7 @@ mod rows;
 mod text;
 pub use columns::*;
 use rows::*;
-pub use text::*;
+pub(crate) use text::*;
 
 use super::series::{self, Series, Statistic};
 use super::workbook;
@@ -41,7 +41,7 @@ use crate::{Error, Result};
 /// The most readings one sheet may hold (a QC sheet of 10 000 panels × 20 readings has 200 000): each is a
 /// [`SheetRow`] of about 250 bytes, so that a 16 MiB sheet of one-digit cells stays far below 512 MiB
 /// (docs/instrument.md §Sheets).
-pub const MAX_READINGS: usize = 500_000;
+pub(crate) const MAX_READINGS: usize = 500_000;
 
 /// What the reader was asked to do differently from its defaults.
 #[derive(Clone, Debug, Default)]
@@ -112,7 +112,7 @@ pub struct Sheet {
 
 impl Sheet {
     /// The metadata as a JSON object (a key given twice keeps both values, joined by "; ").
-    pub fn metadata_json(&self) -> serde_json::Value {
+    pub(crate) fn metadata_json(&self) -> serde_json::Value {
         let mut m = serde_json::Map::new();
         for (k, v) in &self.metadata {
             match m.get_mut(k) {
@@ -146,7 +146,7 @@ impl Sheet {
     }
 
     /// The distinct geometry ids of the rows, in order of appearance.
-    pub fn geometry_ids(&self) -> Vec<String> {
+    pub(crate) fn geometry_ids(&self) -> Vec<String> {
         let mut ids: Vec<String> = Vec::new();
         for r in &self.rows {
             if !ids.contains(&r.geometry) {
@@ -185,7 +185,7 @@ pub fn from_bytes(bytes: &[u8], file: &str, options: &SheetOptions) -> Result<Sh
 }
 
 /// A workbook's sheet (`options.sheet_name`, or the first) read by the rules of a text sheet.
-pub fn parse_workbook(bytes: &[u8], file: &str, options: &SheetOptions) -> Result<Sheet> {
+pub(crate) fn parse_workbook(bytes: &[u8], file: &str, options: &SheetOptions) -> Result<Sheet> {
     if options.delimiter.is_some() {
         return Err(Error::Argument(
             Words::from(format!("{file} is a workbook, which has cells, not separators: "))
@@ -203,7 +203,7 @@ pub fn parse_workbook(bytes: &[u8], file: &str, options: &SheetOptions) -> Resul
     Ok(sheet)
 }
 
-pub fn parse_bytes(bytes: &[u8], file: &str, options: &SheetOptions) -> Result<Sheet> {
+pub(crate) fn parse_bytes(bytes: &[u8], file: &str, options: &SheetOptions) -> Result<Sheet> {
     let (text, encoding) = decode(bytes, file)?;
     let mut sheet = parse(&text, file, options)?;
     sheet.encoding = encoding;

@@ -4,7 +4,7 @@
 use super::*;
 
 /// Decode a sheet's bytes: a BOM decides; else UTF-8 if it is valid UTF-8; else Windows-1252.
-pub fn decode(bytes: &[u8], file: &str) -> Result<(String, String)> {
+pub(crate) fn decode(bytes: &[u8], file: &str) -> Result<(String, String)> {
     if let Some((enc, bom)) = encoding_rs::Encoding::for_bom(bytes) {
         let (text, had_errors) = enc.decode_without_bom_handling(&bytes[bom..]);
         if had_errors {
@@ -29,7 +29,7 @@ pub fn decode(bytes: &[u8], file: &str) -> Result<(String, String)> {
 }
 
 /// The separator of the header line: the most frequent of `;`, `,` and tab outside quotes (`,` on a tie).
-pub fn detect_delimiter(header_line: &str) -> u8 {
+pub(crate) fn detect_delimiter(header_line: &str) -> u8 {
     let mut counts = [(b',', 0usize), (b';', 0), (b'\t', 0)];
     let mut quoted = false;
     for c in header_line.bytes() {
@@ -53,7 +53,7 @@ pub fn detect_delimiter(header_line: &str) -> u8 {
 
 /// A number as sheets write it: `89.1`, `89,1` (decimal comma), `-1.5e-3`. A field with both `.` and `,`
 /// (a thousands separator?) is refused rather than guessed.
-pub fn parse_number(s: &str) -> std::result::Result<f64, String> {
+pub(crate) fn parse_number(s: &str) -> std::result::Result<f64, String> {
     let t = s.trim();
     let t = if t.contains(',') {
         if t.contains('.') || t.matches(',').count() > 1 {

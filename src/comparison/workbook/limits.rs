@@ -8,22 +8,22 @@
 //! as text (10⁶ cells, about 24 MiB of string headers plus their text).
 
 /// The largest decompressed size of one member of a zip workbook (`.xlsx`, `.xlsb`, `.ods`): 64 MiB.
-pub const MAX_MEMBER_BYTES: u64 = 64 << 20;
+pub(crate) const MAX_MEMBER_BYTES: u64 = 64 << 20;
 /// The largest decompressed size of all members together: 256 MiB (each is read once, to check its CRC).
-pub const MAX_TOTAL_BYTES: u64 = 256 << 20;
+pub(crate) const MAX_TOTAL_BYTES: u64 = 256 << 20;
 /// The largest ratio of a member's decompressed to compressed size, for members over [`RATIO_FLOOR_BYTES`]:
 /// spreadsheet XML deflates 5–30×; a zip bomb of spaces deflates about 1 000×.
-pub const MAX_RATIO: u64 = 200;
+pub(crate) const MAX_RATIO: u64 = 200;
 /// Members smaller than this (1 MiB) are not held to [`MAX_RATIO`].
-pub const RATIO_FLOOR_BYTES: u64 = 1 << 20;
+pub(crate) const RATIO_FLOOR_BYTES: u64 = 1 << 20;
 /// The most members a zip workbook may have.
-pub const MAX_MEMBERS: usize = 10_000;
+pub(crate) const MAX_MEMBERS: usize = 10_000;
 /// The most cells of a sheet's used range (rows × columns, from its first to its last non-empty cell), and
 /// of all the sheets of an `.xls` together (its reader reads every sheet when it opens the file).
-pub const MAX_CELLS: u64 = 1_000_000;
+pub(crate) const MAX_CELLS: u64 = 1_000_000;
 /// The most shared strings (`.xlsx` `uniqueCount` and `count`, `.xls` SST counts).
-pub const MAX_SHARED_STRINGS: u64 = 1_000_000;
+pub(crate) const MAX_SHARED_STRINGS: u64 = 1_000_000;
 /// The most sheets of a workbook.
-pub const MAX_SHEETS: u64 = 1_000;
+pub(crate) const MAX_SHEETS: u64 = 1_000;
 /// The largest workbook file: the input limit of every sheet (16 MiB).
-pub const MAX_FILE_BYTES: usize = 16 << 20;
+pub(crate) const MAX_FILE_BYTES: usize = 16 << 20;

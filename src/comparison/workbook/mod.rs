@@ -33,7 +33,7 @@ use archive::ZipKind;
 
 /// Whether the bytes are a workbook rather than text: a ZIP archive (`PK\x03\x04`: xlsx, xlsm, xlsb, ods) or an
 /// OLE compound file (`D0 CF 11 E0`: xls). A text sheet never starts so (`P` then `K` then a control byte).
-pub fn is_workbook(bytes: &[u8]) -> bool {
+pub(crate) fn is_workbook(bytes: &[u8]) -> bool {
     bytes.starts_with(b"PK\x03\x04") || bytes.starts_with(&[0xD0, 0xCF, 0x11, 0xE0, 0xA1, 0xB1, 0x1A, 0xE1])
 }
 
@@ -53,7 +53,7 @@ pub struct WorkbookSheet {
 }
 
 /// The cell name of a 1-based row and a 0-based column: (5, 2) → `C5`.
-pub fn cell_name(row: usize, column: u32) -> String {
+pub(crate) fn cell_name(row: usize, column: u32) -> String {
     let mut letters = vec![];
     let mut c = column as u64 + 1;
     while c > 0 {

@@ -40,7 +40,7 @@ impl<'a> ChartMap<'a> {
     }
 
     /// The receptor's axes (the viewing angle).
-    pub fn rec_axes(&self) -> &Axes {
+    pub(crate) fn rec_axes(&self) -> &Axes {
         &self.rec_axes
     }
 

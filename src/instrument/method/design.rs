@@ -310,7 +310,7 @@ impl Method {
     /// §Batch and sweep throughput); a frozen part costs exactly its partition; the shaped rules are guessed
     /// from their first two levels (what they evaluate before they can first stop), doubled for one raise; a
     /// sphere integral is a flat guess (4 096).
-    pub fn expected_evaluations(&self) -> f64 {
+    pub(crate) fn expected_evaluations(&self) -> f64 {
         if self.aperture.integral != Integral::Aperture {
             return 4096.0;
         }

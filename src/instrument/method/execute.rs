@@ -33,7 +33,7 @@ impl Method {
     /// refining at that deadline, or [`LATE_START_SHARE`] of its own budget after it starts if that is
     /// later (so an integral queued behind slow ones still gets a moment to converge), and never later than
     /// its own budget.
-    pub fn execute_until(&self, brdf: &dyn Brdf, deadline: Option<Instant>) -> Flux {
+    pub(crate) fn execute_until(&self, brdf: &dyn Brdf, deadline: Option<Instant>) -> Flux {
         self.run(brdf, false, deadline).0
     }
 
@@ -45,7 +45,7 @@ impl Method {
     }
 
     /// [`Method::execute_and_freeze`] with a shared deadline as in [`Method::execute_until`].
-    pub fn execute_and_freeze_until(&self, brdf: &dyn Brdf, deadline: Option<Instant>) -> (Flux, Method) {
+    pub(crate) fn execute_and_freeze_until(&self, brdf: &dyn Brdf, deadline: Option<Instant>) -> (Flux, Method) {
         let (flux, frozen) = self.run(brdf, true, deadline);
         (flux, frozen.expect("kept"))
     }

@@ -160,7 +160,7 @@ impl MaterialFacts {
     }
 
     /// The facts of a material's hints ([`Brdf::hints`], read once by the caller).
-    pub fn from_hints(hints: &Hints) -> MaterialFacts {
+    pub(crate) fn from_hints(hints: &Hints) -> MaterialFacts {
         MaterialFacts {
             lobes: hints.lobes(),
             kinks: hints.kinks.clone(),
@@ -379,7 +379,7 @@ impl Flux {
 impl Method {
     /// The same method at another relative tolerance: the flux's and each part's tolerance and absolute floor
     /// scaled by rtol / self.rtol (the shares and floors of `Plan::compile` are proportional to the rtol).
-    pub fn with_rtol(&self, rtol: f64) -> Method {
+    pub(crate) fn with_rtol(&self, rtol: f64) -> Method {
         let s = rtol / self.rtol;
         let mut m = self.clone();
         m.rtol = rtol;

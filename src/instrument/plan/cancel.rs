@@ -41,12 +41,12 @@ impl Cancel {
     }
 
     /// Whether the deadline (not the flag) has passed.
-    pub fn is_late(&self) -> bool {
+    pub(crate) fn is_late(&self) -> bool {
         self.0.as_ref().and_then(|s| s.deadline).is_some_and(|d| Instant::now() >= d)
     }
 
     /// The earlier of `deadline` and the signal's own (None: neither has one).
-    pub fn earliest(&self, deadline: Option<Instant>) -> Option<Instant> {
+    pub(crate) fn earliest(&self, deadline: Option<Instant>) -> Option<Instant> {
         match (deadline, self.0.as_ref().and_then(|s| s.deadline)) {
             (Some(a), Some(b)) => Some(a.min(b)),
             (a, b) => a.or(b),

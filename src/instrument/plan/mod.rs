@@ -81,28 +81,28 @@ pub const MIN_RTOL: f64 = 1e-12;
 /// (docs/instrument.md §Bounded work). Every shipped fixture reading needs at most 7.3·10⁴; a measured table
 /// read at 85° (the kinks at every cell boundary) reaches it in 0.9 s (the RGL fixture, D523 85°, measured).
 /// There is no default wall-clock budget: [`PlanOptions::max_seconds`] is opt-in, and an integral that meets it gives no value.
-pub const DEFAULT_MAX_EVALS: usize = 2_000_000;
+pub(crate) const DEFAULT_MAX_EVALS: usize = 2_000_000;
 
 /// The fraction of a measured table's data uncertainty that its specimen integrals are asked for by default
 /// ([`PlanOptions::rtol_from_data`]): the numerical error then adds at most a quarter of the data uncertainty
 /// to a reading, and the integral is not driven to a precision its data does not have (docs/accuracy.md
 /// §Data uncertainty of measured tables).
-pub const DATA_FRACTION: f64 = 0.25;
+pub(crate) const DATA_FRACTION: f64 = 0.25;
 
 /// The loosest relative tolerance the data uncertainty may set (a table so coarse that a quarter of its
 /// uncertainty exceeds 1 % is still integrated to 1 %).
-pub const DATA_MAX_RTOL: f64 = 1e-2;
+pub(crate) const DATA_MAX_RTOL: f64 = 1e-2;
 
 /// The tolerances at which a table and its coarse twins are integrated to estimate the data uncertainty, in
 /// turn until the sum of their numerical errors is at most [`DATA_RESOLVED`] times the difference of the two
 /// fluxes (so that the difference, not the integration, is most of what is measured), and never tighter
 /// than the plan's rtol. (Looser first tolerances cost the same: the initial partition at the table's
 /// resolution already meets 10⁻², measured on `beckmann-iso-32`.)
-pub const DATA_PILOT_RTOL: [f64; 3] = [1e-2, 1e-3, 1e-4];
+pub(crate) const DATA_PILOT_RTOL: [f64; 3] = [1e-2, 1e-3, 1e-4];
 
 /// When the pilots stop: e_coarse + e_table ≤ DATA_RESOLVED·|Φ_coarse − Φ_table| (then the data
 /// uncertainty u = |Φ_coarse − Φ_table| + e_coarse + e_table is at most 3 × the difference).
-pub const DATA_RESOLVED: f64 = 2.0;
+pub(crate) const DATA_RESOLVED: f64 = 2.0;
 
 /// The relative tolerance of every reading when none is given: the one default of every request and front
 /// end (`crate::request`), and of [`PlanOptions::default`].
@@ -380,7 +380,7 @@ impl Plan {
     /// wall-clock budget): a command that runs several plans (`measure --envelope`, its nominal plan and
     /// every variant's) holds them all to one limit counted from its start. The integrals still take their
     /// budget from [`PlanOptions::max_seconds`] ([`Method::execute_until`]).
-    pub fn run_until(&self, deadline: Option<std::time::Instant>) -> Execution {
+    pub(crate) fn run_until(&self, deadline: Option<std::time::Instant>) -> Execution {
         let deadline = self.options.cancel.earliest(deadline);
         let todo = self.specimen_jobs();
         let computed: Vec<Flux> = todo.par_iter().map(|&j| self.run_job(j, deadline, false).0).collect();
@@ -413,7 +413,7 @@ impl Plan {
 
     /// [`Plan::run_all`], calling `done(plan, job)` on the worker thread as each specimen integral ends (for
     /// progress: the weights of the integrals are their `expected_evaluations`). The results are the same bits.
-    pub fn run_all_reporting(plans: &[Plan], done_integral: &(dyn Fn(usize, usize) + Sync)) -> Vec<Execution> {
+    pub(crate) fn run_all_reporting(plans: &[Plan], done_integral: &(dyn Fn(usize, usize) + Sync)) -> Vec<Execution> {
         let tasks: Vec<(usize, usize)> = plans
             .iter()
             .enumerate()

@@ -58,7 +58,7 @@ pub enum ColourKind {
 const COMMON: &[&str] = &["id", "title", "standards", "kind", "notes"];
 
 /// Whether a geometry file is a colour geometry (it has a `kind`; gloss files do not).
-pub fn is_colour_spec(spec: &serde_json::Value) -> bool {
+pub(crate) fn is_colour_spec(spec: &serde_json::Value) -> bool {
     spec.get("kind").is_some()
 }
 
@@ -269,7 +269,7 @@ pub fn describe(g: &StandardGeometry) -> String {
 
 /// Projected solid angles of the source stop (about the source axis at `illumination`) and the receptor stop
 /// (about the receptor axis at `viewing`), by Lambert's polygon formula.
-pub fn projected_solid_angles(illumination: f64, viewing: f64, source: Stop, receptor: Stop) -> (f64, f64) {
+pub(crate) fn projected_solid_angles(illumination: f64, viewing: f64, source: Stop, receptor: Stop) -> (f64, f64) {
     let (si, ci) = illumination.sin_cos();
     let (sv, cv) = viewing.sin_cos();
     let ps = projected_solid_angle(Vec3::new(-si, 0.0, ci), Vec3::new(ci, 0.0, si), source);

@@ -448,7 +448,7 @@ pub fn describe(g: &StandardGeometry) -> String {
 /// `docs/instrument.md` §1.9), the lines `--explain` adds: each window's pixels and angles, each reading's
 /// definition, and every number of the file whose status is `assumed` (JSON Pointer, value, the start of its
 /// reason). None for any other geometry.
-pub fn pixel_array_text(g: &StandardGeometry) -> Option<String> {
+pub(crate) fn pixel_array_text(g: &StandardGeometry) -> Option<String> {
     let recs = g.spec.get("receptors").and_then(Value::as_array)?;
     let is_pixels = |r: &Value| r.get("shape").and_then(Value::as_str) == Some("pixels");
     if !recs.iter().any(is_pixels) {

@@ -50,7 +50,7 @@ fn catalogue() -> Result<(&'static [StandardGeometry], usize)> {
 
 /// Every builtin geometry, gloss then colour, borrowed from the one per-process parse (`find` copies only the
 /// one it returns). `Planner::new` calls it to check the shipped files.
-pub fn builtin_static() -> Result<&'static [StandardGeometry]> {
+pub(crate) fn builtin_static() -> Result<&'static [StandardGeometry]> {
     Ok(catalogue()?.0)
 }
 
@@ -203,7 +203,7 @@ pub fn load_source(source: &crate::input::Source) -> Result<StandardGeometry> {
 }
 
 /// [`describe`] for gloss geometries, `colour::describe` for colour ones.
-pub fn describe_any(g: &StandardGeometry) -> String {
+pub(crate) fn describe_any(g: &StandardGeometry) -> String {
     if g.geometry.is_colour() {
         colour::describe(g)
     } else {
@@ -212,7 +212,7 @@ pub fn describe_any(g: &StandardGeometry) -> String {
 }
 
 /// [`list_line`] for gloss geometries, `colour::list_line` for colour ones.
-pub fn list_line_any(g: &StandardGeometry) -> String {
+pub(crate) fn list_line_any(g: &StandardGeometry) -> String {
     if g.geometry.is_colour() {
         colour::list_line(g)
     } else {

@@ -14,7 +14,7 @@ use crate::Result;
 
 /// The largest pixel count a profile may have (a guard against a typo's hours of work: 65 536 aperture
 /// integrals).
-pub const MAX_PIXELS: usize = 65_536;
+pub(crate) const MAX_PIXELS: usize = 65_536;
 
 /// The name of the normalising window (a pixel-sized stop centred on the specular direction).
 pub const REFERENCE: &str = "profile-reference";
@@ -69,7 +69,7 @@ impl ProfileSpec {
 /// Parse a `profile` block (`o` is the block) of a geometry of angle `angle_deg`: `pixels` (an integer ≥ 1),
 /// `pixel_deg` and `perpendicular_deg`, each `{"value", "source", "status"}`, and optional `notes`. The array
 /// must stay above the specimen plane.
-pub fn parse_spec(o: &Obj, angle_deg: f64) -> Result<ProfileSpec> {
+pub(crate) fn parse_spec(o: &Obj, angle_deg: f64) -> Result<ProfileSpec> {
     o.deny_unknown(&["pixels", "pixel_deg", "perpendicular_deg", "notes"])?;
     let n = sourced(o, "pixels", Range::closed(1.0, MAX_PIXELS as f64), "the number of pixels of the profile array")?;
     if n.fract() != 0.0 {
@@ -95,7 +95,7 @@ pub fn parse_spec(o: &Obj, angle_deg: f64) -> Result<ProfileSpec> {
 /// within the array). The stop is the union of those pixels: in plane from the left edge of `pixel_first` to the
 /// right edge of `pixel_last`, as tall as the pixels. A geometry without a `profile` block, a pixel outside the
 /// array or a window whose first pixel lies after its last is refused, naming the file and the field.
-pub fn pixel_window(o: &Obj, array: Option<&ProfileSpec>) -> Result<Stop> {
+pub(crate) fn pixel_window(o: &Obj, array: Option<&ProfileSpec>) -> Result<Stop> {
     o.deny_unknown(&["name", "shape", "pixel_first", "pixel_last", "notes"])?;
     let Some(p) = array else {
         return Err(o.err(

@@ -98,7 +98,11 @@ fn section_axis(p: &Section) -> (f64, f64) {
     (lo, hi)
 }
 
-pub fn draw_sections<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, name: &str, panels: &[Section]) -> Result<()> {
+pub(crate) fn draw_sections<DB: DrawingBackend>(
+    root: DrawingArea<DB, Shift>,
+    name: &str,
+    panels: &[Section],
+) -> Result<()> {
     root.fill(&WHITE).map_err(plot_err)?;
     let areas = root.split_evenly((panels.len(), 1));
     for (area, p) in areas.iter().zip(panels) {
@@ -170,7 +174,7 @@ pub fn draw_sections<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, name: &st
 /// The axis a reading is drawn on (docs/instrument.md §Pictures): one per unit (GU, HU, HU(log), DOI, the hue
 /// angle's °), and colour's unitless coordinates on two of their own, CIELAB (L*, a*, b*, C*) and the
 /// tristimulus values (X, Y, Z), never beside a unit's. `unit` and `name` are the reading's.
-pub fn axis_of(unit: &str, name: &str) -> String {
+pub(crate) fn axis_of(unit: &str, name: &str) -> String {
     match (unit, name) {
         ("", "X" | "Y" | "Z") => "X, Y, Z".into(),
         ("", _) => "L*, a*, b*, C*".into(),
@@ -201,7 +205,7 @@ fn by_axis(keys: impl Iterator<Item = String>) -> Vec<(String, Vec<usize>)> {
 
 /// The picture size of [`draw_vs_parameter`]: 1000 × 640, and 360 pixels a panel when the readings need more
 /// than one axis.
-pub fn vs_parameter_size(series: &[(String, Vec<(f64, f64)>)]) -> (u32, u32) {
+pub(crate) fn vs_parameter_size(series: &[(String, Vec<(f64, f64)>)]) -> (u32, u32) {
     match by_axis(series.iter().map(|s| series_axis(&s.0))).len() {
         0 | 1 => (1000, 640),
         n => (1000, 360 * n as u32),
@@ -210,7 +214,7 @@ pub fn vs_parameter_size(series: &[(String, Vec<(f64, f64)>)]) -> (u32, u32) {
 
 /// Readings against the parameter, one chart per axis ([`axis_of`]: a unit, or colour's CIELAB or X, Y, Z)
 /// stacked with the same x axis, so that GU, HU, DOI and colour never share a scale.
-pub fn draw_vs_parameter<DB: DrawingBackend>(
+pub(crate) fn draw_vs_parameter<DB: DrawingBackend>(
     root: DrawingArea<DB, Shift>,
     name: &str,
     label: &str,
@@ -298,7 +302,7 @@ fn draw_vs_parameter_panel<DB: DrawingBackend>(
 
 /// One row of the residual chart.
 #[derive(Clone)]
-pub struct Residual {
+pub(crate) struct Residual {
     /// `SAMPLE GEOMETRY READING`.
     pub label: String,
     pub unit: String,
@@ -323,7 +327,7 @@ fn residual_axis(r: &Residual) -> String {
 }
 
 /// The picture height of [`draw_comparison`] for `rows`: one panel per axis, each tall enough for its legend.
-pub fn comparison_height(rows: &[Residual]) -> u32 {
+pub(crate) fn comparison_height(rows: &[Residual]) -> u32 {
     let axes = by_axis(rows.iter().map(residual_axis));
     if axes.len() <= 1 {
         return 640.max(120 + 42 * rows.len().min(40) as u32);
@@ -338,7 +342,11 @@ fn panel_height(rows: usize) -> u32 {
 
 /// `compare --plot`: the residuals, one chart per axis ([`axis_of`]: a unit, or colour's CIELAB or X, Y, Z),
 /// stacked, so that GU, HU, DOI and colour never share a scale.
-pub fn draw_comparison<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, name: &str, rows: &[Residual]) -> Result<()> {
+pub(crate) fn draw_comparison<DB: DrawingBackend>(
+    root: DrawingArea<DB, Shift>,
+    name: &str,
+    rows: &[Residual],
+) -> Result<()> {
     let axes = by_axis(rows.iter().map(residual_axis));
     if axes.len() <= 1 {
         return draw_comparison_panel(root, name, rows, None);

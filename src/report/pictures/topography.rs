@@ -10,7 +10,7 @@ use crate::topography::map::HeightMap;
 use crate::Result;
 
 /// The most cells drawn along each side of the height map (the map is averaged in blocks down to them).
-pub const MAX_CELLS: usize = 128;
+pub(crate) const MAX_CELLS: usize = 128;
 
 /// A colour for t in [0, 1]: dark blue through cyan and yellow to dark red.
 fn ramp(t: f64) -> RGBColor {
