@@ -1,12 +1,8 @@
 //! The binary's contract: exit statuses, errors that name the file, outputs that never overwrite.
 #![cfg(feature = "cli")]
+mod common;
+use common::tmp;
 use glossmeter::cli::run;
-fn tmp(name: &str) -> std::path::PathBuf {
-    let d = std::env::temp_dir().join(format!("glossmeter-cli-test-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d.join(name)
-}
-
 #[test]
 fn measure_succeeds_and_bad_input_exits_2() {
     assert_eq!(run(["glossmeter", "measure", "fixtures/recipes/glass-n1.5.json", "-g", "astm-d523-60"]), 0);
@@ -109,11 +105,7 @@ fn compare_passes_within_and_fails_outside_the_sheet() {
 }
 
 fn stderr_of(args: &[&str]) -> (Option<i32>, String, String) {
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_glossmeter"))
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .args(args)
-        .output()
-        .unwrap();
+    let out = common::glossmeter().current_dir(env!("CARGO_MANIFEST_DIR")).args(args).output().unwrap();
     (
         out.status.code(),
         String::from_utf8_lossy(&out.stdout).into_owned(),

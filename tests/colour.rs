@@ -2,6 +2,7 @@
 //! ColorChecker spectra on the d/8 sphere (after the SCE aperture factor), the white diffuser's L* = 100, the flop
 //! of a metallic, the refusal of RGB materials, sharing with gloss, and the CLI. Colour readings go through the
 //! same plan as gloss (the X, Y, Z rows of the k × n weighting folded into the integrand).
+mod common;
 use std::sync::Arc;
 
 use glossmeter::brdf::Brdf;
@@ -282,12 +283,12 @@ fn a_long_lived_planner_knows_the_colour_geometries() {
 fn fit_takes_colour_targets() {
     // A spectral Lambertian whose 550 nm albedo is 0.5 reads L* = 73.0519 at E2194 45° (D65, 10°); fitting that
     // albedo from 0.3 to this one colour target recovers it.
-    let dir = std::env::temp_dir().join(format!("glossmeter-colour-fit-{}", std::process::id()));
+    let dir = common::tmp_dir("colour-fit");
     std::fs::create_dir_all(&dir).unwrap();
     let recipe = dir.join("start.json");
     std::fs::write(&recipe, r#"{"model": "lambert", "wavelengths_nm": [400, 550, 700], "albedo": [0.2, 0.3, 0.4]}"#)
         .unwrap();
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_glossmeter"))
+    let out = common::glossmeter()
         .args(["fit", recipe.to_str().unwrap(), "--free", "/albedo/1=0.05..0.95"])
         .args(["--target", "astm-e2194-45/L*=73.05188932989438±0.01", "--format", "json", "--no-timing"])
         .output()

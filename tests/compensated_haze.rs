@@ -6,6 +6,7 @@
 //! * a glossy lobe on a black body keeps its compensated haze within 1 % of its raw one;
 //! * the log form is K·log10(H_c/20 + 1) of the linear one;
 //! * a compensation receptor that overlaps the specular (or a haze) receptor is refused, naming file and field.
+mod common;
 use glossmeter::instrument::geometry::{solid_angle_density, Axes, Stop};
 use glossmeter::instrument::plan::{PlanOptions, Reading};
 use glossmeter::instrument::reading::ReadingSpec;
@@ -181,11 +182,11 @@ fn a_compensation_receptor_overlapping_the_specular_one_is_refused() {
 #[cfg(feature = "cli")]
 #[test]
 fn the_cli_refuses_an_overlapping_compensation_receptor_with_exit_2() {
-    let dir = std::env::temp_dir().join(format!("glossmeter-comp-{}", std::process::id()));
+    let dir = common::tmp_dir("comp");
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("overlap.json");
     std::fs::write(&path, with_compensation(0.0).to_string()).unwrap();
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_glossmeter"))
+    let out = common::glossmeter()
         .args(["measure", "fixtures/recipes/grey-lambert.json", "--geometry-file", path.to_str().unwrap()])
         .current_dir(env!("CARGO_MANIFEST_DIR"))
         .output()

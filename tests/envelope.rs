@@ -2,17 +2,13 @@
 //! plausible ranges of assumed numbers) brackets the nominal reading; geometries whose data give no tolerance
 //! say so (null), and the extremes are those of independent single-geometry runs at the corners.
 #![cfg(feature = "cli")]
+mod common;
+use common::tmp;
 use glossmeter::cli::run;
 use glossmeter::instrument::envelope;
 use glossmeter::instrument::plan::{Plan, PlanOptions};
 use glossmeter::instrument::standards;
 use glossmeter::recipe;
-
-fn tmp(name: &str) -> std::path::PathBuf {
-    let d = std::env::temp_dir().join(format!("glossmeter-envelope-test-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d.join(name)
-}
 
 #[test]
 fn envelope_brackets_the_nominal_reading_in_json() {

@@ -1,9 +1,9 @@
 //! The cost of a whole plan (`docs/instrument.md` §Output): `Execution::evaluations` and the top-level `"evaluations"`
 //! of `measure --format json` count every distinct integral of the plan once, while each reading keeps counting
 //! every integral it uses.
+mod common;
 use std::collections::BTreeSet;
 use std::path::Path;
-use std::process::Command;
 use std::sync::Arc;
 
 use glossmeter::brdf::Brdf;
@@ -63,7 +63,7 @@ fn a_shared_integral_is_counted_once() {
 #[test]
 fn measure_json_reports_the_plan_cost() {
     let gm = |args: &[&str]| -> serde_json::Value {
-        let out = Command::new(env!("CARGO_BIN_EXE_glossmeter")).args(args).output().unwrap();
+        let out = common::glossmeter().args(args).output().unwrap();
         assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
         serde_json::from_slice(&out.stdout).unwrap()
     };

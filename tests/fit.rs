@@ -2,11 +2,12 @@
 //! the known parameters within 3 standard errors), a Monte Carlo check that the standard errors match the
 //! spread of fits over noisy targets, degenerate cases reported as not identifiable, bounds that hold, and
 //! every bad input refused with exit status 2.
+mod common;
+use common::{gm, tmp};
 use glossmeter::fit::{fit, FitOptions, FitReport, FreeParameter, TargetReading};
 use glossmeter::{measure, recipe, resolve_geometries, PlanOptions};
 use serde_json::{json, Value};
 use std::path::PathBuf;
-use std::process::Command;
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -270,28 +271,13 @@ fn bounds_hold() {
 // The command line
 // ---------------------------------------------------------------------------------------------------------
 
-fn glossmeter(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_glossmeter")).args(args).current_dir(root()).output().unwrap();
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into(),
-        String::from_utf8_lossy(&out.stderr).into(),
-    )
-}
-
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("glossmeter-fit-test-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d.join(name)
-}
-
 #[test]
 fn cli_fits_writes_json_and_never_overwrites() {
     let recipe = tmp("rough.json");
     std::fs::write(&recipe, glass("ggx", 0.1, 1.5).to_string()).unwrap();
     let out = tmp("fitted.json");
     let _ = std::fs::remove_file(&out);
-    let (code, stdout, stderr) = glossmeter(&[
+    let (code, stdout, stderr) = gm(&[
         "fit",
         recipe.to_str().unwrap(),
         "--free",
@@ -347,7 +333,7 @@ fn cli_fits_writes_json_and_never_overwrites() {
     assert_eq!(fitted["roughness"], v["parameters"][0]["value"]);
     // The same -o again: refused, file untouched.
     let before = std::fs::read(&out).unwrap();
-    let (code, _, stderr) = glossmeter(&[
+    let (code, _, stderr) = gm(&[
         "fit",
         recipe.to_str().unwrap(),
         "--free",
@@ -367,7 +353,7 @@ fn cli_fits_writes_json_and_never_overwrites() {
         "sample,geometry,quantity,value,uncertainty\na,astm-d523-60,gloss,60,0.2\nb,astm-d523-60,gloss,40,0.2\n",
     )
     .unwrap();
-    let (code, stdout, stderr) = glossmeter(&[
+    let (code, stdout, stderr) = gm(&[
         "fit",
         recipe.to_str().unwrap(),
         "--free",
@@ -379,7 +365,7 @@ fn cli_fits_writes_json_and_never_overwrites() {
     ]);
     assert_eq!(code, 0, "{stdout}{stderr}");
     assert!(stdout.contains("identifiable: yes"), "{stdout}");
-    let (code, _, stderr) = glossmeter(&[
+    let (code, _, stderr) = gm(&[
         "fit",
         recipe.to_str().unwrap(),
         "--free",
@@ -390,7 +376,7 @@ fn cli_fits_writes_json_and_never_overwrites() {
     assert_eq!(code, 2, "{stderr}");
     assert!(stderr.contains("--sample"), "{stderr}");
     // Not identifiable → exit 1 (the report is still printed).
-    let (code, stdout, _) = glossmeter(&[
+    let (code, stdout, _) = gm(&[
         "fit",
         recipe.to_str().unwrap(),
         "--free",
@@ -416,7 +402,7 @@ fn cli_fits_writes_json_and_never_overwrites() {
 #[test]
 fn cli_constraints_and_goodness_of_fit() {
     let ct = "fixtures/recipes/cook-torrance-lobes.json";
-    let (code, stdout, stderr) = glossmeter(&[
+    let (code, stdout, stderr) = gm(&[
         "fit",
         ct,
         "--free",
@@ -431,7 +417,7 @@ fn cli_constraints_and_goodness_of_fit() {
     assert_eq!(code, 0, "{stdout}{stderr}");
     let v: Value = serde_json::from_str(&stdout).unwrap();
     assert!((v["targets"][0]["predicted"].as_f64().unwrap() - 40.0).abs() < 0.01, "{v}");
-    let (code, stdout, stderr) = glossmeter(&[
+    let (code, stdout, stderr) = gm(&[
         "fit",
         ct,
         "--free",
@@ -453,7 +439,7 @@ fn cli_constraints_and_goodness_of_fit() {
     std::fs::write(&recipe, glass("ggx", 0.12, 1.5).to_string()).unwrap();
     let mut g = readings(&glass("ggx", 0.1, 1.5), D523);
     g[1] += 15.0;
-    let (code, stdout, stderr) = glossmeter(&[
+    let (code, stdout, stderr) = gm(&[
         "fit",
         recipe.to_str().unwrap(),
         "--free",
@@ -479,14 +465,8 @@ fn cli_constraints_and_goodness_of_fit() {
     let mut rec: Value = serde_json::from_str(&std::fs::read_to_string(root().join(ct)).unwrap()).unwrap();
     rec["lobes"][1]["ks"] = json!(0.7);
     std::fs::write(&bad, rec.to_string()).unwrap();
-    let (code, stdout, stderr) = glossmeter(&[
-        "fit",
-        bad.to_str().unwrap(),
-        "--free",
-        "/lobes/1/ks=0.01..0.9",
-        "--target",
-        "astm-d523-60/gloss=40",
-    ]);
+    let (code, stdout, stderr) =
+        gm(&["fit", bad.to_str().unwrap(), "--free", "/lobes/1/ks=0.01..0.9", "--target", "astm-d523-60/gloss=40"]);
     assert_eq!(code, 2, "{stdout}{stderr}");
     assert!(stderr.contains("ct-bad.json") && !stderr.contains("panicked"), "{stderr}");
 }
@@ -518,7 +498,7 @@ fn bad_input_is_refused_with_exit_2_naming_the_argument() {
         (&["fit", "fixtures/recipes/none.json", "--free", "/roughness=0..1", "--target", t], "none.json"),
     ];
     for (args, needle) in cases {
-        let (code, stdout, stderr) = glossmeter(args);
+        let (code, stdout, stderr) = gm(args);
         assert_eq!(code, 2, "{args:?}: {stdout}{stderr}");
         assert!(stderr.contains(needle), "{args:?}: stderr lacks {needle:?}: {stderr}");
         assert!(!stderr.contains("panicked"), "{stderr}");
@@ -557,9 +537,8 @@ fn cli_target_errors_escape_the_users_text_and_exit_2() {
     // able to end or fake a line of the message), with exit status 2.
     let recipe = tmp("escape.json");
     std::fs::write(&recipe, glass("ggx", 0.1, 1.5).to_string()).unwrap();
-    let fit = |target: &str| {
-        glossmeter(&["fit", recipe.to_str().unwrap(), "--free", "/roughness=log:1e-3..0.5", "--target", target])
-    };
+    let fit =
+        |target: &str| gm(&["fit", recipe.to_str().unwrap(), "--free", "/roughness=log:1e-3..0.5", "--target", target]);
     for (target, want) in [
         ("astm-d523-60/gl\"o\nss=60±0.2", r#"has no reading "gl\"o\nss""#),
         ("no\"such\n/gloss=60±0.2", r#"unknown geometry id "no\"such\n""#),
@@ -822,7 +801,7 @@ fn cli_user_geometries_are_targets() {
         let mut a: Vec<&str> = base.to_vec();
         a.extend_from_slice(&["--free", "/roughness=log:1e-3..0.5", "--rtol", "1e-6", "--format", "json"]);
         a.extend_from_slice(extra);
-        glossmeter(&a)
+        gm(&a)
     };
     let (t1, t2) = (format!("user-doi-45/doi-0.5={doi}±0.2"), format!("user-grazing-89/gloss={gloss}±0.2"));
     let (code, stdout, stderr) = with(&["--target", &t1, "--target", &t2]);
@@ -850,7 +829,7 @@ fn cli_user_geometries_are_targets() {
     let (code, _, stderr) = with(&["--target", "user-doi-46/gloss=3"]);
     assert_eq!(code, 2, "{stderr}");
     assert!(stderr.contains("user-doi-46") && stderr.contains("the user geometries given are user-doi-45"), "{stderr}");
-    let (code, _, stderr) = glossmeter(&[
+    let (code, _, stderr) = gm(&[
         "fit",
         recipe.to_str().unwrap(),
         "--geometry-file",

@@ -8,8 +8,8 @@
 //!
 //! A change that is meant to move a document re-blesses it: `GLOSSMETER_BLESS_FIT=1 cargo test --test
 //! fit_documents`, then review the diff of `tests/fit_documents/` like any other change of results.
+mod common;
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -18,7 +18,7 @@ fn root() -> PathBuf {
 /// Run `glossmeter fit ARGS --format json --no-timing` on `threads` rayon threads (the machine's default for
 /// `None`); the exit code and stdout.
 fn fit(args: &[&str], threads: Option<usize>) -> (i32, String, String) {
-    let mut command = Command::new(env!("CARGO_BIN_EXE_glossmeter"));
+    let mut command = common::glossmeter();
     if let Some(t) = threads {
         command.env("RAYON_NUM_THREADS", t.to_string());
     }

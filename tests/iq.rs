@@ -3,7 +3,8 @@
 //! haze, a Lambertian body reads the closed forms of its windows' projected solid angles (computed here from the
 //! pixel edges, not through the engine's windows), and windows outside the array are refused with exit 2 naming the
 //! file, the field and the range allowed.
-use std::process::Command;
+mod common;
+use common::{gm, tmp};
 use std::sync::Arc;
 
 use glossmeter::brdf::Brdf;
@@ -15,21 +16,6 @@ use glossmeter::recipe::parse_str;
 use serde_json::Value;
 
 const W: f64 = 0.02832; // degrees per pixel (the shipped array)
-
-fn gm(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_glossmeter")).args(args).output().expect("run glossmeter");
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
-
-fn tmp(name: &str) -> std::path::PathBuf {
-    let d = std::env::temp_dir().join(format!("glossmeter-iq-test-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d.join(name)
-}
 
 fn brdf(text: &str) -> Arc<dyn Brdf> {
     parse_str(text, "<test>").unwrap().brdf

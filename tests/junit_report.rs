@@ -10,19 +10,15 @@
 //! `cargo test --test junit_report -- --ignored`. There, a missing tool fails the test, saying what to install:
 //! a check that cannot run does not pass. What needs no tool (exit statuses, counts, class names, numbers
 //! without noise, read by quick-xml) runs in every `cargo test`.
+mod common;
+use common::tmp;
 use std::process::Command;
 
 use serde_json::Value;
 
 fn gm(args: &[&str]) -> (i32, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_glossmeter")).args(args).output().expect("run glossmeter");
+    let out = common::glossmeter().args(args).output().expect("run glossmeter");
     (out.status.code().unwrap_or(-1), String::from_utf8_lossy(&out.stdout).into_owned())
-}
-
-fn tmp(name: &str) -> std::path::PathBuf {
-    let d = std::env::temp_dir().join(format!("glossmeter-junit-test-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d.join(name)
 }
 
 fn xmllint(file: &std::path::Path) {

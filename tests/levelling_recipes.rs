@@ -2,6 +2,7 @@
 //! application. The cured spectrum's moments against closed forms, the smooth limit bit for bit, the readings'
 //! direction and size against film build and viscosity, bad input naming its JSON Pointer, and the shipped
 //! example recipes read through the default panel.
+mod common;
 use glossmeter::instrument::plan::{PlanOptions, Reading};
 use glossmeter::instrument::standards;
 use glossmeter::optics::levelling::{Application, CuredPsd, Flow, ViscosityPoint};
@@ -281,7 +282,7 @@ fn write_gsf(path: &std::path::Path, n: usize, dx_um: f64, z: impl Fn(usize, usi
 /// that levels flat and a missing file are refused at their pointers.
 #[test]
 fn a_measured_texture_levels_mode_by_mode() {
-    let dir = std::env::temp_dir().join(format!("glossmeter-measured-texture-{}", std::process::id()));
+    let dir = common::tmp_dir("measured-texture");
     std::fs::create_dir_all(&dir).unwrap();
     let (n, dx, periods, a) = (64, 10.0, 4.0, 1.0);
     let lambda = n as f64 * dx / periods;
@@ -336,7 +337,7 @@ fn a_measured_texture_levels_mode_by_mode() {
 #[test]
 fn the_command_line_reads_levelled_recipes_and_refuses_bad_ones() {
     let exe = env!("CARGO_BIN_EXE_glossmeter");
-    let dir = std::env::temp_dir().join(format!("glossmeter-levelling-{}", std::process::id()));
+    let dir = common::tmp_dir("levelling");
     std::fs::create_dir_all(&dir).unwrap();
     let mut app = application(3000.0, 60.0, 20.0, 100.0);
     app["viscosity"][1]["eta_pa_s"] = json!(-3);
@@ -368,7 +369,7 @@ fn the_command_line_reads_levelled_recipes_and_refuses_bad_ones() {
 #[test]
 fn sweep_varies_film_build_flash_off_and_viscosity() {
     let exe = env!("CARGO_BIN_EXE_glossmeter");
-    let dir = std::env::temp_dir().join(format!("glossmeter-levelling-sweep-{}", std::process::id()));
+    let dir = common::tmp_dir("levelling-sweep");
     std::fs::create_dir_all(&dir).unwrap();
     let template = dir.join("template.json");
     std::fs::write(&template, with_application(application(3000.0, 60.0, 20.0, 100.0)).to_string()).unwrap();

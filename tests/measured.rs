@@ -4,6 +4,8 @@
 //! is generated in a temporary directory.
 // Channels index several parallel arrays (values, scales, expected values) at once.
 #![allow(clippy::needless_range_loop)]
+mod common;
+use common::tmp_dir;
 
 use glossmeter::brdf::{Brdf, Hints, TermKind};
 use glossmeter::instrument::plan::{Plan, PlanOptions};
@@ -13,12 +15,6 @@ use glossmeter::recipe;
 use glossmeter::Vec3;
 use std::f64::consts::{FRAC_PI_2, PI};
 use std::path::{Path, PathBuf};
-
-fn temp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("glossmeter-measured-{name}-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
 
 /// Write a MERL file whose stored (unscaled) value of cell (ih, id, ip) in channel c is `raw(ih, id, ip, c)`.
 fn write_merl(path: &Path, dims: [usize; 3], raw: impl Fn(usize, usize, usize, usize) -> f64) {
@@ -174,7 +170,7 @@ fn grid() -> Vec<Vec3> {
 
 #[test]
 fn lambertian_table_reads_rho_over_pi_with_both_lookups() {
-    let d = temp_dir("lambert");
+    let d = tmp_dir("lambert");
     lambert_table(&d.join("lambert.binary"), MERL_DIMS);
     for interp in ["nearest", "trilinear"] {
         let r = write_recipe(
@@ -249,7 +245,7 @@ fn centre(ih: usize, id: usize, ip: usize) -> (f64, f64, f64) {
 
 #[test]
 fn nearest_lookup_index_mapping_and_reciprocity() {
-    let d = temp_dir("smooth");
+    let d = tmp_dir("smooth");
     let file = d.join("smooth.binary");
     write_merl(&file, MERL_DIMS, |ih, id, ip, c| {
         let (th, td, pd) = centre(ih, id, ip);
@@ -309,7 +305,7 @@ fn nearest_lookup_index_mapping_and_reciprocity() {
 #[test]
 fn trilinear_interpolates_in_index_space() {
     let dims = [30, 20, 40];
-    let d = temp_dir("trilinear");
+    let d = tmp_dir("trilinear");
     let file = d.join("linear.binary");
     let lin = |u: f64, v: f64, w: f64, c: usize| 1.0 + 0.5 * u + 0.25 * v + 0.125 * w + c as f64;
     write_merl(&file, dims, |i, j, k, c| lin(i as f64, j as f64, k as f64, c) / MERL_SCALE[c]);
@@ -349,7 +345,7 @@ fn trilinear_interpolates_in_index_space() {
 /// Negative (unmeasured) and non-finite values are counted and read as 0, channel by channel.
 #[test]
 fn invalid_entries_are_counted_and_read_as_zero() {
-    let d = temp_dir("invalid");
+    let d = tmp_dir("invalid");
     let file = d.join("holes.binary");
     let dims = [4, 3, 2];
     write_merl(&file, dims, |i, j, _, c| match (i, j, c) {
@@ -376,7 +372,7 @@ fn invalid_entries_are_counted_and_read_as_zero() {
 /// model has no splits: the partitions differ, the value must not.
 #[test]
 fn lambertian_table_gloss_equals_lambert_model() {
-    let d = temp_dir("gloss");
+    let d = tmp_dir("gloss");
     lambert_table(&d.join("lambert.binary"), MERL_DIMS);
     let rtol = 1e-10;
     let read = |m: recipe::Material| {
@@ -427,7 +423,7 @@ fn refusal(dir: &Path, recipe_name: &str, body: &str) -> String {
 
 #[test]
 fn bad_tables_and_recipes_are_refused_with_the_file_named() {
-    let d = temp_dir("refuse");
+    let d = tmp_dir("refuse");
     let good = d.join("good.binary");
     lambert_table(&good, [2, 2, 2]);
     let bytes = std::fs::read(&good).unwrap();
@@ -525,7 +521,7 @@ impl Brdf for LobeFn {
 #[test]
 #[ignore]
 fn report_tabulated_lobe_convergence() {
-    let d = temp_dir("report");
+    let d = tmp_dir("report");
     let file = d.join("lobe.binary");
     write_merl(&file, MERL_DIMS, |ih, id, _, c| {
         let th = FRAC_PI_2 * (ih as f64 / 90.0).powi(2);

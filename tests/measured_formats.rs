@@ -3,6 +3,8 @@
 //! `tools/make_inplane_fixture.py`): each holds a Lambertian or a Beckmann lobe, so its readings must equal the
 //! engine's own `lambert` and `microfacet` models within the table's resolution error, stated per test. Broken
 //! files are refused with the offset (or line) and the field.
+mod common;
+use common::tmp_dir;
 use glossmeter::brdf::Brdf;
 use glossmeter::instrument::plan::{Plan, PlanOptions};
 use glossmeter::instrument::standards;
@@ -15,12 +17,6 @@ const BECKMANN: &str = r#"{"model": "microfacet", "distribution": "beckmann", "r
 
 fn fixture(p: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures").join(p)
-}
-
-fn temp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("glossmeter-formats-{name}-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
 }
 
 /// Gloss readings at 20°, 60°, 85° (value, error estimate).
@@ -66,7 +62,7 @@ fn dir(theta_deg: f64, phi_deg: f64) -> Vec3 {
 
 #[test]
 fn rgl_lambertian_reads_rho_over_pi_and_the_lambert_gloss() {
-    let d = temp_dir("rgl-lambert");
+    let d = tmp_dir("rgl-lambert");
     let m = rgl(&d, "lambert-rgb.bsdf");
     // Point values: f = ρ/π wherever the warp's grid reaches (12 × 12 grid; σ and the spectra are smooth).
     for (wi, wo) in
@@ -92,7 +88,7 @@ fn rgl_lambertian_reads_rho_over_pi_and_the_lambert_gloss() {
 
 #[test]
 fn rgl_beckmann_reads_the_microfacet_gloss_within_its_resolution() {
-    let d = temp_dir("rgl-beckmann");
+    let d = tmp_dir("rgl-beckmann");
     let exact = gloss(recipe::parse_str(BECKMANN, "b").unwrap().brdf);
     let coarse = gloss(rgl(&d, "beckmann-iso-16.bsdf").brdf);
     let fine = gloss(rgl(&d, "beckmann-iso-32.bsdf").brdf);
@@ -121,7 +117,7 @@ fn inplane(dir: &Path, model: &str, file: &str) -> recipe::Material {
 
 #[test]
 fn inplane_tables_read_the_closed_forms() {
-    let d = temp_dir("inplane");
+    let d = tmp_dir("inplane");
     let lambert = gloss(recipe::parse_str(r#"{"model": "lambert", "albedo": 0.5}"#, "l").unwrap().brdf);
     let exact = gloss(recipe::parse_str(BECKMANN, "b").unwrap().brdf);
     let lam = gloss(inplane(&d, "inplane-csv", "lambert-cos.csv").brdf);
@@ -147,7 +143,7 @@ fn inplane_tables_read_the_closed_forms() {
 
 #[test]
 fn broken_files_are_refused_with_offset_and_field() {
-    let d = temp_dir("broken");
+    let d = tmp_dir("broken");
     let good = std::fs::read(fixture("materials/rgl/lambert-rgb.bsdf")).unwrap();
     let try_rgl = |name: &str, bytes: &[u8]| -> String {
         let p = d.join(name);
@@ -225,7 +221,7 @@ fn the_table_resolution_is_stated_with_the_lobe() {
             other => panic!("{other:?}"),
         }
     };
-    let d = temp_dir("widths");
+    let d = tmp_dir("widths");
     for file in ["beckmann-iso-16.bsdf", "beckmann-iso-32.bsdf", "lambert-rgb.bsdf"] {
         let bytes = std::fs::read(fixture(&format!("materials/rgl/{file}"))).unwrap();
         let tf = glossmeter::measured::rgl::TensorFile::parse(&bytes, file).unwrap();
@@ -246,7 +242,7 @@ fn the_table_resolution_is_stated_with_the_lobe() {
 #[test]
 fn broken_tables_exit_with_status_2() {
     use glossmeter::cli::run;
-    let d = temp_dir("broken-cli");
+    let d = tmp_dir("broken-cli");
     let good = std::fs::read(fixture("materials/rgl/lambert-rgb.bsdf")).unwrap();
     std::fs::write(d.join("cut.bsdf"), &good[..good.len() / 2]).unwrap();
     let mut magic = good.clone();
@@ -279,7 +275,7 @@ fn inplane_with(dir: &Path, model: &str, file: &str, off_plane: &str) -> recipe:
 /// factor instead; at 85° both read low (stated bounds, measured values in the comments).
 #[test]
 fn inplane_cosine_weighted_extension_reads_the_lobe() {
-    let d = temp_dir("inplane-coscos");
+    let d = tmp_dir("inplane-coscos");
     let lambert = gloss(recipe::parse_str(r#"{"model": "lambert", "albedo": 0.5}"#, "l").unwrap().brdf);
     let exact = gloss(recipe::parse_str(BECKMANN, "b").unwrap().brdf);
     let csv = gloss(inplane_with(&d, "inplane-csv", "beckmann.csv", "f-cos-cos").brdf);
@@ -307,7 +303,7 @@ fn inplane_cosine_weighted_extension_reads_the_lobe() {
 /// 85° within the table's resolution error (bounds with margin over the measured values in the comments).
 #[test]
 fn inplane_microfacet_extension_reads_the_closed_forms() {
-    let d = temp_dir("inplane-microfacet");
+    let d = tmp_dir("inplane-microfacet");
     let exact = gloss(recipe::parse_str(BECKMANN, "b").unwrap().brdf);
     let csv = gloss(inplane_with(&d, "inplane-csv", "beckmann.csv", "microfacet").brdf);
     let txt = gloss(inplane_with(&d, "e1392", "beckmann-e1392.txt", "microfacet").brdf);
@@ -346,7 +342,7 @@ fn write_inplane_table(path: &Path, di: f64, dto: f64) {
 /// continuation beyond the measured θo) is left at this level. Tables written from the closed form here.
 #[test]
 fn inplane_microfacet_error_is_the_tables_resolution() {
-    let d = temp_dir("inplane-resolution");
+    let d = tmp_dir("inplane-resolution");
     let exact = gloss(recipe::parse_str(BECKMANN, "b").unwrap().brdf);
     let mut errors = Vec::new();
     for (di, dto) in [(1.0, 0.1), (0.5, 0.05)] {
@@ -382,7 +378,7 @@ fn inplane_microfacet_error_is_the_tables_resolution() {
 #[test]
 fn tables_state_their_half_width_and_a_flat_table_is_diffuse() {
     use glossmeter::brdf::{Tail, TermKind};
-    let d = temp_dir("half-width");
+    let d = tmp_dir("half-width");
     let tail = |m: &recipe::Material| match &m.brdf.hints().terms[0].kind {
         TermKind::Lobe(l) => Some(l.tail),
         _ => None,
@@ -429,7 +425,7 @@ fn tables_state_their_half_width_and_a_flat_table_is_diffuse() {
 #[test]
 fn a_table_lobe_keeps_the_partition_and_its_frozen_method_repeats_its_bits() {
     use glossmeter::instrument::method::{Method, Rule};
-    let d = temp_dir("table-plan");
+    let d = tmp_dir("table-plan");
     let m = inplane_with(&d, "inplane-csv", "beckmann.csv", "microfacet");
     let plan = Plan::compile(
         m.brdf.clone(),

@@ -1,22 +1,10 @@
 //! What a newcomer meets first at the command line: a mistyped geometry id gets the ids it was probably meant as,
 //! a recipe given where the sheet goes is named as such, and the help describes what the commands read.
 #![cfg(feature = "cli")]
-use std::process::Command;
+mod common;
+use common::gm;
 
 /// Run the binary from the checkout; (exit status, stdout, stderr).
-fn gm(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_glossmeter"))
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .args(args)
-        .output()
-        .expect("run glossmeter");
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
-
 #[test]
 fn a_bare_angle_as_geometry_gets_a_did_you_mean() {
     let (code, out, err) = gm(&["measure", "fixtures/recipes/glass-n1.5.json", "-g", "60"]);
@@ -62,7 +50,7 @@ fn completions_and_the_man_page_come_from_the_same_definition_as_help() {
 
 #[test]
 fn force_replaces_an_existing_output_and_without_it_the_file_is_kept() {
-    let dir = std::env::temp_dir().join(format!("glossmeter-newcomer-force-{}", std::process::id()));
+    let dir = common::tmp_dir("newcomer-force");
     std::fs::create_dir_all(&dir).unwrap();
     let out = dir.join("readings.csv");
     std::fs::write(&out, "earlier run\n").unwrap();

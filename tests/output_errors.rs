@@ -2,13 +2,9 @@
 //! the run quietly with status 0, as ripgrep does; a full disk is an error (status 2) with the file named, never a
 //! panic (101) and never a silent success.
 #![cfg(feature = "cli")]
+mod common;
+use common::glossmeter;
 use std::process::{Command, Stdio};
-
-fn glossmeter() -> Command {
-    let mut c = Command::new(env!("CARGO_BIN_EXE_glossmeter"));
-    c.current_dir(env!("CARGO_MANIFEST_DIR"));
-    c
-}
 
 /// Run with standard output on a pipe whose reading end is closed before the process starts, so every
 /// write fails with EPIPE (no race with a reader). `std::io::pipe` is Rust 1.87; the crate's MSRV (1.85) is
@@ -174,12 +170,11 @@ fn help_and_version_on_a_full_disk_exit_2() {
     }
     for args in [&["--help"][..], &["--version"], &["measure", "--help"]] {
         let full = std::fs::OpenOptions::new().write(true).open("/dev/full").unwrap();
-        let out =
-            std::process::Command::new(env!("CARGO_BIN_EXE_glossmeter")).args(args).stdout(full).output().unwrap();
+        let out = common::glossmeter().args(args).stdout(full).output().unwrap();
         let err = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
         assert!(err.contains("<stdout>") && err.contains("No space left"), "{args:?}: {err}");
-        let ok = std::process::Command::new(env!("CARGO_BIN_EXE_glossmeter")).args(args).output().unwrap();
+        let ok = common::glossmeter().args(args).output().unwrap();
         assert_eq!(ok.status.code(), Some(0), "{args:?}");
         assert!(!ok.stdout.is_empty());
     }

@@ -2,16 +2,10 @@
 //! colours and a share of non-white pixels; an SVG has lines and text, drawn with the embedded font), and an
 //! existing file is never overwritten.
 #![cfg(feature = "cli")]
+mod common;
+use common::fresh;
 use glossmeter::cli::run;
 use std::path::PathBuf;
-
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("glossmeter-plots-test-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    let p = d.join(name);
-    let _ = std::fs::remove_file(&p);
-    p
-}
 
 fn check_png(p: &PathBuf) {
     let bytes = std::fs::read(p).unwrap();
@@ -53,7 +47,7 @@ fn check_picture(p: &PathBuf) {
 #[test]
 fn section_plots_in_both_formats() {
     for ext in ["png", "svg"] {
-        let p = tmp(&format!("section.{ext}"));
+        let p = fresh(&format!("section.{ext}"));
         let args = [
             "glossmeter",
             "plot",
@@ -74,7 +68,7 @@ fn section_plots_in_both_formats() {
         assert_eq!(run(args), 2);
         assert_eq!(std::fs::read(&p).unwrap(), before);
     }
-    let bad = tmp("section.jpg");
+    let bad = fresh("section.jpg");
     assert_eq!(
         run([
             "glossmeter",
@@ -93,7 +87,7 @@ fn section_plots_in_both_formats() {
 #[test]
 fn gloss_vs_parameter_plots() {
     for ext in ["png", "svg"] {
-        let p = tmp(&format!("vary.{ext}"));
+        let p = fresh(&format!("vary.{ext}"));
         let args = [
             "glossmeter",
             "plot",
@@ -115,7 +109,7 @@ fn gloss_vs_parameter_plots() {
         check_picture(&p);
     }
     // A pointer that names no number is bad input.
-    let p = tmp("vary-bad.svg");
+    let p = fresh("vary-bad.svg");
     let args = [
         "glossmeter",
         "plot",
@@ -134,7 +128,7 @@ fn gloss_vs_parameter_plots() {
 #[test]
 fn compare_and_convergence_plots() {
     for ext in ["png", "svg"] {
-        let p = tmp(&format!("compare.{ext}"));
+        let p = fresh(&format!("compare.{ext}"));
         let args = [
             "glossmeter",
             "compare",
@@ -146,7 +140,7 @@ fn compare_and_convergence_plots() {
         assert_eq!(run(args), 0);
         check_picture(&p);
     }
-    let p = tmp("convergence.png");
+    let p = fresh("convergence.png");
     assert_eq!(
         run([
             "glossmeter",
@@ -173,7 +167,7 @@ fn compare_and_convergence_plots() {
 /// residual chart of a gloss, haze and DOI sheet too. Readings of one unit keep the one chart.
 #[test]
 fn every_unit_and_colour_get_an_axis_of_their_own() {
-    let p = tmp("units.svg");
+    let p = fresh("units.svg");
     let args = [
         "glossmeter",
         "plot",
@@ -206,13 +200,13 @@ fn every_unit_and_colour_get_an_axis_of_their_own() {
         assert!(svg.contains(axis), "no axis {axis:?}");
     }
     assert!(!svg.contains("unit in the legend"), "no shared axis");
-    let p = tmp("one-unit.svg");
+    let p = fresh("one-unit.svg");
     let one = ["glossmeter", "plot", "fixtures/recipes/cerulean-blue-c.json", "--kind", "gloss-vs-parameter"];
     let rest = ["--vary", "/clear_coat/index=1.45..1.55", "--points", "2", "-o", p.to_str().unwrap()];
     assert_eq!(run(one.iter().chain(&rest).copied()), 0);
     let svg = std::fs::read_to_string(&p).unwrap();
     assert!(svg.contains("reading (GU)") && svg.contains("height=\"640\""), "one unit, one chart as before");
-    let p = tmp("residual-units.svg");
+    let p = fresh("residual-units.svg");
     let args = [
         "glossmeter",
         "compare",

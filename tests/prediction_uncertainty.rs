@@ -4,6 +4,7 @@
 //! Gauss–Legendre mirror flux) and against a seeded Monte Carlo of the inputs; the recipe block's bad inputs;
 //! and a two-sample sheet that is OUTSIDE on every row when the prediction's uncertainty is ignored and inside
 //! when the recipes state plausible uncertainties.
+mod common;
 use std::path::{Path, PathBuf};
 
 use glossmeter::comparison::propagation::{self, Difference};
@@ -275,11 +276,7 @@ fn a_two_sample_sheet_is_judged_with_the_predictions_uncertainty() {
 #[test]
 fn the_command_line_reports_the_allowances_parts() {
     let gm = |args: &[&str]| {
-        let out = std::process::Command::new(env!("CARGO_BIN_EXE_glossmeter"))
-            .current_dir(root())
-            .args(args)
-            .output()
-            .unwrap();
+        let out = common::glossmeter().current_dir(root()).args(args).output().unwrap();
         (out.status.code().unwrap_or(-1), String::from_utf8_lossy(&out.stdout).into_owned())
     };
     let sheet = "fixtures/sheets/byk-smart-chart-two-samples.csv";

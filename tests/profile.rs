@@ -2,7 +2,8 @@
 //! Lambertian body against closed forms computed here independently of the engine, Rspec of smooth
 //! specimens, the CSV / JSON schema of `glossmeter profile`, its picture, and bad input (exit 2 naming the
 //! file and the field).
-use std::process::Command;
+mod common;
+use common::{fresh, gm};
 use std::sync::Arc;
 
 use glossmeter::brdf::Brdf;
@@ -13,23 +14,6 @@ use glossmeter::instrument::reference::gauss_legendre;
 use glossmeter::instrument::standards;
 use glossmeter::recipe::parse_str;
 use serde_json::Value;
-
-fn gm(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_glossmeter")).args(args).output().expect("run glossmeter");
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
-
-fn tmp(name: &str) -> std::path::PathBuf {
-    let d = std::env::temp_dir().join(format!("glossmeter-profile-test-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    let p = d.join(name);
-    let _ = std::fs::remove_file(&p);
-    p
-}
 
 fn brdf(text: &str) -> Arc<dyn Brdf> {
     parse_str(text, "<test>").unwrap().brdf
@@ -173,7 +157,7 @@ fn rspec_of_a_smooth_surface_is_its_20_degree_gloss_and_texture_lowers_it() {
 #[test]
 fn csv_json_and_plot() {
     let recipe = "fixtures/recipes/cerulean-blue-c.json";
-    let svg = tmp("cerulean.svg");
+    let svg = fresh("cerulean.svg");
     let (code, out, err) = gm(&["profile", recipe, "--plot", svg.to_str().unwrap()]);
     assert_eq!(code, 0, "{err}");
     let mut lines = out.lines();
@@ -238,7 +222,7 @@ fn bad_profiles_are_refused_with_the_file_and_the_field() {
         let mut g = base.clone();
         g["id"] = Value::from("my-profile");
         g["profile"]["pixels"]["value"] = pixels.clone();
-        let f = tmp(name);
+        let f = fresh(name);
         std::fs::write(&f, serde_json::to_string(&g).unwrap()).unwrap();
         let (code, _, err) =
             gm(&["profile", "fixtures/recipes/glass-n1.5.json", "--geometry-file", f.to_str().unwrap()]);
@@ -253,7 +237,7 @@ fn bad_profiles_are_refused_with_the_file_and_the_field() {
     let mut g = base.clone();
     g["id"] = Value::from("my-profile");
     g["profile"]["pixel_deg"]["value"] = Value::from(0.5);
-    let f = tmp("wide.json");
+    let f = fresh("wide.json");
     std::fs::write(&f, serde_json::to_string(&g).unwrap()).unwrap();
     let (code, _, err) = gm(&["profile", "fixtures/recipes/glass-n1.5.json", "--geometry-file", f.to_str().unwrap()]);
     assert_eq!(code, 2);

@@ -1,6 +1,7 @@
 //! The README shows the output of its main command; this test keeps that output true. The output is
 //! deterministic (everything but the time column, which `--no-timing` drops), so the comparison is exact.
 #![cfg(feature = "cli")]
+mod common;
 use std::path::PathBuf;
 #[test]
 fn readme_example_is_the_actual_output() {
@@ -49,7 +50,7 @@ fn readme_fit_example_is_the_actual_output() {
     let quoted: String =
         readme[start..].split("It exits 1").next().unwrap().split_whitespace().collect::<Vec<_>>().join(" ");
 
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_glossmeter"))
+    let out = common::glossmeter()
         .current_dir(&root)
         .args([
             "fit",
@@ -98,7 +99,7 @@ fn readme_literal_flakes_reading_is_the_actual_output() {
     let text = readme.split_whitespace().collect::<Vec<_>>().join(" ");
     let quoted = number_after(&text, "second mirror under the coat and read ");
     assert!(text.contains("GU at 20°: `fixtures/recipes/cerulean-blue-c-literal.json`"), "README changed");
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_glossmeter"))
+    let out = common::glossmeter()
         .current_dir(&root)
         .args(["measure", "fixtures/recipes/cerulean-blue-c-literal.json", "-g", "astm-d523-20", "--format", "json"])
         .output()

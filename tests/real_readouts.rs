@@ -2,7 +2,7 @@
 //! plausible BRDF each (docs/instrument.md §1.10): every fit exits 0 and every reading is reproduced within two
 //! of its uncertainties. The starts (`fixtures/real/models/`) are near the solutions, so each fit takes a few
 //! seconds.
-use std::process::Command;
+mod common;
 
 use serde_json::Value;
 
@@ -24,7 +24,7 @@ const PANEL_TARGETS: [&str; 12] = [
 ];
 
 fn fit(args: &[&str]) -> (i32, Value, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_glossmeter"))
+    let out = common::glossmeter()
         .arg("fit")
         .args(args)
         .args(["--format", "json", "--no-timing"])

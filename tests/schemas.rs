@@ -1,12 +1,12 @@
 //! The output schemas (`glossmeter schema --output-format ...`) against real outputs, validated with the
 //! `jsonschema` crate (draft 2020-12), so a field added to an output without its schema fails here, and so does
 //! a schema that is not a valid JSON Schema.
-use std::process::Command;
+mod common;
 
 use serde_json::Value;
 
 fn gm(args: &[&str]) -> (i32, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_glossmeter")).args(args).output().expect("run glossmeter");
+    let out = common::glossmeter().args(args).output().expect("run glossmeter");
     (out.status.code().unwrap_or(-1), String::from_utf8_lossy(&out.stdout).into_owned())
 }
 
@@ -35,7 +35,7 @@ fn assert_valid(s: &Value, v: &Value, what: &str) {
 #[test]
 fn outputs_follow_their_schemas() {
     // A previous run as the baseline (measure JSON of one reading).
-    let dir = std::env::temp_dir().join(format!("glossmeter-schemas-test-{}", std::process::id()));
+    let dir = common::tmp_dir("schemas-test");
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     let base = dir.join("glass-n1.5.json");

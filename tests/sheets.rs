@@ -1,30 +1,14 @@
 //! Instrument sheets end to end (`docs/instrument.md` §Sheets): every shipped dialect under fixtures/sheets/, repeated
 //! readings and their statistics, many samples with their own recipes, JUnit XML (parsed back), baselines, and every
 //! malformed sheet (exit 2 with the file, the line and the column).
-use std::process::Command;
+mod common;
+use common::{fresh, gm};
 
 use serde_json::Value;
 
 const GLASS: &str = "fixtures/recipes/glass-n1.5.json";
 
-fn tmp(name: &str) -> std::path::PathBuf {
-    let d = std::env::temp_dir().join(format!("glossmeter-sheets-test-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    let p = d.join(name);
-    let _ = std::fs::remove_file(&p);
-    p
-}
-
 /// Run the binary; (exit status, stdout, stderr).
-fn gm(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_glossmeter")).args(args).output().expect("run glossmeter");
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
-
 fn json_of(args: &[&str]) -> (i32, Value) {
     let mut a = args.to_vec();
     a.extend(["--format", "json"]);
@@ -201,7 +185,7 @@ fn junit_xml_parses_and_counts_failures() {
 #[test]
 fn a_baseline_fails_predictions_that_moved() {
     let sheet = "fixtures/sheets/qc-many-samples.csv";
-    let base = tmp("baseline.json");
+    let base = fresh("baseline.json");
     let b = base.to_str().unwrap();
     assert_eq!(gm(&["compare", sheet, "--recipe-dir", "fixtures/recipes", "--format", "json", "-o", b]).0, 0);
     let (code, doc) = json_of(&["compare", sheet, "--recipe-dir", "fixtures/recipes", "--baseline", b]);
@@ -211,7 +195,7 @@ fn a_baseline_fails_predictions_that_moved() {
     let mut old: Value = serde_json::from_str(&std::fs::read_to_string(&base).unwrap()).unwrap();
     let p = old["comparisons"][2]["predicted"].as_f64().unwrap();
     old["comparisons"][2]["predicted"] = serde_json::json!(p + 1e-6);
-    let drifted = tmp("drifted.json");
+    let drifted = fresh("drifted.json");
     std::fs::write(&drifted, serde_json::to_string(&old).unwrap()).unwrap();
     let d = drifted.to_str().unwrap();
     let (code, doc) = json_of(&["compare", sheet, "--recipe-dir", "fixtures/recipes", "--baseline", d]);
@@ -265,7 +249,7 @@ fn malformed_sheets_name_the_file_line_and_column() {
 /// `--recipe 'NAME=FILE'`: the argument splits at its last `=`, and the advice the error gives works.
 #[test]
 fn a_sample_name_with_an_equals_sign_takes_its_recipe() {
-    let dir = std::env::temp_dir().join(format!("glossmeter-eq-{}", std::process::id()));
+    let dir = common::tmp_dir("eq");
     std::fs::create_dir_all(&dir).unwrap();
     let sheet = dir.join("eq.csv");
     std::fs::write(&sheet, "sample;geometry;value;uncertainty\na=b;astm-d523-60;100;0.1\n").unwrap();
@@ -297,7 +281,7 @@ fn instrument_exports_compare_without_edits() {
         }
     }
     // A statistics row that disagrees with the readings above it is an error naming its cell.
-    let bad = tmp("byk-wrong-mean.csv");
+    let bad = fresh("byk-wrong-mean.csv");
     let text = std::fs::read_to_string("fixtures/sheets/byk-smart-chart-report.csv").unwrap();
     std::fs::write(&bad, text.replace(",Mean,,82.02,", ",Mean,,83.02,")).unwrap();
     let (code, _, err) = gm(&["compare", GLASS, bad.to_str().unwrap(), "--tolerance", "1"]);

@@ -2,6 +2,7 @@
 //! population it is today's model to the bit; it is reciprocal and reflects at most what it receives (white
 //! furnace with F → 1); its D523 glosses agree with an independent Monte Carlo (`tools/iq/check_mixture.py`, on
 //! check_85.py's optics) within that Monte Carlo's standard error; bad input exits 2 naming the file and field.
+mod common;
 use glossmeter::brdf::albedo::directional_albedo_to;
 use glossmeter::brdf::dielectric::Ior;
 use glossmeter::brdf::mixture::MixtureSurface;
@@ -13,7 +14,6 @@ use glossmeter::optics::slope_mixture::SlopeMixture;
 use glossmeter::spectrum::Sampling;
 use glossmeter::Vec3;
 use num_complex::Complex64;
-use std::process::Command;
 
 fn load(json: &str) -> glossmeter::recipe::Material {
     glossmeter::recipe::parse_str(json, "mixture.json").unwrap_or_else(|e| panic!("{e}\n{json}"))
@@ -164,10 +164,8 @@ fn measure(json: &str, name: &str) -> (i32, String) {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join(name);
     std::fs::write(&path, json).unwrap();
-    let out = Command::new(env!("CARGO_BIN_EXE_glossmeter"))
-        .args(["measure", path.to_str().unwrap(), "--geometry", "astm-d523-60"])
-        .output()
-        .unwrap();
+    let out =
+        common::glossmeter().args(["measure", path.to_str().unwrap(), "--geometry", "astm-d523-60"]).output().unwrap();
     (out.status.code().unwrap_or(-1), String::from_utf8_lossy(&out.stderr).into_owned())
 }
 

@@ -1,14 +1,15 @@
 //! `-` is standard input for every input file (recipes, sheets and workbooks, geometry files, baselines, sweep
 //! templates) and standard output for `-o` (docs/instrument.md §Standard input and output): the same results
 //! as from files, one `-` per run (a second is an error, not an empty file), errors naming `<stdin>`.
+mod common;
 use std::io::Write;
-use std::process::{Command, Stdio};
+use std::process::Stdio;
 
 use serde_json::Value;
 
 /// Run the binary with `input` on standard input; (status, stdout, stderr).
 fn piped(args: &[&str], input: &[u8]) -> (i32, String, String) {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_glossmeter"))
+    let mut child = common::glossmeter()
         .args(args)
         .stdin(Stdio::piped())
         .stdout(Stdio::piped())

@@ -1,10 +1,12 @@
 //! `glossmeter sweep` and batch `measure`: shards whose concatenation is the unsharded run byte for byte,
 //! invalid points reported in their row, bad sweeps refused (exit 2), and results that do not depend on the
 //! thread count or on how many recipes are measured together.
+mod common;
+use common::fresh_dir;
 use std::process::Command;
 
 fn gm_env(args: &[&str], threads: Option<&str>) -> (i32, String, String) {
-    let mut c = Command::new(env!("CARGO_BIN_EXE_glossmeter"));
+    let mut c = common::glossmeter();
     c.args(args);
     if let Some(t) = threads {
         c.env("RAYON_NUM_THREADS", t);
@@ -19,13 +21,6 @@ fn gm_env(args: &[&str], threads: Option<&str>) -> (i32, String, String) {
 
 fn gm(args: &[&str]) -> (i32, String, String) {
     gm_env(args, None)
-}
-
-fn tmp_dir(name: &str) -> std::path::PathBuf {
-    let d = std::env::temp_dir().join(format!("glossmeter-sweep-test-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
 }
 
 const T: &str = "fixtures/recipes/rgb-lambert.json";
@@ -135,7 +130,7 @@ fn a_batch_reads_the_same_bits_as_one_recipe_at_a_time() {
 
 #[test]
 fn a_measure_baseline_fails_readings_that_moved() {
-    let dir = tmp_dir("baseline");
+    let dir = fresh_dir("baseline");
     let base = dir.join("glass.json");
     let b = base.to_str().unwrap();
     let glass = "fixtures/recipes/glass-n1.5.json";
@@ -188,7 +183,7 @@ fn a_batch_is_bit_identical_on_one_and_two_threads() {
 /// optional parameter the template lacks is added at every point; `-o` streams into a file that appears whole.
 #[test]
 fn sweep_paths_come_from_the_registry() {
-    let dir = tmp_dir("registry");
+    let dir = fresh_dir("registry");
     let t = dir.join("phong-no-kd.json");
     std::fs::write(&t, r#"{"model": "phong", "exponent": 200, "ks": 0.04}"#).unwrap();
     let t = t.to_str().unwrap();
@@ -228,7 +223,7 @@ fn the_progress_bar_is_drawn_on_a_terminal_only() {
     if Command::new("script").arg("--version").output().is_err() {
         panic!("util-linux `script` is needed to give the sweep a terminal (apt-get install util-linux)");
     }
-    let d = tmp_dir("pty");
+    let d = fresh_dir("pty");
     let (plain, on_tty) = (d.join("plain.csv"), d.join("tty.csv"));
     let exe = env!("CARGO_BIN_EXE_glossmeter");
     let args = ["sweep", T, "-g", "astm-d523-60", "--no-timing", "--vary", "/albedo/0=0.2..1.2:40"];
@@ -286,7 +281,7 @@ fn sweep_rows_are_those_of_points_run_alone() {
 fn the_last_shard_of_a_two_to_the_64_hypercube_ends() {
     let n = u64::MAX.to_string();
     let shard = format!("{n}/{n}");
-    let mut child = Command::new(env!("CARGO_BIN_EXE_glossmeter"))
+    let mut child = common::glossmeter()
         .args(["sweep", "fixtures/recipes/bench-b2-beckmann-0.1.json", "--vary", "/roughness=0.01..0.5"])
         .args(["--lhs", &n, "--seed", "1", "--shard", &shard, "-g", "astm-d523-60", "--no-timing"])
         .stdout(std::process::Stdio::piped())

@@ -2,13 +2,13 @@
 //! specific `--tolerance KEY=NUMBER` decides each row, the JSON says which, and a key that names no reading of the
 //! sheet is refused.
 #![cfg(feature = "cli")]
-use std::process::Command;
+mod common;
 
 use serde_json::Value;
 
 /// Run `compare` on black glass against the n = 1.50 tri-gloss sheet (three single readings: 20°, 60°, 85°).
 fn compare(extra: &[&str]) -> (i32, Value, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_glossmeter"))
+    let out = common::glossmeter()
         .current_dir(env!("CARGO_MANIFEST_DIR"))
         .args(["compare", "fixtures/recipes/black-glass.json", "fixtures/sheets/glass-n1.5-trigloss.csv"])
         .args(["--format", "json"])

@@ -3,7 +3,9 @@
 //! (`fixtures/topography/expected.json`), and bad files refused with exit status 2, naming the file and the
 //! field.
 #![cfg(feature = "cli")]
-use std::path::{Path, PathBuf};
+mod common;
+use common::tmp;
+use std::path::Path;
 
 use glossmeter::cli::run;
 use glossmeter::request::TopographyRequest;
@@ -14,12 +16,6 @@ use glossmeter::topography::text::Calibration;
 use serde_json::Value;
 
 const DIR: &str = "fixtures/topography";
-
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("glossmeter-topography-test-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d.join(name)
-}
 
 fn expected(which: &str) -> Value {
     let text = std::fs::read_to_string(format!("{DIR}/expected.json")).unwrap();

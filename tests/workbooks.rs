@@ -3,21 +3,13 @@
 //! 0, its statistics columns checked against the readings; `fit --sheet` reads it; bad workbooks (not a
 //! workbook, a missing sheet, a statistic that disagrees with its readings, options that do not apply) exit 2
 //! with errors naming the file, the sheet and the row and cell.
-use std::process::Command;
+mod common;
+use common::gm;
 
 use serde_json::Value;
 
 const GLASS: &str = "fixtures/recipes/glass-n1.5.json";
 const BOOK: &str = "fixtures/sheets/byk-smart-chart-export.xlsx";
-
-fn gm(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_glossmeter")).args(args).output().expect("run glossmeter");
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
 
 #[test]
 fn the_shipped_export_with_statistics_columns_compares_with_exit_0() {
@@ -70,7 +62,7 @@ fn bad_workbooks_name_the_file_sheet_row_and_cell() {
     assert_eq!(code, 2);
     assert!(err.contains(r#"sheet "Instrument", row 1, cell A1 (Instrument)"#), "{err}");
     // Not a workbook although it starts like one (a truncated download).
-    let d = std::env::temp_dir().join(format!("glossmeter-workbooks-{}", std::process::id()));
+    let d = common::tmp_dir("workbooks");
     std::fs::create_dir_all(&d).unwrap();
     let broken = d.join("truncated.xlsx");
     let bytes = std::fs::read(BOOK).unwrap();
@@ -89,7 +81,7 @@ fn bad_workbooks_name_the_file_sheet_row_and_cell() {
 
 #[test]
 fn statistics_columns_in_text_sheets_are_checked_too() {
-    let d = std::env::temp_dir().join(format!("glossmeter-stats-{}", std::process::id()));
+    let d = common::tmp_dir("stats");
     std::fs::create_dir_all(&d).unwrap();
     let cases: [(&str, &str, i32, &[&str]); 4] = [
         // A series in one row, Excel summary columns (population std accepted as well as the sample's).

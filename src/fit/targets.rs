@@ -133,6 +133,16 @@ mod tests {
     }
 
     #[test]
+    fn a_reading_is_matched_on_its_own_geometry() {
+        let names: Vec<ReadingName> = [("g20", "gloss", "gloss"), ("g60", "gloss", "gloss")]
+            .iter()
+            .map(|(g, n, q)| (g.to_string(), n.to_string(), q.to_string()))
+            .collect();
+        assert_eq!(match_targets(&names, &[target("g60", "gloss"), target("g20", "gloss")]).unwrap(), vec![1, 0]);
+        assert!(match_targets(&names, &[target("g85", "gloss")]).is_err());
+    }
+
+    #[test]
     fn an_unknown_reading_names_the_geometrys_readings() {
         let e = match_targets(&names(), &[target("g20", "rspec")]).unwrap_err().to_string();
         assert!(e.contains("\"g20/rspec\"") && e.contains("its readings are gloss, haze-narrow"), "{e}");

@@ -1,5 +1,9 @@
-//! Test helpers shared by the integration tests.
-#![allow(dead_code)]
+//! Test helpers shared by the integration tests: the binary, temporary files and fixtures ([`process`]), the
+//! fixture readings, and reference models written apart from the library's.
+#![allow(dead_code, unused_imports)]
+mod process;
+pub use process::*;
+
 use glossmeter::brdf::{Brdf, Hints, Lobe, Term, TermKind};
 use glossmeter::optics::fresnel::fr_dielectric;
 use glossmeter::spectrum::Sampling;
