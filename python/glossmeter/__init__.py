@@ -26,7 +26,7 @@ Every function is a thin layer over the library (see docs/python.md):
 Bad input raises ``ValueError`` with the message the CLI prints; an argument of the wrong type raises
 ``TypeError`` naming the argument and what it allows; an unreadable file raises ``OSError``.
 """
-from typing import TYPE_CHECKING, Any, Dict, List, Literal, Optional, Sequence, Union, overload
+from typing import TYPE_CHECKING, Any, Dict, List, Literal, Mapping, Optional, Sequence, Union, overload
 
 import numpy as np
 import numpy.typing as npt
@@ -367,7 +367,7 @@ def sweep(template: Recipe, vary: Union[str, Sequence[str]], log: Union[None, st
     return out
 
 
-def _frame(rows: Sequence[Dict[str, Any]], columns: Sequence[str], floats: Sequence[str]) -> "pandas.DataFrame":
+def _frame(rows: Sequence[Mapping[str, object]], columns: Sequence[str], floats: Sequence[str]) -> "pandas.DataFrame":
     """``rows`` as a DataFrame with ``columns`` in order, the ``floats`` columns float64 (None → NaN)."""
     import pandas as pd
 
