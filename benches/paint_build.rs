@@ -11,7 +11,7 @@
 //! the sweep-point rows (`sweep_points`).
 use std::time::Instant;
 
-use glossmeter::brdf::paint::{Paint, TableBuild};
+use glossmeter::brdf::paint::{Paint, PaintBuild, TableBuild, TableMemo, TableWork};
 use glossmeter::optics::coat_albedo::CoatAlbedo;
 use glossmeter::optics::microfacet::{Distribution, Microfacet};
 
@@ -24,12 +24,13 @@ fn median(mut v: Vec<f64>) -> f64 {
 type Setter = Box<dyn Fn(&mut serde_json::Value, f64)>;
 
 /// A sweep point's paint built from its recipe text as `Sweep::plan_point` builds it (the JSON read, the spec
-/// validated, the paint built), with the flake tables fitted as `build` says.
-fn build_paint(text: &str, build: TableBuild) -> Paint {
+/// validated, the paint built), built as `build` says (how the flake tables are fitted, in which memo), with the
+/// film-stack work that build did.
+fn build_paint(text: &str, build: PaintBuild<'_>) -> (Paint, TableWork) {
     let json = glossmeter::input::json::parse_json(text, "bench.json").expect("json");
     let obj = glossmeter::input::json::Obj::new("bench.json", "", &json).expect("object");
     let spec = glossmeter::recipe::paint::parse_paint_spec(&obj).expect("recipe");
-    Paint::with_table_build(spec, build).expect("paint")
+    Paint::build(spec, build).expect("paint")
 }
 
 /// What one sweep point rebuilds (`docs/performance.md` §"Paint rebuilds in sweeps"): the recipe of a point is
@@ -75,30 +76,30 @@ fn sweep_points() {
                     serde_json::to_string(&v).expect("json")
                 })
                 .collect();
-            // Interleaved: a build without the memo, tables one sample at a time (forgotten first: every table
-            // computed, the engine before both), one with the memo and tables one sample at a time (the engine
-            // before `docs/model.md` §Evaluation cost "shared across samples"), one with the memo and the samples
-            // fitted at once (after). A memo build is timed right after an untimed build of the other value in
-            // the same mode (the memo then holds what a sweep's previous point left), the values alternating.
+            // Interleaved: a build without a memo, tables one sample at a time (every table computed, the engine
+            // before both), one with a memo and tables one sample at a time (the engine before `docs/model.md`
+            // §Evaluation cost "shared across samples"), one with a memo and the samples fitted at once (after).
+            // A memo build is timed right after an untimed build of the other value into a fresh memo of its own
+            // (which then holds what a sweep's previous point left), the values alternating. The process's memo
+            // is never read.
             let modes = [(true, TableBuild::PerSample), (false, TableBuild::PerSample), (false, TableBuild::Shared)];
             let mut times: [Vec<f64>; 3] = Default::default();
-            let mut work = [(0, 0); 3];
+            let mut work = [TableWork::default(); 3];
             let start = Instant::now();
             let mut i = 0;
             while start.elapsed().as_secs_f64() < 0.9 || times[2].len() < 6 {
-                for (m, &(cold, build)) in modes.iter().enumerate() {
-                    glossmeter::brdf::paint::forget_tables();
+                for (m, &(cold, tables)) in modes.iter().enumerate() {
+                    let memo = TableMemo::new();
+                    let build = PaintBuild { tables, memo: (!cold).then_some(&memo) };
                     if !cold {
                         std::hint::black_box(build_paint(&texts[(i + 1) % 2], build));
                     }
-                    let before = glossmeter::brdf::paint::table_work();
                     let t = Instant::now();
                     let b = build_paint(&texts[i % 2], build);
                     let dt = t.elapsed().as_secs_f64();
-                    let after = glossmeter::brdf::paint::table_work();
-                    std::hint::black_box(b);
                     times[m].push(dt);
-                    work[m] = (after.0 - before.0, after.1 - before.1);
+                    work[m] = b.1;
+                    std::hint::black_box(b);
                 }
                 i += 1;
             }
@@ -111,10 +112,10 @@ fn sweep_points() {
                 cold * 1e3,
                 before * 1e3,
                 after * 1e3,
-                work[1].0,
-                work[1].1,
-                work[2].0,
-                work[2].1
+                work[1].stack_setups,
+                work[1].stack_evaluations,
+                work[2].stack_setups,
+                work[2].stack_evaluations
             );
         }
     }
@@ -155,9 +156,8 @@ fn coat_index_points() {
             let mut tabulated = true;
             let start = Instant::now();
             while start.elapsed().as_secs_f64() < 0.25 || times.len() < 3 {
-                glossmeter::brdf::paint::forget_tables();
                 let t0 = Instant::now();
-                let p = build_paint(&t, TableBuild::Shared);
+                let (p, _) = build_paint(&t, PaintBuild { tables: TableBuild::Shared, memo: None });
                 times.push(t0.elapsed().as_secs_f64());
                 tabulated &= p.flake_tables().iter().all(|(_, d)| d.is_some());
                 std::hint::black_box(p);

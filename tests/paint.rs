@@ -1238,7 +1238,7 @@ fn smooth_is_claimed_only_for_the_physical_form_under_a_smooth_coat() {
 /// deviations and the split light's constants in round-trip form.
 #[test]
 fn flake_tables_built_for_all_samples_at_once_are_those_built_one_at_a_time() {
-    use glossmeter::brdf::paint::{forget_tables, TableBuild};
+    use glossmeter::brdf::paint::{PaintBuild, TableBuild, TableMemo};
     use glossmeter::recipe::paint::parse_paint_spec;
     let dir = format!("{}/fixtures/recipes", env!("CARGO_MANIFEST_DIR"));
     let (mut paints, mut pearls, mut tabled, mut flaked) = (0, 0, 0, 0);
@@ -1257,14 +1257,27 @@ fn flake_tables_built_for_all_samples_at_once_are_those_built_one_at_a_time() {
                 let mut v = base.clone();
                 v["clear_coat"]["index"] = eta.into();
                 v["flake_light"] = light.into();
-                let build = |how: TableBuild| {
-                    forget_tables();
+                // Each build computes its tables (no memo: the two builds share a memo key).
+                let build = |tables: TableBuild, memo: Option<&TableMemo>| {
                     let spec = parse_paint_spec(&Obj::new("test.json", "", &v).unwrap()).unwrap();
-                    format!("{:?}", Paint::with_table_build(spec, how).unwrap())
+                    let (paint, work) = Paint::build(spec, PaintBuild { tables, memo }).unwrap();
+                    (format!("{paint:?}"), work)
                 };
-                let (alone, together) = (build(TableBuild::PerSample), build(TableBuild::Shared));
+                let ((alone, alone_work), (together, together_work)) =
+                    (build(TableBuild::PerSample, None), build(TableBuild::Shared, None));
                 tabled += together.contains("ChebTable") as usize;
                 assert!(alone == together, "{}, coat index {eta}, {light} light: the tables differ", path.display());
+                // The work is the build's own: only a pearl's film stack is counted; a build whose memo has the
+                // tables does none, and gives the same paint.
+                let pearl = base.get("pearlescent_flakes").is_some_and(|p| p["area_ratio"].as_f64() != Some(0.0));
+                for w in [alone_work, together_work] {
+                    assert_eq!(w.stack_setups > 0 && w.stack_evaluations > 0, pearl, "{}: {w:?}", path.display());
+                }
+                let memo = TableMemo::new();
+                let (first, first_work) = build(TableBuild::Shared, Some(&memo));
+                let (again, again_work) = build(TableBuild::Shared, Some(&memo));
+                assert_eq!((first, first_work), (together.clone(), together_work));
+                assert_eq!((again, again_work.stack_setups, again_work.stack_evaluations), (together, 0, 0));
             }
         }
     }

@@ -5,12 +5,13 @@
 
 Every function is a thin layer over the library (see docs/python.md):
 
-* ``measure(recipe, geometries=None, rtol=None, timing=True, *, as_frame=False, as_arrays=False)``: readings
+* ``measure(recipe, geometries=None, rtol=None, timing=True, *, max_evals=None, max_seconds=None,
+  illuminant=None, observer=None, as_frame=False, as_arrays=False)``: readings
   of a recipe (dict, JSON string or path), one dict per reading with the fields of
   ``glossmeter measure --format json``; or a pandas DataFrame (``as_frame=True``), or a dict of NumPy arrays,
   one per field (``as_arrays=True``).
 * ``measure_brdf(f, geometries=None, rtol=None, lobes=None, delta=None, wavelengths=None, timing=True, *,
-  as_frame=False, as_arrays=False)``: readings of a Python BRDF ``f(wi, wo)`` evaluated in batches of (N, 3)
+  max_evals=None, max_seconds=None, as_frame=False, as_arrays=False)``: readings of a Python BRDF ``f(wi, wo)`` evaluated in batches of (N, 3)
   NumPy arrays.
 * ``standards()``, ``geometry(id)``, ``describe_geometry(id)``, ``schema()``, ``describe(recipe)``.
 * The other actions of the command line, each returning the document of ``glossmeter ACTION --format json``
@@ -18,13 +19,14 @@ Every function is a thin layer over the library (see docs/python.md):
   ``compare(recipe, sheet, tolerance=None, ...)``, ``sweep(template, vary, ...)``, ``fit(recipe, targets,
   free=..., ...)``, ``profile(recipe, geometry=None, ...)``, ``convergence(recipe, geometries=None, ...)``.
   ``sweep`` and ``fit`` (and ``compare``, ``profile``) release the GIL and stop on Ctrl-C
-  (``KeyboardInterrupt``). ``read_sheet(..., as_frame=True)`` and ``sweep(..., as_frame=True)`` give their
-  rows as a pandas DataFrame.
+  (``KeyboardInterrupt``). ``read_sheet``, ``sweep``, ``compare``, ``fit`` and ``profile`` take
+  ``as_frame=True`` for the rows of their main table as a pandas DataFrame (one row per value, per point and
+  reading, per verdict, per fitted parameter, per profile pixel).
 
 Bad input raises ``ValueError`` with the message the CLI prints; an argument of the wrong type raises
 ``TypeError`` naming the argument and what it allows; an unreadable file raises ``OSError``.
 """
-from typing import TYPE_CHECKING, Any, Dict, List, Literal, Optional, Sequence, Union, overload
+from typing import TYPE_CHECKING, Any, Dict, List, Literal, Mapping, Optional, Sequence, Union, overload
 
 import numpy as np
 import numpy.typing as npt
@@ -33,13 +35,10 @@ from . import _glossmeter
 from ._glossmeter import (
     DEFAULT_GEOMETRIES,
     __version__,
-    compare,
     convergence,
     describe,
     describe_geometry,
-    fit,
     geometry,
-    profile,
     schema,
     standards,
 )
@@ -137,7 +136,9 @@ __all__ = [
     "Tolerance",
     "VerdictRule",
     "__version__",
+    "COMPARE_COLUMNS",
     "compare",
+    "compare_rows",
     "convergence",
     "describe",
     "describe_geometry",
@@ -223,48 +224,58 @@ def _check_shape_flags(as_frame: object, as_arrays: object) -> None:
 
 @overload
 def measure(recipe: Recipe, geometries: Geometries = ..., rtol: Optional[float] = ..., timing: bool = ..., *,
-            as_frame: Literal[False] = ..., as_arrays: Literal[False] = ...) -> Readings: ...
+            max_evals: Optional[int] = ..., max_seconds: Optional[float] = ..., illuminant: Optional[str] = ...,
+            observer: Optional[str] = ..., as_frame: Literal[False] = ..., as_arrays: Literal[False] = ...) -> Readings: ...
 @overload
 def measure(recipe: Recipe, geometries: Geometries = ..., rtol: Optional[float] = ..., timing: bool = ..., *,
-            as_frame: Literal[True], as_arrays: Literal[False] = ...) -> "pandas.DataFrame": ...
+            max_evals: Optional[int] = ..., max_seconds: Optional[float] = ..., illuminant: Optional[str] = ...,
+            observer: Optional[str] = ..., as_frame: Literal[True], as_arrays: Literal[False] = ...) -> "pandas.DataFrame": ...
 @overload
 def measure(recipe: Recipe, geometries: Geometries = ..., rtol: Optional[float] = ..., timing: bool = ..., *,
-            as_frame: Literal[False] = ..., as_arrays: Literal[True]) -> Arrays: ...
+            max_evals: Optional[int] = ..., max_seconds: Optional[float] = ..., illuminant: Optional[str] = ...,
+            observer: Optional[str] = ..., as_frame: Literal[False] = ..., as_arrays: Literal[True]) -> Arrays: ...
 def measure(recipe: Recipe, geometries: Geometries = None, rtol: Optional[float] = None, timing: bool = True, *,
-            as_frame: bool = False, as_arrays: bool = False) -> Union[Readings, Arrays, "pandas.DataFrame"]:
+            max_evals: Optional[int] = None, max_seconds: Optional[float] = None, illuminant: Optional[str] = None,
+            observer: Optional[str] = None, as_frame: bool = False, as_arrays: bool = False) -> Union[Readings, Arrays, "pandas.DataFrame"]:
     """Read a recipe (a dict, a JSON string or a path) through instrument geometries (None: the default panel
-    of ``glossmeter measure``; or one or a list of builtin ids, geometry files or geometry dicts).
+    of ``glossmeter measure``; or one or a list of builtin ids, geometry files or geometry dicts). ``rtol``,
+    ``max_evals``, ``max_seconds``, ``illuminant`` and ``observer`` are ``measure``'s ``--rtol``,
+    ``--max-evals``, ``--max-seconds``, ``--illuminant`` and ``--observer`` (None: the command line's default).
 
     Returns one dict per reading with the fields of ``glossmeter measure --format json``; with
     ``as_frame=True`` a pandas DataFrame, with ``as_arrays=True`` a dict of NumPy arrays (:func:`to_arrays`).
     Bad input raises ValueError with the message the CLI prints; a reading without a finite value has value
     None (NaN in a frame or array) and a "problem"."""
     _check_shape_flags(as_frame, as_arrays)
-    return _shaped(_glossmeter.measure(recipe, geometries, rtol, timing), as_frame, as_arrays)
+    readings = _glossmeter.measure(recipe, geometries, rtol, timing, max_evals=max_evals, max_seconds=max_seconds,
+                                   illuminant=illuminant, observer=observer)
+    return _shaped(readings, as_frame, as_arrays)
 
 
 @overload
 def measure_brdf(f: BrdfFunction, geometries: Geometries = ..., rtol: Optional[float] = ..., lobes: Optional[Lobes] = ...,
                  delta: Optional[Delta] = ..., wavelengths: Optional[Sequence[float]] = ..., timing: bool = ..., *,
-                 as_frame: Literal[False] = ..., as_arrays: Literal[False] = ...) -> Readings: ...
+                 max_evals: Optional[int] = ..., max_seconds: Optional[float] = ..., as_frame: Literal[False] = ..., as_arrays: Literal[False] = ...) -> Readings: ...
 @overload
 def measure_brdf(f: BrdfFunction, geometries: Geometries = ..., rtol: Optional[float] = ..., lobes: Optional[Lobes] = ...,
                  delta: Optional[Delta] = ..., wavelengths: Optional[Sequence[float]] = ..., timing: bool = ..., *,
-                 as_frame: Literal[True], as_arrays: Literal[False] = ...) -> "pandas.DataFrame": ...
+                 max_evals: Optional[int] = ..., max_seconds: Optional[float] = ..., as_frame: Literal[True], as_arrays: Literal[False] = ...) -> "pandas.DataFrame": ...
 @overload
 def measure_brdf(f: BrdfFunction, geometries: Geometries = ..., rtol: Optional[float] = ..., lobes: Optional[Lobes] = ...,
                  delta: Optional[Delta] = ..., wavelengths: Optional[Sequence[float]] = ..., timing: bool = ..., *,
-                 as_frame: Literal[False] = ..., as_arrays: Literal[True]) -> Arrays: ...
+                 max_evals: Optional[int] = ..., max_seconds: Optional[float] = ..., as_frame: Literal[False] = ..., as_arrays: Literal[True]) -> Arrays: ...
 def measure_brdf(f: BrdfFunction, geometries: Geometries = None, rtol: Optional[float] = None, lobes: Optional[Lobes] = None,
                  delta: Optional[Delta] = None, wavelengths: Optional[Sequence[float]] = None, timing: bool = True,
-                 *, as_frame: bool = False, as_arrays: bool = False) -> Union[Readings, Arrays, "pandas.DataFrame"]:
+                 *, max_evals: Optional[int] = None, max_seconds: Optional[float] = None, as_frame: bool = False,
+                 as_arrays: bool = False) -> Union[Readings, Arrays, "pandas.DataFrame"]:
     """Read a Python BRDF ``f(wi, wo)`` through instrument geometries: f takes two (N, 3) float64 arrays of
     unit directions (local frame, z the normal) and returns f_r in sr⁻¹ as (N,) or (N, S). ``lobes`` hints the
     lobe widths (None: probe f; []: f is smooth), ``delta`` is a mirror component, ``wavelengths`` (nm) name
     S spectral samples other than 1 (grey) or 3 (linear RGB). Returns what :func:`measure` returns; an
     exception raised in f propagates as itself. See docs/python.md."""
     _check_shape_flags(as_frame, as_arrays)
-    readings = _glossmeter.measure_brdf(f, geometries, rtol, lobes, delta, wavelengths, timing)
+    readings = _glossmeter.measure_brdf(f, geometries, rtol, lobes, delta, wavelengths, timing,
+                                        max_evals=max_evals, max_seconds=max_seconds)
     return _shaped(readings, as_frame, as_arrays)
 
 
@@ -354,3 +365,121 @@ def sweep(template: Recipe, vary: Union[str, Sequence[str]], log: Union[None, st
         if c in out:
             out[c] = out[c].astype(np.float64)
     return out
+
+
+def _frame(rows: Sequence[Mapping[str, object]], columns: Sequence[str], floats: Sequence[str]) -> "pandas.DataFrame":
+    """``rows`` as a DataFrame with ``columns`` in order, the ``floats`` columns float64 (None → NaN)."""
+    import pandas as pd
+
+    out = pd.DataFrame(list(rows), columns=list(columns))
+    for c in floats:
+        out[c] = out[c].astype(np.float64)
+    return out
+
+
+#: The columns of ``compare(..., as_frame=True)``: one row per compared (sample, reading), the scalar fields of
+#: a comparison, ``allowance`` its total and ``prediction_uncertainty`` NaN without a recipe uncertainty block.
+COMPARE_COLUMNS = ("sample", "material", "recipe", "geometry", "reading", "predicted_reading", "n", "mean", "std",
+                   "min", "max", "uncertainty", "predicted", "error_estimate", "difference", "allowance",
+                   "prediction_uncertainty", "verdict", "inside", "reason", "unchecked")
+_COMPARE_FLOATS = ("mean", "std", "min", "max", "uncertainty", "predicted", "error_estimate", "difference",
+                   "allowance", "prediction_uncertainty")
+
+
+def compare_rows(report: CompareReport) -> List[Dict[str, Any]]:
+    """A comparison document's verdicts as flat rows, one per compared (sample, reading), the columns of
+    :data:`COMPARE_COLUMNS` (the per-line ``lines``/``columns``/``values`` and the allowance's parts stay in
+    the document)."""
+    rows: List[Dict[str, Any]] = []
+    for c in report["comparisons"]:
+        row: Dict[str, Any] = {k: c.get(k) for k in COMPARE_COLUMNS}
+        allowance = c.get("allowance")
+        row["allowance"] = None if allowance is None else allowance["total"]
+        rows.append(row)
+    return rows
+
+
+@overload
+def compare(recipe: Recipe, sheet: SheetSource, tolerance: Optional[Tolerance] = ..., k: Optional[float] = ...,
+            max_de00: Optional[float] = ..., rtol: Optional[float] = ..., illuminant: Optional[str] = ...,
+            observer: Optional[str] = ..., delimiter: Optional[str] = ..., sheet_name: Optional[str] = ...,
+            header_row: Optional[int] = ..., ignore_columns: Union[None, str, Sequence[str]] = ..., *,
+            as_frame: Literal[False] = ...) -> CompareReport: ...
+@overload
+def compare(recipe: Recipe, sheet: SheetSource, tolerance: Optional[Tolerance] = ..., k: Optional[float] = ...,
+            max_de00: Optional[float] = ..., rtol: Optional[float] = ..., illuminant: Optional[str] = ...,
+            observer: Optional[str] = ..., delimiter: Optional[str] = ..., sheet_name: Optional[str] = ...,
+            header_row: Optional[int] = ..., ignore_columns: Union[None, str, Sequence[str]] = ..., *,
+            as_frame: Literal[True]) -> "pandas.DataFrame": ...
+def compare(recipe: Recipe, sheet: SheetSource, tolerance: Optional[Tolerance] = None, k: Optional[float] = None,
+            max_de00: Optional[float] = None, rtol: Optional[float] = None, illuminant: Optional[str] = None,
+            observer: Optional[str] = None, delimiter: Optional[str] = None, sheet_name: Optional[str] = None,
+            header_row: Optional[int] = None, ignore_columns: Union[None, str, Sequence[str]] = None, *,
+            as_frame: bool = False) -> Union[CompareReport, "pandas.DataFrame"]:
+    """The recipe's predictions beside an instrument sheet, with the verdicts: the document of ``glossmeter
+    compare RECIPE SHEET --format json``. With ``as_frame=True``, a pandas DataFrame of :func:`compare_rows`,
+    one row per compared (sample, reading). See docs/python.md."""
+    frame = _check_frame_flag(as_frame)
+    doc = _glossmeter.compare(recipe, sheet, tolerance, k, max_de00, rtol, illuminant, observer, delimiter,
+                              sheet_name, header_row, ignore_columns)
+    if not frame:
+        return doc
+    return _frame(compare_rows(doc), COMPARE_COLUMNS, _COMPARE_FLOATS)
+
+
+@overload
+def fit(recipe: Recipe, targets: Optional[Targets] = ..., *, free: FreeParameters,
+        sheet: Optional[SheetSource] = ..., sample: Optional[str] = ..., uncertainty: Optional[float] = ...,
+        restarts: Optional[int] = ..., rtol: Optional[float] = ..., geometries: Geometries = ...,
+        timing: bool = ..., delimiter: Optional[str] = ..., sheet_name: Optional[str] = ...,
+        header_row: Optional[int] = ..., ignore_columns: Union[None, str, Sequence[str]] = ...,
+        as_frame: Literal[False] = ...) -> FitReport: ...
+@overload
+def fit(recipe: Recipe, targets: Optional[Targets] = ..., *, free: FreeParameters,
+        sheet: Optional[SheetSource] = ..., sample: Optional[str] = ..., uncertainty: Optional[float] = ...,
+        restarts: Optional[int] = ..., rtol: Optional[float] = ..., geometries: Geometries = ...,
+        timing: bool = ..., delimiter: Optional[str] = ..., sheet_name: Optional[str] = ...,
+        header_row: Optional[int] = ..., ignore_columns: Union[None, str, Sequence[str]] = ...,
+        as_frame: Literal[True]) -> "pandas.DataFrame": ...
+def fit(recipe: Recipe, targets: Optional[Targets] = None, *, free: FreeParameters,
+        sheet: Optional[SheetSource] = None, sample: Optional[str] = None, uncertainty: Optional[float] = None,
+        restarts: Optional[int] = None, rtol: Optional[float] = None, geometries: Geometries = None,
+        timing: bool = True, delimiter: Optional[str] = None, sheet_name: Optional[str] = None,
+        header_row: Optional[int] = None, ignore_columns: Union[None, str, Sequence[str]] = None,
+        as_frame: bool = False) -> Union[FitReport, "pandas.DataFrame"]:
+    """Recipe parameters from readings: the ``free`` parameters fitted to ``targets`` or to a ``sheet``'s
+    ``sample``; the document of ``glossmeter fit --format json``. With ``as_frame=True``, a pandas DataFrame
+    with one row per fitted parameter (``path``, ``value``, ``std_error``, ``lower``, ``upper``, ``at_bound``;
+    the fit's verdict stays in the document). See docs/python.md."""
+    frame = _check_frame_flag(as_frame)
+    doc = _glossmeter.fit(recipe, targets, free=free, sheet=sheet, sample=sample, uncertainty=uncertainty,
+                          restarts=restarts, rtol=rtol, geometries=geometries, timing=timing, delimiter=delimiter,
+                          sheet_name=sheet_name, header_row=header_row, ignore_columns=ignore_columns)
+    if not frame:
+        return doc
+    columns = ("path", "value", "std_error", "lower", "upper", "at_bound")
+    return _frame(doc["parameters"], columns, ("value", "std_error", "lower", "upper"))
+
+
+@overload
+def profile(recipe: Recipe, geometry: Optional[Geometry] = ..., rtol: Optional[float] = ...,
+            max_evals: Optional[int] = ..., max_total_evals: Optional[int] = ..., *,
+            as_frame: Literal[False] = ...) -> ProfileReport: ...
+@overload
+def profile(recipe: Recipe, geometry: Optional[Geometry] = ..., rtol: Optional[float] = ...,
+            max_evals: Optional[int] = ..., max_total_evals: Optional[int] = ..., *,
+            as_frame: Literal[True]) -> "pandas.DataFrame": ...
+def profile(recipe: Recipe, geometry: Optional[Geometry] = None, rtol: Optional[float] = None,
+            max_evals: Optional[int] = None, max_total_evals: Optional[int] = None, *,
+            as_frame: bool = False) -> Union[ProfileReport, "pandas.DataFrame"]:
+    """The goniophotometric profile of a recipe on a geometry with a profile array (None: rspec-20): the
+    document of ``glossmeter profile --format json``. With ``as_frame=True``, a pandas DataFrame with one row
+    per pixel (the document's ``rows``: ``pixel``, ``angle_deg``, ``angle_half_width_deg``, ``value``,
+    ``error_estimate``, ``unit``, ``converged``, ``evaluations``, ``problem``). See docs/python.md."""
+    frame = _check_frame_flag(as_frame)
+    doc = _glossmeter.profile(recipe, geometry, rtol, max_evals, max_total_evals)
+    if not frame:
+        return doc
+    columns = ("pixel", "angle_deg", "angle_half_width_deg", "value", "error_estimate", "unit", "converged",
+               "evaluations", "problem")
+    return _frame(doc["rows"], columns, ("angle_deg", "angle_half_width_deg", "value", "error_estimate"))

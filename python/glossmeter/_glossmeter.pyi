@@ -31,6 +31,11 @@ def measure(
     geometries: Geometries = None,
     rtol: Optional[float] = None,
     timing: bool = True,
+    *,
+    max_evals: Optional[int] = None,
+    max_seconds: Optional[float] = None,
+    illuminant: Optional[str] = None,
+    observer: Optional[str] = None,
 ) -> List[Reading]: ...
 def measure_brdf(
     f: BrdfFunction,
@@ -40,6 +45,9 @@ def measure_brdf(
     delta: Optional[Delta] = None,
     wavelengths: Optional[Sequence[float]] = None,
     timing: bool = True,
+    *,
+    max_evals: Optional[int] = None,
+    max_seconds: Optional[float] = None,
 ) -> List[Reading]: ...
 def standards() -> List[Dict[str, Any]]: ...
 def geometry(id: Geometry) -> Dict[str, Any]: ...

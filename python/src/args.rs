@@ -1,7 +1,7 @@
 //! Arguments from Python, converted with refusals that name the argument and what it allows
 //! (docs/python.md §Errors): a value of the wrong type is a `TypeError`, a value out of range a `ValueError`,
 //! each saying `name: expected ..., got ...` instead of PyO3's generic conversion messages.
-use glossmeter::instrument::plan::{rtol_refusal, PlanOptions};
+use glossmeter::request::{MeasureRequest, PlanRequest};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyString};
@@ -20,18 +20,29 @@ pub fn real(name: &str, v: &Bound<'_, PyAny>, allowed: &str) -> PyResult<f64> {
     v.extract::<f64>().map_err(|_| refuse())
 }
 
-/// `rtol`: None is the planner's default (10⁻⁶, and for a measured table the tolerance its data uncertainty
-/// allows); a number in (0, 1) (the planner's check, `plan::rtol_refusal`) is used as given, as the command
-/// line's `--rtol` is (docs/accuracy.md §Data uncertainty of measured tables).
-pub fn plan_options(v: Option<&Bound<'_, PyAny>>) -> PyResult<PlanOptions> {
-    let x = match v {
-        None => return Ok(PlanOptions::default()),
-        Some(v) => real("rtol", v, "the relative tolerance of the integrals, in (0, 1), e.g. 1e-6")?,
-    };
-    match rtol_refusal(x) {
-        Some(why) => Err(PyValueError::new_err(format!("rtol {why} (the relative tolerance of the integrals)"))),
-        None => Ok(PlanOptions { rtol: x, rtol_from_data: false, ..PlanOptions::default() }),
-    }
+/// The keywords of a measurement (`measure`, `measure_brdf`) as the library's request
+/// ([`MeasureRequest`]), in this one place, as the command line converts its flags and the server its body: the
+/// request owns the defaults (10⁻⁶; for a measured table, without `rtol`, the tolerance its data uncertainty
+/// allows, docs/accuracy.md §Data uncertainty of measured tables; a given `rtol` is used as given) and the
+/// checks, whose messages name each keyword ([`keyword`]). Here only the types are checked.
+pub fn measure_request(
+    rtol: Option<&Bound<'_, PyAny>>,
+    max_evals: Option<&Bound<'_, PyAny>>,
+    max_seconds: Option<&Bound<'_, PyAny>>,
+    illuminant: Option<&Bound<'_, PyAny>>,
+    observer: Option<&Bound<'_, PyAny>>,
+) -> PyResult<MeasureRequest> {
+    let max_evals = opt_count("max_evals", max_evals, "the evaluation budget of each aperture integral, ≥ 1")?;
+    Ok(MeasureRequest {
+        plan: PlanRequest {
+            rtol: opt_real("rtol", rtol, "the relative tolerance of the integrals, in (0, 1), e.g. 1e-6")?,
+            max_evals: max_evals.map(|n| usize::try_from(n).unwrap_or(usize::MAX)),
+            illuminant: opt_string("illuminant", illuminant, "\"D65\", \"D50\", \"A\" or \"C\"")?,
+            observer: opt_string("observer", observer, "\"10\" or \"2\"")?,
+        },
+        max_seconds: opt_real("max_seconds", max_seconds, "a wall-clock limit in seconds, ≥ 0 (0: none)")?
+            .unwrap_or(0.0),
+    })
 }
 
 /// A flag: True or False (a NumPy bool too); None is `default`. An int is refused (0 and 1 are not flags).

@@ -287,23 +287,32 @@ pub(crate) fn run_plan(
     })
 }
 
-/// measure(recipe, geometries=None, rtol=None, timing=True) -> list[dict]
+/// measure(recipe, geometries=None, rtol=None, timing=True, *, max_evals=None, max_seconds=None,
+/// illuminant=None, observer=None) -> list[dict]
 ///
 /// Read a recipe (a dict, a JSON string or a path) through instrument geometries (None: the default panel of
 /// `glossmeter measure`; or a list of builtin ids, geometry files or geometry dicts). Returns one dict per
 /// reading with the fields of `glossmeter measure --format json`. Bad input raises ValueError with the
 /// message the CLI prints; a reading without a finite value has value None and a "problem".
 #[pyfunction]
-#[pyo3(signature = (recipe, geometries=None, rtol=None, timing=None))]
-#[pyo3(text_signature = "(recipe, geometries=None, rtol=None, timing=True)")]
+#[pyo3(signature = (recipe, geometries=None, rtol=None, timing=None, *, max_evals=None, max_seconds=None,
+    illuminant=None, observer=None))]
+#[pyo3(text_signature = "(recipe, geometries=None, rtol=None, timing=True, *, max_evals=None, max_seconds=None, \
+    illuminant=None, observer=None)")]
+#[allow(clippy::too_many_arguments)]
 fn measure<'py>(
     py: Python<'py>,
     recipe: &Bound<'py, PyAny>,
     geometries: Option<&Bound<'py, PyAny>>,
     rtol: Option<&Bound<'py, PyAny>>,
     timing: Option<&Bound<'py, PyAny>>,
+    max_evals: Option<&Bound<'py, PyAny>>,
+    max_seconds: Option<&Bound<'py, PyAny>>,
+    illuminant: Option<&Bound<'py, PyAny>>,
+    observer: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyList>> {
-    let options = args::plan_options(rtol)?;
+    let request = args::measure_request(rtol, max_evals, max_seconds, illuminant, observer)?;
+    let options = guarded(|| request.options().map_err(to_py_err))?;
     let timing = args::flag("timing", timing, true)?;
     let material = guarded(|| load_recipe(py, recipe))?;
     let geos = guarded(|| load_geometries(py, geometries))?;
@@ -379,12 +388,13 @@ fn schema<'py>(py: Python<'py>, output_format: Option<&str>) -> PyResult<Bound<'
     })
 }
 
-/// _cli(argv) -> int: the command line (`glossmeter::cli::run`, the binary's own code) on `argv` (`argv[0]` the
-/// program's name); returns its exit status. The wheel's console command `glossmeter` calls it
-/// (`glossmeter/_cli.py`), so a pip user runs every command without Rust; `serve` needs the binary.
+/// _cli(argv) -> int: the command line on `argv` (`argv[0]` the program's name), with the server as
+/// `glossmeter serve` (`glossmeter::cli::run_with` and `glossmeter::serve::run_command`, what the binary's
+/// `main` runs); returns its exit status. The wheel's console command `glossmeter` calls it
+/// (`glossmeter/_cli.py`), so a pip user runs every command, `serve` included, without Rust.
 #[pyfunction]
 fn _cli(py: Python<'_>, argv: Vec<String>) -> i32 {
-    py.detach(|| glossmeter::cli::run(argv))
+    py.detach(|| glossmeter::cli::run_with(argv, &glossmeter::serve::run_command))
 }
 
 /// describe(recipe) -> str: the one-line description of the model a recipe builds.

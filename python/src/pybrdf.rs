@@ -349,7 +349,38 @@ fn parse_lobes(lobes: &Bound<'_, PyAny>) -> PyResult<Vec<Lobe>> {
     Ok(out)
 }
 
-/// measure_brdf(f, geometries=None, rtol=None, lobes=None, delta=None, wavelengths=None, timing=True)
+/// `delta=`: None, a mirror reflectance R in [0, 1] (a number, or a list of `s` numbers, one per spectral sample),
+/// or a callable R(wi).
+fn parse_delta(delta: Option<&Bound<'_, PyAny>>, s: usize) -> PyResult<Option<Delta>> {
+    Ok(match delta {
+        None => None,
+        Some(d) if d.is_callable() => Some(Delta::Callable(d.clone().unbind())),
+        Some(d) => {
+            let allowed = "the mirror reflectance R in [0, 1]: a number, a list of S numbers, or a callable R(wi)";
+            let r: Vec<f64> = match args::real("delta", d, allowed) {
+                Ok(x) => vec![x; s],
+                Err(_) => args::reals("delta", d, allowed)
+                    .map_err(|_| PyTypeError::new_err(format!("delta: expected {allowed}, got {}", type_name(d))))?,
+            };
+            if r.len() != s {
+                return Err(PyValueError::new_err(format!(
+                    "delta: {} values, but f returns {s} spectral sample(s) per point (one R per sample)",
+                    r.len()
+                )));
+            }
+            if let Some(x) = r.iter().find(|x| !(x.is_finite() && **x >= 0.0 && **x <= 1.0)) {
+                return Err(PyValueError::new_err(format!(
+                    "delta: reflectance {} is outside [0, 1]",
+                    glossmeter::error::given(*x)
+                )));
+            }
+            Some(Delta::Constant(r))
+        }
+    })
+}
+
+/// measure_brdf(f, geometries=None, rtol=None, lobes=None, delta=None, wavelengths=None, timing=True, *,
+/// max_evals=None, max_seconds=None)
 ///
 /// Read a Python BRDF through instrument geometries. `f(wi, wo)` takes two (N, 3) float64 arrays (local
 /// frame, z the normal) and returns f_r in sr⁻¹, shape (N,) or (N, S), S spectral samples (1: grey, 3: linear
@@ -357,10 +388,13 @@ fn parse_lobes(lobes: &Bound<'_, PyAny>) -> PyResult<Vec<Lobe>> {
 /// `lobes`: hints of the lobe widths, a list of slope widths or dicts {"slope", "tail", "eta", "label"};
 /// None probes f around the specular direction (and says so in each reading's "note"); [] declares f
 /// smooth. `delta`: a mirror component, R as a number, a list of S numbers, or a callable R(wi) → (N,) or
-/// (N, S). An exception raised in f propagates as itself.
+/// (N, S). `rtol`, `max_evals` and `max_seconds` are `measure`'s ([`args::measure_request`]). An exception
+/// raised in f propagates as itself.
 #[pyfunction]
-#[pyo3(signature = (f, geometries=None, rtol=None, lobes=None, delta=None, wavelengths=None, timing=None))]
-#[pyo3(text_signature = "(f, geometries=None, rtol=None, lobes=None, delta=None, wavelengths=None, timing=True)")]
+#[pyo3(signature = (f, geometries=None, rtol=None, lobes=None, delta=None, wavelengths=None, timing=None, *,
+    max_evals=None, max_seconds=None))]
+#[pyo3(text_signature = "(f, geometries=None, rtol=None, lobes=None, delta=None, wavelengths=None, timing=True, \
+    *, max_evals=None, max_seconds=None)")]
 #[allow(clippy::too_many_arguments)]
 pub fn measure_brdf<'py>(
     py: Python<'py>,
@@ -371,6 +405,8 @@ pub fn measure_brdf<'py>(
     delta: Option<&Bound<'py, PyAny>>,
     wavelengths: Option<&Bound<'py, PyAny>>,
     timing: Option<&Bound<'py, PyAny>>,
+    max_evals: Option<&Bound<'py, PyAny>>,
+    max_seconds: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyList>> {
     if !f.is_callable() {
         return Err(PyTypeError::new_err(format!(
@@ -379,7 +415,10 @@ pub fn measure_brdf<'py>(
             type_name(f)
         )));
     }
-    let options = args::plan_options(rtol)?;
+    // The measurement's request (the library's defaults and checks, as `measure`'s); colour readings need
+    // a recipe's spectral data, so a Python BRDF's plan keeps the default conditions.
+    let request = args::measure_request(rtol, max_evals, max_seconds, None, None)?;
+    let options = guarded(|| request.options().map_err(to_py_err))?;
     let timing = args::flag("timing", timing, true)?;
     let wavelengths = match wavelengths {
         None => None,
@@ -439,31 +478,7 @@ pub fn measure_brdf<'py>(
         }
     };
 
-    let delta = match delta {
-        None => None,
-        Some(d) if d.is_callable() => Some(Delta::Callable(d.clone().unbind())),
-        Some(d) => {
-            let allowed = "the mirror reflectance R in [0, 1]: a number, a list of S numbers, or a callable R(wi)";
-            let r: Vec<f64> = match args::real("delta", d, allowed) {
-                Ok(x) => vec![x; s],
-                Err(_) => args::reals("delta", d, allowed)
-                    .map_err(|_| PyTypeError::new_err(format!("delta: expected {allowed}, got {}", type_name(d))))?,
-            };
-            if r.len() != s {
-                return Err(PyValueError::new_err(format!(
-                    "delta: {} values, but f returns {s} spectral sample(s) per point (one R per sample)",
-                    r.len()
-                )));
-            }
-            if let Some(x) = r.iter().find(|x| !(x.is_finite() && **x >= 0.0 && **x <= 1.0)) {
-                return Err(PyValueError::new_err(format!(
-                    "delta: reflectance {} is outside [0, 1]",
-                    glossmeter::error::given(*x)
-                )));
-            }
-            Some(Delta::Constant(r))
-        }
-    };
+    let delta = parse_delta(delta, s)?;
 
     let mut terms = Vec::new();
     if delta.is_some() {

@@ -200,6 +200,46 @@ def test_a_sheet_and_a_sweep_as_frames_hold_the_same_doubles():
     assert "seconds" in glossmeter.sweep(ROUGH, "/roughness=0.1..0.2:2", geometries="astm-d523-60", as_frame=True)
 
 
+def _same(column, values):
+    """A frame's column holds these values (None as NaN in a float column), the same doubles."""
+    import math
+
+    got = column.tolist()
+    assert len(got) == len(values)
+    for g, v in zip(got, values):
+        if v is None or (isinstance(v, float) and math.isnan(v)):
+            assert g is None or (isinstance(g, float) and math.isnan(g)), (g, v)
+        else:
+            assert g == v, (g, v)
+
+
+def test_compare_fit_and_profile_as_frames_hold_their_main_table_row_for_row():
+    pytest.importorskip("pandas", reason="pandas is not installed (pip install pandas); .ci/run installs it")
+    # compare: one row per compared (sample, reading), the verdict's scalars, the allowance's total.
+    sheet = SHEETS / "glass-n1.5-trigloss.csv"
+    doc = glossmeter.compare(GLASS, sheet, tolerance=0.5)
+    frame = glossmeter.compare(GLASS, sheet, tolerance=0.5, as_frame=True)
+    cs = doc["comparisons"]
+    assert list(frame.columns) == list(glossmeter.COMPARE_COLUMNS) and len(frame) == len(cs) > 1
+    for col in ("sample", "geometry", "reading", "verdict", "n", "mean", "predicted", "difference", "inside"):
+        _same(frame[col], [c[col] for c in cs])
+    _same(frame["allowance"], [c["allowance"]["total"] if c["allowance"] else None for c in cs])
+    _same(frame["prediction_uncertainty"], [c.get("prediction_uncertainty") for c in cs])
+    assert str(frame["predicted"].dtype) == "float64"
+    # fit: one row per fitted parameter.
+    fitted = glossmeter.fit(GLASS, free=["/ior=1.3..1.8"], sheet=sheet, timing=False)
+    frame = glossmeter.fit(GLASS, free=["/ior=1.3..1.8"], sheet=sheet, timing=False, as_frame=True)
+    assert list(frame.columns) == ["path", "value", "std_error", "lower", "upper", "at_bound"]
+    assert frame.to_dict("records") == fitted["parameters"]
+    # profile: one row per pixel.
+    prof = glossmeter.profile(BLACK, max_total_evals=200_000)
+    frame = glossmeter.profile(BLACK, max_total_evals=200_000, as_frame=True)
+    assert len(frame) == prof["pixels"] == len(prof["rows"])
+    for col in ("pixel", "angle_deg", "value", "error_estimate", "converged", "evaluations", "problem"):
+        _same(frame[col], [r[col] for r in prof["rows"]])
+    assert str(frame["value"].dtype) == "float64"
+
+
 def test_a_point_without_readings_is_one_row_with_its_problem():
     rows = glossmeter.sweep_rows([{"index": 4, "parameters": {"/ior": 9.0}, "problem": "ior out of range"},
                                   {"index": 5, "parameters": {"/ior": 1.5}, "seconds": 0.25,
@@ -270,6 +310,10 @@ CHECK = SHEETS / "black-glass-check.csv"
     (lambda: glossmeter.convergence(BLACK, reference_run=1), TypeError, ["reference_run:", "True or False"]),
     (lambda: glossmeter.read_sheet(CHECK, as_frame=1), TypeError, ["as_frame:", "True or False"]),
     (lambda: glossmeter.sweep(ROUGH, "/roughness=0.1..0.2:3", as_frame="yes"), TypeError, ["as_frame:"]),
+    (lambda: glossmeter.compare(BLACK, CHECK, as_frame=1), TypeError, ["as_frame:", "True or False"]),
+    (lambda: glossmeter.fit(ROUGH, ["astm-d523-60/gloss=60"], free=["/roughness=0.01..0.5"], as_frame=None),
+     TypeError, ["as_frame:"]),
+    (lambda: glossmeter.profile(BLACK, as_frame="yes"), TypeError, ["as_frame:"]),
 ])
 def test_a_bad_keyword_is_refused_naming_it(call, exc, words):
     with pytest.raises(exc) as e:

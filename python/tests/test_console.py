@@ -41,3 +41,33 @@ def test_the_console_command_runs_the_command_line():
 def test_the_console_module_runs_without_the_script():
     out = subprocess.run([sys.executable, "-m", "glossmeter._cli", "standards"], capture_output=True, text=True)
     assert out.returncode == 0 and "astm-d523-60" in out.stdout, out
+
+
+def test_the_console_command_serves_the_page_and_stops_on_ctrl_c():
+    # The wheel builds the library with its server (python/Cargo.toml, features "cli" and "serve"), so a pip user
+    # runs `glossmeter serve` without Rust: on port 0 (a free port, printed), it answers the API and ends on
+    # Ctrl-C (SIGINT) as the binary does, killed by the signal (_cli.py restores its default action).
+    import re
+    import signal
+    import urllib.request
+
+    exe = _console()
+    assert exe, "the wheel installs a `glossmeter` command beside the venv's python"
+    usage = subprocess.run([exe, "serve", "--help"], capture_output=True, text=True)
+    assert usage.returncode == 0 and "--port" in usage.stdout, usage
+    proc = subprocess.Popen([exe, "serve", "--port", "0"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        line = proc.stdout.readline()
+        found = re.search(r"http://127\.0\.0\.1:(\d+)/", line)
+        assert found and int(found.group(1)) > 0, (line, proc.poll(), proc.stderr.read() if proc.poll() else "")
+        with urllib.request.urlopen(found.group(0) + "api/fixtures", timeout=60) as reply:
+            assert reply.status == 200
+            doc = json.load(reply)
+        names = [f["name"] for f in doc["fixtures"]]
+        assert "cerulean-blue-c" in names, names
+        proc.send_signal(signal.SIGINT)
+        assert proc.wait(timeout=30) == -signal.SIGINT
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()

@@ -74,6 +74,52 @@ def test_a_table_s_tolerance_is_chosen_as_the_command_line_chooses_it(rtol):
     assert json.loads(out.stdout)["readings"] == glossmeter.measure(str(path), "astm-d523-60", rtol, timing=False)
 
 
+@pytest.mark.parametrize("fixture, ids, kwargs, flags", [
+    ("rough-dielectric-ggx-vcavity", ["astm-d523-60", "astm-e430-30"], {"max_evals": 200, "rtol": 1e-9},
+     ["--max-evals", "200", "--rtol", "1e-9"]),
+    ("blue-metallic-spectral", ["astm-d523-60", "d8-sci"], {"illuminant": "A", "observer": "2"},
+     ["--illuminant", "A", "--observer", "2"]),
+    ("blue-metallic-spectral", ["astm-d523-60", "d8-sci"], {"rtol": 1e-4, "max_seconds": 600},
+     ["--rtol", "1e-4", "--max-seconds", "600"]),
+])
+def test_measure_s_keywords_are_the_command_line_s_flags(fixture, ids, kwargs, flags):
+    # measure converts its keywords into the library's MeasureRequest, as the command line converts its flags
+    # (docs/python.md §API): the same request gives the same readings, to the bit.
+    exe = cli_binary()
+    if exe is None:
+        pytest.skip("the release CLI is not built (cargo build --release); .ci/run builds it first")
+    path = RECIPES / f"{fixture}.json"
+    args = [exe, "measure", str(path), "-g", ids[0], "-g", ids[1], "--format", "json", "--no-timing", *flags]
+    out = subprocess.run(args, capture_output=True, text=True)
+    assert out.returncode in (0, 1), out.stderr
+    readings = glossmeter.measure(str(path), ids, timing=False, **kwargs)
+    assert json.loads(out.stdout)["readings"] == readings
+    # Each keyword reaches the plan: a budget of 200 evaluations an integral leaves 10⁻⁹ readings unconverged
+    # (without it they converge), and illuminant A with the 2° observer moves the colour.
+    if "max_evals" in kwargs:
+        default = glossmeter.measure(str(path), ids, timing=False, rtol=kwargs["rtol"])
+        assert all(r["converged"] for r in default) and not any(r["converged"] for r in readings), readings
+    if "illuminant" in kwargs:
+        default = glossmeter.measure(str(path), ids, timing=False)
+        colour = [(r["name"], r["value"]) for r in readings if r["geometry"] == "d8-sci"]
+        assert colour and colour != [(r["name"], r["value"]) for r in default if r["geometry"] == "d8-sci"]
+
+
+@pytest.mark.parametrize("kwargs, exc, words", [
+    ({"max_evals": 0}, ValueError, ["`max_evals`", "at least 1"]),
+    ({"max_evals": 1.5}, TypeError, ["max_evals:", "whole number", "got float"]),
+    ({"max_seconds": -1}, ValueError, ["`max_seconds`", "≥ 0"]),
+    ({"max_seconds": "10"}, TypeError, ["max_seconds:", "got str"]),
+    ({"illuminant": "D99"}, ValueError, ["D99"]),
+    ({"observer": 10}, TypeError, ["observer:", "got int"]),
+    ({"rtol": 2.0}, ValueError, ["`rtol`", "(0, 1)"]),
+])
+def test_measure_s_request_refuses_a_bad_keyword_naming_it(kwargs, exc, words):
+    with pytest.raises(exc) as e:
+        glossmeter.measure({"model": "lambert", "albedo": 0.5}, "astm-d523-60", **kwargs)
+    assert all(w in str(e.value) for w in words), str(e.value)
+
+
 def cli_error(args):
     exe = cli_binary()
     if exe is None:

@@ -43,6 +43,20 @@ def test_lambert_reads_like_the_recipe():
     assert_agree(py, rust, 1e-7)
 
 
+def test_the_evaluation_budget_reaches_the_plan():
+    # measure_brdf's max_evals is the request's (as measure's): a budget far below what a 10⁻⁸ tolerance needs
+    # leaves the readings unconverged, each within it, and the same budget of a recipe gives the same verdicts.
+    recipe = {"model": "microfacet", "distribution": "ggx", "roughness": 0.05, "ior": 1.5, "shadowing": "v-cavity"}
+    f = microfacet_vcavity("ggx", 0.05, 1.5)
+    full = glossmeter.measure_brdf(f, geometries=D523, rtol=1e-8, lobes=[0.05], timing=False)
+    tight = glossmeter.measure_brdf(f, geometries=D523, rtol=1e-8, lobes=[0.05], timing=False, max_evals=200)
+    assert all(r["converged"] for r in full)
+    assert not any(r["converged"] for r in tight), tight
+    assert sum(r["evaluations"] for r in tight) < sum(r["evaluations"] for r in full)
+    rust = glossmeter.measure(recipe, geometries=D523, rtol=1e-8, timing=False, max_evals=200)
+    assert [r["converged"] for r in rust] == [r["converged"] for r in tight]
+
+
 @pytest.mark.parametrize("hint", [True, False])
 def test_ggx_vcavity_dielectric_with_and_without_hint(hint):
     recipe = {"model": "microfacet", "distribution": "ggx", "roughness": 0.05, "ior": 1.5, "shadowing": "v-cavity"}

@@ -59,6 +59,11 @@ def usage() -> None:
     prof: ProfileReport = glossmeter.profile("r.json", "rspec-20", max_total_evals=10_000)
     conv: ConvergenceReport = glossmeter.convergence({"model": "lambert", "albedo": 0.5}, tolerances=[1e-3])
     print(prof["rows"][0]["angle_deg"], conv["rows"][0]["rtol"], glossmeter.schema("sheet")["title"])
+    verdicts: pd.DataFrame = glossmeter.compare("r.json", "s.csv", tolerance=2.0, as_frame=True)
+    params: pd.DataFrame = glossmeter.fit("r.json", free=["/ior=1.3..1.8"], sheet="s.csv", as_frame=True)
+    pixels: pd.DataFrame = glossmeter.profile("r.json", as_frame=True)
+    budgeted: List[Reading] = glossmeter.measure("r.json", max_evals=1000, max_seconds=5.0, illuminant="A")
+    print(verdicts.shape, params.shape, pixels.shape, budgeted[0]["value"])
 
     # What the types refuse (each ignore is needed, or mypy --strict fails on an unused one):
     glossmeter.measure(42)  # type: ignore[call-overload]
@@ -69,8 +74,9 @@ def usage() -> None:
     not_a_str: int = glossmeter.describe("r.json")  # type: ignore[assignment]
     glossmeter.read_sheet(42)  # type: ignore[call-overload]
     glossmeter.sweep("r.json", vary=5)  # type: ignore[call-overload]
-    glossmeter.fit("r.json", ["astm-d523-60/gloss=60"])  # type: ignore[call-arg]
+    glossmeter.fit("r.json", ["astm-d523-60/gloss=60"])  # type: ignore[call-overload]
+    not_a_report: CompareReport = glossmeter.compare("r.json", "s.csv", as_frame=True)  # type: ignore[assignment]
     not_points: Sheet = glossmeter.sweep("r.json", "/roughness=0.1..0.2:3")  # type: ignore[assignment]
     not_a_frame: Sheet = glossmeter.read_sheet("s.csv", as_frame=True)  # type: ignore[assignment]
     bad_field = glossmeter.profile("r.json")["pixel"]  # type: ignore[typeddict-item]
-    print(bad_hint, wrong, not_a_str, not_points, not_a_frame, bad_field)
+    print(bad_hint, wrong, not_a_str, not_points, not_a_frame, bad_field, not_a_report)

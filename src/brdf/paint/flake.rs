@@ -14,7 +14,6 @@ use crate::quadrature::gauss_legendre;
 use num_complex::Complex64;
 use std::cell::Cell;
 use std::f64::consts::PI;
-use std::sync::atomic::{AtomicU64, Ordering};
 
 /// Largest accepted deviation of a flake-reflectance table from the direct evaluation (absolute, on a
 /// reflectance ≤ 1): far below any tolerance a reading is asked for.
@@ -304,27 +303,40 @@ impl FlakeTerm {
 
     /// Everything the term computes from its optics, its cover and the samples: the tables ([`FlakeTerm::table`],
     /// [`FlakeTerm::grid`]) and, for the split flake light, its constants ([`FlakeTerm::split_constants`]) —
-    /// taken from the process's [`Memo`] when a build before had the same inputs to the bit (what a sweep point
-    /// that varies an area ratio, a spread, the primer or the coat's roughness meets), else computed and kept.
-    /// `build` says how tables the memo does not have are fitted (the bits are the same either way).
+    /// taken from the build's memo ([`PaintBuild::memo`]) when a build before had the same inputs to the bit (what
+    /// a sweep point that varies an area ratio, a spread, the primer or the coat's roughness meets), else computed
+    /// and kept there. `build.tables` says how tables the memo does not have are fitted (the bits are the same
+    /// either way). Returns the work this build did: none when the memo had the tables.
     pub(super) fn prepare(
         &mut self,
         k_mix: &[f64],
         s_mix: &[f64],
         depth_mm: f64,
         wavelengths_nm: &[f64],
-        build: TableBuild,
-    ) {
-        let mut key = self.key(k_mix, s_mix, depth_mm, wavelengths_nm);
-        key.push((build == TableBuild::Direct) as u64);
-        let made = TABLES.get_or_make(key, || self.compute(k_mix, s_mix, depth_mm, wavelengths_nm, build));
+        build: PaintBuild<'_>,
+    ) -> TableWork {
+        let mut work = TableWork::default();
+        let mut compute = || {
+            let (made, w) = self.compute(k_mix, s_mix, depth_mm, wavelengths_nm, build.tables);
+            work = w;
+            made
+        };
+        let made = match build.memo {
+            Some(memo) => {
+                let mut key = self.key(k_mix, s_mix, depth_mm, wavelengths_nm);
+                key.push((build.tables == TableBuild::Direct) as u64);
+                memo.0.get_or_make(key, compute)
+            }
+            None => std::sync::Arc::new(compute()),
+        };
         self.table = made.table.clone();
         self.grid = made.grid.clone();
         self.depth = made.depth.clone();
         self.diffuse = made.diffuse.clone();
+        work
     }
 
-    /// What [`FlakeTerm::prepare`] computes when the memo does not have it, counted in [`table_work`].
+    /// What [`FlakeTerm::prepare`] computes when the memo does not have it, with the film-stack work it did.
     fn compute(
         &self,
         k_mix: &[f64],
@@ -332,7 +344,7 @@ impl FlakeTerm {
         depth_mm: f64,
         wavelengths_nm: &[f64],
         build: TableBuild,
-    ) -> Prepared {
+    ) -> (Prepared, TableWork) {
         let per_sample = build == TableBuild::PerSample;
         let work = Work::default();
         let mut t = self.clone();
@@ -343,11 +355,13 @@ impl FlakeTerm {
         if t.split {
             t.split_constants(k_mix, s_mix, depth_mm, wavelengths_nm, per_sample, &work);
         }
-        if let FlakeOptics::Pearl { .. } = t.optics {
-            STACK_SETUPS.fetch_add(work.setups.get(), Ordering::Relaxed);
-            STACK_WAVELENGTHS.fetch_add(work.evaluations.get(), Ordering::Relaxed);
-        }
-        Prepared { table: t.table, grid: t.grid, depth: t.depth, diffuse: t.diffuse }
+        let counted = match t.optics {
+            FlakeOptics::Pearl { .. } => {
+                TableWork { stack_setups: work.setups.get(), stack_evaluations: work.evaluations.get() }
+            }
+            FlakeOptics::Metal(_) => TableWork::default(),
+        };
+        (Prepared { table: t.table, grid: t.grid, depth: t.depth, diffuse: t.diffuse }, counted)
     }
 
     /// The bits of every input [`FlakeTerm::prepare`] reads: the optics, the cover per sample, whether the light
@@ -399,14 +413,74 @@ fn same_kinks(kinks: &[Vec<f64>]) -> Vec<Vec<usize>> {
     groups
 }
 
-/// The flake terms' tables kept between paint builds ([`FlakeTerm::prepare`]).
-static TABLES: Memo<Prepared> = Memo::new();
+/// Flake tables kept between paint builds ([`FlakeTerm::prepare`]), keyed by the bits of every input they are
+/// computed from, so a kept entry is what a rebuild would give to the bit. [`TableMemo::process`] is the one
+/// every front end's build reads ([`Paint::new`](super::Paint::new)): a cache, not a switch; it stays
+/// process-wide because a sweep or fit point is built anew from its recipe text and finds its neighbour's
+/// tables only there (`docs/model.md` §Evaluation cost, "Tables kept between builds"; `docs/performance.md`
+/// §"Paint rebuilds in sweeps"). A bench or a test that compares builds passes its own memo, or none
+/// ([`PaintBuild`]), instead of clearing this one.
+pub struct TableMemo(Memo<Prepared>);
 
-/// Forget every kept flake table, so that the next paint build computes its tables as if it were the first of
-/// the process (what `benches/paint_build.rs` times as the build without the memo; readings are the same bits
-/// either way).
-pub fn forget_tables() {
-    TABLES.clear();
+impl TableMemo {
+    /// An empty memo of its own (at most [`super::MEMO_ENTRIES`] entries).
+    pub const fn new() -> TableMemo {
+        TableMemo(Memo::new())
+    }
+
+    /// The memo of the process, what [`PaintBuild::default`] reads.
+    pub fn process() -> &'static TableMemo {
+        static TABLES: TableMemo = TableMemo::new();
+        &TABLES
+    }
+}
+
+impl Default for TableMemo {
+    fn default() -> TableMemo {
+        TableMemo::new()
+    }
+}
+
+impl std::fmt::Debug for TableMemo {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("TableMemo")
+    }
+}
+
+/// How a paint is built ([`super::Paint::build`]): how its flake tables are fitted, and the memo its tables are
+/// looked up in and kept in (None: computed by this build alone, neither read nor kept). The default is what
+/// [`super::Paint::new`] does: [`TableBuild::Shared`] and [`TableMemo::process`].
+#[derive(Clone, Copy, Debug)]
+pub struct PaintBuild<'a> {
+    pub tables: TableBuild,
+    pub memo: Option<&'a TableMemo>,
+}
+
+impl Default for PaintBuild<'_> {
+    fn default() -> Self {
+        PaintBuild { tables: TableBuild::Shared, memo: Some(TableMemo::process()) }
+    }
+}
+
+/// The film-stack work one paint build did for its pearl flake tables (exact counts, what
+/// `benches/paint_build.rs` reports beside its times; zero when the memo had the tables, and for metal flakes):
+/// `stack_setups`, angles of incidence at which a stack's angles and interface amplitudes were computed;
+/// `stack_evaluations`, reflectances ρ(μ, λ) computed. Per sample, one of each per evaluation; shared, one
+/// set-up serves every sample at its angle (`docs/model.md` §Evaluation cost).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct TableWork {
+    pub stack_setups: u64,
+    pub stack_evaluations: u64,
+}
+
+impl std::ops::Add for TableWork {
+    type Output = TableWork;
+    fn add(self, o: TableWork) -> TableWork {
+        TableWork {
+            stack_setups: self.stack_setups + o.stack_setups,
+            stack_evaluations: self.stack_evaluations + o.stack_evaluations,
+        }
+    }
 }
 
 /// What [`FlakeTerm::prepare`] computes and the memo keeps.
@@ -431,18 +505,7 @@ pub enum TableBuild {
     /// `tests/paint.rs`; not the same bits, and far slower).
     Direct,
 }
-static STACK_SETUPS: AtomicU64 = AtomicU64::new(0);
-static STACK_WAVELENGTHS: AtomicU64 = AtomicU64::new(0);
-
-/// The film-stack work the pearl flake tables built so far in this process have done (exact counts, what
-/// `benches/paint_build.rs` reports beside its times): (stack set-ups, i.e. angles of incidence at which a
-/// stack's angles and interface amplitudes were computed; wavelength evaluations, i.e. reflectances ρ(μ, λ)
-/// computed). Per sample, one of each per evaluation; shared, one set-up serves every sample at its angle.
-pub fn table_work() -> (u64, u64) {
-    (STACK_SETUPS.load(Ordering::Relaxed), STACK_WAVELENGTHS.load(Ordering::Relaxed))
-}
-
-/// Counts of one table build ([`table_work`]).
+/// Counts of one table build, as it goes ([`TableWork`] when it is done).
 #[derive(Default)]
 struct Work {
     setups: Cell<u64>,

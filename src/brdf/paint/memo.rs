@@ -1,4 +1,4 @@
-//! A small process-wide memo of what a paint build computes from a few inputs ([`Memo`]): the flake terms'
+//! A small memo of what a paint build computes from a few inputs ([`Memo`]): the flake terms'
 //! verified tables, kept between builds so that a sweep or fit point that changes a field a table does not depend
 //! on (an area ratio, a flake spread, the primer, a coat's roughness or thickness) reuses the tables instead of
 //! rebuilding them (`docs/model.md` §Folded evaluation, `docs/performance.md` §"Paint rebuilds in sweeps").
@@ -41,13 +41,6 @@ impl<T> Memo<T> {
             }
         }
         value
-    }
-
-    /// Drop every entry (the next build of each key computes it again).
-    pub(super) fn clear(&self) {
-        if let Ok(mut entries) = self.entries.lock() {
-            entries.clear();
-        }
     }
 }
 

@@ -53,7 +53,7 @@ mod hemisphere;
 mod memo;
 mod spec;
 
-pub use flake::{forget_tables, table_work, TableBuild, TABLE_TOLERANCE};
+pub use flake::{PaintBuild, TableBuild, TableMemo, TableWork, TABLE_TOLERANCE};
 pub use hemisphere::{
     diffuse_fresnel_reflectance, hemispherical_mean, internal_diffuse_reflectance, DIFFUSE_FRESNEL_NODES,
 };
@@ -111,10 +111,16 @@ impl Paint {
         Paint::with_table_build(spec, TableBuild::Shared)
     }
 
-    /// [`Paint::new`] with the flake tables fitted as `build` says ([`TableBuild`]: the same bits either way;
+    /// [`Paint::new`] with the flake tables fitted as `tables` says ([`TableBuild`]: the same bits either way;
     /// `benches/paint_build.rs` compares the two builds' times), or with none ([`TableBuild::Direct`]: every
     /// flake reflectance evaluated directly, the reference the tables are checked against).
-    pub fn with_table_build(spec: PaintSpec, build: TableBuild) -> Result<Paint> {
+    pub fn with_table_build(spec: PaintSpec, tables: TableBuild) -> Result<Paint> {
+        Paint::build(spec, PaintBuild { tables, ..PaintBuild::default() }).map(|(paint, _)| paint)
+    }
+
+    /// [`Paint::new`] built as `build` says (how the flake tables are fitted, and the memo they are kept in, or
+    /// none), with the film-stack work this build did ([`TableWork`]: none for tables the memo had).
+    pub fn build(spec: PaintSpec, build: PaintBuild<'_>) -> Result<(Paint, TableWork)> {
         let n = spec.sampling.len();
         if n == 0 || n > MAX_SAMPLES {
             return Err(usage(format!("{n} spectral samples; a paint takes 1 to {MAX_SAMPLES}")));
@@ -209,6 +215,7 @@ impl Paint {
         let cover =
             |depth: f64| -> Vec<Layer> { (0..n).map(|j| kubelka_munk::layer(k_mix[j], s_mix[j], depth)).collect() };
         let split = spec.form == Form::Physical && spec.flake_light == FlakeLight::Split;
+        let work = std::cell::Cell::new(TableWork::default());
         let flake = |label, spread: Spread, area, depth, optics| {
             let facets = Microfacet::new(Distribution::Beckmann, spread.slope());
             let mut term = FlakeTerm {
@@ -224,7 +231,7 @@ impl Paint {
                 diffuse: vec![0.0; n],
                 split,
             };
-            term.prepare(&k_mix, &s_mix, depth, &spec.sampling.wavelengths_nm, build);
+            work.set(work.get() + term.prepare(&k_mix, &s_mix, depth, &spec.sampling.wavelengths_nm, build));
             term
         };
         let metallic = spec.metallic.as_ref().filter(|m| m.area_ratio > 0.0).map(|m| {
@@ -255,7 +262,7 @@ impl Paint {
         let luminous = Weighting::luminous(&paint.spec.sampling).ok().and_then(|w| w.rows.into_iter().next());
         paint.folded =
             luminous.map(|w| Folded::new(paint.metallic.as_ref(), paint.pearlescent.as_ref(), &paint.body, &w));
-        Ok(paint)
+        Ok((paint, work.get()))
     }
 
     pub fn spec(&self) -> &PaintSpec {

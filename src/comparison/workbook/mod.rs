@@ -102,7 +102,10 @@ thread_local! {
 }
 
 /// Run `f`, turning a panic into its message; the panic hook stays silent for this thread meanwhile (it is
-/// installed once, and passes every other panic to the hook it replaced).
+/// installed once, and passes every other panic to the hook it replaced). This is the library's one
+/// process-wide hook, and it stays: calamine can panic on a malformed workbook (docs/instrument.md
+/// §Workbooks), `catch_unwind` is the only way to turn that into an error, and Rust prints a caught panic
+/// through the hook; the hook only silences the reader's own thread, it changes no result.
 fn quietly<T>(f: impl FnOnce() -> T) -> std::result::Result<T, String> {
     static HOOK: std::sync::Once = std::sync::Once::new();
     HOOK.call_once(|| {
