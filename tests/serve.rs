@@ -658,7 +658,11 @@ const GLASS: &str = "fixtures/recipes/glass-n1.5.json";
 /// `glossmeter ARGS…`: its exit code, standard output and standard error.
 fn cli(args: &[&str]) -> (Option<i32>, String, String) {
     let out = std::process::Command::new(env!("CARGO_BIN_EXE_glossmeter")).args(args).output().unwrap();
-    (out.status.code(), String::from_utf8_lossy(&out.stdout).into_owned(), String::from_utf8_lossy(&out.stderr).into_owned())
+    (
+        out.status.code(),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
 }
 
 /// The command line's error as the server words it: without `error: `, with the file's path given as the name

@@ -26,8 +26,7 @@ pub struct Options {
 
 impl Default for Options {
     fn default() -> Self {
-        // The library's one default tolerance (docs/accuracy.md), not a copy of its value.
-        Options { rtol: crate::DEFAULT_RTOL, atol: 0.0, max_evals: 20_000_000, deadline: None, max_shrink: MAX_SHRINK, checked: false }
+        Options { rtol: 1e-6, atol: 0.0, max_evals: 20_000_000, deadline: None, max_shrink: MAX_SHRINK, checked: false }
     }
 }
 
