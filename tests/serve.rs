@@ -652,3 +652,218 @@ fn an_rgb_recipe_is_refused_colour_as_the_command_line_refuses_it() {
     assert_eq!(a, b);
     assert!(a["readings"].as_array().unwrap().iter().any(|r| r["name"] == "L*"));
 }
+
+const GLASS: &str = "fixtures/recipes/glass-n1.5.json";
+
+/// `glossmeter ARGS…`: its exit code, standard output and standard error.
+fn cli(args: &[&str]) -> (Option<i32>, String, String) {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_glossmeter")).args(args).output().unwrap();
+    (
+        out.status.code(),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+/// The command line's error as the server words it: without `error: `, with the file's path given as the name
+/// the upload carries, and an argument named as the body's field (the library's words, each front end naming
+/// its arguments its own way: `--ignore-column`, `` `ignore_columns` ``).
+fn cli_error(stderr: &str, path: &str, name: &str) -> String {
+    let line = stderr.trim_end();
+    line.strip_prefix("error: ").unwrap_or(line).replace(path, name).replace("--ignore-column", "`ignore_columns`")
+}
+
+/// A `compare` or `fit` body: `rest` with the file at `path` uploaded as `sheet` (its base64, under its name).
+fn upload(path: &str, rest: Value) -> Vec<u8> {
+    let name = path.rsplit('/').next().unwrap();
+    let mut rest = rest;
+    rest["sheet"] = json!({"name": name, "base64": base64(&std::fs::read(path).unwrap())});
+    with_recipe(&std::fs::read_to_string(GLASS).unwrap(), rest)
+}
+
+/// A `compare` document with the paths of the command line's files given as the server names them.
+fn as_served(cli_json: &str, sheet_path: &str) -> Value {
+    let name = sheet_path.rsplit('/').next().unwrap();
+    let mut doc: Value = serde_json::from_str(cli_json).unwrap_or_else(|e| panic!("{e}: {cli_json}"));
+    let text = doc.to_string().replace(sheet_path, name).replace(GLASS, "recipe");
+    doc = serde_json::from_str(&text).unwrap();
+    doc
+}
+
+/// `sheet_name` (with `delimiter`, `ignore_columns` and `header_row`, docs/serve.md §The API) reads an uploaded
+/// workbook's sheet as `compare --sheet-name` and `fit --sheet-name` read the file's: the named sheet, and for a
+/// sheet the workbook does not have (or one without readings) the command line's message.
+#[test]
+fn sheet_name_reads_the_named_sheet_of_an_uploaded_workbook() {
+    let addr = default_server();
+    let book = "fixtures/sheets/byk-smart-chart-export.xlsx";
+    let first = request(addr, "POST", "/api/compare", &upload(book, json!({})), &[]);
+    assert_eq!(first.status, 200, "{}", first.body);
+    let named = request(addr, "POST", "/api/compare", &upload(book, json!({"sheet_name": "Measurements"})), &[]);
+    assert_eq!(named.status, 200, "{}", named.body);
+    assert_eq!(named.json(), first.json());
+    let (code, out, err) = cli(&["compare", GLASS, book, "--sheet-name", "Measurements", "--format", "json"]);
+    assert_eq!(code, Some(0), "{err}");
+    assert_eq!(named.json(), as_served(&out, book));
+    for (sheet, says) in [("Instrument", r#"sheet "Instrument", row 1"#), ("Readings", r#"no sheet "Readings""#)] {
+        let a = request(addr, "POST", "/api/compare", &upload(book, json!({"sheet_name": sheet})), &[]);
+        assert_eq!(a.status, 400, "{sheet}: {}", a.body);
+        let served = a.json()["error"].as_str().unwrap().to_string();
+        assert!(served.contains(says), "{served}");
+        let (code, _, err) = cli(&["compare", GLASS, book, "--sheet-name", sheet]);
+        assert_eq!(code, Some(2));
+        assert_eq!(served, cli_error(&err, book, "byk-smart-chart-export.xlsx"));
+        let fit = json!({"free": ["/ior=1.3..1.8"], "sheet_name": sheet, "restarts": 0});
+        let a = request(addr, "POST", "/api/fit", &upload(book, fit), &[]);
+        assert_eq!(a.status, 400, "{sheet}: {}", a.body);
+        let (code, _, err) = cli(&["fit", GLASS, "--sheet", book, "--sheet-name", sheet, "--free", "/ior=1.3..1.8"]);
+        assert_eq!(code, Some(2));
+        assert_eq!(a.json()["error"].as_str().unwrap(), cli_error(&err, book, "byk-smart-chart-export.xlsx"));
+    }
+    // A sheet's options without a sheet are refused, as `fit --sheet-name` without `--sheet` is.
+    let body = with_recipe(
+        &std::fs::read_to_string(GLASS).unwrap(),
+        json!({"free": ["/ior=1.3..1.8"], "target": ["astm-d523-60/gloss=89±0.1"], "sheet_name": "Measurements"}),
+    );
+    let a = request(addr, "POST", "/api/fit", &body, &[]);
+    assert_eq!(a.status, 400, "{}", a.body);
+    assert!(a.json()["error"].as_str().unwrap().contains("field `/sheet_name`"), "{}", a.body);
+    // The delimiter is the command line's too: `;` is not the separator of a comma sheet.
+    let csv = "fixtures/sheets/glass-n1.5-trigloss.csv";
+    let a = request(addr, "POST", "/api/compare", &upload(csv, json!({"delimiter": "|"})), &[]);
+    assert_eq!(a.status, 400, "{}", a.body);
+    let (_, _, err) = cli(&["compare", GLASS, csv, "--delimiter", "|"]);
+    let e = a.json()["error"].as_str().unwrap().to_string();
+    assert!(e.contains("field `/delimiter`") && err.contains("--delimiter"), "{e} / {err}");
+    assert_eq!(e.split_once("must be").unwrap().1, err.trim_end().split_once("must be").unwrap().1);
+}
+
+/// `tolerance` as `compare --tolerance` takes it (docs/serve.md §The API): per reading, as an array of
+/// `KEY=NUMBER` strings or as an object, gives the command line's document; a refused entry is named by its
+/// JSON Pointer with the command line's reason.
+#[test]
+fn per_reading_tolerances_give_the_command_lines_document() {
+    let addr = default_server();
+    let csv = "fixtures/sheets/glass-n1.5-trigloss.csv";
+    let (code, out, err) = cli(&[
+        "compare",
+        GLASS,
+        csv,
+        "--format",
+        "json",
+        "--tolerance",
+        "gloss=0.01",
+        "--tolerance",
+        "astm-d523-60/gloss=1",
+    ]);
+    assert_eq!(code, Some(1), "one reading is inside, two outside: {err}");
+    let cli_doc = as_served(&out, csv);
+    let verdicts: Vec<&Value> = cli_doc["comparisons"].as_array().unwrap().iter().map(|c| &c["verdict"]).collect();
+    assert_eq!(verdicts, [&json!("OUTSIDE"), &json!("ok"), &json!("OUTSIDE")], "{cli_doc}");
+    for tolerance in [json!(["gloss=0.01", "astm-d523-60/gloss=1"]), json!({"gloss": 0.01, "astm-d523-60/gloss": 1})] {
+        let a = request(addr, "POST", "/api/compare", &upload(csv, json!({"tolerance": tolerance})), &[]);
+        assert_eq!(a.status, 200, "{}", a.body);
+        assert_eq!(a.body, report_pretty(&cli_doc), "{tolerance}");
+    }
+    // A plain number is every reading's, as `--tolerance 1` is.
+    let a = request(addr, "POST", "/api/compare", &upload(csv, json!({"tolerance": 1})), &[]);
+    let (_, out, _) = cli(&["compare", GLASS, csv, "--format", "json", "--tolerance", "1"]);
+    assert_eq!(a.json(), as_served(&out, csv));
+    for (tolerance, pointer) in [
+        (json!(["gloss=2", "gloss=x"]), "/tolerance/1"),
+        (json!(["gloss=2", 3]), "/tolerance/1"),
+        (json!({"gloss": "2"}), "/tolerance/gloss"),
+        (json!({"no-such/gloss": 2}), "/tolerance/no-such~1gloss"),
+        (json!(true), "/tolerance"),
+        (json!(["gloss=1", "gloss=2"]), "/tolerance"),
+    ] {
+        let a = request(addr, "POST", "/api/compare", &upload(csv, json!({"tolerance": tolerance})), &[]);
+        assert_eq!(a.status, 400, "{tolerance}: {}", a.body);
+        let e = a.json()["error"].as_str().unwrap().to_string();
+        assert!(e.starts_with(&format!("request: field `{pointer}`: ")), "{tolerance}: {e}");
+    }
+    let a = request(addr, "POST", "/api/compare", &upload(csv, json!({"tolerance": ["gloss=x"]})), &[]);
+    let (code, _, err) = cli(&["compare", GLASS, csv, "--tolerance", "gloss=x"]);
+    assert_eq!(code, Some(2));
+    let e = a.json()["error"].as_str().unwrap().to_string();
+    let why = e.split_once("`/tolerance/0`: ").unwrap().1;
+    assert!(err.contains(why), "the command line gives the same reason: {why:?} in {err}");
+}
+
+/// The server's JSON text of a document (`report::pretty`).
+fn report_pretty(doc: &Value) -> String {
+    glossmeter::report::pretty(doc)
+}
+
+/// Workbook uploads are read as `compare` reads the files (docs/serve.md §The page): an `.xls` and an `.ods`
+/// (and the `.xlsx`) give the command line's document; each hostile workbook of docs/reliability.md
+/// §Workbooks gets 400 with the command line's message.
+#[test]
+fn workbook_uploads_are_answered_as_compare_answers_the_files() {
+    let addr = default_server();
+    for book in [
+        "fixtures/sheets/byk-smart-chart-export.xls",
+        "fixtures/sheets/byk-smart-chart-export.ods",
+        "fixtures/sheets/byk-smart-chart-export.xlsx",
+    ] {
+        let a = request(addr, "POST", "/api/compare", &upload(book, json!({})), &[]);
+        assert_eq!(a.status, 200, "{book}: {}", a.body);
+        let (code, out, err) = cli(&["compare", GLASS, book, "--format", "json"]);
+        assert_eq!(code, Some(0), "{book}: {err}");
+        let cli_doc = as_served(&out, book);
+        assert_eq!(a.body, report_pretty(&cli_doc), "{book}");
+        let cmp = cli_doc["comparisons"].as_array().unwrap();
+        assert_eq!(cmp.len(), 3, "{book}");
+        assert!(cmp.iter().all(|c| c["verdict"] == "ok" && c["n"] == 5), "{book}: {cli_doc}");
+    }
+    let dir = "fixtures/sheets/hostile";
+    let mut names: Vec<String> =
+        std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    names.sort();
+    assert_eq!(names.len(), 10, "{names:?}");
+    for name in &names {
+        let path = format!("{dir}/{name}");
+        let a = request(addr, "POST", "/api/compare", &upload(&path, json!({})), &[]);
+        assert_eq!(a.status, 400, "{name}: {}", a.body);
+        let (code, _, err) = cli(&["compare", GLASS, &path]);
+        assert_eq!(code, Some(2), "{name}: {err}");
+        let served = a.json()["error"].as_str().unwrap().to_string();
+        assert!(served.contains(name.as_str()) && !served.contains("panicked"), "{served}");
+        assert_eq!(served, cli_error(&err, &path, name), "{name}");
+    }
+}
+
+/// `/api/plot` of `kind: gloss-vs-parameter` and `plot --kind gloss-vs-parameter` with the same numbers give the
+/// same SVG, byte for byte: both convert into the library's request and draw with the library's pictures.
+#[test]
+fn a_gloss_vs_parameter_picture_is_the_command_lines_svg() {
+    let addr = default_server();
+    let out = scratch("vs-parameter").join("picture.svg");
+    let (code, _, err) = cli(&[
+        "plot",
+        "fixtures/recipes/black-glass.json",
+        "--kind",
+        "gloss-vs-parameter",
+        "--vary",
+        "/ior=1.4..1.6",
+        "--points",
+        "4",
+        "--rtol",
+        "1e-4",
+        "-g",
+        "astm-d523-20",
+        "-g",
+        "astm-d523-85",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, Some(0), "{err}");
+    let file = std::fs::read_to_string(&out).unwrap();
+    let _ = std::fs::remove_file(&out);
+    let body = json!({"kind": "gloss-vs-parameter", "vary": "/ior=1.4..1.6", "points": 4, "rtol": 1e-4,
+                      "geometries": ["astm-d523-20", "astm-d523-85"]});
+    let a = request(addr, "POST", "/api/plot", &with_recipe(&fixture("black-glass"), body), &[]);
+    assert_eq!(a.status, 200, "{}", a.body);
+    assert!(file.starts_with("<svg") && file.contains("astm-d523-85"), "{file}");
+    assert_eq!(a.body, file);
+}

@@ -50,7 +50,8 @@ def best(fn, repeat):
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--repeat", type=int, default=3)
-    ap.add_argument("--rtol", type=float, default=1e-6)
+    # None: the library's default relative tolerance (DEFAULT_RTOL), not a copy of its value here.
+    ap.add_argument("--rtol", type=float, default=None)
     a = ap.parse_args()
     cases = [
         ("GGX α=0.05 V-cavity", {"model": "microfacet", "distribution": "ggx", "roughness": 0.05, "ior": 1.5,

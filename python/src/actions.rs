@@ -435,11 +435,12 @@ fn target_readings(v: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<String>> {
     Ok(out)
 }
 
-/// fit(recipe, targets=None, free=..., sheet=None, sample=None, uncertainty=0.2, restarts=2, rtol=1e-6,
+/// fit(recipe, targets=None, free=..., sheet=None, sample=None, uncertainty=0.2, restarts=2, rtol=None,
 /// geometries=None, timing=True, delimiter=None, sheet_name=None, header_row=None, ignore_columns=None) -> dict
 ///
 /// Recipe parameters from readings: the `free` parameters fitted to `targets` or to a `sheet`'s `sample`;
-/// the document of `glossmeter fit --format json`. A fit not to be trusted is said in the document
+/// the document of `glossmeter fit --format json`. `rtol` None is the library's default relative tolerance
+/// (`DEFAULT_RTOL`, the one `glossmeter fit --rtol` defaults to). A fit not to be trusted is said in the document
 /// (`reproduces`, `identifiable`, `verdict`), not raised; a fit that cannot run raises RuntimeError.
 #[pyfunction]
 #[pyo3(signature = (recipe, targets=None, *, free, sheet=None, sample=None, uncertainty=None, restarts=None,

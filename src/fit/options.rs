@@ -10,9 +10,9 @@ pub const DEFAULT_UNCERTAINTY: f64 = 0.2;
 /// Knobs of the fit.
 #[derive(Clone, Debug)]
 pub struct FitOptions {
-    /// Relative tolerance of every forward reading. The default is `measure`'s (1e-6): the Jacobians run on
-    /// frozen methods, so their differences do not need a tighter one, and a reading's 1e-6 is far below a
-    /// glossmeter's repeatability (60 GU × 1e-6 = 6·10⁻⁵ GU against 0.2 GU).
+    /// Relative tolerance of every forward reading. The default is `measure`'s, the library's
+    /// [`DEFAULT_RTOL`](crate::DEFAULT_RTOL) (1e-6): the Jacobians run on frozen methods, so their differences
+    /// do not need a tighter one, and a reading's 1e-6 is far below a glossmeter's repeatability (60 GU × 1e-6 = 6·10⁻⁵ GU against 0.2 GU).
     pub rtol: f64,
     /// Uncertainty of a target without one.
     pub default_uncertainty: f64,

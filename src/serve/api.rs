@@ -424,10 +424,24 @@ pub fn run_sweep(s: &Sweep, mut line: impl FnMut(String) -> Result<()>) -> Resul
     Ok(())
 }
 
+/// The body's `delimiter`, `ignore_columns`, `sheet_name` and `header_row`: how the sheet is read, as
+/// `compare --delimiter --ignore-column --sheet-name --header-row` say it (docs/serve.md §The API).
+fn sheet_request(o: &Obj) -> Result<SheetRequest> {
+    Ok(SheetRequest {
+        delimiter: o.opt_str("delimiter")?.map(str::to_owned),
+        ignore_columns: strings(o, "ignore_columns")?,
+        sheet_name: o.opt_str("sheet_name")?.map(str::to_owned),
+        header_row: whole(o, "header_row", 1, 1_000_000, "the header's 1-based row")?,
+    })
+}
+
+/// The fields of a body that say how its sheet is read ([`sheet_request`]).
+const SHEET_FIELDS: &[&str] = &["sheet", "delimiter", "ignore_columns", "sheet_name", "header_row"];
+
 /// The sheet of a request: `{"name": …, "base64": …}` (any file `compare` reads) or `{"name": …, "text": …}`,
-/// read by the same code as `compare`'s files (`comparison::sheet::from_bytes`: text or workbook); `name` names it in
-/// messages and nothing is written to disk.
-fn sheet(o: &Obj) -> Result<Sheet> {
+/// read by the same code as `compare`'s files (`comparison::sheet::from_bytes`: text or workbook) with the
+/// request's options; `name` names it in messages and nothing is written to disk.
+fn sheet(o: &Obj, request: &SheetRequest) -> Result<Sheet> {
     let s = o.obj("sheet")?;
     s.deny_unknown(&["name", "base64", "text"])?;
     let name: String = s.opt_str("name")?.unwrap_or("sheet.csv").chars().take(200).collect();
@@ -441,15 +455,65 @@ fn sheet(o: &Obj) -> Result<Sheet> {
         (None, Some(t)) => t.as_bytes().to_vec(),
         _ => return Err(s.err("text", "give the sheet as `base64` (its bytes) or as `text`, one of the two")),
     };
-    let options = SheetRequest {
-        delimiter: o.opt_str("delimiter")?.map(str::to_owned),
-        ignore_columns: strings(o, "ignore_columns")?,
-        sheet_name: o.opt_str("sheet_name")?.map(str::to_owned),
-        header_row: whole(o, "header_row", 1, 1_000_000, "the header's 1-based row")?,
-    }
-    .options()
-    .map_err(|e| at_field(o, e))?;
+    let options = request.options().map_err(|e| at_field(o, e))?;
     sheet::from_bytes(&bytes, &name, &options)
+}
+
+/// The body's `tolerance` as `compare --tolerance` takes it (docs/serve.md §The API): a number for every
+/// reading; an array of `[KEY=]NUMBER` strings, one per `--tolerance`; or an object `{KEY: NUMBER}`. Each
+/// entry is checked by the command line's parser ([`comparison::parse_tolerance`]) and a refusal names its
+/// element (`/tolerance/1`, `/tolerance/gloss`). The plain number and the entries, for [`CompareRequest`].
+fn tolerances(o: &Obj) -> Result<(Option<f64>, Vec<String>)> {
+    let entry = |pointer: String, text: String| -> Result<String> {
+        comparison::parse_tolerance(&text).map_err(|e| match e {
+            Error::Argument(words) => {
+                let why = match words.leading_argument() {
+                    Some((_, rest)) => rest.naming(&|a| format!("`{a}`")),
+                    None => words.naming(&|a| format!("`{a}`")),
+                };
+                Error::input(REQUEST, pointer, why.trim_start().to_string())
+            }
+            e => e,
+        })?;
+        Ok(text)
+    };
+    match o.get("tolerance") {
+        None => Ok((None, vec![])),
+        Some(Value::Number(_)) => Ok((o.opt_num("tolerance", 0.0, f64::INFINITY, "tolerance")?, vec![])),
+        Some(Value::Array(a)) => {
+            let texts = a
+                .iter()
+                .enumerate()
+                .map(|(i, v)| match v.as_str() {
+                    Some(t) => entry(o.element("tolerance", i), t.to_string()),
+                    None => Err(Error::input(
+                        REQUEST,
+                        o.element("tolerance", i),
+                        format!("expected a string `[KEY=]NUMBER` (`gloss=2`), got {}", kind(v)),
+                    )),
+                })
+                .collect::<Result<Vec<_>>>()?;
+            Ok((None, texts))
+        }
+        Some(Value::Object(m)) => {
+            let at = |key: &str| registry::child(&o.field("tolerance"), key);
+            let texts = m
+                .iter()
+                .map(|(key, v)| match v {
+                    Value::Number(n) => entry(at(key), format!("{key}={n}")),
+                    v => Err(Error::input(REQUEST, at(key), format!("expected a number, got {}", kind(v)))),
+                })
+                .collect::<Result<Vec<_>>>()?;
+            Ok((None, texts))
+        }
+        Some(v) => Err(o.err(
+            "tolerance",
+            format!(
+                "expected a number, an array of `[KEY=]NUMBER` strings or an object {{KEY: NUMBER}}, got {}",
+                kind(v)
+            ),
+        )),
+    }
 }
 
 /// `POST /api/compare`: the sheet beside the recipe's predictions (the one recipe for every sample), as
@@ -457,28 +521,16 @@ fn sheet(o: &Obj) -> Result<Sheet> {
 /// HTTP status is 200 whatever they are.
 pub fn compare(req: &Request, ctx: Context) -> Result<Reply> {
     let o = req.obj();
-    o.deny_unknown(&[
-        "recipe",
-        "sheet",
-        "delimiter",
-        "ignore_columns",
-        "header_row",
-        "k",
-        "tolerance",
-        "max_de00",
-        "rtol",
-        "max_evals",
-        "illuminant",
-        "observer",
-        "format",
-    ])?;
+    let fields = ["recipe", "k", "tolerance", "max_de00", "rtol", "max_evals", "illuminant", "observer", "format"];
+    o.deny_unknown(&[&fields[..], SHEET_FIELDS].concat())?;
+    let (tolerance, tolerances) = tolerances(&o)?;
     let request = CompareRequest {
         k: o.opt_num("k", 0.0, f64::INFINITY, "k")?.unwrap_or(DEFAULT_K),
-        tolerance: o.opt_num("tolerance", 0.0, f64::INFINITY, "tolerance")?,
-        tolerances: vec![],
+        tolerance,
+        tolerances,
         max_de00: o.opt_num("max_de00", 0.0, f64::INFINITY, "largest ΔE00")?,
         plan: plan_request(&o, ctx)?,
-        sheet: SheetRequest::default(),
+        sheet: sheet_request(&o)?,
     };
     let rule = request.rule().map_err(|e| at_field(&o, e))?;
     let max_de00 = request.max_de00().map_err(|e| at_field(&o, e))?;
@@ -487,7 +539,7 @@ pub fn compare(req: &Request, ctx: Context) -> Result<Reply> {
     if !["json", "csv", "junit"].contains(&format) {
         return Err(o.err("format", format!("unknown format {format:?}; allowed: \"json\", \"csv\", \"junit\"")));
     }
-    let sheet = sheet(&o)?;
+    let sheet = sheet(&o, &request.sheet)?;
     let ids = sheet.geometry_ids();
     if ids.len() > ctx.limits.geometries {
         return Err(
@@ -508,19 +560,8 @@ pub fn compare(req: &Request, ctx: Context) -> Result<Reply> {
 /// PATH=log:LO..HI) fitted to `target` readings (GEOMETRY/READING=VALUE[±U]) or to a `sheet`'s `sample`.
 pub fn fit(req: &Request, ctx: Context) -> Result<Reply> {
     let o = req.obj();
-    o.deny_unknown(&[
-        "recipe",
-        "free",
-        "target",
-        "sheet",
-        "sample",
-        "delimiter",
-        "ignore_columns",
-        "header_row",
-        "uncertainty",
-        "restarts",
-        "rtol",
-    ])?;
+    let fields = ["recipe", "free", "target", "sample", "uncertainty", "restarts", "rtol"];
+    o.deny_unknown(&[&fields[..], SHEET_FIELDS].concat())?;
     let l = ctx.limits;
     let rtol = plan_options(&o, ctx, DEFAULT_RTOL)?.rtol;
     let request = FitRequest {
@@ -532,7 +573,7 @@ pub fn fit(req: &Request, ctx: Context) -> Result<Reply> {
         restarts: whole(&o, "restarts", 0, l.fit_restarts, "restarts")?
             .unwrap_or(fit::DEFAULT_RESTARTS.min(l.fit_restarts)),
         rtol,
-        sheet: SheetRequest::default(),
+        sheet: sheet_request(&o)?,
         sample: o.opt_str("sample")?.map(str::to_owned),
     };
     let options = request.options().map_err(|e| at_field(&o, e))?;
@@ -540,11 +581,17 @@ pub fn fit(req: &Request, ctx: Context) -> Result<Reply> {
     if free.len() > l.fit_free {
         return Err(o.err("free", format!("{} free parameters; this server fits at most {}", free.len(), l.fit_free)));
     }
+    if o.get("sheet").is_none() {
+        // As `fit --sheet-name` without `--sheet` is refused: options of no sheet.
+        if let Some(k) = SHEET_FIELDS[1..].iter().find(|k| o.get(k).is_some()) {
+            return Err(o.err(k, "says how a sheet is read, but the request has no `sheet`"));
+        }
+    }
     let sheet = match o.get("sheet") {
         Some(_) if o.get("target").is_some() => {
             return Err(o.err("target", "give `target` readings or a `sheet`, not both"))
         }
-        Some(_) => Some(sheet(&o)?),
+        Some(_) => Some(sheet(&o, &request.sheet)?),
         None => None,
     };
     let targets = request.targets(sheet.as_ref())?.0;
