@@ -24,9 +24,20 @@ pub struct Options {
     pub checked: bool,
 }
 
+/// The relative tolerance when none is given: the one default of the whole library (re-exported as
+/// `instrument::plan::DEFAULT_RTOL` for every request and front end).
+pub const DEFAULT_RTOL: f64 = 1e-6;
+
 impl Default for Options {
     fn default() -> Self {
-        Options { rtol: 1e-6, atol: 0.0, max_evals: 20_000_000, deadline: None, max_shrink: MAX_SHRINK, checked: false }
+        Options {
+            rtol: DEFAULT_RTOL,
+            atol: 0.0,
+            max_evals: 20_000_000,
+            deadline: None,
+            max_shrink: MAX_SHRINK,
+            checked: false,
+        }
     }
 }
 

@@ -47,6 +47,6 @@ pub use polar::{
 };
 
 pub use genz_malik::{
-    integrate, integrate_partition, pointwise, Cell, Estimate, GenzMalikRule, Options, Refine, MAX_SHRINK,
-    MAX_SHRINK_LOBE, MAX_SHRINK_PLAIN,
+    integrate, integrate_partition, pointwise, Cell, Estimate, GenzMalikRule, Options, Refine, DEFAULT_RTOL,
+    MAX_SHRINK, MAX_SHRINK_LOBE, MAX_SHRINK_PLAIN,
 };

@@ -105,8 +105,9 @@ pub(crate) const DATA_PILOT_RTOL: [f64; 3] = [1e-2, 1e-3, 1e-4];
 pub(crate) const DATA_RESOLVED: f64 = 2.0;
 
 /// The relative tolerance of every reading when none is given: the one default of every request and front
-/// end (`crate::request`), and of [`PlanOptions::default`].
-pub const DEFAULT_RTOL: f64 = 1e-6;
+/// end (`crate::request`), of [`PlanOptions::default`] and of the integrator's own options (defined on the
+/// integrator's floor, `quadrature::DEFAULT_RTOL`, which the instrument stands on).
+pub use crate::quadrature::DEFAULT_RTOL;
 
 /// What a front end asks of a plan: the tolerance, the budgets, the colour conditions and the stop signal.
 /// Every field is a user's choice; the engine's own switches, kept to measure what each optimisation saves,
