@@ -820,7 +820,7 @@ fn workbook_uploads_are_answered_as_compare_answers_the_files() {
     let mut names: Vec<String> =
         std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
     names.sort();
-    assert_eq!(names.len(), 10, "{names:?}");
+    assert_eq!(names.len(), 11, "{names:?}");
     for name in &names {
         let path = format!("{dir}/{name}");
         let a = request(addr, "POST", "/api/compare", &upload(&path, json!({})), &[]);

@@ -2019,7 +2019,10 @@ pub fn generate_workbook(rng: &mut Rng, seeds: &Seeds) -> String {
 /// field or line; a cell's name its sheet and cell.
 pub fn run_workbook(path: &str) -> Result<Outcome, String> {
     let bytes = std::fs::read(path).map_err(|e| format!("the case's file {path}: {e}"))?;
-    let _ = std::fs::remove_file(path);
+    // GLOSSMETER_FUZZ_KEEP=1 keeps the file, to replay a case by hand (docs/reliability.md §Replaying a case).
+    if std::env::var_os("GLOSSMETER_FUZZ_KEEP").is_none() {
+        let _ = std::fs::remove_file(path);
+    }
     let name = "fuzz.xlsx";
     match sheet::from_bytes(&bytes, name, &sheet::SheetOptions::default()) {
         Ok(sheet) => {

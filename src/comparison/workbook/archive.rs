@@ -49,6 +49,7 @@ pub fn check(bytes: &[u8], file: &str) -> Result<ZipKind> {
                 .into(),
         ));
     };
+    check_xml_closed(&mut zip, file)?;
     match kind {
         ZipKind::Xlsx => check_shared_strings(&mut zip, file)?,
         ZipKind::Ods => check_ods_extent(&mut zip, file)?,
@@ -108,6 +109,43 @@ fn check_member(zip: &mut Archive, i: usize, file: &str, total: u64) -> Result<u
         return Err(corrupt(format!("has CRC-32 {crc:08x}, but the archive records {:08x} (bad CRC)", m.crc32())));
     }
     Ok(n)
+}
+
+/// Every XML member ends with its elements closed and is well-formed as far as an XML reader follows it: calamine's
+/// readers loop on an `.ods` `content.xml` cut short inside its table (they wait for an end tag that never comes),
+/// so a member that ends inside an element, or that the reader cannot follow, is refused here first.
+fn check_xml_closed(zip: &mut Archive, file: &str) -> Result<()> {
+    let names: Vec<String> =
+        zip.file_names().filter(|n| n.to_ascii_lowercase().ends_with(".xml")).map(str::to_string).collect();
+    for name in names {
+        let Some(bytes) = member(zip, &name) else { continue };
+        if let Some(why) = unclosed(&bytes) {
+            return Err(Error::input(file, name.as_str(), why));
+        }
+    }
+    Ok(())
+}
+
+/// Why an XML text is cut short or cannot be followed (None: every element it opens is closed).
+fn unclosed(bytes: &[u8]) -> Option<String> {
+    let mut r = quick_xml::Reader::from_reader(bytes);
+    let (mut buf, mut depth) = (vec![], 0usize);
+    loop {
+        match r.read_event_into(&mut buf) {
+            Ok(Event::Start(_)) => depth += 1,
+            Ok(Event::End(_)) => depth = depth.saturating_sub(1),
+            Ok(Event::Eof) if depth == 0 => return None,
+            Ok(Event::Eof) => {
+                return Some(format!(
+                    "the XML ends inside {depth} open element{} (the workbook is cut short or damaged)",
+                    if depth == 1 { "" } else { "s" }
+                ))
+            }
+            Err(e) => return Some(format!("not well-formed XML at byte {}: {e}", r.error_position())),
+            _ => {}
+        }
+        buf.clear();
+    }
 }
 
 /// The member of that name (ASCII case ignored), decompressed (its size was checked).
@@ -279,6 +317,16 @@ impl OdsTable {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Found by the 10⁶-case fuzz run of 2026-12-06 (case 158049): an `.ods` whose `content.xml` ends after a
+    /// row, inside its table, kept calamine's reader waiting for the end tag for good.
+    #[test]
+    fn a_member_cut_short_inside_an_element_is_named() {
+        assert_eq!(unclosed(b"<a><b/></a>"), None);
+        let why = unclosed(b"<a><t><r></r>").unwrap();
+        assert!(why.contains("inside 2 open elements"), "{why}");
+        assert!(unclosed(b"<a></b>").unwrap().contains("not well-formed"));
+    }
 
     /// Found by the 10⁶-case fuzz run: a cell repeated 2³² − 1 times in a row whose end tag never comes
     /// (calamine read on and expanded it for minutes) is over the limit while its row is read.

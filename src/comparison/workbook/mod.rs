@@ -346,6 +346,7 @@ mod hostile {
         for (name, words) in [
             ("crc-stored.xlsx", "bad CRC"),
             ("far-cells.xlsx", "at most 1000000 cells"),
+            ("ods-content-cut-short.ods", "ends inside"),
             ("sst-reserve.xlsx", "uniqueCount"),
             ("xls-alloc-4GiB.xls", "chain"),
             ("xls-dim-reversed.xls", "reversed DIMENSIONS"),
