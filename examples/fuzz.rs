@@ -30,7 +30,8 @@
 mod fuzz_cases;
 
 use std::collections::BTreeMap;
-use std::time::Instant;
+use std::sync::Mutex;
+use std::time::{Duration, Instant};
 
 use fuzz_cases::{case_text, check_readings, run_case, Category, Outcome, Rng, Seeds, BINARY};
 use glossmeter::{measure, resolve_geometries, PlanOptions, DEFAULT_PANEL};
@@ -57,6 +58,32 @@ const SLOW_S: f64 = 20.0;
 /// command line, [`fuzz_cases::CLI_TIMEOUT_S`].
 const HANG_S: f64 = fuzz_cases::CLI_TIMEOUT_S;
 
+/// The watchdog's bound: a case's own bound ([`HANG_S`], which a command line's timeout enforces) and a margin,
+/// so that a command line killed at its timeout is reported by the loop, not by the watchdog.
+const WATCHDOG_S: f64 = HANG_S + 30.0;
+
+/// The case running now (its number, its text, when it or its measurement started), for [`watchdog`].
+static CURRENT: Mutex<Option<(usize, String, Instant)>> = Mutex::new(None);
+
+/// Mark the case `k` running (or, with `None`, nothing).
+fn running(now: Option<(usize, &str)>) {
+    *CURRENT.lock().unwrap() = now.map(|(k, text)| (k, text.to_string(), Instant::now()));
+}
+
+/// A case that never returns (a reader waiting for good) would stall the loop, which checks a case's time only
+/// once it returns: this thread ends the run with the case named once it has run [`WATCHDOG_S`].
+fn watchdog() {
+    std::thread::spawn(|| loop {
+        std::thread::sleep(Duration::from_secs(1));
+        if let Some((k, text, t0)) = CURRENT.lock().unwrap().as_ref() {
+            if t0.elapsed().as_secs_f64() > WATCHDOG_S {
+                eprintln!("FAILURE case {k}: a hang, no answer after {WATCHDOG_S:.0} s on {text:?}");
+                std::process::exit(1);
+            }
+        }
+    });
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let arg = |i: usize, d: u64| args.get(i).and_then(|s| s.parse().ok()).unwrap_or(d);
@@ -72,6 +99,7 @@ fn main() {
     assert!(bin.exists(), "{} not built: cargo build --release --bin glossmeter first", bin.display());
     BINARY.set(bin).unwrap();
     std::panic::set_hook(Box::new(|_| {}));
+    watchdog();
     let seeds = Seeds::load();
     let panel = resolve_geometries(DEFAULT_PANEL, &[] as &[&str]).unwrap();
     let light = PlanOptions { rtol: 1e-3, max_evals: 200_000, max_seconds: Some(1.0), ..PlanOptions::default() };
@@ -95,7 +123,10 @@ fn main() {
         let text = case_text(cat, &seeds, &mut rng);
         let t = tally.entry(cat).or_default();
         t.cases += 1;
-        match std::panic::catch_unwind(|| run_case(cat, &text)) {
+        running(Some((k, &text)));
+        let outcome = std::panic::catch_unwind(|| run_case(cat, &text));
+        running(None);
+        match outcome {
             Err(_) => {
                 t.failures += 1;
                 failures.push(format!("case {k} ({}): panic on {text:?}", cat.name()));
@@ -121,7 +152,9 @@ fn main() {
                     if let Some(opts) = which {
                         let is_full = std::ptr::eq(opts, &full);
                         let t1 = Instant::now();
+                        running(Some((k, &text)));
                         let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| measure(&m, &panel, opts)));
+                        running(None);
                         let secs = t1.elapsed().as_secs_f64();
                         let verdict = match r {
                             Err(_) => Err("panic while measuring".to_string()),
