@@ -11,15 +11,10 @@
 //! a check that cannot run does not pass. What needs no tool (exit statuses, counts, class names, numbers
 //! without noise, read by quick-xml) runs in every `cargo test`.
 mod common;
-use common::tmp;
+use common::{gm_out, tmp};
 use std::process::Command;
 
 use serde_json::Value;
-
-fn gm(args: &[&str]) -> (i32, String) {
-    let out = common::glossmeter().args(args).output().expect("run glossmeter");
-    (out.status.code().unwrap_or(-1), String::from_utf8_lossy(&out.stdout).into_owned())
-}
 
 fn xmllint(file: &std::path::Path) {
     let out = Command::new("xmllint")
@@ -113,7 +108,7 @@ fn reports() -> Vec<(&'static str, String, usize, usize, usize)> {
         .map(|&(label, args, status, tests, failures, skipped)| {
             let mut a = args.to_vec();
             a.extend(["--format", "junit"]);
-            let (code, xml) = gm(&a);
+            let (code, xml) = gm_out(&a);
             assert_eq!(code, status, "{label}: {xml}");
             (label, xml, tests, failures, skipped)
         })
@@ -191,8 +186,9 @@ fn baseline_report() -> String {
     let base = tmp("baseline.json");
     let _ = std::fs::remove_file(&base);
     let b = base.to_str().unwrap();
-    assert_eq!(gm(&["compare", sheet, "--recipe-dir", "fixtures/recipes", "--format", "json", "-o", b]).0, 0);
-    let (code, xml) = gm(&["compare", sheet, "--recipe-dir", "fixtures/recipes", "--baseline", b, "--format", "junit"]);
+    assert_eq!(gm_out(&["compare", sheet, "--recipe-dir", "fixtures/recipes", "--format", "json", "-o", b]).0, 0);
+    let (code, xml) =
+        gm_out(&["compare", sheet, "--recipe-dir", "fixtures/recipes", "--baseline", b, "--format", "junit"]);
     assert_eq!(code, 0);
     xml
 }
@@ -223,9 +219,9 @@ fn a_baseline_suite_validates_too() {
 #[test]
 fn csv_numbers_are_rounded_to_their_precision_and_json_keeps_every_digit() {
     let args = ["compare", "fixtures/recipes/glass-n1.5.json", "fixtures/sheets/byk-smart-chart-export.xlsx"];
-    let (_, csv) = gm(&[&args[..], &["--format", "csv"]].concat());
+    let (_, csv) = gm_out(&[&args[..], &["--format", "csv"]].concat());
     assert!(!has_noise(&csv), "{csv}");
-    let (_, json) = gm(&[&args[..], &["--format", "json"]].concat());
+    let (_, json) = gm_out(&[&args[..], &["--format", "json"]].concat());
     let doc: Value = serde_json::from_str(&json).unwrap();
     let mut rdr = csv::Reader::from_reader(csv.as_bytes());
     let head = rdr.headers().unwrap().clone();

@@ -2,13 +2,9 @@
 //! `jsonschema` crate (draft 2020-12), so a field added to an output without its schema fails here, and so does
 //! a schema that is not a valid JSON Schema.
 mod common;
+use common::gm_out;
 
 use serde_json::Value;
-
-fn gm(args: &[&str]) -> (i32, String) {
-    let out = common::glossmeter().args(args).output().expect("run glossmeter");
-    (out.status.code().unwrap_or(-1), String::from_utf8_lossy(&out.stdout).into_owned())
-}
 
 /// Every violation, as "pointer: what".
 fn violations(s: &Value, v: &Value) -> Vec<String> {
@@ -17,7 +13,7 @@ fn violations(s: &Value, v: &Value) -> Vec<String> {
 }
 
 fn schema(kind: &str) -> Value {
-    let (code, text) = gm(&["schema", "--output-format", kind]);
+    let (code, text) = gm_out(&["schema", "--output-format", kind]);
     assert_eq!(code, 0);
     let s: Value = serde_json::from_str(&text).unwrap();
     assert_eq!(s["$schema"], "https://json-schema.org/draft/2020-12/schema", "{kind}");
@@ -41,7 +37,7 @@ fn outputs_follow_their_schemas() {
     let base = dir.join("glass-n1.5.json");
     let base = base.to_str().unwrap();
     let glass = "fixtures/recipes/glass-n1.5.json";
-    assert_eq!(gm(&["measure", glass, "-g", "astm-d523-60", "--format", "json", "-o", base]).0, 0);
+    assert_eq!(gm_out(&["measure", glass, "-g", "astm-d523-60", "--format", "json", "-o", base]).0, 0);
     let m = schema("measure");
     for args in [
         &["measure", "fixtures/recipes/glass-n1.5.json", "--format", "json"][..],
@@ -72,15 +68,15 @@ fn outputs_follow_their_schemas() {
             base,
         ],
     ] {
-        let (_, out) = gm(args);
+        let (_, out) = gm_out(args);
         assert_valid(&m, &serde_json::from_str(&out).unwrap(), &format!("{args:?}"));
     }
     // A reading without a value (the DOI of a black body) and a note (the D4039 scope) are in the schema too.
-    let (_, out) = gm(&["measure", "fixtures/recipes/phong.json", "--format", "json"]);
+    let (_, out) = gm_out(&["measure", "fixtures/recipes/phong.json", "--format", "json"]);
     assert_valid(&m, &serde_json::from_str(&out).unwrap(), "phong");
     // A recipe that states uncertainties: each reading's prediction_uncertainty and its budget.
     let (code, out) =
-        gm(&["measure", "fixtures/uncertainty/semigloss-white.json", "-g", "astm-d523-60", "--format", "json"]);
+        gm_out(&["measure", "fixtures/uncertainty/semigloss-white.json", "-g", "astm-d523-60", "--format", "json"]);
     assert_eq!(code, 0);
     let doc: Value = serde_json::from_str(&out).unwrap();
     assert_eq!(doc["readings"][0]["uncertainty_budget"].as_array().map(Vec::len), Some(2), "{out}");
@@ -92,7 +88,7 @@ fn outputs_follow_their_schemas() {
         ("glass-n1.5.json", "tab-separated.csv"),
         ("blue-metallic-spectral.json", "colour-blue-metallic.csv"),
     ] {
-        let (_, out) = gm(&[
+        let (_, out) = gm_out(&[
             "compare",
             &format!("fixtures/recipes/{recipe}"),
             &format!("fixtures/sheets/{sheet}"),
@@ -105,7 +101,7 @@ fn outputs_follow_their_schemas() {
         }
         assert_valid(&c, &doc, sheet);
     }
-    let (_, out) = gm(&[
+    let (_, out) = gm_out(&[
         "compare",
         "fixtures/sheets/qc-many-samples.csv",
         "--recipe-dir",
@@ -118,7 +114,7 @@ fn outputs_follow_their_schemas() {
     assert_valid(&c, &serde_json::from_str(&out).unwrap(), "many samples with a baseline");
     // Recipes that state uncertainties: each comparison's prediction_uncertainty, its budget, and the
     // allowance's parts.
-    let (code, out) = gm(&[
+    let (code, out) = gm_out(&[
         "compare",
         "fixtures/sheets/byk-smart-chart-two-samples.csv",
         "--recipe",
@@ -136,7 +132,7 @@ fn outputs_follow_their_schemas() {
     );
     assert_valid(&c, &doc, "stated uncertainties");
     let s = schema("sweep");
-    let (code, out) = gm(&[
+    let (code, out) = gm_out(&[
         "sweep",
         "fixtures/recipes/rgb-lambert.json",
         "--vary",
@@ -206,7 +202,7 @@ fn outputs_follow_their_schemas() {
             "json",
         ],
     ] {
-        let (code, out) = gm(args);
+        let (code, out) = gm_out(args);
         assert!(code == 0 || code == 1, "{args:?}: exit {code}");
         let doc: Value = serde_json::from_str(&out).unwrap_or_else(|e| panic!("{args:?}: {e}: {out}"));
         assert_valid(&f, &doc, &format!("{args:?}"));
@@ -218,7 +214,7 @@ fn outputs_follow_their_schemas() {
 #[test]
 fn the_schemas_refuse_what_no_output_holds() {
     let m = schema("measure");
-    let (_, out) = gm(&["measure", "fixtures/recipes/glass-n1.5.json", "-g", "astm-d523-60", "--format", "json"]);
+    let (_, out) = gm_out(&["measure", "fixtures/recipes/glass-n1.5.json", "-g", "astm-d523-60", "--format", "json"]);
     let good: Value = serde_json::from_str(&out).unwrap();
     assert!(violations(&m, &good).is_empty());
     let bad = |f: &dyn Fn(&mut Value)| {
@@ -263,7 +259,7 @@ fn profile_and_convergence_follow_their_schemas() {
         &["profile", "fixtures/recipes/black-glass.json", "--format", "json"][..],
         &["profile", "fixtures/recipes/black-glass.json", "--format", "json", "--max-total-evals", "1000"],
     ] {
-        let (_, text) = gm(args);
+        let (_, text) = gm_out(args);
         let v: Value = serde_json::from_str(&text).unwrap_or_else(|e| panic!("{args:?}: {e}: {text}"));
         assert!(v["rows"].as_array().is_some_and(|r| !r.is_empty()), "{args:?}");
         assert_valid(&p, &v, &format!("{args:?}"));
@@ -283,7 +279,7 @@ fn profile_and_convergence_follow_their_schemas() {
             "--max-repetitions",
             "1",
         ];
-        let (code, text) = gm(&args);
+        let (code, text) = gm_out(&args);
         assert_eq!(code, 0, "{args:?}");
         let v: Value = serde_json::from_str(&text).unwrap();
         assert_valid(&c, &v, &format!("{args:?}"));
@@ -310,7 +306,7 @@ fn sheets_as_read_follow_their_schema() {
         assert_eq!(doc["rows"].as_array().unwrap().len(), sheet.rows.len(), "{file}");
     }
     // The `sheet` part is `compare`'s own.
-    let (_, text) = gm(&[
+    let (_, text) = gm_out(&[
         "compare",
         "fixtures/recipes/black-glass.json",
         "fixtures/sheets/black-glass-check.csv",
@@ -329,7 +325,7 @@ fn sheets_as_read_follow_their_schema() {
 fn topography_follows_its_schema() {
     let s = schema("topography");
     for file in ["fixtures/topography/gaussian.x3p", "fixtures/topography/gaussian-masked.x3p"] {
-        let (code, text) = gm(&["topography", file, "--format", "json"]);
+        let (code, text) = gm_out(&["topography", file, "--format", "json"]);
         assert_eq!(code, 0, "{file}");
         let v: Value = serde_json::from_str(&text).unwrap();
         assert_valid(&s, &v, file);
@@ -337,8 +333,16 @@ fn topography_follows_its_schema() {
     // A flat map has no skewness nor kurtosis: nulls, which the schema allows.
     let flat = std::env::temp_dir().join(format!("glossmeter-schemas-flat-{}.csv", std::process::id()));
     std::fs::write(&flat, "1 1 1\n1 1 1\n1 1 1\n").unwrap();
-    let (code, text) =
-        gm(&["topography", flat.to_str().unwrap(), "--format", "json", "--pixel-size", "1um", "--height-unit", "um"]);
+    let (code, text) = gm_out(&[
+        "topography",
+        flat.to_str().unwrap(),
+        "--format",
+        "json",
+        "--pixel-size",
+        "1um",
+        "--height-unit",
+        "um",
+    ]);
     assert_eq!(code, 0);
     let v: Value = serde_json::from_str(&text).unwrap();
     assert!(v["heights"]["ssk"].is_null());

@@ -2,7 +2,7 @@
 //! invalid points reported in their row, bad sweeps refused (exit 2), and results that do not depend on the
 //! thread count or on how many recipes are measured together.
 mod common;
-use common::fresh_dir;
+use common::{fresh_dir, gm};
 use std::process::Command;
 
 fn gm_env(args: &[&str], threads: Option<&str>) -> (i32, String, String) {
@@ -17,10 +17,6 @@ fn gm_env(args: &[&str], threads: Option<&str>) -> (i32, String, String) {
         String::from_utf8_lossy(&out.stdout).into_owned(),
         String::from_utf8_lossy(&out.stderr).into_owned(),
     )
-}
-
-fn gm(args: &[&str]) -> (i32, String, String) {
-    gm_env(args, None)
 }
 
 const T: &str = "fixtures/recipes/rgb-lambert.json";

@@ -29,6 +29,12 @@ pub fn gm(args: &[&str]) -> (i32, String, String) {
     )
 }
 
+/// Run `glossmeter ARGS`: its exit status and standard output (standard error left out).
+pub fn gm_out(args: &[&str]) -> (i32, String) {
+    let (code, out, _) = gm(args);
+    (code, out)
+}
+
 /// This test binary's own temporary directory (one per binary and process, created).
 fn own_dir() -> PathBuf {
     let d = std::env::temp_dir().join(format!("glossmeter-{}-{}", env!("CARGO_CRATE_NAME"), std::process::id()));
