@@ -17,9 +17,12 @@ pub(crate) const MAGIC_COMPRESSED: &[u8] = b"DSCOMPRESSED";
 /// The header's size, bytes.
 pub(crate) const HEADER: usize = 512;
 
-/// The object type of a surface (1 is a profile, 3 a binary image, 4 and 5 series, 6 and later intensity,
-/// spectral and RGB objects).
+/// The object type of a surface (3 is a binary image, 4 and 5 series, 6 and later intensity, spectral and RGB
+/// objects).
 const SURFACE: i16 = 2;
+
+/// The object type of a profile.
+const PROFILE: i16 = 1;
 
 fn i16_at(b: &[u8], at: usize) -> i16 {
     i16::from_le_bytes([b[at], b[at + 1]])
@@ -72,10 +75,15 @@ fn header(b: &[u8], file: &str) -> Result<Header> {
         ));
     }
     let kind = i16_at(b, 18);
-    if kind != SURFACE {
+    // Gwyddion's export writes a surface with the profile's type (surfalize reads it so): a "profile" of at
+    // least two lines is read as the surface it is; one of a single line is refused with the dimensions.
+    if kind != SURFACE && kind != PROFILE {
         return Err(bad(
             "object type",
-            format!("{kind} is not a surface; allowed: {SURFACE} (profiles, series and images are not read)"),
+            format!(
+                "{kind} is not a surface; allowed: {SURFACE} (or {PROFILE} with at least 2 lines; series and images \
+                 are not read)"
+            ),
         ));
     }
     let points_size = i16_at(b, 98);
@@ -241,7 +249,11 @@ mod tests {
             b
         };
         assert!(e(&set(12, &257i16.to_le_bytes())).contains("field `format`"));
-        assert!(e(&set(18, &1i16.to_le_bytes())).contains("field `object type`"));
+        assert!(e(&set(18, &3i16.to_le_bytes())).contains("field `object type`"));
+        assert!(read(&set(18, &1i16.to_le_bytes()), "t.sur").is_ok());
+        let mut profile = sur(2, 1, &[0; 2], 0, false);
+        profile[18..20].copy_from_slice(&1i16.to_le_bytes());
+        assert!(e(&profile).contains("2 × 1 points is not a surface"));
         assert!(e(&set(98, &8i16.to_le_bytes())).contains("field `point size`"));
         assert!(e(&set(108, &(-2i32).to_le_bytes())).contains("field `number of points per line`"));
         assert!(e(&set(108, &i32::MAX.to_le_bytes())).contains("too large"));
