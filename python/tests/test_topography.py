@@ -68,7 +68,10 @@ def test_a_mask_and_nan_heights_are_invalid_points():
     # NaN marks the same points.
     zn = z.astype(float)
     zn[~valid] = np.nan
-    same_but_source(glossmeter.topography(zn, dx_um=1.0, unit="nm"), glossmeter.topography(z, dx_um=1.0, unit="nm", mask=valid))
+    same_but_source(
+        glossmeter.topography(zn, dx_um=1.0, unit="nm"),
+        glossmeter.topography(z, dx_um=1.0, unit="nm", mask=valid),
+    )
     want = expected("gaussian_masked")
     doc = glossmeter.topography(zn, dx_um=1.0, unit="nm")
     assert doc["heights"]["sq_um"] == pytest.approx(want["sq_um"], rel=1e-9)
