@@ -65,6 +65,14 @@ fn every_reader_agrees_with_numpy_on_the_same_surface() {
     close(&masked, &expected("gaussian_masked"), 1e-9, "gaussian-masked.x3p");
     let map = glossmeter::topography::load(Path::new(&format!("{DIR}/gaussian-masked.x3p")), None).unwrap();
     assert_eq!(map.nx * map.ny - map.valid(), 3);
+    // Digital Surf: i32 counts of an f32 Z step plus an offset, three points non-measured; NumPy computed its
+    // statistics on the same heights.
+    let (f, sur) = read("gaussian.sur", None);
+    assert_eq!(f, Format::Sur);
+    close(&sur, &expected("gaussian_sur"), 1e-9, "gaussian.sur");
+    let map = glossmeter::topography::load(Path::new(&format!("{DIR}/gaussian.sur")), None).unwrap();
+    assert_eq!(map.nx * map.ny - map.valid(), 3);
+    assert!(map.z[3].is_nan() && map.z[20 * 64 + 10].is_nan() && map.z[64 * 64 - 1].is_nan());
 }
 
 #[test]
@@ -94,7 +102,7 @@ fn the_command_prints_the_statistics_and_refuses_what_it_cannot_read() {
         doc["slopes"]["angle_histogram"].as_array().unwrap().iter().map(|b| b["fraction"].as_f64().unwrap()).sum();
     assert!((total - 1.0).abs() < 1e-12);
     // The table, every format, and a text matrix with its calibration.
-    for file in ["gaussian.gsf", "gaussian-text.sdf", "gaussian-binary.sdf", "gaussian-masked.x3p"] {
+    for file in ["gaussian.gsf", "gaussian-text.sdf", "gaussian-binary.sdf", "gaussian-masked.x3p", "gaussian.sur"] {
         assert_eq!(run(["glossmeter", "topography", &format!("{DIR}/{file}")]), 0, "{file}");
     }
     let csv = "fixtures/topography/gaussian.csv";
@@ -142,6 +150,20 @@ fn bad_files_exit_2_naming_the_file_and_the_field() {
     let gsf = std::fs::read(format!("{DIR}/gaussian.gsf")).unwrap();
     let e = refused("truncated.gsf", &gsf[..gsf.len() - 4], &[]);
     assert!(e.contains("field `data`") && e.contains("truncated"), "{e}");
+    let sur = std::fs::read(format!("{DIR}/gaussian.sur")).unwrap();
+    let e = refused("truncated.sur", &sur[..sur.len() - 4], &[]);
+    assert!(e.contains("field `data`") && e.contains("truncated"), "{e}");
+    let e = refused("short.sur", &sur[..100], &[]);
+    assert!(e.contains("field `header`") && e.contains("truncated"), "{e}");
+    // A hostile SUR header: 2³¹ − 1 points a line, refused before anything is allocated; a point size of 8 bits.
+    let mut huge = sur.clone();
+    huge[108..112].copy_from_slice(&i32::MAX.to_le_bytes());
+    let e = refused("huge.sur", &huge, &[]);
+    assert!(e.contains("too large") && e.contains("field `number of points per line`"), "{e}");
+    let mut bits = sur.clone();
+    bits[98..100].copy_from_slice(&8i16.to_le_bytes());
+    let e = refused("bits.sur", &bits, &[]);
+    assert!(e.contains("field `point size`") && e.contains("16 or 32"), "{e}");
     // Inconsistent dimensions: a ragged matrix; an SDF whose header says more points than it has.
     let e = refused("ragged.csv", b"1 2 3\n4 5 6\n7 8\n", &cal);
     assert!(e.contains("field `line 3`"), "{e}");

@@ -14,7 +14,10 @@ written, the same heights each time, as:
 * gaussian.gsf          Gwyddion Simple Field (f32 heights: compared at f32 precision);
 * gaussian-text.sdf     ISO 25178-71 text form, DataType 7 (f64), Zscale 1e-9 (heights in nm, 17 digits);
 * gaussian-binary.sdf   ISO 25178-71 binary form, DataType 7 (f64);
-* gaussian.csv          a comma-separated matrix in µm (17 digits): read with --pixel-size 1um --height-unit um.
+* gaussian.csv          a comma-separated matrix in µm (17 digits): read with --pixel-size 1um --height-unit um;
+* gaussian.sur          Digital Surf (docs/topography.md §Digital Surf SUR): 32-bit integers, Z step 1e-5 µm (as
+                        f32), Z offset 0.5 µm, a comment and a private zone, the points of INVALID non-measured
+                        (zmin − 2).
 
 Usage: python3 tools/make_topography_fixtures.py  (from the repository root; NumPy ≥ 1.17).
 """
@@ -29,7 +32,7 @@ import numpy as np
 OUT = "fixtures/topography/"
 NX, NY, DX = 64, 64, 1e-6
 SQ, ELL = 0.1e-6, 8e-6
-INVALID = [(3, 0), (10, 20), (63, 63)]  # (i, j) points masked in gaussian-masked.x3p
+INVALID = [(3, 0), (10, 20), (63, 63)]  # (i, j) points masked in gaussian-masked.x3p and gaussian.sur
 
 
 def surface():
@@ -114,6 +117,39 @@ def x3p(path, xml, members):
     open(path, "wb").write(buf.getvalue())
 
 
+def sur(path, z, mask):
+    """Write z (metres) as a Digital Surf .sur surface, its masked points non-measured; return the heights, metres,
+    as a reader computes them from the file (value·Δz + offset in µm, Δz and the offset the header's f32)."""
+    dz = float(np.float32(1e-5))  # µm a count
+    offset = 0.5  # µm
+    zi = np.round((z * 1e6 - offset) / dz).astype("<i4")
+    zmin, zmax = int(zi.min()), int(zi.max())
+    zi[~mask] = zmin - 2
+    comment, private = b"Gaussian random surface, seed 41", b"\x01\x02\x03\x04\x05\x06\x07\x08"
+    h = bytearray(512)
+
+    def put(at, fmt, *v):
+        struct.pack_into("<" + fmt, h, at, *v)
+
+    put(0, "12s", b"DIGITAL SURF")
+    put(12, "3h", 0, 1, 1)  # PC format, one object, version 1
+    put(18, "h", 2)  # a surface
+    put(20, "30s", b"gaussian")
+    put(86, "h", 1)  # non-measured points present
+    put(98, "h", 32)
+    put(100, "5i", zmin, zmax, NX, NY, NX * NY)
+    put(120, "3f", DX * 1e6, DX * 1e6, dz)
+    for k, name in enumerate([b"X", b"Y", b"Z"] + [b"\xb5m"] * 6):  # axis names, step units, length units (Latin-1)
+        put(132 + 16 * k, "16s", name)
+    put(276, "3f", 1.0, 1.0, 1.0)
+    put(334, "2h", len(comment), len(private))
+    put(474, "f", offset)
+    open(path, "wb").write(bytes(h) + comment + private + zi.tobytes())
+    dz_m = float(np.float32(dz)) * 1e-6
+    zs = zi.astype(float) * dz_m + float(np.float32(offset)) * 1e-6
+    return np.where(mask, zs, 0.0)
+
+
 def main():
     z = surface()
     link = "<DataLink><PointDataLink>bindata/data.bin</PointDataLink><MD5ChecksumPointData>{}</MD5ChecksumPointData></DataLink>"
@@ -151,12 +187,15 @@ def main():
         "# Gaussian random surface (tools/make_topography_fixtures.py): heights in um, 1 um apart\n"
         + "\n".join(",".join(repr(float(v)) for v in row) for row in z * 1e6) + "\n")
 
+    zs_m = sur(OUT + "gaussian.sur", z, mask)
+
     zi_m = zi.astype(float) * 1e-9
     expected = {
         "provenance": "tools/make_topography_fixtures.py (NumPy), plane levelling, cells' bilinear gradients",
         "gaussian": stats(z, DX, DX),
         "gaussian_masked": stats(zi_m, DX, DX, mask),
         "gaussian_f32": stats(z.astype("<f4").astype(float), DX, DX),
+        "gaussian_sur": stats(zs_m, DX, DX, mask),
     }
     open(OUT + "expected.json", "w").write(json.dumps(expected, indent=1) + "\n")
 

@@ -41,6 +41,7 @@ from ._glossmeter import (
     geometry,
     schema,
     standards,
+    topography,
 )
 from ._types import (
     Allowance,
@@ -153,6 +154,7 @@ __all__ = [
     "sweep",
     "sweep_rows",
     "to_arrays",
+    "topography",
     "to_frame",
 ]
 

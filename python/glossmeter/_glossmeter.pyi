@@ -1,6 +1,10 @@
 """Stubs of the compiled module ``glossmeter._glossmeter`` (python/src/lib.rs, python/src/pybrdf.rs). The
 public API is ``glossmeter`` (``__init__.py``), which re-exports these with ``as_frame``/``as_arrays`` added."""
+import os
 from typing import Any, Dict, List, Literal, Optional, Sequence, Union
+
+import numpy as np
+import numpy.typing as npt
 
 from ._types import (
     BrdfFunction,
@@ -121,5 +125,13 @@ def convergence(
     max_repetitions: Optional[int] = None,
     reference_run: bool = False,
 ) -> ConvergenceReport: ...
+def topography(
+    source: Union[npt.NDArray[Any], str, os.PathLike[str]],
+    dx_um: Optional[float] = None,
+    dy_um: Optional[float] = None,
+    unit: Optional[Literal["m", "mm", "um", "µm", "nm", "pm"]] = None,
+    mask: Optional[npt.NDArray[np.bool_]] = None,
+    levelling: Optional[str] = None,
+) -> Dict[str, Any]: ...
 def _cli(argv: List[str]) -> int: ...
 def _panic() -> None: ...

@@ -24,6 +24,7 @@ mod actions;
 mod args;
 mod probe;
 mod pybrdf;
+mod topography;
 
 /// A library error as the Python exception a caller expects, with the message the CLI prints after
 /// "error: " (an argument it names as its keyword, `` `vary` ``, where the CLI writes `--vary`: [`args::keyword`]). Bad
@@ -420,6 +421,7 @@ fn _glossmeter(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(_cli, m)?)?;
     m.add_function(wrap_pyfunction!(_panic, m)?)?;
     m.add_function(wrap_pyfunction!(pybrdf::measure_brdf, m)?)?;
+    m.add_function(wrap_pyfunction!(topography::topography, m)?)?;
     actions::add(m)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add("DEFAULT_GEOMETRIES", glossmeter::api::DEFAULT_PANEL.to_vec())?;

@@ -67,6 +67,11 @@ def usage() -> None:
 
     # What the types refuse (each ignore is needed, or mypy --strict fails on an unused one):
     glossmeter.measure(42)  # type: ignore[call-overload]
+    topo: Dict[str, Any] = glossmeter.topography(np.zeros((4, 4)), dx_um=0.5, unit="nm", levelling="plane")
+    topo = glossmeter.topography(pathlib.Path("fixtures/topography/gaussian.sur"))
+    glossmeter.topography(np.zeros((4, 4)), dx_um="0.5")  # type: ignore[arg-type]
+    glossmeter.topography(np.zeros((4, 4)), dx_um=0.5, unit="inch")  # type: ignore[arg-type]
+    print(topo)
     glossmeter.measure("r.json", rtol="x")  # type: ignore[call-overload]
     glossmeter.measure_brdf(42)  # type: ignore[call-overload]
     bad_hint: LobeHint = {"slope": 0.05, "tail": "fat"}  # type: ignore[typeddict-item]

@@ -23,8 +23,8 @@ pub enum TopographyFormat {
 /// Arguments of `glossmeter topography`.
 #[derive(clap::Args, Debug)]
 pub struct TopographyArgs {
-    /// The topography: ISO 25178-72 .x3p, ISO 25178-71 .sdf (text or binary), Gwyddion .gsf, or a text/CSV
-    /// matrix of heights (one row per line; give --pixel-size and --height-unit).
+    /// The topography: ISO 25178-72 .x3p, ISO 25178-71 .sdf (text or binary), Gwyddion .gsf, Digital Surf
+    /// .sur, or a text/CSV matrix of heights (one row per line; give --pixel-size and --height-unit).
     pub file: PathBuf,
     #[arg(long, value_enum, default_value_t = TopographyFormat::Table)]
     pub format: TopographyFormat,

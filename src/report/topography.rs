@@ -17,7 +17,7 @@ pub(crate) const ANGLE_BINS: usize = 45;
 pub struct TopographyMapDoc {
     /// The file (`<stdin>` for standard input).
     pub file: String,
-    /// `x3p`, `sdf-text`, `sdf-binary`, `gsf` or `text`.
+    /// `x3p`, `sdf-text`, `sdf-binary`, `gsf`, `sur`, `text` or `array` (a NumPy array from Python).
     pub format: String,
     /// Points along x and y.
     pub points_x: usize,

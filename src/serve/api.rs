@@ -670,7 +670,7 @@ pub const TABLE_MODELS: &[(&str, &[&str])] = &[
     ("rgl", &[".bsdf"]),
     ("inplane-csv", &[".csv"]),
     ("e1392", &[".txt"]),
-    ("topography", &[".x3p", ".sdf", ".gsf"]),
+    ("topography", &[".x3p", ".sdf", ".gsf", ".sur"]),
 ];
 
 /// `GET /api/tables`: the table files a recipe may name on this server, per model (docs/serve.md §The page:

@@ -33,6 +33,10 @@ pub enum Format {
     SdfBinary,
     /// Gwyddion Simple Field (`.gsf`).
     Gsf,
+    /// Digital Surf (`.sur`, MountainsMap).
+    Sur,
+    /// An array of heights handed over with its calibration (the Python bindings: docs/python.md §Topography).
+    Array,
     /// A plain text or CSV matrix of heights, its calibration given by the caller.
     Text,
 }
@@ -45,6 +49,8 @@ impl Format {
             Format::SdfText => "sdf-text",
             Format::SdfBinary => "sdf-binary",
             Format::Gsf => "gsf",
+            Format::Sur => "sur",
+            Format::Array => "array",
             Format::Text => "text",
         }
     }
@@ -68,7 +74,7 @@ pub struct HeightMap {
 
 /// Check a map's dimensions against the limits before anything of that size is allocated; `field` names
 /// where the dimensions were read.
-pub(crate) fn check_dimensions(file: &str, field: &str, nx: u64, ny: u64) -> Result<usize> {
+pub fn check_dimensions(file: &str, field: &str, nx: u64, ny: u64) -> Result<usize> {
     let allowed = format!("allowed: at least {MIN_SIDE} points each way and at most {MAX_POINTS} points in all");
     if nx < MIN_SIDE as u64 || ny < MIN_SIDE as u64 {
         return Err(Error::input(
@@ -84,7 +90,7 @@ pub(crate) fn check_dimensions(file: &str, field: &str, nx: u64, ny: u64) -> Res
 }
 
 /// Check a lateral spacing (metres) read from `field`.
-pub(crate) fn check_spacing(file: &str, field: &str, d: f64) -> Result<f64> {
+pub fn check_spacing(file: &str, field: &str, d: f64) -> Result<f64> {
     let (lo, hi) = PIXEL_RANGE_M;
     if d.is_finite() && (lo..=hi).contains(&d) {
         Ok(d)

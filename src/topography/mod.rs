@@ -9,7 +9,7 @@
 //!   limits ([`map::MAX_FILE_BYTES`], [`map::MAX_POINTS`]);
 //! * [`units`]: length units and lengths as files and users write them;
 //! * the readers, one per format: [`x3p`] (ISO 25178-72), [`sdf`] (ISO 25178-71, text and binary), [`gsf`]
-//!   (Gwyddion Simple Field), [`text`] (plain text and CSV matrices, with a [`text::Calibration`] given);
+//!   (Gwyddion Simple Field), [`sur`] (Digital Surf), [`text`] (plain text and CSV matrices, with a [`text::Calibration`] given);
 //! * [`level`]: the reference surface removed (mean, plane, polynomial);
 //! * [`heights`]: Sq, Sa, Sp, Sv, Sz, Ssk, Sku;
 //! * [`slopes`]: the cells' slopes, Sdq, Sdr and the slope-angle histogram;
@@ -24,6 +24,7 @@ pub mod map;
 pub mod psd;
 pub mod sdf;
 pub mod slopes;
+pub mod sur;
 pub mod text;
 pub mod units;
 pub mod x3p;
@@ -46,14 +47,20 @@ fn is_sdf(bytes: &[u8]) -> bool {
     bytes.len() >= 4 && matches!(bytes[0], b'a' | b'b') && matches!(&bytes[1..4], b"ISO" | b"BCR")
 }
 
-/// Whether a file's first bytes announce one of the calibrated formats (X3P, GSF, SDF; [`from_bytes`]) rather
-/// than a plain matrix, whose calibration only its caller can give (docs/topography.md §Plain text matrices).
+fn is_sur(bytes: &[u8]) -> bool {
+    bytes.starts_with(sur::MAGIC) || bytes.starts_with(sur::MAGIC_COMPRESSED)
+}
+
+/// Whether a file's first bytes announce one of the calibrated formats (X3P, GSF, SDF, SUR; [`from_bytes`])
+/// rather than a plain matrix, whose calibration only its caller can give (docs/topography.md §Plain text
+/// matrices).
 pub(crate) fn announces_calibrated_format(head: &[u8]) -> bool {
-    head.starts_with(b"PK\x03\x04") || head.starts_with(gsf::MAGIC) || is_sdf(head)
+    head.starts_with(b"PK\x03\x04") || head.starts_with(gsf::MAGIC) || is_sdf(head) || is_sur(head)
 }
 
 /// The format of a file, from its first bytes: a zip archive is X3P, `Gwyddion Simple Field 1.0` GSF,
-/// `aISO`/`bISO` (or the older `aBCR`/`bBCR`) SDF, anything else a plain matrix. An extension that names a
+/// `aISO`/`bISO` (or the older `aBCR`/`bBCR`) SDF, `DIGITAL SURF` (or `DSCOMPRESSED`) SUR, anything else a
+/// plain matrix. An extension that names a
 /// format the bytes are not is an error (a damaged file, or the wrong one).
 pub fn from_bytes(bytes: &[u8], file: &str, ext: &str, calibration: Option<Calibration>) -> Result<HeightMap> {
     let not = |what: &str| {
@@ -65,18 +72,21 @@ pub fn from_bytes(bytes: &[u8], file: &str, ext: &str, calibration: Option<Calib
         gsf::read(bytes, file)
     } else if is_sdf(bytes) {
         sdf::read(bytes, file)
+    } else if is_sur(bytes) {
+        sur::read(bytes, file)
     } else {
         match ext {
             "x3p" => Err(not("a zip archive (ISO 25178-72)")),
             "gsf" => Err(not("a Gwyddion Simple Field, beginning `Gwyddion Simple Field 1.0`")),
             "sdf" => Err(not("an ISO 25178-71 file, beginning `aISO-1.0` or `bISO-1.0`")),
+            "sur" => Err(not("a Digital Surf file, beginning `DIGITAL SURF`")),
             _ => {
                 let text = std::str::from_utf8(bytes).map_err(|e| {
                     Error::input(
                         file,
                         "",
                         format!(
-                            "not a topography this program reads: neither X3P, SDF, GSF nor a text matrix (invalid \
+                            "not a topography this program reads: neither X3P, SDF, GSF, SUR nor a text matrix (invalid \
                              UTF-8 at offset {})",
                             e.valid_up_to()
                         ),
@@ -98,6 +108,8 @@ mod tests {
         assert_eq!(from_bytes(b"1 2\n3 4\n", "t.txt", "txt", cal).unwrap().format, map::Format::Text);
         let e = from_bytes(b"1 2\n3 4\n", "t.x3p", "x3p", cal).unwrap_err().to_string();
         assert!(e.contains("zip archive"), "{e}");
+        let e = from_bytes(b"1 2\n3 4\n", "t.sur", "sur", cal).unwrap_err().to_string();
+        assert!(e.contains("DIGITAL SURF"), "{e}");
         assert!(from_bytes(&[0xff, 0xfe, 0], "t.bin", "bin", cal).unwrap_err().to_string().contains("UTF-8"));
     }
 }

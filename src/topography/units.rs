@@ -11,7 +11,7 @@ pub fn allowed() -> String {
 }
 
 /// The value in metres of a length unit (`None` if it is not one).
-pub(crate) fn metres_per(unit: &str) -> Option<f64> {
+pub fn metres_per(unit: &str) -> Option<f64> {
     let u = unit.trim();
     UNITS.iter().find(|(name, _)| *name == u).map(|(_, f)| *f)
 }
