@@ -52,6 +52,7 @@ pub mod multilobe;
 pub mod paint;
 pub mod phong;
 pub mod topography;
+pub(crate) mod map_two_scale;
 pub(crate) mod two_scale;
 pub mod ward;
 
