@@ -348,8 +348,11 @@ fn short_waves_added_to_a_long_wave_map_raise_the_haze_and_lower_the_gloss() {
     write_gsf(&tmp("long-short.gsf"), n, 2.0, &cosines(n, &both));
     let recipe = |name: &str, map: &str, extra: &str| {
         let p = tmp(name);
-        std::fs::write(&p, format!(r#"{{"model": "topography", "file": "{map}", "ior": 1.5, "levelling": "mean"{extra}}}"#))
-            .unwrap();
+        std::fs::write(
+            &p,
+            format!(r#"{{"model": "topography", "file": "{map}", "ior": 1.5, "levelling": "mean"{extra}}}"#),
+        )
+        .unwrap();
         glossmeter::recipe::load_file(&p).unwrap()
     };
     let facets = recipe("long-facets.json", "long.gsf", "");

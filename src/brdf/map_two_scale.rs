@@ -197,8 +197,12 @@ impl MapTwoScale {
         let lambda_min = self.sampling.wavelengths_nm.iter().copied().fold(f64::INFINITY, f64::min);
         let f_lo = self.short.f_s.max(self.short.dfx.min(self.short.dfy));
         let label = format!("scatter halo of the map's short waves (σ_> = {:.3} nm)", self.short.sigma2.sqrt());
-        let lobe =
-            Lobe { slope_width: 0.5 * lambda_min * 1e-3 * f_lo, medium_eta: 1.0, label: label.clone(), tail: Tail::Unknown };
+        let lobe = Lobe {
+            slope_width: 0.5 * lambda_min * 1e-3 * f_lo,
+            medium_eta: 1.0,
+            label: label.clone(),
+            tail: Tail::Unknown,
+        };
         Term { label, kind: TermKind::Lobe(lobe) }
     }
 }

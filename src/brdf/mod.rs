@@ -47,12 +47,12 @@ pub mod conductor;
 pub mod dielectric;
 pub mod halo;
 pub mod lambert;
+pub(crate) mod map_two_scale;
 pub mod mixture;
 pub mod multilobe;
 pub mod paint;
 pub mod phong;
 pub mod topography;
-pub(crate) mod map_two_scale;
 pub(crate) mod two_scale;
 pub mod ward;
 

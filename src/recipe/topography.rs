@@ -11,11 +11,11 @@ use crate::brdf::map_two_scale::{MapTwoScale, ShortWaves};
 use crate::brdf::topography::TopographySurface;
 use crate::brdf::Brdf;
 use crate::input::json::Obj;
+use crate::optics::microfacet::Microfacet;
 use crate::optics::slope_table::SlopeTable;
 use crate::registry::{self, Param};
-use crate::topography::level::{level, Levelled, Levelling};
-use crate::optics::microfacet::Microfacet;
 use crate::spectrum::Sampling;
+use crate::topography::level::{level, Levelled, Levelling};
 use crate::topography::map::HeightMap;
 use crate::topography::psd::{low_pass, psd, Psd2};
 use crate::topography::slopes::slopes;
@@ -183,11 +183,11 @@ pub(crate) fn rayleigh_split(p: &Psd2, sigma_max_nm: f64) -> f64 {
 mod tests {
     use super::*;
     use crate::brdf::Brdf;
+    use crate::optics::scatter::Psd;
+    use crate::optics::slope_table::SlopeTable;
     use crate::Vec3;
     use num_complex::Complex64;
     use std::f64::consts::PI;
-    use crate::optics::scatter::Psd;
-    use crate::optics::slope_table::SlopeTable;
 
     fn unit(x: f64, y: f64) -> Vec3 {
         Vec3::new(x, y, (1.0 - x * x - y * y).sqrt())
@@ -268,16 +268,18 @@ mod tests {
             let (mut r, g) = ([0.0], halo.loss(0, c));
             assert!(m.delta_reflectance(wi, &mut r));
             let want = halo.mirror_reflectance(0, c) * (1.0 - g);
+            eprintln!("{deg}°: mirror {:.8}, R(1 − g) {want:.8}, g {g:.6}", r[0]);
             assert!((r[0] - want).abs() < 0.02 * g * want, "{deg}: {r:?} vs {want}");
-            // The halo, in and across the plane, at |f| from 2 to 8 grid steps (0.125-0.5/µm): within 6 % (the
-            // bilinear interpolation of the grid's S₂).
-            for (dx, dy) in [(0.07, 0.0), (0.2, 0.0), (-0.1, 0.0), (0.0, 0.1), (0.15, -0.15)] {
+            // The halo, in and across the plane, at |f| from 2 to 8 grid steps (0.125-0.5/µm): within 2 % (the
+            // bilinear interpolation of the grid's S₂; measured within 1.2 %).
+            for (dx, dy) in [(0.07, 0.0), (-0.2, 0.0), (-0.1, 0.0), (0.0, 0.1), (-0.15, -0.15)] {
                 let wo = unit(s + dx, dy);
                 let (mut a, mut b, mut back) = ([0.0], [0.0], [0.0]);
                 m.eval(wi, wo, &mut a);
                 m.eval(wo, wi, &mut back);
                 halo.add(wi, wo, &mut b);
-                assert!((a[0] - b[0]).abs() < 0.06 * b[0], "{deg} ({dx}, {dy}): {a:?} vs {b:?}");
+                eprintln!("{deg}° ({dx}, {dy}): map {:.6e}, PSD {:.6e}, {:+.4}", a[0], b[0], a[0] / b[0] - 1.0);
+                assert!(b[0] > 0.0 && (a[0] - b[0]).abs() < 0.02 * b[0], "{deg} ({dx}, {dy}): {a:?} vs {b:?}");
                 assert!((a[0] - back[0]).abs() <= 1e-12 * a[0], "reciprocity: {a:?} {back:?}");
             }
         }
