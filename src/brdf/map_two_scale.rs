@@ -140,7 +140,7 @@ impl MapTwoScale {
     ) -> Result<MapTwoScale> {
         let sigma_max = super::halo::Halo::sigma_max(&sampling);
         let sigma = short.sigma2.sqrt();
-        if !(sigma <= sigma_max) || !(ior.is_finite() && ior > 0.0) {
+        if !(sigma <= sigma_max && ior.is_finite() && ior > 0.0) {
             return Err(Error::Usage(format!(
                 "the short waves of the map (|f| ≥ {} /µm) have rms height σ_> = {} nm, outside the smooth-surface \
                  (Rayleigh–Rice) theory at λ = {} nm; allowed: σ_> ≤ {} nm (4πσ_>/λ ≤ {}, docs/optics.md §Two-scale \

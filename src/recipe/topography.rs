@@ -106,7 +106,8 @@ fn head(path: &std::path::Path) -> Vec<u8> {
     head
 }
 
-/// Where the two-scale split comes from (docs/optics.md §Two-scale surface of a measured map): the rule of [`rayleigh_split`] or a frequency given (1/m).
+/// Where the two-scale split comes from (docs/optics.md §Two-scale surface of a measured map): the rule of
+/// [`rayleigh_split`] or a frequency given (1/m).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) enum Split {
     Rayleigh,
