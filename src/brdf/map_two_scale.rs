@@ -143,8 +143,8 @@ impl MapTwoScale {
         if !(sigma <= sigma_max && ior.is_finite() && ior > 0.0) {
             return Err(Error::Usage(format!(
                 "the short waves of the map (|f| ≥ {} /µm) have rms height σ_> = {} nm, outside the smooth-surface \
-                 (Rayleigh–Rice) theory at λ = {} nm; allowed: σ_> ≤ {} nm (4πσ_>/λ ≤ {}, docs/optics.md §Two-scale \
-                 surface of a measured map): a higher split frequency",
+                 (Rayleigh–Rice) theory at λ = {} nm; allowed: σ_> ≤ {} nm (4πσ_>/λ ≤ {}, docs/optics.md §10): a \
+                 higher split frequency",
                 crate::error::number(short.f_s),
                 crate::error::number(sigma),
                 sampling.wavelengths_nm.iter().copied().fold(f64::INFINITY, f64::min),
