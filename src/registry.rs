@@ -961,6 +961,24 @@ pub(crate) const TOPOGRAPHY_LEVELLING: Param = p(
     Opt("\"plane\""),
     "the reference surface removed before the slopes are read: the mean height, the least-squares plane or polynomial of that degree",
 );
+pub(crate) const TOPOGRAPHY_SCALE_SPLIT: Param = p(
+    "/scale_split",
+    TOPOGRAPHY,
+    Type::Choice(&["none", "rayleigh"]),
+    "",
+    NONE,
+    Opt("\"none\""),
+    "none: the facets of the whole map; rayleigh: the two-scale surface, the map's spectrum split at the lowest frequency whose short waves meet the smooth-surface bound 4πσ/λ ≤ 0.5, long waves as facets, short waves as a Rayleigh–Rice halo of their own PSD (docs/optics.md §Two-scale surface of a measured map)",
+);
+pub(crate) const TOPOGRAPHY_SPLIT_FREQUENCY: Param = p(
+    "/split_frequency",
+    TOPOGRAPHY,
+    Type::Number,
+    "1/um",
+    Some(Range { lo: 0.0, lo_closed: false, hi: 1e4, hi_closed: true }),
+    Opt("the rule of scale_split"),
+    "the two-scale surface split at this spatial frequency instead of by the rule (refused if the short waves break the smooth-surface bound)",
+);
 
 // ---------------------------------------------------------------------------------------------------------
 // Near-specular scatter: a Rayleigh–Rice halo from a surface PSD (docs/optics.md §Near-specular scatter), at
@@ -1375,6 +1393,8 @@ pub static PARAMS: &[&Param] = &[
     &TOPOGRAPHY_FILE,
     &TOPOGRAPHY_IOR,
     &TOPOGRAPHY_LEVELLING,
+    &TOPOGRAPHY_SCALE_SPLIT,
+    &TOPOGRAPHY_SPLIT_FREQUENCY,
 ];
 
 // ---------------------------------------------------------------------------------------------------------

@@ -322,3 +322,109 @@ fn the_picture_is_drawn_and_never_overwritten() {
     assert_eq!(std::fs::read(&png).unwrap(), before);
     assert_eq!(run(["glossmeter", "topography", x3p, "--plot", "map.gif"]), 2);
 }
+
+/// A GSF file of n × n heights `z` (µm), `dx` µm apart.
+fn write_gsf(path: &Path, n: usize, dx: f64, z: &[f64]) {
+    let mut b = b"Gwyddion Simple Field 1.0\n".to_vec();
+    let side = n as f64 * dx;
+    b.extend_from_slice(
+        format!("XRes = {n}\nYRes = {n}\nXReal = {side}\nYReal = {side}\nXYUnits = um\nZUnits = um\n").as_bytes(),
+    );
+    let pad = 4 - b.len() % 4;
+    b.extend(std::iter::repeat_n(0u8, pad));
+    for v in z {
+        b.extend_from_slice(&(*v as f32).to_le_bytes());
+    }
+    std::fs::write(path, b).unwrap();
+}
+
+/// Cosines (kx, ky, amplitude µm, phase) summed on an n × n grid of periodic indices.
+fn cosines(n: usize, terms: &[(f64, f64, f64, f64)]) -> Vec<f64> {
+    (0..n * n)
+        .map(|k| {
+            let (i, j) = ((k % n) as f64, (k / n) as f64);
+            let t = |(kx, ky, a, p): &(f64, f64, f64, f64)| {
+                a * (2.0 * std::f64::consts::PI * (kx * i + ky * j) / n as f64 + p).cos()
+            };
+            terms.iter().map(t).sum()
+        })
+        .collect()
+}
+
+#[test]
+fn short_waves_added_to_a_long_wave_map_raise_the_haze_and_lower_the_gloss() {
+    use glossmeter::instrument::plan::PlanOptions;
+    // A 512 µm map (256 points 2 µm apart): long waves of 0.4 µm amplitude at 1-3 grid steps (≤ 0.006/µm),
+    // and short waves of σ ≈ 10 nm (within the bound 22.3 nm at 560 nm) at 10-40 steps (0.02-0.08/µm: a halo
+    // 0.6°-2.6° from the specular direction at 20°-30°, over the haze windows).
+    let n = 256;
+    let long = [(1.0, 0.0, 0.4, 0.3), (2.0, 1.0, 0.4, 1.1), (-1.0, 3.0, 0.3, 2.0), (3.0, -2.0, 0.2, 0.7)];
+    let mut short = Vec::new();
+    for k in 0..60u32 {
+        let kx = 10.0 + ((k * 37) % 31) as f64;
+        let ky = ((k * 53) % 41) as f64 - 20.0;
+        short.push((kx, ky, 0.01 * (2.0f64 / 60.0).sqrt(), k as f64 * 0.9));
+    }
+    let both: Vec<_> = long.iter().chain(&short).copied().collect();
+    write_gsf(&tmp("long.gsf"), n, 2.0, &cosines(n, &long));
+    write_gsf(&tmp("long-short.gsf"), n, 2.0, &cosines(n, &both));
+    let recipe = |name: &str, map: &str, extra: &str| {
+        let p = tmp(name);
+        std::fs::write(
+            &p,
+            format!(r#"{{"model": "topography", "file": "{map}", "ior": 1.5, "levelling": "mean"{extra}}}"#),
+        )
+        .unwrap();
+        glossmeter::recipe::load_file(&p).unwrap()
+    };
+    let facets = recipe("long-facets.json", "long.gsf", "");
+    let long2 = recipe("long-two.json", "long.gsf", r#", "scale_split": "rayleigh""#);
+    let both2 = recipe("both-two.json", "long-short.gsf", r#", "scale_split": "rayleigh""#);
+    assert!(both2.brdf.describe().contains("two-scale"), "{}", both2.brdf.describe());
+    let geos = glossmeter::resolve_geometries(&["astm-d523-20", "astm-e430-30"], &[] as &[&str]).unwrap();
+    let options = PlanOptions { rtol: 1e-5, ..PlanOptions::default() };
+    let read = |m: &glossmeter::recipe::Material| glossmeter::measure(m, &geos, &options).unwrap();
+    let (a, b, c) = (read(&facets), read(&long2), read(&both2));
+    let value = |r: &[glossmeter::Reading], geo: &str, q: &str| {
+        r.iter().find(|x| x.geometry == geo && x.quantity == q).and_then(|x| x.value).unwrap()
+    };
+    for (x, y, z) in a.iter().zip(&b).zip(&c).map(|((x, y), z)| (x, y, z)) {
+        eprintln!(
+            "{} {} {}: facets {:?}, two-scale {:?}, with short waves {:?}",
+            x.geometry, x.name, x.quantity, x.value, y.value, z.value
+        );
+        // (1) Long waves alone: the two-scale surface reads as the facets (its halo has no power), within the
+        // integration tolerance.
+        if let (Some(p), Some(q)) = (x.value, y.value) {
+            assert!((p - q).abs() <= 1e-4 * p.abs().max(1.0), "{}: {p} vs {q}", x.name);
+        }
+    }
+    let gloss = |r: &[glossmeter::Reading]| value(r, "astm-d523-20", "gloss");
+    let haze = |r: &[glossmeter::Reading]| value(r, "astm-e430-30", "haze");
+    // (3) Short waves: less 20° gloss (the facets keep 1 − g, g ≈ 4.5 % at 20° less what the halo returns to
+    // the aperture; measured 35.66 -> 34.53 GU), more haze (E430 narrow haze 0.906 -> 0.958).
+    assert!(gloss(&c) < 0.98 * gloss(&b), "{} vs {}", gloss(&c), gloss(&b));
+    assert!(haze(&c) > 1.03 * haze(&b), "{} vs {}", haze(&c), haze(&b));
+}
+
+#[test]
+fn a_two_scale_split_whose_short_waves_break_the_bound_is_refused() {
+    let dir = tmp("two-scale");
+    std::fs::create_dir_all(&dir).unwrap();
+    let x3p = std::fs::canonicalize(format!("{DIR}/gaussian.x3p")).unwrap();
+    let e = |extra: &str| {
+        let p = dir.join("r.json");
+        std::fs::write(&p, format!(r#"{{"model": "topography", "file": "{}", "ior": 1.5{extra}}}"#, x3p.display()))
+            .unwrap();
+        glossmeter::recipe::load_file(&p).map(|m| m.brdf.describe())
+    };
+    // The fixture's Sq is 100 nm: split at 0.01/µm, its short waves break 4πσ/λ ≤ 0.5 at 560 nm.
+    let low = e(r#", "split_frequency": 0.01"#).unwrap_err().to_string();
+    assert!(low.contains("field `/split_frequency`") && low.contains("gaussian.x3p") && low.contains("σ_>"), "{low}");
+    // The rule splits where the bound holds; a split above the map's band leaves the facets alone.
+    assert!(e(r#", "scale_split": "rayleigh""#).unwrap().contains("two-scale"));
+    assert!(e(r#", "split_frequency": 100"#).unwrap().contains("σ_> = 0 nm"));
+    let both = e(r#", "scale_split": "rayleigh", "split_frequency": 0.2"#).unwrap_err().to_string();
+    assert!(both.contains("field `/split_frequency`"), "{both}");
+    assert!(e(r#", "scale_split": "fourier""#).unwrap_err().to_string().contains("field `/scale_split`"));
+}

@@ -47,6 +47,7 @@ pub mod conductor;
 pub mod dielectric;
 pub mod halo;
 pub mod lambert;
+pub(crate) mod map_two_scale;
 pub mod mixture;
 pub mod multilobe;
 pub mod paint;

@@ -71,6 +71,42 @@ pub fn psd(z: &[f64], nx: usize, ny: usize, dx: f64, dy: f64) -> Psd2 {
     Psd2 { nx, ny, dfx: 1.0 / (nx as f64 * dx), dfy: 1.0 / (ny as f64 * dy), s }
 }
 
+/// The heights `z` (nx × ny, NaN: invalid, left invalid) low-passed below `f_s` (1/m): every mode of the
+/// map's transform with |f| ≥ f_s set to zero and the transform inverted, the long-wave part of the two-scale
+/// split (docs/optics.md §Two-scale surface of a measured map). The map is one period, as for [`psd`].
+pub(crate) fn low_pass(z: &[f64], nx: usize, ny: usize, dx: f64, dy: f64, f_s: f64) -> Vec<f64> {
+    let n = nx * ny;
+    let mut rows: Vec<Complex64> = z.iter().map(|&v| Complex64::new(if v.is_nan() { 0.0 } else { v }, 0.0)).collect();
+    let mut planner = FftPlannerScalar::<f64>::new();
+    let (fwd_x, fwd_y) = (planner.plan_fft_forward(nx), planner.plan_fft_forward(ny));
+    let (inv_x, inv_y) = (planner.plan_fft_inverse(nx), planner.plan_fft_inverse(ny));
+    fwd_x.process(&mut rows);
+    let mut cols = vec![Complex64::new(0.0, 0.0); n];
+    for j in 0..ny {
+        for i in 0..nx {
+            cols[i * ny + j] = rows[j * nx + i];
+        }
+    }
+    fwd_y.process(&mut cols);
+    let (dfx, dfy) = (1.0 / (nx as f64 * dx), 1.0 / (ny as f64 * dy));
+    for kx in 0..nx {
+        for ky in 0..ny {
+            let f = (signed(kx, nx) * dfx).hypot(signed(ky, ny) * dfy);
+            if f >= f_s {
+                cols[kx * ny + ky] = Complex64::new(0.0, 0.0);
+            }
+        }
+    }
+    inv_y.process(&mut cols);
+    for j in 0..ny {
+        for i in 0..nx {
+            rows[j * nx + i] = cols[i * ny + j];
+        }
+    }
+    inv_x.process(&mut rows);
+    z.iter().zip(&rows).map(|(v, c)| if v.is_nan() { f64::NAN } else { c.re / n as f64 }).collect()
+}
+
 impl Psd2 {
     /// The frequency of grid point (kₓ, k_y), 1/m.
     pub fn frequency(&self, kx: usize, ky: usize) -> (f64, f64) {
@@ -171,6 +207,27 @@ mod tests {
         assert!(p.weighted_moment(0, 0.0, 0.5 * f, |_| 1.0) < 1e-12 * sq2);
         let w = p.weighted_moment(0, 0.5 * f, 2.0 * f, |g| if (g - f).abs() < 1e-9 * f { 0.25 } else { 0.0 });
         assert!((w - 0.25 * sq2).abs() < 1e-12 * sq2, "{w}");
+    }
+
+    #[test]
+    fn low_pass_keeps_the_long_waves_and_removes_the_short() {
+        let (nx, ny, dx, dy) = (32, 16, 1e-6, 1e-6);
+        let wave = |kx: f64, ky: f64, i: usize, j: usize| {
+            (2.0 * PI * (kx * i as f64 / nx as f64 + ky * j as f64 / ny as f64)).cos()
+        };
+        let long: Vec<f64> =
+            (0..ny).flat_map(|j| (0..nx).map(move |i| 3.0 * wave(1.0, 1.0, i, j) + wave(2.0, 0.0, i, j))).collect();
+        let z: Vec<f64> = (0..ny)
+            .flat_map(|j| (0..nx).map(move |i| (i, j)))
+            .zip(&long)
+            .map(|((i, j), l)| l + 0.1 * wave(9.0, 5.0, i, j))
+            .collect();
+        // The split at 0.2/µm: (1, 1) is at 0.07/µm, (2, 0) at 0.06/µm, (9, 5) at 0.43/µm.
+        let low = low_pass(&z, nx, ny, dx, dy, 0.2e6);
+        assert!(low.iter().zip(&long).all(|(a, b)| (a - b).abs() < 1e-12), "{:?}", &low[..4]);
+        let all = low_pass(&z, nx, ny, dx, dy, f64::INFINITY);
+        assert!(all.iter().zip(&z).all(|(a, b)| (a - b).abs() < 1e-12));
+        assert!(low_pass(&z, nx, ny, dx, dy, 0.0).iter().all(|v| v.abs() < 1e-12));
     }
 
     #[test]
