@@ -68,7 +68,7 @@ fn scale_split(obj: &Obj) -> Result<Option<Split>> {
 pub(crate) fn levelled_map(obj: &Obj, file: &Param, levelling: &Param) -> Result<(HeightMap, Levelled, Levelling)> {
     let name = obj.str(&obj.param_key(file))?;
     if name.is_empty() {
-        return Err(obj.err("file", "empty path; expected the path of an .x3p, .sdf or .gsf topography"));
+        return Err(obj.err("file", "empty path; expected the path of an .x3p, .sdf, .gsf or .sur topography"));
     }
     let how = match obj.opt_str(&obj.param_key(levelling))? {
         None => Levelling::Plane,
@@ -82,12 +82,15 @@ pub(crate) fn levelled_map(obj: &Obj, file: &Param, levelling: &Param) -> Result
         other => {
             // A recipe gives no calibration, so a plain matrix (a file announcing none of the calibrated formats)
             // cannot be read by one: the error says which files can.
-            let named = path
-                .extension()
-                .is_some_and(|e| ["x3p", "gsf", "sdf"].iter().any(|f| e.to_string_lossy().eq_ignore_ascii_case(f)));
+            let named = path.extension().is_some_and(|e| {
+                ["x3p", "gsf", "sdf", "sur"].iter().any(|f| e.to_string_lossy().eq_ignore_ascii_case(f))
+            });
             let plain = !named && !crate::topography::announces_calibrated_format(&head(&path));
-            let hint =
-                if plain { " (a recipe reads .x3p, .sdf and .gsf files, which carry their calibration)" } else { "" };
+            let hint = if plain {
+                " (a recipe reads .x3p, .sdf, .gsf and .sur files, which carry their calibration)"
+            } else {
+                ""
+            };
             obj.err("file", format!("not a topography this model reads: {other}{hint}"))
         }
     };
