@@ -148,18 +148,32 @@ impl Application {
         if log_span / MAX_LOG_STEP > MAX_PIECES as f64 / 2.0 {
             return Err(invalid(
                 "viscosity",
-                format!("rises by e^{log_span:.0}, beyond what the model resolves (e^50 000)"),
+                if log_span.is_finite() {
+                    format!("rises by e^{log_span:.0}, beyond what the model resolves (e^50 000)")
+                } else {
+                    "rises by a factor beyond double precision, beyond what the model resolves (e^50 000)".to_string()
+                },
             ));
         }
         let growth = self.largest_growth();
         if !(growth <= MAX_GROWTH) {
+            // The growth exp(B²/4A) overflows past e^709, and is unbounded without levelling (A = 0): say so in
+            // words, never print an infinity (docs/instrument.md §Numbers in text).
+            let log = self.largest_log_growth();
+            let by = if growth.is_finite() {
+                format!("up to {}×", crate::error::number(growth))
+            } else if log.is_finite() {
+                format!("up to e^{log:.0}×")
+            } else {
+                "without bound (no levelling acts against it)".to_string()
+            };
+            let f = self.fastest_growing_frequency_per_um();
+            let at = if f > 0.0 { format!(" (at Λ = {} µm)", crate::error::number(1.0 / f)) } else { String::new() };
             return Err(invalid(
                 "surface_tension_gradient_mn_m_per_um",
                 format!(
-                    "the gradient grows the texture by up to {}× (at Λ = {} µm) before the flow ends, beyond the \
-                     linear model (allowed: a growth of at most {MAX_GROWTH}×; a smaller gradient, or more levelling)",
-                    crate::error::number(growth),
-                    crate::error::number(1.0 / self.fastest_growing_frequency_per_um()),
+                    "the gradient grows the texture by {by}{at} before the flow ends, beyond the linear model \
+                     (allowed: a growth of at most {MAX_GROWTH}×; a smaller gradient, or more levelling)"
                 ),
             ));
         }
@@ -256,15 +270,21 @@ impl Application {
     /// The largest amplitude transfer over all frequencies: exp(B²/(4A)) with A = (16π⁴/3)L, B = 4π²M when
     /// the gradient works against levelling (M > 0), else 1 (at f → 0); infinite when nothing levels (L = 0).
     pub fn largest_growth(&self) -> f64 {
+        self.largest_log_growth().exp()
+    }
+
+    /// The natural logarithm of [`Application::largest_growth`], B²/(4A) (finite where the growth overflows; 0
+    /// without a gradient against levelling, infinite without levelling).
+    pub(crate) fn largest_log_growth(&self) -> f64 {
         let flow = self.flow();
         if !(flow.m_um2 > 0.0) {
-            return 1.0;
+            return 0.0;
         }
         let (a, b) = (16.0 * PI.powi(4) / 3.0 * flow.l_um4, 4.0 * PI * PI * flow.m_um2);
         if !(a > 0.0) {
             return f64::INFINITY;
         }
-        (b * b / (4.0 * a)).exp()
+        b * b / (4.0 * a)
     }
 
     /// The frequency of the largest growth, f² = B/(2A) (1/µm); 0 without a gradient against levelling.
@@ -554,6 +574,28 @@ mod tests {
         let mut a = good;
         a.surface_tension_gradient_mn_m_per_um = 1e6;
         assert_eq!(a.validate().unwrap_err().field, "surface_tension_gradient_mn_m_per_um");
+    }
+
+    /// Found by the 10⁶-case fuzz run of 2026-12-06 (case 476713): a growth past e^709 printed "inf×".
+    #[test]
+    fn a_growth_beyond_double_precision_is_said_in_words() {
+        let mut overflowed = 0;
+        for g in [900.0, 4000.0, 1e5, 1e6, 1e8] {
+            let mut a = film(vec![(0.0, 0.5), (600.0, 0.5)], 0.0);
+            a.surface_tension_gradient_mn_m_per_um = g;
+            let Err(e) = a.validate() else { continue };
+            let m = e.message.to_string();
+            assert!(!m.contains("inf") && !m.contains("NaN"), "{g}: {m}");
+            if !a.largest_growth().is_finite() && a.largest_log_growth().is_finite() {
+                overflowed += 1;
+                assert!(m.contains("grows the texture by up to e^"), "{g}: {m}");
+            }
+        }
+        assert!(overflowed > 0, "no gradient overflowed the growth");
+        // Case 698493: a viscosity rising from 1e-300 to 1e300 Pa·s within one step (its ratio overflows).
+        let e = film(vec![(0.0, 1e-300), (1.0, 1e300)], 0.0).validate().unwrap_err();
+        assert!(e.field == "viscosity" && e.message.contains("beyond double precision"), "{e:?}");
+        assert!(!e.message.contains("inf"), "{e:?}");
     }
 
     #[test]
