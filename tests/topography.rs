@@ -428,3 +428,49 @@ fn a_two_scale_split_whose_short_waves_break_the_bound_is_refused() {
     assert!(both.contains("field `/split_frequency`"), "{both}");
     assert!(e(r#", "scale_split": "fourier""#).unwrap_err().to_string().contains("field `/scale_split`"));
 }
+
+/// A real measured surface (fixtures/topography/real/README.md): its statistics agree with NumPy's reading of
+/// the same file, and its `topography` recipe reads through the default panel with no fitted parameter.
+#[test]
+fn a_real_measured_x3p_reads_through_the_default_panel() {
+    let file = "fixtures/topography/real/sample-land.x3p";
+    let map = glossmeter::topography::load(Path::new(file), None).unwrap();
+    let a = analyse(&map, Levelling::Polynomial(2)).unwrap();
+    let text = std::fs::read_to_string("fixtures/topography/real/expected.json").unwrap();
+    let want = serde_json::from_str::<Value>(&text).unwrap()["sample_land_poly2"].clone();
+    assert_eq!((map.nx, map.ny), (918, 256));
+    assert_eq!((map.nx * map.ny - map.valid()) as u64, want["invalid"].as_u64().unwrap());
+    let got = serde_json::json!({
+        "sq_um": a.heights.sq * 1e6,
+        "sa_um": a.heights.sa * 1e6,
+        "sdq": a.slope_stats.sdq,
+        "psd_power_um2": a.psd.power() * 1e12,
+        "tilt_x": a.tilt[0],
+        "tilt_y": a.tilt[1],
+    });
+    close(&got, &want, 1e-9, file);
+
+    let out = tmp("land-replica.json");
+    let _ = std::fs::remove_file(&out);
+    let o = out.to_str().unwrap();
+    let recipe = "fixtures/topography/real/land-replica.json";
+    assert_eq!(run(["glossmeter", "measure", recipe, "--format", "json", "-o", o]), 0);
+    let doc: Value = serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
+    let readings = doc["readings"].as_array().unwrap();
+    // The default panel: D523 20/60/85, E430, ISO 13803 and D4039, every reading converged with its estimate.
+    for geometry in ["astm-d523-20", "astm-d523-60", "astm-d523-85", "astm-e430-30", "iso-13803-20", "astm-d4039"] {
+        assert!(readings.iter().any(|r| r["geometry"] == geometry), "{geometry} missing");
+    }
+    for r in readings {
+        let (v, e) = (r["value"].as_f64().unwrap(), r["error_estimate"].as_f64().unwrap());
+        assert!(v.is_finite() && e.is_finite() && e >= 0.0 && r["converged"] == true, "{r}");
+    }
+    // A matte surface (Sdq 0.71: facets up to 88°): its specular gloss is a few units at most, far below the
+    // smooth interface of the same index (about 90 GU at 60°), and above zero.
+    let gloss = |g: &str| {
+        readings.iter().find(|r| r["geometry"] == g && r["name"] == "gloss").unwrap()["value"].as_f64().unwrap()
+    };
+    for g in ["astm-d523-20", "astm-d523-60", "astm-d523-85"] {
+        assert!(gloss(g) > 0.0 && gloss(g) < 10.0, "{g}: {}", gloss(g));
+    }
+}

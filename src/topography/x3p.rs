@@ -37,7 +37,8 @@ pub fn read(bytes: &[u8], file: &str) -> Result<HeightMap> {
     let mut zip = zip::ZipArchive::new(Cursor::new(bytes)).map_err(|e| {
         Error::input(file, "", format!("not a readable X3P file: its zip archive is damaged or truncated ({e})"))
     })?;
-    let xml = member(&mut zip, file, "main.xml", MAX_FILE_BYTES, None)?;
+    let folder = root_folder(&zip, file)?;
+    let xml = member(&mut zip, file, &format!("{folder}main.xml"), MAX_FILE_BYTES, None)?;
     let main = parse_main(&xml, file)?;
     let field = |p: &str| format!("main.xml/{p}");
     let bad = |p: &str, m: String| Error::input(file, field(p), m);
@@ -123,7 +124,7 @@ pub fn read(bytes: &[u8], file: &str) -> Result<HeightMap> {
                     ))
                 }
             };
-            let data = member(&mut zip, file, name, (n * size) as u64, Some(&field(link)))?;
+            let data = member(&mut zip, file, &format!("{folder}{name}"), (n * size) as u64, Some(&field(link)))?;
             data.chunks_exact(size)
                 .map(|c| match ty {
                     "I" => i16::from_le_bytes([c[0], c[1]]) as f64,
@@ -150,7 +151,7 @@ pub fn read(bytes: &[u8], file: &str) -> Result<HeightMap> {
     }
     if let Some(name) = main.get("Record3/DataLink/ValidPointsLink") {
         let link = field("Record3/DataLink/ValidPointsLink");
-        let mask = member(&mut zip, file, name, n.div_ceil(8) as u64, Some(&link))?;
+        let mask = member(&mut zip, file, &format!("{folder}{name}"), n.div_ceil(8) as u64, Some(&link))?;
         for (k, v) in z.iter_mut().enumerate() {
             if mask[k / 8] & (1 << (k % 8)) == 0 {
                 *v = f64::NAN;
@@ -162,6 +163,33 @@ pub fn read(bytes: &[u8], file: &str) -> Result<HeightMap> {
     let note = format!(" (CZ Increment {}, Offset {})", number(z_scale), number(z_offset));
     let (nx, ny) = (nx as usize, ny as usize);
     HeightMap::with_height_note(file, Format::X3p, nx, ny, spacing[0], spacing[1], z, &field(data_field), &note)
+}
+
+/// Where the archive's `main.xml` is: at its root (`""`, as ISO 25178-72 places it), or in the one top folder
+/// that holds every member (`"land/"`, as zipping a folder gives; a `__MACOSX/` folder of resource forks is
+/// not a member of the file); the links of `main.xml` are relative to it (docs/topography.md §ISO 25178-72 X3P).
+fn root_folder(zip: &Archive, file: &str) -> Result<String> {
+    if zip.index_for_name("main.xml").is_some() {
+        return Ok(String::new());
+    }
+    let found: Vec<&str> = zip
+        .file_names()
+        .filter(|n| !n.starts_with("__MACOSX/"))
+        .filter(|n| n.strip_suffix("main.xml").is_some_and(|d| d.ends_with('/') && d.matches('/').count() == 1))
+        .collect();
+    match found.as_slice() {
+        [one] => Ok(one.trim_end_matches("main.xml").to_string()),
+        [] => Err(Error::input(
+            file,
+            "main.xml",
+            "the archive has no member `main.xml` (allowed: at the archive's root, or in one top folder)",
+        )),
+        many => Err(Error::input(
+            file,
+            "main.xml",
+            format!("the archive has {} top folders with a `main.xml` ({}); allowed: one", many.len(), many.join(", ")),
+        )),
+    }
 }
 
 /// The member `name`, inflated: exactly `size` bytes if `linked` (a data file whose size the grid fixes, named
@@ -305,6 +333,23 @@ pub(crate) mod tests {
         let x = main_xml(2, 2, "1e-6", "D", list);
         let m = read(&zip_of(&[("main.xml", x.as_bytes())]), "t.x3p").unwrap();
         assert!(m.z[1].is_nan() && m.z[3] == 4e-9);
+    }
+
+    #[test]
+    fn a_map_zipped_as_one_folder_reads_from_it() {
+        let data: Vec<u8> = [1.0f64, 2.0, 3.0, 4.0].iter().flat_map(|v| v.to_le_bytes()).collect();
+        let x = main_xml(2, 2, "1e-6", "D", LINK);
+        let members = [
+            ("__MACOSX/land/._main.xml", &b"resource fork"[..]),
+            ("land/main.xml", x.as_bytes()),
+            ("land/bindata/data.bin", &data),
+        ];
+        let m = read(&zip_of(&members), "t.x3p").unwrap();
+        assert_eq!(m.z[3], 4e-9);
+        let two = [("a/main.xml", x.as_bytes()), ("b/main.xml", x.as_bytes())];
+        assert!(read(&zip_of(&two), "t.x3p").unwrap_err().to_string().contains("2 top folders"));
+        let deep = [("a/b/main.xml", x.as_bytes())];
+        assert!(read(&zip_of(&deep), "t.x3p").unwrap_err().to_string().contains("no member `main.xml`"));
     }
 
     #[test]
