@@ -537,7 +537,7 @@ pub(crate) const WARD_RHO_D: Param = p("/rho_d", &["ward"], Type::Colour, "", UN
 
 const CT: &[&str] = &["cook-torrance-lobes"];
 /// Maximum number of lobes of a `cook-torrance-lobes` recipe.
-pub const MAX_LOBES: usize = 8;
+pub(crate) const MAX_LOBES: usize = 8;
 pub(crate) const CT_KD: Param =
     p("/kd", CT, Type::Colour, "", UNIT, Req, "Lambertian albedo Kd; Kd + Σ Ks ≤ 1 per channel");
 pub(crate) const CT_LOBES: Param =

@@ -29,27 +29,27 @@ use crate::topography::{self, units};
 use crate::{recipe, Error, Result};
 
 /// The illuminant of colour readings when none is given.
-pub const DEFAULT_ILLUMINANT: &str = "D65";
+pub(crate) const DEFAULT_ILLUMINANT: &str = "D65";
 /// The observer of colour readings when none is given (CIE 1964 10°).
-pub const DEFAULT_OBSERVER: &str = "10";
+pub(crate) const DEFAULT_OBSERVER: &str = "10";
 /// The geometries `plot` draws (and reads against a parameter) when none is given.
-pub const PLOT_GEOMETRIES: &[&str] = &["astm-d523-20", "astm-d523-60", "astm-d523-85"];
+pub(crate) const PLOT_GEOMETRIES: &[&str] = &["astm-d523-20", "astm-d523-60", "astm-d523-85"];
 /// The geometries `convergence` sweeps when none is given.
 pub const CONVERGENCE_GEOMETRIES: &[&str] = &["astm-d523-20", "astm-d523-60", "astm-d523-85"];
 /// The geometry `profile` profiles when none is given (the 512-pixel array of a Rhopoint IQ-class meter).
 pub const PROFILE_GEOMETRY: &str = "rspec-20";
 /// The relative tolerance of the readings of a gloss-vs-parameter picture when none is given: a picture
 /// needs no more (1e-5 of 100 GU is far below a pixel).
-pub const PLOT_RTOL: f64 = 1e-5;
+pub(crate) const PLOT_RTOL: f64 = 1e-5;
 /// The values of the varied number of a gloss-vs-parameter picture when none is given.
-pub const PLOT_POINTS: usize = 9;
+pub(crate) const PLOT_POINTS: usize = 9;
 /// The most values a gloss-vs-parameter picture draws.
-pub const PLOT_POINTS_MAX: usize = 200;
+pub(crate) const PLOT_POINTS_MAX: usize = 200;
 /// Standard errors of the mean allowed for repeated readings (`k`) when none is given.
 pub const DEFAULT_K: f64 = 2.0;
 
 /// `rtol` in (0, 1), checked before any work (the planner's check, [`rtol_refusal`], naming the argument).
-pub fn check_rtol(rtol: f64) -> Result<f64> {
+pub(crate) fn check_rtol(rtol: f64) -> Result<f64> {
     match rtol_refusal(rtol) {
         Some(why) => Err(Error::argument("rtol", format!(" {why}"))),
         None => Ok(rtol),
@@ -65,12 +65,12 @@ fn at_least_one(name: &'static str, n: usize) -> Result<usize> {
 
 /// A template recipe's JSON, read as every recipe is (`input::json::parse_json`: a byte-order mark skipped, a key
 /// given twice refused), for the front ends that vary it (`sweep`, `plot`).
-pub fn read_template(text: &str, file: &str) -> Result<Value> {
+pub(crate) fn read_template(text: &str, file: &str) -> Result<Value> {
     crate::input::json::parse_json(text, file)
 }
 
 /// `,`, `;`, `tab` (or a literal tab): the separator of a text sheet.
-pub fn parse_delimiter(s: &str) -> Result<u8> {
+pub(crate) fn parse_delimiter(s: &str) -> Result<u8> {
     match s {
         "," => Ok(b','),
         ";" => Ok(b';'),
@@ -101,7 +101,7 @@ impl PlanRequest {
     }
 
     /// The plan's options, `default_rtol` without a tolerance.
-    pub fn options_or(&self, default_rtol: f64) -> Result<PlanOptions> {
+    pub(crate) fn options_or(&self, default_rtol: f64) -> Result<PlanOptions> {
         let rtol = check_rtol(self.rtol.unwrap_or(default_rtol))?;
         let colour = self.colour()?;
         let max_evals = at_least_one("max_evals", self.max_evals.unwrap_or(PlanOptions::default().max_evals))?;
@@ -185,7 +185,7 @@ impl SweepRequest {
 
     /// [`SweepRequest::sweep`], every point's plan stopped by `cancel` (the server's, raised when its client
     /// leaves or its time is up).
-    pub fn sweep_until(
+    pub(crate) fn sweep_until(
         &self,
         text: &str,
         file: &str,
@@ -244,7 +244,7 @@ impl VsParameterRequest {
 
     /// [`VsParameterRequest::sweep`], every point's plan stopped by `cancel` (the server's, raised when its
     /// client leaves or its time is up).
-    pub fn sweep_until(
+    pub(crate) fn sweep_until(
         &self,
         text: &str,
         file: &str,
@@ -280,7 +280,7 @@ impl VsParameterRequest {
     }
 
     /// [`VsParameterRequest::read`], stopped by `cancel` as [`VsParameterRequest::sweep_until`] is.
-    pub fn read_until(
+    pub(crate) fn read_until(
         &self,
         text: &str,
         file: &str,
@@ -315,7 +315,7 @@ impl VsParameterRequest {
 /// The axis name of a recipe number (docs/instrument.md §Pictures): the registry's words for it, the
 /// alternative that names the recipe's own choice where the words offer several (`GGX α` out of `Beckmann rms
 /// slope m or GGX α` for a GGX recipe), its unit, and the pointer: `GGX α (slope), /roughness`.
-pub fn parameter_label(recipe: &Value, pointer: &str) -> String {
+pub(crate) fn parameter_label(recipe: &Value, pointer: &str) -> String {
     let model = recipe.get("model").and_then(Value::as_str).unwrap_or("");
     let Some(p) = crate::registry::lookup(model, pointer) else { return format!("recipe {pointer}") };
     let first = p.description.split(';').next().unwrap_or("").trim();

@@ -10,7 +10,6 @@ use crate::input::Stdin;
 use crate::report::pictures::charts::{
     comparison_height, draw_comparison, draw_sections, draw_vs_parameter, section, vs_parameter_size, Residual, Section,
 };
-pub use crate::report::pictures::charts::{section_svg, vs_parameter_svg};
 use crate::request::{self, PlanRequest, VsParameterRequest};
 use crate::{recipe, Error, Result};
 
@@ -60,8 +59,6 @@ pub enum Spacing {
 }
 
 const DEFAULT: &[&str] = crate::request::PLOT_GEOMETRIES;
-
-pub use crate::request::parameter_label;
 
 /// The request of a command line (the one place where `plot --kind gloss-vs-parameter`'s arguments become the
 /// library's).

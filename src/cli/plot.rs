@@ -4,9 +4,7 @@ use std::path::Path;
 
 use super::output::Existing;
 use crate::instrument::convergence::Sweep;
-pub use crate::report::pictures::{
-    draw_legend, draw_side_legend, draw_sweep, plot_err, register_font, tick, to_svg, Mark, PlotSummary,
-};
+pub(crate) use crate::report::pictures::{draw_sweep, register_font, PlotSummary};
 use crate::{Error, Result};
 
 /// The picture formats, from the file name.

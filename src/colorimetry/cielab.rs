@@ -18,7 +18,7 @@ pub struct Lab {
 
 /// C*ab and hab (degrees in [0, 360); `None` for a neutral colour, C*ab = 0, where the hue is undefined).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Lch {
+pub(crate) struct Lch {
     pub c: f64,
     pub h: Option<f64>,
 }
@@ -36,7 +36,7 @@ pub(crate) fn lab_f(t: f64) -> f64 {
 }
 
 /// L*, a*, b* of X, Y, Z relative to the white (Xn, Yn, Zn).
-pub fn xyz_to_lab(xyz: [f64; 3], white: [f64; 3]) -> Lab {
+pub(crate) fn xyz_to_lab(xyz: [f64; 3], white: [f64; 3]) -> Lab {
     let fx = lab_f(xyz[0] / white[0]);
     let fy = lab_f(xyz[1] / white[1]);
     let fz = lab_f(xyz[2] / white[2]);
@@ -56,7 +56,7 @@ pub(crate) fn lab_errors(xyz: [f64; 3], err: [f64; 3], white: [f64; 3]) -> [f64;
 }
 
 /// C*ab and hab.
-pub fn lab_to_lch(lab: Lab) -> Lch {
+pub(crate) fn lab_to_lch(lab: Lab) -> Lch {
     let c = lab.a.hypot(lab.b);
     let h = (c > 0.0).then(|| lab.b.atan2(lab.a).to_degrees().rem_euclid(360.0));
     Lch { c, h }

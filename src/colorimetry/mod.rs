@@ -37,10 +37,10 @@
 use crate::spectrum::{interp, parse_columns, parse_table, Sampling, SamplingKind};
 use crate::{Error, Result};
 
-pub mod cielab;
+pub(crate) mod cielab;
 pub mod weighting;
 
-pub use cielab::{ciede2000, lab_to_lch, xyz_to_lab, Lab, Lch};
+pub use cielab::{ciede2000, Lab};
 
 /// CIE 1931 2° colour-matching functions, 1 nm, 360–830 nm.
 pub(crate) const CIE1931_2DEG_CSV: &str = include_str!("../../standards/cie/cie1931-2deg-xyz.csv");
@@ -261,6 +261,7 @@ pub(crate) const RGB_REFUSAL: &str =
 
 #[cfg(test)]
 mod tests {
+    use super::cielab::xyz_to_lab;
     use super::*;
 
     #[test]

@@ -23,7 +23,7 @@ pub fn load_baseline(path: &Path) -> Result<Vec<BaselineEntry>> {
 }
 
 /// [`load_baseline`] of a source (a file, or standard input as a front end read it).
-pub fn load_baseline_source(source: &Source) -> Result<Vec<BaselineEntry>> {
+pub(crate) fn load_baseline_source(source: &Source) -> Result<Vec<BaselineEntry>> {
     let file = source.name();
     // Read as every JSON input is: the size limit, a BOM, duplicate keys refused.
     let text = source.text("baseline")?;
@@ -35,7 +35,7 @@ pub fn load_baseline_source(source: &Source) -> Result<Vec<BaselineEntry>> {
     Ok(entries)
 }
 
-pub fn parse_baseline(doc: &serde_json::Value, file: &str) -> Result<Vec<BaselineEntry>> {
+pub(crate) fn parse_baseline(doc: &serde_json::Value, file: &str) -> Result<Vec<BaselineEntry>> {
     let bad = |ptr: String, m: &str| Error::input(file, ptr, m.to_string());
     // A number, or absent / null (no value then); anything else is not a `measure` or `compare` JSON.
     let number_at = |v: &serde_json::Value, k: &str, ptr: &str| -> Result<Option<f64>> {

@@ -58,7 +58,9 @@ use crate::instrument::standards::{self, StandardGeometry};
 use crate::recipe::{self, Material};
 use crate::{Error, Result};
 
-pub use self::baseline::{check_baseline, load_baseline, load_baseline_source, parse_baseline, BaselineEntry, Drift};
+#[cfg(feature = "cli")]
+pub(crate) use self::baseline::load_baseline_source;
+pub use self::baseline::{check_baseline, load_baseline, BaselineEntry, Drift};
 
 /// n, mean, sample standard deviation, min and max of repeated readings.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -56,9 +56,10 @@ mod search;
 mod targets;
 
 pub use goodness::{chi2_survival, gamma_q, P_THRESHOLD};
-pub use options::{FitOptions, DEFAULT_RESTARTS, DEFAULT_UNCERTAINTY};
+pub use options::FitOptions;
+pub(crate) use options::{DEFAULT_RESTARTS, DEFAULT_UNCERTAINTY};
 pub use params::{targets_from_sheet, FreeParameter, TargetReading};
-pub use report::{FitReport, FittedParameter, FittedTarget};
+pub use report::FitReport;
 pub use search::restart_fractions;
 
 use std::time::Instant;

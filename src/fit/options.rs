@@ -5,7 +5,7 @@ use crate::instrument::standards::StandardGeometry;
 
 /// Uncertainty of a target given without one, in the reading's unit: the 0.2 GU repeatability that
 /// `docs/inverse.md` assumes for a glossmeter (its opening list, "Weights"), used for haze and DOI units alike.
-pub const DEFAULT_UNCERTAINTY: f64 = 0.2;
+pub(crate) const DEFAULT_UNCERTAINTY: f64 = 0.2;
 
 /// Knobs of the fit.
 #[derive(Clone, Debug)]
@@ -31,7 +31,7 @@ pub struct FitOptions {
 }
 
 /// Restarts of an exactly determined fit by default.
-pub const DEFAULT_RESTARTS: usize = 2;
+pub(crate) const DEFAULT_RESTARTS: usize = 2;
 
 impl Default for FitOptions {
     fn default() -> Self {

@@ -19,8 +19,9 @@
 //! This file only decodes the bytes and chooses those coordinates; the table and its interpolation are the
 //! shared layer in `table.rs`. `docs/model.md` §Measured tables (MERL) gives the details and the known limits
 //! of the data.
+pub(crate) use super::table::HalfDiff;
 use super::table::{file_name, floor_index, reflection_half_diff, Edge, Resolution, Table, TableAxis};
-pub use super::table::{fold_phi_d, half_diff, HalfDiff};
+pub use super::table::{fold_phi_d, half_diff};
 use crate::brdf::{Brdf, Hints, Lobe, Term, TermKind};
 use crate::spectrum::Sampling;
 use crate::{Error, Result, Vec3};

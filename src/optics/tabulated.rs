@@ -152,7 +152,7 @@ impl ChebTable {
 
     /// [`ChebTable::fit_with_pieces`] of the functions `which` of `f` at once (as [`ChebTable::fit_each`]):
     /// one result per entry of `which`.
-    pub fn fit_each_with_pieces(
+    pub(crate) fn fit_each_with_pieces(
         f: impl FnMut(f64, &[usize], &mut [f64]),
         which: &[usize],
         a: f64,

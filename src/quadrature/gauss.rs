@@ -39,12 +39,12 @@ pub fn gauss_legendre(n: usize) -> (Vec<f64>, Vec<f64>) {
 }
 
 /// The largest order [`gauss_legendre_table`] holds.
-pub const TABLE_MAX_ORDER: usize = 64;
+pub(crate) const TABLE_MAX_ORDER: usize = 64;
 
 /// The n-point Gauss–Legendre rule on [−1, 1] (1 ≤ n ≤ [`TABLE_MAX_ORDER`]) from a table computed once per
 /// process by [`gauss_legendre`] (the same bits), so that a rule raised level by level in a hot loop
 /// (`instrument::method`'s polar and Gauss–Hermite rules) neither recomputes nor allocates its nodes.
-pub fn gauss_legendre_table(n: usize) -> (&'static [f64], &'static [f64]) {
+pub(crate) fn gauss_legendre_table(n: usize) -> (&'static [f64], &'static [f64]) {
     static TABLE: RuleTable = RuleTable::new();
     from_table(&TABLE, n, TABLE_MAX_ORDER, gauss_legendre, "Gauss–Legendre")
 }

@@ -327,13 +327,13 @@ const MAX_SMALL: usize = 8;
 /// The calibration of [`calibrated`]: the error of the reported I₇ is taken as `CALIBRATION`·r·N₁ when the
 /// null rules fall by r per step, never less than N₁/`MAX_SHRINK`.
 pub(crate) const CALIBRATION: f64 = 3.0;
-pub const MAX_SHRINK: f64 = 8.0;
+pub(crate) const MAX_SHRINK: f64 = 8.0;
 /// The shrink limit on the lobe chart of a smooth material (`Options::max_shrink`, `docs/accuracy.md` §5).
 pub const MAX_SHRINK_LOBE: f64 = 16.0;
 /// The shrink limit on the plain chart (no lobe narrower than the stops: a diffuse body or a lobe's tail seen
 /// off the specular direction): none. There the null rules of split boxes were fooled by up to 11× on heavy
 /// GGX tails (E2539 −15°, `docs/accuracy.md` §5.2), so the plain chart's estimate is N₁ itself.
-pub const MAX_SHRINK_PLAIN: f64 = 1.0;
+pub(crate) const MAX_SHRINK_PLAIN: f64 = 1.0;
 
 /// The calibrated error of one region from three successive null rules, N₁ = |I₇ − I₅|, N₂ = |I₅ − I₃| and
 /// N₃ = |I₃ − I₁| (I₃ on the centre and the ±λ4 axial points, I₁ the centre alone), in the manner of DCUHRE

@@ -5,7 +5,7 @@
 /// Nodes (increasing) and weights of the n-point Gauss–Hermite rule for the weight e^{−x²} on ℝ (Newton
 /// iteration on the orthonormal Hermite recurrence from the asymptotic initial guesses; Press et al.,
 /// Numerical Recipes §4.6 `gauher`; Abramowitz & Stegun 25.4.46).
-pub fn gauss_hermite(n: usize) -> (Vec<f64>, Vec<f64>) {
+pub(crate) fn gauss_hermite(n: usize) -> (Vec<f64>, Vec<f64>) {
     // π^(−1/4): the orthonormal polynomial of degree 0.
     const PIM4: f64 = 0.751_125_544_464_942_5;
     let mut x = vec![0.0; n];
@@ -48,11 +48,11 @@ pub fn gauss_hermite(n: usize) -> (Vec<f64>, Vec<f64>) {
 }
 
 /// The largest order [`gauss_hermite_table`] holds.
-pub const HERMITE_TABLE_MAX_ORDER: usize = 32;
+pub(crate) const HERMITE_TABLE_MAX_ORDER: usize = 32;
 
 /// The n-point Gauss–Hermite rule (1 ≤ n ≤ [`HERMITE_TABLE_MAX_ORDER`]) from a table computed once per process by
 /// [`gauss_hermite`] (the same bits): a rule raised level by level neither recomputes nor allocates its nodes.
-pub fn gauss_hermite_table(n: usize) -> (&'static [f64], &'static [f64]) {
+pub(crate) fn gauss_hermite_table(n: usize) -> (&'static [f64], &'static [f64]) {
     static TABLE: super::gauss::RuleTable = super::gauss::RuleTable::new();
     super::gauss::from_table(&TABLE, n, HERMITE_TABLE_MAX_ORDER, gauss_hermite, "Gauss–Hermite")
 }

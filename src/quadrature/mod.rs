@@ -39,14 +39,14 @@ mod hermite;
 mod polar;
 pub mod tensor;
 
-pub use gauss::{adaptive as gauss_kronrod_adaptive, gauss_legendre, gauss_legendre_table, TABLE_MAX_ORDER};
-pub use hermite::{gauss_hermite, gauss_hermite_table, HERMITE_TABLE_MAX_ORDER};
-pub use polar::{
-    legendre_on, legendre_on_into, mapped_legendre, mapped_legendre_into, polar_rectangle, polar_rectangle_into, Map,
-    PolarBuffers,
-};
+pub(crate) use gauss::gauss_legendre_table;
+pub use gauss::{adaptive as gauss_kronrod_adaptive, gauss_legendre};
+pub(crate) use hermite::gauss_hermite_table;
+pub use polar::{legendre_on, mapped_legendre, polar_rectangle, Map};
+pub(crate) use polar::{legendre_on_into, mapped_legendre_into, polar_rectangle_into, PolarBuffers};
 
+pub use genz_malik::GenzMalikRule;
 pub use genz_malik::{
-    integrate, integrate_partition, pointwise, Cell, Estimate, GenzMalikRule, Options, Refine, DEFAULT_RTOL,
-    MAX_SHRINK, MAX_SHRINK_LOBE, MAX_SHRINK_PLAIN,
+    integrate, integrate_partition, pointwise, Cell, Estimate, Options, Refine, DEFAULT_RTOL, MAX_SHRINK_LOBE,
 };
+pub(crate) use genz_malik::{MAX_SHRINK, MAX_SHRINK_PLAIN};

@@ -23,7 +23,7 @@ pub fn legendre_on(n: usize, a: f64, b: f64) -> (Vec<f64>, Vec<f64>) {
 }
 
 /// [`legendre_on`] into the caller's buffers (cleared first): no allocation once they have room for n.
-pub fn legendre_on_into(n: usize, a: f64, b: f64, x: &mut Vec<f64>, w: &mut Vec<f64>) {
+pub(crate) fn legendre_on_into(n: usize, a: f64, b: f64, x: &mut Vec<f64>, w: &mut Vec<f64>) {
     let (gx, gw) = gauss_legendre_table(n);
     let (c, h) = (0.5 * (a + b), 0.5 * (b - a));
     x.clear();
@@ -76,7 +76,7 @@ pub fn mapped_legendre(n: usize, a: f64, b: f64, map: Map) -> (Vec<f64>, Vec<f64
 
 /// [`mapped_legendre`] into the caller's buffers (cleared first; the same bits): no allocation once they
 /// have room for n.
-pub fn mapped_legendre_into(n: usize, a: f64, b: f64, map: Map, x: &mut Vec<f64>, w: &mut Vec<f64>) {
+pub(crate) fn mapped_legendre_into(n: usize, a: f64, b: f64, map: Map, x: &mut Vec<f64>, w: &mut Vec<f64>) {
     match map {
         Map::Linear => legendre_on_into(n, a, b, x, w),
         Map::Reciprocal => {
@@ -112,14 +112,14 @@ pub fn polar_rectangle(lo: [f64; 2], hi: [f64; 2], n_phi: usize, n_r: usize, rad
 /// The one-dimensional node buffers [`polar_rectangle_into`] works in (kept by a caller that calls it level
 /// after level, so that nothing is allocated once they have grown).
 #[derive(Debug, Default)]
-pub struct PolarBuffers {
+pub(crate) struct PolarBuffers {
     phi: (Vec<f64>, Vec<f64>),
     rho: (Vec<f64>, Vec<f64>),
 }
 
 /// [`polar_rectangle`] into `out` (cleared first; the same nodes, weights and order), working in `buffers`:
 /// no allocation once the buffers and `out` have room.
-pub fn polar_rectangle_into(
+pub(crate) fn polar_rectangle_into(
     lo: [f64; 2],
     hi: [f64; 2],
     n_phi: usize,

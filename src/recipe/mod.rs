@@ -55,7 +55,8 @@ pub mod schema;
 pub mod topography;
 pub mod uncertainty;
 
-pub use crate::registry::{MAX_LOBES, MODELS};
+pub(crate) use crate::registry::MAX_LOBES;
+pub use crate::registry::MODELS;
 
 /// Descriptive fields allowed in every recipe: `name`, `description`, `provenance` (strings) and `notes`
 /// (a string or an array of strings). They do not change the model.
@@ -84,7 +85,7 @@ pub fn load_file(path: &std::path::Path) -> Result<Material> {
 }
 
 /// [`load_file`] of a source (a file, or standard input as a front end read it).
-pub fn load_source(source: &crate::input::Source) -> Result<Material> {
+pub(crate) fn load_source(source: &crate::input::Source) -> Result<Material> {
     parse_str(&source.text("recipe")?, &source.name())
 }
 

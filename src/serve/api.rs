@@ -27,7 +27,7 @@ use crate::sweep::Sweep;
 use crate::{report, Error, Result};
 
 /// How a request body is named in messages.
-pub const REQUEST: &str = "request";
+pub(crate) const REQUEST: &str = "request";
 /// How the request's recipe is named in messages (and in the documents' `material.file`).
 pub const RECIPE: &str = "recipe";
 
@@ -413,7 +413,7 @@ pub fn sweep(req: &Request, ctx: Context) -> Result<Sweep> {
 
 /// Run a checked sweep, handing each JSON line (a row of `sweep --format jsonl --no-timing`) to `line` in
 /// index order, a few points at a time (so that the page can show progress).
-pub fn run_sweep(s: &Sweep, mut line: impl FnMut(String) -> Result<()>) -> Result<()> {
+pub(crate) fn run_sweep(s: &Sweep, mut line: impl FnMut(String) -> Result<()>) -> Result<()> {
     let step = rayon::current_num_threads().max(1) as u64;
     let mut start = 0;
     while start < s.len() {
@@ -606,7 +606,7 @@ pub fn fit(req: &Request, ctx: Context) -> Result<Reply> {
 
 /// `GET /api/registry`: every recipe parameter (JSON Pointer, models, type, unit, range, default, meaning)
 /// and the models, from which the page builds its editor.
-pub fn registry_doc() -> Reply {
+pub(crate) fn registry_doc() -> Reply {
     let params: Vec<Value> = registry::PARAMS
         .iter()
         .map(|p| {
@@ -642,7 +642,7 @@ fn finite(x: f64) -> Value {
 /// `GET /api/geometries`: the shipped geometries (id, the instrument's title and standards as the geometry
 /// file names them, the line of `glossmeter standards`, whether it is in the default panel, whether it has a
 /// profile array, and every number of the file whose status is `assumed`, with its JSON Pointer and reason).
-pub fn geometries_doc() -> Result<Reply> {
+pub(crate) fn geometries_doc() -> Result<Reply> {
     let all = standards::builtin_all()?;
     let list: Vec<Value> = all
         .iter()
@@ -665,7 +665,7 @@ pub fn geometries_doc() -> Result<Reply> {
 }
 
 /// The models whose recipe names a table file (`/file`), with the file name endings each reads.
-pub const TABLE_MODELS: &[(&str, &[&str])] = &[
+pub(crate) const TABLE_MODELS: &[(&str, &[&str])] = &[
     ("merl", &[".binary"]),
     ("rgl", &[".bsdf"]),
     ("inplane-csv", &[".csv"]),
@@ -678,7 +678,7 @@ pub const TABLE_MODELS: &[(&str, &[&str])] = &[
 /// deep at most, 200 files at most, in path order) whose name ends as the model's tables do, named by its path
 /// relative to the directory, each resolved as a recipe's path is ([`table_path`]: a link out of the
 /// directory is not listed). Without `--data-dir`, `"data_dir": false` and no files.
-pub fn tables_doc(data_dir: Option<&Path>) -> Reply {
+pub(crate) fn tables_doc(data_dir: Option<&Path>) -> Reply {
     let mut found: Vec<String> = Vec::new();
     if let Some(root) = data_dir {
         walk_tables(root, root, 0, &mut found);

@@ -3,9 +3,9 @@
 //! that names no table file), so that the binary serves them with nothing beside it.
 
 /// The page.
-pub const INDEX_HTML: &str = include_str!("page/index.html");
-pub const APP_JS: &str = include_str!("page/app.js");
-pub const APP_CSS: &str = include_str!("page/app.css");
+pub(crate) const INDEX_HTML: &str = include_str!("page/index.html");
+pub(crate) const APP_JS: &str = include_str!("page/app.js");
+pub(crate) const APP_CSS: &str = include_str!("page/app.css");
 
 /// The shipped recipes the page starts from: (name, the file's text), the first the page's default.
 pub const FIXTURES: &[(&str, &str)] = &[

@@ -31,7 +31,7 @@ use super::security::{Limits, FDS_PER_JOB, RESERVED_FDS};
 use crate::{Error, Result};
 
 /// The process's soft open-file limit (`ulimit -n`; None: unlimited or unknown).
-pub fn open_file_limit() -> Option<u64> {
+pub(crate) fn open_file_limit() -> Option<u64> {
     #[cfg(unix)]
     return rustix::process::getrlimit(rustix::process::Resource::Nofile).current;
     #[cfg(not(unix))]
@@ -40,7 +40,7 @@ pub fn open_file_limit() -> Option<u64> {
 
 /// The most connections the server keeps open: `wanted` (`--max-connections`), and at most the open-file
 /// limit less [`RESERVED_FDS`] + [`FDS_PER_JOB`]·`jobs`. An error when that leaves room for fewer than 8.
-pub fn connection_cap(wanted: usize, fd_limit: Option<u64>, jobs: usize) -> Result<usize> {
+pub(crate) fn connection_cap(wanted: usize, fd_limit: Option<u64>, jobs: usize) -> Result<usize> {
     if wanted == 0 {
         return Err(Error::argument("max_connections", " must be at least 1"));
     }

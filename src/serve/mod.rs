@@ -35,7 +35,8 @@ pub mod connections;
 pub mod security;
 
 use api::{Context, Reply};
-pub use security::{Guard, Limits};
+pub(crate) use security::Guard;
+pub use security::Limits;
 
 /// How to start a server.
 #[derive(Clone, Debug)]
@@ -161,7 +162,7 @@ impl Server {
     }
 
     /// The page's address, under a name the server answers to.
-    pub fn url(&self) -> String {
+    pub(crate) fn url(&self) -> String {
         let port = self.addr.port();
         match self.addr {
             a if a.ip().is_unspecified() || a.ip().is_loopback() && a.is_ipv4() => format!("http://127.0.0.1:{port}/"),

@@ -49,8 +49,8 @@ pub struct Limits {
 /// File descriptors the server keeps free of connections: standard streams, the listener, the runtime's
 /// poller and room for connections being closed; and [`FDS_PER_JOB`] more for each computation (the table
 /// files it reads).
-pub const RESERVED_FDS: u64 = 32;
-pub const FDS_PER_JOB: u64 = 4;
+pub(crate) const RESERVED_FDS: u64 = 32;
+pub(crate) const FDS_PER_JOB: u64 = 4;
 
 impl Default for Limits {
     fn default() -> Self {
@@ -78,7 +78,7 @@ impl Default for Limits {
 /// wildcard), each with the bound port. A browser on a page of another site sends that site's `Origin`; a
 /// DNS-rebinding page reaches the server under its own name in `Host`: both are refused (403).
 #[derive(Clone, Debug)]
-pub struct Guard {
+pub(crate) struct Guard {
     hosts: Vec<String>,
 }
 
@@ -103,7 +103,7 @@ impl Guard {
     /// Whether a request with these headers may be answered ([`Guard::check`]); the reason if not. A `Host`
     /// or an `Origin` sent twice is refused, whatever the two say (no browser sends either twice, and which
     /// of two a proxy or a framework would read is not this server's to guess).
-    pub fn check_headers(&self, headers: &axum::http::HeaderMap) -> std::result::Result<(), String> {
+    pub(crate) fn check_headers(&self, headers: &axum::http::HeaderMap) -> std::result::Result<(), String> {
         for name in ["host", "origin", "sec-fetch-site"] {
             let n = headers.get_all(name).iter().count();
             if n > 1 {
@@ -149,7 +149,7 @@ impl Guard {
 /// The file a recipe's table path `given` names inside `data_dir`, canonical: refused without a data
 /// directory, for an absolute path or one with `..`, for a file that is not there, and for a path that leads
 /// out of the directory through a symbolic link. `file` and `field` name the recipe and its field in messages.
-pub fn table_path(data_dir: Option<&Path>, given: &str, file: &str, field: &str) -> Result<PathBuf> {
+pub(crate) fn table_path(data_dir: Option<&Path>, given: &str, file: &str, field: &str) -> Result<PathBuf> {
     let Some(root) = data_dir else {
         return Err(Error::input(
             file,

@@ -163,7 +163,7 @@ pub fn load(path: &Path, options: &SheetOptions) -> Result<Sheet> {
 }
 
 /// [`load`] of a source (a file, or standard input as a front end read it).
-pub fn load_source(source: &crate::input::Source, options: &SheetOptions) -> Result<Sheet> {
+pub(crate) fn load_source(source: &crate::input::Source, options: &SheetOptions) -> Result<Sheet> {
     from_bytes(&source.bytes("sheet")?, &source.name(), options)
 }
 

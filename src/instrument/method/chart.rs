@@ -8,7 +8,7 @@ use crate::instrument::geometry::{Axes, Stop};
 /// A chart with everything its map needs: the source's and the receptor's axes, the clipped stops, and the
 /// cosines of the half-angle kinks that cut its position variable (`RegularPart::kinks`; empty: none).
 #[derive(Clone, Copy, Debug)]
-pub struct ChartMap<'a> {
+pub(crate) struct ChartMap<'a> {
     pub chart: Chart,
     kinks: &'a [f64],
     axes: Axes,

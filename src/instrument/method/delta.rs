@@ -14,7 +14,7 @@ pub const DELTA_RADII: [f64; 2] = [2.5, 5.0];
 /// correction by second differences (in the metric of the fitted curvature B); beyond it the tail, bounded by a
 /// Gaussian of the decay rate measured on that ring ([`DELTA_TAIL_SAFETY`]). It is the last of [`DELTA_RADII`]; the
 /// overlap kinks are ≥ [`LOBE_REACH`](super::LOBE_REACH) = 8 widths away.
-pub const DELTA_RADIUS: f64 = DELTA_RADII[DELTA_RADII.len() - 1];
+pub(crate) const DELTA_RADIUS: f64 = DELTA_RADII[DELTA_RADII.len() - 1];
 
 /// The factor by which [`Rule::LobeDelta`](super::Rule::LobeDelta) multiplies the largest sampled second difference to
 /// stand for a bound over the whole disc: one of the two assumptions of its majorant (`docs/instrument.md` §Quadrature;
@@ -38,13 +38,13 @@ pub const DELTA_T_ORDERS: (usize, usize) = (2, 3);
 const DELTA_NODE_POINTS: (usize, usize) = (1 + 8, 1 + 8 * (1 + DELTA_RADII.len()));
 
 /// The evaluations of one [`Rule::LobeDelta`](super::Rule::LobeDelta) (181).
-pub const DELTA_COST: usize = DELTA_T_ORDERS.1 * DELTA_T_ORDERS.1 * DELTA_NODE_POINTS.0
+pub(crate) const DELTA_COST: usize = DELTA_T_ORDERS.1 * DELTA_T_ORDERS.1 * DELTA_NODE_POINTS.0
     + DELTA_T_ORDERS.0 * DELTA_T_ORDERS.0 * DELTA_NODE_POINTS.1;
 const _: () = assert!(DELTA_COST == 181, "the docs and --explain's cost figures say 181");
 
 /// The directions of the stencil of [`Rule::LobeDelta`](super::Rule::LobeDelta) in the scaled lobe variables (each with
 /// its opposite point): 0°, 45°, 90°, 135°.
-pub const DELTA_DIRECTIONS: [[f64; 2]; 4] = [
+pub(crate) const DELTA_DIRECTIONS: [[f64; 2]; 4] = [
     [1.0, 0.0],
     [std::f64::consts::FRAC_1_SQRT_2, std::f64::consts::FRAC_1_SQRT_2],
     [0.0, 1.0],

@@ -19,7 +19,7 @@ use crate::quadrature::{tensor, Cell, Refine};
 
 /// How far (in lobe widths, on both axes and both sides) the overlap kinks must be from the lobe centre for
 /// [`Rule::LobePolar`]: the polar piece then holds the peak and the tail pieces only the tail.
-pub const POLAR_REACH: f64 = 2.0;
+pub(crate) const POLAR_REACH: f64 = 2.0;
 
 /// At geometry angles of [`POLAR_GRAZING`] and above, [`Rule::LobePolar`] needs the overlap kinks and range
 /// ends at least [`POLAR_REACH_GRAZING`] lobe widths from the centre on the u axis (the plane of incidence).
@@ -32,7 +32,7 @@ pub const POLAR_REACH: f64 = 2.0;
 /// and at 20°–60° the polar rule won at every α tried down to [`POLAR_REACH`].
 pub const POLAR_REACH_GRAZING: f64 = 8.0;
 /// See [`POLAR_REACH_GRAZING`]: 80°, between TAPPI T480's 75° and D523's 85°.
-pub const POLAR_GRAZING: f64 = 80.0 * std::f64::consts::PI / 180.0;
+pub(crate) const POLAR_GRAZING: f64 = 80.0 * std::f64::consts::PI / 180.0;
 
 /// [`Rule::TensorGauss`] is chosen ([`smooth_rule`]) when every lobe is at least [`TENSOR_MIN_WIDTH_U`]
 /// times the u-range wide (smooth in the plane of incidence) and between [`TENSOR_MIN_WIDTH`] and
@@ -42,22 +42,22 @@ pub const POLAR_GRAZING: f64 = 80.0 * std::f64::consts::PI / 180.0;
 /// α = 0.3 at 85° (7.2 × the u-range, 0.35 of the v-range) 2 159 against 2 639; it cost more at every
 /// other wide-lobe integral tried (B4 at 75°: 2.9 and 0.63, 2 204 against 986; GGX α = 0.3 conductor at
 /// 60°: 4.5 and 0.81, 3 023 against 872; Blinn–Phong at 20°: 2.0 and 0.79, 1 574 against 530).
-pub const TENSOR_MIN_WIDTH: f64 = 0.25;
+pub(crate) const TENSOR_MIN_WIDTH: f64 = 0.25;
 /// See [`TENSOR_MIN_WIDTH`].
-pub const TENSOR_MAX_WIDTH_V: f64 = 0.5;
+pub(crate) const TENSOR_MAX_WIDTH_V: f64 = 0.5;
 /// See [`TENSOR_MIN_WIDTH`].
-pub const TENSOR_MIN_WIDTH_U: f64 = 4.0;
+pub(crate) const TENSOR_MIN_WIDTH_U: f64 = 4.0;
 
 /// How far (in lobe widths) the nearest overlap kink or range end must be from the lobe centre, on both
 /// axes, for [`Rule::LobeGaussHermite`]: the largest node of the 16-point rule is at 4.69 widths, and the
 /// Gaussian is below e⁻⁶⁴ of its peak at 8.
-pub const LOBE_REACH: f64 = 8.0;
+pub(crate) const LOBE_REACH: f64 = 8.0;
 
 /// The design-time gate of [`delta_rule`]: a majorant of [`Rule::LobeDelta`] relative to the reading, per
 /// squared lobe width, above the 50–270 measured at 20°, 60°, E430 and ISO 13803 (at 85°, ≈ 1.8·10⁴, the
 /// rule is tried and may refuse itself; `docs/instrument.md` §Quadrature). Only a gate: the majorant itself
 /// is computed at run time.
-pub const DELTA_GATE: f64 = 1.0e3;
+pub(crate) const DELTA_GATE: f64 = 1.0e3;
 
 impl Method {
     /// Design the method of one integral.
@@ -203,7 +203,7 @@ impl Method {
 /// part is one Gaussian-tailed lobe (no diffuse term, no heavy tail) whose centre u = v = 0 is inside the
 /// range of the lobe variables and at least
 /// [`LOBE_REACH`] widths from every kink of the overlap length and every end of the range, on both axes.
-pub fn lobe_rule(l: &LobesAt, src: Stop, rec: Stop) -> Option<Rule> {
+pub(crate) fn lobe_rule(l: &LobesAt, src: Stop, rec: Stop) -> Option<Rule> {
     let ([lobe], [width]) = (l.lobes, l.widths.as_slice()) else { return None };
     if l.has_diffuse || lobe.tail.is_heavy() {
         return None;
@@ -225,7 +225,7 @@ pub fn lobe_rule(l: &LobesAt, src: Stop, rec: Stop) -> Option<Rule> {
 /// measured at 50–270·w² at 20°, 60°, E430 and ISO 13803 (≈ 1.8·10⁴·w² at 85°), so the rule is tried only
 /// when [`DELTA_GATE`]·w² ≤ rtol (otherwise its evaluations would be spent for nothing before the
 /// Gauss–Hermite rule). Whether the majorant meets the tolerance is decided when it runs, on the material.
-pub fn delta_rule(l: &LobesAt, src: Stop, rec: Stop, rtol: f64) -> Option<Rule> {
+pub(crate) fn delta_rule(l: &LobesAt, src: Stop, rec: Stop, rtol: f64) -> Option<Rule> {
     let Some(Rule::LobeGaussHermite { width, .. }) = lobe_rule(l, src, rec) else {
         return None;
     };
@@ -238,7 +238,7 @@ pub fn delta_rule(l: &LobesAt, src: Stop, rec: Stop, rtol: f64) -> Option<Rule> 
 /// lobe is far wider than the stops, the lobe variable across it, where the ridge v = q_s + q_r becomes an
 /// axis) within the bounds of [`TENSOR_MIN_WIDTH`] (B4's GGX α = 0.3 at 85°: 0.6 wide in u against a u-range
 /// of 0.083, 0.052 in v against 0.15). The levels start at 1 (2 points) on every axis.
-pub fn smooth_rule(l: &LobesAt, src: Stop, rec: Stop) -> Option<Rule> {
+pub(crate) fn smooth_rule(l: &LobesAt, src: Stop, rec: Stop) -> Option<Rule> {
     let range = [(src.p[1] - src.p[0]) + (rec.p[1] - rec.p[0]), (src.q[1] - src.q[0]) + (rec.q[1] - rec.q[0])];
     let fits = |w: &[f64; 2]| {
         w.iter().all(|w| w.is_finite())

@@ -358,6 +358,6 @@ fn store(out: &mut [f64], values: &[f64], weighting: &Weighting, g: f64, project
 
 /// The instant `seconds` after `start`; None (no deadline) when the budget is not a finite non-negative
 /// number of seconds or lies beyond what an `Instant` can hold (`--max-seconds 1e19` is, in effect, none).
-pub fn deadline_after(start: Instant, seconds: f64) -> Option<Instant> {
+pub(crate) fn deadline_after(start: Instant, seconds: f64) -> Option<Instant> {
     std::time::Duration::try_from_secs_f64(seconds).ok().and_then(|d| start.checked_add(d))
 }

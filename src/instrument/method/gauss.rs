@@ -13,7 +13,7 @@ pub const LOBE_LEVELS: [(usize, usize); 5] = [(4, 2), (6, 3), (8, 4), (12, 5), (
 
 /// The highest level of [`Rule::TensorGauss`] an axis may reach (`tensor::ORDERS[TENSOR_MAX_LEVEL]` = 24
 /// points): beyond it the integrand is not smooth at the scale of the box and the fallback does better.
-pub const TENSOR_MAX_LEVEL: usize = 9;
+pub(crate) const TENSOR_MAX_LEVEL: usize = 9;
 
 /// The boxes of [`Rule::TensorGauss`] in its chart's variables: the stops' product (p_s, q_s, p_r, q_r) in the
 /// plain chart; in the lobe chart (u, t_p, v, t_q) the products of the intervals between the range ends and

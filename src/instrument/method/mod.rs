@@ -47,19 +47,18 @@ mod polar;
 mod rule;
 mod shape;
 
-pub use chart::ChartMap;
+pub(crate) use delta::DELTA_RADIUS;
 pub use delta::{
-    delta_fit, delta_stencil, DeltaFit, DELTA_COST, DELTA_DIRECTIONS, DELTA_FIT_RADIUS, DELTA_RADII, DELTA_RADIUS,
-    DELTA_SAFETY, DELTA_TAIL_SAFETY, DELTA_T_ORDERS,
+    delta_fit, delta_stencil, DeltaFit, DELTA_FIT_RADIUS, DELTA_RADII, DELTA_SAFETY, DELTA_TAIL_SAFETY, DELTA_T_ORDERS,
 };
-pub use design::{
-    delta_rule, lobe_rule, polar_rule, smooth_rule, DELTA_GATE, LOBE_REACH, POLAR_GRAZING, POLAR_REACH,
-    POLAR_REACH_GRAZING, TENSOR_MAX_WIDTH_V, TENSOR_MIN_WIDTH, TENSOR_MIN_WIDTH_U,
-};
-pub use execute::{deadline_after, LATE_START_SHARE};
-pub use gauss::{tensor_boxes, LOBE_LEVELS, TENSOR_MAX_LEVEL};
-pub use polar::{POLAR_LEVELS, TAIL_LEVELS};
-pub use shape::{Integrand, Outcome, RuleRun, ShapedRule};
+pub use design::{polar_rule, POLAR_REACH_GRAZING};
+pub(crate) use design::{LOBE_REACH, POLAR_REACH};
+pub(crate) use execute::deadline_after;
+pub use execute::LATE_START_SHARE;
+pub(crate) use gauss::TENSOR_MAX_LEVEL;
+pub use gauss::{tensor_boxes, LOBE_LEVELS};
+pub(crate) use polar::POLAR_LEVELS;
+pub use shape::Outcome;
 
 #[cfg(doc)]
 use crate::instrument::aperture::DELTA_SHARE;

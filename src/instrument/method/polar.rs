@@ -9,12 +9,12 @@ use crate::quadrature::{
 
 /// The (φ nodes per sector, β nodes, t nodes per axis) of the polar piece of [`Rule::LobePolar`], level by
 /// level: 4·3·6·2² = 288 points, then 512, 1 152, 4 608, 18 432, 51 200.
-pub const POLAR_LEVELS: [(usize, usize, usize); 6] =
+pub(crate) const POLAR_LEVELS: [(usize, usize, usize); 6] =
     [(3, 6, 2), (4, 8, 2), (6, 12, 2), (8, 16, 3), (12, 24, 4), (16, 32, 5)];
 
 /// The (tail-axis nodes, cross-axis nodes, t nodes per axis) of a tail piece of [`Rule::LobePolar`], level by
 /// level: 3·3·2² = 36 points, then 64, 144, 576, 2 304, 6 400.
-pub const TAIL_LEVELS: [(usize, usize, usize); 6] =
+pub(crate) const TAIL_LEVELS: [(usize, usize, usize); 6] =
     [(3, 3, 2), (4, 4, 2), (6, 6, 2), (8, 8, 3), (12, 12, 4), (16, 16, 5)];
 
 /// One piece of [`Rule::LobePolar`]: its u and v intervals, whether it holds the lobe centre (the polar

@@ -8,7 +8,7 @@ use crate::quadrature::{Cell, Estimate, Options, Refine};
 
 /// The regular part's integrand as the rules see it: at each point of a batch (in the rule's chart), the
 /// `ncomp` values written point-major to the output (left as they were outside the overlap).
-pub type Integrand<'a> = dyn FnMut(&[[f64; 4]], &mut [f64]) + 'a;
+pub(crate) type Integrand<'a> = dyn FnMut(&[[f64; 4]], &mut [f64]) + 'a;
 
 /// What a rule run is given besides its integrand.
 #[derive(Clone, Copy, Debug)]
@@ -51,7 +51,7 @@ impl Outcome {
 }
 
 /// A rule of a regular part, run on the integrand in its chart.
-pub trait ShapedRule {
+pub(crate) trait ShapedRule {
     /// Run the rule: [`Outcome::done`] is the estimate and the rule frozen at what it reached when it agreed
     /// with itself to the part's tolerance (or, frozen, replayed what it reached before), else None.
     fn estimate(&self, f: &mut Integrand, run: &RuleRun) -> Outcome;

@@ -23,7 +23,7 @@ use super::{Engine, Job, Plan, PlanOptions, PlannedReading, Shape, MIN_RTOL, SPE
 
 /// Why `rtol` is not a relative tolerance (a number in (0, 1)), if it is not: the words after its name, which
 /// [`Planner::compile`] calls "the relative tolerance (rtol)" and the command line `--rtol`.
-pub fn rtol_refusal(rtol: f64) -> Option<String> {
+pub(crate) fn rtol_refusal(rtol: f64) -> Option<String> {
     (!(rtol.is_finite() && rtol > 0.0 && rtol < 1.0))
         .then(|| format!("must be a number in (0, 1), got {}", crate::error::given(rtol)))
 }

@@ -55,11 +55,9 @@ mod explain;
 mod readings;
 
 pub use cancel::Cancel;
-pub use compile::{rtol_refusal, Planner};
-pub use readings::{
-    colour_value, colour_xyz, haze_index_value, neutral_chroma, reading_value, NeutralHue, NEUTRAL_CHROMA_FLOOR,
-    NEUTRAL_HUE,
-};
+pub(crate) use compile::rtol_refusal;
+pub use compile::Planner;
+pub(crate) use readings::{haze_index_value, reading_value};
 
 /// Share of a reading's relative tolerance given to each specimen flux and to the gloss standard's flux. A
 /// gloss reading's propagated relative error is at most the sum of its two fluxes' (first order), so

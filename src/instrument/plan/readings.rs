@@ -51,7 +51,7 @@ fn problem_reading(r: &PlannedReading, why: String) -> Reading {
 /// The value and first-order error of a direct (non-composite) reading from its fluxes, each given as
 /// (value, error) by receptor name: the definitions of the readings (`ReadingSpec`), in one place. Err says
 /// why there is no value (a zero reference flux).
-pub fn reading_value(
+pub(crate) fn reading_value(
     spec: &ReadingSpec,
     specimen: &dyn Fn(&str) -> (f64, f64),
     standard: &dyn Fn(&str) -> (f64, f64),
@@ -120,7 +120,7 @@ fn compensated_haze(
 }
 
 /// The value and error of a haze index (ASTM D4039) from its two gloss readings' (value, error).
-pub fn haze_index_value(minuend: (f64, f64), subtrahend: (f64, f64)) -> (f64, f64) {
+pub(crate) fn haze_index_value(minuend: (f64, f64), subtrahend: (f64, f64)) -> (f64, f64) {
     (minuend.0 - subtrahend.0, minuend.1 + subtrahend.1)
 }
 
@@ -131,7 +131,7 @@ fn component_of(r: &PlannedReading, jobs: &[Job], j: usize) -> usize {
 
 /// X, Y, Z of a colour reading: Σ sign·Φ_XYZ over its integrals, ÷ the perfect diffuser's flux, with the
 /// summed error bounds (a difference's bound is the sum of the bounds).
-pub fn colour_xyz(
+pub(crate) fn colour_xyz(
     terms: &[(String, f64)],
     white: f64,
     flux: &dyn Fn(&str, usize) -> (f64, f64),
@@ -152,7 +152,7 @@ pub fn colour_xyz(
 /// [`neutral_chroma`] gives (docs/colour.md §Neutral colours). Its `Display` is the reading's note, which
 /// starts with [`NEUTRAL_HUE`].
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct NeutralHue {
+pub(crate) struct NeutralHue {
     pub chroma: f64,
     pub floor: f64,
 }
@@ -176,7 +176,7 @@ enum NoValue {
 
 /// A colour quantity and its error bound from X, Y, Z (`docs/colour.md`: L*, a*, b* by intervals, C*ab and
 /// hab from the a*b* box). Err for the hue of a neutral colour (C*ab = 0), which is undefined.
-pub fn colour_value(
+pub(crate) fn colour_value(
     q: ColourQuantity,
     xyz: [f64; 3],
     err: [f64; 3],
@@ -202,16 +202,16 @@ pub fn colour_value(
 }
 
 /// How the hue reading of a neutral colour explains its missing value: the first words of its note.
-pub const NEUTRAL_HUE: &str = "neutral colour";
+pub(crate) const NEUTRAL_HUE: &str = "neutral colour";
 
 /// The rounding floor of C*ab: L*a*b* values of order 100 computed in double precision carry ~10⁻¹³ of
 /// rounding, so a chroma below 10⁻⁹ is noise whatever the integration's error (docs/colour.md §Neutral colours).
-pub const NEUTRAL_CHROMA_FLOOR: f64 = 1e-9;
+pub(crate) const NEUTRAL_CHROMA_FLOOR: f64 = 1e-9;
 
 /// The chroma at or below which a colour is neutral and its hue undefined: 3 × the chroma's error estimate
 /// (the error ellipse of (a*, b*) then reaches the origin, so the integration does not determine the hue;
 /// docs/colour.md §Neutral colours), and never below [`NEUTRAL_CHROMA_FLOOR`].
-pub fn neutral_chroma(chroma_error: f64) -> f64 {
+pub(crate) fn neutral_chroma(chroma_error: f64) -> f64 {
     (3.0 * chroma_error).max(NEUTRAL_CHROMA_FLOOR)
 }
 

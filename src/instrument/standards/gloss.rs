@@ -51,7 +51,7 @@ const TOP_FIELDS: &[&str] = &[
 const GEOMETRY_ONLY: &[&str] = &["angle_deg", "scale", "reference_index", "source", "receptors", "profile"];
 
 /// The allowed `scale.kind` values.
-pub const SCALE_KINDS: &[&str] = &["black-glass", "mirror"];
+pub(crate) const SCALE_KINDS: &[&str] = &["black-glass", "mirror"];
 
 /// The geometry's scale: `"scale": {"kind": "black-glass", "reference_index": {…}, "assigned_gu": {…}}` or
 /// `{"kind": "mirror", "assigned_gu": {…}}`, each number sourced. A file that gives only the older top-level
@@ -245,7 +245,7 @@ fn check_receptor(o: &Obj, path: &str, name: &str, names: &[&str]) -> Result<()>
 }
 
 /// The allowed `quantity` values of a reading.
-pub const QUANTITIES: &[&str] =
+pub(crate) const QUANTITIES: &[&str] =
     &["gloss", "haze", "log-haze", "haze-compensated", "log-haze-compensated", "doi", "haze-index"];
 
 /// The subtraction factor of a compensated haze reading: mean_r Ω⊥(r) / Ω⊥(compensation), the ratio of the

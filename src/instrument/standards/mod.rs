@@ -30,7 +30,7 @@ pub mod gloss;
 pub mod profile;
 pub mod sourced;
 
-pub use gloss::{builtin_ids, describe, list_line, parse, BUILTIN, QUANTITIES, SCALE_KINDS};
+pub use gloss::{builtin_ids, describe, list_line, parse, BUILTIN};
 pub use sourced::{StandardGeometry, STATUSES};
 
 /// Every shipped geometry, parsed and checked once per process: the gloss ones ([`BUILTIN`] order), then the
@@ -193,7 +193,7 @@ pub fn load_file(path: &Path) -> Result<StandardGeometry> {
 }
 
 /// [`load_file`] of a source (a file, or standard input as a front end read it).
-pub fn load_source(source: &crate::input::Source) -> Result<StandardGeometry> {
+pub(crate) fn load_source(source: &crate::input::Source) -> Result<StandardGeometry> {
     let name = source.name();
     let text = source.text("geometry file")?;
     let is_colour = parse_json(&text, &name).map(|v| colour::is_colour_spec(&v)).unwrap_or(false);

@@ -462,7 +462,7 @@ fn draw_comparison_panel<DB: DrawingBackend>(
 
 /// The in-plane section picture of `material` through `geometries` as an SVG document in memory (what
 /// `plot --kind section` writes to a file; the server's `/api/plot`).
-pub fn section_svg(material: &recipe::Material, geometries: &[StandardGeometry]) -> Result<String> {
+pub(crate) fn section_svg(material: &recipe::Material, geometries: &[StandardGeometry]) -> Result<String> {
     let panels: Vec<Section> = geometries.iter().filter_map(|g| section(material.brdf.as_ref(), g)).collect();
     if panels.is_empty() {
         return Err(Error::Usage("none of the geometries has a receptor in the plane of incidence to draw".into()));
@@ -475,7 +475,12 @@ pub fn section_svg(material: &recipe::Material, geometries: &[StandardGeometry])
 /// `series` holds a label
 /// (geometry, reading, unit) and its (value of the number, reading) points, as `plot --kind
 /// gloss-vs-parameter` draws them.
-pub fn vs_parameter_svg(name: &str, label: &str, log: bool, series: &[(String, Vec<(f64, f64)>)]) -> Result<String> {
+pub(crate) fn vs_parameter_svg(
+    name: &str,
+    label: &str,
+    log: bool,
+    series: &[(String, Vec<(f64, f64)>)],
+) -> Result<String> {
     if series.iter().all(|s| s.1.is_empty()) {
         return Err(Error::Numeric("no reading has a value over the range".into()));
     }

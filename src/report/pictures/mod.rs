@@ -37,7 +37,7 @@ pub struct PlotSummary {
 }
 
 /// Register the embedded font once (plotters' `ab_glyph` text renderer has no font until one is registered).
-pub fn register_font() {
+pub(crate) fn register_font() {
     static ONCE: std::sync::Once = std::sync::Once::new();
     ONCE.call_once(|| {
         // The font is embedded and known to be valid; an error here would only lose the text.
@@ -49,13 +49,13 @@ pub fn register_font() {
     });
 }
 
-pub fn plot_err(e: impl std::fmt::Display) -> Error {
+pub(crate) fn plot_err(e: impl std::fmt::Display) -> Error {
     Error::Numeric(format!("plotting failed: {e}"))
 }
 
 /// The legend of every chart the command line draws: the series labels in a framed, slightly transparent box
 /// in a corner, in a sans-serif font of `size` px.
-pub fn draw_legend<'a, DB: DrawingBackend + 'a, CT: plotters::coord::CoordTranslate>(
+pub(crate) fn draw_legend<'a, DB: DrawingBackend + 'a, CT: plotters::coord::CoordTranslate>(
     chart: &mut ChartContext<'a, DB, CT>,
     position: SeriesLabelPosition,
     size: u32,
@@ -80,7 +80,7 @@ pub enum Mark {
 
 /// A legend beside the chart, in its own drawing area, so that it never covers the data: one entry per line
 /// (long texts wrapped at words), a mark then the text, in a sans-serif font of `size` px.
-pub fn draw_side_legend<DB: DrawingBackend>(
+pub(crate) fn draw_side_legend<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     title: &str,
     entries: &[(Mark, String)],
@@ -133,7 +133,7 @@ fn wrap(text: &str, width: usize) -> Vec<String> {
 }
 
 /// A tick label with two significant digits: plain from 10⁻³ to 10⁴, else `3.2e-5`.
-pub fn tick(y: f64) -> String {
+pub(crate) fn tick(y: f64) -> String {
     if y == 0.0 || !y.is_finite() {
         return "0".into();
     }
@@ -152,7 +152,11 @@ struct Series {
 }
 
 /// Draw the sweep on `root` (1000 × 720). `title` goes on top of the chart.
-pub fn draw_sweep<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, sweep: &Sweep, title: &str) -> Result<PlotSummary>
+pub(crate) fn draw_sweep<DB: DrawingBackend>(
+    root: DrawingArea<DB, Shift>,
+    sweep: &Sweep,
+    title: &str,
+) -> Result<PlotSummary>
 where
     DB::ErrorType: 'static,
 {
@@ -291,7 +295,7 @@ fn tolerance_span(t: &[f64]) -> String {
 
 /// Draw with `draw` into an SVG document of `size` pixels held in memory (the server's pictures,
 /// docs/serve.md): the same drawing code and embedded font as the files `render_plot!` writes.
-pub fn to_svg<T>(
+pub(crate) fn to_svg<T>(
     size: (u32, u32),
     draw: impl FnOnce(DrawingArea<SVGBackend<'_>, Shift>) -> Result<T>,
 ) -> Result<String> {
