@@ -470,7 +470,9 @@ fn a_real_measured_x3p_reads_through_the_default_panel() {
     let gloss = |g: &str| {
         readings.iter().find(|r| r["geometry"] == g && r["name"] == "gloss").unwrap()["value"].as_f64().unwrap()
     };
-    for g in ["astm-d523-20", "astm-d523-60", "astm-d523-85"] {
+    // The display fixtures/topography/real/README.md and docs/topography.md §Fixtures show: 0.3 / 3.3 / 1.3 GU.
+    for (g, shown) in [("astm-d523-20", "0.3"), ("astm-d523-60", "3.3"), ("astm-d523-85", "1.3")] {
         assert!(gloss(g) > 0.0 && gloss(g) < 10.0, "{g}: {}", gloss(g));
+        assert_eq!(format!("{:.1}", gloss(g)), shown, "{g}");
     }
 }
