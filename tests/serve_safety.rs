@@ -71,6 +71,7 @@ fn heavy_plot() -> Vec<u8> {
         "points": 41,
         "geometries": ALL,
         "rtol": 1e-12,
+        "max_evals": 100_000_000,
         "recipe": recipe("fixtures/real/models/panel-three-populations.json"),
     })
     .to_string()
@@ -194,7 +195,9 @@ fn a_body_slower_than_the_body_timeout_is_answered_408() {
 
 #[test]
 fn a_client_that_leaves_frees_its_slot_at_the_next_integral() {
-    let addr = start(Limits { jobs: 1, request_seconds: 3600.0, ..Limits::default() });
+    // The plot's budget is fifty times the default, so that it holds the slot for longer than the polling below
+    // takes on any machine (under the default budget a fast machine finished it before a poll saw it busy).
+    let addr = start(Limits { jobs: 1, request_seconds: 3600.0, max_evals: 100_000_000, ..Limits::default() });
     let mut leaver = TcpStream::connect(addr).unwrap();
     let body = heavy_plot();
     let head = format!("POST /api/plot HTTP/1.1\r\nHost: {addr}\r\nContent-Length: {}\r\n\r\n", body.len());
