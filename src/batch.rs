@@ -43,7 +43,7 @@ pub(crate) fn recipe_files(paths: &[PathBuf]) -> Result<Vec<PathBuf>> {
 }
 
 /// Load every recipe (the first bad one is the error, before any work is done).
-pub fn load_all(files: &[PathBuf]) -> Result<Vec<Material>> {
+pub(crate) fn load_all(files: &[PathBuf]) -> Result<Vec<Material>> {
     files.iter().map(|f| recipe::load_file(Path::new(f))).collect()
 }
 

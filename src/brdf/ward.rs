@@ -46,7 +46,7 @@ impl Ward {
     }
 
     /// The closed-form specular albedo at normal incidence per unit ρs: 1 − α²(1 − e^(−1/α²)).
-    pub fn normal_incidence_lobe_albedo(alpha: f64) -> f64 {
+    pub(crate) fn normal_incidence_lobe_albedo(alpha: f64) -> f64 {
         let a2 = alpha * alpha;
         1.0 + a2 * (-1.0 / a2).exp_m1()
     }

@@ -49,7 +49,7 @@ pub enum Interpolation {
 }
 
 impl Interpolation {
-    pub fn name(self) -> &'static str {
+    pub(crate) fn name(self) -> &'static str {
         match self {
             Interpolation::Nearest => "nearest",
             Interpolation::Trilinear => "trilinear",
@@ -224,7 +224,7 @@ impl MerlBrdf {
         self.invalid
     }
 
-    pub fn interpolation(&self) -> Interpolation {
+    pub(crate) fn interpolation(&self) -> Interpolation {
         self.interpolation
     }
 

@@ -46,21 +46,21 @@ use num_complex::Complex64;
 use serde_json::Value;
 use std::sync::Arc;
 
-pub mod fields;
-pub mod levelling;
+pub(crate) mod fields;
+pub(crate) mod levelling;
 pub mod measured;
 pub mod paint;
-pub mod scatter;
+pub(crate) mod scatter;
 pub mod schema;
-pub mod topography;
-pub mod uncertainty;
+pub(crate) mod topography;
+pub(crate) mod uncertainty;
 
 pub(crate) use crate::registry::MAX_LOBES;
 pub use crate::registry::MODELS;
 
 /// Descriptive fields allowed in every recipe: `name`, `description`, `provenance` (strings) and `notes`
 /// (a string or an array of strings). They do not change the model.
-pub const META_FIELDS: &[&str] = &["model", "name", "description", "provenance", "notes"];
+pub(crate) const META_FIELDS: &[&str] = &["model", "name", "description", "provenance", "notes"];
 
 /// Slack on the energy sums (kd + ks ≤ 1) for decimal rounding in the files.
 const ENERGY_SLACK: f64 = 1e-9;

@@ -6,7 +6,7 @@ use crate::quadrature::gauss_legendre;
 
 /// Gauss–Legendre order used for the diffuse Fresnel reflectance r_e (the integrand is smooth in cos θ on
 /// [0, 1], so 64 nodes give it to rounding; checked against an independent Simpson rule in `tests/paint.rs`).
-pub const DIFFUSE_FRESNEL_NODES: usize = 64;
+pub(crate) const DIFFUSE_FRESNEL_NODES: usize = 64;
 
 /// The hemispherical mean 2∫₀¹ f(μ) μ dμ of a function of the cosine that is smooth on [0, 1] except at the
 /// cosines `kinks` (sorted, in (0, 1)), where it is continuous but its derivative is not.
@@ -18,7 +18,7 @@ pub const DIFFUSE_FRESNEL_NODES: usize = 64;
 /// midpoints between them, and each piece that ends on a kink is mapped by μ = μc ± h·s² (s ∈ [0, 1]), which
 /// turns √(μ − μc) into the smooth h^½·s, so that each piece's rule again converges like a smooth integrand's
 /// (docs/model.md §Pearlescent flakes).
-pub fn hemispherical_mean(f: impl Fn(f64) -> f64, kinks: &[f64]) -> f64 {
+pub(crate) fn hemispherical_mean(f: impl Fn(f64) -> f64, kinks: &[f64]) -> f64 {
     hemispherical_means(|mu, v| v[0] = f(mu), 1, kinks)[0]
 }
 
@@ -70,7 +70,7 @@ pub(crate) fn hemispherical_means(mut f: impl FnMut(f64, &mut [f64]), count: usi
 
 /// Diffuse (hemispherical) reflectance of the air → coat interface for light incident from air,
 /// r_e = ∫₀^{π/2} F(θ) 2 sin θ cos θ dθ = ∫₀¹ F(μ) 2μ dμ (Judd 1942; Stern 1964), by Gauss–Legendre.
-pub fn diffuse_fresnel_reflectance(eta: f64) -> f64 {
+pub(crate) fn diffuse_fresnel_reflectance(eta: f64) -> f64 {
     let (x, w) = gauss_legendre(DIFFUSE_FRESNEL_NODES);
     x.iter()
         .zip(&w)
@@ -84,7 +84,7 @@ pub fn diffuse_fresnel_reflectance(eta: f64) -> f64 {
 /// Diffuse reflectance of the coat–air interface for diffuse light incident from inside the coat:
 /// r_i = 1 − (1 − r_e)/η² (the exit cone carries 1/η² of the internal diffuse flux, and Fresnel
 /// transmittance is the same both ways; Saunderson 1942, Stern 1964). For η = 1.5, r_i ≈ 0.596.
-pub fn internal_diffuse_reflectance(eta: f64) -> f64 {
+pub(crate) fn internal_diffuse_reflectance(eta: f64) -> f64 {
     1.0 - (1.0 - diffuse_fresnel_reflectance(eta)) / (eta * eta)
 }
 

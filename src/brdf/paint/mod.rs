@@ -54,11 +54,11 @@ mod memo;
 mod spec;
 
 pub use flake::{PaintBuild, TableBuild, TableMemo, TableWork, TABLE_TOLERANCE};
-pub use hemisphere::{
+pub(crate) use hemisphere::{
     diffuse_fresnel_reflectance, hemispherical_mean, internal_diffuse_reflectance, DIFFUSE_FRESNEL_NODES,
 };
-pub use memo::MEMO_ENTRIES;
-pub use spec::{
+pub(crate) use memo::MEMO_ENTRIES;
+pub(crate) use spec::{
     spread_to_slope, ClearCoat, FlakeLight, Form, MetallicFlakes, PaintSpec, PearlescentFlakes, Pigment,
     PigmentedLayer, Spread,
 };
@@ -265,7 +265,7 @@ impl Paint {
         Ok((paint, work.get()))
     }
 
-    pub fn spec(&self) -> &PaintSpec {
+    pub(crate) fn spec(&self) -> &PaintSpec {
         &self.spec
     }
 

@@ -90,11 +90,11 @@ pub enum Spread {
 impl Spread {
     /// Largest accepted spread angle in degrees, and the slope it corresponds to (tan 60° = 1.732); the
     /// registry's ranges (`crate::registry::SPREAD_DEG_RANGE`, `SPREAD_SLOPE_RANGE`).
-    pub const MAX_DEG: f64 = reg::SPREAD_DEG_RANGE.hi;
-    pub const MAX_SLOPE: f64 = reg::SPREAD_SLOPE_RANGE.hi;
+    pub(crate) const MAX_DEG: f64 = reg::SPREAD_DEG_RANGE.hi;
+    pub(crate) const MAX_SLOPE: f64 = reg::SPREAD_SLOPE_RANGE.hi;
 
     /// The Beckmann rms slope m.
-    pub fn slope(self) -> f64 {
+    pub(crate) fn slope(self) -> f64 {
         match self {
             Spread::Degrees(d) => spread_to_slope(d),
             Spread::Slope(m) => m,
@@ -171,6 +171,6 @@ pub(super) fn check_spectral(p: &Param, v: &[f64], n: usize) -> Result<()> {
 }
 
 /// Beckmann rms slope m = tan σ of a flake spread σ in degrees.
-pub fn spread_to_slope(spread_deg: f64) -> f64 {
+pub(crate) fn spread_to_slope(spread_deg: f64) -> f64 {
     spread_deg.to_radians().tan()
 }

@@ -30,7 +30,7 @@ fn ramp(t: f64) -> RGBColor {
 }
 
 /// Draw the height map (µm, block means over the valid points; invalid blocks grey) and the radial PSD.
-pub fn draw<DB: DrawingBackend>(
+pub(crate) fn draw<DB: DrawingBackend>(
     root: DrawingArea<DB, Shift>,
     map: &HeightMap,
     a: &Analysis,
