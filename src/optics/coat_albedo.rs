@@ -57,11 +57,11 @@ use crate::Vec3;
 use std::f64::consts::PI;
 
 /// Gauss–Legendre nodes of each azimuthal panel.
-pub(crate) const PHI_NODES: usize = 12;
+pub const PHI_NODES: usize = 12;
 /// Gauss–Legendre nodes of the core radial panel (Beckmann t ∈ [0, 2.5], GGX t ∈ [0, 1]).
-pub(crate) const CORE_NODES: usize = 48;
+pub const CORE_NODES: usize = 48;
 /// Gauss–Legendre nodes of the Beckmann tail panel t ∈ [2.5, 6.5] and of each graded GGX tail panel.
-pub(crate) const TAIL_NODES: usize = 24;
+pub const TAIL_NODES: usize = 24;
 /// Where the Beckmann core panel ends (scaled slope).
 const BECKMANN_SPLIT: f64 = 2.5;
 /// Beckmann's scaled-slope cut: e^{−T²} = 5·10⁻¹⁹.
@@ -72,26 +72,26 @@ pub const MU_MIN: f64 = 1.0 / 64.0;
 /// grazing, where E varies on the scale of α), then [1 − 2^{−k}, 1 − 2^{−k−1}] up to 15/16 and [15/16, 1]
 /// (graded towards the normal, where Λ(ωi) ∝ exp(−μ²/(α² sin²θ)) makes E non-analytic at μ = 1: negligible
 /// for small α, not for α ~ 1).
-pub(crate) const BREAKS: [f64; 10] = [MU_MIN, 1.0 / 32.0, 1.0 / 16.0, 0.125, 0.25, 0.5, 0.75, 0.875, 0.9375, 1.0];
+pub const BREAKS: [f64; 10] = [MU_MIN, 1.0 / 32.0, 1.0 / 16.0, 0.125, 0.25, 0.5, 0.75, 0.875, 0.9375, 1.0];
 /// Pieces of the per-paint function.
-pub(crate) const PIECES: usize = BREAKS.len() - 1;
+pub const PIECES: usize = BREAKS.len() - 1;
 /// Chebyshev coefficients (and nodes) per μ piece.
-pub(crate) const NODES: usize = 14;
+pub const NODES: usize = 14;
 /// Break points of the shipped table's pieces in α (each piece a Chebyshev series in ln α); its ends are the
 /// supported roughness range.
 pub const ALPHA_BREAKS: [f64; 14] = [1e-7, 1e-5, 1e-4, 1e-3, 2e-3, 4e-3, 0.01, 0.02, 0.04, 0.09, 0.18, 0.3, 0.55, 1.0];
 /// Chebyshev terms per α piece.
-pub(crate) const ALPHA_NODES: usize = 16;
+pub const ALPHA_NODES: usize = 16;
 /// The shipped table's index range (the recipe's: `/clear_coat/index`).
-pub(crate) const ETA_MIN: f64 = 1.3;
-pub(crate) const ETA_MAX: f64 = 1.8;
+pub const ETA_MIN: f64 = 1.3;
+pub const ETA_MAX: f64 = 1.8;
 /// Chebyshev terms in η.
-pub(crate) const ETA_NODES: usize = 16;
+pub const ETA_NODES: usize = 16;
 /// Bound on the absolute sum of the coefficients the generator dropped per (distribution, α piece, μ piece)
 /// block, so on the truncation's contribution to |E_table − E_series| anywhere.
-pub(crate) const TRUNCATION_BUDGET: f64 = 1e-11;
+pub const TRUNCATION_BUDGET: f64 = 1e-11;
 /// The distributions in the table's order.
-pub(crate) const DISTRIBUTIONS: [Distribution; 2] = [Distribution::Beckmann, Distribution::Ggx];
+pub const DISTRIBUTIONS: [Distribution; 2] = [Distribution::Beckmann, Distribution::Ggx];
 
 /// The rule's fixed nodes.
 struct AlbedoNodes {
@@ -133,11 +133,6 @@ impl AlbedoNodes {
 /// E(μ) by the fixed rule (module docs).
 pub fn lobe_albedo(mf: &Microfacet, eta: f64, mu: f64) -> f64 {
     lobe_albedo_with(&AlbedoNodes::new(), mf, eta, mu).0
-}
-
-/// E(μ) and the number of lobe evaluations the rule spent.
-pub(crate) fn lobe_albedo_counted(mf: &Microfacet, eta: f64, mu: f64) -> (f64, usize) {
-    lobe_albedo_with(&AlbedoNodes::new(), mf, eta, mu)
 }
 
 fn lobe_albedo_with(rule: &AlbedoNodes, mf: &Microfacet, eta: f64, mu: f64) -> (f64, usize) {
@@ -260,7 +255,7 @@ struct Table {
 /// The bytes of `assets/coat-albedo-table.bin` (format: [`parse_table`]).
 pub(crate) const TABLE_BYTES: &[u8] = include_bytes!("../../assets/coat-albedo-table.bin");
 /// Its first eight bytes.
-pub(crate) const TABLE_MAGIC: &[u8; 8] = b"GMCOAT01";
+pub const TABLE_MAGIC: &[u8; 8] = b"GMCOAT01";
 
 /// Rows of the table, in its order.
 pub(crate) const TABLE_ROWS: usize = DISTRIBUTIONS.len() * (ALPHA_BREAKS.len() - 1) * PIECES * ALPHA_NODES * ETA_NODES;

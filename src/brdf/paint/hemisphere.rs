@@ -70,7 +70,7 @@ pub(crate) fn hemispherical_means(mut f: impl FnMut(f64, &mut [f64]), count: usi
 
 /// Diffuse (hemispherical) reflectance of the air → coat interface for light incident from air,
 /// r_e = ∫₀^{π/2} F(θ) 2 sin θ cos θ dθ = ∫₀¹ F(μ) 2μ dμ (Judd 1942; Stern 1964), by Gauss–Legendre.
-pub(crate) fn diffuse_fresnel_reflectance(eta: f64) -> f64 {
+pub fn diffuse_fresnel_reflectance(eta: f64) -> f64 {
     let (x, w) = gauss_legendre(DIFFUSE_FRESNEL_NODES);
     x.iter()
         .zip(&w)
@@ -84,7 +84,7 @@ pub(crate) fn diffuse_fresnel_reflectance(eta: f64) -> f64 {
 /// Diffuse reflectance of the coat–air interface for diffuse light incident from inside the coat:
 /// r_i = 1 − (1 − r_e)/η² (the exit cone carries 1/η² of the internal diffuse flux, and Fresnel
 /// transmittance is the same both ways; Saunderson 1942, Stern 1964). For η = 1.5, r_i ≈ 0.596.
-pub(crate) fn internal_diffuse_reflectance(eta: f64) -> f64 {
+pub fn internal_diffuse_reflectance(eta: f64) -> f64 {
     1.0 - (1.0 - diffuse_fresnel_reflectance(eta)) / (eta * eta)
 }
 

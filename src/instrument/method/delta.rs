@@ -8,7 +8,7 @@ use crate::quadrature::{legendre_on_into, Estimate, Options, Refine};
 /// The radii (in lobe widths) of the rings on which [`Rule::LobeDelta`](super::Rule::LobeDelta) samples the even part
 /// of h (four directions, 0°, 45°, 90°, 135°, each with its opposite point; with the curvature ring): the majorant's
 /// second differences.
-pub(crate) const DELTA_RADII: [f64; 2] = [2.5, 5.0];
+pub const DELTA_RADII: [f64; 2] = [2.5, 5.0];
 
 /// The radius (in lobe widths) of the disc inside which [`Rule::LobeDelta`](super::Rule::LobeDelta) bounds the
 /// correction by second differences (in the metric of the fitted curvature B); beyond it the tail, bounded by a
@@ -20,18 +20,18 @@ pub(crate) const DELTA_RADIUS: f64 = DELTA_RADII[DELTA_RADII.len() - 1];
 /// stand for a bound over the whole disc: one of the two assumptions of its majorant (`docs/instrument.md` §Quadrature;
 /// checked against a stencil of 24 directions × 30 radii by `tests/delta_limit.rs`, where the dense maximum
 /// is at most 1.1× the sampled one).
-pub(crate) const DELTA_SAFETY: f64 = 4.0;
+pub const DELTA_SAFETY: f64 = 4.0;
 
 /// The factor by which [`Rule::LobeDelta`](super::Rule::LobeDelta) divides the decay rate λ of the lobe measured on its
 /// outer ring (the smallest ln(F(0)/F(x))/xᵀBx there) before it bounds the tail beyond the ring by F(0)·e^{−λ·xᵀBx}:
 /// the other assumption of its majorant. (A Gaussian of the fitted curvature, |h| ≤ its largest value on the
 /// ring, does not hold: at grazing incidence the lobe's exponent in these variables falls a few per cent
 /// short of xᵀBx at 12 widths, and h = F·e^{xᵀBx} grows there by 100× — measured by the same test.)
-pub(crate) const DELTA_TAIL_SAFETY: f64 = 1.25;
+pub const DELTA_TAIL_SAFETY: f64 = 1.25;
 
 /// The Gauss–Legendre orders per t axis of [`Rule::LobeDelta`](super::Rule::LobeDelta): the second-difference stencil
 /// on the lower's nodes, the value on the higher's, their difference the t rule's error.
-pub(crate) const DELTA_T_ORDERS: (usize, usize) = (2, 3);
+pub const DELTA_T_ORDERS: (usize, usize) = (2, 3);
 
 /// The points per t node of [`Rule::LobeDelta`](super::Rule::LobeDelta): the centre and the curvature ring (four
 /// directions, both signs) at the higher order's nodes, and with them the bound's rings at the lower order's.
@@ -53,7 +53,7 @@ pub(crate) const DELTA_DIRECTIONS: [[f64; 2]; 4] = [
 
 /// The radius (in lobe widths) of the ring on which [`Rule::LobeDelta`](super::Rule::LobeDelta) measures the lobe's
 /// curvature.
-pub(crate) const DELTA_FIT_RADIUS: f64 = 1.0;
+pub const DELTA_FIT_RADIUS: f64 = 1.0;
 
 /// [`Rule::LobeDelta`]'s parameters: the lobe's widths in (u, v).
 pub(super) struct Delta {
@@ -170,7 +170,7 @@ pub(super) fn delta_node(vals: &[f64], radii: &[f64]) -> Option<(f64, f64)> {
 
 /// What [`Rule::LobeDelta`](super::Rule::LobeDelta) measures at one t node ([`delta_fit`]), before its safety factors.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) struct DeltaFit {
+pub struct DeltaFit {
     /// The fitted curvature (b_xx, b_yy, b_xy).
     pub b: [f64; 3],
     /// F(0).
@@ -190,14 +190,14 @@ impl DeltaFit {
     }
 
     /// The delta limit's mass relative to π·w_u·w_v: F(0)/√det B.
-    pub(crate) fn mass(&self) -> f64 {
+    pub fn mass(&self) -> f64 {
         self.f0 / self.root()
     }
 
     /// The majorant of [`delta_node`] (relative to π·w_u·w_v) for the constants `q` and `lambda`:
     /// (q + F(0)·(e^{−λR²}/λ + e^{−R²}))/√det B. The rule passes its sampled constants with
     /// [`DELTA_SAFETY`] and [`DELTA_TAIL_SAFETY`] applied; `tests/delta_limit.rs` passes a denser stencil's.
-    pub(crate) fn majorant(&self, q: f64, lambda: f64) -> f64 {
+    pub fn majorant(&self, q: f64, lambda: f64) -> f64 {
         let tail = if lambda.is_finite() { (-lambda * self.r2).exp() / lambda } else { 0.0 };
         (q + self.f0 * (tail + (-self.r2).exp())) / self.root()
     }
@@ -207,7 +207,7 @@ impl DeltaFit {
 /// the values `vals` on its stencil ([`delta_stencil`] with `radii`; see [`delta_node`] for the formulas). None when
 /// the values are not positive where the curvature is measured or the fitted curvature is not positive
 /// definite.
-pub(crate) fn delta_fit(vals: &[f64], radii: &[f64]) -> Option<DeltaFit> {
+pub fn delta_fit(vals: &[f64], radii: &[f64]) -> Option<DeltaFit> {
     let f0 = vals[0];
     if f0 <= 0.0 || vals[1..9].iter().any(|v| *v <= 0.0) {
         return None;
@@ -248,7 +248,7 @@ pub(crate) fn delta_fit(vals: &[f64], radii: &[f64]) -> Option<DeltaFit> {
 /// Append the stencil of one t node (t_p, t_q) of [`Rule::LobeDelta`](super::Rule::LobeDelta) to `pts`, in the order
 /// [`delta_fit`] reads it: the centre, then per ring of `radii` (in lobe widths) and direction of [`DELTA_DIRECTIONS`]
 /// the point and its opposite, in the chart (u, t_p, v, t_q) with the lobe widths `width`.
-pub(crate) fn delta_stencil(width: [f64; 2], tp: f64, tq: f64, radii: &[f64], pts: &mut Vec<[f64; 4]>) {
+pub fn delta_stencil(width: [f64; 2], tp: f64, tq: f64, radii: &[f64], pts: &mut Vec<[f64; 4]>) {
     pts.push([0.0, tp, 0.0, tq]);
     for r in radii {
         for d in DELTA_DIRECTIONS {

@@ -48,17 +48,15 @@ mod rule;
 mod shape;
 
 pub(crate) use delta::DELTA_RADIUS;
-pub(crate) use delta::{
+pub use delta::{
     delta_fit, delta_stencil, DeltaFit, DELTA_FIT_RADIUS, DELTA_RADII, DELTA_SAFETY, DELTA_TAIL_SAFETY, DELTA_T_ORDERS,
 };
-pub(crate) use design::{polar_rule, POLAR_REACH_GRAZING};
 pub(crate) use design::{LOBE_REACH, POLAR_REACH};
 pub(crate) use execute::deadline_after;
 pub use execute::LATE_START_SHARE;
 pub(crate) use gauss::TENSOR_MAX_LEVEL;
 pub use gauss::{tensor_boxes, LOBE_LEVELS};
 pub(crate) use polar::POLAR_LEVELS;
-pub(crate) use shape::Outcome;
 
 #[cfg(doc)]
 use crate::instrument::aperture::DELTA_SHARE;
