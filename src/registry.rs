@@ -332,7 +332,8 @@ pub(crate) const MODEL: Param =
 pub(crate) const NAME: Param =
     p("/name", ALL, Type::Text, "", NONE, Opt("the file name without extension"), "label shown in reports");
 pub(crate) const DESCRIPTION: Param = p("/description", ALL, Type::Text, "", NONE, Opt("none"), "free text");
-pub(crate) const PROVENANCE: Param = p("/provenance", ALL, Type::Text, "", NONE, Opt("none"), "where the numbers come from");
+pub(crate) const PROVENANCE: Param =
+    p("/provenance", ALL, Type::Text, "", NONE, Opt("none"), "where the numbers come from");
 pub(crate) const NOTES: Param = p("/notes", ALL, Type::Notes, "", NONE, Opt("none"), "free text for provenance");
 /// The standard uncertainties of some of the recipe's numbers, each key a JSON Pointer to one number of the recipe
 /// that a numeric entry of its model governs, each value u > 0 in that entry's unit (`recipe::uncertainty`;

@@ -238,7 +238,7 @@ pub(crate) struct VsParameter {
 
 impl VsParameterRequest {
     /// The sweep of the template `text` (named `file`), checked before any work: one axis on a grid.
-    pub(crate) fn sweep(&self, text: &str, file: &str, geometries: Vec<StandardGeometry>) -> Result<Sweep> {
+    pub fn sweep(&self, text: &str, file: &str, geometries: Vec<StandardGeometry>) -> Result<Sweep> {
         self.sweep_until(text, file, geometries, Cancel::default())
     }
 

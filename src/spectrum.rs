@@ -25,6 +25,7 @@ pub(crate) const RGB_LUMINANCE_WEIGHTS: [f64; 3] = [0.17697, 0.81240, 0.01063];
 /// Relative radiant powers of the CIE 1931 RGB primaries that match the equal-energy white, 72.0962 : 1.3791 : 1
 /// (Wyszecki & Stiles, *Color Science*, 2nd ed., §3.3.2). Their products with ȳ at the primaries' wavelengths
 /// are the luminances behind [`RGB_LUMINANCE_WEIGHTS`] (test `rgb_weights_are_the_cie_primaries_luminances`).
+#[cfg(test)]
 pub(crate) const CIE_RGB_RADIANT_POWER_RATIOS: [f64; 3] = [72.0962, 1.3791, 1.0];
 
 /// Wavelengths at which an RGB material's wavelength-dependent optics (thin-film interference) are evaluated:
@@ -75,7 +76,7 @@ impl Sampling {
         self.wavelengths_nm.len()
     }
 
-    pub(crate) fn is_empty(&self) -> bool {
+    pub fn is_empty(&self) -> bool {
         self.wavelengths_nm.is_empty()
     }
 

@@ -244,7 +244,7 @@ impl Sweep {
         self.checked_len().expect("checked in new")
     }
 
-    pub(crate) fn is_empty(&self) -> bool {
+    pub fn is_empty(&self) -> bool {
         self.len() == 0
     }
 

@@ -137,14 +137,7 @@ pub enum Kink {
     HalfAngle { cos: f64 },
 }
 
-impl Kink {
-    /// The cosine of the critical angle.
-    pub(crate) fn cos(&self) -> f64 {
-        match *self {
-            Kink::Incidence { cos } | Kink::HalfAngle { cos } => cos,
-        }
-    }
-}
+impl Kink {}
 
 /// The kinks of a set of Fresnel indices, one per distinct critical angle, in increasing order of cos θc;
 /// `delta` selects the term (the delta limit kinks in cos θi, a lobe in ωi·h).

@@ -64,14 +64,8 @@ pub enum Observer {
 }
 
 impl Observer {
+    #[cfg(test)]
     pub(crate) const ALL: [Observer; 2] = [Observer::Cie1931, Observer::Cie1964];
-
-    pub(crate) fn id(self) -> &'static str {
-        match self {
-            Observer::Cie1931 => "2",
-            Observer::Cie1964 => "10",
-        }
-    }
 
     pub fn describe(self) -> &'static str {
         match self {
@@ -107,6 +101,7 @@ pub enum Illuminant {
 }
 
 impl Illuminant {
+    #[cfg(test)]
     pub(crate) const ALL: [Illuminant; 4] = [Illuminant::D65, Illuminant::D50, Illuminant::A, Illuminant::C];
 
     pub(crate) fn id(self) -> &'static str {
@@ -192,14 +187,10 @@ pub(crate) struct Weights {
 
 impl Weights {
     /// X, Y, Z of per-sample reflectance factors `r`.
+    #[cfg(test)]
     pub(crate) fn xyz(&self, r: &[f64]) -> [f64; 3] {
         let dot = |w: &Vec<f64>| w.iter().zip(r).map(|(a, b)| a * b).sum::<f64>();
         [dot(&self.rows[0]), dot(&self.rows[1]), dot(&self.rows[2])]
-    }
-
-    /// Error bound of X, Y, Z from per-sample absolute error bounds `e`: Σ_k W_ck e_k (weights are ≥ 0).
-    pub(crate) fn xyz_error(&self, e: &[f64]) -> [f64; 3] {
-        self.xyz(e)
     }
 }
 

@@ -72,7 +72,7 @@ impl Weighting {
         self.rows.len()
     }
 
-    pub(crate) fn is_empty(&self) -> bool {
+    pub fn is_empty(&self) -> bool {
         self.rows.is_empty()
     }
 

@@ -140,7 +140,7 @@ pub(crate) fn group_rows(rows: &[SheetRow]) -> Vec<Group> {
 
 /// A sheet read as targets, for callers other than `compare` (`fit --sheet`): every (sample, geometry,
 /// reading) with its values, the largest stated uncertainty, the statistics and the lines they came from.
-pub(crate) fn read_targets(source: &Source, options: &SheetOptions) -> Result<(Sheet, Vec<Group>)> {
+pub fn read_targets(source: &Source, options: &SheetOptions) -> Result<(Sheet, Vec<Group>)> {
     let sheet = sheet::load_source(source, options)?;
     let groups = group_rows(&sheet.rows);
     Ok((sheet, groups))
@@ -349,7 +349,14 @@ pub struct Allowance {
 impl Allowance {
     /// The allowance of k, the standard error of the mean s/√n (`statistical` is k·s/√n as the caller computed
     /// it), u_pred, the stated uncertainty and the prediction's numerical error.
-    pub(crate) fn new(k: f64, statistical: f64, standard_error: f64, u_pred: f64, stated: f64, prediction: f64) -> Self {
+    pub(crate) fn new(
+        k: f64,
+        statistical: f64,
+        standard_error: f64,
+        u_pred: f64,
+        stated: f64,
+        prediction: f64,
+    ) -> Self {
         let random =
             if u_pred > 0.0 { k * (standard_error * standard_error + u_pred * u_pred).sqrt() } else { statistical };
         Allowance { statistical, prediction_uncertainty: u_pred, random, stated, prediction }
@@ -393,6 +400,7 @@ impl Verdict {
     }
     /// Whether the verdict fails a check (exit status 1): outside, or a check that could not be made
     /// (docs/instrument.md §Exit statuses). "Not predicted" is reported, not failed.
+    #[cfg(test)]
     pub(crate) fn fails(&self) -> bool {
         matches!(self, Verdict::Outside | Verdict::NoValue(_) | Verdict::NoAllowance)
     }

@@ -100,17 +100,6 @@ impl<'a> Obj<'a> {
         let v = self.required(key)?;
         v.as_array().ok_or_else(|| self.err(key, format!("expected an array, got {}", kind(v))))
     }
-
-    /// An array of numbers each within [lo, hi]; if `len` is given the array must have that length.
-    pub(crate) fn num_array(&self, key: &str, len: Option<usize>, lo: f64, hi: f64, what: &str) -> Result<Vec<f64>> {
-        let a = self.array(key)?;
-        if let Some(n) = len {
-            if a.len() != n {
-                return Err(self.err(key, format!("expected {n} values, got {}", a.len())));
-            }
-        }
-        a.iter().enumerate().map(|(i, v)| number(self.file, &self.element(key, i), v, lo, hi, what)).collect()
-    }
 }
 
 /// Check that `v` is a finite number in [lo, hi]. JSON has no NaN, but a string "NaN" or a huge exponent

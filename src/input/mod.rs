@@ -82,14 +82,6 @@ impl Source {
         }
     }
 
-    /// The file's path (None for bytes already read).
-    pub(crate) fn path(&self) -> Option<&Path> {
-        match self {
-            Source::File(p) => Some(p),
-            Source::Read { .. } => None,
-        }
-    }
-
     /// The bytes of the source, of at most [`MAX_TEXT_BYTES`] (for sheets, whose encoding is decided after
     /// reading).
     pub(crate) fn bytes(&self, what: &str) -> Result<Vec<u8>> {

@@ -66,16 +66,7 @@ pub enum OffPlane {
     Microfacet,
 }
 
-impl OffPlane {
-    /// The recipe's name of each choice.
-    pub(crate) fn name(self) -> &'static str {
-        match self {
-            OffPlane::Brdf => "f",
-            OffPlane::BrdfCosCos => "f-cos-cos",
-            OffPlane::Microfacet => "microfacet",
-        }
-    }
-}
+impl OffPlane {}
 
 /// One measured point: θi, signed θo (degrees) and the value, with the line it came from.
 #[derive(Clone, Copy, Debug)]
@@ -375,12 +366,6 @@ impl InPlaneBrdf {
         super::table::specular_half_width(|wi, wo, out| self.eval(wi, wo, out), 1)
     }
 
-    /// The lobe's half width at half maximum about the specular direction, as a slope, measured from the
-    /// table with its off-plane extension (`Tail::Table`).
-    pub(crate) fn half_width(&self) -> f64 {
-        self.half_width
-    }
-
     /// Whether the table is a constant BRDF as evaluated: every value the same (to `table::FLAT_RTOL`, the
     /// rounding of a file of f·cos θo) and the `f` extension
     /// ([`Hints::terms`] then states a diffuse term, integrated in the plain chart).
@@ -401,15 +386,6 @@ impl InPlaneBrdf {
         }
         self.half_width = self.measure_half_width();
         self
-    }
-
-    pub(crate) fn off_plane(&self) -> OffPlane {
-        self.off_plane
-    }
-
-    /// Smith's Λ(θ) of the table's distribution (0 unless the extension is `microfacet`).
-    pub(crate) fn smith_lambda(&self, theta: f64) -> f64 {
-        self.lambda.at(theta)
     }
 
     /// f_r at an in-plane pair (θi ≥ 0, signed θo), radians: linear in θo within rows; between rows linear in

@@ -224,10 +224,6 @@ impl MerlBrdf {
         self.invalid
     }
 
-    pub(crate) fn interpolation(&self) -> Interpolation {
-        self.interpolation
-    }
-
     /// The scaled value (sr⁻¹, R G B) of cell (θh index, θd index, φd index); None outside the table.
     pub fn cell(&self, ih: usize, id: usize, ip: usize) -> Option<[f64; 3]> {
         let [nh, nd, np] = self.dims;

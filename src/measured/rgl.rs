@@ -584,20 +584,6 @@ impl RglBrdf {
         Ok(brdf)
     }
 
-    /// The lobe's half width at half maximum about the specular direction, as a slope, measured from the
-    /// table when it was loaded (`Tail::Table`).
-    pub(crate) fn half_width(&self) -> f64 {
-        self.half_width
-    }
-
-    pub(crate) fn is_isotropic(&self) -> bool {
-        self.isotropic
-    }
-
-    pub(crate) fn description(&self) -> &str {
-        &self.description
-    }
-
     /// The resolution stated with the lobe (`Tail::Table`): tan of the polar angle of the first node off the pole of the
     /// finer of the NDF and VNDF grids, θ = (π/2)/(n − 1)² (u_θ = √(2θ/π) puts the nodes densest there).
     pub(crate) fn resolution_slope(&self) -> f64 {

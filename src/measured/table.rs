@@ -93,10 +93,6 @@ impl TableAxis {
         }
     }
 
-    pub(crate) fn is_empty(&self) -> bool {
-        self.len() == 0
-    }
-
     /// The two neighbouring samples of `u` and the weight t of the second: the value is
     /// (1 − t)·v[i0] + t·v[i1]. NaN reads as the first sample.
     pub(crate) fn linear(&self, u: f64) -> (usize, usize, f64) {
@@ -173,6 +169,7 @@ impl TableAxis {
     }
 
     /// The sample at or below `u` (the cell that contains it), clamped to the axis; NaN → 0.
+    #[cfg(test)]
     pub(crate) fn floor(&self, u: f64) -> usize {
         match &self.nodes {
             Nodes::Index(n) => floor_index(u, *n),
@@ -265,10 +262,6 @@ impl Table {
         &self.axes
     }
 
-    pub(crate) fn channels(&self) -> usize {
-        self.channels
-    }
-
     /// The channels of one cell.
     pub(crate) fn cell(&self, idx: &[usize]) -> &[f64] {
         let o: usize = idx.iter().zip(&self.strides).map(|(i, s)| i * s).sum();
@@ -276,11 +269,13 @@ impl Table {
     }
 
     /// The cell that contains the point (each axis' `floor`): piecewise constant lookup.
+    #[cfg(test)]
     pub(crate) fn nearest(&self, coords: &[f64], out: &mut [f64]) {
         self.nearest_at(coords, Resolution::Own, out)
     }
 
     /// [`Table::nearest`] at a [`Resolution`] (a twin: its sample at or below each axis' floor).
+    #[cfg(test)]
     pub(crate) fn nearest_at(&self, coords: &[f64], res: Resolution, out: &mut [f64]) {
         let mut o = 0;
         for (k, a) in self.axes.iter().enumerate() {
@@ -292,6 +287,7 @@ impl Table {
 
     /// Multilinear interpolation: the 2^N corners in order (first axis outermost), each weighted by the
     /// product of its axes' weights taken in axis order; corners of weight 0 are skipped.
+    #[cfg(test)]
     pub(crate) fn linear(&self, coords: &[f64], out: &mut [f64]) {
         self.linear_at(coords, Resolution::Own, out)
     }

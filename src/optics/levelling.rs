@@ -304,6 +304,7 @@ impl Application {
     }
 
     /// The frequency (1/µm) whose amplitude the levelling takes down by 1/e: f_e = (3/(16π⁴ L))^{1/4}.
+    #[cfg(test)]
     pub(crate) fn levelled_frequency_per_um(&self) -> f64 {
         levelled_frequency(self.levelling_integral_um4())
     }

@@ -92,12 +92,6 @@ impl ChebTable {
         ChebTable::fit_each(|x, _, v| v[0] = f(x), 1, a, b, tol).pop().flatten()
     }
 
-    /// The table of `pieces` pieces, if its deviation at the check points is ≤ `tol` (`fit` at one piece
-    /// count: what [`ChebTable::on_grid_of`] needs to put tables on a common grid).
-    pub(crate) fn fit_with_pieces(f: impl Fn(f64) -> f64, a: f64, b: f64, pieces: usize, tol: f64) -> Option<ChebTable> {
-        ChebTable::fit_each_with_pieces(|x, _, v| v[0] = f(x), &[0], a, b, pieces, tol).pop().flatten()
-    }
-
     /// [`ChebTable::fit`] of `count` functions f_0 … f_{count−1} on the same [a, b] at once: the same tables to
     /// the bit as fitting each alone, but every point is asked of all the functions that need it in one call,
     /// `f(x, which, values)` setting `values[i]` = f_{which[i]}(x), so that work they share at one x (a film
@@ -152,6 +146,7 @@ impl ChebTable {
 
     /// [`ChebTable::fit_with_pieces`] of the functions `which` of `f` at once (as [`ChebTable::fit_each`]):
     /// one result per entry of `which`.
+    #[cfg(test)]
     pub(crate) fn fit_each_with_pieces(
         f: impl FnMut(f64, &[usize], &mut [f64]),
         which: &[usize],

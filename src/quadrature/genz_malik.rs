@@ -146,10 +146,6 @@ impl<const D: usize> GenzMalikRule<D> {
     pub(crate) fn len(&self) -> usize {
         self.points.len()
     }
-
-    pub(crate) fn is_empty(&self) -> bool {
-        self.points.is_empty()
-    }
 }
 
 /// One box of a partition, as its centre and half-widths (the form the rule is applied in). A partition kept

@@ -58,10 +58,6 @@ pub(crate) mod uncertainty;
 pub(crate) use crate::registry::MAX_LOBES;
 pub use crate::registry::MODELS;
 
-/// Descriptive fields allowed in every recipe: `name`, `description`, `provenance` (strings) and `notes`
-/// (a string or an array of strings). They do not change the model.
-pub(crate) const META_FIELDS: &[&str] = &["model", "name", "description", "provenance", "notes"];
-
 /// Slack on the energy sums (kd + ks ≤ 1) for decimal rounding in the files.
 const ENERGY_SLACK: f64 = 1e-9;
 

@@ -22,7 +22,13 @@ impl<'a> ChartMap<'a> {
     /// The map of `chart` for source axis θ, receptor axis `viewing` and the clipped stops; `kinks` cut the
     /// first position variable: t of p_s in the plain chart (`aperture::plain_kink_point`), t_p in the lobe
     /// chart (`aperture::half_angle_kink_point`); the mixed chart `PlainPLobeQ` has none.
-    pub(crate) fn new(chart: Chart, kinks: &'a [f64], theta: f64, viewing: f64, (src, rec): (Stop, Stop)) -> ChartMap<'a> {
+    pub(crate) fn new(
+        chart: Chart,
+        kinks: &'a [f64],
+        theta: f64,
+        viewing: f64,
+        (src, rec): (Stop, Stop),
+    ) -> ChartMap<'a> {
         ChartMap {
             chart,
             kinks,

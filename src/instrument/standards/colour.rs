@@ -228,6 +228,7 @@ pub fn builtin_ids() -> Vec<&'static str> {
 }
 
 /// True if `id` names a builtin colour geometry.
+#[cfg(test)]
 pub(crate) fn is_colour_id(id: &str) -> bool {
     builtin_ids().contains(&id)
 }

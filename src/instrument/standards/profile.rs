@@ -55,11 +55,6 @@ impl ProfileSpec {
         Stop::from_angles(hi - lo, self.perpendicular, 0.5 * (lo + hi))
     }
 
-    /// The window's edges from the specular direction, degrees: (left edge of `first`, right edge of `last`).
-    pub(crate) fn window_deg(&self, first: usize, last: usize) -> (f64, f64) {
-        (self.centre_deg(first) - 0.5 * self.pixel_deg, self.centre_deg(last) + 0.5 * self.pixel_deg)
-    }
-
     /// The name of pixel k (and of its reading): `pixel-0000` … (four digits at least, sorted as numbers).
     pub(crate) fn name(&self, k: usize) -> String {
         format!("pixel-{k:04}")

@@ -124,8 +124,3 @@ pub(crate) fn draw<DB: DrawingBackend>(
     root.present().map_err(plot_err)?;
     Ok(())
 }
-
-/// The picture as an SVG document in memory.
-pub fn svg(map: &HeightMap, a: &Analysis, doc: &TopographyDoc, title: &str) -> Result<String> {
-    super::to_svg((1200, 560), |root| draw(root, map, a, doc, title))
-}
