@@ -144,8 +144,8 @@ impl ChebTable {
         out
     }
 
-    /// [`ChebTable::fit_with_pieces`] of the functions `which` of `f` at once (as [`ChebTable::fit_each`]):
-    /// one result per entry of `which`.
+    /// The tables of `pieces` pieces of the functions `which` of `f` at once (as [`ChebTable::fit_each`]),
+    /// each if its deviation at the check points is ≤ `tol`: one result per entry of `which`.
     #[cfg(test)]
     pub(crate) fn fit_each_with_pieces(
         f: impl FnMut(f64, &[usize], &mut [f64]),

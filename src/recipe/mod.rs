@@ -10,7 +10,7 @@
 //! The folder:
 //! * `mod.rs` (this): a recipe file or text read into a [`Material`] ([`load_file`], [`parse_str`]), the
 //!   dispatch on `"model"` ([`parse_brdf`]) and the analytic models' fields (Lambert, the smooth and rough
-//!   interfaces, Phong, Ward, the Cook–Torrance lobes), [`META_FIELDS`];
+//!   interfaces, Phong, Ward, the Cook–Torrance lobes);
 //! * `fields.rs`: the registry-driven reading of a parameter (`Obj::param`, `opt_param`, `param_array`,
 //!   `param_key`, `deny_unknown_in`, [`fields::param_number`]) on `input::json`'s reader;
 //! * `levelling.rs`: a paint coat's `application` block, levelled into the coat's facets and halo
