@@ -4,13 +4,13 @@
 //! are freed in parallel. One integral always runs on one thread, so every reading is the same bits whatever
 //! the thread count or the number of recipes measured together (tests/sheets.rs compares a batch with
 //! one-by-one runs).
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use rayon::prelude::*;
 
 use crate::instrument::plan::{Execution, Plan, PlanOptions, Planner, Reading};
 use crate::instrument::standards::StandardGeometry;
-use crate::recipe::{self, Material};
+use crate::recipe::Material;
 use crate::{Error, Result};
 
 /// The recipe files named by `paths`: files as given, directories replaced by their `*.json` entries (not
@@ -40,11 +40,6 @@ pub(crate) fn recipe_files(paths: &[PathBuf]) -> Result<Vec<PathBuf>> {
         }
     }
     Ok(out)
-}
-
-/// Load every recipe (the first bad one is the error, before any work is done).
-pub fn load_all(files: &[PathBuf]) -> Result<Vec<Material>> {
-    files.iter().map(|f| recipe::load_file(Path::new(f))).collect()
 }
 
 /// Read every material through the geometries; the readings of material i are element i.
@@ -80,6 +75,11 @@ pub(crate) fn run_many(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Load every recipe (the first bad one is the error, before any work is done).
+    fn load_all(files: &[PathBuf]) -> Result<Vec<Material>> {
+        files.iter().map(|f| crate::recipe::load_file(std::path::Path::new(f))).collect()
+    }
 
     #[test]
     fn a_dangling_link_in_a_directory_is_an_error_naming_it() {

@@ -43,7 +43,7 @@ pub fn given(x: f64) -> String {
 /// A number for a message or a description: its shortest round-trip digits, plain in the everyday range
 /// [10⁻⁶, 10¹⁵) and in scientific notation outside it, so that 1e300 is not printed with all its 301 digits
 /// nor 1e-300 with 300 zeros (`docs/instrument.md` §Numbers in text).
-pub fn number(x: f64) -> String {
+pub(crate) fn number(x: f64) -> String {
     if x.is_finite() && x != 0.0 && !(1e-6..1e15).contains(&x.abs()) {
         format!("{x:e}")
     } else {
@@ -65,12 +65,12 @@ pub struct Words {
 
 impl Words {
     /// Words that begin with an argument.
-    pub fn argument(name: &'static str) -> Words {
+    pub(crate) fn argument(name: &'static str) -> Words {
         Words::default().and_argument(name)
     }
 
     /// These words, then `text`.
-    pub fn and(mut self, text: impl AsRef<str>) -> Words {
+    pub(crate) fn and(mut self, text: impl AsRef<str>) -> Words {
         self.text.push_str(text.as_ref());
         self
     }
@@ -99,7 +99,7 @@ impl Words {
     }
 
     /// The words with each argument written by `name`.
-    pub fn naming(&self, name: &dyn Fn(&'static str) -> String) -> String {
+    pub(crate) fn naming(&self, name: &dyn Fn(&'static str) -> String) -> String {
         let mut out = String::with_capacity(self.text.len());
         let mut at = 0;
         for (span, argument) in &self.arguments {
@@ -144,13 +144,13 @@ impl From<&String> for Words {
 }
 
 impl Error {
-    pub fn input(file: impl Into<String>, field: impl Into<String>, message: impl Into<Words>) -> Self {
+    pub(crate) fn input(file: impl Into<String>, field: impl Into<String>, message: impl Into<Words>) -> Self {
         Error::Input { file: file.into(), field: field.into(), message: message.into() }
     }
 
     /// An [`Error::Argument`] whose message begins with the argument `name`, followed directly by `rest` (which
     /// begins with its own space or colon: `` `lhs` N must be at least 1 ``, `` `vary`: not a parameter ``).
-    pub fn argument(name: &'static str, rest: impl AsRef<str>) -> Self {
+    pub(crate) fn argument(name: &'static str, rest: impl AsRef<str>) -> Self {
         Error::Argument(Words::argument(name).and(rest))
     }
 

@@ -54,11 +54,11 @@ pub struct Range {
 
 impl Range {
     /// [lo, hi].
-    pub const fn closed(lo: f64, hi: f64) -> Range {
+    pub(crate) const fn closed(lo: f64, hi: f64) -> Range {
         Range { lo, lo_closed: true, hi, hi_closed: true }
     }
     /// (lo, hi).
-    pub const fn open(lo: f64, hi: f64) -> Range {
+    pub(crate) const fn open(lo: f64, hi: f64) -> Range {
         Range { lo, lo_closed: false, hi, hi_closed: false }
     }
     /// [lo, ∞).
@@ -66,7 +66,7 @@ impl Range {
         Range { lo, lo_closed: true, hi: f64::INFINITY, hi_closed: false }
     }
     /// (lo, ∞).
-    pub const fn above(lo: f64) -> Range {
+    pub(crate) const fn above(lo: f64) -> Range {
         Range { lo, lo_closed: false, hi: f64::INFINITY, hi_closed: false }
     }
 
@@ -219,13 +219,13 @@ impl Param {
     }
 
     /// Whether the entry's pointer pattern matches the concrete pointer `p`.
-    pub fn matches(&self, p: &str) -> bool {
+    pub(crate) fn matches(&self, p: &str) -> bool {
         pattern_matches(self.pointer, p)
     }
 }
 
 /// RFC 6901 escaping of one reference token: `~` → `~0`, `/` → `~1`.
-pub fn escape(token: &str) -> String {
+pub(crate) fn escape(token: &str) -> String {
     token.replace('~', "~0").replace('/', "~1")
 }
 
@@ -235,7 +235,7 @@ pub(crate) fn unescape(token: &str) -> String {
 }
 
 /// `parent` + `/` + escaped `key`.
-pub fn child(parent: &str, key: &str) -> String {
+pub(crate) fn child(parent: &str, key: &str) -> String {
     format!("{parent}/{}", escape(key))
 }
 
@@ -280,7 +280,7 @@ pub fn lookup(model: &str, pointer: &str) -> Option<&'static Param> {
 }
 
 /// The keys allowed in the object at the concrete pointer `parent` of a `model` recipe, in registry order.
-pub fn children(model: &str, parent: &str) -> Vec<String> {
+pub(crate) fn children(model: &str, parent: &str) -> Vec<String> {
     let depth = tokens(parent).map_or(0, |t| t.len());
     let mut keys: Vec<String> = Vec::new();
     for e in PARAMS.iter().filter(|e| e.applies_to(model)) {
@@ -327,12 +327,13 @@ const fn p(
 use Presence::{Default as Opt, Required as Req};
 
 // Descriptive fields, in every model.
-pub const MODEL: Param =
+pub(crate) const MODEL: Param =
     p("/model", ALL, Type::Choice(MODELS), "", NONE, Req, "the reflectance model; selects the other fields");
-pub const NAME: Param =
+pub(crate) const NAME: Param =
     p("/name", ALL, Type::Text, "", NONE, Opt("the file name without extension"), "label shown in reports");
 pub(crate) const DESCRIPTION: Param = p("/description", ALL, Type::Text, "", NONE, Opt("none"), "free text");
-pub const PROVENANCE: Param = p("/provenance", ALL, Type::Text, "", NONE, Opt("none"), "where the numbers come from");
+pub(crate) const PROVENANCE: Param =
+    p("/provenance", ALL, Type::Text, "", NONE, Opt("none"), "where the numbers come from");
 pub(crate) const NOTES: Param = p("/notes", ALL, Type::Notes, "", NONE, Opt("none"), "free text for provenance");
 /// The standard uncertainties of some of the recipe's numbers, each key a JSON Pointer to one number of the recipe
 /// that a numeric entry of its model governs, each value u > 0 in that entry's unit (`recipe::uncertainty`;

@@ -109,7 +109,7 @@ impl PlanRequest {
     }
 
     /// The conditions of colour readings.
-    pub fn colour(&self) -> Result<Conditions> {
+    pub(crate) fn colour(&self) -> Result<Conditions> {
         Ok(Conditions {
             illuminant: Illuminant::parse(self.illuminant.as_deref().unwrap_or(DEFAULT_ILLUMINANT))?,
             observer: Observer::parse(self.observer.as_deref().unwrap_or(DEFAULT_OBSERVER))?,
@@ -225,7 +225,7 @@ pub struct VsParameterRequest {
 
 /// A gloss-vs-parameter picture's numbers, ready to draw.
 #[derive(Clone, Debug, PartialEq)]
-pub struct VsParameter {
+pub(crate) struct VsParameter {
     /// The recipe's name (the picture's title).
     pub name: String,
     /// The axis' words ([`parameter_label`]).
@@ -275,7 +275,7 @@ impl VsParameterRequest {
 
     /// The picture's numbers: every point of the sweep read (in order); a point whose recipe is invalid is an
     /// error naming its value.
-    pub fn read(&self, text: &str, file: &str, geometries: Vec<StandardGeometry>) -> Result<VsParameter> {
+    pub(crate) fn read(&self, text: &str, file: &str, geometries: Vec<StandardGeometry>) -> Result<VsParameter> {
         self.read_until(text, file, geometries, Cancel::default())
     }
 
@@ -391,7 +391,7 @@ impl TopographyRequest {
     }
 
     /// A plain matrix's calibration: `None` unless the pixel size is given, which then needs the height unit.
-    pub fn calibration(&self) -> Result<Option<Calibration>> {
+    pub(crate) fn calibration(&self) -> Result<Option<Calibration>> {
         let length = |name: &'static str, v: &str| {
             units::parse_length(v).ok_or_else(|| {
                 Error::argument(

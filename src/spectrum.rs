@@ -25,7 +25,8 @@ pub(crate) const RGB_LUMINANCE_WEIGHTS: [f64; 3] = [0.17697, 0.81240, 0.01063];
 /// Relative radiant powers of the CIE 1931 RGB primaries that match the equal-energy white, 72.0962 : 1.3791 : 1
 /// (Wyszecki & Stiles, *Color Science*, 2nd ed., §3.3.2). Their products with ȳ at the primaries' wavelengths
 /// are the luminances behind [`RGB_LUMINANCE_WEIGHTS`] (test `rgb_weights_are_the_cie_primaries_luminances`).
-pub const CIE_RGB_RADIANT_POWER_RATIOS: [f64; 3] = [72.0962, 1.3791, 1.0];
+#[cfg(test)]
+pub(crate) const CIE_RGB_RADIANT_POWER_RATIOS: [f64; 3] = [72.0962, 1.3791, 1.0];
 
 /// Wavelengths at which an RGB material's wavelength-dependent optics (thin-film interference) are evaluated:
 /// the CIE 1931 RGB primaries 700 nm, 546.1 nm and 435.8 nm (CIE 15:2004 §3.1 / Wright–Guild primaries).
@@ -167,7 +168,7 @@ pub(crate) fn luminous_grid_weights(wavelengths_nm: &[f64]) -> Result<Vec<f64>> 
 }
 
 /// Parse a two-column CSV table `wavelength_nm,value`; lines starting with `#` are comments (provenance).
-pub fn parse_table(text: &str, file: &str) -> Result<Vec<(f64, f64)>> {
+pub(crate) fn parse_table(text: &str, file: &str) -> Result<Vec<(f64, f64)>> {
     Ok(parse_columns(text, file, 1)?.into_iter().map(|(l, v)| (l, v[0])).collect())
 }
 
@@ -201,7 +202,7 @@ pub(crate) fn parse_columns(text: &str, file: &str, ncols: usize) -> Result<Vec<
 }
 
 /// Linear interpolation in a table; None outside its range.
-pub fn interp(table: &[(f64, f64)], x: f64) -> Option<f64> {
+pub(crate) fn interp(table: &[(f64, f64)], x: f64) -> Option<f64> {
     let (first, last) = (table.first()?, table.last()?);
     if x < first.0 || x > last.0 {
         return None;

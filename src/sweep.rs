@@ -119,7 +119,7 @@ pub enum SweepDesign {
 
 /// SplitMix64's finaliser (Steele, Lea & Flood 2014, "Fast splittable pseudorandom number generators"): a
 /// bijective 64-bit mix, used as a keyed hash.
-pub fn splitmix64(mut z: u64) -> u64 {
+pub(crate) fn splitmix64(mut z: u64) -> u64 {
     z = z.wrapping_add(0x9e37_79b9_7f4a_7c15);
     z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
     z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
@@ -256,7 +256,7 @@ impl Sweep {
     }
 
     /// The parameter values of point i.
-    pub fn point(&self, i: u64) -> Vec<f64> {
+    pub(crate) fn point(&self, i: u64) -> Vec<f64> {
         let map = |a: &SweepAxis, t: f64| -> f64 {
             // The ends exactly (exp(ln LO) is not always LO).
             if t <= 0.0 {
@@ -302,7 +302,7 @@ impl Sweep {
     }
 
     /// The reported readings of every point: (geometry id, reading name, unit), in output order.
-    pub fn columns(&self) -> Vec<(String, String, String)> {
+    pub(crate) fn columns(&self) -> Vec<(String, String, String)> {
         let mut out = vec![];
         for g in &self.geometries {
             for (name, spec) in g.reading_names.iter().zip(&g.geometry.readings) {

@@ -18,7 +18,7 @@ pub(crate) struct SmoothConductor {
 
 impl SmoothConductor {
     /// One finite complex index per spectral sample, else an error.
-    pub fn new(ior: Vec<Complex64>, sampling: Sampling) -> crate::Result<Self> {
+    pub(crate) fn new(ior: Vec<Complex64>, sampling: Sampling) -> crate::Result<Self> {
         let parts: Vec<f64> = ior.iter().map(|c| c.re + c.im).collect();
         super::per_sample("conductor index", &parts, &sampling)?;
         Ok(SmoothConductor { ior, sampling })

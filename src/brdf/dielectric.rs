@@ -29,7 +29,7 @@ pub enum Ior {
 impl Ior {
     /// Unpolarised Fresnel reflectance at cos θ = `cos_i` (Born & Wolf §1.5.2 / §14.2; pbrt-v4 `FrDielectric`,
     /// `FrConductor`).
-    pub fn reflectance(&self, cos_i: f64) -> f64 {
+    pub(crate) fn reflectance(&self, cos_i: f64) -> f64 {
         let c = cos_i.clamp(0.0, 1.0);
         match *self {
             Ior::Dielectric(n) => fr_dielectric(c, n),
@@ -84,7 +84,7 @@ impl SmoothDielectric {
     }
 
     /// The delta reflection's weight at cos θi = `cos_i`: gain·F(cos θi, n), gain for the perfect mirror.
-    pub fn reflectance(&self, cos_i: f64) -> f64 {
+    pub(crate) fn reflectance(&self, cos_i: f64) -> f64 {
         if self.ior == f64::INFINITY {
             self.gain
         } else {

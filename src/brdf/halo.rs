@@ -60,7 +60,7 @@ impl Halo {
     }
 
     /// The halo's value per sample, added to `out`.
-    pub fn add(&self, wi: Vec3, wo: Vec3, out: &mut [f64]) {
+    pub(crate) fn add(&self, wi: Vec3, wo: Vec3, out: &mut [f64]) {
         let (a, b) = ([wi.x, wi.y, wi.z], [wo.x, wo.y, wo.z]);
         if self.eps.windows(2).all(|w| w[0] == w[1]) {
             // One ε (a coat's real index): Q once per pair, the same bits as per sample.
@@ -101,7 +101,7 @@ impl Halo {
     }
 
     /// The halo as a term of the model it is added to (its [`Halo::lobe`]).
-    pub fn term(&self) -> Term {
+    pub(crate) fn term(&self) -> Term {
         let lobe = self.lobe();
         Term { label: lobe.label.clone(), kind: TermKind::Lobe(lobe) }
     }
@@ -112,7 +112,7 @@ impl Halo {
     /// law (K-correlation) or a Gaussian in f that is not one in the planner's lobe variables, so it is
     /// reported as heavy and unstated ([`Tail::Unknown`]): splits out to the ends of the range, the adaptive
     /// partition, no shaped rule.
-    pub fn lobe(&self) -> Lobe {
+    pub(crate) fn lobe(&self) -> Lobe {
         let lambda_min = self.lambda_nm.iter().copied().fold(f64::INFINITY, f64::min);
         Lobe {
             slope_width: 0.5 * lambda_min * 1e-3 * self.psd.knee(),
@@ -127,7 +127,7 @@ impl Halo {
     /// symmetric in ωi, ωo) and analytic in the upper hemispheres (a real ε > 1 has no critical angle from
     /// outside; a conductor's ε none at all), so the whole keeps the inner model's kinks, seams, reciprocity
     /// and smoothness.
-    pub fn over(&self, inner: Hints) -> Hints {
+    pub(crate) fn over(&self, inner: Hints) -> Hints {
         let mut h = inner;
         h.terms.push(self.term());
         h
@@ -162,7 +162,7 @@ impl WithHalo {
     /// `inner` must have a delta term that contains the Fresnel mirror of the interface of `halo` (the
     /// recipe parser attaches halos only there: a smooth paint coat, a Cook–Torrance model's clear coat, a
     /// smooth microfacet interface).
-    pub fn new(inner: Arc<dyn Brdf>, halo: Halo) -> Result<WithHalo> {
+    pub(crate) fn new(inner: Arc<dyn Brdf>, halo: Halo) -> Result<WithHalo> {
         if !inner.has_delta() {
             return Err(Error::Usage("a scatter halo needs a model with a mirror (delta) term".into()));
         }

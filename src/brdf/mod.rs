@@ -43,7 +43,7 @@ use crate::{Error, Result, Vec3};
 
 pub mod albedo;
 pub(crate) mod annotated;
-pub mod conductor;
+pub(crate) mod conductor;
 pub mod dielectric;
 pub mod halo;
 pub mod lambert;
@@ -52,7 +52,7 @@ pub mod mixture;
 pub mod multilobe;
 pub mod paint;
 pub mod phong;
-pub mod topography;
+pub(crate) mod topography;
 pub(crate) mod two_scale;
 pub mod ward;
 
@@ -137,14 +137,7 @@ pub enum Kink {
     HalfAngle { cos: f64 },
 }
 
-impl Kink {
-    /// The cosine of the critical angle.
-    pub fn cos(&self) -> f64 {
-        match *self {
-            Kink::Incidence { cos } | Kink::HalfAngle { cos } => cos,
-        }
-    }
-}
+impl Kink {}
 
 /// The kinks of a set of Fresnel indices, one per distinct critical angle, in increasing order of cos θc;
 /// `delta` selects the term (the delta limit kinks in cos θi, a lobe in ωi·h).
@@ -233,7 +226,7 @@ impl Hints {
     }
 
     /// The lobes among the terms.
-    pub fn lobes(&self) -> Vec<Lobe> {
+    pub(crate) fn lobes(&self) -> Vec<Lobe> {
         self.terms
             .iter()
             .filter_map(|t| match &t.kind {
@@ -244,12 +237,12 @@ impl Hints {
     }
 
     /// Whether the model has a delta term.
-    pub fn has_delta(&self) -> bool {
+    pub(crate) fn has_delta(&self) -> bool {
         self.terms.iter().any(|t| t.kind == TermKind::Delta)
     }
 
     /// Whether `eval` can be non-zero (the model has a diffuse or lobe term).
-    pub fn has_regular(&self) -> bool {
+    pub(crate) fn has_regular(&self) -> bool {
         self.terms.iter().any(|t| t.kind != TermKind::Delta)
     }
 

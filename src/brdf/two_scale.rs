@@ -39,7 +39,7 @@ const LOSS_TOL: f64 = 1e-13;
 impl RoughWithHalo {
     /// `inner` is the rough interface (the recipe parser passes a microfacet surface whose roughness is above
     /// the smooth limit); `halo` the scatter of the same interface.
-    pub fn new(inner: Arc<dyn Brdf>, halo: Halo) -> Result<RoughWithHalo> {
+    pub(crate) fn new(inner: Arc<dyn Brdf>, halo: Halo) -> Result<RoughWithHalo> {
         if halo.eps.len() != inner.sampling().len() {
             return Err(Error::Usage("scatter halo: sampling differs from the model's".into()));
         }

@@ -44,12 +44,6 @@ impl Ward {
         }
         Ok(Ward { rho_d, rho_s, alpha, sampling })
     }
-
-    /// The closed-form specular albedo at normal incidence per unit ρs: 1 − α²(1 − e^(−1/α²)).
-    pub fn normal_incidence_lobe_albedo(alpha: f64) -> f64 {
-        let a2 = alpha * alpha;
-        1.0 + a2 * (-1.0 / a2).exp_m1()
-    }
 }
 
 impl Brdf for Ward {

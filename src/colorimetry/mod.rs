@@ -64,14 +64,8 @@ pub enum Observer {
 }
 
 impl Observer {
-    pub const ALL: [Observer; 2] = [Observer::Cie1931, Observer::Cie1964];
-
-    pub fn id(self) -> &'static str {
-        match self {
-            Observer::Cie1931 => "2",
-            Observer::Cie1964 => "10",
-        }
-    }
+    #[cfg(test)]
+    pub(crate) const ALL: [Observer; 2] = [Observer::Cie1931, Observer::Cie1964];
 
     pub fn describe(self) -> &'static str {
         match self {
@@ -107,9 +101,10 @@ pub enum Illuminant {
 }
 
 impl Illuminant {
-    pub const ALL: [Illuminant; 4] = [Illuminant::D65, Illuminant::D50, Illuminant::A, Illuminant::C];
+    #[cfg(test)]
+    pub(crate) const ALL: [Illuminant; 4] = [Illuminant::D65, Illuminant::D50, Illuminant::A, Illuminant::C];
 
-    pub fn id(self) -> &'static str {
+    pub(crate) fn id(self) -> &'static str {
         match self {
             Illuminant::D65 => "D65",
             Illuminant::D50 => "D50",
@@ -182,7 +177,7 @@ fn summation_grid(c: Conditions) -> Result<Vec<(f64, f64, [f64; 3])>> {
 /// Tristimulus weights of a material's spectral samples under given conditions: X = Σ_k rows[0][k]·R_k, etc.,
 /// with R_k the reflectance factor of sample k (1 for the perfect reflecting diffuser).
 #[derive(Clone, Debug, PartialEq)]
-pub struct Weights {
+pub(crate) struct Weights {
     pub conditions: Conditions,
     /// rows[c][k], c = X, Y, Z; all ≥ 0.
     pub rows: [Vec<f64>; 3],
@@ -192,14 +187,10 @@ pub struct Weights {
 
 impl Weights {
     /// X, Y, Z of per-sample reflectance factors `r`.
-    pub fn xyz(&self, r: &[f64]) -> [f64; 3] {
+    #[cfg(test)]
+    pub(crate) fn xyz(&self, r: &[f64]) -> [f64; 3] {
         let dot = |w: &Vec<f64>| w.iter().zip(r).map(|(a, b)| a * b).sum::<f64>();
         [dot(&self.rows[0]), dot(&self.rows[1]), dot(&self.rows[2])]
-    }
-
-    /// Error bound of X, Y, Z from per-sample absolute error bounds `e`: Σ_k W_ck e_k (weights are ≥ 0).
-    pub fn xyz_error(&self, e: &[f64]) -> [f64; 3] {
-        self.xyz(e)
     }
 }
 
@@ -245,7 +236,7 @@ pub(crate) fn weights_for_grid(wavelengths_nm: &[f64], c: Conditions) -> Result<
 }
 
 /// Weights for a material's sampling. Grey: wavelength-flat. Spectral: its grid. RGB: refused (no spectrum).
-pub fn weights(sampling: &Sampling, c: Conditions) -> Result<Weights> {
+pub(crate) fn weights(sampling: &Sampling, c: Conditions) -> Result<Weights> {
     match sampling.kind {
         SamplingKind::Grey => weights_for_grid(&[560.0], c),
         SamplingKind::Spectral => weights_for_grid(&sampling.wavelengths_nm, c),

@@ -51,7 +51,7 @@ impl Weighting {
     }
 
     /// The kinds (each once, in the order given) stacked into one matrix.
-    pub fn stack(kinds: &[WeightingKind], sampling: &Sampling) -> Result<Weighting> {
+    pub(crate) fn stack(kinds: &[WeightingKind], sampling: &Sampling) -> Result<Weighting> {
         let mut w = Weighting { parts: Vec::new(), rows: Vec::new() };
         for &kind in kinds {
             if w.parts.iter().all(|(k, _)| *k != kind) {
@@ -77,7 +77,7 @@ impl Weighting {
     }
 
     /// Index of the first component of `kind`, if the matrix has it.
-    pub fn offset(&self, kind: WeightingKind) -> Option<usize> {
+    pub(crate) fn offset(&self, kind: WeightingKind) -> Option<usize> {
         self.parts.iter().find(|(k, _)| *k == kind).map(|(_, o)| *o)
     }
 
@@ -93,7 +93,7 @@ impl Weighting {
     }
 
     /// All k components of the weighted values.
-    pub fn apply(&self, values: &[f64]) -> Vec<f64> {
+    pub(crate) fn apply(&self, values: &[f64]) -> Vec<f64> {
         (0..self.len()).map(|c| self.component(c, values)).collect()
     }
 

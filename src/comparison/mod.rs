@@ -40,9 +40,9 @@
 //!   every reading to first order ([`propagation::propagate`]).
 mod baseline;
 pub mod propagation;
-pub mod series;
+pub(crate) mod series;
 pub mod sheet;
-pub mod workbook;
+pub(crate) mod workbook;
 
 use std::collections::HashMap;
 use std::path::PathBuf;
@@ -74,7 +74,7 @@ pub struct Statistics {
 }
 
 /// Statistics of a non-empty list of finite values (two-pass: mean first, then squared deviations).
-pub fn statistics(values: &[f64]) -> Statistics {
+pub(crate) fn statistics(values: &[f64]) -> Statistics {
     assert!(!values.is_empty(), "statistics of no values");
     let n = values.len();
     let mean = values.iter().sum::<f64>() / n as f64;
@@ -178,7 +178,7 @@ pub struct ReadingTolerance {
 
 impl ReadingTolerance {
     /// The key as written (`gloss`, `astm-e430-30/doi`).
-    pub fn key(&self) -> String {
+    pub(crate) fn key(&self) -> String {
         match &self.geometry {
             Some(g) => format!("{g}/{}", self.reading),
             None => self.reading.clone(),
@@ -237,7 +237,7 @@ pub(crate) fn parse_tolerance(text: &str) -> Result<(Option<ReadingTolerance>, f
 }
 
 impl VerdictRule {
-    pub fn check(&self) -> Result<()> {
+    pub(crate) fn check(&self) -> Result<()> {
         if !(self.k.is_finite() && self.k >= 0.0) {
             return Err(Error::argument(
                 "k",
@@ -349,7 +349,14 @@ pub struct Allowance {
 impl Allowance {
     /// The allowance of k, the standard error of the mean s/√n (`statistical` is k·s/√n as the caller computed
     /// it), u_pred, the stated uncertainty and the prediction's numerical error.
-    pub fn new(k: f64, statistical: f64, standard_error: f64, u_pred: f64, stated: f64, prediction: f64) -> Self {
+    pub(crate) fn new(
+        k: f64,
+        statistical: f64,
+        standard_error: f64,
+        u_pred: f64,
+        stated: f64,
+        prediction: f64,
+    ) -> Self {
         let random =
             if u_pred > 0.0 { k * (standard_error * standard_error + u_pred * u_pred).sqrt() } else { statistical };
         Allowance { statistical, prediction_uncertainty: u_pred, random, stated, prediction }
@@ -383,7 +390,7 @@ pub enum Verdict {
 }
 
 impl Verdict {
-    pub fn label(&self) -> &'static str {
+    pub(crate) fn label(&self) -> &'static str {
         match self {
             Verdict::Inside => "ok",
             Verdict::Outside => "OUTSIDE",
@@ -393,7 +400,8 @@ impl Verdict {
     }
     /// Whether the verdict fails a check (exit status 1): outside, or a check that could not be made
     /// (docs/instrument.md §Exit statuses). "Not predicted" is reported, not failed.
-    pub fn fails(&self) -> bool {
+    #[cfg(test)]
+    pub(crate) fn fails(&self) -> bool {
         matches!(self, Verdict::Outside | Verdict::NoValue(_) | Verdict::NoAllowance)
     }
     /// Why the row could not be checked, if it could not.

@@ -43,7 +43,7 @@ pub enum Difference {
 }
 
 impl Difference {
-    pub fn label(&self) -> &'static str {
+    pub(crate) fn label(&self) -> &'static str {
         match self {
             Difference::Central => "central",
             Difference::Forward => "forward",
@@ -77,7 +77,7 @@ pub struct PredictionUncertainty {
 
 /// The recipe `json` with the number at `pointer` set to `x` and without its `uncertainty` block (a displaced
 /// recipe is a point, not a statement of uncertainty).
-pub fn displaced(json: &Value, pointer: &str, x: f64) -> Value {
+pub(crate) fn displaced(json: &Value, pointer: &str, x: f64) -> Value {
     let mut v = json.clone();
     if let Some(slot) = v.pointer_mut(pointer) {
         *slot = serde_json::json!(x);

@@ -7,7 +7,7 @@
 
 /// A statistic of a series of readings.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Statistic {
+pub(crate) enum Statistic {
     Mean,
     Std,
     Min,
@@ -16,7 +16,7 @@ pub enum Statistic {
 }
 
 impl Statistic {
-    pub fn name(self) -> &'static str {
+    pub(crate) fn name(self) -> &'static str {
         match self {
             Statistic::Mean => "mean",
             Statistic::Std => "standard deviation",
@@ -51,7 +51,7 @@ pub(crate) const STATISTIC_WORDS: &[(&str, Statistic)] = &[
 
 /// A statistics header split into the statistic and the rest (the reading it is of, possibly empty): the word
 /// as a prefix (`mean20` → Mean, `20`) or a suffix (`20mean`, `hazestddev`).
-pub fn split(normalised: &str) -> Option<(Statistic, &str)> {
+pub(crate) fn split(normalised: &str) -> Option<(Statistic, &str)> {
     for (w, s) in STATISTIC_WORDS {
         if let Some(rest) = normalised.strip_prefix(w) {
             return Some((*s, rest));
@@ -67,7 +67,7 @@ pub fn split(normalised: &str) -> Option<(Statistic, &str)> {
 
 /// What the readings of a series say.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Series {
+pub(crate) struct Series {
     pub n: usize,
     pub mean: f64,
     /// Denominator n − 1 (NaN for n = 1).
@@ -79,7 +79,7 @@ pub struct Series {
 }
 
 impl Series {
-    pub fn of(values: &[f64]) -> Series {
+    pub(crate) fn of(values: &[f64]) -> Series {
         let n = values.len();
         let mean = values.iter().sum::<f64>() / n as f64;
         let ss: f64 = values.iter().map(|v| (v - mean).powi(2)).sum();
@@ -109,7 +109,7 @@ pub(crate) fn written_decimals(text: &str) -> i32 {
 /// written decimal (an export rounds to its display), plus 10⁻⁹ of its size for the binary arithmetic. A
 /// standard deviation may be the sample's (n − 1) or the population's (n): makers and spreadsheets use both
 /// (Excel STDEV and STDEV.P). Err says what the readings give.
-pub fn check(stat: Statistic, value: f64, text: &str, s: &Series) -> std::result::Result<(), String> {
+pub(crate) fn check(stat: Statistic, value: f64, text: &str, s: &Series) -> std::result::Result<(), String> {
     let allowed = |x: f64| 0.5 * 10f64.powi(-written_decimals(text)) + 1e-9 * x.abs().max(value.abs());
     let near = |x: f64| x.is_finite() && (value - x).abs() <= allowed(x);
     // Ten significant digits: the readings' sum in binary is not news (89.12, not 89.12000000000002).

@@ -26,16 +26,16 @@ impl<'a> Obj<'a> {
     }
 
     /// JSON Pointer of a child field (the key escaped per RFC 6901).
-    pub fn field(&self, key: &str) -> String {
+    pub(crate) fn field(&self, key: &str) -> String {
         registry::child(&self.path, key)
     }
 
     /// JSON Pointer of element `i` of the array at `key`.
-    pub fn element(&self, key: &str, i: usize) -> String {
+    pub(crate) fn element(&self, key: &str, i: usize) -> String {
         format!("{}/{i}", self.field(key))
     }
 
-    pub fn err(&self, key: &str, message: impl Into<String>) -> Error {
+    pub(crate) fn err(&self, key: &str, message: impl Into<String>) -> Error {
         Error::input(self.file, self.field(key), message.into())
     }
 
@@ -58,15 +58,15 @@ impl<'a> Obj<'a> {
         Ok(())
     }
 
-    pub fn get(&self, key: &str) -> Option<&'a Value> {
+    pub(crate) fn get(&self, key: &str) -> Option<&'a Value> {
         self.map.get(key)
     }
 
-    pub fn required(&self, key: &str) -> Result<&'a Value> {
+    pub(crate) fn required(&self, key: &str) -> Result<&'a Value> {
         self.map.get(key).ok_or_else(|| self.err(key, "missing required field"))
     }
 
-    pub fn obj(&self, key: &str) -> Result<Obj<'a>> {
+    pub(crate) fn obj(&self, key: &str) -> Result<Obj<'a>> {
         Obj::new(self.file, self.field(key), self.required(key)?)
     }
 
@@ -74,7 +74,7 @@ impl<'a> Obj<'a> {
         self.get(key).map(|v| Obj::new(self.file, self.field(key), v)).transpose()
     }
 
-    pub fn str(&self, key: &str) -> Result<&'a str> {
+    pub(crate) fn str(&self, key: &str) -> Result<&'a str> {
         let v = self.required(key)?;
         v.as_str().ok_or_else(|| self.err(key, format!("expected a string, got {}", kind(v))))
     }
@@ -87,7 +87,7 @@ impl<'a> Obj<'a> {
     }
 
     /// A finite number within [lo, hi] (use f64::INFINITY for no upper bound).
-    pub fn num(&self, key: &str, lo: f64, hi: f64, what: &str) -> Result<f64> {
+    pub(crate) fn num(&self, key: &str, lo: f64, hi: f64, what: &str) -> Result<f64> {
         let v = self.required(key)?;
         number(self.file, &self.field(key), v, lo, hi, what)
     }
@@ -96,32 +96,21 @@ impl<'a> Obj<'a> {
         self.get(key).map(|v| number(self.file, &self.field(key), v, lo, hi, what)).transpose()
     }
 
-    pub fn array(&self, key: &str) -> Result<&'a Vec<Value>> {
+    pub(crate) fn array(&self, key: &str) -> Result<&'a Vec<Value>> {
         let v = self.required(key)?;
         v.as_array().ok_or_else(|| self.err(key, format!("expected an array, got {}", kind(v))))
-    }
-
-    /// An array of numbers each within [lo, hi]; if `len` is given the array must have that length.
-    pub fn num_array(&self, key: &str, len: Option<usize>, lo: f64, hi: f64, what: &str) -> Result<Vec<f64>> {
-        let a = self.array(key)?;
-        if let Some(n) = len {
-            if a.len() != n {
-                return Err(self.err(key, format!("expected {n} values, got {}", a.len())));
-            }
-        }
-        a.iter().enumerate().map(|(i, v)| number(self.file, &self.element(key, i), v, lo, hi, what)).collect()
     }
 }
 
 /// Check that `v` is a finite number in [lo, hi]. JSON has no NaN, but a string "NaN" or a huge exponent
 /// (which parses to infinity) must be refused too.
-pub fn number(file: &str, path: &str, v: &Value, lo: f64, hi: f64, what: &str) -> Result<f64> {
+pub(crate) fn number(file: &str, path: &str, v: &Value, lo: f64, hi: f64, what: &str) -> Result<f64> {
     let range = if hi.is_infinite() { Range::at_least(lo) } else { Range::closed(lo, hi) };
     number_in(file, path, v, range, what)
 }
 
 /// Check that `v` is a finite number in `range`.
-pub fn number_in(file: &str, path: &str, v: &Value, range: Range, what: &str) -> Result<f64> {
+pub(crate) fn number_in(file: &str, path: &str, v: &Value, range: Range, what: &str) -> Result<f64> {
     let x = match v {
         Value::Number(n) => n.as_f64(),
         _ => None,
@@ -137,12 +126,12 @@ pub fn number_in(file: &str, path: &str, v: &Value, range: Range, what: &str) ->
 }
 
 /// A number for a message ([`crate::error::number`]).
-pub fn show(x: f64) -> String {
+pub(crate) fn show(x: f64) -> String {
     crate::error::number(x)
 }
 
 /// A short description of a JSON value's kind for error messages.
-pub fn kind(v: &Value) -> String {
+pub(crate) fn kind(v: &Value) -> String {
     match v {
         Value::Null => "null".into(),
         Value::Bool(b) => format!("boolean {b}"),

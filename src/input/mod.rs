@@ -75,29 +75,21 @@ impl From<PathBuf> for Source {
 
 impl Source {
     /// The source as messages name it: the path as given, or the name of bytes read ([`STDIN`]).
-    pub fn name(&self) -> String {
+    pub(crate) fn name(&self) -> String {
         match self {
             Source::File(p) => p.display().to_string(),
             Source::Read { name, .. } => name.clone(),
         }
     }
 
-    /// The file's path (None for bytes already read).
-    pub fn path(&self) -> Option<&Path> {
-        match self {
-            Source::File(p) => Some(p),
-            Source::Read { .. } => None,
-        }
-    }
-
     /// The bytes of the source, of at most [`MAX_TEXT_BYTES`] (for sheets, whose encoding is decided after
     /// reading).
-    pub fn bytes(&self, what: &str) -> Result<Vec<u8>> {
+    pub(crate) fn bytes(&self, what: &str) -> Result<Vec<u8>> {
         self.bytes_limited(what, MAX_TEXT_BYTES)
     }
 
     /// The source as UTF-8 text of at most [`MAX_TEXT_BYTES`]; `what` names the kind of file in messages.
-    pub fn text(&self, what: &str) -> Result<String> {
+    pub(crate) fn text(&self, what: &str) -> Result<String> {
         self.text_limited(what, MAX_TEXT_BYTES)
     }
 
@@ -152,7 +144,7 @@ impl Stdin {
     /// The source of a command-line argument: a file, or for `-` standard input read now (at most `limit` + 1
     /// bytes: the reader, which has the same limit, refuses more), named [`STDIN`]. `what` names the kind of
     /// input in the message refusing a second `-`.
-    pub fn open(&mut self, path: &Path, what: &str, limit: u64) -> Result<Source> {
+    pub(crate) fn open(&mut self, path: &Path, what: &str, limit: u64) -> Result<Source> {
         if !is_stdin(path) {
             return Ok(Source::File(path.to_path_buf()));
         }

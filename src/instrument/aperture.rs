@@ -41,7 +41,7 @@ pub fn lobe_widths_uv(lobe: &Lobe, theta: f64) -> [f64; 2] {
 /// (`method::design`): each lobe's [`lobe_widths_uv`] and, for a measured table's lobe, the widths of its
 /// first ring ([`table_pole_widths`]); with whether a diffuse term lies under them (the choosers' gate).
 #[derive(Clone, Debug)]
-pub struct LobesAt<'a> {
+pub(crate) struct LobesAt<'a> {
     pub lobes: &'a [Lobe],
     /// [`lobe_widths_uv`] of each lobe at θ.
     pub widths: Vec<[f64; 2]>,
@@ -53,7 +53,7 @@ pub struct LobesAt<'a> {
 
 impl<'a> LobesAt<'a> {
     /// `lobes` at θ, over a diffuse term or not.
-    pub fn new(lobes: &'a [Lobe], theta: f64, has_diffuse: bool) -> LobesAt<'a> {
+    pub(crate) fn new(lobes: &'a [Lobe], theta: f64, has_diffuse: bool) -> LobesAt<'a> {
         let widths = lobes.iter().map(|l| lobe_widths_uv(l, theta)).collect();
         let poles = lobes.iter().map(|l| table_pole_widths(l, theta)).collect();
         LobesAt { lobes, widths, poles, has_diffuse, theta }
@@ -105,7 +105,7 @@ pub(crate) fn mirror_overlap(source: Stop, receptor: Stop) -> Option<([f64; 2], 
 }
 
 /// The split points of the lobe chart on each axis (u, then v), from the stops and the lobes at their angle.
-pub fn lobe_splits(l: &LobesAt, source: Stop, receptor: Stop) -> [Vec<f64>; 2] {
+pub(crate) fn lobe_splits(l: &LobesAt, source: Stop, receptor: Stop) -> [Vec<f64>; 2] {
     let ap = AxisMap { s: source.p, r: receptor.p };
     let aq = AxisMap { s: source.q, r: receptor.q };
     let lobes = l.lobes;
@@ -200,13 +200,13 @@ impl AxisMap {
     /// The overlap [lo, hi] of p_s at lobe coordinate u: the source points whose partner u − p_s lies in the
     /// receptor (empty when hi ≤ lo).
     #[inline]
-    pub fn overlap(&self, u: f64) -> (f64, f64) {
+    pub(crate) fn overlap(&self, u: f64) -> (f64, f64) {
         (self.s[0].max(u - self.r[1]), self.s[1].min(u - self.r[0]))
     }
 
     /// (p_s, p_r, Jacobian) at lobe coordinate u and overlap position t.
     #[inline]
-    pub fn at(&self, u: f64, t: f64) -> (f64, f64, f64) {
+    pub(crate) fn at(&self, u: f64, t: f64) -> (f64, f64, f64) {
         let (lo, hi) = self.overlap(u);
         let len = (hi - lo).max(0.0);
         let ps = lo + t * len;
@@ -364,7 +364,7 @@ pub(crate) fn increasing_root(g: impl Fn(f64) -> (f64, f64), lo: f64, hi: f64) -
 /// so that √(x − b_j) ∝ s and the integrand is smooth up to the boundary (a linear Jacobian, the least
 /// polynomial degree a grading costs the cubature). Returns (x, dx/dt), dx/dt = 0 for an empty segment.
 #[inline]
-pub fn kinked_position(t: f64, lo: f64, hi: f64, cuts: usize, root: impl Fn(usize) -> f64) -> (f64, f64) {
+pub(crate) fn kinked_position(t: f64, lo: f64, hi: f64, cuts: usize, root: impl Fn(usize) -> f64) -> (f64, f64) {
     if !(hi > lo) {
         return (lo, 0.0);
     }
@@ -413,7 +413,7 @@ pub(crate) fn half_angle_kink_point(axes: &Axes, dot: f64, u: f64, qs: f64, qr: 
 /// It increases with p_s for a receptor across the normal (the source direction turns towards it) and
 /// decreases for one on the source's side; the root is found on the increasing one of ±(ωi·ωo − dot). The end
 /// on the kink's side when the kink does not cross.
-pub fn plain_kink_point(axes: &Axes, dot: f64, qs: f64, wo: crate::Vec3, lo: f64, hi: f64) -> f64 {
+pub(crate) fn plain_kink_point(axes: &Axes, dot: f64, qs: f64, wo: crate::Vec3, lo: f64, hi: f64) -> f64 {
     let (c, s) = (axes.theta.cos(), axes.theta.sin());
     let g = |p: f64| {
         let sv = crate::Vec3::new(-s + p * c, qs, c + p * s);
@@ -453,7 +453,7 @@ pub(crate) fn incidence_kink_point(axes: &Axes, cos: f64, q: f64, lo: f64, hi: f
 /// Clip a stop to the upper hemisphere. For the source, z ∝ cos θ + p sin θ; for the receptor,
 /// z ∝ cos θ − p sin θ: the horizon is the line p = ∓cot θ, independent of q, so clipping is exact. A negative
 /// θ (a multi-angle colour receptor on the illuminator's side) keeps the other side of that line.
-pub fn clip(stop: Stop, theta: f64, is_source: bool) -> Option<Stop> {
+pub(crate) fn clip(stop: Stop, theta: f64, is_source: bool) -> Option<Stop> {
     let mut s = stop;
     if theta != 0.0 {
         let cot = theta.cos() / theta.sin();

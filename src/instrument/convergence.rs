@@ -86,7 +86,7 @@ pub enum ReferenceKind {
 
 impl ReferenceKind {
     /// The label printed in every row: "closed form" or "rtol=1e-12 run".
-    pub fn label(&self) -> String {
+    pub(crate) fn label(&self) -> String {
         match self {
             ReferenceKind::ClosedForm => "closed form".into(),
             ReferenceKind::Run { rtol } => format!("rtol={rtol:e} run"),

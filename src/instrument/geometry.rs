@@ -139,7 +139,7 @@ impl Geometry {
     }
 
     /// The non-aperture integral of this name, if any.
-    pub fn integral(&self, name: &str) -> Option<Integral> {
+    pub(crate) fn integral(&self, name: &str) -> Option<Integral> {
         self.integrals.iter().find(|(n, _)| n == name).map(|(_, i)| *i)
     }
 

@@ -39,5 +39,5 @@ pub mod plan;
 pub mod profile;
 pub mod reading;
 pub mod reference;
-pub mod sphere;
+pub(crate) mod sphere;
 pub mod standards;

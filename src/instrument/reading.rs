@@ -51,7 +51,7 @@ pub enum ColourQuantity {
 
 impl ColourQuantity {
     /// Every colour quantity, in output order.
-    pub const ALL: [ColourQuantity; 8] = [
+    pub(crate) const ALL: [ColourQuantity; 8] = [
         ColourQuantity::X,
         ColourQuantity::Y,
         ColourQuantity::Z,
@@ -63,7 +63,7 @@ impl ColourQuantity {
     ];
 
     /// The reading's name: X, Y, Z, L*, a*, b*, C* (C*ab), h (hab).
-    pub fn name(self) -> &'static str {
+    pub(crate) fn name(self) -> &'static str {
         match self {
             ColourQuantity::X => "X",
             ColourQuantity::Y => "Y",
@@ -78,7 +78,7 @@ impl ColourQuantity {
 }
 
 impl ReadingSpec {
-    pub fn quantity(&self) -> &'static str {
+    pub(crate) fn quantity(&self) -> &'static str {
         match self {
             ReadingSpec::Gloss { .. } => "gloss",
             ReadingSpec::Haze { .. } => "haze",
@@ -95,14 +95,14 @@ impl ReadingSpec {
     /// The spectral weighting the reading's fluxes need: gloss, haze and DOI are luminous (ISO 2813 and
     /// ASTM D523 weight the flux by V(λ) under CIE illuminant C); a colour reading needs X, Y, Z under the
     /// plan's colour conditions (`colorimetry::weighting::WeightingKind::Xyz`).
-    pub fn weighting(&self, colour: Conditions) -> WeightingKind {
+    pub(crate) fn weighting(&self, colour: Conditions) -> WeightingKind {
         match self {
             ReadingSpec::Colour { .. } => WeightingKind::Xyz(colour),
             _ => WeightingKind::Luminous,
         }
     }
 
-    pub fn unit(&self) -> &'static str {
+    pub(crate) fn unit(&self) -> &'static str {
         match self {
             ReadingSpec::Gloss { .. } | ReadingSpec::HazeIndex { .. } | ReadingSpec::Profile { .. } => "GU",
             ReadingSpec::Haze { .. } | ReadingSpec::HazeCompensated { .. } => "HU",
@@ -131,7 +131,7 @@ impl Scale {
     /// mirror, with gain 100/value (exactly 1 for the usual 100 GU, so those standards are bit-identical to
     /// plain glass). The plan integrates it by the same engine as any specimen and multiplies every ratio by
     /// 100, which puts readings on this scale.
-    pub fn standard(&self) -> crate::brdf::dielectric::SmoothDielectric {
+    pub(crate) fn standard(&self) -> crate::brdf::dielectric::SmoothDielectric {
         let (ior, value) = match *self {
             Scale::BlackGlass { index, value } => (index, value),
             Scale::Mirror { value } => (f64::INFINITY, value),
@@ -156,7 +156,7 @@ impl Scale {
     }
 
     /// Bits identifying the standard (for sharing integrals between geometries).
-    pub fn key(&self) -> [u64; 3] {
+    pub(crate) fn key(&self) -> [u64; 3] {
         match *self {
             Scale::BlackGlass { index, value } => [0, index.to_bits(), value.to_bits()],
             Scale::Mirror { value } => [1, value.to_bits(), 0],

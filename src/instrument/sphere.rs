@@ -25,7 +25,7 @@ use crate::spectrum::Sampling;
 use crate::Vec3;
 
 /// A per-sample result: values, absolute error bounds, evaluations, converged.
-pub struct PerSample {
+pub(crate) struct PerSample {
     pub value: Vec<f64>,
     pub error: Vec<f64>,
     pub evaluations: usize,

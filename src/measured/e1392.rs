@@ -136,7 +136,7 @@ pub fn parse(text: &str, file: &str) -> Result<InPlaneBrdf> {
 }
 
 /// Read an E1392-style text file.
-pub fn load(path: &Path) -> Result<InPlaneBrdf> {
+pub(crate) fn load(path: &Path) -> Result<InPlaneBrdf> {
     let file = path.display().to_string();
     let text = crate::input::read_text_limited(path, "table", crate::input::MAX_TABLE_BYTES)?;
     parse(&text, &file)

@@ -66,20 +66,11 @@ pub enum OffPlane {
     Microfacet,
 }
 
-impl OffPlane {
-    /// The recipe's name of each choice.
-    pub fn name(self) -> &'static str {
-        match self {
-            OffPlane::Brdf => "f",
-            OffPlane::BrdfCosCos => "f-cos-cos",
-            OffPlane::Microfacet => "microfacet",
-        }
-    }
-}
+impl OffPlane {}
 
 /// One measured point: θi, signed θo (degrees) and the value, with the line it came from.
 #[derive(Clone, Copy, Debug)]
-pub struct Point {
+pub(crate) struct Point {
     pub theta_i_deg: f64,
     pub theta_o_deg: f64,
     pub value: f64,
@@ -375,16 +366,10 @@ impl InPlaneBrdf {
         super::table::specular_half_width(|wi, wo, out| self.eval(wi, wo, out), 1)
     }
 
-    /// The lobe's half width at half maximum about the specular direction, as a slope, measured from the
-    /// table with its off-plane extension (`Tail::Table`).
-    pub fn half_width(&self) -> f64 {
-        self.half_width
-    }
-
     /// Whether the table is a constant BRDF as evaluated: every value the same (to `table::FLAT_RTOL`, the
     /// rounding of a file of f·cos θo) and the `f` extension
     /// ([`Hints::terms`] then states a diffuse term, integrated in the plain chart).
-    pub fn is_flat(&self) -> bool {
+    pub(crate) fn is_flat(&self) -> bool {
         self.flat && self.off_plane == OffPlane::Brdf
     }
 
@@ -403,19 +388,10 @@ impl InPlaneBrdf {
         self
     }
 
-    pub fn off_plane(&self) -> OffPlane {
-        self.off_plane
-    }
-
-    /// Smith's Λ(θ) of the table's distribution (0 unless the extension is `microfacet`).
-    pub fn smith_lambda(&self, theta: f64) -> f64 {
-        self.lambda.at(theta)
-    }
-
     /// f_r at an in-plane pair (θi ≥ 0, signed θo), radians: linear in θo within rows; between rows linear in
     /// θi at a fixed offset θo − θi from the specular direction (so that the specular peak, which moves with
     /// θi, is interpolated onto itself).
-    pub fn in_plane(&self, theta_i: f64, theta_o: f64) -> f64 {
+    pub(crate) fn in_plane(&self, theta_i: f64, theta_o: f64) -> f64 {
         self.interpolate(theta_i, theta_o, Row::F)
     }
 
@@ -521,7 +497,7 @@ impl InPlaneBrdf {
 
     /// The resolution stated with the lobe (`Tail::Table`): tan of half the smallest θo step (a step of the receptor by
     /// Δ turns the half vector by Δ/2).
-    pub fn resolution_slope(&self) -> f64 {
+    pub(crate) fn resolution_slope(&self) -> f64 {
         (0.5 * self.min_step).tan()
     }
 }

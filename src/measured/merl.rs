@@ -49,7 +49,7 @@ pub enum Interpolation {
 }
 
 impl Interpolation {
-    pub fn name(self) -> &'static str {
+    pub(crate) fn name(self) -> &'static str {
         match self {
             Interpolation::Nearest => "nearest",
             Interpolation::Trilinear => "trilinear",
@@ -222,10 +222,6 @@ impl MerlBrdf {
     /// channels read as 0.
     pub fn invalid_entries(&self) -> usize {
         self.invalid
-    }
-
-    pub fn interpolation(&self) -> Interpolation {
-        self.interpolation
     }
 
     /// The scaled value (sr⁻¹, R G B) of cell (θh index, θd index, φd index); None outside the table.

@@ -22,8 +22,8 @@
 //! (`Tail::Table`); the kinks at the table's cells are left to the adaptive refinement, which meets the
 //! tolerance the data allow far sooner than a partition split at every cell (`docs/instrument.md`
 //! §Quadrature, *Measured tables*). A table that is a constant (`table::is_flat`) is a diffuse term instead.
-pub mod e1392;
+pub(crate) mod e1392;
 pub mod inplane;
 pub mod merl;
 pub mod rgl;
-pub mod table;
+pub(crate) mod table;

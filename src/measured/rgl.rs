@@ -74,7 +74,7 @@ impl Dtype {
         })
     }
 
-    pub fn size(self) -> usize {
+    pub(crate) fn size(self) -> usize {
         use Dtype::*;
         match self {
             U8 | I8 => 1,
@@ -84,7 +84,7 @@ impl Dtype {
         }
     }
 
-    pub fn name(self) -> &'static str {
+    pub(crate) fn name(self) -> &'static str {
         use Dtype::*;
         match self {
             U8 => "uint8",
@@ -116,7 +116,7 @@ pub struct Field {
 
 impl Field {
     /// The values of an f32 field.
-    pub fn f32s(&self) -> Vec<f64> {
+    pub(crate) fn f32s(&self) -> Vec<f64> {
         self.bytes.chunks_exact(4).map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64).collect()
     }
 }
@@ -451,7 +451,7 @@ impl RglBrdf {
     }
 
     /// Parse and check a whole `.bsdf` file held in memory; `file` names it in messages.
-    pub fn from_bytes(bytes: &[u8], file: &str) -> Result<Self> {
+    pub(crate) fn from_bytes(bytes: &[u8], file: &str) -> Result<Self> {
         let tf = TensorFile::parse(bytes, file)?;
         let get = |name: &str, dtype: Dtype, rank: usize| -> Result<&Field> {
             let f = tf.field(name).ok_or_else(|| {
@@ -584,23 +584,9 @@ impl RglBrdf {
         Ok(brdf)
     }
 
-    /// The lobe's half width at half maximum about the specular direction, as a slope, measured from the
-    /// table when it was loaded (`Tail::Table`).
-    pub fn half_width(&self) -> f64 {
-        self.half_width
-    }
-
-    pub fn is_isotropic(&self) -> bool {
-        self.isotropic
-    }
-
-    pub fn description(&self) -> &str {
-        &self.description
-    }
-
     /// The resolution stated with the lobe (`Tail::Table`): tan of the polar angle of the first node off the pole of the
     /// finer of the NDF and VNDF grids, θ = (π/2)/(n − 1)² (u_θ = √(2θ/π) puts the nodes densest there).
-    pub fn resolution_slope(&self) -> f64 {
+    pub(crate) fn resolution_slope(&self) -> f64 {
         let n = self.ndf.nx.max(self.vndf.nx) as f64;
         (FRAC_PI_2 / ((n - 1.0) * (n - 1.0))).tan()
     }

@@ -17,7 +17,7 @@ use std::sync::Arc;
 /// the last, its first interval spanning three and its last two or three. A periodic axis (n even) keeps
 /// 0, 2, … or 1, 3, … and wraps.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum Resolution {
+pub(crate) enum Resolution {
     /// Every sample: the table as given.
     #[default]
     Own,
@@ -34,7 +34,7 @@ impl Resolution {
 
     /// A table's coarse twins, `at(r)` being the table read at resolution r: both [`Resolution::TWINS`] for a
     /// table at its own resolution, none for a twin (twins have no twins).
-    pub fn twins<T>(self, at: impl Fn(Resolution) -> T) -> Vec<T> {
+    pub(crate) fn twins<T>(self, at: impl Fn(Resolution) -> T) -> Vec<T> {
         if self != Resolution::Own {
             return Vec::new();
         }
@@ -42,7 +42,7 @@ impl Resolution {
     }
 
     /// The sample of a twin at or below sample `i` of the table (for a piecewise constant lookup).
-    pub fn floor(self, i: usize) -> usize {
+    pub(crate) fn floor(self, i: usize) -> usize {
         match self {
             Resolution::Own => i,
             Resolution::Coarse => i - i % 2,
@@ -54,7 +54,7 @@ impl Resolution {
 
 /// Where the samples of an axis sit, in the axis' coordinate.
 #[derive(Clone, Debug, PartialEq)]
-pub enum Nodes {
+pub(crate) enum Nodes {
     /// Samples at 0, 1, …, n − 1 (an index coordinate; MERL's bins, a unit square scaled by n − 1).
     Index(usize),
     /// Samples at strictly increasing values (angles of a goniometer, pbrt's parameter grids).
@@ -63,7 +63,7 @@ pub enum Nodes {
 
 /// What happens beyond the last sample.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Edge {
+pub(crate) enum Edge {
     /// The value of the nearest end sample (weights clamped to [0, 1]).
     Clamp,
     /// Period n (index nodes only): sample n is sample 0.
@@ -72,34 +72,30 @@ pub enum Edge {
 
 /// One axis of a table.
 #[derive(Clone, Debug, PartialEq)]
-pub struct TableAxis {
+pub(crate) struct TableAxis {
     pub nodes: Nodes,
     pub edge: Edge,
 }
 
 impl TableAxis {
-    pub fn index(n: usize, edge: Edge) -> Self {
+    pub(crate) fn index(n: usize, edge: Edge) -> Self {
         TableAxis { nodes: Nodes::Index(n), edge }
     }
 
-    pub fn values(v: Vec<f64>) -> Self {
+    pub(crate) fn values(v: Vec<f64>) -> Self {
         TableAxis { nodes: Nodes::Values(v), edge: Edge::Clamp }
     }
 
-    pub fn len(&self) -> usize {
+    pub(crate) fn len(&self) -> usize {
         match &self.nodes {
             Nodes::Index(n) => *n,
             Nodes::Values(v) => v.len(),
         }
     }
 
-    pub fn is_empty(&self) -> bool {
-        self.len() == 0
-    }
-
     /// The two neighbouring samples of `u` and the weight t of the second: the value is
     /// (1 − t)·v[i0] + t·v[i1]. NaN reads as the first sample.
-    pub fn linear(&self, u: f64) -> (usize, usize, f64) {
+    pub(crate) fn linear(&self, u: f64) -> (usize, usize, f64) {
         match (&self.nodes, self.edge) {
             (Nodes::Index(n), Edge::Clamp) => clamped_index_pair(u, *n),
             (Nodes::Index(n), Edge::Periodic) => periodic_index_pair(u, *n),
@@ -173,7 +169,8 @@ impl TableAxis {
     }
 
     /// The sample at or below `u` (the cell that contains it), clamped to the axis; NaN → 0.
-    pub fn floor(&self, u: f64) -> usize {
+    #[cfg(test)]
+    pub(crate) fn floor(&self, u: f64) -> usize {
         match &self.nodes {
             Nodes::Index(n) => floor_index(u, *n),
             Nodes::Values(v) => value_pair(v, u).0,
@@ -240,7 +237,7 @@ fn value_pair(v: &[f64], u: f64) -> (usize, usize, f64) {
 /// An N-dimensional table of `channels` values per cell, stored row-major (last axis fastest), channels
 /// innermost.
 #[derive(Clone, Debug)]
-pub struct Table {
+pub(crate) struct Table {
     axes: Vec<TableAxis>,
     strides: Vec<usize>,
     channels: usize,
@@ -250,7 +247,7 @@ pub struct Table {
 
 impl Table {
     /// `data.len()` must be channels × Π axis lengths (the readers check their files before this).
-    pub fn new(axes: Vec<TableAxis>, channels: usize, data: Vec<f64>) -> Self {
+    pub(crate) fn new(axes: Vec<TableAxis>, channels: usize, data: Vec<f64>) -> Self {
         let mut strides = vec![0; axes.len()];
         let mut s = channels;
         for (k, a) in axes.iter().enumerate().rev() {
@@ -261,26 +258,24 @@ impl Table {
         Table { axes, strides, channels, data: Arc::new(data) }
     }
 
-    pub fn axes(&self) -> &[TableAxis] {
+    pub(crate) fn axes(&self) -> &[TableAxis] {
         &self.axes
     }
 
-    pub fn channels(&self) -> usize {
-        self.channels
-    }
-
     /// The channels of one cell.
-    pub fn cell(&self, idx: &[usize]) -> &[f64] {
+    pub(crate) fn cell(&self, idx: &[usize]) -> &[f64] {
         let o: usize = idx.iter().zip(&self.strides).map(|(i, s)| i * s).sum();
         &self.data[o..o + self.channels]
     }
 
     /// The cell that contains the point (each axis' `floor`): piecewise constant lookup.
-    pub fn nearest(&self, coords: &[f64], out: &mut [f64]) {
+    #[cfg(test)]
+    pub(crate) fn nearest(&self, coords: &[f64], out: &mut [f64]) {
         self.nearest_at(coords, Resolution::Own, out)
     }
 
     /// [`Table::nearest`] at a [`Resolution`] (a twin: its sample at or below each axis' floor).
+    #[cfg(test)]
     pub(crate) fn nearest_at(&self, coords: &[f64], res: Resolution, out: &mut [f64]) {
         let mut o = 0;
         for (k, a) in self.axes.iter().enumerate() {
@@ -292,7 +287,8 @@ impl Table {
 
     /// Multilinear interpolation: the 2^N corners in order (first axis outermost), each weighted by the
     /// product of its axes' weights taken in axis order; corners of weight 0 are skipped.
-    pub fn linear(&self, coords: &[f64], out: &mut [f64]) {
+    #[cfg(test)]
+    pub(crate) fn linear(&self, coords: &[f64], out: &mut [f64]) {
         self.linear_at(coords, Resolution::Own, out)
     }
 
@@ -370,7 +366,7 @@ pub(crate) fn reflection_half_diff(wi: Vec3, wo: Vec3, out: &mut [f64]) -> Optio
 }
 
 /// The file name of a table's path, for `describe` (the path as given is in the error messages).
-pub fn file_name(file: &str) -> String {
+pub(crate) fn file_name(file: &str) -> String {
     std::path::Path::new(file).file_name().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default()
 }
 
@@ -402,7 +398,7 @@ pub(crate) fn elevation(d: Vec3) -> f64 {
 pub(crate) const FLAT_RTOL: f64 = 1e-9;
 
 /// Whether `values` are all finite and within [`FLAT_RTOL`] of one another (relative to the largest).
-pub fn is_flat(values: impl IntoIterator<Item = f64>) -> bool {
+pub(crate) fn is_flat(values: impl IntoIterator<Item = f64>) -> bool {
     let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
     for v in values {
         if !v.is_finite() {

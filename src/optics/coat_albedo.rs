@@ -135,11 +135,6 @@ pub fn lobe_albedo(mf: &Microfacet, eta: f64, mu: f64) -> f64 {
     lobe_albedo_with(&AlbedoNodes::new(), mf, eta, mu).0
 }
 
-/// E(μ) and the number of lobe evaluations the rule spent.
-pub fn lobe_albedo_counted(mf: &Microfacet, eta: f64, mu: f64) -> (f64, usize) {
-    lobe_albedo_with(&AlbedoNodes::new(), mf, eta, mu)
-}
-
 fn lobe_albedo_with(rule: &AlbedoNodes, mf: &Microfacet, eta: f64, mu: f64) -> (f64, usize) {
     let c = mu.clamp(1e-12, 1.0);
     let s = (1.0 - c * c).max(0.0).sqrt();

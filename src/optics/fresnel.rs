@@ -21,7 +21,7 @@ pub struct FresnelPower {
 
 impl FresnelPower {
     /// Unpolarised reflectance (Rs + Rp)/2.
-    pub fn r(&self) -> f64 {
+    pub(crate) fn r(&self) -> f64 {
         0.5 * (self.rs + self.rp)
     }
     /// Unpolarised transmittance (Ts + Tp)/2.
@@ -32,7 +32,7 @@ impl FresnelPower {
 
 /// Complex amplitude coefficients of an interface (for thin-film stacks).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Amplitudes {
+pub(crate) struct Amplitudes {
     pub rs: Complex64,
     pub rp: Complex64,
     pub ts: Complex64,
@@ -165,7 +165,7 @@ pub(crate) fn forward_sqrt(w: Complex64) -> Complex64 {
 /// r_p = (n₂c₁ − n₁c₂)/(n₂c₁ + n₁c₂), t_p = 2n₁c₁/(n₂c₁ + n₁c₂).
 /// With this convention r₂₁ = −r₁₂ and t₁₂t₂₁ − r₁₂r₂₁ = 1, as the Airy recursion of
 /// [`crate::optics::thin_film`] requires.
-pub fn amplitudes(n1: Complex64, cos1: Complex64, n2: Complex64, cos2: Complex64) -> Amplitudes {
+pub(crate) fn amplitudes(n1: Complex64, cos1: Complex64, n2: Complex64, cos2: Complex64) -> Amplitudes {
     let s1 = n1 * cos1;
     let s2 = n2 * cos2;
     let p1 = n2 * cos1;

@@ -116,7 +116,7 @@ pub fn layer_reflectance(k: f64, s: f64, x: f64, rg: f64) -> f64 {
 }
 
 /// Mixing by concentration: K = Σ Cᵢ Kᵢ, S = Σ Cᵢ Sᵢ (Duncan's rule). Items are (C, K, S).
-pub fn mix(pigments: impl IntoIterator<Item = (f64, f64, f64)>) -> (f64, f64) {
+pub(crate) fn mix(pigments: impl IntoIterator<Item = (f64, f64, f64)>) -> (f64, f64) {
     pigments.into_iter().fold((0.0, 0.0), |(k, s), (c, ki, si)| (k + c * ki, s + c * si))
 }
 

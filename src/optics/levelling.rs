@@ -191,7 +191,7 @@ impl Application {
     }
 
     /// Film thickness at time t, µm: linear from wet to dry over the flash-off, dry after it.
-    pub fn thickness_um(&self, t: f64) -> f64 {
+    pub(crate) fn thickness_um(&self, t: f64) -> f64 {
         let dry = self.dry_film_um();
         if self.flash_off_s <= 0.0 || t >= self.flash_off_s {
             return dry;
@@ -304,7 +304,8 @@ impl Application {
     }
 
     /// The frequency (1/µm) whose amplitude the levelling takes down by 1/e: f_e = (3/(16π⁴ L))^{1/4}.
-    pub fn levelled_frequency_per_um(&self) -> f64 {
+    #[cfg(test)]
+    pub(crate) fn levelled_frequency_per_um(&self) -> f64 {
         levelled_frequency(self.levelling_integral_um4())
     }
 }
@@ -319,7 +320,7 @@ pub struct Flow {
 
 impl Flow {
     /// The amplitude left of a mode of spatial frequency f (1/µm): exp(−(16π⁴/3) f⁴ L + 4π² f² M).
-    pub fn amplitude_transfer(&self, f_per_um: f64) -> f64 {
+    pub(crate) fn amplitude_transfer(&self, f_per_um: f64) -> f64 {
         (-(16.0 * PI.powi(4) / 3.0) * f_per_um.powi(4) * self.l_um4 + 4.0 * PI * PI * f_per_um.powi(2) * self.m_um2)
             .exp()
     }
@@ -409,7 +410,7 @@ impl CuredPsd {
     }
 
     /// S_c(f), nm²·µm², over the whole spectrum (no band limit).
-    pub fn cured(&self, f: f64) -> f64 {
+    pub(crate) fn cured(&self, f: f64) -> f64 {
         psd_transfer(self.volume_solids, self.flow, f) * self.applied.s2(f)
     }
 

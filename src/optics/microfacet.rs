@@ -49,16 +49,6 @@ impl Microfacet {
         Microfacet { distribution, alpha }
     }
 
-    /// Whether the distribution's tail falls off slower than a Gaussian: GGX's D ∝ tan⁻⁴θh far out (Walter et
-    /// al. 2007, Eq. 33) holds ~1e-4 of its mass beyond 100 α, while Beckmann's exp(−tan²θh/m²) is below e⁻¹⁰⁰
-    /// of its peak beyond 10 m. The integrator places its split points by it (`brdf::Lobe::heavy_tail`).
-    pub fn heavy_tail(&self) -> bool {
-        match self.distribution {
-            Distribution::Ggx => true,
-            Distribution::Beckmann => false,
-        }
-    }
-
     pub(crate) fn effectively_smooth(&self) -> bool {
         self.alpha < Self::SMOOTH_THRESHOLD
     }
@@ -172,7 +162,7 @@ impl Microfacet {
     ///   the same back-facing test (0 if ωi·h ≤ 0 or ωo·h ≤ 0). `h` need not be normalised (it is).
     ///
     /// Both are symmetric in (ωi, ωo) and in [0, 1].
-    pub fn g(&self, wi: Vec3, wo: Vec3, h: Vec3, shadowing: Shadowing) -> f64 {
+    pub(crate) fn g(&self, wi: Vec3, wo: Vec3, h: Vec3, shadowing: Shadowing) -> f64 {
         g_with_lambda(wi, wo, h, shadowing, |w| self.lambda_in_g(w))
     }
 }

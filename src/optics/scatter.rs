@@ -73,7 +73,7 @@ impl Psd {
     }
 
     /// The 2-D isotropic PSD S₂(f), nm²·µm², at |f| = `f` (1/µm).
-    pub fn s2(&self, f: f64) -> f64 {
+    pub(crate) fn s2(&self, f: f64) -> f64 {
         match *self {
             Psd::KCorrelation { a, b, c } => {
                 let k = a * b * gamma_ratio((c + 1.0) / 2.0, c / 2.0) / (2.0 * PI.sqrt());
@@ -152,7 +152,7 @@ pub fn rayleigh_rice(psd: &Psd, eps: Complex64, lambda_nm: f64, wi: [f64; 3], wo
 /// Q of [`polarisation_factor`] for the directions `wi`, `wo` (components x, y, z): the one factor of
 /// [`rayleigh_rice`] that depends on ε and not on λ, so a model whose ε is the same at every sample computes
 /// it once per direction pair.
-pub fn polarisation(eps: Complex64, wi: [f64; 3], wo: [f64; 3]) -> f64 {
+pub(crate) fn polarisation(eps: Complex64, wi: [f64; 3], wo: [f64; 3]) -> f64 {
     let (cos_phi, sin_phi) = scatter_azimuth(wi, wo);
     polarisation_factor(eps, wi[2], wo[2], cos_phi, sin_phi)
 }

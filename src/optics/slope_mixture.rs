@@ -23,7 +23,7 @@ impl SlopeMixture {
     }
 
     /// D(h) = Σ wᵢ Dᵢ(h); with one population of weight 1 the same bits as its D (1·x = x, 0 + x = x).
-    pub fn d(&self, h: Vec3) -> f64 {
+    pub(crate) fn d(&self, h: Vec3) -> f64 {
         self.populations.iter().fold(0.0, |s, (w, m)| s + w * m.d(h))
     }
 
@@ -35,7 +35,7 @@ impl SlopeMixture {
 
     /// G(ωi, ωo) for the half vector `h`, as `Microfacet::g` with the mixture's Λ (the V-cavity G does not
     /// depend on the distribution). Symmetric in (ωi, ωo) bit for bit, in [0, 1].
-    pub fn g(&self, wi: Vec3, wo: Vec3, h: Vec3, shadowing: Shadowing) -> f64 {
+    pub(crate) fn g(&self, wi: Vec3, wo: Vec3, h: Vec3, shadowing: Shadowing) -> f64 {
         g_with_lambda(wi, wo, h, shadowing, |w| self.lambda_in_g(w))
     }
 }

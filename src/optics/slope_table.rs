@@ -167,7 +167,7 @@ impl SlopeTable {
     }
 
     /// The distribution of normals D(h) = P₂₂(−h_x/h_z, −h_y/h_z)/h_z⁴ (Heitz 2014 Eq. 9); 0 for h_z ≤ 0.
-    pub fn d(&self, h: Vec3) -> f64 {
+    pub(crate) fn d(&self, h: Vec3) -> f64 {
         let len = h.length();
         if !(h.z > 0.0 && len > 0.0) {
             return 0.0;
@@ -192,13 +192,13 @@ impl SlopeTable {
     }
 
     /// Smith Λ(ω) as it enters G: Beckmann's with the Gaussian-equivalent α along ω's azimuth.
-    pub fn lambda(&self, w: Vec3) -> f64 {
+    pub(crate) fn lambda(&self, w: Vec3) -> f64 {
         Microfacet::new(Distribution::Beckmann, self.alpha_along(w)).lambda_in_g(w)
     }
 
     /// The lobe's width for the planner: the largest Gaussian-equivalent α over the azimuths, √(2·λ_max) with
     /// λ_max the larger eigenvalue of the moment matrix.
-    pub fn width(&self) -> f64 {
+    pub(crate) fn width(&self) -> f64 {
         let [xx, xy, yy] = self.moments;
         let mean = (xx + yy) / 2.0;
         let lmax = mean + (((xx - yy) / 2.0).powi(2) + xy * xy).sqrt();

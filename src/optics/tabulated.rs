@@ -29,13 +29,13 @@
 //! Interpolation nodes never fall on it (Chebyshev–Gauss nodes are interior).
 
 /// Interpolation nodes per piece (degree N − 1).
-pub const N: usize = 16;
+pub(crate) const N: usize = 16;
 /// Largest number of pieces tried before giving up.
 const MAX_PIECES: usize = 1024;
 
 /// A verified piecewise Chebyshev table on [a, b].
 #[derive(Clone, Debug, PartialEq)]
-pub struct ChebTable {
+pub(crate) struct ChebTable {
     a: f64,
     b: f64,
     pieces: usize,
@@ -88,14 +88,8 @@ impl ChebTable {
     /// Fit `f` on [a, b] with doubling numbers of pieces (from 8) until the deviation at the check points
     /// (the N + 1 Chebyshev–Lobatto points of every piece, which interleave the nodes and include the piece
     /// ends) is ≤ `tol`. `None` if no table of at most `MAX_PIECES` pieces meets it, or if `f` is not finite.
-    pub fn fit(f: impl Fn(f64) -> f64, a: f64, b: f64, tol: f64) -> Option<ChebTable> {
+    pub(crate) fn fit(f: impl Fn(f64) -> f64, a: f64, b: f64, tol: f64) -> Option<ChebTable> {
         ChebTable::fit_each(|x, _, v| v[0] = f(x), 1, a, b, tol).pop().flatten()
-    }
-
-    /// The table of `pieces` pieces, if its deviation at the check points is ≤ `tol` (`fit` at one piece
-    /// count: what [`ChebTable::on_grid_of`] needs to put tables on a common grid).
-    pub fn fit_with_pieces(f: impl Fn(f64) -> f64, a: f64, b: f64, pieces: usize, tol: f64) -> Option<ChebTable> {
-        ChebTable::fit_each_with_pieces(|x, _, v| v[0] = f(x), &[0], a, b, pieces, tol).pop().flatten()
     }
 
     /// [`ChebTable::fit`] of `count` functions f_0 … f_{count−1} on the same [a, b] at once: the same tables to
@@ -150,8 +144,9 @@ impl ChebTable {
         out
     }
 
-    /// [`ChebTable::fit_with_pieces`] of the functions `which` of `f` at once (as [`ChebTable::fit_each`]):
-    /// one result per entry of `which`.
+    /// The tables of `pieces` pieces of the functions `which` of `f` at once (as [`ChebTable::fit_each`]),
+    /// each if its deviation at the check points is ≤ `tol`: one result per entry of `which`.
+    #[cfg(test)]
     pub(crate) fn fit_each_with_pieces(
         f: impl FnMut(f64, &[usize], &mut [f64]),
         which: &[usize],
@@ -277,7 +272,7 @@ impl ChebTable {
             .collect()
     }
 
-    pub fn pieces(&self) -> usize {
+    pub(crate) fn pieces(&self) -> usize {
         self.pieces
     }
 
@@ -287,7 +282,7 @@ impl ChebTable {
     }
 
     /// Whether the table is cut at kinks ([`ChebTable::fit_kinked`]).
-    pub fn kinked(&self) -> bool {
+    pub(crate) fn kinked(&self) -> bool {
         !self.segments.is_empty()
     }
 
@@ -317,13 +312,13 @@ impl ChebTable {
 
     /// The N Chebyshev coefficients of piece `p`.
     #[inline]
-    pub fn piece(&self, p: usize) -> &[f64; N] {
+    pub(crate) fn piece(&self, p: usize) -> &[f64; N] {
         self.coeffs[p * N..(p + 1) * N].try_into().expect("N coefficients per piece")
     }
 
     /// The interpolant at x (clamped into [a, b]).
     #[inline]
-    pub fn eval(&self, x: f64) -> f64 {
+    pub(crate) fn eval(&self, x: f64) -> f64 {
         let (p, t) = self.locate(x);
         clenshaw(self.piece(p), t)
     }
@@ -414,7 +409,7 @@ pub fn coefficients(vals: &[f64]) -> Vec<f64> {
 
 /// Σ_k c_k T_k(t) from the [`basis`] at t.
 #[inline]
-pub fn dot(c: &[f64; N], basis: &[f64; N]) -> f64 {
+pub(crate) fn dot(c: &[f64; N], basis: &[f64; N]) -> f64 {
     // Four partial sums (independent chains) added pairwise.
     let mut s = [0.0; 4];
     for (cc, bb) in c.chunks_exact(4).zip(basis.chunks_exact(4)) {

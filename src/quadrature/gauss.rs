@@ -6,7 +6,7 @@ use std::f64::consts::PI;
 
 /// Nodes and weights of the n-point Gauss–Legendre rule on [−1, 1] (Newton iteration on P_n from the
 /// Tricomi initial guesses; Abramowitz & Stegun 25.4.29; Press et al., Numerical Recipes §4.6 `gauleg`).
-pub fn gauss_legendre(n: usize) -> (Vec<f64>, Vec<f64>) {
+pub(crate) fn gauss_legendre(n: usize) -> (Vec<f64>, Vec<f64>) {
     let mut x = vec![0.0; n];
     let mut w = vec![0.0; n];
     let nf = n as f64;
@@ -132,7 +132,7 @@ fn gk15(
 /// Adaptive G7/K15 over the partition `breaks` (increasing), bisecting the worst panel until the summed
 /// error is ≤ `tol` or `max_panels` is reached. Returns (integral, error estimate).
 /// Only the first `checked` components drive the error (the others are carried along).
-pub fn adaptive(
+pub(crate) fn adaptive(
     f: &mut dyn FnMut(f64, &mut [f64]),
     breaks: &[f64],
     n: usize,

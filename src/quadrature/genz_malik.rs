@@ -59,7 +59,7 @@ pub struct Estimate {
 
 /// The Genz–Malik point set and weights for dimension `D` (2 ≤ D ≤ 8).
 #[derive(Clone, Debug)]
-pub struct GenzMalikRule<const D: usize> {
+pub(crate) struct GenzMalikRule<const D: usize> {
     /// Points of the unit cube [−1, 1]^D with their weight index (0..5) and, for the axial points
     /// (classes 1 and 2), their axis (0 otherwise).
     points: Vec<([f64; D], usize, usize)>,
@@ -84,7 +84,7 @@ impl<const D: usize> GenzMalikRule<D> {
     /// The rule exists for 2 ≤ D ≤ 8 (Genz & Malik 1980); another D is refused at compile time.
     const DIMENSION_SUPPORTED: () = assert!(D >= 2 && D <= 8, "Genz–Malik needs 2 ≤ D ≤ 8");
 
-    pub fn new() -> Self {
+    pub(crate) fn new() -> Self {
         let () = Self::DIMENSION_SUPPORTED;
         let d = D as f64;
         let mut points = Vec::with_capacity(1 + 4 * D + 2 * D * (D - 1) + (1 << D));
@@ -143,12 +143,8 @@ impl<const D: usize> GenzMalikRule<D> {
     }
 
     /// Number of integrand evaluations per region: 2^D + 2D² + 2D + 1.
-    pub fn len(&self) -> usize {
+    pub(crate) fn len(&self) -> usize {
         self.points.len()
-    }
-
-    pub fn is_empty(&self) -> bool {
-        self.points.is_empty()
     }
 }
 
@@ -348,7 +344,7 @@ pub(crate) const MAX_SHRINK_PLAIN: f64 = 1.0;
 /// shrank estimates 20× below the actual error; a cap of 16 stays honest only on the lobe chart of a smooth
 /// material (`max_shrink` = [`MAX_SHRINK_LOBE`] there, `Options::max_shrink`, §5.1).
 #[inline]
-pub fn calibrated(n1: f64, n2: f64, n3: f64, abs7: f64, max_shrink: f64) -> f64 {
+pub(crate) fn calibrated(n1: f64, n2: f64, n3: f64, abs7: f64, max_shrink: f64) -> f64 {
     let r = (n1 / n2).max(n2 / n3);
     if CALIBRATION * r < 1.0 {
         (CALIBRATION * r * n1).max(n1 / max_shrink).max(n1.min(50.0 * f64::EPSILON * abs7))
@@ -369,7 +365,7 @@ pub(crate) const CANCELLATION: f64 = 8.0;
 /// across it, had N₁ = 7.9·10⁻¹³ against N₂ = 8.4·10⁻⁹, N₃ = 6.2·10⁻⁸ and an actual error of 1.0·10⁻¹¹
 /// (the reading 1.2× below its actual error, the V-cavity and the Smith G alike).
 #[inline]
-pub fn unsplit_estimate(n1: f64, n2: f64, n3: f64) -> f64 {
+pub(crate) fn unsplit_estimate(n1: f64, n2: f64, n3: f64) -> f64 {
     chance_free(n1, n2, n3, CANCELLATION)
 }
 
@@ -387,7 +383,7 @@ pub(crate) const SPLIT_CANCELLATION: f64 = 64.0;
 /// 2.8·10⁻¹⁴ each: the calibrated 3r·N₁ = 3.1·10⁻¹⁷ put the reading 13× below its actual error; from the
 /// prediction (1.6·10⁻¹²) the calibrated estimate is 2.5·10⁻¹³.
 #[inline]
-pub fn split_n1(n1: f64, n2: f64, n3: f64) -> f64 {
+pub(crate) fn split_n1(n1: f64, n2: f64, n3: f64) -> f64 {
     chance_free(n1, n2, n3, SPLIT_CANCELLATION)
 }
 

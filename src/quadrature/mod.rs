@@ -40,12 +40,11 @@ mod polar;
 pub mod tensor;
 
 pub(crate) use gauss::gauss_legendre_table;
-pub use gauss::{adaptive as gauss_kronrod_adaptive, gauss_legendre};
+pub(crate) use gauss::{adaptive as gauss_kronrod_adaptive, gauss_legendre};
 pub(crate) use hermite::gauss_hermite_table;
 pub use polar::{legendre_on, mapped_legendre, polar_rectangle, Map};
 pub(crate) use polar::{legendre_on_into, mapped_legendre_into, polar_rectangle_into, PolarBuffers};
 
-pub use genz_malik::GenzMalikRule;
 pub use genz_malik::{
     integrate, integrate_partition, pointwise, Cell, Estimate, Options, Refine, DEFAULT_RTOL, MAX_SHRINK_LOBE,
 };

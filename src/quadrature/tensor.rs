@@ -181,7 +181,7 @@ impl Path {
         (s / 4, s % 4)
     }
     /// The highest level of each axis over the boxes after the path's raises from `start`.
-    pub fn replayed<const D: usize>(&self, start: [usize; D], boxes: usize) -> [usize; D] {
+    pub(crate) fn replayed<const D: usize>(&self, start: [usize; D], boxes: usize) -> [usize; D] {
         let mut n = vec![start.map(|l| l.max(1)); boxes.max(1)];
         for i in 0..self.len as usize {
             let (b, k) = self.step(i);

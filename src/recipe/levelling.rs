@@ -28,7 +28,7 @@ pub(crate) const BANDS_MM: [(&str, f64, f64); 6] =
 
 /// The applicator's texture as applied (wet): an analytic isotropic PSD, or a measured topography's own 2-D PSD.
 #[derive(Clone, Debug)]
-pub enum Texture {
+pub(crate) enum Texture {
     Analytic(Psd),
     Measured {
         /// The levelled map's 2-D PSD (1/m, m⁴).
@@ -40,7 +40,7 @@ pub enum Texture {
 
 /// The cured texture: the applied one after the flow, kept at v of its amplitude.
 #[derive(Clone, Debug)]
-pub enum Cured {
+pub(crate) enum Cured {
     /// An analytic texture's cured spectrum, over all frequencies.
     Analytic(CuredPsd),
     /// A measured texture's grid spectrum, each mode multiplied by the PSD transfer: over the map's band only
@@ -77,7 +77,7 @@ impl Cured {
 
 /// What a coat's application gives: the levelling, the cured spectrum and the facets' roughness.
 #[derive(Clone, Debug)]
-pub struct LevelledCoat {
+pub(crate) struct LevelledCoat {
     pub application: Application,
     /// The flow's integrals: L (µm⁴), which levels, and the surface-tension gradient's M (µm²).
     pub flow: Flow,
@@ -179,7 +179,7 @@ fn parse_texture(t: &Obj) -> Result<Texture> {
 
 /// Level the applied texture (docs/model.md §From the cured spectrum to the coat): the facets' α is the
 /// cured spectrum's rms slope, Sdq = (∫∫ (2π|f|)² S_c d²f)^{1/2}.
-pub fn level(app: &Application, applied: Texture) -> LevelledCoat {
+pub(crate) fn level(app: &Application, applied: Texture) -> LevelledCoat {
     let flow = app.flow();
     let cured = match applied {
         Texture::Analytic(psd) => Cured::Analytic(CuredPsd::new(psd, app.volume_solids, flow)),
@@ -197,7 +197,7 @@ impl LevelledCoat {
     }
 
     /// The cured rms slope Sdq (rad) over the whole spectrum.
-    pub fn sdq(&self) -> f64 {
+    pub(crate) fn sdq(&self) -> f64 {
         self.cured.slope_ms().sqrt() * 1e-3
     }
 
@@ -217,7 +217,7 @@ impl LevelledCoat {
 
     /// The line `--explain` prints after the model: the levelling, the cured Sq and Sdq and the
     /// levelled spectrum band by band.
-    pub fn note(&self) -> String {
+    pub(crate) fn note(&self) -> String {
         let e = crate::error::number;
         let fe = levelled_frequency(self.flow.l_um4);
         let gradient = if self.flow.m_um2 != 0.0 {

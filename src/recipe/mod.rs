@@ -10,7 +10,7 @@
 //! The folder:
 //! * `mod.rs` (this): a recipe file or text read into a [`Material`] ([`load_file`], [`parse_str`]), the
 //!   dispatch on `"model"` ([`parse_brdf`]) and the analytic models' fields (Lambert, the smooth and rough
-//!   interfaces, Phong, Ward, the Cook–Torrance lobes), [`META_FIELDS`];
+//!   interfaces, Phong, Ward, the Cook–Torrance lobes);
 //! * `fields.rs`: the registry-driven reading of a parameter (`Obj::param`, `opt_param`, `param_array`,
 //!   `param_key`, `deny_unknown_in`, [`fields::param_number`]) on `input::json`'s reader;
 //! * `levelling.rs`: a paint coat's `application` block, levelled into the coat's facets and halo
@@ -46,21 +46,17 @@ use num_complex::Complex64;
 use serde_json::Value;
 use std::sync::Arc;
 
-pub mod fields;
-pub mod levelling;
+pub(crate) mod fields;
+pub(crate) mod levelling;
 pub mod measured;
 pub mod paint;
-pub mod scatter;
+pub(crate) mod scatter;
 pub mod schema;
-pub mod topography;
-pub mod uncertainty;
+pub(crate) mod topography;
+pub(crate) mod uncertainty;
 
 pub(crate) use crate::registry::MAX_LOBES;
 pub use crate::registry::MODELS;
-
-/// Descriptive fields allowed in every recipe: `name`, `description`, `provenance` (strings) and `notes`
-/// (a string or an array of strings). They do not change the model.
-pub const META_FIELDS: &[&str] = &["model", "name", "description", "provenance", "notes"];
 
 /// Slack on the energy sums (kd + ks ≤ 1) for decimal rounding in the files.
 const ENERGY_SLACK: f64 = 1e-9;

@@ -18,7 +18,7 @@ use crate::{Error, Result};
 use serde_json::Value;
 
 /// The key of the block in a recipe.
-pub const KEY: &str = "uncertainty";
+pub(crate) const KEY: &str = "uncertainty";
 
 /// At most this many numbers may carry an uncertainty (each costs two runs of the plan).
 pub(crate) const MAX_STATED: usize = 64;

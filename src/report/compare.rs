@@ -99,7 +99,7 @@ pub struct ComparisonDoc {
 }
 
 impl ComparisonDoc {
-    pub fn new(c: &Comparison) -> ComparisonDoc {
+    pub(crate) fn new(c: &Comparison) -> ComparisonDoc {
         let p = c.predicted.as_ref();
         let s = c.group.stats;
         ComparisonDoc {
@@ -171,7 +171,7 @@ pub struct SheetDoc {
 }
 
 impl SheetDoc {
-    pub fn new(sheet: &Sheet) -> SheetDoc {
+    pub(crate) fn new(sheet: &Sheet) -> SheetDoc {
         SheetDoc {
             file: sheet.file.clone(),
             encoding: sheet.encoding.clone(),
@@ -316,7 +316,7 @@ pub struct CompareDoc {
 
 impl CompareDoc {
     /// The document printed as the CLI prints it ([`pretty`]).
-    pub fn text(&self) -> String {
+    pub(crate) fn text(&self) -> String {
         pretty(&to_json(self))
     }
 }
@@ -364,7 +364,7 @@ pub fn json_doc(
 }
 
 /// The CSV of `compare`: a header, then one record per comparison.
-pub fn csv(cmp: &[Comparison]) -> Result<String> {
+pub(crate) fn csv(cmp: &[Comparison]) -> Result<String> {
     let head = [
         "line",
         "sample",

@@ -18,7 +18,7 @@ fn g(v: Option<f64>) -> String {
 /// A JUnit class name: a dotted identifier of identifier parts (letters, digits, `_`; CI servers split the
 /// class at its dots into packages and class). Every run of other characters becomes one `_`, and a part that
 /// would start with a digit or be empty gets a leading `_`: `Black-backed glass, n = 1.50` → `Black_backed_glass_n_1_50`.
-pub fn identifier(text: &str) -> String {
+pub(crate) fn identifier(text: &str) -> String {
     let mut s = String::new();
     for c in text.chars() {
         if c.is_ascii_alphanumeric() {
@@ -37,7 +37,7 @@ pub fn identifier(text: &str) -> String {
 
 /// The class name of a sheet's cases: the sheet's file name without its folder and extension (and the
 /// workbook's sheet), then the sample, as identifiers (`glass_n1_5_trigloss.Black_backed_glass_n_1_50`).
-pub fn classname(sheet: &Sheet, sample: &str) -> String {
+pub(crate) fn classname(sheet: &Sheet, sample: &str) -> String {
     let stem = std::path::Path::new(&sheet.file)
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
@@ -52,7 +52,7 @@ pub fn classname(sheet: &Sheet, sample: &str) -> String {
 
 /// The message of a comparison case: every number to its precision (`report::measured`,
 /// `report::with_error_text`).
-pub fn message(c: &Comparison) -> String {
+pub(crate) fn message(c: &Comparison) -> String {
     let s = c.group.stats;
     let p = c.predicted.as_ref();
     let predicted = match p.and_then(|p| p.value.map(|v| (v, p.error_estimate))) {
@@ -84,7 +84,7 @@ pub fn message(c: &Comparison) -> String {
     )
 }
 
-pub fn compare(sheet: &Sheet, cmp: &[Comparison], drift: &[Drift]) -> Result<String> {
+pub(crate) fn compare(sheet: &Sheet, cmp: &[Comparison], drift: &[Drift]) -> Result<String> {
     let mut report = Report::new("glossmeter compare");
     let mut suite = TestSuite::new(sheet.file.clone());
     for c in cmp {

@@ -24,7 +24,7 @@ pub struct MaterialDoc {
 }
 
 impl MaterialDoc {
-    pub fn new(m: &Material) -> MaterialDoc {
+    pub(crate) fn new(m: &Material) -> MaterialDoc {
         MaterialDoc { name: m.name.clone(), file: m.file.clone(), model: m.brdf.describe() }
     }
 }
@@ -96,7 +96,7 @@ impl MeasureDoc {
 }
 
 /// The CSV of `measure`: a header, then one record per reading (the fields of [`reading_json`]).
-pub fn csv(readings: &[Reading], timing: bool) -> Result<String> {
+pub(crate) fn csv(readings: &[Reading], timing: bool) -> Result<String> {
     let mut head = vec![
         "geometry",
         "name",
@@ -240,7 +240,7 @@ impl BatchDoc {
     }
 
     /// The document printed as the CLI prints it ([`pretty`]).
-    pub fn text(&self) -> String {
+    pub(crate) fn text(&self) -> String {
         pretty(&to_json(self))
     }
 }

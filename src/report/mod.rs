@@ -22,10 +22,10 @@ pub mod compare;
 pub mod convergence;
 pub mod fit;
 #[cfg(feature = "junit")]
-pub mod junit;
+pub(crate) mod junit;
 pub mod measure;
 #[cfg(feature = "pictures")]
-pub mod pictures;
+pub(crate) mod pictures;
 pub mod profile;
 pub mod schema;
 pub mod topography;
@@ -41,7 +41,7 @@ use serde::Serialize;
 /// Decimal places of a reading in the table: one, i.e. 0.1 of the instrument's unit (GU, HU, DOI), as a
 /// glossmeter displays it (ASTM D523 reports gloss to 0.1 GU); none if the numerical error is larger than
 /// half of that. Full precision is in the JSON and CSV output; the numerical error has its own column.
-pub fn decimals(error: f64) -> usize {
+pub(crate) fn decimals(error: f64) -> usize {
     if error.is_finite() && error > 0.05 {
         0
     } else {
@@ -80,7 +80,7 @@ pub(crate) fn displayed(v: f64, step: f64) -> String {
 /// A number for CSV: the shortest digits that read back to the same double, plain decimals in
 /// [10⁻¹⁵, 10¹⁵) (never `1e2`) and scientific notation outside it (`1e300`, not 301 digits; every CSV reader
 /// takes both; `docs/instrument.md` §Numbers in text).
-pub fn plain(v: f64) -> String {
+pub(crate) fn plain(v: f64) -> String {
     if v.is_finite() && v != 0.0 && !(1e-15..1e15).contains(&v.abs()) {
         format!("{v:e}")
     } else {
@@ -92,7 +92,7 @@ pub fn plain(v: f64) -> String {
 /// JUnit text: rounded to ten significant digits, then its shortest decimals, plain or scientific as [`plain`].
 /// A sheet's 99.99 averaged in binary is `99.99000000000001`; no instrument reads to 10⁻¹⁴ GU, so it prints
 /// `99.99` (docs/instrument.md §Numbers in text). JSON keeps the full double.
-pub fn measured(v: f64) -> String {
+pub(crate) fn measured(v: f64) -> String {
     if !v.is_finite() || v == 0.0 {
         return plain(v);
     }
@@ -186,7 +186,7 @@ fn two_digits_up(x: f64) -> String {
 
 /// A reading's value for a table: `decimals` places, or three significant digits in scientific notation
 /// from 10¹⁵ on (a 1e300-class reading is not a 300-character column).
-pub fn shown(v: f64, decimals: usize) -> String {
+pub(crate) fn shown(v: f64, decimals: usize) -> String {
     if v.is_finite() && v.abs() >= 1e15 {
         format!("{v:.3e}")
     } else {
@@ -325,7 +325,7 @@ pub struct BudgetLineDoc {
 
 impl BudgetLineDoc {
     /// The budget of a prediction uncertainty.
-    pub fn budget(u: &PredictionUncertainty) -> Vec<BudgetLineDoc> {
+    pub(crate) fn budget(u: &PredictionUncertainty) -> Vec<BudgetLineDoc> {
         u.contributions
             .iter()
             .map(|c| BudgetLineDoc {
@@ -474,7 +474,7 @@ pub struct BaselineDoc {
 }
 
 impl BaselineDoc {
-    pub fn new(file: String, drift: &[Drift]) -> BaselineDoc {
+    pub(crate) fn new(file: String, drift: &[Drift]) -> BaselineDoc {
         BaselineDoc {
             file,
             checks: drift.iter().map(DriftDoc::from).collect(),
@@ -515,7 +515,7 @@ pub struct SweepReadingDoc {
 }
 
 impl SweepReadingDoc {
-    pub fn new(r: &Reading) -> SweepReadingDoc {
+    pub(crate) fn new(r: &Reading) -> SweepReadingDoc {
         let d = ReadingDoc::new(r, false);
         SweepReadingDoc {
             geometry: d.geometry,

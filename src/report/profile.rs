@@ -18,7 +18,7 @@ pub struct ProfileMaterialDoc {
 }
 
 impl ProfileMaterialDoc {
-    pub fn of(m: &Material) -> ProfileMaterialDoc {
+    pub(crate) fn of(m: &Material) -> ProfileMaterialDoc {
         ProfileMaterialDoc { name: m.name.clone(), file: m.file.clone(), model: m.brdf.describe() }
     }
 }
@@ -121,7 +121,7 @@ impl ProfileDoc {
     }
 
     /// The JSON text (pretty, keys in alphabetical order, a final newline).
-    pub fn text(&self) -> String {
+    pub(crate) fn text(&self) -> String {
         super::pretty(&super::to_json(self))
     }
 }

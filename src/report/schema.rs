@@ -52,6 +52,6 @@ pub fn sheet() -> Value {
 }
 
 /// `topography --format json`.
-pub fn topography() -> Value {
+pub(crate) fn topography() -> Value {
     to_json(&schema_for!(TopographyDoc))
 }

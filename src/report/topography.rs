@@ -214,7 +214,7 @@ impl TopographyDoc {
     }
 
     /// The JSON text (pretty, keys in alphabetical order, a final newline).
-    pub fn text(&self) -> String {
+    pub(crate) fn text(&self) -> String {
         super::pretty(&super::to_json(self))
     }
 }

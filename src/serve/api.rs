@@ -29,11 +29,11 @@ use crate::{report, Error, Result};
 /// How a request body is named in messages.
 pub(crate) const REQUEST: &str = "request";
 /// How the request's recipe is named in messages (and in the documents' `material.file`).
-pub const RECIPE: &str = "recipe";
+pub(crate) const RECIPE: &str = "recipe";
 
 /// What every endpoint knows of the server.
 #[derive(Clone, Copy, Debug)]
-pub struct Context<'a> {
+pub(crate) struct Context<'a> {
     pub limits: &'a Limits,
     /// Where recipes may name table files (None: nowhere).
     pub data_dir: Option<&'a Path>,
@@ -43,7 +43,7 @@ pub struct Context<'a> {
 
 /// An answer: its media type and its body.
 #[derive(Clone, Debug, PartialEq)]
-pub struct Reply {
+pub(crate) struct Reply {
     pub content_type: &'static str,
     pub body: String,
 }
@@ -55,7 +55,7 @@ impl Reply {
 }
 
 /// A request: its JSON object, and the text of its `recipe` member as sent.
-pub struct Request {
+pub(crate) struct Request {
     pub value: Value,
     pub recipe: Option<String>,
 }
@@ -261,7 +261,7 @@ fn profile_request(o: &Obj, ctx: Context) -> Result<ProfileRequest> {
 
 /// `POST /api/measure`: the document of `glossmeter measure --format json` (with `--no-timing` unless
 /// `timing` is true) for the recipe through `geometries` (default: the default panel).
-pub fn measure(req: &Request, ctx: Context) -> Result<Reply> {
+pub(crate) fn measure(req: &Request, ctx: Context) -> Result<Reply> {
     let o = req.obj();
     o.deny_unknown(MEASURE_FIELDS)?;
     let options = plan_options(&o, ctx, DEFAULT_RTOL)?;
@@ -291,7 +291,7 @@ pub fn measure(req: &Request, ctx: Context) -> Result<Reply> {
 }
 
 /// `POST /api/explain`: the measurement plan of `measure --explain`, as text in `{"plan": …}`.
-pub fn explain(req: &Request, ctx: Context) -> Result<Reply> {
+pub(crate) fn explain(req: &Request, ctx: Context) -> Result<Reply> {
     let o = req.obj();
     o.deny_unknown(MEASURE_FIELDS)?;
     let options = plan_options(&o, ctx, DEFAULT_RTOL)?;
@@ -309,7 +309,7 @@ pub fn explain(req: &Request, ctx: Context) -> Result<Reply> {
 /// section with the apertures, `plot --kind section`), `profile` (the goniophotometric profile of
 /// `geometry`, default rspec-20, `profile --plot`) or `gloss-vs-parameter` (`vary` PATH=LO..HI over `points`
 /// values, `plot --kind gloss-vs-parameter`).
-pub fn plot(req: &Request, ctx: Context) -> Result<Reply> {
+pub(crate) fn plot(req: &Request, ctx: Context) -> Result<Reply> {
     let o = req.obj();
     o.deny_unknown(&[
         "recipe",
@@ -377,7 +377,7 @@ pub fn plot(req: &Request, ctx: Context) -> Result<Reply> {
 
 /// `POST /api/sweep`, checked before any work: the sweep of `glossmeter sweep --format jsonl --no-timing`
 /// (`vary` PATH=LO..HI:N strings, `log` paths, `lhs` N and `seed`), at most `limits.sweep_points` points.
-pub fn sweep(req: &Request, ctx: Context) -> Result<Sweep> {
+pub(crate) fn sweep(req: &Request, ctx: Context) -> Result<Sweep> {
     let o = req.obj();
     o.deny_unknown(&[
         "recipe",
@@ -519,7 +519,7 @@ fn tolerances(o: &Obj) -> Result<(Option<f64>, Vec<String>)> {
 /// `POST /api/compare`: the sheet beside the recipe's predictions (the one recipe for every sample), as
 /// `compare --format json|csv|junit` writes them (`format`, default json); verdicts are in the document, the
 /// HTTP status is 200 whatever they are.
-pub fn compare(req: &Request, ctx: Context) -> Result<Reply> {
+pub(crate) fn compare(req: &Request, ctx: Context) -> Result<Reply> {
     let o = req.obj();
     let fields = ["recipe", "k", "tolerance", "max_de00", "rtol", "max_evals", "illuminant", "observer", "format"];
     o.deny_unknown(&[&fields[..], SHEET_FIELDS].concat())?;
@@ -558,7 +558,7 @@ pub fn compare(req: &Request, ctx: Context) -> Result<Reply> {
 
 /// `POST /api/fit`: `glossmeter fit --format json --no-timing`: `free` parameters (PATH=LO..HI or
 /// PATH=log:LO..HI) fitted to `target` readings (GEOMETRY/READING=VALUE[±U]) or to a `sheet`'s `sample`.
-pub fn fit(req: &Request, ctx: Context) -> Result<Reply> {
+pub(crate) fn fit(req: &Request, ctx: Context) -> Result<Reply> {
     let o = req.obj();
     let fields = ["recipe", "free", "target", "sample", "uncertainty", "restarts", "rtol"];
     o.deny_unknown(&[&fields[..], SHEET_FIELDS].concat())?;

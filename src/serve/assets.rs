@@ -8,7 +8,7 @@ pub(crate) const APP_JS: &str = include_str!("page/app.js");
 pub(crate) const APP_CSS: &str = include_str!("page/app.css");
 
 /// The shipped recipes the page starts from: (name, the file's text), the first the page's default.
-pub const FIXTURES: &[(&str, &str)] = &[
+pub(crate) const FIXTURES: &[(&str, &str)] = &[
     ("cerulean-blue-c", include_str!("../../fixtures/recipes/cerulean-blue-c.json")),
     ("semigloss-white", include_str!("../../fixtures/recipes/semigloss-white.json")),
     ("black-glass", include_str!("../../fixtures/recipes/black-glass.json")),

@@ -29,10 +29,10 @@ use crate::instrument::plan::Cancel;
 use crate::request::ServeRequest;
 use crate::{Error, Result};
 
-pub mod api;
-pub mod assets;
-pub mod connections;
-pub mod security;
+pub(crate) mod api;
+pub(crate) mod assets;
+pub(crate) mod connections;
+pub(crate) mod security;
 
 use api::{Context, Reply};
 pub(crate) use security::Guard;
@@ -152,7 +152,7 @@ impl Server {
 
     /// The connections the server keeps open at most ([`connections::connection_cap`]) and the open-file
     /// limit it stays below (None: none).
-    pub fn connections(&self) -> (usize, Option<u64>) {
+    pub(crate) fn connections(&self) -> (usize, Option<u64>) {
         (self.connections, self.fd_limit)
     }
 

@@ -83,7 +83,7 @@ pub(crate) struct Guard {
 }
 
 impl Guard {
-    pub fn new(addr: SocketAddr, allow: &[String]) -> Guard {
+    pub(crate) fn new(addr: SocketAddr, allow: &[String]) -> Guard {
         let port = addr.port();
         let mut names: Vec<String> = vec!["localhost".into(), "127.0.0.1".into(), "[::1]".into()];
         if !addr.ip().is_unspecified() {
@@ -116,7 +116,7 @@ impl Guard {
 
     /// Whether a request with this `Host` (and `Origin`, `Sec-Fetch-Site`, if sent) may be answered; the
     /// reason if not.
-    pub fn check(
+    pub(crate) fn check(
         &self,
         host: Option<&str>,
         origin: Option<&str>,

@@ -429,7 +429,7 @@ impl TableMemo {
     }
 
     /// The memo of the process, what [`PaintBuild::default`] reads.
-    pub fn process() -> &'static TableMemo {
+    pub(crate) fn process() -> &'static TableMemo {
         static TABLES: TableMemo = TableMemo::new();
         &TABLES
     }

@@ -6,7 +6,7 @@ use crate::quadrature::gauss_legendre;
 
 /// Gauss–Legendre order used for the diffuse Fresnel reflectance r_e (the integrand is smooth in cos θ on
 /// [0, 1], so 64 nodes give it to rounding; checked against an independent Simpson rule in `tests/paint.rs`).
-pub const DIFFUSE_FRESNEL_NODES: usize = 64;
+pub(crate) const DIFFUSE_FRESNEL_NODES: usize = 64;
 
 /// The hemispherical mean 2∫₀¹ f(μ) μ dμ of a function of the cosine that is smooth on [0, 1] except at the
 /// cosines `kinks` (sorted, in (0, 1)), where it is continuous but its derivative is not.
@@ -18,7 +18,7 @@ pub const DIFFUSE_FRESNEL_NODES: usize = 64;
 /// midpoints between them, and each piece that ends on a kink is mapped by μ = μc ± h·s² (s ∈ [0, 1]), which
 /// turns √(μ − μc) into the smooth h^½·s, so that each piece's rule again converges like a smooth integrand's
 /// (docs/model.md §Pearlescent flakes).
-pub fn hemispherical_mean(f: impl Fn(f64) -> f64, kinks: &[f64]) -> f64 {
+pub(crate) fn hemispherical_mean(f: impl Fn(f64) -> f64, kinks: &[f64]) -> f64 {
     hemispherical_means(|mu, v| v[0] = f(mu), 1, kinks)[0]
 }
 

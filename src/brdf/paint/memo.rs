@@ -11,7 +11,7 @@ use std::sync::{Arc, Mutex};
 
 /// Entries a [`Memo`] keeps: a sweep alternating between a few materials (a fit's finite differences touch one
 /// parameter at a time) still finds each; the tables of a 21-sample pearl paint are ≈ 0.2 MB an entry.
-pub const MEMO_ENTRIES: usize = 8;
+pub(crate) const MEMO_ENTRIES: usize = 8;
 
 /// Values keyed by the bits of their inputs, at most [`MEMO_ENTRIES`] of them, shared by every thread.
 pub(super) struct Memo<T> {

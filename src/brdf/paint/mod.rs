@@ -54,13 +54,9 @@ mod memo;
 mod spec;
 
 pub use flake::{PaintBuild, TableBuild, TableMemo, TableWork, TABLE_TOLERANCE};
-pub use hemisphere::{
-    diffuse_fresnel_reflectance, hemispherical_mean, internal_diffuse_reflectance, DIFFUSE_FRESNEL_NODES,
-};
-pub use memo::MEMO_ENTRIES;
+pub use hemisphere::{diffuse_fresnel_reflectance, internal_diffuse_reflectance};
 pub use spec::{
-    spread_to_slope, ClearCoat, FlakeLight, Form, MetallicFlakes, PaintSpec, PearlescentFlakes, Pigment,
-    PigmentedLayer, Spread,
+    ClearCoat, FlakeLight, Form, MetallicFlakes, PaintSpec, PearlescentFlakes, Pigment, PigmentedLayer, Spread,
 };
 
 use super::{above_horizon, Brdf, Hints, Lobe, Term, TermKind};
@@ -263,10 +259,6 @@ impl Paint {
         paint.folded =
             luminous.map(|w| Folded::new(paint.metallic.as_ref(), paint.pearlescent.as_ref(), &paint.body, &w));
         Ok((paint, work.get()))
-    }
-
-    pub fn spec(&self) -> &PaintSpec {
-        &self.spec
     }
 
     /// R_l per sample: the KM reflectance of the pigmented layer over the primer.

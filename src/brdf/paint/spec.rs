@@ -2,7 +2,7 @@
 //! layer and its pigments, the two kinds of flakes and their [`Spread`]), the [`Form`] and [`FlakeLight`]
 //! readings of the paper, and the range checks of the registry's entries that `Paint::new` runs on them.
 use crate::optics::microfacet::Distribution;
-use crate::registry::{self as reg, Param, Range};
+use crate::registry::{Param, Range};
 use crate::spectrum::Sampling;
 use crate::{Error, Result};
 
@@ -88,13 +88,8 @@ pub enum Spread {
 }
 
 impl Spread {
-    /// Largest accepted spread angle in degrees, and the slope it corresponds to (tan 60° = 1.732); the
-    /// registry's ranges (`crate::registry::SPREAD_DEG_RANGE`, `SPREAD_SLOPE_RANGE`).
-    pub const MAX_DEG: f64 = reg::SPREAD_DEG_RANGE.hi;
-    pub const MAX_SLOPE: f64 = reg::SPREAD_SLOPE_RANGE.hi;
-
     /// The Beckmann rms slope m.
-    pub fn slope(self) -> f64 {
+    pub(crate) fn slope(self) -> f64 {
         match self {
             Spread::Degrees(d) => spread_to_slope(d),
             Spread::Slope(m) => m,
@@ -171,6 +166,6 @@ pub(super) fn check_spectral(p: &Param, v: &[f64], n: usize) -> Result<()> {
 }
 
 /// Beckmann rms slope m = tan σ of a flake spread σ in degrees.
-pub fn spread_to_slope(spread_deg: f64) -> f64 {
+pub(crate) fn spread_to_slope(spread_deg: f64) -> f64 {
     spread_deg.to_radians().tan()
 }

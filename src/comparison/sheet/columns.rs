@@ -111,7 +111,7 @@ pub(crate) const READING_COLUMNS: &[ReadingColumn] = &[
 /// The geometry of a Rhopoint IQ-class meter's 20° pixel-array readings: an IQ sheet's Haze, Log Haze, DOI,
 /// Rspec and RIQ columns are readings of it (its 20°, 60° and 85° gloss columns are the ISO 2813 / D523 gloss
 /// the maker says they follow, [`GLOSS_ANGLES`]).
-pub const IQ: &str = "rhopoint-iq-20";
+pub(crate) const IQ: &str = "rhopoint-iq-20";
 
 /// Columns that say which sample a row is.
 pub(crate) const SAMPLE_COLUMNS: &[&str] =

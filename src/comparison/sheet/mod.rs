@@ -29,7 +29,7 @@ use std::path::Path;
 mod columns;
 mod rows;
 mod text;
-pub use columns::*;
+pub(crate) use columns::*;
 use rows::*;
 pub(crate) use text::*;
 
@@ -130,7 +130,7 @@ impl Sheet {
 
     /// `line L, column C (header)` of a row's sample or geometry cell (`sheet "S", row L, cell B7 (header)` in
     /// a workbook).
-    pub fn cell(&self, line: usize, column: Option<usize>, what: &str) -> String {
+    pub(crate) fn cell(&self, line: usize, column: Option<usize>, what: &str) -> String {
         let place = self.place();
         match column {
             Some(c) => at(&place, line, c, &self.headers[c]),

@@ -12,7 +12,7 @@ use crate::{Error, Result};
 
 /// Which zip workbook the members say it is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum ZipKind {
+pub(crate) enum ZipKind {
     Xlsx,
     Xlsb,
     Ods,
@@ -21,7 +21,7 @@ pub enum ZipKind {
 type Archive<'a> = zip::ZipArchive<Cursor<&'a [u8]>>;
 
 /// Check a zip workbook's members and counts; say which kind it is.
-pub fn check(bytes: &[u8], file: &str) -> Result<ZipKind> {
+pub(crate) fn check(bytes: &[u8], file: &str) -> Result<ZipKind> {
     let bad = |m: String| Error::input(file, "", m);
     let mut zip = zip::ZipArchive::new(Cursor::new(bytes))
         .map_err(|e| bad(format!("not a readable workbook: its zip archive is damaged ({e})")))?;

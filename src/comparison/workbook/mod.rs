@@ -25,9 +25,9 @@ use calamine::{Data, DataRef, Reader};
 
 use crate::{Error, Result};
 
-pub mod archive;
-pub mod limits;
-pub mod xls;
+pub(crate) mod archive;
+pub(crate) mod limits;
+pub(crate) mod xls;
 
 use archive::ZipKind;
 
@@ -39,7 +39,7 @@ pub(crate) fn is_workbook(bytes: &[u8]) -> bool {
 
 /// One sheet of a workbook, as text for the sheet reader.
 #[derive(Clone, Debug, PartialEq)]
-pub struct WorkbookSheet {
+pub(crate) struct WorkbookSheet {
     /// `xlsx`, `xls`, `xlsb` or `ods`.
     pub format: &'static str,
     /// The sheet read.
@@ -66,7 +66,7 @@ pub(crate) fn cell_name(row: usize, column: u32) -> String {
 
 /// Read sheet `name` (the first sheet when None) of the workbook in `bytes`; `file` names it in errors. The
 /// file is checked against the limits first; a panic of the reader is an error naming the file.
-pub fn read(bytes: &[u8], file: &str, name: Option<&str>) -> Result<WorkbookSheet> {
+pub(crate) fn read(bytes: &[u8], file: &str, name: Option<&str>) -> Result<WorkbookSheet> {
     if bytes.len() > limits::MAX_FILE_BYTES {
         return Err(Error::input(
             file,

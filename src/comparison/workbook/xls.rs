@@ -29,7 +29,7 @@ fn u32_at(b: &[u8], i: usize) -> Option<u32> {
 }
 
 /// Check an `.xls` file: its compound-file structure, then its workbook stream's records.
-pub fn check(bytes: &[u8], file: &str) -> Result<()> {
+pub(crate) fn check(bytes: &[u8], file: &str) -> Result<()> {
     let bad = |m: String| Error::input(file, "", format!("not a readable .xls workbook: {m}"));
     let cfb = Cfb::new(bytes).map_err(bad)?;
     let stream = cfb.workbook_stream().map_err(bad)?;

@@ -22,7 +22,13 @@ impl<'a> ChartMap<'a> {
     /// The map of `chart` for source axis θ, receptor axis `viewing` and the clipped stops; `kinks` cut the
     /// first position variable: t of p_s in the plain chart (`aperture::plain_kink_point`), t_p in the lobe
     /// chart (`aperture::half_angle_kink_point`); the mixed chart `PlainPLobeQ` has none.
-    pub fn new(chart: Chart, kinks: &'a [f64], theta: f64, viewing: f64, (src, rec): (Stop, Stop)) -> ChartMap<'a> {
+    pub(crate) fn new(
+        chart: Chart,
+        kinks: &'a [f64],
+        theta: f64,
+        viewing: f64,
+        (src, rec): (Stop, Stop),
+    ) -> ChartMap<'a> {
         ChartMap {
             chart,
             kinks,
@@ -35,7 +41,7 @@ impl<'a> ChartMap<'a> {
     }
 
     /// The source's axes (θ).
-    pub fn axes(&self) -> &Axes {
+    pub(crate) fn axes(&self) -> &Axes {
         &self.axes
     }
 
@@ -47,7 +53,7 @@ impl<'a> ChartMap<'a> {
     /// The stops' coordinates (p_s, q_s, p_r, q_r) of the chart's point `x` and the Jacobian; a Jacobian
     /// ≤ 0 marks a point outside the overlap (the integrand skips it).
     #[inline]
-    pub fn map(&self, x: &[f64; 4]) -> ([f64; 4], f64) {
+    pub(crate) fn map(&self, x: &[f64; 4]) -> ([f64; 4], f64) {
         let (src, axes) = (self.src, &self.axes);
         let (ps, qs, pr, qr, jac) = match self.chart {
             // The plain chart cut at the kinks: x[0] is the kinked position t of p_s.

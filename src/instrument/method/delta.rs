@@ -185,7 +185,7 @@ pub struct DeltaFit {
 
 impl DeltaFit {
     /// √det B.
-    pub fn root(&self) -> f64 {
+    pub(crate) fn root(&self) -> f64 {
         (self.b[0] * self.b[1] - self.b[2] * self.b[2]).sqrt()
     }
 

@@ -30,7 +30,7 @@ pub(crate) const POLAR_REACH: f64 = 2.0;
 /// (u reach 14.2, 10.9, 8.9 widths) 29 536 against 39 216, 38 304, 34 998; α = 0.002, 0.003, 0.005 (7.1,
 /// 4.7, 2.8 widths) 80 736, 80 736, 87 136 against 32 832, 28 386, 25 308. At TAPPI T480 75° (u reach 4.4–7.0)
 /// and at 20°–60° the polar rule won at every α tried down to [`POLAR_REACH`].
-pub const POLAR_REACH_GRAZING: f64 = 8.0;
+pub(crate) const POLAR_REACH_GRAZING: f64 = 8.0;
 /// See [`POLAR_REACH_GRAZING`]: 80°, between TAPPI T480's 75° and D523's 85°.
 pub(crate) const POLAR_GRAZING: f64 = 80.0 * std::f64::consts::PI / 180.0;
 
@@ -61,7 +61,7 @@ pub(crate) const DELTA_GATE: f64 = 1.0e3;
 
 impl Method {
     /// Design the method of one integral.
-    pub fn design(d: Design<'_>) -> Method {
+    pub(crate) fn design(d: Design<'_>) -> Method {
         let (a, facts) = (d.aperture, d.facts);
         let clipped = match (clip(a.source, a.theta, true), clip(a.receptor, a.viewing, false)) {
             (Some(s), Some(r)) if a.integral == Integral::Aperture => Some((s, r)),
@@ -259,7 +259,7 @@ pub(crate) fn smooth_rule(l: &LobesAt, src: Stop, rec: Stop) -> Option<Rule> {
 /// `docs/instrument.md` §Quadrature, *Measured tables*) whose centre u = v = 0 is inside the range of the lobe variables and at least
 /// [`POLAR_REACH`] widths from every kink of the overlap length and every end of the range, on both axes
 /// (on the u axis [`POLAR_REACH_GRAZING`] widths at geometry angles of [`POLAR_GRAZING`] and above).
-pub fn polar_rule(l: &LobesAt, src: Stop, rec: Stop) -> Option<Rule> {
+pub(crate) fn polar_rule(l: &LobesAt, src: Stop, rec: Stop) -> Option<Rule> {
     let ([lobe], [width]) = (l.lobes, l.widths.as_slice()) else { return None };
     if l.has_diffuse || lobe.tail != Tail::InverseQuartic {
         return None;

@@ -51,14 +51,12 @@ pub(crate) use delta::DELTA_RADIUS;
 pub use delta::{
     delta_fit, delta_stencil, DeltaFit, DELTA_FIT_RADIUS, DELTA_RADII, DELTA_SAFETY, DELTA_TAIL_SAFETY, DELTA_T_ORDERS,
 };
-pub use design::{polar_rule, POLAR_REACH_GRAZING};
 pub(crate) use design::{LOBE_REACH, POLAR_REACH};
 pub(crate) use execute::deadline_after;
 pub use execute::LATE_START_SHARE;
 pub(crate) use gauss::TENSOR_MAX_LEVEL;
 pub use gauss::{tensor_boxes, LOBE_LEVELS};
 pub(crate) use polar::POLAR_LEVELS;
-pub use shape::Outcome;
 
 #[cfg(doc)]
 use crate::instrument::aperture::DELTA_SHARE;
@@ -142,7 +140,7 @@ impl std::hash::Hash for Aperture {
 /// integral): its lobes (for the chart, the split points and the shaped rules), its kinks (put on partition
 /// boundaries) and which kinds of terms it has.
 #[derive(Clone, Debug, PartialEq)]
-pub struct MaterialFacts {
+pub(crate) struct MaterialFacts {
     pub lobes: Vec<Lobe>,
     /// The material's kinks (`Hints::kinks`).
     pub kinks: Vec<Kink>,
@@ -154,7 +152,7 @@ pub struct MaterialFacts {
 
 impl MaterialFacts {
     /// The facts of `brdf`'s terms and kinks.
-    pub fn of(brdf: &dyn Brdf) -> MaterialFacts {
+    pub(crate) fn of(brdf: &dyn Brdf) -> MaterialFacts {
         MaterialFacts::from_hints(&brdf.hints())
     }
 
@@ -170,7 +168,7 @@ impl MaterialFacts {
     }
 
     /// A gloss standard's: an ideal mirror and nothing else.
-    pub fn mirror() -> MaterialFacts {
+    pub(crate) fn mirror() -> MaterialFacts {
         MaterialFacts { lobes: vec![], kinks: vec![], has_delta: true, has_regular: false, has_diffuse: false }
     }
 }
@@ -307,7 +305,7 @@ pub struct Method {
 
 /// What the designer needs to know about an integral.
 #[derive(Clone, Debug)]
-pub struct Design<'a> {
+pub(crate) struct Design<'a> {
     pub aperture: Aperture,
     /// What the designer needs to know about the material (computed once per plan).
     pub facts: &'a MaterialFacts,
@@ -357,7 +355,7 @@ pub struct Flux {
 
 impl Flux {
     /// The flux of an empty integral (stops below the horizon, or nothing to integrate), k components.
-    pub fn zero(k: usize) -> Flux {
+    pub(crate) fn zero(k: usize) -> Flux {
         Flux {
             value: vec![0.0; k],
             error: vec![0.0; k],

@@ -31,7 +31,7 @@ impl ShapedRule for Partition {
 
 impl Rule {
     /// The chart the rule's points are in: the part's (`part`), except the tensor rule's own.
-    pub fn chart(&self, part: Chart) -> Chart {
+    pub(crate) fn chart(&self, part: Chart) -> Chart {
         match self {
             Rule::TensorGauss { chart, .. } => *chart,
             _ => part,
@@ -41,7 +41,7 @@ impl Rule {
     /// The rule that runs when this one does not agree: the delta limit falls back to the lobe's
     /// Gauss–Hermite rule over all its levels, every other shaped rule to the Genz–Malik partition, which
     /// has none (it always returns).
-    pub fn fallback(&self) -> Option<Rule> {
+    pub(crate) fn fallback(&self) -> Option<Rule> {
         match *self {
             Rule::LobeDelta { width } => Some(Rule::LobeGaussHermite { width, levels: (0, LOBE_LEVELS.len() - 1) }),
             Rule::LobeGaussHermite { .. } | Rule::LobePolar { .. } | Rule::TensorGauss { .. } => {
@@ -52,7 +52,7 @@ impl Rule {
     }
 
     /// Run this rule ([`ShapedRule::estimate`] of its file's implementation).
-    pub fn estimate(&self, f: &mut Integrand, run: &RuleRun) -> Outcome {
+    pub(crate) fn estimate(&self, f: &mut Integrand, run: &RuleRun) -> Outcome {
         match *self {
             Rule::GenzMalik75 => Partition.estimate(f, run),
             Rule::LobeGaussHermite { width, levels } => GaussHermite { width, levels }.estimate(f, run),

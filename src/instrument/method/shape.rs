@@ -12,7 +12,7 @@ pub(crate) type Integrand<'a> = dyn FnMut(&[[f64; 4]], &mut [f64]) + 'a;
 
 /// What a rule run is given besides its integrand.
 #[derive(Clone, Copy, Debug)]
-pub struct RuleRun<'a> {
+pub(crate) struct RuleRun<'a> {
     /// Components per point.
     pub ncomp: usize,
     /// The part's tolerances, budget, deadline and the Genz–Malik calibration's limits.
@@ -28,7 +28,7 @@ pub struct RuleRun<'a> {
 
 /// The one result shape of every rule.
 #[derive(Clone, Debug, PartialEq)]
-pub struct Outcome {
+pub(crate) struct Outcome {
     /// The estimate (its `evaluations` counts this run's), the rule frozen at what it reached, and the final
     /// partition when the rule refined one (the Genz–Malik rule; None: the part keeps its own); None when the
     /// rule did not agree (its fallback runs next).
@@ -39,7 +39,7 @@ pub struct Outcome {
 
 impl Outcome {
     /// A shaped rule's outcome: its estimate and frozen self, or None; `spent` evaluations.
-    pub fn shaped(done: Option<(Estimate, Rule)>, spent: usize) -> Outcome {
+    pub(crate) fn shaped(done: Option<(Estimate, Rule)>, spent: usize) -> Outcome {
         Outcome {
             done: done.map(|(mut est, rule)| {
                 est.evaluations = spent;

@@ -228,7 +228,8 @@ pub fn builtin_ids() -> Vec<&'static str> {
 }
 
 /// True if `id` names a builtin colour geometry.
-pub fn is_colour_id(id: &str) -> bool {
+#[cfg(test)]
+pub(crate) fn is_colour_id(id: &str) -> bool {
     builtin_ids().contains(&id)
 }
 

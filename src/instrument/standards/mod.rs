@@ -26,9 +26,9 @@ use crate::instrument::reading::ReadingSpec;
 use crate::{Error, Result};
 
 pub mod colour;
-pub mod gloss;
+pub(crate) mod gloss;
 pub mod profile;
-pub mod sourced;
+pub(crate) mod sourced;
 
 pub use gloss::{builtin_ids, describe, list_line, parse, BUILTIN};
 pub use sourced::{StandardGeometry, STATUSES};

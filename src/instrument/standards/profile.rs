@@ -17,7 +17,7 @@ use crate::Result;
 pub(crate) const MAX_PIXELS: usize = 65_536;
 
 /// The name of the normalising window (a pixel-sized stop centred on the specular direction).
-pub const REFERENCE: &str = "profile-reference";
+pub(crate) const REFERENCE: &str = "profile-reference";
 
 /// A profile array, compiled: pixel count, pixel size and height (radians).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -38,7 +38,7 @@ impl ProfileSpec {
     }
 
     /// The in-plane centre of pixel k from the specular direction, radians.
-    pub fn centre(&self, k: usize) -> f64 {
+    pub(crate) fn centre(&self, k: usize) -> f64 {
         self.centre_deg(k).to_radians()
     }
 
@@ -49,19 +49,14 @@ impl ProfileSpec {
 
     /// The stop of pixels `first` ..= `last` side by side: in plane from the left edge of `first` to the right
     /// edge of `last`, as tall as the pixels.
-    pub fn window(&self, first: usize, last: usize) -> Stop {
+    pub(crate) fn window(&self, first: usize, last: usize) -> Stop {
         let lo = (self.centre_deg(first) - 0.5 * self.pixel_deg).to_radians();
         let hi = (self.centre_deg(last) + 0.5 * self.pixel_deg).to_radians();
         Stop::from_angles(hi - lo, self.perpendicular, 0.5 * (lo + hi))
     }
 
-    /// The window's edges from the specular direction, degrees: (left edge of `first`, right edge of `last`).
-    pub fn window_deg(&self, first: usize, last: usize) -> (f64, f64) {
-        (self.centre_deg(first) - 0.5 * self.pixel_deg, self.centre_deg(last) + 0.5 * self.pixel_deg)
-    }
-
     /// The name of pixel k (and of its reading): `pixel-0000` … (four digits at least, sorted as numbers).
-    pub fn name(&self, k: usize) -> String {
+    pub(crate) fn name(&self, k: usize) -> String {
         format!("pixel-{k:04}")
     }
 }
@@ -147,7 +142,7 @@ pub fn of(g: &StandardGeometry) -> Result<ProfileSpec> {
 
 /// The geometry the plan measures for a profile: the geometry's angle, scale and source, the N pixels and
 /// the normalising window as receptors, one [`ReadingSpec::Profile`] reading per pixel.
-pub fn geometry(g: &StandardGeometry, p: &ProfileSpec) -> StandardGeometry {
+pub(crate) fn geometry(g: &StandardGeometry, p: &ProfileSpec) -> StandardGeometry {
     let mut geo = g.geometry.clone();
     geo.receptors = (0..p.pixels).map(|k| (p.name(k), p.stop(k))).collect();
     geo.receptors.push((REFERENCE.to_string(), Stop::from_angles(p.pixel, p.perpendicular, 0.0)));

@@ -13,7 +13,7 @@ use crate::instrument::standards::StandardGeometry;
 use crate::{recipe, Error, Result, Vec3};
 
 /// One panel of the section plot.
-pub struct Section {
+pub(crate) struct Section {
     id: String,
     angle: f64,
     /// (θo, f_r luminous) in degrees and sr⁻¹.
@@ -32,7 +32,7 @@ fn value(spec: &Value, pointer: &str) -> Option<f64> {
 
 /// The in-plane section of `brdf` through geometry `g`: the source at its nominal angle, the receptor swept
 /// through the plane of incidence from 40° before to 40° past the specular direction (within ±89.5°).
-pub fn section(brdf: &dyn Brdf, g: &StandardGeometry) -> Option<Section> {
+pub(crate) fn section(brdf: &dyn Brdf, g: &StandardGeometry) -> Option<Section> {
     let spec = &g.spec;
     let angle = value(spec, "/angle_deg")?;
     let s_in = value(spec, "/source/in_plane_deg")?;

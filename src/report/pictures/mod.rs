@@ -19,9 +19,9 @@ use plotters::prelude::*;
 use crate::instrument::convergence::Sweep;
 use crate::{Error, Result};
 
-pub mod charts;
-pub mod profile;
-pub mod topography;
+pub(crate) mod charts;
+pub(crate) mod profile;
+pub(crate) mod topography;
 
 /// What was drawn, for messages.
 #[derive(Clone, Debug, PartialEq)]
@@ -72,7 +72,7 @@ pub(crate) fn draw_legend<'a, DB: DrawingBackend + 'a, CT: plotters::coord::Coor
 
 /// The mark of a legend entry drawn beside a chart ([`draw_side_legend`]).
 #[derive(Clone, Copy, Debug)]
-pub enum Mark {
+pub(crate) enum Mark {
     Line(RGBAColor),
     Box(RGBAColor),
     Dot(RGBAColor),

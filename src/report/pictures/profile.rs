@@ -9,7 +9,7 @@ use crate::Result;
 
 /// Draw the profile: reading (GU) against the angle from the specular direction, one point per pixel joined
 /// by a line; pixels without a value are left out (the caption says how many).
-pub fn draw<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, p: &Profile, title: &str) -> Result<()> {
+pub(crate) fn draw<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, p: &Profile, title: &str) -> Result<()> {
     root.fill(&WHITE).map_err(plot_err)?;
     let pts: Vec<(f64, f64)> = p.rows.iter().filter_map(|r| r.reading.value.map(|v| (r.angle_deg, v))).collect();
     let missing = p.rows.len() - pts.len();

@@ -30,7 +30,7 @@ fn ramp(t: f64) -> RGBColor {
 }
 
 /// Draw the height map (µm, block means over the valid points; invalid blocks grey) and the radial PSD.
-pub fn draw<DB: DrawingBackend>(
+pub(crate) fn draw<DB: DrawingBackend>(
     root: DrawingArea<DB, Shift>,
     map: &HeightMap,
     a: &Analysis,
@@ -123,9 +123,4 @@ pub fn draw<DB: DrawingBackend>(
     chart.draw_series(LineSeries::new(pts, BLUE.stroke_width(2))).map_err(plot_err)?;
     root.present().map_err(plot_err)?;
     Ok(())
-}
-
-/// The picture as an SVG document in memory.
-pub fn svg(map: &HeightMap, a: &Analysis, doc: &TopographyDoc, title: &str) -> Result<String> {
-    super::to_svg((1200, 560), |root| draw(root, map, a, doc, title))
 }
