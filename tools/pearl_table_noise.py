@@ -66,6 +66,26 @@ def rho(mu, eta, lam_nm, d_tio2=135.0, n_tio2=2.5, n_mica=1.58, d_mica=400.0):
     return min(max(out, 0.0), 1.0)
 
 
+def rho_on_segment(s, h, mc, eta, lam_nm, d_tio2=135.0, n_tio2=2.5, n_mica=1.58, d_mica=400.0):
+    """rho at mu = mc + h s^2 with the mica's n cos from the segment variable, eta sqrt((mu - mc)(mu + mc)),
+    mu - mc = h s^2 exactly (the cure proposed in docs/model.md): no cancellation next to the kink."""
+    dmu = h * s * s
+    mu = mc + dmu
+    if mu <= 0:
+        return 1.0
+    resin = complex(eta * mu)
+    t_nc = n_cos(eta, mu, n_tio2)
+    m_nc = eta * cmath.sqrt(complex(dmu * (mu + mc)))
+    m_nc = -m_nc if m_nc.imag < 0 else m_nc
+    p = math.exp(-4 * math.pi * d_mica * m_nc.imag / lam_nm)
+    out = 0.0
+    for pol in "sp":
+        rf, tf = film(resin, n_tio2, t_nc, m_nc, d_tio2, lam_nm, pol, eta, n_mica)
+        rb, tb = film(m_nc, n_tio2, t_nc, resin, d_tio2, lam_nm, pol, n_mica, eta)
+        out += 0.5 * (rf + tf * tb * p * p * rb / (1 - rb * p * p * rb) if tf != 0 else rf)
+    return min(max(out, 0.0), 1.0)
+
+
 def coefficients(vals):
     return [(1 if k == 0 else 2) / N * sum(v * math.cos(math.pi * k * (j + 0.5) / N) for j, v in enumerate(vals))
             for k in range(N)]
@@ -109,6 +129,15 @@ def main():
                     for lam in lams for h in [-mc, 1 - mc] for p in range(per))
             row.append(f"{2 * per}: {w:.1e}")
         print(f"  eta {eta} (mu_c {mc:.4f}): " + ", ".join(row), flush=True)
+    print("The same, the mica's cosine from the segment variable (rho_on_segment):")
+    for eta in [1.59, 1.6]:
+        mc = math.sqrt(1 - (1.58 / eta) ** 2)
+        row = []
+        for per in [4, 8, 16, 32, 64]:
+            w = max(piece_deviation(lambda s: rho_on_segment(s, h, mc, eta, lam), p / per, (p + 1) / per, p == 0)
+                    for lam in lams for h in [-mc, 1 - mc] for p in range(per))
+            row.append(f"{2 * per}: {w:.1e}")
+        print(f"  eta {eta}: " + ", ".join(row), flush=True)
 
 
 if __name__ == "__main__":
