@@ -585,7 +585,7 @@ mod tests {
             }
             println!("{line}");
             let a = (1.0 - f(1e-3)) / 1e-3;
-            let mut near = format!("   (1 − ρ)/(aμ) − 1, a from μ = 10⁻³, and the exit cosine's relative error:");
+            let mut near = "   (1 − ρ)/(aμ) − 1, a from μ = 10⁻³, and the exit cosine's relative error:".to_string();
             for mu in [1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9] {
                 let c = complex_cos_transmitted(
                     Complex64::new(eta, 0.0),
