@@ -536,4 +536,60 @@ mod tests {
             assert!((s.eval(c) - f(c)).abs() < 1e-12);
         }
     }
+
+    /// Why the Cerulean (c) pearl's table misses 10⁻¹² at coat indices 1.54, 1.56 and 1.59 (`docs/model.md`
+    /// §Evaluation cost, "Where the direct evaluation is the noise"): prints, for its stack at 546.1 nm, the
+    /// largest deviation of the table from the direct evaluation at each piece count (it grows with the count, on
+    /// the piece at μ = 0 or at the kink) and the direct evaluation near grazing against its linear law
+    /// 1 − ρ ≈ aμ. A tool, not a check: `cargo test --lib pearl_deviation_near_grazing -- --ignored --nocapture`.
+    #[test]
+    #[ignore]
+    fn pearl_deviation_near_grazing() {
+        use crate::optics::fresnel::complex_cos_transmitted;
+        use crate::optics::thin_film::{stack, FilmLayer};
+        use num_complex::Complex64;
+        let tio2 = FilmLayer { n: Complex64::new(2.5, 0.0), thickness_nm: 135.0, coherent: true };
+        let mica = FilmLayer { n: Complex64::new(1.58, 0.0), thickness_nm: 400.0, coherent: false };
+        for eta in [1.5, 1.54, 1.56, 1.58, 1.59, 1.6] {
+            let f = |c: f64| stack(eta, &[tio2, mica, tio2], Complex64::new(eta, 0.0), c, 546.1).r().clamp(0.0, 1.0);
+            let kinks: Vec<f64> = [(1.0 - (1.58f64 / eta).powi(2)).sqrt()].into_iter().filter(|c| *c > 0.0).collect();
+            let mut line = format!("η {eta}: deviation (piece, check point) at");
+            for pieces in [8usize, 16, 32, 64, 128, 1024] {
+                let f1 = |x, _: &[usize], v: &mut [f64]| v[0] = f(x);
+                let t = ChebTable::fit_each_kinked_with_pieces(f1, &[0], 0.0, 1.0, &kinks, pieces, 1.0).pop().flatten();
+                let Some(t) = t else { continue };
+                let (segs, per) = (t.segments.clone(), pieces / t.segments.len().max(1));
+                let (mut worst, mut at) = (0.0f64, (0, 0));
+                for p in 0..pieces {
+                    for j in 0..=N {
+                        if !segs.is_empty() && p % per == 0 && j == N {
+                            continue;
+                        }
+                        let u = 0.5 - 0.5 * (std::f64::consts::PI * j as f64 / N as f64).cos();
+                        let x = match segs.is_empty() {
+                            true => (p as f64 + u) / pieces as f64,
+                            false => segs[p / per].x(((p % per) as f64 + 1.0 - u) / per as f64),
+                        };
+                        let e = (t.eval(x) - f(x)).abs();
+                        if e > worst {
+                            (worst, at) = (e, (p, j));
+                        }
+                    }
+                }
+                line += &format!(" {pieces}: {worst:.1e} {at:?};");
+            }
+            println!("{line}");
+            let a = (1.0 - f(1e-3)) / 1e-3;
+            let mut near = "   (1 − ρ)/(aμ) − 1, a from μ = 10⁻³, and the exit cosine's relative error:".to_string();
+            for mu in [1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9] {
+                let c = complex_cos_transmitted(
+                    Complex64::new(eta, 0.0),
+                    Complex64::new(mu, 0.0),
+                    Complex64::new(eta, 0.0),
+                );
+                near += &format!(" μ {mu:.0e}: {:.1e}, {:.1e};", (1.0 - f(mu)) / (a * mu) - 1.0, (c.re - mu) / mu);
+            }
+            println!("{near}");
+        }
+    }
 }
