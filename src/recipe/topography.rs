@@ -7,10 +7,12 @@ use std::sync::Arc;
 
 use super::measured::resolve;
 use crate::brdf::halo::Halo;
+use crate::brdf::kirchhoff::KirchhoffSurface;
 use crate::brdf::map_two_scale::{MapTwoScale, ShortWaves};
 use crate::brdf::topography::TopographySurface;
 use crate::brdf::Brdf;
 use crate::input::json::Obj;
+use crate::optics::kirchhoff::{Edge, KirchhoffMap};
 use crate::optics::microfacet::Microfacet;
 use crate::optics::slope_table::SlopeTable;
 use crate::registry::{self, Param};
@@ -28,6 +30,12 @@ pub(crate) fn parse_topography(obj: &Obj) -> Result<Arc<dyn Brdf>> {
     let ior = obj.param(&registry::TOPOGRAPHY_IOR)?;
     let (map, levelled, levelling) = levelled_map(obj, &registry::TOPOGRAPHY_FILE, &registry::TOPOGRAPHY_LEVELLING)?;
     let wrap = |e: Error| obj.err("file", format!("not a topography this model reads: {e}"));
+    if let Some(edge) = kirchhoff_edge(obj)? {
+        let source = format!("{}, levelling {}", map.file, levelling.name());
+        let km = KirchhoffMap::new(&levelled.z, (map.nx, map.ny), (map.dx, map.dy), GREY_WAVELENGTH, ior, edge)
+            .map_err(|m| obj.err("file", format!("{}: {m}", map.file)))?;
+        return Ok(Arc::new(KirchhoffSurface::new(km, obj.file.to_string(), source)));
+    }
     if let Some(split) = scale_split(obj)? {
         let source = format!("{}, levelling {}", map.file, levelling.name());
         let field = if matches!(split, Split::At(_)) { "split_frequency" } else { "file" };
@@ -39,6 +47,40 @@ pub(crate) fn parse_topography(obj: &Obj) -> Result<Arc<dyn Brdf>> {
     let table = SlopeTable::from_slopes(&s.sx, &s.sy).map_err(|m| obj.err("file", format!("{}: {m}", map.file)))?;
     let source = format!("{}, levelling {}", map.file, levelling.name());
     Ok(Arc::new(TopographySurface::new(table, ior, source)?))
+}
+
+/// The grey sampling's wavelength, m (`Sampling::grey`, 560 nm), at which the Kirchhoff method reads a map.
+pub(crate) const GREY_WAVELENGTH: f64 = 560e-9;
+
+/// The Kirchhoff method's edge when the recipe asks for `"method": "kirchhoff"` (docs/optics.md §11), None for
+/// the BRDF (the default); an `edge` without it, or with a scale split, is refused.
+fn kirchhoff_edge(obj: &Obj) -> Result<Option<Edge>> {
+    let method = obj.opt_str(&obj.param_key(&registry::TOPOGRAPHY_METHOD))?;
+    let edge = obj.opt_str(&obj.param_key(&registry::TOPOGRAPHY_EDGE))?;
+    match method {
+        None | Some("brdf") => {
+            if edge.is_some() {
+                return Err(obj.err("edge", "an edge is read only with \"method\": \"kirchhoff\""));
+            }
+            Ok(None)
+        }
+        Some("kirchhoff") => {
+            for f in ["scale_split", "split_frequency"] {
+                if obj.get(f).is_some() {
+                    return Err(
+                        obj.err(f, "a scale split with \"method\": \"kirchhoff\"; the far field reads the whole map")
+                    );
+                }
+            }
+            match edge {
+                None => Ok(Some(Edge::Periodic)),
+                Some(s) => Edge::parse(s)
+                    .map(Some)
+                    .ok_or_else(|| obj.err("edge", format!("unknown edge {s:?}; allowed: periodic, taper"))),
+            }
+        }
+        Some(s) => Err(obj.err("method", format!("unknown method {s:?}; allowed: brdf, kirchhoff"))),
+    }
 }
 
 /// The two-scale split the recipe asks for (docs/optics.md §Two-scale surface of a measured map): None
