@@ -47,9 +47,12 @@ pub enum Family {
     OrangePeel { sigma_long: f64, wavelength: f64, width: f64, sigma_micro: f64, ell_micro: f64 },
 }
 
+/// One component of a surface: its rms height and its PSD's shape S(f).
+type Component = (f64, Box<dyn Fn(f64) -> f64>);
+
 impl Family {
     /// The components: (rms height, shape S(f)).
-    fn components(&self) -> Vec<(f64, Box<dyn Fn(f64) -> f64>)> {
+    fn components(&self) -> Vec<Component> {
         match *self {
             Family::Gaussian { sigma, ell } => vec![(sigma, Box::new(move |f: f64| (-(PI * ell * f).powi(2)).exp()))],
             Family::Abc { sigma, b, c } => {
