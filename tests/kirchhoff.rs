@@ -1,33 +1,21 @@
-//! The Kirchhoff method against closed forms (docs/optics.md §11.6): a flat map is the Fresnel mirror, a
+//! The Kirchhoff method against closed forms (docs/optics.md §11.5): a flat map is the Fresnel mirror, a
 //! sinusoidal grating's orders carry J_m²(q_z a), a Gaussian surface's specular cell exp(−(q_z σ)²), a periodic
 //! map reads the same with either edge, and each validity refusal names the file, the field and the reason.
 use std::f64::consts::PI;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use glossmeter::instrument::plan::PlanOptions;
 use glossmeter::optics::kirchhoff::{Edge, KirchhoffMap};
 use glossmeter::topography::synthetic::{generate, Family};
 use glossmeter::Reading;
 
+mod common;
+use common::write_gsf;
+
 fn tmp(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("glossmeter-kirchhoff-{}", std::process::id()));
     std::fs::create_dir_all(&d).unwrap();
     d.join(name)
-}
-
-/// A GSF file of n × n heights `z` (m), `dx` m apart.
-fn write_gsf(path: &Path, n: usize, dx: f64, z: &[f64]) {
-    let mut b = b"Gwyddion Simple Field 1.0\n".to_vec();
-    let side = n as f64 * dx * 1e6;
-    b.extend_from_slice(
-        format!("XRes = {n}\nYRes = {n}\nXReal = {side}\nYReal = {side}\nXYUnits = um\nZUnits = um\n").as_bytes(),
-    );
-    let pad = 4 - b.len() % 4;
-    b.extend(std::iter::repeat_n(0u8, pad));
-    for v in z {
-        b.extend_from_slice(&((v * 1e6) as f32).to_le_bytes());
-    }
-    std::fs::write(path, b).unwrap();
 }
 
 /// The readings of a topography recipe on `file` with `extra` fields, through these geometries.
@@ -166,10 +154,21 @@ fn each_validity_refusal_names_the_file_the_field_and_the_reason() {
     let r = read("small", 64, 1e-6, &vec![0.0; 64 * 64], r#", "method": "kirchhoff""#, &["astm-d523-85"]);
     let p = problem(&r, "astm-d523-85");
     assert!(p.contains("small.json: /file:") && p.contains("too small to resolve the receptor"), "{p}");
-    // Too coarse: 40 µm spacing reaches |λf| ≤ 0.007, less than the 60° receptor's half-width.
-    let r = read("coarse", 64, 40e-6, &vec![0.0; 64 * 64], r#", "method": "kirchhoff""#, &["astm-d523-60"]);
+    // Too coarse: 40 µm spacing reaches |λf| ≤ 0.007, less than the 60° receptor's half-width, and a white
+    // roughness of 20 nm puts as much power at the Nyquist edge as anywhere, so most of what the receptor may
+    // receive is beyond what the map resolves.
+    let white: Vec<f64> = (0..64 * 64u64)
+        .map(|k| {
+            let h = k.wrapping_mul(0x9E37_79B9_7F4A_7C15) >> 11;
+            20e-9 * 3f64.sqrt() * (2.0 * (h as f64 / (1u64 << 53) as f64) - 1.0)
+        })
+        .collect();
+    let r = read("coarse", 64, 40e-6, &white, r#", "method": "kirchhoff""#, &["astm-d523-60"]);
     let p = problem(&r, "astm-d523-60");
-    assert!(p.contains("coarse.json: /file:") && p.contains("too coarse to reach the receptor"), "{p}");
+    assert!(p.contains("coarse.json: /file:") && p.contains("too coarse for the receptor"), "{p}");
+    // A flat map at that spacing is a mirror whatever the sampling: it reads, with nothing unresolved.
+    let r = read("coarse-flat", 64, 40e-6, &vec![0.0; 64 * 64], r#", "method": "kirchhoff""#, &["astm-d523-60"]);
+    assert!(problem(&r, "astm-d523-60").is_empty() && value(&r, "astm-d523-60", "gloss") > 0.0);
     // Phase aliasing: a 0.5 µm step between neighbours at 20° (q_z·Δz ≈ 10.5 rad).
     let z: Vec<f64> = (0..128 * 128).map(|k| if (k % 128) % 2 == 0 { 0.5e-6 } else { 0.0 }).collect();
     let r = read("steep", 128, 4e-6, &z, r#", "method": "kirchhoff""#, &["astm-d523-20"]);

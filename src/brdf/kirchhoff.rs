@@ -3,7 +3,7 @@
 //! through [`Brdf::far_field`]. As a BRDF (what the planner designs its methods from, and `--explain` prints)
 //! it is the smooth interface of the same index; no specimen aperture flux is integrated from it.
 use super::dielectric::SmoothDielectric;
-use super::{Brdf, FarField, Hints};
+use super::{Brdf, FarField, FarFieldFlux, Hints};
 use crate::optics::kirchhoff::{Aperture, KirchhoffMap, StopBox};
 use crate::spectrum::Sampling;
 use crate::Vec3;
@@ -63,7 +63,7 @@ impl FarField for KirchhoffSurface {
         viewing: f64,
         source: [[f64; 2]; 2],
         receptor: [[f64; 2]; 2],
-    ) -> std::result::Result<(f64, f64), String> {
+    ) -> std::result::Result<FarFieldFlux, String> {
         let a = Aperture {
             theta,
             viewing,
@@ -71,7 +71,7 @@ impl FarField for KirchhoffSurface {
             receptor: StopBox { p: receptor[0], q: receptor[1] },
         };
         match self.map.aperture_flux(&a) {
-            Ok(f) => Ok((f.value, f.speckle())),
+            Ok(f) => Ok(FarFieldFlux { value: f.value, error: f.error, data_uncertainty: f.speckle() }),
             Err(e) => Err(format!("{}: /file: {e}", self.file)),
         }
     }

@@ -273,7 +273,8 @@ pub(crate) fn below_horizon(wi: Vec3, wo: Vec3, out: &mut [f64]) -> bool {
 /// A material whose aperture fluxes come from a far field (docs/optics.md §11): `aperture_flux(θ, viewing,
 /// source stop, receptor stop)` with the stops as tangent-coordinate boxes `[[p0, p1], [q0, q1]]`
 /// (docs/instrument.md §1.2) gives the grey flux ∫_S R·P(R | ωi) cos θi dωi (the units of docs/instrument.md §1.4)
-/// and its data (speckle) uncertainty, or why this receptor cannot be read (a reading marked with it).
+/// with its numerical error and its data (speckle) uncertainty, or why this receptor cannot be read (a reading
+/// marked with it).
 pub trait FarField: Send + Sync {
     fn aperture_flux(
         &self,
@@ -281,7 +282,16 @@ pub trait FarField: Send + Sync {
         viewing: f64,
         source: [[f64; 2]; 2],
         receptor: [[f64; 2]; 2],
-    ) -> std::result::Result<(f64, f64), String>;
+    ) -> std::result::Result<FarFieldFlux, String>;
+}
+
+/// One grey aperture flux of a [`FarField`]: its value, the estimate of its numerical error, and its data
+/// uncertainty (docs/optics.md §11.3–§11.4).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FarFieldFlux {
+    pub value: f64,
+    pub error: f64,
+    pub data_uncertainty: f64,
 }
 
 /// A reflectance model. Implementations must be pure: the same arguments give the same bits.

@@ -14,17 +14,21 @@ use rustfft::FftPlannerScalar;
 use std::f64::consts::PI;
 
 use super::fresnel::fresnel_dielectric;
-use crate::quadrature::gauss_legendre;
 
-/// Sub-samples per cell and axis for cells cut by a receptor's edge (docs/optics.md §11.3).
-pub const SUBSAMPLES: usize = 4;
+/// Midpoints per axis of the source stop a reading is taken with (docs/optics.md §11.3).
+pub const FINE: usize = 32;
 
-/// Gauss–Legendre nodes per axis of the source stop (docs/optics.md §11.3).
-pub const SOURCE_NODES: usize = 6;
+/// The midpoints per axis whose difference from [`FINE`] is the reading's error estimate (docs/optics.md
+/// §11.3).
+pub const COARSE: usize = 16;
 
 /// The largest cell λ/L allowed, as a fraction of the receptor's smallest extent in direction cosines
 /// (docs/optics.md §11.4).
 pub const RESOLUTION_FRACTION: f64 = 0.25;
+
+/// The largest bound on the flux beyond the map's Nyquist frequencies allowed, as a fraction of the flux
+/// (docs/optics.md §11.4); below it the bound is part of the error estimate.
+pub const UNRESOLVED_FRACTION: f64 = 0.01;
 
 /// The edge treatment (docs/optics.md §11.1).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -72,10 +76,16 @@ pub struct Aperture {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ApertureFlux {
     pub value: f64,
+    /// The estimate of the discretisation error of `value`: |value − the same flux with [`COARSE`] nodes|, plus
+    /// `unresolved`.
+    pub error: f64,
     /// The part carried by the specular cell f = 0 (the coherent reflection).
     pub coherent: f64,
     /// Independent speckle cells in the receptor (cells of size λ/L, at the source's centre).
     pub cells: f64,
+    /// The bound on the flux the cells beyond the map's Nyquist frequencies send into the receptor (each at
+    /// the largest power on the grid's outer rings, docs/optics.md §11.4); part of `error`.
+    pub unresolved: f64,
 }
 
 impl ApertureFlux {
@@ -90,7 +100,8 @@ impl ApertureFlux {
 pub enum Refusal {
     /// The map is too small: λ/L exceeds a quarter of the receptor's smallest extent.
     Resolution(String),
-    /// The sampling is too coarse: the receptor needs |λf| beyond the Nyquist frequency.
+    /// The sampling is too coarse: what the receptor may receive beyond the Nyquist frequency is more than
+    /// [`UNRESOLVED_FRACTION`] of its flux.
     Nyquist(String),
     /// q_z·max|Δz| > π between neighbouring points.
     Aliasing(String),
@@ -118,13 +129,13 @@ pub struct KirchhoffMap {
     pub wavelength: f64,
     pub ior: f64,
     pub edge: Edge,
-    /// The largest |Δz| between valid neighbours (across the wrap too for a periodic edge), m.
+    /// The largest |Δz| between valid neighbours within the map (not across a periodic wrap), m.
     pub max_step: f64,
 }
 
-/// The Hann weight of point i of n: sin²(π(i + ½)/n) (never 0 at a sample, symmetric).
+/// The Hann weight of point i of n in its periodic ("DFT-even") form, sin²(πi/n) (docs/optics.md §11.1).
 fn hann(i: usize, n: usize) -> f64 {
-    let s = (PI * (i as f64 + 0.5) / n as f64).sin();
+    let s = (PI * i as f64 / n as f64).sin();
     s * s
 }
 
@@ -170,7 +181,8 @@ impl KirchhoffMap {
             return Err("no valid point in the map".into());
         }
         let zz: Vec<f64> = z.iter().map(|&v| if v.is_finite() { v } else { 0.0 }).collect();
-        let wrap = edge == Edge::Periodic;
+        // Steps between neighbours within the map only: the step across a periodic map's wrap is its edge, which
+        // the periodic continuation makes (§11.1), not a slope the sampling fails to follow.
         let mut max_step: f64 = 0.0;
         for j in 0..ny {
             for i in 0..nx {
@@ -178,8 +190,8 @@ impl KirchhoffMap {
                 if !z[k].is_finite() {
                     continue;
                 }
-                let right = if i + 1 < nx { Some(k + 1) } else { wrap.then_some(j * nx) };
-                let up = if j + 1 < ny { Some(k + nx) } else { wrap.then_some(i) };
+                let right = (i + 1 < nx).then_some(k + 1);
+                let up = (j + 1 < ny).then_some(k + nx);
                 for n in [right, up].into_iter().flatten() {
                     if z[n].is_finite() {
                         max_step = max_step.max((z[n] - z[k]).abs());
@@ -267,27 +279,64 @@ impl KirchhoffMap {
                 lambda / (RESOLUTION_FRACTION * smallest) * 1e3
             )));
         }
-        let (fnx, fny) = (0.5 / self.dx, 0.5 / self.dy);
-        let sx = -s0[0];
-        let need_x = (bb[0] - sx).abs().max((bb[1] - sx).abs()) / lambda;
-        let need_y = bb[2].abs().max(bb[3].abs()) / lambda;
-        if need_x > fnx || need_y > fny {
+        let p = self.power(qz)?;
+        let edge = self.edge_power(&p);
+        let fine = self.source_average(&p, edge, &rx, &bb, a.source, &source_dir, FINE);
+        let coarse = self.source_average(&p, edge, &rx, &bb, a.source, &source_dir, COARSE);
+        if fine.unresolved > UNRESOLVED_FRACTION * fine.value {
             return Err(Refusal::Nyquist(format!(
-                "the sampling ({:.3} × {:.3} µm) is too coarse to reach the receptor: it needs |λf| up to \
-                 ({:.4}, {:.4}), beyond the Nyquist λ/(2Δ) = ({:.4}, {:.4}) (docs/optics.md §11.4)",
+                "the sampling ({:.3} × {:.3} µm) is too coarse for the receptor: the part of it beyond the map's \
+                 Nyquist frequencies (|λf| > λ/(2Δ) = ({:.4}, {:.4}) in direction cosines) may receive {:.2e} of \
+                 the flux {:.2e} (bounded by the map's power at its Nyquist edge); allowed: at most \
+                 {UNRESOLVED_FRACTION} of it (docs/optics.md §11.4: a finer sampling is needed)",
                 self.dx * 1e6,
                 self.dy * 1e6,
-                need_x * lambda,
-                need_y * lambda,
-                fnx * lambda,
-                fny * lambda
+                0.5 * lambda / self.dx,
+                0.5 * lambda / self.dy,
+                fine.unresolved,
+                fine.value
             )));
         }
-        let p = self.power(qz)?;
-        let (xs, ws) = gauss_legendre(SOURCE_NODES);
-        let (mut value, mut coherent, mut cells) = (0.0, 0.0, 0.0);
-        let [p0, p1] = a.source.p;
-        let [q0, q1] = a.source.q;
+        Ok(ApertureFlux { error: (fine.value - coarse.value).abs() + fine.unresolved, ..fine })
+    }
+
+    /// The largest p(f) on the two outermost rings of the frequency grid: the bound assumed for every cell
+    /// beyond the Nyquist frequencies (docs/optics.md §11.4).
+    fn edge_power(&self, p: &[f64]) -> f64 {
+        let (hx, hy) = ((self.nx / 2) as i64, (self.ny / 2) as i64);
+        let mut most: f64 = 0.0;
+        for ky in 0..self.ny {
+            for kx in 0..self.nx {
+                let (sx, sy) = (signed(kx, self.nx), signed(ky, self.ny));
+                if sx.abs() >= hx - 1 || sy.abs() >= hy - 1 {
+                    most = most.max(p[ky * self.nx + kx]);
+                }
+            }
+        }
+        most
+    }
+
+    /// The flux for the source uniformly filling `source` by `nodes` × `nodes` midpoints
+    /// (docs/optics.md §11.3); `error` 0, and
+    /// `unresolved` the bound on what the cells beyond the Nyquist frequencies send, each taken as `edge`.
+    #[allow(clippy::too_many_arguments)]
+    fn source_average(
+        &self,
+        p: &[f64],
+        edge: f64,
+        rx: &Receptor,
+        bb: &[f64; 4],
+        source: StopBox,
+        source_dir: &dyn Fn(f64, f64) -> [f64; 3],
+        nodes: usize,
+    ) -> ApertureFlux {
+        // The composite midpoint rule: the integrand is continuous but kinked wherever a cell's corner crosses
+        // the receptor's edge, which a Gauss rule does not converge on steadily (§11.3).
+        let xs: Vec<f64> = (0..nodes).map(|i| 2.0 * (i as f64 + 0.5) / nodes as f64 - 1.0).collect();
+        let ws = vec![2.0 / nodes as f64; nodes];
+        let (mut value, mut coherent, mut cells, mut unresolved) = (0.0, 0.0, 0.0, 0.0);
+        let [p0, p1] = source.p;
+        let [q0, q1] = source.q;
         for (i, (&u, &wu)) in xs.iter().zip(&ws).enumerate() {
             for (j, (&v, &wv)) in xs.iter().zip(&ws).enumerate() {
                 let (ps, qs) = (p0 + (p1 - p0) * 0.5 * (u + 1.0), q0 + (q1 - q0) * 0.5 * (v + 1.0));
@@ -295,22 +344,23 @@ impl KirchhoffMap {
                 let s = source_dir(ps, qs);
                 // cos θi dωi of this node (dω = dp dq/(1+p²+q²)^{3/2}, docs/instrument.md §1.2).
                 let weight = wu * wv * 0.25 * (p1 - p0) * (q1 - q0) / (r2 * r2.sqrt()) * s[2];
-                let centre = i == SOURCE_NODES / 2 && j == SOURCE_NODES / 2;
-                let (sum, spec, n) = self.cells_in(&p, &rx, &bb, s, centre);
-                value += weight * sum;
-                coherent += weight * spec;
+                let centre = i == nodes / 2 && j == nodes / 2;
+                let c = self.cells_in(p, edge, rx, bb, s, centre);
+                value += weight * c.sum;
+                coherent += weight * c.coherent;
+                unresolved += weight * c.unresolved;
                 if centre {
-                    cells = n;
+                    cells = c.count;
                 }
             }
         }
-        Ok(ApertureFlux { value, coherent, cells })
+        ApertureFlux { value, error: 0.0, coherent, cells, unresolved }
     }
 
     /// Σ_f R_F(θ_h)·p(f)·(fraction of cell f inside the receptor) for the source direction `s` (θ_h the half
-    /// angle between s and the cell's direction, §11.3), the f = 0 cell's part of it, and (if `count`) the
-    /// fraction-weighted number of cells.
-    fn cells_in(&self, p: &[f64], rx: &Receptor, bb: &[f64; 4], s: [f64; 3], count: bool) -> (f64, f64, f64) {
+    /// angle between s and the cell's direction, §11.3), its parts (see [`CellSums`]).
+    #[allow(clippy::too_many_arguments)]
+    fn cells_in(&self, p: &[f64], edge: f64, rx: &Receptor, bb: &[f64; 4], s: [f64; 3], count: bool) -> CellSums {
         let m = [-s[0], -s[1]];
         let lambda = self.wavelength;
         let (lx, ly) = self.extent();
@@ -321,31 +371,50 @@ impl KirchhoffMap {
         let ky_lo = ((m[1] - bb[3]) / cy).floor() as i64 - 1;
         let ky_hi = ((m[1] - bb[2]) / cy).ceil() as i64 + 1;
         let (hx, hy) = ((self.nx / 2) as i64, (self.ny / 2) as i64);
-        let (mut sum, mut spec, mut n) = (0.0, 0.0, 0.0);
-        for ky in ky_lo.max(-hy + 1)..=ky_hi.min(hy) {
-            for kx in kx_lo.max(-hx + 1)..=kx_hi.min(hx) {
+        let mut c = CellSums::default();
+        for ky in ky_lo..=ky_hi {
+            for kx in kx_lo..=kx_hi {
                 let ox = m[0] - kx as f64 * cx;
                 let oy = m[1] - ky as f64 * cy;
                 let frac = rx.fraction(ox, oy, cx, cy);
                 if frac == 0.0 {
                     continue;
                 }
-                let bx = kx.rem_euclid(self.nx as i64) as usize;
-                let by = ky.rem_euclid(self.ny as i64) as usize;
                 let oz = (1.0 - ox * ox - oy * oy).max(0.0).sqrt();
                 let cos_h = (0.5 * (1.0 + s[0] * ox + s[1] * oy + s[2] * oz)).max(0.0).sqrt();
-                let v = fresnel_dielectric(cos_h, self.ior).r() * p[by * self.nx + bx] * frac;
-                sum += v;
+                let rf = fresnel_dielectric(cos_h, self.ior).r();
+                if kx <= -hx || kx > hx || ky <= -hy || ky > hy {
+                    // Beyond the Nyquist frequencies: the map cannot say; bounded by its edge's power.
+                    c.unresolved += rf * edge * frac;
+                    continue;
+                }
+                let bx = kx.rem_euclid(self.nx as i64) as usize;
+                let by = ky.rem_euclid(self.ny as i64) as usize;
+                let v = rf * p[by * self.nx + bx] * frac;
+                c.sum += v;
                 if kx == 0 && ky == 0 {
-                    spec += v;
+                    c.coherent += v;
                 }
                 if count {
-                    n += frac;
+                    c.count += frac;
                 }
             }
         }
-        (sum, spec, n)
+        c
     }
+}
+
+/// What the cells send into the receptor for one source direction (`KirchhoffMap::cells_in`).
+#[derive(Clone, Copy, Debug, Default)]
+struct CellSums {
+    /// Σ R_F·p·fraction over the cells the map resolves.
+    sum: f64,
+    /// The f = 0 cell's part of `sum`.
+    coherent: f64,
+    /// The fraction-weighted number of resolved cells (when asked).
+    count: f64,
+    /// The bound on what the cells beyond the Nyquist frequencies send (each taken at the edge's power).
+    unresolved: f64,
 }
 
 /// A receptor stop on its lens axis: directions ↔ tangent coordinates (docs/instrument.md §1.1–1.2).
@@ -401,10 +470,14 @@ impl Receptor {
         b
     }
 
-    /// The fraction of the cell centred on (ox, oy), cx × cy in direction cosines, inside the stop: 1 or 0 when
-    /// its four corners agree (all inside, or all beyond one edge), else the share of SUBSAMPLES² points.
+    /// The fraction of the cell centred on (ox, oy), cx × cy in direction cosines, inside the stop (§11.3):
+    /// 1 or 0 when its four corners agree (all inside, or all beyond one edge); else the cell's outline
+    /// (`EDGE_POINTS` points a side) is taken to the stop's tangent coordinates, clipped by the stop's
+    /// rectangle there, and the clipped polygon's vertices taken back to direction cosines, where its area over
+    /// the cell's is the fraction. A point that does not reach the lens (beyond the horizon) falls back on the
+    /// share of `FALLBACK_SUBSAMPLES`² points.
     fn fraction(&self, ox: f64, oy: f64, cx: f64, cy: f64) -> f64 {
-        let corners = [(-0.5, -0.5), (0.5, -0.5), (-0.5, 0.5), (0.5, 0.5)]
+        let corners = [(-0.5, -0.5), (0.5, -0.5), (0.5, 0.5), (-0.5, 0.5)]
             .map(|(a, b)| self.tangent(ox + a * cx, oy + b * cy).unwrap_or((f64::NAN, f64::NAN)));
         let all = |f: &dyn Fn(f64, f64) -> bool| corners.iter().all(|&(p, q)| f(p, q));
         let s = self.stop;
@@ -416,8 +489,33 @@ impl Receptor {
             {
                 return 0.0;
             }
+            let k = EDGE_POINTS;
+            let mut outline = Vec::with_capacity(4 * k);
+            for side in 0..4 {
+                let (a, b) = (
+                    [(-0.5, -0.5), (0.5, -0.5), (0.5, 0.5), (-0.5, 0.5)][side],
+                    [(0.5, -0.5), (0.5, 0.5), (-0.5, 0.5), (-0.5, -0.5)][side],
+                );
+                for i in 0..k {
+                    let t = i as f64 / k as f64;
+                    let (u, v) = (a.0 + t * (b.0 - a.0), a.1 + t * (b.1 - a.1));
+                    outline.push(self.tangent(ox + u * cx, oy + v * cy));
+                }
+            }
+            if let Some(poly) = outline.into_iter().collect::<Option<Vec<_>>>() {
+                // Back in direction cosines, where p(f) is uniform over the cell (the map's Jacobian varies
+                // across a cell near grazing, so areas in (p, q) would weight it wrongly).
+                let inside: Vec<(f64, f64)> = clip(&poly, s)
+                    .into_iter()
+                    .map(|(p, q)| {
+                        let d = self.dir(p, q);
+                        (d[0], d[1])
+                    })
+                    .collect();
+                return (area(&inside) / (cx * cy)).clamp(0.0, 1.0);
+            }
         }
-        let m = SUBSAMPLES;
+        let m = FALLBACK_SUBSAMPLES;
         let mut hits = 0;
         for a in 0..m {
             for b in 0..m {
@@ -432,9 +530,99 @@ impl Receptor {
     }
 }
 
+/// Sub-samples per axis of a cell whose outline does not all reach the lens (docs/optics.md §11.3).
+const FALLBACK_SUBSAMPLES: usize = 16;
+
+/// Points per side of a cut cell's outline (docs/optics.md §11.3).
+const EDGE_POINTS: usize = 8;
+
+/// The polygon `poly` (vertices in order, simple) clipped by the rectangle `stop`: Sutherland–Hodgman, one
+/// half-plane of the rectangle at a time (empty when nothing is inside).
+fn clip(poly: &[(f64, f64)], stop: StopBox) -> Vec<(f64, f64)> {
+    // Each half-plane as (axis, bound, keep the side ≥ bound?).
+    let planes = [(0, stop.p[0], true), (0, stop.p[1], false), (1, stop.q[0], true), (1, stop.q[1], false)];
+    let mut poly: Vec<(f64, f64)> = poly.to_vec();
+    for (axis, bound, above) in planes {
+        let coord = |v: (f64, f64)| if axis == 0 { v.0 } else { v.1 };
+        let inside = |v: (f64, f64)| if above { coord(v) >= bound } else { coord(v) <= bound };
+        let mut out = Vec::with_capacity(poly.len() + 2);
+        for i in 0..poly.len() {
+            let (a, b) = (poly[i], poly[(i + 1) % poly.len()]);
+            if inside(a) {
+                out.push(a);
+            }
+            if inside(a) != inside(b) {
+                let t = (bound - coord(a)) / (coord(b) - coord(a));
+                out.push((a.0 + t * (b.0 - a.0), a.1 + t * (b.1 - a.1)));
+            }
+        }
+        poly = out;
+        if poly.len() < 3 {
+            return Vec::new();
+        }
+    }
+    poly
+}
+
+/// The area of a simple polygon (the shoelace formula).
+fn area(poly: &[(f64, f64)]) -> f64 {
+    let n = poly.len();
+    0.5 * (0..n).map(|i| poly[i].0 * poly[(i + 1) % n].1 - poly[(i + 1) % n].0 * poly[i].1).sum::<f64>().abs()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_cut_cells_share_is_what_dense_points_inside_it_give() {
+        // The D523 85° receptor (4° × 6° at 85°) and cells of 5.5e-4 in direction cosines about its edges.
+        let (a, b) = (4f64.to_radians(), 6f64.to_radians());
+        let stop = StopBox { p: [(-a / 2.0).tan(), (a / 2.0).tan()], q: [(-b / 2.0).tan(), (b / 2.0).tan()] };
+        let rx = Receptor::new(85f64.to_radians(), stop);
+        let bb = rx.bounds();
+        let c = 5.5e-4;
+        let mut worst: f64 = 0.0;
+        for k in 0..400 {
+            let t = (k as f64 + 0.37) / 400.0;
+            for (ox, oy) in [
+                (bb[0] + t * 1e-3 - 5e-4, 0.3 * bb[3] * t),
+                (bb[1] + t * 1e-3 - 5e-4, -0.5 * bb[3] * t),
+                (0.5 * (bb[0] + bb[1]) + (t - 0.5) * 1e-3, bb[3] + t * 1e-3 - 5e-4),
+            ] {
+                let m = 400;
+                let mut hits = 0;
+                for i in 0..m {
+                    for j in 0..m {
+                        let u = (i as f64 + 0.5) / m as f64 - 0.5;
+                        let v = (j as f64 + 0.5) / m as f64 - 0.5;
+                        hits += rx.inside(ox + u * c, oy + v * c) as usize;
+                    }
+                }
+                let dense = hits as f64 / (m * m) as f64;
+                let got = rx.fraction(ox, oy, c, c);
+                if (got - dense).abs() > 2e-3 {
+                    eprintln!("cell ({ox}, {oy}): clip {got} dense {dense}");
+                }
+                worst = worst.max((got - dense).abs());
+            }
+        }
+        assert!(worst < 2e-3, "{worst}");
+    }
+
+    #[test]
+    fn a_clipped_square_has_the_share_of_its_area_inside() {
+        let stop = StopBox { p: [0.0, 1.0], q: [0.0, 1.0] };
+        let clipped_share = |poly: &[(f64, f64)], stop| area(&clip(poly, stop)) / area(poly);
+        let square = |x: f64, y: f64| [(x, y), (x + 0.5, y), (x + 0.5, y + 0.5), (x, y + 0.5)];
+        assert_eq!(clipped_share(&square(0.25, 0.25), stop), 1.0);
+        assert!((clipped_share(&square(0.75, 0.25), stop) - 0.5).abs() < 1e-15);
+        assert!((clipped_share(&square(0.75, 0.75), stop) - 0.25).abs() < 1e-15);
+        assert_eq!(clipped_share(&square(1.5, 0.25), stop), 0.0);
+        // A diamond over the corner (1, 1): the triangle below-left of it is 1/4 of its area.
+        let diamond = [(1.0, 0.5), (1.5, 1.0), (1.0, 1.5), (0.5, 1.0)];
+        assert!((clipped_share(&diamond, stop) - 0.25).abs() < 1e-15);
+    }
 
     #[test]
     fn a_tilt_sends_its_light_where_the_tilted_mirror_does() {

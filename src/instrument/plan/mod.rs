@@ -607,9 +607,9 @@ impl Plan {
 }
 
 /// A specimen flux from a material's far field (docs/optics.md §11; docs/architecture.md §The flow of one
-/// reading): the grey flux and its speckle uncertainty through the method's weighting, no evaluation and no
-/// numerical error; a refusal, or an integral that is no aperture integral (a sphere's), is a flux with no
-/// value whose readings carry the reason.
+/// reading): the grey flux, its numerical error and its speckle uncertainty through the method's weighting, no
+/// evaluation of the BRDF; a refusal, or an integral that is no aperture integral (a sphere's), is a flux with
+/// no value whose readings carry the reason.
 fn far_field_flux(ff: &dyn crate::brdf::FarField, method: &Method) -> Flux {
     let a = &method.aperture;
     let k = method.weighting.len();
@@ -623,12 +623,14 @@ fn far_field_flux(ff: &dyn crate::brdf::FarField, method: &Method) -> Flux {
             .into()),
     };
     match got {
-        Ok((phi, u)) => {
-            let value = method.weighting.apply(&[phi]);
+        Ok(f) => {
+            let w = &method.weighting;
+            let value = w.apply(&[f.value]);
             Flux {
                 regular: value.clone(),
                 value,
-                data_uncertainty: Some(method.weighting.apply(&[u])),
+                error: (0..k).map(|c| w.component_error(c, &[f.error])).collect(),
+                data_uncertainty: Some((0..k).map(|c| w.component_error(c, &[f.data_uncertainty])).collect()),
                 seconds: start.elapsed().as_secs_f64(),
                 ..Flux::zero(k)
             }
