@@ -6,6 +6,7 @@
 use std::sync::Arc;
 
 use super::measured::resolve;
+use crate::brdf::annotated::Annotated;
 use crate::brdf::halo::Halo;
 use crate::brdf::kirchhoff::KirchhoffSurface;
 use crate::brdf::map_two_scale::{MapTwoScale, ShortWaves};
@@ -41,12 +42,38 @@ pub(crate) fn parse_topography(obj: &Obj) -> Result<Arc<dyn Brdf>> {
         let field = if matches!(split, Split::At(_)) { "split_frequency" } else { "file" };
         let m = from_heights(&levelled.z, (map.nx, map.ny), (map.dx, map.dy), ior, split, source)
             .map_err(|(at_split, m)| obj.err(if at_split { field } else { "file" }, format!("{}: {m}", map.file)))?;
-        return Ok(Arc::new(m));
+        let sq = crate::topography::heights::heights(&levelled.z, &map.file).map_err(wrap)?.sq;
+        return Ok(match beyond_the_study(sq) {
+            Some(note) => Arc::new(Annotated { inner: Arc::new(m), note }),
+            None => Arc::new(m),
+        });
     }
     let s = slopes(&levelled.z, map.nx, map.ny, map.dx, map.dy, &map.file).map_err(wrap)?;
     let table = SlopeTable::from_slopes(&s.sx, &s.sy).map_err(|m| obj.err("file", format!("{}: {m}", map.file)))?;
     let source = format!("{}, levelling {}", map.file, levelling.name());
     Ok(Arc::new(TopographySurface::new(table, ior, source)?))
+}
+
+/// The largest roughness phase 4π·Sq/λ (at the grey wavelength) at which the study of docs/optics.md §11.6
+/// found the two-scale surface reading what the map's Kirchhoff far field reads, to 0.1 GU at D523 20°/60°/85°
+/// (Sq ≤ 10 nm; it found differences beyond 0.1 GU from Sq = 20 nm, phase 0.45, on).
+pub(crate) const TWO_SCALE_CHECKED_PHASE: f64 = 0.225;
+
+/// The note a two-scale surface carries when its map's roughness is beyond what the study checked
+/// (docs/optics.md §11.6), None within it.
+fn beyond_the_study(sq: f64) -> Option<String> {
+    let phase = 4.0 * std::f64::consts::PI * sq / GREY_WAVELENGTH;
+    (phase > TWO_SCALE_CHECKED_PHASE).then(|| {
+        format!(
+            "beyond the roughness where the two-scale surface was checked against the map's Kirchhoff far field \
+             (4π·Sq/λ = {phase:.3} with Sq = {:.1} nm, above {TWO_SCALE_CHECKED_PHASE}: Sq ≤ {:.1} nm at {:.0} nm): \
+             its gloss may differ from wave optics by more than 0.1 GU (docs/optics.md §11.6); \"method\": \
+             \"kirchhoff\" reads the map itself",
+            sq * 1e9,
+            TWO_SCALE_CHECKED_PHASE * GREY_WAVELENGTH / (4.0 * std::f64::consts::PI) * 1e9,
+            GREY_WAVELENGTH * 1e9
+        )
+    })
 }
 
 /// The grey sampling's wavelength, m (`Sampling::grey`, 560 nm), at which the Kirchhoff method reads a map.
