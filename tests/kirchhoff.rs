@@ -2,7 +2,6 @@
 //! sinusoidal grating's orders carry J_m²(q_z a), a Gaussian surface's specular cell exp(−(q_z σ)²), a periodic
 //! map reads the same with either edge, and each validity refusal names the file, the field and the reason.
 use std::f64::consts::PI;
-use std::path::PathBuf;
 
 use glossmeter::instrument::plan::PlanOptions;
 use glossmeter::optics::kirchhoff::{Edge, KirchhoffMap};
@@ -10,13 +9,7 @@ use glossmeter::topography::synthetic::{generate, Family};
 use glossmeter::Reading;
 
 mod common;
-use common::write_gsf;
-
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("glossmeter-kirchhoff-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d.join(name)
-}
+use common::{tmp, write_gsf};
 
 /// The readings of a topography recipe on `file` with `extra` fields, through these geometries.
 fn read(name: &str, n: usize, dx: f64, z: &[f64], extra: &str, ids: &[&str]) -> Vec<Reading> {

@@ -606,7 +606,7 @@ impl Plan {
     }
 }
 
-/// A specimen flux from a material's far field (docs/optics.md §11; docs/architecture.md §The flow of one
+/// A specimen flux from a material's far field (docs/optics.md §11; docs/architecture.md §From recipe to
 /// reading): the grey flux, its numerical error and its speckle uncertainty through the method's weighting, no
 /// evaluation of the BRDF; a refusal, or an integral that is no aperture integral (a sphere's), is a flux with
 /// no value whose readings carry the reason.
