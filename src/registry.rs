@@ -980,6 +980,24 @@ pub(crate) const TOPOGRAPHY_SPLIT_FREQUENCY: Param = p(
     Opt("the rule of scale_split"),
     "the two-scale surface split at this spatial frequency instead of by the rule (refused if the short waves break the smooth-surface bound)",
 );
+pub(crate) const TOPOGRAPHY_METHOD: Param = p(
+    "/method",
+    TOPOGRAPHY,
+    Type::Choice(&["brdf", "kirchhoff"]),
+    "",
+    NONE,
+    Opt("\"brdf\""),
+    "brdf: the map read as a BRDF (the facets, or the two-scale surface) integrated over the stops; kirchhoff: each aperture flux from the map's scalar Beckmann–Kirchhoff far field by one FFT at 560 nm, the wave-optics ground truth (docs/optics.md §11)",
+);
+pub(crate) const TOPOGRAPHY_EDGE: Param = p(
+    "/edge",
+    TOPOGRAPHY,
+    Type::Choice(&["periodic", "taper"]),
+    "",
+    NONE,
+    Opt("\"periodic\""),
+    "with method kirchhoff: periodic (the map is one period of the surface) or taper (a separable Hann window, the edge of the illuminated spot) (docs/optics.md §11.1)",
+);
 
 // ---------------------------------------------------------------------------------------------------------
 // Near-specular scatter: a Rayleigh–Rice halo from a surface PSD (docs/optics.md §Near-specular scatter), at
@@ -1396,6 +1414,8 @@ pub static PARAMS: &[&Param] = &[
     &TOPOGRAPHY_LEVELLING,
     &TOPOGRAPHY_SCALE_SPLIT,
     &TOPOGRAPHY_SPLIT_FREQUENCY,
+    &TOPOGRAPHY_METHOD,
+    &TOPOGRAPHY_EDGE,
 ];
 
 // ---------------------------------------------------------------------------------------------------------

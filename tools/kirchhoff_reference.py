@@ -19,13 +19,14 @@ The spec (shared with the Rust implementation, written independently of it):
 * q_z = k (cos θi + cos θo,c), θo,c = θi for the gloss receptors (the specular); u = w·exp(i q_z z);
   U = FFT2(u) (numpy.fft.fft2: U(f) = Σ u exp(-2πi f·x)); p(f) = |U(f)|² / (N Σw²), Σ_f p = 1 (Parseval);
   f on numpy.fft.fftfreq's grid, f_x along the map's x (the plane of measurement, docs/instrument.md §1.1);
-* the scattered ray leaving cell f: its direction cosines (o_x, o_y) = mirror(s) + λ f, with mirror(s) =
+* the scattered ray leaving cell f: its direction cosines (o_x, o_y) = mirror(s) − λ f, with mirror(s) =
   (-s_x, -s_y), s the source direction, o_z = sqrt(1 - o_x² - o_y²) (cells with o_x² + o_y² ≥ 1 are lost);
   p(f) is spread uniformly over its cell [f - Δf/2, f + Δf/2], Δf = (1/(Nx dx), 1/(Ny dy));
-* flux fraction into a receptor = R_F(n, θ) × ⟨Σ_f p(f) · overlap(cell f, receptor | s)⟩_s, the average over
+* flux fraction into a receptor = ⟨Σ_f p(f) · R_F(n, θh) · overlap(cell f, receptor | s)⟩_s, the average over
   source directions s filling the source stop uniformly (constant radiance), weighted by cos θi dω_i as in
   docs/instrument.md §1.4 (dω = dp dq / (1 + p² + q²)^{3/2}); R_F the unpolarised Fresnel reflectance of
-  index n at the nominal angle θ (the specular angle of the geometry);
+  index n at the half angle θh between s and the ray (cos θh = sqrt((1 + s·o)/2): the facet that sends s into
+  o), taken point by point over the cell's overlap;
 * gloss = 100 × flux fraction / flux fraction of the black glass standard (n = 1.567, docs/instrument.md §1.5,
   the standards' "reference_index") read by the same formula (a flat map: p = δ(f)), through the same stops.
 
@@ -37,17 +38,19 @@ is inside the receptor when o·r0 > 0 and its gnomonic coordinates p = o·e∥/o
 rectangle (the exact inverse of the map above).
 
 How this script averages (its own method, not the Rust side's): the surface-independent acceptance kernel
-K(f) = ⟨overlap(cell f, receptor | s)⟩_s is computed per geometry by stratified jittered sampling of the source
-rectangle (NS × NS strata in (p, q), weight cos θi /(1 + p² + q²)^{3/2}) crossed with stratified jittered
-sub-cell offsets (NC × NC strata); then flux = R_F Σ_f p(f) K(f). R independent replicates (independent
-jitter) give the mean and the error estimate: 3 × the standard error of the replicates' mean, plus the
-maximum spread of the replicates / R (conservative). A kernel that is 0 or 1 over a whole cell is exact.
+K_n(f) = ⟨R_F(n, θh) · overlap(cell f, receptor | s)⟩_s is computed per geometry, for the sample's index and
+the standard's, by stratified jittered sampling of the source rectangle (NS × NS strata in (p, q), weight
+cos θi /(1 + p² + q²)^{3/2}) crossed with stratified jittered sub-cell offsets (NC × NC strata); then flux =
+Σ_f p(f) K_n(f), and the standard's flux K_nref(0). R independent replicates (independent jitter) each give a
+gloss (its sample and its standard from the same samples); the error estimate is 3 × the standard error of
+the replicates' mean plus the range of the replicates / R (conservative).
 
 The sign of f. With u = exp(+i q_z z) and a forward FFT exp(-2πi f·x), a tilt z = αx puts the power at
-f_x = +2α cosθ/λ, so "mirror + λ f" sends it to larger o_x; geometrical optics sends the reflection of a plane
-tilted towards the source (α > 0) to smaller o_x (mirror - 2α cos θ). The spec's convention is kept for the
-primary numbers ("gloss"); the other sign (p(f) read at -f, the physically signed direction) is stored as
-"gloss_other_sign", so the difference is visible (it vanishes for a map symmetric under x → -x, y → -y).
+f_x = +2α cosθ/λ; geometrical optics sends the reflection of a plane tilted towards the source (α > 0) to
+smaller o_x (mirror - 2α cos θ), so the ray of cell f leaves along mirror − λ f (the self-check "sign_of_f"
+shows it). The first version of this script used mirror + λ f; its readings are kept beside the others as
+"gloss_mirrored_f" (p(f) read at -f), so the difference is visible (it vanishes for a map symmetric under
+x → -x, y → -y).
 
 Usage: python3 tools/kirchhoff_reference.py  (from the repository root; NumPy ≥ 1.17; SciPy optional, for the
 Bessel self-check, otherwise a power series is used).
@@ -163,8 +166,12 @@ def power(z, qz, edge, symmetric_hann=False):
 
 def fresnel(n, theta):
     """Unpolarised Fresnel reflectance of a dielectric of index n from air at angle theta (radians)."""
-    c = np.cos(theta)
-    s2 = np.sin(theta) ** 2
+    return fresnel_cos(n, np.cos(theta))
+
+
+def fresnel_cos(n, c):
+    """The same at the cosine c of the angle of incidence (an array)."""
+    s2 = 1 - c**2
     ct = np.sqrt(1 - s2 / n**2)
     rs = (c - n * ct) / (c + n * ct)
     rp = (n * c - ct) / (n * c + ct)
@@ -205,7 +212,7 @@ def source_samples(geo, rng):
     sy = q / norm
     sz = (np.cos(t) + p * np.sin(t)) / norm
     weight = sz / norm**3
-    return sx, sy, weight / weight.sum()
+    return sx, sy, sz, weight / weight.sum()
 
 
 def inside_receptor(ox, oy, geo):
@@ -223,8 +230,10 @@ def inside_receptor(ox, oy, geo):
 
 
 def kernel(geo, dfx, dfy, rng):
-    """K[j, i] for the cell indices j, i ∈ [-N/2, N/2] (f = index × Δf), one replicate."""
-    sx, sy, ws = source_samples(geo, rng)
+    """K_n[j, i] for the cell indices j, i ∈ [-N/2, N/2] (f = index × Δf), one replicate, for the sample's
+    index n = IOR and the standard's n_ref: the source average of R_F(n, θh)·overlap, θh the half angle between
+    the source direction and the ray (the facet that sends one into the other)."""
+    sx, sy, sz, ws = source_samples(geo, rng)
     cu = ((np.arange(NC)[:, None] + rng.random((NC, NC))) / NC - 0.5).ravel()
     cv = ((np.arange(NC)[None, :] + rng.random((NC, NC))) / NC - 0.5).ravel()
     # joint samples: every source point with every sub-cell offset
@@ -233,9 +242,11 @@ def kernel(geo, dfx, dfy, rng):
     du = np.broadcast_to(cu[None, :], mx.shape).ravel() * LAMBDA * dfx
     dv = np.broadcast_to(cv[None, :], mx.shape).ravel() * LAMBDA * dfy
     mx, my = mx.ravel(), my.ravel()
+    sxj, syj, szj = (np.repeat(v, NC * NC) for v in (sx, sy, sz))
     wj = np.repeat(ws, NC * NC) / (NC * NC)
     idx = np.arange(-N // 2, N // 2 + 1)
     kern = np.zeros((idx.size, idx.size))
+    kern_ref = np.zeros((idx.size, idx.size))
     # bounding box of the receptor's direction cosines (its edges sampled densely) → cells that can reach it
     p0, p1, q0, q1 = geo["receptor"]
     pe = np.concatenate([np.linspace(p0, p1, 400), np.full(400, p1), np.linspace(p1, p0, 400), np.full(400, p0)])
@@ -256,16 +267,21 @@ def kernel(geo, dfx, dfy, rng):
         block = np.array(cells[c:c + chunk])
         ox = mx[None, :] + du[None, :] + LAMBDA * dfx * block[:, 1:2]
         oy = my[None, :] + dv[None, :] + LAMBDA * dfy * block[:, 0:1]
-        acc = inside_receptor(ox, oy, geo) @ wj
-        kern[block[:, 0] + N // 2, block[:, 1] + N // 2] = acc
-    return kern
+        oz = np.sqrt(np.clip(1 - ox**2 - oy**2, 0.0, None))
+        cos_h = np.sqrt(np.clip(0.5 * (1 + sxj[None, :] * ox + syj[None, :] * oy + szj[None, :] * oz), 0.0, 1.0))
+        inside = inside_receptor(ox, oy, geo)
+        at = (block[:, 0] + N // 2, block[:, 1] + N // 2)
+        kern[at] = (inside * fresnel_cos(IOR, cos_h)) @ wj
+        kern_ref[at] = (inside * fresnel_cos(geo["n_ref"], cos_h)) @ wj
+    return kern, kern_ref
 
 
-def on_fft_grid(kern, ny, nx, other_sign=False):
-    """K at numpy's fftfreq cell indices (or at their negatives), as an (ny, nx) array."""
+def on_fft_grid(kern, ny, nx, at_minus_f=False):
+    """K at numpy's fftfreq cell indices (or at their negatives: the ray of cell f leaving along mirror − λ f),
+    as an (ny, nx) array."""
     iy = np.fft.fftfreq(ny, 1 / ny).astype(int)
     ix = np.fft.fftfreq(nx, 1 / nx).astype(int)
-    if other_sign:
+    if at_minus_f:
         iy, ix = -iy, -ix
     return kern[iy[:, None] + N // 2, ix[None, :] + N // 2]
 
@@ -285,14 +301,13 @@ def bessel_j(m, x):
 
 def self_checks(kernels, geos):
     out = {}
-    # flat map: p = δ(0); flux fraction = R_F × K(0); the standard's index reads exactly the assigned value
+    # flat map: p = δ(0); flux fraction = K_n(0); the standard's index reads exactly the assigned value
     flat = {}
     for g in geos:
         kr = np.mean(kernels[g["id"]], axis=0)
-        k0 = kr[N // 2, N // 2]
-        std = fresnel(g["n_ref"], g["theta"]) * k0
+        k0, std = kr[0, N // 2, N // 2], kr[1, N // 2, N // 2]
         flat[g["id"]] = {"K0": float(k0), "gloss_n_ref": float(100 * std / std),
-                         "gloss_ior_1.5": float(100 * fresnel(IOR, g["theta"]) * k0 / std)}
+                         "gloss_ior_1.5": float(100 * k0 / std)}
         print(f"  flat {g['id']}: K(0) = {float(k0)!r}, n = {g['n_ref']} reads {float(100 * std / std)!r} GU, "
               f"n = 1.5 reads {flat[g['id']]['gloss_ior_1.5']:.6f} GU")
     out["flat_map"] = flat
@@ -328,12 +343,17 @@ def self_checks(kernels, geos):
     o = 2 * s0.dot(tilted) * tilted - s0
     geometric = (o[0] - np.sin(t)) / (LAMBDA / (N * DX))
     out["sign_of_f"] = {"alpha": alpha, "peak_cell_fx_of_spec": peak, "geometric_reflection_cell_fx": geometric}
-    print(f"  sign of f: tilt α = {alpha:.3e} towards the source at 20°: the spec's power at cell f_x = {peak:+d}, "
-          f"the geometrical reflection at {geometric:+.3f} cells")
+    print(f"  sign of f: tilt α = {alpha:.3e} towards the source at 20°: p(f) peaks at cell f_x = {peak:+d}, "
+          f"the geometrical reflection lies {geometric:+.3f} cells from the mirror (so o = mirror − λ f)")
     return out
 
 
 # --------------------------------------------------------------------------------------------- main
+def spread(values):
+    """The error estimate of the replicates' mean: 3 × its standard error plus the replicates' range / R."""
+    return 3 * values.std(ddof=1) / np.sqrt(REPLICATES) + np.ptp(values) / REPLICATES
+
+
 def main():
     os.makedirs(OUT, exist_ok=True)
     geos = [load_geometry(g) for g in GEOMETRIES]
@@ -366,35 +386,33 @@ def main():
                 p = power(zl, qz, edge)
                 psum = float(p.sum())
                 checks["parseval"][f"{name}/{edge}/{g['id']}"] = psum - 1
-                reps = kernels[g["id"]]
-                rf = fresnel(IOR, g["theta"])
-                std = fresnel(g["n_ref"], g["theta"]) * np.mean(reps, axis=0)[N // 2, N // 2]
-                ff = np.array([rf * np.sum(p * on_fft_grid(kr, N, N)) for kr in reps])
-                ff_o = np.array([rf * np.sum(p * on_fft_grid(kr, N, N, True)) for kr in reps])
-                mean = ff.mean()
-                err = 3 * ff.std(ddof=1) / np.sqrt(REPLICATES) + np.ptp(ff) / REPLICATES
-                gloss = g["assigned"] * mean / std
+                reps = kernels[g["id"]]  # (replicate, sample | standard, cell j, cell i)
+                stds = reps[:, 1, N // 2, N // 2]  # each replicate's flat standard
+                ff = np.array([np.sum(p * on_fft_grid(kr[0], N, N, True)) for kr in reps])
+                ff_o = np.array([np.sum(p * on_fft_grid(kr[0], N, N)) for kr in reps])
+                glosses = g["assigned"] * ff / stds  # a replicate's sample and standard share its samples
+                gloss = glosses.mean()
                 rec = {
-                    "flux_fraction": float(mean),
-                    "flux_fraction_error": float(err),
-                    "flux_fraction_standard": float(std),
+                    "flux_fraction": float(ff.mean()),
+                    "flux_fraction_error": float(spread(ff)),
+                    "flux_fraction_standard": float(stds.mean()),
                     "gloss": float(gloss),
-                    "gloss_error": float(g["assigned"] * err / std),
-                    "gloss_other_sign": float(g["assigned"] * ff_o.mean() / std),
+                    "gloss_error": float(spread(glosses)),
+                    "gloss_mirrored_f": float(np.mean(g["assigned"] * ff_o / stds)),
                     "specular_cell_power": float(p[0, 0]),
                     "sum_p": psum,
                 }
                 if edge == "taper":
                     ps = power(zl, qz, edge, symmetric_hann=True)
-                    fs = np.mean([rf * np.sum(ps * on_fft_grid(kr, N, N)) for kr in reps])
-                    rec["taper_symmetric_hann_gloss"] = float(g["assigned"] * fs / std)
+                    fs = np.array([np.sum(ps * on_fft_grid(kr[0], N, N, True)) for kr in reps])
+                    rec["taper_symmetric_hann_gloss"] = float(np.mean(g["assigned"] * fs / stds))
                 if edge == "periodic" and name.startswith("gauss"):
                     want = float(np.exp(-((qz * sq_l) ** 2)))
                     checks["gaussian_specular"][f"{name}/{g['id']}"] = {
                         "p0": float(p[0, 0]), "exp(-(q_z Sq)^2)": want, "ratio": float(p[0, 0] / want)}
                 entry["readings"][edge][g["id"]] = rec
-                print(f"{name:12s} {edge:8s} {g['id']}: flux {mean:.6e} ± {err:.1e}, gloss {gloss:9.4f} "
-                      f"± {rec['gloss_error']:.1e} (other sign {rec['gloss_other_sign']:9.4f}"
+                print(f"{name:12s} {edge:8s} {g['id']}: flux {rec['flux_fraction']:.6e} ± {rec['flux_fraction_error']:.1e}, gloss {gloss:9.4f} "
+                      f"± {rec['gloss_error']:.1e} (mirrored f {rec['gloss_mirrored_f']:9.4f}"
                       + (f", symmetric Hann {rec['taper_symmetric_hann_gloss']:9.4f}" if edge == "taper" else "")
                       + f"), p(0) {p[0, 0]:.4e}, Σp-1 {psum - 1:.1e}", flush=True)
         surfaces[name] = entry
@@ -412,17 +430,18 @@ def main():
         "levelling": "least-squares plane over the valid points",
         "q_z": "k (cos θi + cos θo,c), θo,c = θi (the gloss receptor's centre is the specular)",
         "power": "p(f) = |FFT2(w exp(i q_z z))|² / (N Σw²), numpy.fft.fft2 (exp(-2πi f·x)), fftfreq grid",
-        "direction": "(o_x, o_y) = (-s_x, -s_y) + λ f; p(f) uniform over its cell; o_x² + o_y² ≥ 1 lost",
+        "direction": "(o_x, o_y) = (-s_x, -s_y) - λ f; p(f) uniform over its cell; o_x² + o_y² ≥ 1 lost",
         "edges": {"periodic": "w = 1", "taper": "w = h(x) h(y), h[n] = sin²(π n / N) (periodic Hann)"},
         "source_average": "uniform radiance over the source stop, weight cos θi dω (docs/instrument.md §1.4)",
-        "fresnel": "unpolarised R_F(n, θ) at the geometry's nominal angle θ, sample n = ior, standard n = "
-                   "reference_index (1.567) read by the same formula as a flat map",
+        "fresnel": "unpolarised R_F(n, θh) at the half angle between the source direction and the ray, point by "
+                   "point; sample n = ior, standard n = reference_index (1.567) read by the same formula as a "
+                   "flat map",
         "stops": "standards/astm-d523-{20,60,85}.json, docs/instrument.md §1.2 tangent coordinates",
         "method": f"kernel K(f) by stratified jittered sampling: {NS}x{NS} source strata × {NC}x{NC} sub-cell "
                   f"strata per replicate, {REPLICATES} independent replicates (seed {SEED})",
-        "error_estimate": "flux_fraction_error = 3 × standard error of the replicates' mean + their range / R; "
-                          "gloss_error the same scaled to GU (the standard's own flux is exact: K(0) = 1)",
-        "other_sign": "gloss_other_sign: p(f) read at -f (the geometrically signed direction; see the script)",
+        "error_estimate": "3 × standard error of the replicates' mean + their range / R, of the flux fraction and "
+                          "of the gloss (each replicate's gloss from its own sample and standard fluxes)",
+        "mirrored_f": "gloss_mirrored_f: the direction (-s_x, -s_y) + λ f of the script's first version",
         "surfaces": "white noise (PCG64, per-surface seed) filtered in the Fourier domain, float64, written "
                     "as f32 GSF; the reference is computed from the f32 values read back",
     }

@@ -46,6 +46,7 @@ pub(crate) mod annotated;
 pub(crate) mod conductor;
 pub mod dielectric;
 pub mod halo;
+pub(crate) mod kirchhoff;
 pub mod lambert;
 pub(crate) mod map_two_scale;
 pub mod mixture;
@@ -269,6 +270,30 @@ pub(crate) fn below_horizon(wi: Vec3, wo: Vec3, out: &mut [f64]) -> bool {
     below
 }
 
+/// A material whose aperture fluxes come from a far field (docs/optics.md §11): `aperture_flux(θ, viewing,
+/// source stop, receptor stop)` with the stops as tangent-coordinate boxes `[[p0, p1], [q0, q1]]`
+/// (docs/instrument.md §1.2) gives the grey flux ∫_S R·P(R | ωi) cos θi dωi (the units of docs/instrument.md §1.4)
+/// with its numerical error and its data (speckle) uncertainty, or why this receptor cannot be read (a reading
+/// marked with it).
+pub trait FarField: Send + Sync {
+    fn aperture_flux(
+        &self,
+        theta: f64,
+        viewing: f64,
+        source: [[f64; 2]; 2],
+        receptor: [[f64; 2]; 2],
+    ) -> std::result::Result<FarFieldFlux, String>;
+}
+
+/// One grey aperture flux of a [`FarField`]: its value, the estimate of its numerical error, and its data
+/// uncertainty (docs/optics.md §11.3–§11.4).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FarFieldFlux {
+    pub value: f64,
+    pub error: f64,
+    pub data_uncertainty: f64,
+}
+
 /// A reflectance model. Implementations must be pure: the same arguments give the same bits.
 pub trait Brdf: Send + Sync + std::fmt::Debug {
     /// The spectral samples this model evaluates.
@@ -335,6 +360,13 @@ pub trait Brdf: Send + Sync + std::fmt::Debug {
     /// copy of the table, which a plan asks for once.
     fn coarser(&self) -> Vec<std::sync::Arc<dyn Brdf>> {
         Vec::new()
+    }
+
+    /// The material's own aperture fluxes, when it is read by a far field rather than by integrating its BRDF
+    /// (a topography read by the Kirchhoff method, docs/optics.md §11): the planner then takes each specimen
+    /// aperture flux from it and the quadrature runs on nothing. None (the default) for every BRDF.
+    fn far_field(&self) -> Option<&dyn FarField> {
+        None
     }
 
     /// A one-line human description, e.g. "microfacet (GGX α = 0.1, n = 1.5, Smith height-correlated)".

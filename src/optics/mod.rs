@@ -28,11 +28,15 @@
 //!   PSD's transfer ([`levelling::Application`], [`levelling::psd_transfer`]);
 //! * `tabulated.rs`: piecewise Chebyshev tables of smooth functions of one variable, accepted only with their
 //!   error verified when built ([`tabulated::ChebTable`]; the node and basis helpers the coat-albedo table uses);
+//! * `kirchhoff.rs` (on `fresnel.rs` and the Gauss–Legendre rule): the scalar Beckmann–Kirchhoff far field of a
+//!   height map by one FFT and the flux it sends into a receptor stop, with its validity refusals
+//!   ([`kirchhoff::KirchhoffMap`], [`kirchhoff::Edge`], [`kirchhoff::Refusal`]; docs/optics.md §11);
 //! * `coat_albedo.rs`: the directional albedo E(μ) of a rough coat's lobe and its mean Ē
 //!   ([`coat_albedo::CoatAlbedo`], read from the shipped table `assets/coat-albedo-table.bin` or computed by
 //!   the module's reference rule; [`coat_albedo::lobe_albedo`]).
 pub mod coat_albedo;
 pub mod fresnel;
+pub mod kirchhoff;
 pub mod kubelka_munk;
 pub mod levelling;
 pub mod microfacet;

@@ -6,11 +6,14 @@
 use std::sync::Arc;
 
 use super::measured::resolve;
+use crate::brdf::annotated::Annotated;
 use crate::brdf::halo::Halo;
+use crate::brdf::kirchhoff::KirchhoffSurface;
 use crate::brdf::map_two_scale::{MapTwoScale, ShortWaves};
 use crate::brdf::topography::TopographySurface;
 use crate::brdf::Brdf;
 use crate::input::json::Obj;
+use crate::optics::kirchhoff::{Edge, KirchhoffMap};
 use crate::optics::microfacet::Microfacet;
 use crate::optics::slope_table::SlopeTable;
 use crate::registry::{self, Param};
@@ -28,17 +31,83 @@ pub(crate) fn parse_topography(obj: &Obj) -> Result<Arc<dyn Brdf>> {
     let ior = obj.param(&registry::TOPOGRAPHY_IOR)?;
     let (map, levelled, levelling) = levelled_map(obj, &registry::TOPOGRAPHY_FILE, &registry::TOPOGRAPHY_LEVELLING)?;
     let wrap = |e: Error| obj.err("file", format!("not a topography this model reads: {e}"));
+    if let Some(edge) = kirchhoff_edge(obj)? {
+        let source = format!("{}, levelling {}", map.file, levelling.name());
+        let km = KirchhoffMap::new(&levelled.z, (map.nx, map.ny), (map.dx, map.dy), GREY_WAVELENGTH, ior, edge)
+            .map_err(|m| obj.err("file", format!("{}: {m}", map.file)))?;
+        return Ok(Arc::new(KirchhoffSurface::new(km, obj.file.to_string(), source)));
+    }
     if let Some(split) = scale_split(obj)? {
         let source = format!("{}, levelling {}", map.file, levelling.name());
         let field = if matches!(split, Split::At(_)) { "split_frequency" } else { "file" };
         let m = from_heights(&levelled.z, (map.nx, map.ny), (map.dx, map.dy), ior, split, source)
             .map_err(|(at_split, m)| obj.err(if at_split { field } else { "file" }, format!("{}: {m}", map.file)))?;
-        return Ok(Arc::new(m));
+        let sq = crate::topography::heights::heights(&levelled.z, &map.file).map_err(wrap)?.sq;
+        return Ok(match beyond_the_study(sq) {
+            Some(note) => Arc::new(Annotated { inner: Arc::new(m), note }),
+            None => Arc::new(m),
+        });
     }
     let s = slopes(&levelled.z, map.nx, map.ny, map.dx, map.dy, &map.file).map_err(wrap)?;
     let table = SlopeTable::from_slopes(&s.sx, &s.sy).map_err(|m| obj.err("file", format!("{}: {m}", map.file)))?;
     let source = format!("{}, levelling {}", map.file, levelling.name());
     Ok(Arc::new(TopographySurface::new(table, ior, source)?))
+}
+
+/// The largest roughness phase 4π·Sq/λ (at the grey wavelength) at which the study of docs/optics.md §11.6
+/// found the two-scale surface reading what the map's Kirchhoff far field reads, to 0.1 GU at D523 20°/60°/85°
+/// (Sq ≤ 10 nm; it found differences beyond 0.1 GU from Sq = 20 nm, phase 0.45, on).
+pub(crate) const TWO_SCALE_CHECKED_PHASE: f64 = 0.225;
+
+/// The note a two-scale surface carries when its map's roughness is beyond what the study checked
+/// (docs/optics.md §11.6), None within it.
+fn beyond_the_study(sq: f64) -> Option<String> {
+    let phase = 4.0 * std::f64::consts::PI * sq / GREY_WAVELENGTH;
+    (phase > TWO_SCALE_CHECKED_PHASE).then(|| {
+        format!(
+            "beyond the roughness where the two-scale surface was checked against the map's Kirchhoff far field \
+             (4π·Sq/λ = {phase:.3} with Sq = {:.1} nm, above {TWO_SCALE_CHECKED_PHASE}: Sq ≤ {:.1} nm at {:.0} nm): \
+             its gloss may differ from wave optics by more than 0.1 GU (docs/optics.md §11.6); \"method\": \
+             \"kirchhoff\" reads the map itself",
+            sq * 1e9,
+            TWO_SCALE_CHECKED_PHASE * GREY_WAVELENGTH / (4.0 * std::f64::consts::PI) * 1e9,
+            GREY_WAVELENGTH * 1e9
+        )
+    })
+}
+
+/// The grey sampling's wavelength, m (`Sampling::grey`, 560 nm), at which the Kirchhoff method reads a map.
+pub(crate) const GREY_WAVELENGTH: f64 = 560e-9;
+
+/// The Kirchhoff method's edge when the recipe asks for `"method": "kirchhoff"` (docs/optics.md §11), None for
+/// the BRDF (the default); an `edge` without it, or with a scale split, is refused.
+fn kirchhoff_edge(obj: &Obj) -> Result<Option<Edge>> {
+    let method = obj.opt_str(&obj.param_key(&registry::TOPOGRAPHY_METHOD))?;
+    let edge = obj.opt_str(&obj.param_key(&registry::TOPOGRAPHY_EDGE))?;
+    match method {
+        None | Some("brdf") => {
+            if edge.is_some() {
+                return Err(obj.err("edge", "an edge is read only with \"method\": \"kirchhoff\""));
+            }
+            Ok(None)
+        }
+        Some("kirchhoff") => {
+            for f in ["scale_split", "split_frequency"] {
+                if obj.get(f).is_some() {
+                    return Err(
+                        obj.err(f, "a scale split with \"method\": \"kirchhoff\"; the far field reads the whole map")
+                    );
+                }
+            }
+            match edge {
+                None => Ok(Some(Edge::Periodic)),
+                Some(s) => Edge::parse(s)
+                    .map(Some)
+                    .ok_or_else(|| obj.err("edge", format!("unknown edge {s:?}; allowed: periodic, taper"))),
+            }
+        }
+        Some(s) => Err(obj.err("method", format!("unknown method {s:?}; allowed: brdf, kirchhoff"))),
+    }
 }
 
 /// The two-scale split the recipe asks for (docs/optics.md §Two-scale surface of a measured map): None

@@ -14,6 +14,8 @@
 //! * [`heights`]: Sq, Sa, Sp, Sv, Sz, Ssk, Sku;
 //! * [`slopes`]: the cells' slopes, Sdq, Sdr and the slope-angle histogram;
 //! * [`psd`]: the 2-D PSD and its radial average;
+//! * [`synthetic`]: seeded random-phase maps from a PSD family (Gaussian, ABC, fractal, orange peel) and the
+//!   SplitMix64 generator they draw phases from;
 //! * [`analysis`]: the one call that levels a map and computes all of it;
 //! * `mod.rs` (this): [`load`] and [`from_bytes`], which tell the format from the file's first bytes.
 pub mod analysis;
@@ -25,6 +27,7 @@ pub mod psd;
 pub mod sdf;
 pub mod slopes;
 pub mod sur;
+pub mod synthetic;
 pub mod text;
 pub mod units;
 pub mod x3p;

@@ -98,3 +98,19 @@ pub fn fixture_readings(
     }
     out
 }
+
+/// A Gwyddion Simple Field file (docs/topography.md §Gwyddion GSF) of n × n heights `z` (m, row-major), `dx` m
+/// apart, stored as f32 µm.
+pub fn write_gsf(path: &std::path::Path, n: usize, dx: f64, z: &[f64]) {
+    let mut b = b"Gwyddion Simple Field 1.0\n".to_vec();
+    let side = n as f64 * dx * 1e6;
+    b.extend_from_slice(
+        format!("XRes = {n}\nYRes = {n}\nXReal = {side}\nYReal = {side}\nXYUnits = um\nZUnits = um\n").as_bytes(),
+    );
+    let pad = 4 - b.len() % 4;
+    b.extend(std::iter::repeat_n(0u8, pad));
+    for v in z {
+        b.extend_from_slice(&((v * 1e6) as f32).to_le_bytes());
+    }
+    std::fs::write(path, b).unwrap();
+}

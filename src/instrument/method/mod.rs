@@ -351,6 +351,9 @@ pub struct Flux {
     /// plan (`Plan::run`; `docs/accuracy.md` §Data uncertainty of measured tables); None for a model, and for
     /// an integral run on its own ([`Method::execute`]). Not part of `error`, which stays the numerical error.
     pub data_uncertainty: Option<Vec<f64>>,
+    /// Why the flux has no value, when its material refused it (a far field outside its validity,
+    /// docs/optics.md §11.4); the readings that use it carry this as their problem.
+    pub refused: Option<String>,
 }
 
 impl Flux {
@@ -369,6 +372,7 @@ impl Flux {
             seconds: 0.0,
             chart: None,
             data_uncertainty: None,
+            refused: None,
         }
     }
 }

@@ -492,6 +492,11 @@ impl Plan {
             return (skipped, freeze.then(|| method.clone()));
         }
         let material = self.material.as_ref();
+        if let Some(ff) = material.far_field() {
+            if method.aperture.target == Target::Specimen {
+                return (far_field_flux(ff, method), freeze.then(|| method.clone()));
+            }
+        }
         let exec = |m: &Method, b: &dyn Brdf| -> (Flux, Option<Method>) {
             if freeze {
                 let (f, m) = m.execute_and_freeze_until(b, deadline);
@@ -598,6 +603,39 @@ impl Plan {
     /// The fluxes known before execution: the standards', by job index.
     fn known_fluxes(&self) -> Vec<Option<Flux>> {
         self.standard_flux.clone()
+    }
+}
+
+/// A specimen flux from a material's far field (docs/optics.md §11; docs/architecture.md §From recipe to
+/// reading): the grey flux, its numerical error and its speckle uncertainty through the method's weighting, no
+/// evaluation of the BRDF; a refusal, or an integral that is no aperture integral (a sphere's), is a flux with
+/// no value whose readings carry the reason.
+fn far_field_flux(ff: &dyn crate::brdf::FarField, method: &Method) -> Flux {
+    let a = &method.aperture;
+    let k = method.weighting.len();
+    let start = std::time::Instant::now();
+    let got = match a.integral {
+        crate::instrument::geometry::Integral::Aperture => {
+            ff.aperture_flux(a.theta, a.viewing, [a.source.p, a.source.q], [a.receptor.p, a.receptor.q])
+        }
+        _ => Err("a sphere's integral is not read by the Kirchhoff method (docs/optics.md §11); read it with the \
+                  default method"
+            .into()),
+    };
+    match got {
+        Ok(f) => {
+            let w = &method.weighting;
+            let value = w.apply(&[f.value]);
+            Flux {
+                regular: value.clone(),
+                value,
+                error: (0..k).map(|c| w.component_error(c, &[f.error])).collect(),
+                data_uncertainty: Some((0..k).map(|c| w.component_error(c, &[f.data_uncertainty])).collect()),
+                seconds: start.elapsed().as_secs_f64(),
+                ..Flux::zero(k)
+            }
+        }
+        Err(why) => Flux { value: vec![f64::NAN; k], converged: false, refused: Some(why), ..Flux::zero(k) },
     }
 }
 

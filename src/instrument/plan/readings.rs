@@ -269,6 +269,10 @@ fn compute_reading(
         // The work done is reported as it was: only the value is withheld.
         return Reading { evaluations, seconds, ..problem_reading(r, why.into()) };
     }
+    if let Some(why) = used.iter().find_map(|f| f.refused.clone()) {
+        // A far field that refused this receptor (docs/optics.md §11.4): no value, the reason as the problem.
+        return Reading { evaluations, seconds, ..problem_reading(r, why) };
+    }
     let value = direct_value(r, flux, jobs, white_point, &|f, c, _| f.error[c]);
     // The data uncertainty: the same first-order propagation with each specimen flux's data uncertainty in
     // place of its error, and none on the standards' (analytic) fluxes.
