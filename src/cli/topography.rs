@@ -110,6 +110,10 @@ pub fn table(d: &TopographyDoc) -> String {
     row("Sdr", format!("{:.4e}", d.slopes.sdr), "");
     row("steepest slope", format!("{:.2}", d.slopes.max_angle_deg), "°");
     row("spectral rms slope", format!("{:.5}", d.slopes.spectral_rms_slope), "");
+    for w in &d.waves.bands {
+        let what = format!("{} ({}–{} mm, rms)", w.name, w.from_mm, w.to_mm);
+        row(&what, w.rms_um.map(g).unwrap_or_else(|| "—".into()), "µm");
+    }
     let mut s = format!("{}: {} topography\n", m.file, m.format);
     s.push_str(&pad_table(&rows, &[1]));
     s

@@ -124,6 +124,34 @@ pub struct TopographyPsdDoc {
     pub radial: Vec<RadialPsdDoc>,
 }
 
+/// One orange-peel band of the profiles along x (docs/topography.md §Orange-peel bands).
+#[derive(Clone, Debug, Serialize, JsonSchema)]
+#[schemars(transform = waves_nullable)]
+pub struct WaveBandDoc {
+    /// `Wa` … `We`, `SW` or `LW`.
+    pub name: String,
+    /// The band's wavelengths, mm (from inclusive, to exclusive).
+    pub from_mm: f64,
+    pub to_mm: f64,
+    /// The rms height of the profiles' components in the band, µm; null when the map cannot resolve it.
+    #[schemars(range(min = 0))]
+    pub rms_um: Option<f64>,
+    /// Why there is no value (the map too short or too coarse, or no complete row); null with a value.
+    pub problem: Option<String>,
+}
+
+fn waves_nullable(schema: &mut schemars::Schema) {
+    super::nullable_but_written(schema, &["rms_um", "problem"]);
+}
+
+/// The orange-peel bands.
+#[derive(Clone, Debug, Serialize, JsonSchema)]
+pub struct TopographyWavesDoc {
+    /// What the values are, in words: not the 0–100 scale of a wave-scan instrument.
+    pub convention: String,
+    pub bands: Vec<WaveBandDoc>,
+}
+
 /// `topography --format json`.
 #[derive(Clone, Debug, Serialize, JsonSchema)]
 pub struct TopographyDoc {
@@ -136,6 +164,7 @@ pub struct TopographyDoc {
     pub heights: TopographyHeightsDoc,
     pub slopes: TopographySlopesDoc,
     pub psd: TopographyPsdDoc,
+    pub waves: TopographyWavesDoc,
 }
 
 const UM: f64 = 1e6;
@@ -207,6 +236,23 @@ impl TopographyDoc {
                         // m⁴ → nm²·µm²: 10¹⁸ · 10¹².
                         psd_nm2_um2: b.s * 1e30,
                         count: b.count,
+                    })
+                    .collect(),
+            },
+            waves: TopographyWavesDoc {
+                convention: "rms height of the levelled profiles along x in each band, from each complete row's \
+                             periodogram (docs/topography.md §Orange-peel bands); the bands are the wave-scan \
+                             instruments', the values are not their 0–100 scale (unpublished)"
+                    .into(),
+                bands: a
+                    .waves
+                    .iter()
+                    .map(|w| WaveBandDoc {
+                        name: w.band.name.into(),
+                        from_mm: w.band.shortest * 1e3,
+                        to_mm: w.band.longest * 1e3,
+                        rms_um: w.rms.as_ref().ok().map(|v| v * UM),
+                        problem: w.rms.as_ref().err().cloned(),
                     })
                     .collect(),
             },

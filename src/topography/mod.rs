@@ -30,6 +30,7 @@ pub mod sur;
 pub mod synthetic;
 pub mod text;
 pub mod units;
+pub mod waves;
 pub mod x3p;
 
 use std::path::Path;
