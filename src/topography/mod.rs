@@ -14,6 +14,7 @@
 //! * [`heights`]: Sq, Sa, Sp, Sv, Sz, Ssk, Sku;
 //! * [`slopes`]: the cells' slopes, Sdq, Sdr and the slope-angle histogram;
 //! * [`psd`]: the 2-D PSD and its radial average;
+//! * [`waves`]: the orange-peel bands (Wa…We, SW, LW) of the profiles along x;
 //! * [`synthetic`]: seeded random-phase maps from a PSD family (Gaussian, ABC, fractal, orange peel) and the
 //!   SplitMix64 generator they draw phases from;
 //! * [`analysis`]: the one call that levels a map and computes all of it;
