@@ -59,6 +59,7 @@ def stats(z, dx, dy, degree=2):
     c10 = coef[powers.index((1, 0))]
     c01 = coef[powers.index((0, 1))]
     return {
+        "waves_um": waves(lev, dx),
         "points": [nx, ny],
         "invalid": int(n - valid.sum()),
         "sq_um": float(np.sqrt(np.mean(h**2))) * 1e6,
@@ -68,6 +69,36 @@ def stats(z, dx, dy, degree=2):
         "tilt_x": float(c10 / ((nx - 1) * dx / 2)),
         "tilt_y": float(c01 / ((ny - 1) * dy / 2)),
     }
+
+
+# The orange-peel bands of docs/topography.md §Orange-peel bands, mm (as `topography::waves::BANDS`).
+BANDS = [("Wa", 0.1, 0.3), ("Wb", 0.3, 1.0), ("Wc", 1.0, 3.0), ("Wd", 3.0, 10.0), ("We", 10.0, 30.0),
+         ("SW", 0.3, 1.2), ("LW", 1.2, 12.0)]
+
+
+def waves(lev, dx):
+    """The rms height (µm) of the rows' components in each band the map resolves, by numpy.fft.rfft: rows with
+    at least half their points valid, less the mean of those, invalid points at it, power × N/N_valid."""
+    ny, nx = lev.shape
+    length = nx * dx
+    k = np.arange(nx // 2 + 1)
+    fold = np.where((k == 0), 0.0, np.where(2 * k == nx, 1.0, 2.0))
+    spectra = []
+    for r in lev:
+        ok = np.isfinite(r)
+        if 2 * ok.sum() < nx:
+            continue
+        u = np.where(ok, r - r[ok].mean(), 0.0)
+        spectra.append(fold * np.abs(np.fft.rfft(u)) ** 2 / nx**2 * (nx / ok.sum()))
+    power = np.mean(spectra, axis=0)
+    out = {"rows": len(spectra)}
+    with np.errstate(divide="ignore"):
+        wavelength = np.where(k > 0, length / np.maximum(k, 1), np.inf)
+    for name, lo, hi in BANDS:
+        lo, hi = lo * 1e-3, hi * 1e-3
+        if hi <= length and lo >= 2 * dx:
+            out[name] = float(np.sqrt(power[(wavelength >= lo) & (wavelength < hi)].sum())) * 1e6
+    return out
 
 
 def main():
