@@ -123,10 +123,9 @@ mod tests {
         assert!((get("Wa").unwrap() - 1e-6 / 2f64.sqrt()).abs() < 1e-15, "{:?}", get("Wa"));
         assert!((get("Wc").unwrap() - 3e-6 / 2f64.sqrt()).abs() < 1e-15, "{:?}", get("Wc"));
         assert!(get("Wb").unwrap() < 1e-18 && get("SW").unwrap() < 1e-18);
-        assert!((get("LW").unwrap() - 3e-6 / 2f64.sqrt()).abs() < 1e-15);
-        // Wd needs 10 mm and We 30 mm of profile: refused, saying so.
+        // Wd, We and LW need 10, 30 and 12 mm of profile: refused, saying so.
         assert!(get("Wd").unwrap_err().contains("4.000 mm long"));
-        assert!(get("We").is_err());
+        assert!(get("We").is_err() && get("LW").unwrap_err().contains("needs 12.000 mm"));
     }
 
     #[test]
