@@ -817,6 +817,17 @@ pub fn generate_registry_recipe(rng: &mut Rng) -> String {
     if model == "topography" {
         let f = root().join("fixtures/topography/gaussian.x3p");
         obj.insert("file".into(), json!(f.to_string_lossy()));
+        // An edge is the Kirchhoff method's, which reads the whole map (no scale split); a third of the
+        // recipes are read by it.
+        if obj.contains_key("edge") || rng.chance(0.33) {
+            obj.insert("method".into(), json!("kirchhoff"));
+        }
+        if obj.get("method").and_then(|v| v.as_str()) == Some("kirchhoff") {
+            obj.remove("scale_split");
+            obj.remove("split_frequency");
+        } else {
+            obj.remove("edge");
+        }
     }
     Value::Object(obj).to_string()
 }
