@@ -23,6 +23,21 @@ const PANEL_TARGETS: [&str; 12] = [
     "rhopoint-iq-20/rspec=26.1",
 ];
 
+/// The five free parameters of the three-population model and their bounds (docs/instrument.md §1.10), as
+/// `fit` arguments.
+const THREE_POPULATION_FREE: [&str; 10] = [
+    "--free",
+    "/ior=1.3..1.8",
+    "--free",
+    "/populations/1/roughness=log:1e-3..0.05",
+    "--free",
+    "/populations/1/weight=0.001..0.7",
+    "--free",
+    "/populations/2/roughness=log:0.01..0.5",
+    "--free",
+    "/populations/2/weight=0.001..0.5",
+];
+
 fn fit(args: &[&str]) -> (i32, Value, String) {
     let out = common::glossmeter()
         .arg("fit")
@@ -120,23 +135,9 @@ fn the_orange_peel_panel_is_not_reproduced_and_the_85_degree_gloss_is_why() {
 /// within 2u, and the index must be a lacquer's.
 #[test]
 fn the_orange_peel_panel_is_a_lacquer_of_three_slope_populations() {
-    let (code, doc, err) = fit(&[
-        &["fixtures/real/models/panel-three-populations.json"][..],
-        &PANEL_TARGETS,
-        &[
-            "--free",
-            "/ior=1.3..1.8",
-            "--free",
-            "/populations/1/roughness=log:1e-3..0.05",
-            "--free",
-            "/populations/1/weight=0.001..0.7",
-            "--free",
-            "/populations/2/roughness=log:0.01..0.5",
-            "--free",
-            "/populations/2/weight=0.001..0.5",
-        ],
-    ]
-    .concat());
+    let (code, doc, err) =
+        fit(&[&["fixtures/real/models/panel-three-populations.json"][..], &PANEL_TARGETS, &THREE_POPULATION_FREE]
+            .concat());
     assert_eq!(code, 0, "{err}");
     check(&doc, 6);
     let p = doc["parameters"].as_array().unwrap();
@@ -231,25 +232,8 @@ fn leave_one_out_predictions_are_those_the_docs_state() {
             args.extend(["--target", t]);
         }
         assert_eq!(args.len(), 2 + 2 * 5, "{held} is one of the six readings");
-        args.extend([
-            "--free",
-            "/ior=1.3..1.8",
-            "--free",
-            "/populations/1/roughness=log:1e-3..0.05",
-            "--free",
-            "/populations/1/weight=0.001..0.7",
-            "--free",
-            "/populations/2/roughness=log:0.01..0.5",
-            "--free",
-            "/populations/2/weight=0.001..0.5",
-            "--restarts",
-            "0",
-            "--format",
-            "json",
-            "--no-timing",
-            "-o",
-            fitted.to_str().unwrap(),
-        ]);
+        args.extend(THREE_POPULATION_FREE);
+        args.extend(["--restarts", "0", "--format", "json", "--no-timing", "-o", fitted.to_str().unwrap()]);
         let (code, report, err) = common::gm(&args);
         assert_eq!(code.to_string(), *exit, "α₁ {alpha}, {held} held out: {err}");
         let report: Value = serde_json::from_str(&report).unwrap();
