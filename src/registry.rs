@@ -942,7 +942,7 @@ pub(crate) const TOPOGRAPHY_FILE: Param = p(
     "",
     NONE,
     Req,
-    "path of the measured topography (.x3p, .sdf, .gsf or .sur: a file that carries its own lateral calibration), relative to the recipe's directory",
+    "path of the measured topography (.x3p, .sdf, .gsf or .sur: a file that carries its own lateral calibration), relative to the recipe's directory; from Python, a glossmeter.height_map of a NumPy array",
 );
 pub(crate) const TOPOGRAPHY_IOR: Param = p(
     "/ior",
@@ -1180,7 +1180,7 @@ pub(crate) const APP_TEXTURE_FILE: Param = p(
     "",
     NONE,
     Opt("give this or psd"),
-    "a measured topography of the texture as applied (.x3p, .sdf, .gsf or .sur), relative to the recipe's directory: its own 2-D PSD is levelled, over the map's band (docs/model.md §From the cured spectrum to the coat)",
+    "a measured topography of the texture as applied (.x3p, .sdf, .gsf or .sur), relative to the recipe's directory, or from Python a glossmeter.height_map: its own 2-D PSD is levelled, over the map's band (docs/model.md §From the cured spectrum to the coat)",
 );
 pub(crate) const APP_TEXTURE_LEVELLING: Param = p(
     "/clear_coat/application/texture/levelling",

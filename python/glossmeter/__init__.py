@@ -34,11 +34,13 @@ import numpy.typing as npt
 from . import _glossmeter
 from ._glossmeter import (
     DEFAULT_GEOMETRIES,
+    HeightMap,
     __version__,
     convergence,
     describe,
     describe_geometry,
     geometry,
+    height_map,
     schema,
     standards,
     topography,
@@ -155,6 +157,8 @@ __all__ = [
     "sweep_rows",
     "to_arrays",
     "topography",
+    "height_map",
+    "HeightMap",
     "to_frame",
 ]
 

@@ -1,7 +1,7 @@
 """Stubs of the compiled module ``glossmeter._glossmeter`` (python/src/lib.rs, python/src/pybrdf.rs). The
 public API is ``glossmeter`` (``__init__.py``), which re-exports these with ``as_frame``/``as_arrays`` added."""
 import os
-from typing import Any, Dict, List, Literal, Optional, Sequence, Union
+from typing import Any, Dict, List, Literal, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -125,8 +125,28 @@ def convergence(
     max_repetitions: Optional[int] = None,
     reference_run: bool = False,
 ) -> ConvergenceReport: ...
+class HeightMap:
+    """A height map held in memory for recipes: a recipe's ``file`` (a topography's, a paint's applied
+    texture) may be one. Made by :func:`height_map`; pickles (to a Dask worker) bit for bit."""
+
+    @property
+    def label(self) -> str: ...
+    @property
+    def shape(self) -> Tuple[int, int]: ...
+    @property
+    def dx_um(self) -> float: ...
+    @property
+    def dy_um(self) -> float: ...
+
+def height_map(
+    array: npt.NDArray[Any],
+    dx_um: float,
+    dy_um: Optional[float] = None,
+    unit: Optional[Literal["m", "mm", "um", "µm", "nm", "pm"]] = None,
+    mask: Optional[npt.NDArray[np.bool_]] = None,
+) -> HeightMap: ...
 def topography(
-    source: Union[npt.NDArray[Any], str, os.PathLike[str]],
+    source: Union[npt.NDArray[Any], HeightMap, str, os.PathLike[str]],
     dx_um: Optional[float] = None,
     dy_um: Optional[float] = None,
     unit: Optional[Literal["m", "mm", "um", "µm", "nm", "pm"]] = None,

@@ -70,7 +70,9 @@ pub(crate) fn json_text(py: Python<'_>, obj: &Bound<'_, PyAny>) -> PyResult<Stri
         )));
     }
     let json = py.import("json")?;
-    json.call_method1("dumps", (obj,))?.extract()
+    let kwargs = PyDict::new(py);
+    kwargs.set_item("default", wrap_pyfunction!(topography::json_default, py)?)?;
+    json.call_method("dumps", (obj,), Some(&kwargs))?.extract()
 }
 
 /// The JSON Pointer of the first float that is not finite inside `obj` (through dicts, lists and tuples, to a
@@ -422,6 +424,9 @@ fn _glossmeter(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(_panic, m)?)?;
     m.add_function(wrap_pyfunction!(pybrdf::measure_brdf, m)?)?;
     m.add_function(wrap_pyfunction!(topography::topography, m)?)?;
+    m.add_function(wrap_pyfunction!(topography::height_map, m)?)?;
+    m.add_function(wrap_pyfunction!(topography::_height_map_m, m)?)?;
+    m.add_class::<topography::PyHeightMap>()?;
     actions::add(m)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add("DEFAULT_GEOMETRIES", glossmeter::api::DEFAULT_PANEL.to_vec())?;

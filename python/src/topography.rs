@@ -1,22 +1,26 @@
 //! Height maps from Python (docs/python.md §Topography): a 2-D NumPy array of heights with its pixel spacing,
 //! or a topography file, as the library's [`HeightMap`], converted in this one place with the library's own
 //! checks (docs/topography.md §Limits): the dimensions before anything is copied, the spacings, the heights'
-//! range; NaN heights and the points a mask clears are invalid points, as a file reader marks them.
+//! range; NaN heights and the points a mask clears are invalid points, as a file reader marks them. A map held
+//! for recipes ([`PyHeightMap`]) is registered in the library's `topography::memory`, whose label a recipe's
+//! `file` entry carries through `json.dumps` ([`json_default`]).
 use std::path::PathBuf;
 
 use glossmeter::report::topography::TopographyDoc;
 use glossmeter::request::TopographyRequest;
 use glossmeter::topography::analysis::analyse;
 use glossmeter::topography::map::{check_dimensions, check_spacing, Format, HeightMap};
+use glossmeter::topography::memory::InMemory;
 use glossmeter::topography::text::Calibration;
 use glossmeter::topography::units;
-use numpy::PyReadonlyArray2;
+use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray2};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyString;
 
 use crate::args::{opt_real, opt_string, type_name};
 use crate::{from_json, guarded, to_py_err};
+use pyo3::types::PyTuple;
 
 /// How a map from an array names itself in messages and in the document's `map.file`.
 const ARRAY: &str = "<array>";
@@ -135,7 +139,14 @@ pub(crate) fn topography<'py>(
                 check_spacing(ARRAY, name, d).map_err(to_py_err)?;
             }
         }
-        let map = if py.import("numpy")?.getattr("ndarray").and_then(|t| source.is_instance(&t))? {
+        let map = if let Ok(held) = source.cast::<PyHeightMap>() {
+            if dx.is_some() || dy.is_some() || given(unit) || given(mask) {
+                return Err(PyValueError::new_err(
+                    "dx_um, dy_um, unit, mask: not for a HeightMap, which carries its calibration and invalid points",
+                ));
+            }
+            held.get().held.map().clone()
+        } else if py.import("numpy")?.getattr("ndarray").and_then(|t| source.is_instance(&t))? {
             let dx = dx.ok_or_else(|| {
                 PyValueError::new_err("dx_um: missing: an array carries no calibration; give its pixel spacing in µm")
             })?;
@@ -169,4 +180,115 @@ fn file_path(py: Python<'_>, source: &Bound<'_, PyAny>) -> PyResult<PathBuf> {
             type_name(source)
         ))),
     }
+}
+
+/// Whether an optional keyword was given (not absent, not None).
+fn given(v: Option<&Bound<'_, PyAny>>) -> bool {
+    v.is_some_and(|v| !v.is_none())
+}
+
+/// A height map held in memory for recipes (docs/python.md §Topography): a recipe's `file` entry (the
+/// `topography` model's, a paint's applied texture) may be one, and every reading, sweep and fit of that
+/// recipe reads it. Pickled (to a Dask worker), it is registered again where it is unpickled, bit for bit.
+#[pyclass(frozen, name = "HeightMap", module = "glossmeter")]
+pub(crate) struct PyHeightMap {
+    held: InMemory,
+}
+
+#[pymethods]
+impl PyHeightMap {
+    /// The label a recipe carries in its place (`<height map N>`), and the map's name in messages.
+    #[getter]
+    fn label(&self) -> &str {
+        self.held.label()
+    }
+
+    /// (rows, columns): points along y and along x.
+    #[getter]
+    fn shape(&self) -> (usize, usize) {
+        let m = self.held.map();
+        (m.ny, m.nx)
+    }
+
+    /// The pixel spacing along x, µm.
+    #[getter]
+    fn dx_um(&self) -> f64 {
+        self.held.map().dx * 1e6
+    }
+
+    /// The pixel spacing along y, µm.
+    #[getter]
+    fn dy_um(&self) -> f64 {
+        self.held.map().dy * 1e6
+    }
+
+    fn __repr__(&self) -> String {
+        let m = self.held.map();
+        format!("HeightMap({}, {} × {} points, dx {} µm, dy {} µm)", m.file, m.ny, m.nx, m.dx * 1e6, m.dy * 1e6)
+    }
+
+    /// Pickled as its heights in metres (NaN at invalid points) and its spacings in metres, so that the map
+    /// registered again on unpickling is the same to the bit.
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyTuple>)> {
+        let m = self.held.map();
+        let z = PyArray1::from_slice(py, &m.z).reshape([m.ny, m.nx])?;
+        let rebuild = py.import("glossmeter._glossmeter")?.getattr("_height_map_m")?;
+        Ok((
+            rebuild,
+            PyTuple::new(py, [z.into_any(), m.dx.into_pyobject(py)?.into_any(), m.dy.into_pyobject(py)?.into_any()])?,
+        ))
+    }
+}
+
+/// height_map(array, dx_um, dy_um=None, unit=None, mask=None) -> HeightMap
+///
+/// A 2-D NumPy array of heights (rows along y; `unit` "um" when None) with its pixel spacing in µm (`dy_um`
+/// `dx_um` when None) and an optional bool mask (True: valid), checked as `topography` checks it and held in
+/// memory for recipes: `{"model": "topography", "file": glossmeter.height_map(z, dx_um=2.0), "ior": 1.5}`.
+#[pyfunction]
+#[pyo3(signature = (array, dx_um, dy_um=None, unit=None, mask=None))]
+pub(crate) fn height_map<'py>(
+    py: Python<'py>,
+    array: &Bound<'py, PyAny>,
+    dx_um: &Bound<'py, PyAny>,
+    dy_um: Option<&Bound<'py, PyAny>>,
+    unit: Option<&Bound<'py, PyAny>>,
+    mask: Option<&Bound<'py, PyAny>>,
+) -> PyResult<PyHeightMap> {
+    guarded(|| {
+        let dx = spacing_um("dx_um", Some(dx_um))?
+            .ok_or_else(|| PyValueError::new_err("dx_um: missing: give the array's pixel spacing in µm"))?;
+        let dy = spacing_um("dy_um", dy_um)?.unwrap_or(dx);
+        for (name, d) in [("dx_um", dx), ("dy_um", dy)] {
+            check_spacing(ARRAY, name, d).map_err(to_py_err)?;
+        }
+        let map = from_array(py, array, dx, dy, height_unit(unit)?, mask)?;
+        Ok(PyHeightMap { held: InMemory::register(map) })
+    })
+}
+
+/// The inverse of `HeightMap.__reduce__`: heights and spacings in metres.
+#[pyfunction]
+pub(crate) fn _height_map_m<'py>(py: Python<'py>, z: &Bound<'py, PyAny>, dx: f64, dy: f64) -> PyResult<PyHeightMap> {
+    guarded(|| {
+        let map = from_array(py, z, dx, dy, 1.0, None)?;
+        Ok(PyHeightMap { held: InMemory::register(map) })
+    })
+}
+
+/// `json.dumps`'s `default` for a recipe: a [`PyHeightMap`] is written as its label (which the library finds
+/// in `topography::memory`); a bare array is refused with the way to give its calibration; anything else as
+/// `json.dumps` refuses it.
+#[pyfunction]
+pub(crate) fn json_default<'py>(py: Python<'py>, o: &Bound<'py, PyAny>) -> PyResult<String> {
+    if let Ok(held) = o.cast::<PyHeightMap>() {
+        return Ok(held.get().held.label().to_string());
+    }
+    if py.import("numpy")?.getattr("ndarray").and_then(|t| o.is_instance(&t))? {
+        return Err(PyTypeError::new_err(
+            "a NumPy array in a recipe carries no pixel spacing: give glossmeter.height_map(array, dx_um=…) \
+             (a topography's `file`), or a list",
+        ));
+    }
+    Err(PyTypeError::new_err(format!("Object of type {} is not JSON serializable", type_name(o))))
 }

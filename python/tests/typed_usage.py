@@ -64,6 +64,10 @@ def usage() -> None:
     pixels: pd.DataFrame = glossmeter.profile("r.json", as_frame=True)
     budgeted: List[Reading] = glossmeter.measure("r.json", max_evals=1000, max_seconds=5.0, illuminant="A")
     print(verdicts.shape, params.shape, pixels.shape, budgeted[0]["value"])
+    held: glossmeter.HeightMap = glossmeter.height_map(np.zeros((8, 8)), 1.0, unit="nm")
+    from_map: List[Reading] = glossmeter.measure({"model": "topography", "file": held, "ior": 1.5})
+    stats: Dict[str, Any] = glossmeter.topography(held)
+    print(held.shape[0] + 1, held.dx_um + held.dy_um, held.label.upper(), from_map[0]["value"], stats["map"])
 
     # What the types refuse (each ignore is needed, or mypy --strict fails on an unused one):
     glossmeter.measure(42)  # type: ignore[call-overload]

@@ -20,6 +20,7 @@ use crate::registry::{self, Param};
 use crate::spectrum::Sampling;
 use crate::topography::level::{level, Levelled, Levelling};
 use crate::topography::map::HeightMap;
+use crate::topography::memory;
 use crate::topography::psd::{low_pass, psd, Psd2};
 use crate::topography::slopes::slopes;
 use crate::{Error, Result};
@@ -132,8 +133,9 @@ fn scale_split(obj: &Obj) -> Result<Option<Split>> {
     }
 }
 
-/// The topography that `obj`'s `file` entry names (resolved against the recipe's directory), levelled as its
-/// `levelling` entry says (the plane when absent): the map, its levelled heights and the levelling.
+/// The topography that `obj`'s `file` entry names (a map held in memory under that label, `topography::memory`,
+/// or a file resolved against the recipe's directory), levelled as its `levelling` entry says (the plane when
+/// absent): the map, its levelled heights and the levelling.
 pub(crate) fn levelled_map(obj: &Obj, file: &Param, levelling: &Param) -> Result<(HeightMap, Levelled, Levelling)> {
     let name = obj.str(&obj.param_key(file))?;
     if name.is_empty() {
@@ -145,6 +147,20 @@ pub(crate) fn levelled_map(obj: &Obj, file: &Param, levelling: &Param) -> Result
             obj.err("levelling", format!("unknown levelling {s:?}; allowed: {}", Levelling::allowed()))
         })?,
     };
+    if name.starts_with(memory::LABEL_PREFIX) {
+        let map = memory::lookup(name).ok_or_else(|| {
+            obj.err(
+                "file",
+                format!(
+                    "{name} names a height map held in memory, and none is held under it: the map was released, \
+                     or belongs to another process (a recipe sent elsewhere must name a topography file)"
+                ),
+            )
+        })?;
+        let levelled =
+            level(&map, how).map_err(|e| obj.err("file", format!("not a topography this model reads: {e}")))?;
+        return Ok(((*map).clone(), levelled, how));
+    }
     let path = resolve(obj.file, name);
     let wrap = |e: Error| match e {
         Error::Io { file: f, source } => obj.err("file", format!("cannot read the topography {f}: {source}")),

@@ -17,6 +17,7 @@
 //! * [`waves`]: the orange-peel bands (Wa…We, SW, LW) of the profiles along x;
 //! * [`synthetic`]: seeded random-phase maps from a PSD family (Gaussian, ABC, fractal, orange peel) and the
 //!   SplitMix64 generator they draw phases from;
+//! * [`memory`]: maps held in memory under a label a recipe names as a file (the Python package's arrays);
 //! * [`analysis`]: the one call that levels a map and computes all of it;
 //! * `mod.rs` (this): [`load`] and [`from_bytes`], which tell the format from the file's first bytes.
 pub mod analysis;
@@ -24,6 +25,7 @@ pub mod gsf;
 pub mod heights;
 pub mod level;
 pub mod map;
+pub mod memory;
 pub mod psd;
 pub mod sdf;
 pub mod slopes;
