@@ -154,7 +154,7 @@ const INLINE_MEDIA: usize = 26;
 /// cos θ = `cos_i`) and an exit medium `n_out` (complex allowed), at `wavelength_nm`.
 ///
 /// Angles: the tangential invariant n_in sin θ_in is real; in each medium n cos θ = √(n² − n_in² sin²θ_in)
-/// on the decaying/forward branch, computed without cancellation ([`medium_cos`]: a medium of the ambient
+/// on the decaying/forward branch, computed without cancellation (`medium_cos`: a medium of the ambient
 /// index has cos θ_in itself, the others √((n − n_in)(n + n_in) + (n_in cos θ_in)²)).
 /// Coherent layers: [`coherent_amplitudes`] per polarisation (convention of
 /// [`crate::optics::fresnel::amplitudes`]), R = |ρ|², T = |τ|² Re(n_out cos θout)/(n_in cos θin) for s and
@@ -196,8 +196,9 @@ fn medium_cos(n_in: f64, mu: f64, n: Complex64, near: Option<KinkOffset>) -> Com
 /// [`stack`] at one angle of incidence and several wavelengths: `each(i, result)` for the i-th wavelength, the
 /// same bits as `stack(n_in, layers, n_out, cos_i, wavelength)` when `near` is None. `near`: `cos_i` is on a
 /// table segment at a critical cosine μc of one of the layers, with `cos_i` − μc exactly as the table has it
-/// (`optics::tabulated::Abscissa`); that layer's cosine is then computed from it ([`medium_cos`]). What does not depend on the wavelength (every
-/// medium's cos θ, every interface's amplitudes r, t) is computed once for all of them; per wavelength only
+/// (`optics::tabulated::Abscissa`); that layer's cosine is then computed from it ([`medium_cos`]). What does
+/// not depend on the wavelength (every medium's cos θ, every interface's amplitudes r, t) is computed once for
+/// all of them; per wavelength only
 /// the layers' phases e^{iφⱼ} (once per distinct layer: a stack that repeats a layer, as the pearl's
 /// TiO₂/mica/TiO₂ does, computes its phase once) and the recursions remain (`docs/model.md` §Evaluation cost).
 pub(crate) fn stack_spectrum(
