@@ -126,7 +126,8 @@ fn sweep_points() {
 /// points from 1.3 to 1.8"): each shipped paint with flakes, its coat index set to η, built with an empty memo
 /// (a coat-index point always misses it: every flake table depends on η), the median of the build times; beside it
 /// the ratio to the cost at η = 1.5 and whether every flake is read from its tables (`Paint::flake_tables`) or
-/// evaluated directly. `PAINT_BUILD=coat`.
+/// evaluated directly; η in steps of 0.02 (`PAINT_COAT_STEP=0.01`: every coat index of `tests/paint.rs`), and the
+/// film-stack reflectances ρ(μ, λ) a build computes (`TableWork`, exact) against η = 1.5. `PAINT_BUILD=coat`.
 fn coat_index_points() {
     println!("### A coat-index sweep point from 1.3 to 1.8: building the paint with its coat index set to η\n");
     let fixtures = [
@@ -138,43 +139,52 @@ fn coat_index_points() {
         "blue-metallic-spectral",
         "silver-metallic",
     ];
-    let etas: Vec<f64> = (0..=25).map(|i| ((130 + 2 * i) as f64) / 100.0).collect();
+    let step = if std::env::var("PAINT_COAT_STEP").is_ok_and(|v| v == "0.01") { 1 } else { 2 };
+    let etas: Vec<f64> = (0..=50 / step).map(|i| ((130 + step * i) as f64) / 100.0).collect();
     print!("| fixture | η = 1.5 |");
     for e in &etas {
         print!(" {e:.2} |");
     }
-    println!(" worst / η = 1.5 | builds timed each |");
-    println!("|---|---|{}---|---|", "---|".repeat(etas.len()));
+    println!(" worst / η = 1.5 | builds timed each | ρ(μ, λ) at η = 1.5, worst / η = 1.5 (at η) |");
+    println!("|---|---|{}---|---|---|", "---|".repeat(etas.len()));
     for f in fixtures {
         let Ok(text) = std::fs::read_to_string(format!("fixtures/recipes/{f}.json")) else { continue };
         let Ok(base) = serde_json::from_str::<serde_json::Value>(&text) else { continue };
-        let time_at = |eta: f64| -> (f64, usize, bool) {
+        let time_at = |eta: f64| -> (f64, usize, bool, u64) {
             let mut v = base.clone();
             v["clear_coat"]["index"] = eta.into();
             let t = serde_json::to_string(&v).expect("json");
             let mut times = vec![];
             let mut tabulated = true;
+            let mut rho = 0;
             let start = Instant::now();
             while start.elapsed().as_secs_f64() < 0.25 || times.len() < 3 {
                 let t0 = Instant::now();
-                let (p, _) = build_paint(&t, PaintBuild { tables: TableBuild::Shared, memo: None });
+                let (p, work) = build_paint(&t, PaintBuild { tables: TableBuild::Shared, memo: None });
                 times.push(t0.elapsed().as_secs_f64());
+                rho = work.stack_evaluations;
                 tabulated &= p.flake_tables().iter().all(|(_, d)| d.is_some());
                 std::hint::black_box(p);
             }
-            (median(times.clone()), times.len(), tabulated)
+            (median(times.clone()), times.len(), tabulated, rho)
         };
-        let (at_15, _, _) = time_at(1.5);
+        let (at_15, _, _, rho_15) = time_at(1.5);
         print!("| {f} | {:.3} ms |", at_15 * 1e3);
         let mut worst: f64 = 0.0;
         let mut fewest = usize::MAX;
+        let (mut rho_worst, mut rho_at) = (rho_15, 1.5);
         for &e in &etas {
-            let (t, n, tabulated) = time_at(e);
+            let (t, n, tabulated, rho) = time_at(e);
             worst = worst.max(t / at_15);
             fewest = fewest.min(n);
+            if rho > rho_worst {
+                (rho_worst, rho_at) = (rho, e);
+            }
             print!(" {:.3}{} |", t * 1e3, if tabulated { "" } else { " (direct)" });
         }
-        println!(" {worst:.2}× | ≥ {fewest} |");
+        let ratio =
+            if rho_15 > 0 { format!("{:.2}× ({rho_at:.2})", rho_worst as f64 / rho_15 as f64) } else { "-".into() };
+        println!(" {worst:.2}× | ≥ {fewest} | {rho_15}, {ratio} |");
     }
     println!("\n(ms a build; \"(direct)\": a flake evaluated directly, no table met 10⁻¹²)\n");
 }

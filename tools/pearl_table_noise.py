@@ -6,8 +6,10 @@ The stack is resin (index eta) / TiO2 (coherent) / mica (incoherent) / TiO2 (coh
 as in src/optics/thin_film.rs (Byrnes, arXiv:1603.02720, Eqs. 13-14 for the coherent groups; Katsidis &
 Siapkas, Appl. Opt. 41 (2002) 3978 for the incoherent combination R = Rf + Tf Tb P^2 R'/(1 - Rb P^2 R')).
 Written from those formulas, not from the Rust code, with one difference on purpose: the exit medium is the
-resin again and its cosine is taken as mu itself (the Rust stack computes it as sqrt(eta^2 - eta^2 (1 - mu^2))
-and loses digits as mu -> 0). Every other cosine is computed the usual way, n cos = sqrt(n^2 - eta^2 (1 - mu^2)).
+resin again and its cosine is taken as mu itself (the Rust stack computed it as sqrt(eta^2 - eta^2 (1 - mu^2))
+and lost digits as mu -> 0; since 2026-12-07 it takes mu too, and its other cosines without cancellation,
+optics::thin_film::medium_cos). Every other cosine is computed here the usual way,
+n cos = sqrt(n^2 - eta^2 (1 - mu^2)).
 
 The tables are those of src/optics/tabulated.rs: 16 Chebyshev-Gauss nodes a piece, the deviation checked at
 the 17 Chebyshev-Lobatto points of every piece; on a table cut at a kink mu_c, mu = mu_c + h s^2 and the
@@ -68,7 +70,8 @@ def rho(mu, eta, lam_nm, d_tio2=135.0, n_tio2=2.5, n_mica=1.58, d_mica=400.0):
 
 def rho_on_segment(s, h, mc, eta, lam_nm, d_tio2=135.0, n_tio2=2.5, n_mica=1.58, d_mica=400.0):
     """rho at mu = mc + h s^2 with the mica's n cos from the segment variable, eta sqrt((mu - mc)(mu + mc)),
-    mu - mc = h s^2 exactly (the cure proposed in docs/model.md): no cancellation next to the kink."""
+    mu - mc = h s^2 exactly (the cure of docs/model.md, optics::fresnel::ncos_near_critical): no cancellation
+    next to the kink."""
     dmu = h * s * s
     mu = mc + dmu
     if mu <= 0:

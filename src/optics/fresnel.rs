@@ -150,6 +150,33 @@ pub(crate) fn complex_cos_transmitted(n1: Complex64, cos1: Complex64, n2: Comple
     n2cos2 / n2
 }
 
+/// n₂ cos θ₂ in a medium of index `n2` (complex allowed) for light arriving from a real medium of index `n1` at
+/// cos θ₁ = `mu` ∈ [0, 1], on the forward/decaying branch ([`forward_sqrt`]), without cancellation.
+///
+/// The same identity as [`complex_cos_transmitted`]'s, (n₂ cos θ₂)² = n₂² − n₁²(1 − μ²) (Snell, Born & Wolf
+/// §1.5.1 and §14.2), regrouped as (n₂ − n₁)(n₂ + n₁) + (n₁μ)² (`docs/model.md` §Evaluation cost, "Where the
+/// direct evaluation is the noise"): n₂ − n₁ is exact for real indices within a factor 2 of each other
+/// (Sterbenz), so each term is good to a few ulp of itself, and where both are ≥ 0 (n₂ ≥ n₁, or n₂ = n₁: the
+/// result is then n₁μ to an ulp) so is the sum: the error is relative to the result however small μ is,
+/// where n₂² − n₁²(1 − μ)(1 + μ) is a difference of two numbers of size n₁² and loses digits like 10⁻¹⁶/cos².
+/// Below n₁ (n₂ < n₁, a critical cosine μc) the sum still cancels next to μc: [`ncos_near_critical`]. For a
+/// complex n₂ = a + ib the product is (a − n₁)(a + n₁) − b² + 2iab, the same value as before to rounding.
+pub(crate) fn ncos_from_real(n1: f64, mu: f64, n2: Complex64) -> Complex64 {
+    let nm = n1 * mu;
+    forward_sqrt((n2 - n1) * (n2 + n1) + nm * nm)
+}
+
+/// n₂ cos θ₂ for a real n₂ < n₁ next to the critical cosine μc = √(1 − (n₂/n₁)²) ([`critical_cosine`]), from
+/// the offset δ = μ − μc as the caller has it exactly (a table's segment variable, δ = h·s²,
+/// `optics::tabulated`): n₂² − n₁²(1 − μ²) = n₁²(μ² − μc²) = n₁²·δ(2μc + δ), so
+/// n₂ cos θ₂ = n₁√(δ(2μc + δ)), imaginary (i n₁√|…|, the decaying wave) below μc (`docs/model.md`
+/// §Evaluation cost, "Where the direct evaluation is the noise"). Its relative error is a few ulp at any
+/// δ, for the function whose kink is at the given (rounded) μc; computed from μ itself the cosine carries an
+/// absolute error ~10⁻¹⁶/cos θ₂ there.
+pub(crate) fn ncos_near_critical(n1: f64, mu_c: f64, offset: f64) -> Complex64 {
+    forward_sqrt(Complex64::new(offset * (2.0 * mu_c + offset), 0.0)) * n1
+}
+
 /// √w on the forward/decaying branch: Im ≥ 0, and Re ≥ 0 when Im = 0 (signed zeros normalised).
 pub(crate) fn forward_sqrt(w: Complex64) -> Complex64 {
     let r = w.sqrt();
@@ -403,5 +430,100 @@ mod tests {
                 assert!((t12 * t21 - r12 * r21 - 1.0).norm() < 1e-14);
             }
         }
+    }
+
+    /// a·b as an unevaluated sum hi + lo, exact (the fused multiply-add's error term).
+    fn two_prod(a: f64, b: f64) -> (f64, f64) {
+        let p = a * b;
+        (p, a.mul_add(b, -p))
+    }
+
+    /// a + b as hi + lo, exact (Knuth's TwoSum).
+    fn two_sum(a: f64, b: f64) -> (f64, f64) {
+        let s = a + b;
+        let bb = s - a;
+        (s, (a - (s - bb)) + (b - bb))
+    }
+
+    /// √(hi + lo) for hi + lo > 0, to well below an ulp: one Newton step from √hi.
+    fn dd_sqrt((hi, lo): (f64, f64)) -> f64 {
+        let r = hi.sqrt();
+        let (r2, r2_lo) = two_prod(r, r);
+        r + (((hi - r2) - r2_lo) + lo) / (2.0 * r)
+    }
+
+    /// n₂² − n₁² + (n₁μ)² in f64 pairs (about 32 digits), the reference for n₂ cos θ₂ = √ of it.
+    fn dd_ncos2(n1: f64, mu: f64, n2: f64) -> (f64, f64) {
+        let (a, a_lo) = two_prod(n2, n2);
+        let (b, b_lo) = two_prod(n1, n1);
+        let (m, m_lo) = two_prod(n1, mu);
+        // (m + m_lo)² to the pair's precision.
+        let (c, c_lo) = two_prod(m, m);
+        let c_lo = c_lo + 2.0 * m * m_lo;
+        let (s, s_lo) = two_sum(a, -b);
+        let (s, s2) = two_sum(s, c);
+        (s, s_lo + s2 + a_lo - b_lo + c_lo)
+    }
+
+    /// The cancellation-free n₂ cos θ₂ (`ncos_from_real`) against f64-pair references to a few ulp relative, at
+    /// cosines down to 10⁻¹², for n₂ = n₁ (the closed form n₁μ: the pearl's exit resin), n₂ above n₁ (TiO₂,
+    /// and mica 1.58 in a resin of 1.54, 1.56 and 1.5799), where the old form √(n₂² − n₁²(1 − μ)(1 + μ)) is
+    /// off by up to 10⁻¹⁶/cos² relative; and complex n₂ as the old form (the same value to rounding).
+    #[test]
+    fn cancellation_free_cosine_is_good_to_a_few_ulp_at_every_cosine() {
+        let mus = [1.0, 0.7, 0.3, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-8, 1e-10, 1e-12];
+        let mut old_worst = 0.0f64;
+        for &(n1, n2) in &[(1.54, 1.54), (1.5, 1.5), (1.54, 1.58), (1.56, 1.58), (1.5799, 1.58), (1.5, 2.5), (1.0, 1.5)]
+        {
+            for &mu in &mus {
+                let now = ncos_from_real(n1, mu, c(n2, 0.0));
+                let want = dd_sqrt(dd_ncos2(n1, mu, n2));
+                assert!(now.im == 0.0 && ((now.re - want) / want).abs() < 6e-16, "{n1} {n2} {mu}: {now} vs {want}");
+                if n1 == n2 {
+                    assert!(((now.re - n1 * mu) / (n1 * mu)).abs() < 4.5e-16, "{n1} {mu}: {now}");
+                }
+                let old = c(n2, 0.0) * complex_cos_transmitted(c(n1, 0.0), c(mu, 0.0), c(n2, 0.0));
+                old_worst = old_worst.max(((old.re - want) / want).abs());
+            }
+        }
+        // The test can tell: the old form is off by far more at the small cosines (0.4 relative at μ = 10⁻⁸).
+        assert!(old_worst > 1e-3, "{old_worst:e}");
+        for n2 in [c(2.5, 0.3), c(0.2, 3.0), c(1.58, 1e-4)] {
+            for &mu in &mus[..6] {
+                let a = ncos_from_real(1.5, mu, n2);
+                let b = n2 * complex_cos_transmitted(c(1.5, 0.0), c(mu, 0.0), n2);
+                assert!((a - b).norm() <= 1e-14 * b.norm() && a.im >= 0.0, "{n2} {mu}: {a} vs {b}");
+            }
+        }
+    }
+
+    /// Next to the critical cosine μc of mica 1.58 in a resin of 1.59, 1.6 and 1.8, at μ = μc + δ (δ ≈ ±2⁻ᵏ·μc,
+    /// δ = μ − μc exactly): `ncos_near_critical` from δ against n₁√(μ² − μc²) in f64 pairs, to a few ulp
+    /// relative (imaginary, i n₁√(μc² − μ²), below μc); computed from μ, the cancellation-free form is off by
+    /// ~10⁻¹⁶/cos² relative there, which the test also shows.
+    #[test]
+    fn cosine_near_the_critical_cosine_is_good_to_a_few_ulp() {
+        let mut from_mu_worst = 0.0f64;
+        for n1 in [1.59, 1.6, 1.8] {
+            let mc = critical_cosine(1.58 / n1).unwrap();
+            for k in [2, 5, 10, 20, 30, 40] {
+                for sign in [1.0, -1.0] {
+                    let mu = mc + sign * mc * 2f64.powi(-k);
+                    // The offset of the representable μ, exact (Sterbenz: μ is within a factor 2 of μc).
+                    let d = mu - mc;
+                    // μ² − μc² = (μ − μc)(μ + μc) = d·(μ + μc), in pairs.
+                    let (s, s_lo) = two_sum(mu, mc);
+                    let (p, p_lo) = two_prod(d, s);
+                    let want = n1 * dd_sqrt((p.abs(), (p_lo + d * s_lo) * p.signum()));
+                    let got = ncos_near_critical(n1, mc, d);
+                    let (g, z) = if sign > 0.0 { (got.re, got.im) } else { (got.im, got.re) };
+                    assert!(z == 0.0 && ((g - want) / want).abs() < 8e-16, "{n1} {k} {sign}: {got} vs {want}");
+                    let from_mu = ncos_from_real(n1, mu, c(1.58, 0.0));
+                    let f = if sign > 0.0 { from_mu.re } else { from_mu.im };
+                    from_mu_worst = from_mu_worst.max(((f - want) / want).abs());
+                }
+            }
+        }
+        assert!(from_mu_worst > 1e-6, "{from_mu_worst:e}");
     }
 }

@@ -14,7 +14,8 @@
 //! η_out cos θout/(η_in cos θin) (printed inverted); the mica platelet, which the paper's text calls too
 //! thick to interfere, is handled incoherently here (`coherent == false`) while the printed recursion runs
 //! coherently through it.
-use crate::optics::fresnel::{amplitudes, complex_cos_transmitted};
+use crate::optics::fresnel::{amplitudes, critical_cosine_complex, ncos_from_real, ncos_near_critical};
+use crate::optics::tabulated::KinkOffset;
 use num_complex::Complex64;
 
 /// One layer of a stack.
@@ -153,7 +154,8 @@ const INLINE_MEDIA: usize = 26;
 /// cos θ = `cos_i`) and an exit medium `n_out` (complex allowed), at `wavelength_nm`.
 ///
 /// Angles: the tangential invariant n_in sin θ_in is real; in each medium n cos θ = √(n² − n_in² sin²θ_in)
-/// on the decaying/forward branch ([`complex_cos_transmitted`]).
+/// on the decaying/forward branch, computed without cancellation (`medium_cos`: a medium of the ambient
+/// index has cos θ_in itself, the others √((n − n_in)(n + n_in) + (n_in cos θ_in)²)).
 /// Coherent layers: [`coherent_amplitudes`] per polarisation (convention of
 /// [`crate::optics::fresnel::amplitudes`]), R = |ρ|², T = |τ|² Re(n_out cos θout)/(n_in cos θin) for s and
 /// |τ|² Re(n_out cos θout*)/(n_in cos θin) for p (Byrnes Eqs. 13–14). For an absorbing exit medium this is
@@ -168,13 +170,35 @@ const INLINE_MEDIA: usize = 26;
 /// Grazing incidence (cos_i ≤ 0) returns the limit R = 1, T = 0.
 pub fn stack(n_in: f64, layers: &[FilmLayer], n_out: Complex64, cos_i: f64, wavelength_nm: f64) -> StackResult {
     let mut out = StackResult { rs: 1.0, rp: 1.0, ts: 0.0, tp: 0.0 };
-    stack_spectrum(n_in, layers, n_out, cos_i, [wavelength_nm], |_, r| out = r);
+    stack_spectrum(n_in, layers, n_out, cos_i, None, [wavelength_nm], |_, r| out = r);
     out
 }
 
+/// cos θ in a medium of index `n` of a stack entered from the real index `n_in` at cos θ_in = `mu`
+/// (`docs/model.md` §Evaluation cost, "Where the direct evaluation is the noise"): `mu` itself when `n` is
+/// `n_in` to the bit (the pearl's exit resin: recomputed as √(n² − n²(1 − μ²))/n it lost digits like
+/// 10⁻¹⁶/μ² as μ → 0); on a table segment at a kink (`near`) and `n` real with its critical cosine at that
+/// kink to the bit, from the offset μ − μc ([`ncos_near_critical`]); else from the cancellation-free
+/// [`ncos_from_real`]. Each is n cos θ/n on the forward/decaying branch.
+fn medium_cos(n_in: f64, mu: f64, n: Complex64, near: Option<KinkOffset>) -> Complex64 {
+    if n.re == n_in && n.im == 0.0 {
+        return Complex64::new(mu, 0.0);
+    }
+    let ncos = match near {
+        Some(k) if n.im == 0.0 && critical_cosine_complex(n / n_in) == Some(k.at) => {
+            ncos_near_critical(n_in, k.at, k.offset)
+        }
+        _ => ncos_from_real(n_in, mu, n),
+    };
+    ncos / n
+}
+
 /// [`stack`] at one angle of incidence and several wavelengths: `each(i, result)` for the i-th wavelength, the
-/// same bits as `stack(n_in, layers, n_out, cos_i, wavelength)`. What does not depend on the wavelength (every
-/// medium's cos θ, every interface's amplitudes r, t) is computed once for all of them; per wavelength only
+/// same bits as `stack(n_in, layers, n_out, cos_i, wavelength)` when `near` is None. `near`: `cos_i` is on a
+/// table segment at a critical cosine μc of one of the layers, with `cos_i` − μc exactly as the table has it
+/// (`optics::tabulated::Abscissa`); that layer's cosine is then computed from it ([`medium_cos`]). What does
+/// not depend on the wavelength (every medium's cos θ, every interface's amplitudes r, t) is computed once for
+/// all of them; per wavelength only
 /// the layers' phases e^{iφⱼ} (once per distinct layer: a stack that repeats a layer, as the pearl's
 /// TiO₂/mica/TiO₂ does, computes its phase once) and the recursions remain (`docs/model.md` §Evaluation cost).
 pub(crate) fn stack_spectrum(
@@ -182,6 +206,7 @@ pub(crate) fn stack_spectrum(
     layers: &[FilmLayer],
     n_out: Complex64,
     cos_i: f64,
+    near: Option<KinkOffset>,
     wavelengths_nm: impl IntoIterator<Item = f64>,
     mut each: impl FnMut(usize, StackResult),
 ) {
@@ -202,7 +227,7 @@ pub(crate) fn stack_spectrum(
             down: &mut vec![none; total],
             up: &mut vec![none; total],
         };
-        return stack_in(n_in, layers, n_out, cos_i, wavelengths_nm, &mut each, &mut s);
+        return stack_in(n_in, layers, n_out, (cos_i, near), wavelengths_nm, &mut each, &mut s);
     }
     let mut media = [Medium::VACUUM; INLINE_MEDIA];
     let mut phase = [Complex64::new(1.0, 0.0); INLINE_MEDIA];
@@ -212,7 +237,7 @@ pub(crate) fn stack_spectrum(
     let mut up = [none; INLINE_MEDIA];
     let mut s =
         Scratch { media: &mut media, phase: &mut phase, inc: &mut inc, same: &mut same, down: &mut down, up: &mut up };
-    stack_in(n_in, layers, n_out, cos_i, wavelengths_nm, &mut each, &mut s)
+    stack_in(n_in, layers, n_out, (cos_i, near), wavelengths_nm, &mut each, &mut s)
 }
 
 /// Caller-provided scratch of at least `layers.len() + 2` entries each.
@@ -232,7 +257,7 @@ fn stack_in(
     n_in: f64,
     layers: &[FilmLayer],
     n_out: Complex64,
-    cos_i: f64,
+    (cos_i, near): (f64, Option<KinkOffset>),
     wavelengths_nm: impl IntoIterator<Item = f64>,
     each: &mut impl FnMut(usize, StackResult),
     s: &mut Scratch,
@@ -249,11 +274,11 @@ fn stack_in(
     for (j, l) in layers.iter().enumerate() {
         let first = layers[..j].iter().position(|m| key(m) == key(l)).unwrap_or(j);
         s.same[j + 1] = first + 1;
-        let cos = if first < j { s.media[first + 1].cos } else { complex_cos_transmitted(n0, c0, l.n) };
+        let cos = if first < j { s.media[first + 1].cos } else { medium_cos(n_in, cos_i, l.n, near) };
         s.media[j + 1] = Medium { n: l.n, cos, d: l.thickness_nm.max(0.0) };
     }
     s.same[total - 1] = total - 1;
-    s.media[total - 1] = Medium { n: n_out, cos: complex_cos_transmitted(n0, c0, n_out), d: 0.0 };
+    s.media[total - 1] = Medium { n: n_out, cos: medium_cos(n_in, cos_i, n_out, near), d: 0.0 };
     // The incoherent media (ambient, incoherent layers, exit) split the stack into coherent groups: group
     // i is media[inc[i]..=inc[i+1]], whose end media are treated as semi-infinite.
     let mut n_inc = 0;
@@ -509,7 +534,7 @@ mod tests {
         for (n_in, layers, n_out) in &stacks {
             for ci in angles().chain([-0.1, 1e-9, 0.3]) {
                 let mut seen = 0;
-                stack_spectrum(*n_in, layers, *n_out, ci, lambdas.iter().copied(), |i, r| {
+                stack_spectrum(*n_in, layers, *n_out, ci, None, lambdas.iter().copied(), |i, r| {
                     let alone = stack(*n_in, layers, *n_out, ci, lambdas[i]);
                     for (x, y) in [(r.rs, alone.rs), (r.rp, alone.rp), (r.ts, alone.ts), (r.tp, alone.tp)] {
                         assert_eq!(x.to_bits(), y.to_bits(), "{n_in} {layers:?} {ci} {}", lambdas[i]);

@@ -8,8 +8,8 @@ use super::memo::Memo;
 use crate::optics::fresnel::{critical_cosine_complex, fr_conductor};
 use crate::optics::kubelka_munk::Layer;
 use crate::optics::microfacet::Microfacet;
-use crate::optics::tabulated::ChebTable;
-use crate::optics::thin_film::{stack, stack_spectrum, FilmLayer};
+use crate::optics::tabulated::{Abscissa, ChebTable};
+use crate::optics::thin_film::{stack_spectrum, FilmLayer};
 use crate::quadrature::gauss_legendre;
 use num_complex::Complex64;
 use std::cell::Cell;
@@ -56,13 +56,17 @@ pub(super) struct FlakeTerm {
 }
 
 impl FlakeTerm {
-    /// Flake reflectance ρ at the local cosine `cos_local` for sample `k` (before the pigment above it).
+    /// Flake reflectance ρ at the local cosine `at.x` for sample `k` (before the pigment above it); on a table
+    /// segment at a kink, the pearl's stack takes the offset from it (`optics::thin_film::stack_spectrum`).
     #[inline]
-    fn rho(&self, k: usize, cos_local: f64, wavelength_nm: f64) -> f64 {
+    fn rho(&self, k: usize, at: Abscissa, wavelength_nm: f64) -> f64 {
         match &self.optics {
-            FlakeOptics::Metal(eta) => fr_conductor(cos_local, eta[k]),
+            FlakeOptics::Metal(eta) => fr_conductor(at.x, eta[k]),
             FlakeOptics::Pearl { layers, medium } => {
-                stack(*medium, layers, Complex64::new(*medium, 0.0), cos_local, wavelength_nm).r()
+                let mut r = 1.0;
+                let n = Complex64::new(*medium, 0.0);
+                stack_spectrum(*medium, layers, n, at.x, at.kink, [wavelength_nm], |_, s| r = s.r());
+                r
             }
         }
     }
@@ -81,7 +85,12 @@ impl FlakeTerm {
     /// or the bare flake reflectance ρ for the split flake light (the cover's attenuation is applied by the
     /// caller, it depends on both directions).
     pub(super) fn reflectance_direct(&self, k: usize, cos_local: f64, wavelength_nm: f64) -> f64 {
-        self.lobe_part(k, self.rho(k, cos_local, wavelength_nm).clamp(0.0, 1.0))
+        self.reflectance_at(k, Abscissa { x: cos_local, kink: None }, wavelength_nm)
+    }
+
+    /// [`FlakeTerm::reflectance_direct`] at a point a table asks for ([`Abscissa`]).
+    fn reflectance_at(&self, k: usize, at: Abscissa, wavelength_nm: f64) -> f64 {
+        self.lobe_part(k, self.rho(k, at, wavelength_nm).clamp(0.0, 1.0))
     }
 
     /// What the lobe carries for sample `k` given its clamped flake reflectance ρ: ρ for the split light,
@@ -99,26 +108,25 @@ impl FlakeTerm {
     /// (each the bits of `self.rho(k, …).clamp(0, 1)`): the pearl's stack at every wavelength at once
     /// (`optics::thin_film::stack_spectrum`: its angles and interface amplitudes computed once), a metal's
     /// Fresnel reflectance per sample. `work` counts the stack set-ups and the reflectances.
-    fn rho_each(&self, cos_local: f64, which: &[usize], wavelengths_nm: &[f64], out: &mut [f64], work: &Work) {
+    fn rho_each(&self, at: Abscissa, which: &[usize], wavelengths_nm: &[f64], out: &mut [f64], work: &Work) {
         work.count(1, which.len());
         match &self.optics {
             FlakeOptics::Metal(eta) => {
                 for (o, &k) in out.iter_mut().zip(which) {
-                    *o = fr_conductor(cos_local, eta[k]).clamp(0.0, 1.0);
+                    *o = fr_conductor(at.x, eta[k]).clamp(0.0, 1.0);
                 }
             }
             FlakeOptics::Pearl { layers, medium } => {
                 let lambdas = which.iter().map(|&k| wavelengths_nm[k]);
-                stack_spectrum(*medium, layers, Complex64::new(*medium, 0.0), cos_local, lambdas, |i, r| {
-                    out[i] = r.r().clamp(0.0, 1.0)
-                });
+                let n = Complex64::new(*medium, 0.0);
+                stack_spectrum(*medium, layers, n, at.x, at.kink, lambdas, |i, r| out[i] = r.r().clamp(0.0, 1.0));
             }
         }
     }
 
-    /// [`FlakeTerm::reflectance_direct`] of the samples `which` at once ([`FlakeTerm::rho_each`]).
-    fn reflectance_each(&self, cos_local: f64, which: &[usize], wavelengths_nm: &[f64], out: &mut [f64], work: &Work) {
-        self.rho_each(cos_local, which, wavelengths_nm, out, work);
+    /// [`FlakeTerm::reflectance_at`] of the samples `which` at once ([`FlakeTerm::rho_each`]).
+    fn reflectance_each(&self, at: Abscissa, which: &[usize], wavelengths_nm: &[f64], out: &mut [f64], work: &Work) {
+        self.rho_each(at, which, wavelengths_nm, out, work);
         for (o, &k) in out.iter_mut().zip(which) {
             *o = self.lobe_part(k, *o);
         }
@@ -195,7 +203,7 @@ impl FlakeTerm {
                 *r = hemispherical_mean(
                     |mu| {
                         work.count(1, 1);
-                        self.rho(j, mu, wavelengths_nm[j]).clamp(0.0, 1.0)
+                        self.rho(j, Abscissa { x: mu, kink: None }, wavelengths_nm[j]).clamp(0.0, 1.0)
                     },
                     &kinks[j],
                 );
@@ -203,7 +211,7 @@ impl FlakeTerm {
         } else {
             for group in same_kinks(&kinks) {
                 let means = hemispherical_means(
-                    |mu, out| self.rho_each(mu, &group, wavelengths_nm, out, work),
+                    |mu, out| self.rho_each(Abscissa { x: mu, kink: None }, &group, wavelengths_nm, out, work),
                     group.len(),
                     &kinks[group[0]],
                 );
@@ -238,11 +246,11 @@ impl FlakeTerm {
         self.table = if per_sample {
             (0..n)
                 .map(|k| {
-                    let f = |c| {
+                    let f = |at, _: &[usize], v: &mut [f64]| {
                         work.count(1, 1);
-                        self.reflectance_direct(k, c, wavelengths_nm[k])
+                        v[0] = self.reflectance_at(k, at, wavelengths_nm[k])
                     };
-                    ChebTable::fit_kinked(f, 0.0, 1.0, &kinks[k], TABLE_TOLERANCE)
+                    ChebTable::fit_each_kinked(f, 1, 0.0, 1.0, &kinks[k], TABLE_TOLERANCE).pop().flatten()
                 })
                 .collect()
         } else {
@@ -278,9 +286,9 @@ impl FlakeTerm {
                 .map(|(k, tk)| match tk.pieces() == pieces {
                     true => Some(tk.clone()),
                     false => ChebTable::fit_each_kinked_with_pieces(
-                        |c, _, v| {
+                        |at, _, v| {
                             work.count(1, 1);
-                            v[0] = self.reflectance_direct(k, c, wavelengths_nm[k])
+                            v[0] = self.reflectance_at(k, at, wavelengths_nm[k])
                         },
                         &[0],
                         0.0,
