@@ -844,11 +844,19 @@ fn cli_user_geometries_are_targets() {
 }
 
 /// The documented 6-parameter two-lobe fit (docs/performance.md §Fit: both lobes' Ks, R and m of
-/// `fixtures/inverse/two-lobe-start.json` to the truth's six readings) converges: the solver stops at an
-/// exact fit (χ² ≤ 10⁻⁶) instead of crawling along the valley of lobe 0's Ks and R until its budget ends
-/// (3 304 forward runs and "the evaluation budget ran out" at 8134dee). It is still not one to trust, and says
-/// why: the targets fix lobe 0's Ks and R only as a combination. Run in a local pool of one thread and of
-/// two (the Jacobian's displaced points and the restarts in parallel), the two reports are the same bits.
+/// `fixtures/inverse/two-lobe-start.json` to the six readings of `fixtures/recipes/cook-torrance-lobes.json`)
+/// converges: the solver stops at an exact fit (χ² ≤ 10⁻⁶) instead of crawling along the valley of lobe 0's
+/// Ks and R until its budget ends (3 304 forward runs and "the evaluation budget ran out" at 8134dee).
+///
+/// It reaches the truth as far as the targets fix it: every reading within 10⁻³ of its uncertainty, the truth
+/// within each reported standard error, and lobe 0's m and lobe 1 within 2 % of the truth (0.2 %, 1.3 %,
+/// 1.3 %, 10⁻⁵ in the run documented there; lobe 1's Ks and R move with the valley). It is still not one to
+/// trust (exit 1), and says why: the six readings fix lobe 0's Ks and R only as a combination (both
+/// undetermined), and the restarts find two other exact solutions along that valley; an exit 0 would claim a
+/// unique recipe the readings do not single out.
+///
+/// Run in local pools of one thread and of three (the Jacobian's displaced points and the restarts in
+/// parallel, scheduled differently), the two reports are the same bits.
 #[test]
 fn the_six_parameter_two_lobe_fit_converges_on_any_number_of_threads() {
     let start: Value =
@@ -882,10 +890,27 @@ fn the_six_parameter_two_lobe_fit_converges_on_any_number_of_threads() {
         r.seconds = 0.0;
         r
     };
-    let r = on(2);
+    let r = on(3);
     assert!(r.converged && r.reproduces && !r.stationary, "{r:#?}");
     assert!(r.chi2 <= 1e-6, "{}", r.chi2);
     assert!(r.evaluations < 2000, "{} forward runs", r.evaluations);
+    for tg in &r.targets {
+        assert!(tg.weighted_residual.abs() <= 1e-3, "{tg:?}");
+    }
+    // The truth (fixtures/recipes/cook-torrance-lobes.json), in the order of the free parameters.
+    let truth = [0.1, 0.9, 0.2, 0.05, 0.05, 0.01];
+    for (k, (p, x)) in r.parameters.iter().zip(truth).enumerate() {
+        match p.std_error {
+            None => assert!(k < 2, "{} undetermined", p.pointer),
+            Some(se) => {
+                assert!(k >= 2, "{} = {} ± {se}: lobe 0's Ks and R are undetermined", p.pointer, p.value);
+                assert!((p.value - x).abs() <= se, "{} = {} ± {se}, truth {x}", p.pointer, p.value);
+                assert!((p.value - x).abs() <= 0.02 * x, "{} = {}, truth {x}", p.pointer, p.value);
+            }
+        }
+    }
+    assert!(!r.ok() && !r.identifiable);
     assert!(r.verdict.iter().any(|l| l.contains("cannot tell apart /lobes/0/ks and /lobes/0/r")), "{:?}", r.verdict);
-    assert_eq!(format!("{:?}", on(1)), format!("{r:?}"), "one thread and two differ");
+    assert!(r.verdict.iter().any(|l| l.contains("2 found another solution")), "{:?}", r.verdict);
+    assert_eq!(format!("{:?}", on(1)), format!("{r:?}"), "one thread and three differ");
 }
