@@ -1295,10 +1295,11 @@ fn flake_tables_built_for_all_samples_at_once_are_those_built_one_at_a_time() {
 /// cut there (`docs/model.md` §Evaluation cost, "Tables cut at the kinks"), instead of the flake being evaluated
 /// directly; and next to the mica's index, where the direct evaluation the tables are checked against used to be
 /// the noise (§Evaluation cost, "Where the direct evaluation is the noise"). Each table's deviation at its check
-/// points is within the tolerance, and a build's film-stack reflectances (`TableWork`, exact) are at most 5× those
-/// at η = 1.5 (4.76× at worst: Cerulean (c) at 1.58, its tables met at 32 pieces; a flake evaluated directly
-/// costs 69×), the deterministic proxy of a sweep point's cost (`docs/performance.md` §"Coat-index points from
-/// 1.3 to 1.8").
+/// points is within the tolerance, and a build's film-stack reflectances (`TableWork`, exact) are at most 4.05×
+/// those at η = 1.5 (4.02× at worst: Cerulean (c) at 1.58, its tables met at 32 pieces, the failed attempts at 8
+/// and 16 stopped at their first missed piece; 4.76× when they ran to the end; a flake evaluated directly costs
+/// 69×), the deterministic proxy of a sweep point's cost (`docs/performance.md` §"Coat-index points from 1.3 to
+/// 1.8": that point's sweep time is 1.9× η = 1.5's).
 #[test]
 fn flake_tables_are_used_at_every_coat_index_from_1_3_to_1_8() {
     use glossmeter::brdf::paint::{PaintBuild, TableBuild, TABLE_TOLERANCE};
@@ -1327,7 +1328,7 @@ fn flake_tables_are_used_at_every_coat_index_from_1_3_to_1_8() {
             let eta = 1.3 + 0.01 * i as f64;
             let (paint, work) = build(eta);
             assert!(
-                work.stack_evaluations <= 5 * at_15,
+                100 * work.stack_evaluations <= 405 * at_15,
                 "{}, coat index {eta}: {work:?}, {at_15} reflectances at 1.5",
                 path.display()
             );

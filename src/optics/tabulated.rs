@@ -211,7 +211,11 @@ impl ChebTable {
             .collect()
     }
 
-    /// One piece count for the functions `which` of `f`: each one's outcome.
+    /// One piece count for the functions `which` of `f`: each one's outcome. Piece by piece from a: a piece's
+    /// nodes, then its check points (after the nodes of every piece they lie in, the next one at its upper
+    /// end), so a function stops being evaluated at the first piece where it misses `tol` or is not finite
+    /// (`docs/model.md` §Evaluation cost, "A failed attempt stops at its first missed piece"). A met table
+    /// is the same bits as with every node first: the same nodes, coefficients and check points.
     fn fit_pieces(
         f: &mut impl FnMut(Abscissa, &[usize], &mut [f64]),
         which: &[usize],
@@ -242,35 +246,27 @@ impl ChebTable {
             true => Abscissa { x: u, kink: None },
             false => seg(p).at(u),
         };
-        let mut coeffs: Vec<Vec<f64>> = (0..m).map(|_| Vec::with_capacity(pieces * N)).collect();
-        let mut finite = vec![true; m];
+        let mut tables: Vec<ChebTable> = (0..m)
+            .map(|_| ChebTable {
+                a,
+                b,
+                pieces,
+                coeffs: vec![0.0; pieces * N],
+                segments: segments.to_vec(),
+                max_error: 0.0,
+            })
+            .collect();
+        // The functions still evaluated (indices into `which`), and the outcome of those that are not.
+        let mut live: Vec<usize> = (0..m).collect();
+        let mut out: Vec<Option<Fit>> = (0..m).map(|_| None).collect();
+        let mut worst = vec![0.0f64; m];
         let mut vals = vec![[0.0; N]; m];
         let mut at = vec![0.0; m];
+        let mut done = 0; // pieces whose coefficients are in `tables`
         for p in 0..pieces {
-            let (lo, hi) = range(p);
-            for (j, x) in nodes.iter().enumerate() {
-                f(to_x(p, 0.5 * (lo + hi) + 0.5 * (hi - lo) * x), which, &mut at);
-                for ((v, fin), y) in vals.iter_mut().zip(&mut finite).zip(&at) {
-                    v[j] = *y;
-                    *fin &= y.is_finite();
-                }
+            if live.is_empty() {
+                break;
             }
-            for (v, c) in vals.iter().zip(&mut coeffs) {
-                for (k, row) in basis.iter().enumerate() {
-                    let mut s = 0.0;
-                    for (v, b) in v.iter().zip(row) {
-                        s += v * b;
-                    }
-                    c.push(if k == 0 { s / N as f64 } else { 2.0 * s / N as f64 });
-                }
-            }
-        }
-        let tables: Vec<ChebTable> = coeffs
-            .into_iter()
-            .map(|coeffs| ChebTable { a, b, pieces, coeffs, segments: segments.to_vec(), max_error: 0.0 })
-            .collect();
-        let mut worst = vec![0.0f64; m];
-        for p in 0..pieces {
             let (lo, hi) = range(p);
             for j in 0..=N {
                 // Not at a kink itself (s = 0, the first piece's lower end): there the function's own value is
@@ -280,27 +276,97 @@ impl ChebTable {
                 }
                 let u = 0.5 * (lo + hi) + 0.5 * (hi - lo) * (std::f64::consts::PI * j as f64 / N as f64).cos();
                 let x = to_x(p, u);
-                f(x, which, &mut at);
-                for ((w, t), y) in worst.iter_mut().zip(&tables).zip(&at) {
-                    *w = w.max((t.eval(x.x) - y).abs());
+                let q = tables[0].locate(x.x).0.max(p);
+                while done <= q && !live.is_empty() {
+                    ChebTable::fit_piece(
+                        f,
+                        which,
+                        &mut live,
+                        &mut out,
+                        &mut tables,
+                        &mut vals,
+                        &mut at,
+                        done,
+                        |u| {
+                            let (lo, hi) = range(done);
+                            to_x(done, 0.5 * (lo + hi) + 0.5 * (hi - lo) * u)
+                        },
+                        &nodes,
+                        &basis,
+                    );
+                    done += 1;
                 }
+                if live.is_empty() {
+                    break;
+                }
+                let sub: Vec<usize> = live.iter().map(|&i| which[i]).collect();
+                f(x, &sub, &mut at[..live.len()]);
+                for (&i, y) in live.iter().zip(&at) {
+                    worst[i] = worst[i].max((tables[i].eval(x.x) - y).abs());
+                }
+                live.retain(|&i| match worst[i] <= tol {
+                    true => true,
+                    false => {
+                        out[i] = Some(Fit::Missed);
+                        false
+                    }
+                });
             }
         }
         tables
             .into_iter()
             .zip(worst)
-            .zip(finite)
-            .map(|((mut table, worst), finite)| {
-                if !finite {
-                    Fit::NotFinite
-                } else if worst <= tol {
+            .zip(out)
+            .map(|((mut table, worst), out)| {
+                out.unwrap_or_else(|| {
                     table.max_error = worst;
                     Fit::Met(table)
-                } else {
-                    Fit::Missed
-                }
+                })
             })
             .collect()
+    }
+
+    /// Piece `p` of the tables of the functions `live` (indices into `which`): f at its N nodes (`node(t)`
+    /// the abscissa at t ∈ [−1, 1]) and their Chebyshev coefficients; a function with a value that is not
+    /// finite leaves `live` as [`Fit::NotFinite`].
+    #[allow(clippy::too_many_arguments)]
+    fn fit_piece(
+        f: &mut impl FnMut(Abscissa, &[usize], &mut [f64]),
+        which: &[usize],
+        live: &mut Vec<usize>,
+        out: &mut [Option<Fit>],
+        tables: &mut [ChebTable],
+        vals: &mut [[f64; N]],
+        at: &mut [f64],
+        p: usize,
+        node: impl Fn(f64) -> Abscissa,
+        nodes: &[f64; N],
+        basis: &[[f64; N]; N],
+    ) {
+        let sub: Vec<usize> = live.iter().map(|&i| which[i]).collect();
+        for (j, x) in nodes.iter().enumerate() {
+            f(node(*x), &sub, &mut at[..live.len()]);
+            for (&i, y) in live.iter().zip(at.iter()) {
+                vals[i][j] = *y;
+            }
+        }
+        live.retain(|&i| match vals[i].iter().all(|y| y.is_finite()) {
+            true => true,
+            false => {
+                out[i] = Some(Fit::NotFinite);
+                false
+            }
+        });
+        for &i in live.iter() {
+            let c = &mut tables[i].coeffs[p * N..(p + 1) * N];
+            for (k, row) in basis.iter().enumerate() {
+                let mut s = 0.0;
+                for (v, b) in vals[i].iter().zip(row) {
+                    s += v * b;
+                }
+                c[k] = if k == 0 { s / N as f64 } else { 2.0 * s / N as f64 };
+            }
+        }
     }
 
     pub(crate) fn pieces(&self) -> usize {
