@@ -1,7 +1,8 @@
 //! Design: how [`Method::design`] turns the facts about one integral into a [`Method`] — the clipped stops,
 //! the mirror overlap, the kink cuts, the chart, the initial partition, the tolerance split — and which
 //! shaped rule it tries before the Genz–Malik partition ([`delta_rule`], [`lobe_rule`], [`polar_rule`],
-//! [`smooth_rule`], tried in that order), with the gates that decide.
+//! [`smooth_rule`], tried in that order; [`Rule::TailBound`] where the partition would run on a receptor that
+//! does not see the mirror image), with the gates that decide.
 use super::delta::DELTA_COST;
 #[cfg(doc)]
 use super::gauss::TENSOR_MAX_LEVEL;
