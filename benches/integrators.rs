@@ -282,6 +282,7 @@ fn rule_label(m: &Method, brdf: &dyn Brdf) -> String {
         Rule::LobeGaussHermite { .. } => "Gauss–Hermite × Gauss–Legendre, lobe chart".into(),
         Rule::LobeDelta { .. } => "delta limit of the lobe, lobe chart".into(),
         Rule::LobePolar { .. } => "polar + tail boxes, lobe chart".into(),
+        Rule::TailBound => "the material's tail bound (no evaluation)".into(),
         Rule::TensorGauss { chart, .. } => format!(
             "tensor Gauss–Legendre, {} chart",
             match chart {

@@ -228,6 +228,7 @@ fn the_delta_limit_costs_less_where_it_reads() {
                     Rule::LobePolar { .. } => "polar",
                     Rule::TensorGauss { .. } => "tensor",
                     Rule::GenzMalik75 => "Genz–Malik (or no regular part)",
+                    Rule::TailBound => "tail bound",
                 };
                 eprintln!(
                     "COST {geometry} {d} {m:e}: before {before}, after {after} ({name}); rel estimate {:.1e} → {:.1e}, \

@@ -33,6 +33,9 @@ impl Brdf for Annotated {
     fn delta_reflectance(&self, wi: Vec3, out: &mut [f64]) -> bool {
         self.inner.delta_reflectance(wi, out)
     }
+    fn tail_majorant(&self, psi: f64) -> Option<f64> {
+        self.inner.tail_majorant(psi)
+    }
     fn hints(&self) -> Hints {
         self.inner.hints()
     }

@@ -220,6 +220,16 @@ impl Brdf for MicrofacetSurface {
         true
     }
 
+    /// f·cos θi·cos θo = F·D·G/4 ≤ D(θh)/4 (F ≤ 1, G ≤ 1; Walter et al. 2007 Eq. 20), and θh ≥ ψ/2: the
+    /// reflections of ωi about h and about the normal differ by a rotation of 2θh (docs/instrument.md
+    /// §Quadrature, "A receptor the lobe cannot reach").
+    fn tail_majorant(&self, psi: f64) -> Option<f64> {
+        if self.facets.effectively_smooth() {
+            return Some(0.0);
+        }
+        self.facets.d_majorant(0.5 * psi).map(|d| 0.25 * d)
+    }
+
     /// The Fresnel factor F(ωi·h) of every index below 1 kinks at its critical angle (in cos θi in the
     /// smooth limit). Smooth with a Smith G; the V-cavity G is a min() of three terms, a kink it does not
     /// report.

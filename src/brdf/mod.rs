@@ -345,6 +345,17 @@ pub trait Brdf: Send + Sync + std::fmt::Debug {
         false
     }
 
+    /// An upper bound of f_j(ωi, ωo)·cos θi·cos θo over every spectral sample j and every pair above the
+    /// horizon whose ωo is at least `psi` radians from the mirror image of ωi (docs/instrument.md
+    /// §Quadrature, "A receptor the lobe cannot reach"), or None when the model has none (the default). The
+    /// executor settles a receptor the lobe cannot reach with it ([`Rule::TailBound`]), so it must be a true
+    /// bound, never an estimate.
+    ///
+    /// [`Rule::TailBound`]: crate::instrument::method::Rule::TailBound
+    fn tail_majorant(&self, _psi: f64) -> Option<f64> {
+        None
+    }
+
     /// What the model tells the planner about itself, in one value ([`Hints`]: its terms, kinks, seams,
     /// reciprocity and smoothness). A model states only what differs from [`Hints::new`]'s defaults; a
     /// wrapper forwards or edits this one value. The planner reads it once per plan

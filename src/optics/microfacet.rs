@@ -88,6 +88,25 @@ impl Microfacet {
         }
     }
 
+    /// An upper bound of D(h) over every half vector tilted at least `tilt` radians from the normal
+    /// (docs/instrument.md §Quadrature, "A receptor the lobe cannot reach"): D at that tilt, as D decreases in
+    /// θh — GGX for α < 1 (D ∝ (α² + (1 − α²) sin²θh)⁻²), Beckmann for α² < 1/2 (d ln D/dθh =
+    /// tanθh·(4 − 2/(α² cos²θh)) < 0); None for a rougher lobe, whose D is not monotone. Scaled by 1 + 10⁻⁹
+    /// against the rounding of D's evaluation; 0 at a tilt of 90° or more.
+    pub(crate) fn d_majorant(&self, tilt: f64) -> Option<f64> {
+        let monotone = match self.distribution {
+            Distribution::Beckmann => self.alpha * self.alpha < 0.5,
+            Distribution::Ggx => self.alpha < 1.0,
+        };
+        if !monotone || !(tilt >= 0.0) {
+            return None;
+        }
+        if tilt >= std::f64::consts::FRAC_PI_2 {
+            return Some(0.0);
+        }
+        Some(self.d(Vec3::new(tilt.sin(), 0.0, tilt.cos())) * (1.0 + 1e-9))
+    }
+
     /// Smith Λ(ω) (Beckmann through erfc).
     ///
     /// Λ is defined by the projected-area condition (Heitz 2014 Eq. 72 in slope space); closed forms:

@@ -1,7 +1,8 @@
 //! Design: how [`Method::design`] turns the facts about one integral into a [`Method`] — the clipped stops,
 //! the mirror overlap, the kink cuts, the chart, the initial partition, the tolerance split — and which
 //! shaped rule it tries before the Genz–Malik partition ([`delta_rule`], [`lobe_rule`], [`polar_rule`],
-//! [`smooth_rule`], tried in that order), with the gates that decide.
+//! [`smooth_rule`], tried in that order; [`Rule::TailBound`] where the partition would run on a receptor that
+//! does not see the mirror image), with the gates that decide.
 use super::delta::DELTA_COST;
 #[cfg(doc)]
 use super::gauss::TENSOR_MAX_LEVEL;
@@ -141,6 +142,14 @@ impl Method {
                         .or_else(|| smooth_rule(&l, src, rec))
                         .unwrap_or(Rule::GenzMalik75),
                     _ => Rule::GenzMalik75,
+                };
+                // A receptor that does not see the mirror image of a material without a diffuse term: first the
+                // material's bound of the tail (`Rule::TailBound`, decided at run time).
+                let rule = match rule {
+                    Rule::GenzMalik75 if mirror.is_none() && !facts.has_diffuse && !facts.lobes.is_empty() => {
+                        Rule::TailBound
+                    }
+                    r => r,
                 };
                 Some(RegularPart {
                     chart,
@@ -320,7 +329,8 @@ impl Method {
         };
         let delta = self.delta.as_ref().map_or(0.0, |d| genz_malik(17.0, d.cells.len(), d.refine));
         let regular = self.regular.as_ref().map_or(0.0, |r| match &r.rule {
-            Rule::GenzMalik75 => genz_malik(57.0, r.cells.len(), r.refine),
+            // The tail bound costs nothing when it agrees; guessed as its fallback.
+            Rule::GenzMalik75 | Rule::TailBound => genz_malik(57.0, r.cells.len(), r.refine),
             Rule::LobeDelta { .. } => DELTA_COST as f64,
             Rule::LobeGaussHermite { levels, .. } => {
                 let points = |l: usize| {

@@ -5,7 +5,7 @@
 //! per execution and handed to the rules of `delta.rs`, `gauss.rs` and `polar.rs`.
 use super::chart::ChartMap;
 use super::shape::RuleRun;
-use super::{Flux, Method, Projection, RegularPart};
+use super::{Flux, Method, Projection, RegularPart, Rule};
 use crate::brdf::Brdf;
 use crate::colorimetry::weighting::Weighting;
 use crate::instrument::aperture::{incidence_kink_point, kinked_position, Chart};
@@ -276,7 +276,10 @@ impl Method {
             let (mut est, rule, cells) = loop {
                 let rule = next.expect("the Genz–Malik partition ends every fallback chain");
                 let map = self.chart_map(part, rule.chart(part.chart), (src, rec));
-                let outcome = rule.estimate(&mut self.regular_integrand(brdf, map, (ncomp, in_material)), &run);
+                let outcome = match rule {
+                    Rule::TailBound => self.settle_by_tail(brdf, (src, rec), ncomp, &opts),
+                    _ => rule.estimate(&mut self.regular_integrand(brdf, map, (ncomp, in_material)), &run),
+                };
                 spent += outcome.spent;
                 if let Some(done) = outcome.done {
                     break done;

@@ -34,6 +34,8 @@
 //! - `polar.rs`: [`Rule::LobePolar`]'s executor ([`POLAR_LEVELS`], [`TAIL_LEVELS`]);
 //! - `shape.rs`: the interface every rule implements ([`ShapedRule`], [`Integrand`], [`RuleRun`],
 //!   [`Outcome`]), a leaf of the folder;
+//! - `tail.rs`: [`Rule::TailBound`]'s executor (the material's majorant of a tail the receptor cannot
+//!   reach) and `mirror_gap`;
 //! - `rule.rs`: a [`Rule`] dispatched to its file's implementation, the fallback chain as data
 //!   ([`Rule::fallback`]) and the Genz–Malik partition, the end of every chain.
 //!
@@ -46,6 +48,7 @@ mod gauss;
 mod polar;
 mod rule;
 mod shape;
+mod tail;
 
 pub(crate) use delta::DELTA_RADIUS;
 pub use delta::{
@@ -220,6 +223,15 @@ pub enum Rule {
     /// not, the part's Genz–Malik partition is integrated instead (the fallback). `path` is empty when designed; a
     /// frozen method keeps the raises of its run and replays them (the same points, the same bits).
     TensorGauss { chart: Chart, levels: [usize; 4], path: tensor::Path },
+    /// A receptor the lobe cannot reach (`docs/instrument.md` §Quadrature, "A receptor the lobe cannot
+    /// reach"; `tail.rs`): the regular part settled without evaluating it, by the material's majorant of
+    /// f·cos θi·cos θo at the smallest angle the two stops leave between ωo and the mirror image of ωi
+    /// ([`Brdf::tail_majorant`]) times the stops' solid angles: the reading is half that bound and its error
+    /// the other half, accepted when the error meets the part's tolerance. Designed where the receptor does not
+    /// see the mirror image, the material has no diffuse term and the partition would run otherwise; decided at
+    /// run time (a method does not hold the material), also when frozen. If the material has no majorant or it
+    /// is too large, the part's Genz–Malik partition is integrated instead (the fallback).
+    TailBound,
 }
 
 /// When the spectral weighting is applied.

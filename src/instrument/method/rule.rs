@@ -44,14 +44,15 @@ impl Rule {
     pub(crate) fn fallback(&self) -> Option<Rule> {
         match *self {
             Rule::LobeDelta { width } => Some(Rule::LobeGaussHermite { width, levels: (0, LOBE_LEVELS.len() - 1) }),
-            Rule::LobeGaussHermite { .. } | Rule::LobePolar { .. } | Rule::TensorGauss { .. } => {
+            Rule::LobeGaussHermite { .. } | Rule::LobePolar { .. } | Rule::TensorGauss { .. } | Rule::TailBound => {
                 Some(Rule::GenzMalik75)
             }
             Rule::GenzMalik75 => None,
         }
     }
 
-    /// Run this rule ([`ShapedRule::estimate`] of its file's implementation).
+    /// Run this rule ([`ShapedRule::estimate`] of its file's implementation); [`Rule::TailBound`] needs the
+    /// material and is run by the executor (`Method::settle_by_tail`), so here it never agrees.
     pub(crate) fn estimate(&self, f: &mut Integrand, run: &RuleRun) -> Outcome {
         match *self {
             Rule::GenzMalik75 => Partition.estimate(f, run),
@@ -59,6 +60,8 @@ impl Rule {
             Rule::LobeDelta { width } => Delta { width }.estimate(f, run),
             Rule::LobePolar { width, u, v, levels } => Polar { width, breaks: [u, v], levels }.estimate(f, run),
             Rule::TensorGauss { chart, levels, path } => Tensor { chart, levels, path }.estimate(f, run),
+            // Settled with the material, before the chain reaches the rules (`tail.rs`); without it, no bound.
+            Rule::TailBound => Outcome { done: None, spent: 0 },
         }
     }
 }

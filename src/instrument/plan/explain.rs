@@ -252,6 +252,11 @@ fn describe_method(m: &Method, terms: &[Term]) -> String {
         };
         let rule = match p.rule {
             Rule::GenzMalik75 => format!("Genz–Malik 7/5 on {} initial box(es)", p.cells.len()),
+            Rule::TailBound => format!(
+                "the material's bound of its tail at the smallest angle the stops leave from the mirror image \
+                 (half of it ± half, when within the tolerance; else Genz–Malik 7/5 on {} initial box(es))",
+                p.cells.len()
+            ),
             Rule::LobeGaussHermite { width, levels } => format!(
                 "Gauss–Hermite in (u, v) scaled to the lobe ({:.3e} × {:.3e}) × Gauss–Legendre in (t_p, t_q), \
                  orders {} raised until two successive agree (the lobe is ≥ {} widths from every overlap kink; \
