@@ -44,8 +44,11 @@ def main():
         r_new = d / en if d is not None and en else 0.0
         worst_old, worst_new = max(worst_old, r_old), max(worst_new, r_new)
         if listing:
-            print(f"{k}: value {vo!r} -> {vn!r} (|d| = {d:.3g} = {r_old:.3g} old est, {r_new:.3g} new est); "
-                  f"estimate {eo:.3g} -> {en:.3g}; evaluations {no} -> {nn}; converged {co} -> {cn}")
+            def g(x):
+                return "none" if x is None else f"{x:.3g}"
+
+            print(f"{k}: value {vo!r} -> {vn!r} (|d| = {g(d)} = {r_old:.3g} old est, {r_new:.3g} new est); "
+                  f"estimate {g(eo)} -> {g(en)}; evaluations {no} -> {nn}; converged {co} -> {cn}")
     print(f"{len(moved)} of {len(old)} readings moved ({vmoved} values, {emoved} estimates), {len(added)} added, "
           f"{len(gone)} gone; by geometry: " + ", ".join(f"{g} {n}" for g, n in sorted(by_geo.items())))
     print(f"largest |value change| / old estimate {worst_old:.3g}, / new estimate {worst_new:.3g}; "
