@@ -73,6 +73,18 @@ impl Brdf for MixtureSurface {
         }
     }
 
+    /// Σ wᵢ·Dᵢ(ψ/2)/4, as `MicrofacetSurface::tail_majorant` for each population (F ≤ 1, G ≤ 1, θh ≥ ψ/2;
+    /// docs/instrument.md §Quadrature, "A receptor the lobe cannot reach"): None if any population's D is not
+    /// monotone in the tilt. One population of weight 1 gives the same bits as the one-population model
+    /// (0 + 1·x = x), so that the two read alike.
+    fn tail_majorant(&self, psi: f64) -> Option<f64> {
+        let mut sum = 0.0;
+        for (w, m) in &self.facets.populations {
+            sum += w * m.d_majorant(0.5 * psi)?;
+        }
+        Some(0.25 * sum)
+    }
+
     /// One lobe per population, of its width and tail (the planner splits at each). The Fresnel factor
     /// F(ωi·h) of every index below 1 kinks at its critical angle. Smooth with a Smith G; the V-cavity G's
     /// min() is a kink it does not report.
