@@ -203,6 +203,10 @@ fn a_client_that_leaves_frees_its_slot_at_the_next_integral() {
     let head = format!("POST /api/plot HTTP/1.1\r\nHost: {addr}\r\nContent-Length: {}\r\n\r\n", body.len());
     leaver.write_all(head.as_bytes()).unwrap();
     leaver.write_all(&body).unwrap();
+    // Let the plot reach the server and take the slot before the first poll: a poll that arrived first would
+    // take the only slot itself and the plot would be refused, after which no poll sees the slot busy (a race
+    // that a loaded machine lost, while another test of this file ran beside it).
+    std::thread::sleep(Duration::from_millis(500));
     // It holds the only slot: a cheap request is refused while it computes.
     let clock = Instant::now();
     let mut busy = false;
