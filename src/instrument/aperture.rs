@@ -166,7 +166,7 @@ pub fn seen_widths(lobe: &Lobe, theta: f64, ap: AxisMap, aq: AxisMap) -> [f64; 2
 /// [`seen_widths`] from the lobe's widths `w` at θ ([`lobe_widths_uv`], computed by the caller).
 fn seen_from(lobe: &Lobe, w: [f64; 2], ap: AxisMap, aq: AxisMap) -> [f64; 2] {
     let widens = matches!(lobe.tail, Tail::InverseQuartic | Tail::Table { .. });
-    if !widens || !(w[0] > 0.0 && w[1] > 0.0 && w[0].is_finite() && w[1].is_finite()) {
+    if !(widens && w[0] > 0.0 && w[1] > 0.0 && w[0].is_finite() && w[1].is_finite()) {
         return w;
     }
     let gap = |a: AxisMap| {
