@@ -154,14 +154,19 @@ pub(crate) fn table_pole_widths(lobe: &Lobe, theta: f64) -> Option<[f64; 2]> {
 /// GGX kernel at scaled distance x = u/w_u is 1/(1 + x² + y²)² = 1/(c² + y²)², c = √(1 + x²): a peak c
 /// widths wide, and c only grows away from the centre, so the splits use the width times c at the range's
 /// nearest point (an E430 haze receptor 2° off specular sees a GGX α = 0.003 lobe 5.3 times wider across the
-/// plane of incidence than the specular receptor does; `docs/instrument.md` §Quadrature).
+/// plane of incidence than the specular receptor does; `docs/instrument.md` §Quadrature). A measured table's
+/// lobe (`Tail::Table`, heavy: its tail is whatever the data hold) is seen the same way, as a GGX tail of its
+/// half width; where it is narrower, the adaptive refinement finds it (measured honest against the partition
+/// at the table's resolution: `docs/instrument.md` §Quadrature, *Measured tables*, "Off the specular
+/// direction, the table's lobe seen as a GGX tail").
 pub fn seen_widths(lobe: &Lobe, theta: f64, ap: AxisMap, aq: AxisMap) -> [f64; 2] {
     seen_from(lobe, lobe_widths_uv(lobe, theta), ap, aq)
 }
 
 /// [`seen_widths`] from the lobe's widths `w` at θ ([`lobe_widths_uv`], computed by the caller).
 fn seen_from(lobe: &Lobe, w: [f64; 2], ap: AxisMap, aq: AxisMap) -> [f64; 2] {
-    if lobe.tail != Tail::InverseQuartic || !(w[0] > 0.0 && w[1] > 0.0 && w[0].is_finite() && w[1].is_finite()) {
+    let widens = matches!(lobe.tail, Tail::InverseQuartic | Tail::Table { .. });
+    if !(widens && w[0] > 0.0 && w[1] > 0.0 && w[0].is_finite() && w[1].is_finite()) {
         return w;
     }
     let gap = |a: AxisMap| {
@@ -610,16 +615,20 @@ mod tests {
             Stop { p: [-0.002, 0.002], q: [-0.01, 0.01] },
         );
         assert!(has(&u, ring[0]) && has(&u, -ring[0]) && has(&v, ring[1]) && has(&v, -ring[1]), "{u:?} {v:?}");
-        // 0.03 off specular on p: u never comes within a ring of 0, so v has no ring splits (its lobe splits at
-        // 0 and ± the lobe widths remain); u's range holds no pole to split at.
-        let [u, v] = lobe_splits(
-            &LobesAt::new(std::slice::from_ref(&table), theta, false),
-            src,
-            Stop { p: [0.028, 0.032], q: [-0.01, 0.01] },
-        );
+        // 0.03 off specular on p: u never comes within a ring of 0, so v has no ring splits (its lobe splits
+        // remain, at 0 and ± the lobe's width as seen from u's range); u's range holds no pole to split at.
+        let rec = Stop { p: [0.028, 0.032], q: [-0.01, 0.01] };
+        let [u, v] = lobe_splits(&LobesAt::new(std::slice::from_ref(&table), theta, false), src, rec);
         assert!(!has(&v, ring[1]) && !has(&v, -ring[1]), "{v:?}");
+        // The table's lobe is seen as a GGX tail (`seen_widths`): from u's range, 0.026 = 4.3 widths off its
+        // centre, it is c = √(1 + 4.3²) = 4.4 times wider across, so ± its width fall outside v's range and
+        // v keeps its ends and 0 (which is also both overlap kinks here).
         let w = lobe_widths_uv(&table, theta);
-        assert!(has(&v, 0.0) && has(&v, w[1]) && has(&v, -w[1]), "{v:?}");
+        let seen = seen_widths(&table, theta, AxisMap { s: src.p, r: rec.p }, AxisMap { s: src.q, r: rec.q });
+        let c = (1.0 + (0.026f64 / w[0]).powi(2)).sqrt();
+        assert!((seen[1] / w[1] - c).abs() <= 1e-9 * c && seen[0] == w[0], "{seen:?} {w:?}");
+        assert_eq!(v.len(), 3, "{v:?}");
+        assert!(has(&v, 0.0) && has(&v, -0.02) && has(&v, 0.02), "{v:?}");
         assert!(u.iter().all(|&x| x >= 0.026), "{u:?}");
         // A u-range that starts inside the ring (half a ring from 0) still reaches the pole.
         let rec = Stop { p: [0.002 + 0.5 * ring[0], 0.01], q: [-0.01, 0.01] };
