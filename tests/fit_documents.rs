@@ -112,36 +112,13 @@ fn orange_peel_panel_five_parameters() {
 }
 
 fn panel(threads: Option<usize>) {
-    check_on(
-        "panel-three-populations",
-        0,
-        &[
-            "fixtures/real/models/panel-three-populations.json",
-            "--target",
-            "astm-d523-20/gloss=66.3",
-            "--target",
-            "astm-d523-60/gloss=88.3",
-            "--target",
-            "astm-d523-85/gloss=94.0",
-            "--target",
-            "rhopoint-iq-20/log-haze=14.2",
-            "--target",
-            "rhopoint-iq-20/doi=77.5",
-            "--target",
-            "rhopoint-iq-20/rspec=26.1",
-            "--free",
-            "/ior=1.3..1.8",
-            "--free",
-            "/populations/1/roughness=log:1e-3..0.05",
-            "--free",
-            "/populations/1/weight=0.001..0.7",
-            "--free",
-            "/populations/2/roughness=log:0.01..0.5",
-            "--free",
-            "/populations/2/weight=0.001..0.5",
-        ],
-        threads,
-    );
+    let args = [
+        &["fixtures/real/models/panel-three-populations.json"][..],
+        &common::PANEL_TARGETS,
+        &common::THREE_POPULATION_FREE,
+    ]
+    .concat();
+    check_on("panel-three-populations", 0, &args, threads);
 }
 
 /// A target beyond a constraint (Kd + Σ Ks ≤ 1): refused trial points, the reach line.

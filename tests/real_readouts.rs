@@ -6,38 +6,6 @@ mod common;
 
 use serde_json::Value;
 
-/// The orange-peel panel's readout as printed (`fixtures/real/konica-orange-peel-panel.csv`), its haze read as
-/// log haze (docs/instrument.md §1.10).
-const PANEL_TARGETS: [&str; 12] = [
-    "--target",
-    "astm-d523-20/gloss=66.3",
-    "--target",
-    "astm-d523-60/gloss=88.3",
-    "--target",
-    "astm-d523-85/gloss=94.0",
-    "--target",
-    "rhopoint-iq-20/log-haze=14.2",
-    "--target",
-    "rhopoint-iq-20/doi=77.5",
-    "--target",
-    "rhopoint-iq-20/rspec=26.1",
-];
-
-/// The five free parameters of the three-population model and their bounds (docs/instrument.md §1.10), as
-/// `fit` arguments.
-const THREE_POPULATION_FREE: [&str; 10] = [
-    "--free",
-    "/ior=1.3..1.8",
-    "--free",
-    "/populations/1/roughness=log:1e-3..0.05",
-    "--free",
-    "/populations/1/weight=0.001..0.7",
-    "--free",
-    "/populations/2/roughness=log:0.01..0.5",
-    "--free",
-    "/populations/2/weight=0.001..0.5",
-];
-
 fn fit(args: &[&str]) -> (i32, Value, String) {
     let out = common::glossmeter()
         .arg("fit")
@@ -103,7 +71,7 @@ fn the_orange_peel_panel_is_not_reproduced_and_the_85_degree_gloss_is_why() {
     // 85° gloss as the largest residual.
     let (code, doc, err) = fit(&[
         &["fixtures/real/models/panel-two-scale.json"][..],
-        &PANEL_TARGETS,
+        &common::PANEL_TARGETS,
         &[
             "--free",
             "/roughness=log:1e-4..0.02",
@@ -135,9 +103,12 @@ fn the_orange_peel_panel_is_not_reproduced_and_the_85_degree_gloss_is_why() {
 /// within 2u, and the index must be a lacquer's.
 #[test]
 fn the_orange_peel_panel_is_a_lacquer_of_three_slope_populations() {
-    let (code, doc, err) =
-        fit(&[&["fixtures/real/models/panel-three-populations.json"][..], &PANEL_TARGETS, &THREE_POPULATION_FREE]
-            .concat());
+    let (code, doc, err) = fit(&[
+        &["fixtures/real/models/panel-three-populations.json"][..],
+        &common::PANEL_TARGETS,
+        &common::THREE_POPULATION_FREE,
+    ]
+    .concat());
     assert_eq!(code, 0, "{err}");
     check(&doc, 6);
     let p = doc["parameters"].as_array().unwrap();
@@ -177,7 +148,7 @@ fn the_three_population_fit_reaches_its_solution_from_the_middle_of_its_bounds()
     let file = dir.join("panel-neutral-start.json");
     std::fs::write(&file, start.to_string()).unwrap();
     let mut all: Vec<&str> = vec![file.to_str().unwrap()];
-    all.extend(PANEL_TARGETS);
+    all.extend(common::PANEL_TARGETS);
     all.extend(args.iter().map(String::as_str));
     let (code, doc, err) = fit(&all);
     assert_eq!(code, 0, "{err}");
@@ -212,7 +183,7 @@ fn leave_one_out_predictions_are_those_the_docs_state() {
         .map(|l| l.trim_matches('|').split('|').map(|c| c.trim().trim_matches('`').replace('−', "-")).collect())
         .collect();
     assert_eq!(rows.len(), 3 * 6, "three core widths, six readings held out each: {rows:?}");
-    let targets: Vec<&str> = PANEL_TARGETS.iter().copied().filter(|a| *a != "--target").collect();
+    let targets: Vec<&str> = common::PANEL_TARGETS.iter().copied().filter(|a| *a != "--target").collect();
     let fixture: Value = serde_json::from_str(
         &std::fs::read_to_string(common::fixture_path("real/models/panel-three-populations.json")).unwrap(),
     )
@@ -232,7 +203,7 @@ fn leave_one_out_predictions_are_those_the_docs_state() {
             args.extend(["--target", t]);
         }
         assert_eq!(args.len(), 2 + 2 * 5, "{held} is one of the six readings");
-        args.extend(THREE_POPULATION_FREE);
+        args.extend(common::THREE_POPULATION_FREE);
         args.extend(["--restarts", "0", "--format", "json", "--no-timing", "-o", fitted.to_str().unwrap()]);
         let (code, report, err) = common::gm(&args);
         assert_eq!(code.to_string(), *exit, "α₁ {alpha}, {held} held out: {err}");

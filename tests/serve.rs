@@ -2,6 +2,8 @@
 //! foreign `Host`/`Origin`, oversize bodies, table paths out of the data directory, and a flood of 200
 //! concurrent requests (every one answered, 200 with the right bits or 503, and the server still answering).
 //! The client is a few lines of HTTP/1.1 over a `TcpStream`, so that a test can send any `Host` it likes.
+mod common;
+
 use std::io::{Read, Write};
 use std::net::{SocketAddr, TcpStream};
 use std::path::PathBuf;
@@ -816,20 +818,14 @@ fn workbook_uploads_are_answered_as_compare_answers_the_files() {
         assert_eq!(cmp.len(), 3, "{book}");
         assert!(cmp.iter().all(|c| c["verdict"] == "ok" && c["n"] == 5), "{book}: {cli_doc}");
     }
-    let dir = "fixtures/sheets/hostile";
-    let mut names: Vec<String> =
-        std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
-    names.sort();
-    assert_eq!(names.len(), 11, "{names:?}");
-    for name in &names {
-        let path = format!("{dir}/{name}");
-        let a = request(addr, "POST", "/api/compare", &upload(&path, json!({})), &[]);
+    for (name, path) in &common::hostile_workbooks() {
+        let a = request(addr, "POST", "/api/compare", &upload(path, json!({})), &[]);
         assert_eq!(a.status, 400, "{name}: {}", a.body);
-        let (code, _, err) = cli(&["compare", GLASS, &path]);
+        let (code, _, err) = cli(&["compare", GLASS, path]);
         assert_eq!(code, Some(2), "{name}: {err}");
         let served = a.json()["error"].as_str().unwrap().to_string();
         assert!(served.contains(name.as_str()) && !served.contains("panicked"), "{served}");
-        assert_eq!(served, cli_error(&err, &path, name), "{name}");
+        assert_eq!(served, cli_error(&err, path, name), "{name}");
     }
 }
 

@@ -117,13 +117,7 @@ fn statistics_columns_in_text_sheets_are_checked_too() {
 /// the file, through `compare` and `fit --sheet` alike.
 #[test]
 fn hostile_workbooks_end_in_exit_2_naming_the_file() {
-    let dir = "fixtures/sheets/hostile";
-    let mut names: Vec<String> =
-        std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
-    names.sort();
-    assert_eq!(names.len(), 11, "{names:?}");
-    for name in &names {
-        let path = format!("{dir}/{name}");
+    for (name, path) in &common::hostile_workbooks() {
         for args in [vec!["compare", GLASS, &path], vec!["fit", GLASS, "--sheet", &path, "--free", "/ior=1.3..1.8"]] {
             let (code, out, err) = gm(&args);
             assert_eq!(code, 2, "{args:?}: {out}{err}");

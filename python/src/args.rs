@@ -81,7 +81,7 @@ pub fn keyword(argument: &'static str) -> String {
     }
 }
 
-fn given<'py>(v: Option<&Bound<'py, PyAny>>) -> Option<Bound<'py, PyAny>> {
+pub(crate) fn given<'py>(v: Option<&Bound<'py, PyAny>>) -> Option<Bound<'py, PyAny>> {
     v.filter(|v| !v.is_none()).cloned()
 }
 

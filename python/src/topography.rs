@@ -18,7 +18,7 @@ use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyString;
 
-use crate::args::{opt_real, opt_string, type_name};
+use crate::args::{given, opt_real, opt_string, type_name};
 use crate::{from_json, guarded, to_py_err};
 use pyo3::types::PyTuple;
 
@@ -140,7 +140,7 @@ pub(crate) fn topography<'py>(
             }
         }
         let map = if let Ok(held) = source.cast::<PyHeightMap>() {
-            if dx.is_some() || dy.is_some() || given(unit) || given(mask) {
+            if dx.is_some() || dy.is_some() || given(unit).is_some() || given(mask).is_some() {
                 return Err(PyValueError::new_err(
                     "dx_um, dy_um, unit, mask: not for a HeightMap, which carries its calibration and invalid points",
                 ));
@@ -180,11 +180,6 @@ fn file_path(py: Python<'_>, source: &Bound<'_, PyAny>) -> PyResult<PathBuf> {
             type_name(source)
         ))),
     }
-}
-
-/// Whether an optional keyword was given (not absent, not None).
-fn given(v: Option<&Bound<'_, PyAny>>) -> bool {
-    v.is_some_and(|v| !v.is_none())
 }
 
 /// A height map held in memory for recipes (docs/python.md §Topography): a recipe's `file` entry (the

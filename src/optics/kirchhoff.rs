@@ -139,8 +139,10 @@ fn hann(i: usize, n: usize) -> f64 {
     s * s
 }
 
-/// The signed frequency index of bin k of n.
-fn signed(k: usize, n: usize) -> i64 {
+/// The signed frequency index of a discrete Fourier transform's bin k of n (k ≤ n/2 the non-negative
+/// frequencies, the rest the negative ones, numpy.fft.fftfreq's order); the one place the topography's
+/// transforms (`topography::psd`, `topography::synthetic`) and the scatter integral take it from.
+pub(crate) fn signed_bin(k: usize, n: usize) -> i64 {
     if k <= n / 2 {
         k as i64
     } else {
@@ -214,7 +216,7 @@ impl KirchhoffMap {
     /// The spatial frequency of bin (kx, ky), 1/m.
     pub fn frequency(&self, kx: usize, ky: usize) -> (f64, f64) {
         let (lx, ly) = self.extent();
-        (signed(kx, self.nx) as f64 / lx, signed(ky, self.ny) as f64 / ly)
+        (signed_bin(kx, self.nx) as f64 / lx, signed_bin(ky, self.ny) as f64 / ly)
     }
 
     /// p(f) for a fixed q_z (1/m), in the transform's order (`p[ky·nx + kx]`); refused when q_z·max|Δz| > π.
@@ -312,7 +314,7 @@ impl KirchhoffMap {
         let mut most: f64 = 0.0;
         for ky in 0..self.ny {
             for kx in 0..self.nx {
-                let (sx, sy) = (signed(kx, self.nx), signed(ky, self.ny));
+                let (sx, sy) = (signed_bin(kx, self.nx), signed_bin(ky, self.ny));
                 if sx.abs() >= hx - 1 || sy.abs() >= hy - 1 {
                     most = most.max(p[ky * self.nx + kx]);
                 }

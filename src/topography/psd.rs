@@ -13,6 +13,8 @@ use rustfft::num_complex::Complex64;
 use rustfft::FftPlannerScalar;
 use std::f64::consts::PI;
 
+use crate::optics::kirchhoff::signed_bin;
+
 /// The 2-D PSD on the map's frequency grid.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Psd2 {
@@ -35,15 +37,6 @@ pub struct RadialBin {
     pub s: f64,
     /// How many grid frequencies the annulus holds.
     pub count: usize,
-}
-
-/// The signed index of a transform's bin k of n.
-fn signed(k: usize, n: usize) -> f64 {
-    if k <= n / 2 {
-        k as f64
-    } else {
-        k as f64 - n as f64
-    }
 }
 
 /// The PSD of levelled heights `z` (nx × ny, NaN: invalid; spacings dx, dy in metres).
@@ -91,7 +84,7 @@ pub(crate) fn low_pass(z: &[f64], nx: usize, ny: usize, dx: f64, dy: f64, f_s: f
     let (dfx, dfy) = (1.0 / (nx as f64 * dx), 1.0 / (ny as f64 * dy));
     for kx in 0..nx {
         for ky in 0..ny {
-            let f = (signed(kx, nx) * dfx).hypot(signed(ky, ny) * dfy);
+            let f = (signed_bin(kx, nx) as f64 * dfx).hypot(signed_bin(ky, ny) as f64 * dfy);
             if f >= f_s {
                 cols[kx * ny + ky] = Complex64::new(0.0, 0.0);
             }
@@ -110,7 +103,7 @@ pub(crate) fn low_pass(z: &[f64], nx: usize, ny: usize, dx: f64, dy: f64, f_s: f
 impl Psd2 {
     /// The frequency of grid point (kₓ, k_y), 1/m.
     pub fn frequency(&self, kx: usize, ky: usize) -> (f64, f64) {
-        (signed(kx, self.nx) * self.dfx, signed(ky, self.ny) * self.dfy)
+        (signed_bin(kx, self.nx) as f64 * self.dfx, signed_bin(ky, self.ny) as f64 * self.dfy)
     }
 
     /// Σ S·Δfₓ·Δf_y over the grid: Sq² (Parseval).

@@ -9,6 +9,8 @@ use rustfft::num_complex::Complex64;
 use rustfft::FftPlannerScalar;
 use std::f64::consts::PI;
 
+use crate::optics::kirchhoff::signed_bin;
+
 /// SplitMix64 (Steele, Lea & Flood, "Fast splittable pseudorandom number generators", OOPSLA 2014): the
 /// state advances by 0x9E3779B97F4A7C15 and each output is the state mixed by two xor-shift-multiplies.
 #[derive(Clone, Debug)]
@@ -87,7 +89,7 @@ pub fn generate(family: &Family, n: usize, dx: f64, seed: u64) -> Vec<f64> {
 fn component(shape: &dyn Fn(f64) -> f64, n: usize, dx: f64, seed: u64) -> Vec<f64> {
     let mut rng = SplitMix64::new(seed);
     let l = n as f64 * dx;
-    let signed = |k: usize| if k <= n / 2 { k as f64 } else { k as f64 - n as f64 };
+    let signed = |k: usize| signed_bin(k, n) as f64;
     let mut spec = vec![Complex64::new(0.0, 0.0); n * n];
     for ky in 0..n {
         for kx in 0..n {

@@ -114,3 +114,47 @@ pub fn write_gsf(path: &std::path::Path, n: usize, dx: f64, z: &[f64]) {
     }
     std::fs::write(path, b).unwrap();
 }
+
+/// The orange-peel panel's readout as printed (`fixtures/real/konica-orange-peel-panel.csv`), its haze read as
+/// log haze (docs/instrument.md §1.10).
+pub const PANEL_TARGETS: [&str; 12] = [
+    "--target",
+    "astm-d523-20/gloss=66.3",
+    "--target",
+    "astm-d523-60/gloss=88.3",
+    "--target",
+    "astm-d523-85/gloss=94.0",
+    "--target",
+    "rhopoint-iq-20/log-haze=14.2",
+    "--target",
+    "rhopoint-iq-20/doi=77.5",
+    "--target",
+    "rhopoint-iq-20/rspec=26.1",
+];
+
+/// The five free parameters of the three-population model and their bounds (docs/instrument.md §1.10), as
+/// `fit` arguments.
+pub const THREE_POPULATION_FREE: [&str; 10] = [
+    "--free",
+    "/ior=1.3..1.8",
+    "--free",
+    "/populations/1/roughness=log:1e-3..0.05",
+    "--free",
+    "/populations/1/weight=0.001..0.7",
+    "--free",
+    "/populations/2/roughness=log:0.01..0.5",
+    "--free",
+    "/populations/2/weight=0.001..0.5",
+];
+
+/// The reproducers of docs/reliability.md §Workbooks (`fixtures/sheets/hostile`: crafted and mutated books that
+/// made the reader panic, abort on a huge allocation, inflate a zip bomb or pass a bad CRC), as (file name,
+/// path) in name order; all eleven of them, so that a lost reproducer fails the tests that read them.
+pub fn hostile_workbooks() -> Vec<(String, String)> {
+    let dir = "fixtures/sheets/hostile";
+    let mut names: Vec<String> =
+        std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    names.sort();
+    assert_eq!(names.len(), 11, "{names:?}");
+    names.into_iter().map(|name| (name.clone(), format!("{dir}/{name}"))).collect()
+}
