@@ -258,6 +258,11 @@ impl AxisMap {
                 }
             }
         }
+        // A lobe split within a quarter of its distance from the centre of a kink or a range end would cut a
+        // sliver box beside it: the kink serves as that split (`docs/instrument.md` §Quadrature, "No sliver
+        // beside a kink").
+        let fixed = [a, b, self.s[1] + self.r[0], self.s[0] + self.r[1]];
+        pts.retain(|&x| x == 0.0 || fixed.contains(&x) || fixed.iter().all(|k| (x - k).abs() >= 0.25 * x.abs()));
         pts.retain(|x| *x >= a && *x <= b);
         pts.sort_by(f64::total_cmp);
         let tiny = 1e-14 * (b - a).max(1e-300);

@@ -49,6 +49,14 @@ pub(crate) const TENSOR_MAX_WIDTH_V: f64 = 0.5;
 /// See [`TENSOR_MIN_WIDTH`].
 pub(crate) const TENSOR_MIN_WIDTH_U: f64 = 4.0;
 
+/// [`Rule::TensorGauss`] is chosen ([`smooth_rule`]) only at reading tolerances of [`TENSOR_MAX_RTOL`] and
+/// below: since the initial boxes of a smooth lobe chart are calibrated (`docs/accuracy.md` §5.2), the
+/// Genz–Malik partition reads B4 (GGX α = 0.3 on n = 1.5 at D523 85°) with fewer evaluations at 10⁻³–10⁻⁶
+/// (1 026 / 1 026 / 1 140 / 2 508 against the tensor rule's 1 008 / 1 494 / 2 142 / 3 006), the tensor rule
+/// from 5·10⁻⁷ on (3 006 against 3 534; 10⁻⁷ 4 302 against 7 182; 10⁻⁹ 12 294 against 94 278), each within
+/// its estimate of the rtol-10⁻¹¹ partition (`tests/wide_lobes.rs`, `b4_tensor_against_the_partition`).
+pub(crate) const TENSOR_MAX_RTOL: f64 = 5e-7;
+
 /// How far (in lobe widths) the nearest overlap kink or range end must be from the lobe centre, on both
 /// axes, for [`Rule::LobeGaussHermite`]: the largest node of the 16-point rule is at 4.69 widths, and the
 /// Gaussian is below e⁻⁶⁴ of its peak at 8.
@@ -139,7 +147,7 @@ impl Method {
                     Chart::Lobe if kinks.is_empty() && on_mirror_axis => delta_rule(&l, src, rec, share * d.rtol)
                         .or_else(|| lobe_rule(&l, src, rec))
                         .or_else(|| polar_rule(&l, src, rec))
-                        .or_else(|| smooth_rule(&l, src, rec))
+                        .or_else(|| (d.rtol <= TENSOR_MAX_RTOL).then(|| smooth_rule(&l, src, rec)).flatten())
                         .unwrap_or(Rule::GenzMalik75),
                     _ => Rule::GenzMalik75,
                 };
