@@ -522,7 +522,8 @@ fn summarise<const D: usize>(
                 calibrated(n1s[c], n2, n3, abs7[c] * vol, max_shrink)
             } else if calibrate_initial {
                 // An initial box of a smooth lobe chart: calibrated like a split one, from N₁ freed of a chance
-                // agreement at the unsplit factor (`docs/accuracy.md` §5.3).
+                // agreement at the unsplit factor (`docs/accuracy.md` §5.2, "The initial boxes of a smooth lobe
+                // chart").
                 n1s[c] = unsplit_estimate(n1, n2, n3);
                 calibrated(n1s[c], n2, n3, abs7[c] * vol, max_shrink)
             } else {
