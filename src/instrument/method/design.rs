@@ -68,6 +68,31 @@ pub(crate) const LOBE_REACH: f64 = 8.0;
 /// is computed at run time.
 pub(crate) const DELTA_GATE: f64 = 1.0e3;
 
+/// How near the lobe centre (in the lobe's widths, its distribution's own scale) a receptor must come for
+/// [`Rule::TailBound`] not to be designed: within it the lobe's distribution at the receptor's nearest
+/// direction is at least e⁻⁴ of its peak (Beckmann; GGX's 1/(1 + x²)² holds 1/25 there), so no majorant can
+/// settle the receptor below the floor and the check would only fall back (ASTM E430's DOI receptors, 0.3° off
+/// specular, 0.1° beyond the stops' edges: 0.3 widths of a Beckmann m = 0.003 lobe). A gate at design time:
+/// the bound itself is decided at run time.
+pub(crate) const TAIL_REACH: f64 = 2.0;
+
+/// Whether a lobe of `l` reaches the receptor: the distance of the lobe centre (u = v = 0, the mirror image)
+/// from the nearest point of the lobe variables' ranges u = p_s + p_r, v = q_s + q_r, in the lobe's widths,
+/// is below [`TAIL_REACH`] for some lobe. Off the mirror axis (a receptor whose axis is turned in the plane
+/// of incidence) the in-plane gap is the angle between the receptor's axis and the mirror direction less the
+/// two stops' in-plane half extents.
+fn lobe_reaches(l: &LobesAt, a: &Aperture, src: Stop, rec: Stop) -> bool {
+    let gap = |lo: f64, hi: f64| lo.max(-hi).max(0.0);
+    let half = |s: Stop| s.p[0].abs().max(s.p[1].abs()).atan();
+    let gap_u = if a.viewing == a.theta {
+        gap(src.p[0] + rec.p[0], src.p[1] + rec.p[1])
+    } else {
+        ((a.viewing - a.theta).abs() - half(src) - half(rec)).max(0.0)
+    };
+    let gap_v = gap(src.q[0] + rec.q[0], src.q[1] + rec.q[1]);
+    l.widths.iter().any(|w| (gap_u / w[0]).hypot(gap_v / w[1]) < TAIL_REACH)
+}
+
 impl Method {
     /// Design the method of one integral.
     pub(crate) fn design(d: Design<'_>) -> Method {
@@ -154,7 +179,12 @@ impl Method {
                 // A receptor that does not see the mirror image of a material without a diffuse term: first the
                 // material's bound of the tail (`Rule::TailBound`, decided at run time).
                 let rule = match rule {
-                    Rule::GenzMalik75 if mirror.is_none() && !facts.has_diffuse && !facts.lobes.is_empty() => {
+                    Rule::GenzMalik75
+                        if mirror.is_none()
+                            && !facts.has_diffuse
+                            && !facts.lobes.is_empty()
+                            && !lobe_reaches(&l, &a, src, rec) =>
+                    {
                         Rule::TailBound
                     }
                     r => r,
