@@ -3,29 +3,9 @@
 //! material's majorant without an evaluation, and their estimates cover their actual errors against the
 //! Genz–Malik partition run at 10⁻⁵ of the plan's tolerances (rtol 10⁻¹¹). The counts of the 24 wide-lobe
 //! integrals of `docs/performance.md` §"At the limit" before and after are printed by an ignored test.
-use std::sync::Arc;
+mod common;
 
-use glossmeter::brdf::Brdf;
 use glossmeter::instrument::method::{Method, Rule};
-use glossmeter::instrument::plan::{Plan, PlanOptions};
-use glossmeter::instrument::standards;
-
-fn material(distribution: &str, roughness: f64) -> Arc<dyn Brdf> {
-    let text =
-        format!(r#"{{"model":"microfacet","distribution":"{distribution}","roughness":{roughness:e},"ior":1.5}}"#);
-    glossmeter::recipe::parse_str(&text, "<tail>").unwrap().brdf
-}
-
-/// The specimen methods of a plan of `distribution` at `geometry` (default options), each with its receptor.
-fn specimen_methods(brdf: &Arc<dyn Brdf>, geometry: &str) -> Vec<(String, Method)> {
-    let options = PlanOptions { max_seconds: None, ..PlanOptions::default() };
-    let p = Plan::compile(brdf.clone(), vec![standards::find(geometry).unwrap()], options).unwrap();
-    p.jobs
-        .iter()
-        .filter(|j| j.method.aperture.target == glossmeter::instrument::method::Target::Specimen)
-        .map(|j| (j.used_by.join(","), j.method.clone()))
-        .collect()
-}
 
 /// The method as it was before the tail bound: the partition wherever the bound was designed.
 fn without_bound(m: &Method) -> Method {
@@ -38,9 +18,9 @@ fn without_bound(m: &Method) -> Method {
 
 #[test]
 fn e430_off_specular_receptors_of_a_narrow_beckmann_lobe_are_settled_by_the_bound() {
-    let brdf = material("beckmann", 0.003);
+    let brdf = common::microfacet("beckmann", 0.003);
     let mut settled = 0;
-    for (used_by, method) in specimen_methods(&brdf, "astm-e430-30") {
+    for (used_by, method) in common::specimen_methods(&brdf, "astm-e430-30") {
         let flux = method.execute(brdf.as_ref());
         let off_specular = !used_by.contains("specular") && !used_by.contains("doi");
         if !off_specular {
@@ -82,9 +62,9 @@ fn e430_off_specular_receptors_of_a_narrow_beckmann_lobe_are_settled_by_the_boun
 /// changed so that the bound no longer meets the tolerance falls back to the partition.
 #[test]
 fn a_bound_that_does_not_hold_falls_back_to_the_partition() {
-    let narrow = material("beckmann", 0.003);
-    let wide = material("beckmann", 0.3);
-    let methods = specimen_methods(&narrow, "astm-e430-30");
+    let narrow = common::microfacet("beckmann", 0.003);
+    let wide = common::microfacet("beckmann", 0.3);
+    let methods = common::specimen_methods(&narrow, "astm-e430-30");
     let (_, method) = methods.iter().find(|(u, _)| u.contains("haze-narrow-plus")).unwrap();
     let (_, frozen) = method.execute_and_freeze(narrow.as_ref());
     let flux = frozen.execute(wide.as_ref());
@@ -102,10 +82,10 @@ fn wide_lobe_counts_before_and_after() {
     let (mut all_before, mut all_after) = (0, 0);
     for d in ["beckmann", "ggx"] {
         for m in [0.003, 0.01, 0.03] {
-            let brdf = material(d, m);
+            let brdf = common::microfacet(d, m);
             for g in ["astm-d523-20", "astm-d523-60", "astm-d523-85", "astm-e430-30"] {
                 let (mut before, mut after) = (0, 0);
-                for (used_by, method) in specimen_methods(&brdf, g) {
+                for (used_by, method) in common::specimen_methods(&brdf, g) {
                     let b = without_bound(&method).execute(brdf.as_ref());
                     let a = method.execute(brdf.as_ref());
                     let moved = (a.value[0] - b.value[0]).abs();

@@ -3,28 +3,10 @@
 //! 10⁻⁶): exact evaluation counts against the limit measured by independent code
 //! (`bench/results/limit-wide-lobes-2026-12-03.md`), and every reading's estimate against its actual error
 //! (the same method run at 10⁻⁵ of its tolerances).
-use std::sync::Arc;
+mod common;
 
-use glossmeter::brdf::Brdf;
-use glossmeter::instrument::method::{Method, Target};
-use glossmeter::instrument::plan::{Plan, PlanOptions};
+use glossmeter::instrument::method::Method;
 use glossmeter::instrument::standards;
-
-fn material(distribution: &str, roughness: f64) -> Arc<dyn Brdf> {
-    let text =
-        format!(r#"{{"model":"microfacet","distribution":"{distribution}","roughness":{roughness:e},"ior":1.5}}"#);
-    glossmeter::recipe::parse_str(&text, "<wide>").unwrap().brdf
-}
-
-fn specimen_methods(brdf: &Arc<dyn Brdf>, geometry: &str) -> Vec<(String, Method)> {
-    let options = PlanOptions { max_seconds: None, ..PlanOptions::default() };
-    let p = Plan::compile(brdf.clone(), vec![standards::find(geometry).unwrap()], options).unwrap();
-    p.jobs
-        .iter()
-        .filter(|j| j.method.aperture.target == Target::Specimen)
-        .map(|j| (j.used_by.join(","), j.method.clone()))
-        .collect()
-}
 
 /// The method at `factor` times its tolerances.
 fn tightened(m: &Method, factor: f64) -> Method {
@@ -53,8 +35,8 @@ fn wide_lobe_counts_and_estimates() {
         let mut sum = 0;
         for d in ["beckmann", "ggx"] {
             for m in [0.003, 0.01, 0.03] {
-                let brdf = material(d, m);
-                for (used_by, method) in specimen_methods(&brdf, g) {
+                let brdf = common::microfacet(d, m);
+                for (used_by, method) in common::specimen_methods(&brdf, g) {
                     let boxes = method.regular.as_ref().map_or(0, |p| p.cells.len());
                     let rule = method.regular.as_ref().map(|p| format!("{:?}", p.rule)).unwrap_or_default();
                     let flux = method.execute(brdf.as_ref());

@@ -222,7 +222,9 @@ impl AxisMap {
     /// of each lobe width.
     pub fn splits(&self, widths: &[(f64, bool)]) -> Vec<f64> {
         let [a, b] = self.range();
-        let mut pts = vec![a, b, self.s[1] + self.r[0], self.s[0] + self.r[1]];
+        // The range ends and the overlap kinks: split points always.
+        let fixed = [a, b, self.s[1] + self.r[0], self.s[0] + self.r[1]];
+        let mut pts = fixed.to_vec();
         // Lobes within a factor 3 of a narrower one share its splits: the splits are geometric (×3 apart),
         // so they already resolve it, and each extra set multiplies the number of initial boxes. A shared
         // set reaches as far as the heaviest tail among the lobes it serves.
@@ -261,7 +263,6 @@ impl AxisMap {
         // A lobe split within a quarter of its distance from the centre of a kink or a range end would cut a
         // sliver box beside it: the kink serves as that split (`docs/instrument.md` §Quadrature, "No sliver
         // beside a kink").
-        let fixed = [a, b, self.s[1] + self.r[0], self.s[0] + self.r[1]];
         pts.retain(|&x| x == 0.0 || fixed.contains(&x) || fixed.iter().all(|k| (x - k).abs() >= 0.25 * x.abs()));
         pts.retain(|x| *x >= a && *x <= b);
         pts.sort_by(f64::total_cmp);

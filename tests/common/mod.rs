@@ -158,3 +158,27 @@ pub fn hostile_workbooks() -> Vec<(String, String)> {
     assert_eq!(names.len(), 11, "{names:?}");
     names.into_iter().map(|name| (name.clone(), format!("{dir}/{name}"))).collect()
 }
+
+/// A smooth microfacet dielectric (n = 1.5) of `distribution` and `roughness`, from its recipe.
+pub fn microfacet(distribution: &str, roughness: f64) -> std::sync::Arc<dyn Brdf> {
+    let text =
+        format!(r#"{{"model":"microfacet","distribution":"{distribution}","roughness":{roughness:e},"ior":1.5}}"#);
+    glossmeter::recipe::parse_str(&text, "<microfacet>").unwrap().brdf
+}
+
+/// The specimen methods of a plan of `brdf` at `geometry` alone (default options, no wall-clock limit), each
+/// with the readings that use it.
+pub fn specimen_methods(
+    brdf: &std::sync::Arc<dyn Brdf>,
+    geometry: &str,
+) -> Vec<(String, glossmeter::instrument::method::Method)> {
+    use glossmeter::instrument::plan::{Plan, PlanOptions};
+    let options = PlanOptions { max_seconds: None, ..PlanOptions::default() };
+    let geometries = vec![glossmeter::instrument::standards::find(geometry).unwrap()];
+    let p = Plan::compile(brdf.clone(), geometries, options).unwrap();
+    p.jobs
+        .iter()
+        .filter(|j| j.method.aperture.target == glossmeter::instrument::method::Target::Specimen)
+        .map(|j| (j.used_by.join(","), j.method.clone()))
+        .collect()
+}
