@@ -217,6 +217,9 @@ fn campaign(cases: usize, rtols: Option<&[f64]>) {
     let mut rng = Rng(0x0005_EED0_FE57);
     let (mut checked, mut unchecked, mut exact) = (0usize, 0usize, 0usize);
     let mut ratios: Vec<f64> = Vec::new();
+    // The same ratios split by whether the reading's estimate came within 1/100 of its allowance rtol·|v|
+    // (`near`: the refinement ran until this reading's tolerance was met) or stayed far below it (`far`).
+    let (mut near, mut far): (Vec<f64>, Vec<f64>) = (Vec::new(), Vec::new());
     let mut failures = Vec::new();
     for i in 0..cases {
         let (label, json, file) = recipe(i, &mut rng);
@@ -243,6 +246,9 @@ fn campaign(cases: usize, rtols: Option<&[f64]>) {
                     exact += 1;
                 } else {
                     ratios.push(bound / actual);
+                    // The head room: the estimate against what the tolerance allowed the reading (rtol·|v|).
+                    let room = a.error_estimate / (options.rtol * v.abs());
+                    if room >= 0.01 { &mut near } else { &mut far }.push(bound / actual);
                 }
                 if actual > bound {
                     failures.push(format!(
@@ -267,6 +273,18 @@ fn campaign(cases: usize, rtols: Option<&[f64]>) {
             q(0.9),
             q(1.0)
         );
+        for (label, mut v) in [("within 1/100 of rtol·|v|", near), ("below 1/100 of rtol·|v|", far)] {
+            v.sort_by(f64::total_cmp);
+            let q = |p: f64| v.get(((v.len() as f64 - 1.0) * p) as usize).copied().unwrap_or(f64::NAN);
+            eprintln!(
+                "  estimate {label}: {} readings; min {:.3e}, 10 % {:.3e}, median {:.3e}, 90 % {:.3e}",
+                v.len(),
+                q(0.0),
+                q(0.1),
+                q(0.5),
+                q(0.9)
+            );
+        }
     }
     assert!(
         checked >= 20 * cases * runs.len(),

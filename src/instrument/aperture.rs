@@ -169,12 +169,8 @@ fn seen_from(lobe: &Lobe, w: [f64; 2], ap: AxisMap, aq: AxisMap) -> [f64; 2] {
     if !(widens && w[0] > 0.0 && w[1] > 0.0 && w[0].is_finite() && w[1].is_finite()) {
         return w;
     }
-    let gap = |a: AxisMap| {
-        let [lo, hi] = a.range();
-        lo.max(-hi).max(0.0)
-    };
     let c = |g: f64, w: f64| (1.0 + (g / w) * (g / w)).sqrt();
-    [w[0] * c(gap(aq), w[1]), w[1] * c(gap(ap), w[0])]
+    [w[0] * c(aq.gap(), w[1]), w[1] * c(ap.gap(), w[0])]
 }
 
 /// The initial boxes of the lobe chart in (u, t_p, v, t_q): the product of the split intervals, t ∈ [0, 1].
@@ -200,6 +196,13 @@ pub struct AxisMap {
 impl AxisMap {
     pub fn range(&self) -> [f64; 2] {
         [self.s[0] + self.r[0], self.s[1] + self.r[1]]
+    }
+
+    /// How far the range of the lobe coordinate lies from the lobe centre 0: 0 when it holds 0, else the
+    /// distance of its nearer end.
+    pub(crate) fn gap(&self) -> f64 {
+        let [lo, hi] = self.range();
+        lo.max(-hi).max(0.0)
     }
 
     /// The overlap [lo, hi] of p_s at lobe coordinate u: the source points whose partner u − p_s lies in the

@@ -82,14 +82,13 @@ pub(crate) const TAIL_REACH: f64 = 2.0;
 /// of incidence) the in-plane gap is the angle between the receptor's axis and the mirror direction less the
 /// two stops' in-plane half extents.
 fn lobe_reaches(l: &LobesAt, a: &Aperture, src: Stop, rec: Stop) -> bool {
-    let gap = |lo: f64, hi: f64| lo.max(-hi).max(0.0);
     let half = |s: Stop| s.p[0].abs().max(s.p[1].abs()).atan();
     let gap_u = if a.viewing == a.theta {
-        gap(src.p[0] + rec.p[0], src.p[1] + rec.p[1])
+        AxisMap { s: src.p, r: rec.p }.gap()
     } else {
         ((a.viewing - a.theta).abs() - half(src) - half(rec)).max(0.0)
     };
-    let gap_v = gap(src.q[0] + rec.q[0], src.q[1] + rec.q[1]);
+    let gap_v = AxisMap { s: src.q, r: rec.q }.gap();
     l.widths.iter().any(|w| (gap_u / w[0]).hypot(gap_v / w[1]) < TAIL_REACH)
 }
 
