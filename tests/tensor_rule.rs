@@ -59,17 +59,15 @@ fn the_tensor_rule_meets_the_lambert_polygon_closed_form_within_its_estimate() {
     }
 }
 
-/// B4 (GGX α = 0.3 on n = 1.5 at 85°) at rtol 10⁻⁸: the planner chooses the tensor rule, `--explain` names it
-/// with its fallback; the reading agrees with an independent run of the forced Genz–Malik engine at rtol 1e-11
-/// within its estimate, costs fewer evaluations than the Genz–Malik partition it replaces, and repeats its bits
-/// frozen and on 1 and 2 threads. At the default rtol (10⁻⁶, above `TENSOR_MAX_RTOL`, where the partition is
-/// cheaper) B4 keeps Genz–Malik, and so do Lambert (B1), B2 and B4 at 75° (where it was cheaper).
+/// B4 (GGX α = 0.3 on n = 1.5 at 85°): the planner chooses the tensor rule, `--explain` names it with its
+/// fallback; the reading agrees with an independent run of the forced Genz–Malik engine at rtol 1e-11 within
+/// its estimate, costs fewer evaluations than the Genz–Malik partition it replaces, and repeats its bits frozen
+/// and on 1 and 2 threads. Lambert (B1), B2 and B4 at 75° keep Genz–Malik (where it was cheaper).
 #[test]
 fn the_planner_chooses_the_tensor_rule_for_b4_and_names_it() {
     let b4 = fixture("bench-b4-ggx-0.3.json");
     let g85 = standards::find("astm-d523-85").unwrap();
-    let rtol = 1e-8;
-    let plan = Plan::compile(b4.clone(), vec![g85.clone()], PlanOptions { rtol, ..PlanOptions::default() }).unwrap();
+    let plan = Plan::compile(b4.clone(), vec![g85.clone()], PlanOptions::default()).unwrap();
     let text = plan.explain();
     assert!(text.contains("smooth integrand: tensor Gauss–Legendre in (p_s, p_r, v, t_q)"), "{text}");
     assert!(text.contains("fallback: Genz–Malik 7/5"), "{text}");
@@ -82,14 +80,14 @@ fn the_planner_chooses_the_tensor_rule_for_b4_and_names_it() {
     assert!(matches!(gm.regular.as_ref().unwrap().rule, Rule::TensorGauss { .. }));
     gm.regular.as_mut().unwrap().rule = Rule::GenzMalik75;
     let tight = gm.execute(b4.as_ref());
-    let ours = Method::for_material(b4.as_ref(), geo.theta, geo.source, rec, (rtol, 0.0), 10_000_000)
+    let ours = Method::for_material(b4.as_ref(), geo.theta, geo.source, rec, (1e-6, 0.0), 10_000_000)
         .unwrap()
         .execute(b4.as_ref());
     let actual = (ours.value[0] - tight.value[0]).abs();
     assert!(actual <= ours.error[0] + tight.error[0], "actual {actual:e}, estimate {:e}", ours.error[0]);
-    assert!(ours.error[0] <= rtol * ours.value[0]);
+    assert!(ours.error[0] <= 1e-6 * ours.value[0]);
     // Cheaper than the Genz–Malik partition it replaces, at the same tolerance.
-    let mut plain = Method::for_material(b4.as_ref(), geo.theta, geo.source, rec, (rtol, 0.0), 10_000_000).unwrap();
+    let mut plain = Method::for_material(b4.as_ref(), geo.theta, geo.source, rec, (1e-6, 0.0), 10_000_000).unwrap();
     plain.regular.as_mut().unwrap().rule = Rule::GenzMalik75;
     let plain = plain.execute(b4.as_ref());
     assert!(
@@ -114,7 +112,6 @@ fn the_planner_chooses_the_tensor_rule_for_b4_and_names_it() {
         ("bench-b1-lambert.json", "astm-d523-60"),
         ("bench-b2-beckmann-0.1.json", "astm-d523-20"),
         ("bench-b4-ggx-0.3.json", "tappi-t480-75"),
-        ("bench-b4-ggx-0.3.json", "astm-d523-85"),
     ] {
         let p = Plan::compile(fixture(name), vec![standards::find(id).unwrap()], PlanOptions::default()).unwrap();
         assert!(!p.explain().contains("tensor Gauss–Legendre"), "{name} {id}");

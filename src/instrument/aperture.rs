@@ -263,10 +263,6 @@ impl AxisMap {
                 }
             }
         }
-        // A lobe split within a quarter of its distance from the centre of a kink or a range end would cut a
-        // sliver box beside it: the kink serves as that split (`docs/instrument.md` §Quadrature, "No sliver
-        // beside a kink").
-        pts.retain(|&x| x == 0.0 || fixed.contains(&x) || fixed.iter().all(|k| (x - k).abs() >= 0.25 * x.abs()));
         pts.retain(|x| *x >= a && *x <= b);
         pts.sort_by(f64::total_cmp);
         let tiny = 1e-14 * (b - a).max(1e-300);

@@ -22,11 +22,6 @@ pub struct Options {
     /// ([`child_scale`]); only for an integrand that is smooth inside every box (a material that says
     /// `Hints::smooth`), `docs/accuracy.md` §5.
     pub checked: bool,
-    /// Whether the initial boxes (never split) get the calibrated estimate too, from N₁ freed of a chance
-    /// agreement ([`unsplit_estimate`]), instead of that N₁ itself: only where the boxes are cut to the lobes'
-    /// widths and the material is smooth (the regular part's lobe chart with `checked`), `docs/accuracy.md`
-    /// §5.2, "The initial boxes of a smooth lobe chart".
-    pub calibrate_initial: bool,
 }
 
 /// The relative tolerance when none is given: the one default of the whole library (re-exported as
@@ -42,7 +37,6 @@ impl Default for Options {
             deadline: None,
             max_shrink: MAX_SHRINK,
             checked: false,
-            calibrate_initial: false,
         }
     }
 }
@@ -281,7 +275,6 @@ struct Batch<const D: usize> {
     points: Vec<[f64; D]>,
     values: Vec<f64>,
     max_shrink: f64,
-    calibrate_initial: bool,
 }
 
 /// Apply the rule to the cells in one integrand call: all their points (57 per 4-D cell) are passed to `f`
@@ -319,7 +312,6 @@ fn apply<const D: usize, F: FnMut(&[[f64; D]], &mut [f64])>(
             ncomp,
             first_id + i,
             batch.max_shrink,
-            batch.calibrate_initial,
         )
     }));
 }
@@ -470,7 +462,6 @@ fn summarise<const D: usize>(
     ncomp: usize,
     id: usize,
     max_shrink: f64,
-    calibrate_initial: bool,
 ) -> Region<D> {
     let half = cell.half;
     let vol: f64 = half.iter().map(|h| 2.0 * h).product();
@@ -519,12 +510,6 @@ fn summarise<const D: usize>(
             if cell.split {
                 // The calibration and the checked floors start from N₁ freed of a chance agreement.
                 n1s[c] = split_n1(n1, n2, n3);
-                calibrated(n1s[c], n2, n3, abs7[c] * vol, max_shrink)
-            } else if calibrate_initial {
-                // An initial box of a smooth lobe chart: calibrated like a split one, from N₁ freed of a chance
-                // agreement at the unsplit factor (`docs/accuracy.md` §5.2, "The initial boxes of a smooth lobe
-                // chart").
-                n1s[c] = unsplit_estimate(n1, n2, n3);
                 calibrated(n1s[c], n2, n3, abs7[c] * vol, max_shrink)
             } else {
                 unsplit_estimate(n1, n2, n3)
@@ -587,7 +572,6 @@ pub fn integrate_partition<const D: usize, F: FnMut(&[[f64; D]], &mut [f64])>(
         points: Vec::with_capacity(2 * npts),
         values: Vec::with_capacity(2 * npts * ncomp),
         max_shrink: opts.max_shrink,
-        calibrate_initial: opts.calibrate_initial,
     };
     let mut heap = BinaryHeap::new();
     let mut total = vec![0.0; ncomp];

@@ -49,14 +49,6 @@ pub(crate) const TENSOR_MAX_WIDTH_V: f64 = 0.5;
 /// See [`TENSOR_MIN_WIDTH`].
 pub(crate) const TENSOR_MIN_WIDTH_U: f64 = 4.0;
 
-/// [`Rule::TensorGauss`] is chosen ([`smooth_rule`]) only at reading tolerances of [`TENSOR_MAX_RTOL`] and
-/// below: since the initial boxes of a smooth lobe chart are calibrated (`docs/accuracy.md` §5.2), the
-/// Genz–Malik partition reads B4 (GGX α = 0.3 on n = 1.5 at D523 85°) with fewer evaluations at 10⁻³–10⁻⁶
-/// (1 026 / 1 026 / 1 140 / 2 508 against the tensor rule's 1 008 / 1 494 / 2 142 / 3 006), the tensor rule
-/// from 5·10⁻⁷ on (3 006 against 3 534; 10⁻⁷ 4 302 against 7 182; 10⁻⁹ 12 294 against 94 278), each within
-/// its estimate of the rtol-10⁻¹¹ partition (`tests/wide_lobes.rs`, `b4_tensor_against_the_partition`).
-pub(crate) const TENSOR_MAX_RTOL: f64 = 5e-7;
-
 /// How far (in lobe widths) the nearest overlap kink or range end must be from the lobe centre, on both
 /// axes, for [`Rule::LobeGaussHermite`]: the largest node of the 16-point rule is at 4.69 widths, and the
 /// Gaussian is below e⁻⁶⁴ of its peak at 8.
@@ -171,7 +163,7 @@ impl Method {
                     Chart::Lobe if kinks.is_empty() && on_mirror_axis => delta_rule(&l, src, rec, share * d.rtol)
                         .or_else(|| lobe_rule(&l, src, rec))
                         .or_else(|| polar_rule(&l, src, rec))
-                        .or_else(|| (d.rtol <= TENSOR_MAX_RTOL).then(|| smooth_rule(&l, src, rec)).flatten())
+                        .or_else(|| smooth_rule(&l, src, rec))
                         .unwrap_or(Rule::GenzMalik75),
                     _ => Rule::GenzMalik75,
                 };
@@ -283,8 +275,15 @@ pub(crate) fn delta_rule(l: &LobesAt, src: Stop, rec: Stop, rtol: f64) -> Option
 /// variables (p_s, p_r, v, t_q) ([`Chart::PlainPLobeQ`]: plain in the plane of incidence, where the
 /// lobe is far wider than the stops, the lobe variable across it, where the ridge v = q_s + q_r becomes an
 /// axis) within the bounds of [`TENSOR_MIN_WIDTH`] (B4's GGX α = 0.3 at 85°: 0.6 wide in u against a u-range
-/// of 0.083, 0.052 in v against 0.15). The levels start at 1 (2 points) on every axis.
+/// of 0.083, 0.052 in v against 0.15), and only on a receptor whose range of the lobe variables holds the lobe
+/// centre on both axes (a receptor that sees the mirror image: off it, on the Rhopoint IQ 20° haze receptors,
+/// the rule's estimate fell up to 23× below its actual error, `docs/instrument.md` §Quadrature, "When it is
+/// chosen"). The levels start at 1 (2 points) on every axis.
 pub(crate) fn smooth_rule(l: &LobesAt, src: Stop, rec: Stop) -> Option<Rule> {
+    let (ap, aq) = (AxisMap { s: src.p, r: rec.p }, AxisMap { s: src.q, r: rec.q });
+    if ap.gap() > 0.0 || aq.gap() > 0.0 {
+        return None;
+    }
     let range = [(src.p[1] - src.p[0]) + (rec.p[1] - rec.p[0]), (src.q[1] - src.q[0]) + (rec.q[1] - rec.q[0])];
     let fits = |w: &[f64; 2]| {
         w.iter().all(|w| w.is_finite())

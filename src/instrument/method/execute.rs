@@ -268,15 +268,7 @@ impl Method {
             // The parent's check shrinks no estimate on the plain chart either: it was fooled there as the
             // null rules were (E2539 −15° on GGX tails, 11×; `docs/accuracy.md` §5.2).
             let checked = smooth && part.chart == Chart::Lobe;
-            let opts = Options {
-                rtol: part.rtol,
-                atol,
-                max_evals: self.max_evals,
-                deadline,
-                max_shrink,
-                checked,
-                calibrate_initial: checked,
-            };
+            let opts = Options { rtol: part.rtol, atol, max_evals: self.max_evals, deadline, max_shrink, checked };
             let run = RuleRun { ncomp, opts: &opts, refine: part.refine, stops: (src, rec), cells: &part.cells, keep };
             // The part's rule, then its fallbacks (`Rule::fallback`) until one agrees; the Genz–Malik partition
             // at the end of every chain always does. Each rule gets the integrand in its own chart.
