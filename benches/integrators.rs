@@ -5,7 +5,8 @@
 //! Run: `cargo bench --bench integrators` (release). `BENCH_QUICK=1` shrinks the baselines for a smoke
 //! test. `BENCH_CASES=B1,B3,NARROW,B5,BATCH,WIDE` runs only the sections named (the cases B1–B4, the narrow-GGX
 //! rows, the B5 panel with its side-by-side rule table, the batch throughput, the lobes as wide as the stops); unset, all of them. The Markdown tables go to stdout and to `bench/results/latest.md`; see `bench/README.md` and
-//! `docs/performance.md`.
+//! `docs/performance.md`. `BENCH_JSON=FILE` also writes the specimen integrals of the WIDE section to FILE as JSON
+//! (read by `bench/side_by_side.py`).
 //!
 //! Cases (the specimen flux Φ = ∫_source ∫_receptor f cos θi cos θo dωi dωo through the gloss receptor):
 //! * B1 Lambert, albedo 0.5, astm-d523-60: reference = Lambert's closed form (projected solid angles).
@@ -1318,6 +1319,10 @@ fn batch(md: &mut String, quick: bool) {
 /// (`Chart::Lobe`, falling back to the Genz–Malik partition). For each, the largest actual / estimate over the
 /// recipe's integrals against a Genz–Malik run at 10⁻³ of the integral's tolerances (skipping integrals whose flux is
 /// below the absolute floor). The limit a rule can reach is measured by independent code (`tools/limit_wide_lobes.py`).
+///
+/// With `BENCH_JSON=FILE` set, also writes every specimen integral of this section to FILE as JSON (recipe, the
+/// readings that use it, the planner's rule, evaluations, value, error estimate, the Genz–Malik run at 10⁻³ of its
+/// tolerances, and the two alternatives' evaluations): what `bench/side_by_side.py` reads (`bench/README.md`).
 fn wide_lobes(md: &mut String) {
     use glossmeter::instrument::aperture::{lobe_boxes, AxisMap};
     use glossmeter::quadrature::Cell;
@@ -1326,9 +1331,12 @@ fn wide_lobes(md: &mut String) {
     let _ = writeln!(md, "|---|---|---|---|---|---|---|---|---|---|");
     let set = ["astm-d523-20", "astm-d523-60", "astm-d523-85", "astm-e430-30"];
     let mut cases: Vec<(String, Arc<dyn Brdf>, Vec<&str>)> = vec![];
+    // The microfacet lobes' (distribution, roughness), by recipe name, for the JSON records.
+    let mut lobes: std::collections::HashMap<String, (&str, f64)> = Default::default();
     for d in ["beckmann", "ggx"] {
         for m in [0.003, 0.01, 0.03] {
             let text = format!(r#"{{"model":"microfacet","distribution":"{d}","roughness":{m},"ior":1.5}}"#);
+            lobes.insert(format!("{d} m = {m}"), (d, m));
             match glossmeter::recipe::parse_str(&text, "wide.json") {
                 Ok(r) => cases.push((format!("{d} m = {m}"), r.brdf, set.to_vec())),
                 Err(e) => eprintln!("[bench] {d} {m}: {e}"),
@@ -1354,6 +1362,7 @@ fn wide_lobes(md: &mut String) {
     let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build().expect("pool");
     let opts = PlanOptions { rtol: 1e-6, ..Default::default() };
     let mut totals = [0usize; 3];
+    let mut records: Vec<serde_json::Value> = vec![];
     for (name, brdf, geoms) in cases {
         let geo: Vec<StandardGeometry> = geoms.iter().filter_map(|g| standards::find(g).ok()).collect();
         let Ok(plan) = Plan::compile(brdf.clone(), geo, opts.clone()) else { continue };
@@ -1372,6 +1381,16 @@ fn wide_lobes(md: &mut String) {
             }
             let r = tight.execute(brdf.as_ref()).value[0];
             let floor = job.method.regular.as_ref().map_or(0.0, |p| p.atol);
+            let mut record = serde_json::json!({
+                "recipe": name,
+                "distribution": lobes.get(&name).map(|l| l.0),
+                "roughness": lobes.get(&name).map(|l| l.1),
+                "used_by": job.used_by,
+                "rule": rule_label(&job.method, brdf.as_ref()),
+                "boxes": job.method.regular.as_ref().map_or(0, |p| p.cells.len()),
+                "atol": floor,
+                "reference_gm_1e-3": r,
+            });
             for (v, slot) in [0usize, 1, 2].into_iter().zip(evals.iter_mut()) {
                 let mut m = job.method.clone();
                 let clipped = m.clipped;
@@ -1393,7 +1412,15 @@ fn wide_lobes(md: &mut String) {
                 if r.abs() > floor && f.error[0] > 0.0 {
                     worst[v] = worst[v].max(actual / f.error[0]);
                 }
+                let key = ["planner", "gm_kink_partition", "tensor_kink_partition"][v];
+                record[key] = serde_json::json!({
+                    "evaluations": f.evaluations,
+                    "value": f.value[0],
+                    "error": f.error[0],
+                    "converged": f.converged,
+                });
             }
+            records.push(record);
         }
         for k in 0..3 {
             totals[k] += evals[k];
@@ -1413,4 +1440,17 @@ fn wide_lobes(md: &mut String) {
     }
     let _ = writeln!(md, "| **total** | | | {} | | | {} | | {} | |", totals[0], totals[1], totals[2]);
     let _ = writeln!(md, "\nLoad average at the end of this section {}.", loadavg());
+    if let Some(path) = std::env::var_os("BENCH_JSON") {
+        let doc = serde_json::json!({
+            "commit": git_commit(),
+            "date": date(),
+            "uncommitted_src": dirty_src(),
+            "rtol": opts.rtol,
+            "integrals": records,
+        });
+        match std::fs::write(&path, serde_json::to_string_pretty(&doc).expect("json")) {
+            Ok(()) => eprintln!("[bench] wrote {}", Path::new(&path).display()),
+            Err(e) => eprintln!("[bench] could not write {}: {e}", Path::new(&path).display()),
+        }
+    }
 }
