@@ -196,7 +196,9 @@ fn every_default_reading_s_estimate_covers_its_actual_error() {
 /// same rtol-10⁻¹⁰ reference, whose own estimate is added to the bound (at 10⁻⁸ it is no longer negligible).
 #[test]
 fn the_estimate_covers_its_actual_error_at_rtol_1e_4_and_1e_8() {
-    campaign(12, Some(&[1e-4, 1e-8]));
+    // `GLOSSMETER_ESTIMATE_TIGHT_CASES=N`: more of the generated recipes, by hand.
+    let cases = std::env::var("GLOSSMETER_ESTIMATE_TIGHT_CASES").ok().and_then(|s| s.parse().ok()).unwrap_or(12);
+    campaign(cases, Some(&[1e-4, 1e-8]));
 }
 
 /// Read the first `cases` generated recipes at the default settings (`rtols` None) or at each of `rtols`, and
@@ -504,4 +506,37 @@ fn pearl_paints_estimates_cover_their_actual_error_on_every_haze_receptor() {
     assert!(checked >= 60 * cases, "only {checked} readings checked ({unchecked} unchecked)");
     assert!(unchecked * 25 <= checked, "{unchecked} references did not converge (of {})", checked + unchecked);
     assert!(failures.is_empty(), "{} estimate(s) below the actual error:\n{}", failures.len(), failures.join("\n"));
+}
+
+/// The two readings the 240 recipes at 10⁻⁴ and 10⁻⁸ leave below their actual error (docs/accuracy.md §The
+/// estimate property, "Left open"): the polar rule on GGX α = 0.0058 at D523 60° at 10⁻⁴ (1.20×) and the
+/// Genz–Malik partition on Ward α = 0.161 at D523 85° at 10⁻⁸ (2.91×). It fails today; it is the reproducer for
+/// the work that makes it pass, and joins `cargo test` then.
+#[test]
+#[ignore = "open: fails today, docs/accuracy.md §The estimate property, \"Left open\""]
+fn the_two_readings_left_below_their_actual_error() {
+    let cases = [
+        (r#"{"model":"microfacet","distribution":"ggx","roughness":0.005809,"ior":1.816350}"#, "astm-d523-60", 1e-4),
+        (r#"{"model":"ward","alpha":0.161047,"rho_s":0.194125,"rho_d":0.422030}"#, "astm-d523-85", 1e-8),
+    ];
+    let tight = PlanOptions { rtol: 1e-10, max_seconds: None, rtol_from_data: false, ..PlanOptions::default() };
+    let mut failures = Vec::new();
+    for (json, id, rtol) in cases {
+        let brdf = glossmeter::recipe::parse_str(json, "open.json").unwrap().brdf;
+        let geos = vec![standards::find(id).unwrap()];
+        let options = PlanOptions { rtol, ..tight.clone() };
+        let d = Plan::compile(brdf.clone(), geos.clone(), options).unwrap().execute();
+        let r = Plan::compile(brdf, geos, tight.clone()).unwrap().execute();
+        for (a, b) in d.iter().zip(&r) {
+            let (Some(v), Some(vr)) = (a.value, b.value) else { continue };
+            let actual = (v - vr).abs();
+            if actual > a.error_estimate + b.error_estimate {
+                failures.push(format!(
+                    "{json} {id} {} at rtol {rtol:e}: actual {actual:e} > {:e}",
+                    a.name, a.error_estimate
+                ));
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
