@@ -219,6 +219,16 @@ fn registry_recipes_are_mostly_accepted() {
     assert!(accepted * 2 >= n, "{accepted} of {n} accepted");
 }
 
+/// The command line that `command_lines` found printing `inf` (seed 4146925888915634337): `measure --explain` of an
+/// RGL table whose lobe does not fall to half within 40° of tilt printed its slope width and its widths in the lobe
+/// variables as `inf`; they are "unbounded" now (`plan::explain`).
+#[test]
+fn command_line_seed_4146925888915634337_prints_no_inf() {
+    fuzz_cases::BINARY.get_or_init(|| env!("CARGO_BIN_EXE_glossmeter").into());
+    let seed = 4146925888915634337;
+    assert!(one(Category::CommandLine, seed).is_ok(), "{:?}", one(Category::CommandLine, seed));
+}
+
 /// The sheets case that made `sheets` flaky on main (seed 14908795379597200520): a quoted "NaN" in the
 /// sheet, echoed back in the error, was taken for a NaN printed by glossmeter.
 #[test]

@@ -67,10 +67,14 @@ impl Plan {
                 }
                 TermKind::Diffuse => "smooth in direction: no lobe splits needed".to_string(),
                 TermKind::Lobe(l) => format!(
-                    "glossy lobe, slope width {:.3e}{}{}: lobe variables split at 0 and ±(1, 3, 10, 30, …)× its width, \
+                    "glossy lobe, slope width {}{}{}: lobe variables split at 0 and ±(1, 3, 10, 30, …)× its width, \
                      {}",
-                    l.slope_width,
-                    if l.medium_eta != 1.0 { format!(" inside a medium of index {}", l.medium_eta) } else { String::new() },
+                    width(l.slope_width),
+                    if l.medium_eta != 1.0 {
+                        format!(" inside a medium of index {}", l.medium_eta)
+                    } else {
+                        String::new()
+                    },
                     match l.tail {
                         Tail::Table { half_width, resolution } if half_width.is_finite() => format!(
                             ", a measured table's tail (its own half width at half maximum {half_width:.3e}; also \
@@ -86,7 +90,11 @@ impl Plan {
                         t if t.is_heavy() => ", heavy tail".to_string(),
                         _ => String::new(),
                     },
-                    if l.tail.is_heavy() { "out to the ends of the range" } else { "out to 10× its width (Gaussian tail)" }
+                    if l.tail.is_heavy() {
+                        "out to the ends of the range"
+                    } else {
+                        "out to 10× its width (Gaussian tail)"
+                    }
                 ),
             };
             s.push_str(&format!("  - {}: {how}\n", t.label));
@@ -137,8 +145,10 @@ impl Plan {
             for l in &lobes {
                 let w = lobe_widths_uv(l, geo.theta);
                 s.push_str(&format!(
-                    "  lobe '{}' is {:.3e} × {:.3e} wide in the lobe variables (u, v)\n",
-                    l.label, w[0], w[1]
+                    "  lobe '{}' is {} × {} wide in the lobe variables (u, v)\n",
+                    l.label,
+                    width(w[0]),
+                    width(w[1])
                 ));
             }
         }
@@ -365,4 +375,14 @@ fn describe_kinks(kinks: &[f64], how: &str) -> String {
     }
     let angles: Vec<String> = kinks.iter().map(|c| format!("{:.4}°", c.acos().to_degrees())).collect();
     format!(", {how} (Fresnel critical angle{} θc = {})", if kinks.len() > 1 { "s" } else { "" }, angles.join(", "))
+}
+
+/// A width as `--explain` prints it: a finite one in three digits, and one with no finite value (a measured
+/// table's lobe that does not fall to half within 40° of tilt) in words, never as `inf`.
+fn width(w: f64) -> String {
+    if w.is_finite() {
+        format!("{w:.3e}")
+    } else {
+        "unbounded".to_string()
+    }
 }
