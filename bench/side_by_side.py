@@ -252,6 +252,20 @@ def engine_worst(sel):
     return f"{max(vals):.3f}" if vals else "–"
 
 
+def table_head(w, head, sep, peers, peer_cols):
+    """A Markdown table's head and separator, each peer adding its columns (`peer_cols`: names with {p})."""
+    for p in peers:
+        head += "".join(f" {c.format(p=p)} |" for c in peer_cols)
+        sep += "---:|" * len(peer_cols)
+    w(head)
+    w(sep)
+
+
+def ratio_cell(e, lim):
+    """engine / limit as a table cell: "–" where the limit spent nothing (never nan)."""
+    return f"{e / lim:.2f}×" if lim else "–"
+
+
 def report(rows, peers, meta):
     """rows: list of dict(d, m, g, rec, engine, limit, peers) in case order."""
     md = []
@@ -285,27 +299,22 @@ def report(rows, peers, meta):
         return e, missing, lim
 
     w("## Per geometry (and the 24)\n")
-    head = "| geometry | integrals | engine | limit | engine / limit | target | engine worst error / est. |"
-    sep = "|---|---:|---:|---:|---:|---|---:|"
-    for p in peers:
-        head += f" {p} | {p} worst error |"
-        sep += "---:|---:|"
-    w(head)
-    w(sep)
+    table_head(w, "| geometry | integrals | engine | limit | engine / limit | target | engine worst error / est. |",
+               "|---|---:|---:|---:|---:|---|---:|", peers, ["{p}", "{p} worst error"])
     groups = [(g, [r for r in rows if r["g"] == g]) for g in GEOMETRIES] + [("all", rows)]
     for g, sel in groups:
         if not sel:
             continue
         e, missing, lim = sums(sel)
         ncases = len({(r["d"], r["m"], r["g"]) for r in sel})
-        ratio = e / lim if lim else float("nan")
+        ratio = e / lim if lim else float("inf")
         t = TARGETS.get(g)
         full = ncases == (len(LOBES) * len(GEOMETRIES) if g == "all" else len(LOBES))
         tgt = "" if t is None else f"≤ {t:g}× — " + (
             ("met" if ratio <= t and not missing else "**missed**") if full else "not judged (not all cases run)")
         label = f"**all {ncases}**" if g == "all" else g
         line = (f"| {label} | {ncases} ({len(sel)}) | {fmt_n(e)}{' (%d missing)' % missing if missing else ''} | "
-                f"{fmt_n(lim)} | {ratio:.2f}× | {tgt} | {engine_worst(sel)} |")
+                f"{fmt_n(lim)} | {ratio_cell(e, lim)} | {tgt} | {engine_worst(sel)} |")
         for p in peers:
             xs = [r["peers"].get(p) for r in sel]
             line += f" {peer_sum(xs)} | {worst_peer_err(xs, [r['limit'] for r in sel])} |"
@@ -314,13 +323,7 @@ def report(rows, peers, meta):
       "Targets from docs/performance.md §\"At the limit\". A peer's sum with capped runs is a lower bound.\n")
 
     w("## Per case (lobe × geometry)\n")
-    head = "| D | m | geometry | engine | limit | engine / limit |"
-    sep = "|---|---|---|---:|---:|---:|"
-    for p in peers:
-        head += f" {p} |"
-        sep += "---:|"
-    w(head)
-    w(sep)
+    table_head(w, "| D | m | geometry | engine | limit | engine / limit |", "|---|---|---|---:|---:|---:|", peers, ["{p}"])
     cases = []
     for r in rows:
         k = (r["d"], r["m"], r["g"])
@@ -329,7 +332,7 @@ def report(rows, peers, meta):
     for k in cases:
         sel = [r for r in rows if (r["d"], r["m"], r["g"]) == k]
         e, missing, lim = sums(sel)
-        line = f"| {k[0]} | {k[1]} | {k[2]} | {fmt_n(e)} | {fmt_n(lim)} | {e / lim if lim else float('nan'):.2f}× |"
+        line = f"| {k[0]} | {k[1]} | {k[2]} | {fmt_n(e)} | {fmt_n(lim)} | {ratio_cell(e, lim)} |"
         for p in peers:
             line += f" {peer_sum([r['peers'].get(p) for r in sel])} |"
         w(line)
@@ -338,13 +341,9 @@ def report(rows, peers, meta):
     w("Engine error = |engine value − limit reference| / the engine's own error estimate (≤ 1: the estimate covers "
       "it; a tail bound reads a flux ≈ 0 as Φ̄/2 ± Φ̄/2, hence its ratios just below 1). Peer error = |value − limit "
       "reference|, relative (and in tol). The limit's column: its partition (boxes) and orders (u, t_p, v, t_q).\n")
-    head = "| D | m | geometry | receptor | reference flux | tol | engine | engine rule | engine est. (rel.) | engine error / est. | limit | limit partition, orders |"
-    sep = "|---|---|---|---|---:|---:|---:|---|---:|---:|---:|---|"
-    for p in peers:
-        head += f" {p} | {p} error |"
-        sep += "---:|---:|"
-    w(head)
-    w(sep)
+    table_head(w, "| D | m | geometry | receptor | reference flux | tol | engine | engine rule | engine est. (rel.) | "
+               "engine error / est. | limit | limit partition, orders |",
+               "|---|---|---|---|---:|---:|---:|---|---:|---:|---:|---|", peers, ["{p}", "{p} error"])
     for r in rows:
         lim, eng = r["limit"], r["engine"]
         ref = lim["reference"]

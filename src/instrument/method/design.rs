@@ -169,7 +169,7 @@ impl Method {
                     Chart::Lobe if kinks.is_empty() && on_mirror_axis => delta_rule(&l, src, rec, share * d.rtol)
                         .or_else(|| lobe_rule(&l, src, rec))
                         .or_else(|| polar_rule(&l, src, rec))
-                        .or_else(|| (d.rtol <= TENSOR_MAX_RTOL).then(|| smooth_rule(&l, src, rec)).flatten())
+                        .or_else(|| smooth_rule(&l, src, rec, d.rtol))
                         .unwrap_or(Rule::GenzMalik75),
                     _ => Rule::GenzMalik75,
                 };
@@ -284,10 +284,11 @@ pub(crate) fn delta_rule(l: &LobesAt, src: Stop, rec: Stop, rtol: f64) -> Option
 /// of 0.083, 0.052 in v against 0.15), and only on a receptor whose range of the lobe variables holds the lobe
 /// centre on both axes (a receptor that sees the mirror image: off it, on the Rhopoint IQ 20° haze receptors,
 /// the rule's estimate fell up to 23× below its actual error, `docs/instrument.md` §Quadrature, "When it is
-/// chosen"). The levels start at 1 (2 points) on every axis.
-pub(crate) fn smooth_rule(l: &LobesAt, src: Stop, rec: Stop) -> Option<Rule> {
+/// chosen"), and only at a reading tolerance `rtol` of [`TENSOR_MAX_RTOL`] or tighter. The levels start at 1
+/// (2 points) on every axis.
+pub(crate) fn smooth_rule(l: &LobesAt, src: Stop, rec: Stop, rtol: f64) -> Option<Rule> {
     let (ap, aq) = (AxisMap { s: src.p, r: rec.p }, AxisMap { s: src.q, r: rec.q });
-    if ap.gap() > 0.0 || aq.gap() > 0.0 {
+    if rtol > TENSOR_MAX_RTOL || ap.gap() > 0.0 || aq.gap() > 0.0 {
         return None;
     }
     let range = [(src.p[1] - src.p[0]) + (rec.p[1] - rec.p[0]), (src.q[1] - src.q[0]) + (rec.q[1] - rec.q[0])];
