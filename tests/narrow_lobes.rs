@@ -84,8 +84,10 @@ fn the_cost_stops_growing_as_the_lobe_narrows() {
         assert!(at(1e-5) == at(1e-6) && at(1e-6) == at(1e-7), "{d}: {counts:?}");
         // GGX far below the partition's 28 k – 85 k before the polar rule (Beckmann 1e-3 is still the
         // partition's: its lobe is too close to the kinks for Gauss–Hermite, and the polar rule is GGX's).
+        // α = 1e-3 costs 5 505 since the polar square's levels see their t rule's error (docs/instrument.md
+        // §Quadrature, "Polar variables for a narrow GGX lobe"; 3 345 before).
         if d == "ggx" {
-            assert!(counts.iter().all(|c| *c <= 5_000), "{d}: {counts:?}");
+            assert!(counts.iter().all(|c| *c <= 6_000), "{d}: {counts:?}");
         }
     }
 }

@@ -8,14 +8,19 @@ use crate::quadrature::{
 };
 
 /// The (φ nodes per sector, β nodes, t nodes per axis) of the polar piece of [`Rule::LobePolar`], level by
-/// level: 4·3·6·2² = 288 points, then 512, 1 152, 4 608, 18 432, 51 200.
+/// level: 4·3·6·2² = 288 points on a square's four sectors, then 512, 2 592, 8 192, 28 800, 73 728 (a quarter
+/// more for each sector cut in two, `quadrature::polar::MAX_SECTOR`). From level 1 on every level has more t
+/// nodes than the one below, so that the difference of two levels, the piece's estimate, sees the t rule's
+/// error too (with the t nodes shared, it cannot: `docs/instrument.md` §Quadrature, "Polar variables for a
+/// narrow GGX lobe", *Orders and the estimate*).
 pub(crate) const POLAR_LEVELS: [(usize, usize, usize); 6] =
-    [(3, 6, 2), (4, 8, 2), (6, 12, 2), (8, 16, 3), (12, 24, 4), (16, 32, 5)];
+    [(3, 6, 2), (4, 8, 2), (6, 12, 3), (8, 16, 4), (12, 24, 5), (16, 32, 6)];
 
 /// The (tail-axis nodes, cross-axis nodes, t nodes per axis) of a tail piece of [`Rule::LobePolar`], level by
-/// level: 3·3·2² = 36 points, then 64, 144, 576, 2 304, 6 400.
+/// level: 3·3·2² = 36 points, then 64, 324, 1 024, 3 600, 9 216 (the t nodes rise with the level as in
+/// [`POLAR_LEVELS`]).
 pub(crate) const TAIL_LEVELS: [(usize, usize, usize); 6] =
-    [(3, 3, 2), (4, 4, 2), (6, 6, 2), (8, 8, 3), (12, 12, 4), (16, 16, 5)];
+    [(3, 3, 2), (4, 4, 2), (6, 6, 3), (8, 8, 4), (12, 12, 5), (16, 16, 6)];
 
 /// One piece of [`Rule::LobePolar`]: its u and v intervals, whether it holds the lobe centre (the polar
 /// piece), its level and its sums at that level and the one below.
