@@ -11,7 +11,7 @@
 //! number of nodes integrates the lobe to the same relative accuracy at every α: the cost stops growing as
 //! α → 0. The rectangle [x0, x1] × [y0, y1] (containing 0) is cut into four sectors at its corners' angles;
 //! in each, the radius runs to the side it meets, ρ_max(φ) = x1/cos φ (right side) etc., and β = s·atan ρ_max
-//! with s ∈ [0, 1]. Both rules are exact products of one-dimensional Gauss–Legendre rules (`gauss.rs`).
+//! with s ∈ [0, 1]. A sector wider than [`MAX_SECTOR`] (100°) is cut into equal parts. Both rules are exact products of one-dimensional Gauss–Legendre rules (`gauss.rs`).
 use super::gauss::gauss_legendre_table;
 use std::f64::consts::PI;
 
@@ -186,7 +186,7 @@ mod tests {
             assert!(nodes.iter().all(|([x, y], _)| (lo[0]..=hi[0]).contains(x) && (lo[1]..=hi[1]).contains(y)));
         }
         // The area (g = 1) in the linear radius: ρ dρ is exact with 2 nodes, the sectors' ρ_max(φ)²/2 ∝ sec²φ
-        // converges in φ (to 6e-9 with 16 nodes: the widest sector spans 127°).
+        // converges in φ (the 127° sector of the short side is cut in two, `MAX_SECTOR`).
         let area: f64 = polar_rectangle([-2.0, -3.0], [4.0, 1.0], 16, 2, Map::Linear).iter().map(|(_, w)| w).sum();
         assert!((area - 24.0).abs() < 1e-8 * 24.0, "{area}");
     }
