@@ -508,8 +508,9 @@ fn pearl_paints_estimates_cover_their_actual_error_on_every_haze_receptor() {
     assert!(failures.is_empty(), "{} estimate(s) below the actual error:\n{}", failures.len(), failures.join("\n"));
 }
 
-/// Whether a reading of `json` on geometry `id` at `rtol` is within its estimate (plus the reference's) of the
-/// rtol-10⁻¹⁰ reading; the failures as lines.
+/// Whether every reading of `json` on geometry `id` at `rtol` is within its estimate (plus the reference's) of
+/// the rtol-10⁻¹⁰ reading; the failures as lines. A reading or reference without a value, or not converged, is
+/// a failure too (a check that compared nothing must not pass).
 fn below_their_actual_error(json: &str, id: &str, rtol: f64) -> Vec<String> {
     let tight = PlanOptions { rtol: 1e-10, max_seconds: None, rtol_from_data: false, ..PlanOptions::default() };
     let brdf = glossmeter::recipe::parse_str(json, "open.json").unwrap().brdf;
@@ -518,8 +519,14 @@ fn below_their_actual_error(json: &str, id: &str, rtol: f64) -> Vec<String> {
     let d = Plan::compile(brdf.clone(), geos.clone(), options).unwrap().execute();
     let r = Plan::compile(brdf, geos, tight).unwrap().execute();
     let mut failures = Vec::new();
+    if d.is_empty() || d.len() != r.len() {
+        failures.push(format!("{json} {id}: {} readings against {} references", d.len(), r.len()));
+    }
     for (a, b) in d.iter().zip(&r) {
-        let (Some(v), Some(vr)) = (a.value, b.value) else { continue };
+        let (Some(v), Some(vr), true, true) = (a.value, b.value, a.converged, b.converged) else {
+            failures.push(format!("{json} {id} {} at rtol {rtol:e}: no converged value to compare", a.name));
+            continue;
+        };
         let actual = (v - vr).abs();
         if actual > a.error_estimate + b.error_estimate {
             failures
