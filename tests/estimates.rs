@@ -187,7 +187,7 @@ fn recipe(i: usize, rng: &mut Rng) -> (String, String, String) {
 #[test]
 fn every_default_reading_s_estimate_covers_its_actual_error() {
     let cases: usize = std::env::var("GLOSSMETER_ESTIMATE_CASES").ok().and_then(|s| s.parse().ok()).unwrap_or(240);
-    campaign(cases, None);
+    campaign(cases, None, 1e-10);
 }
 
 /// The same promise at other tolerances on the first 12 recipes (one of each family): rtol 10⁻⁴ and 10⁻⁸
@@ -198,12 +198,25 @@ fn every_default_reading_s_estimate_covers_its_actual_error() {
 fn the_estimate_covers_its_actual_error_at_rtol_1e_4_and_1e_8() {
     // `GLOSSMETER_ESTIMATE_TIGHT_CASES=N`: more of the generated recipes, by hand.
     let cases = std::env::var("GLOSSMETER_ESTIMATE_TIGHT_CASES").ok().and_then(|s| s.parse().ok()).unwrap_or(12);
-    campaign(cases, Some(&[1e-4, 1e-8]));
+    campaign(cases, Some(&[1e-4, 1e-8]), 1e-10);
+}
+
+/// The same promise at rtol 10⁻¹⁰, the tightest tolerance it is measured at, against an rtol-10⁻¹¹ reference
+/// (at `MIN_RTOL`, 10⁻¹², the rough-coat paints' references reach the evaluation budget unconverged, as in the
+/// pearl test below), whose own estimate is added to the bound: by hand,
+/// `GLOSSMETER_ESTIMATE_TIGHT_CASES=240 cargo test --test estimates at_rtol_1e_10 -- --ignored` (about 5 min
+/// on two cores; its result is in docs/accuracy.md §The estimate property).
+#[test]
+#[ignore = "a measurement of about 5 min: see the doc comment"]
+fn the_estimate_covers_its_actual_error_at_rtol_1e_10() {
+    let cases = std::env::var("GLOSSMETER_ESTIMATE_TIGHT_CASES").ok().and_then(|s| s.parse().ok()).unwrap_or(12);
+    campaign(cases, Some(&[1e-10]), 1e-11);
 }
 
 /// Read the first `cases` generated recipes at the default settings (`rtols` None) or at each of `rtols`, and
-/// compare each reading with the rtol-10⁻¹⁰ reference (plus the reference's own estimate when `rtols` is given).
-fn campaign(cases: usize, rtols: Option<&[f64]>) {
+/// compare each reading with the reference read at `reference_rtol` (plus the reference's own estimate when `rtols` is
+/// given).
+fn campaign(cases: usize, rtols: Option<&[f64]>, reference_rtol: f64) {
     let report = std::env::var_os("GLOSSMETER_ESTIMATE_REPORT").is_some();
     let gloss = standards::builtin().unwrap();
     let all = standards::builtin_all().unwrap();
@@ -216,7 +229,8 @@ fn campaign(cases: usize, rtols: Option<&[f64]>) {
             .collect(),
     };
     // Without a wall-clock budget: what is checked must not depend on the machine's load.
-    let tight = PlanOptions { rtol: 1e-10, max_seconds: None, rtol_from_data: false, ..PlanOptions::default() };
+    let tight =
+        PlanOptions { rtol: reference_rtol, max_seconds: None, rtol_from_data: false, ..PlanOptions::default() };
     let mut rng = Rng(0x0005_EED0_FE57);
     let (mut checked, mut unchecked, mut exact) = (0usize, 0usize, 0usize);
     let mut ratios: Vec<f64> = Vec::new();
@@ -307,18 +321,12 @@ fn campaign(cases: usize, rtols: Option<&[f64]>) {
 /// reference.
 #[test]
 fn a_lobe_about_as_wide_as_the_stops_at_85_degrees_is_covered() {
-    let g = standards::find("astm-d523-85").unwrap();
-    let tight = PlanOptions { rtol: 1e-10, max_seconds: None, ..PlanOptions::default() };
     for shadowing in [r#","shadowing":"v-cavity""#, ""] {
         let json = format!(
             r#"{{"model":"microfacet","distribution":"beckmann","roughness":0.029052,"ior":1.548226{shadowing}}}"#
         );
-        let m = glossmeter::recipe::parse_str(&json, "fixtures/recipes/generated.json").unwrap();
-        let d = &Plan::compile(m.brdf.clone(), vec![g.clone()], PlanOptions::default()).unwrap().execute()[0];
-        let r = &Plan::compile(m.brdf.clone(), vec![g.clone()], tight.clone()).unwrap().execute()[0];
-        assert!(d.converged && r.converged, "{json}: {d:?} {r:?}");
-        let actual = (d.value.unwrap() - r.value.unwrap()).abs();
-        assert!(actual <= d.error_estimate, "{json}: actual {actual:e} > estimate {:e}", d.error_estimate);
+        let failures = below_their_actual_error(&json, "astm-d523-85", 1e-6);
+        assert!(failures.is_empty(), "{}", failures.join("\n"));
     }
 }
 
@@ -327,31 +335,15 @@ fn a_lobe_about_as_wide_as_the_stops_at_85_degrees_is_covered() {
 /// width in u, 1.98·10⁻², lies between half and the whole u-range of the 0.1° source against the 1.8° gloss
 /// window (3.34·10⁻²), read 2.07× below its error at the default rtol; and the Rayleigh–Rice halo of
 /// `clear-coat-haze` (1.73·10⁻² wide in u), 1.33× below at rtol 10⁻⁸. The lobe chart had no split at the lobe's
-/// centre on u, so one box held the peak. Each must now cover its error against the rtol-10⁻¹⁰ reading.
+/// centre on u, so one box held the peak. Each reading of the geometry must now cover its error against the
+/// rtol-10⁻¹⁰ reading (the gloss reading was the one found; the others are checked with it).
 #[test]
 fn a_lobe_between_half_and_the_whole_range_wide_is_covered_on_the_pixel_array() {
-    let g = standards::find("rhopoint-iq-20").unwrap();
-    let tight = PlanOptions { rtol: 1e-10, max_seconds: None, rtol_from_data: false, ..PlanOptions::default() };
     let haze = std::fs::read_to_string("fixtures/recipes/clear-coat-haze.json").unwrap();
-    let cases = [
-        (r#"{"model":"phong","exponent":5091.6,"ks":0.28455,"kd":0.140315}"#.to_string(), "generated.json", 1e-6),
-        (haze, "clear-coat-haze.json", 1e-8),
-    ];
-    for (json, file, rtol) in cases {
-        let m = glossmeter::recipe::parse_str(&json, &format!("fixtures/recipes/{file}")).unwrap();
-        let at = |options: PlanOptions| {
-            let readings = Plan::compile(m.brdf.clone(), vec![g.clone()], options).unwrap().execute();
-            readings.into_iter().find(|r| r.name == "gloss").expect("a gloss reading")
-        };
-        let d = at(PlanOptions { rtol, rtol_from_data: false, ..PlanOptions::default() });
-        let r = at(tight.clone());
-        assert!(d.converged && r.converged, "{file}");
-        let actual = (d.value.unwrap() - r.value.unwrap()).abs();
-        assert!(
-            actual <= d.error_estimate,
-            "{file} at rtol {rtol:e}: actual {actual:e} > estimate {:e}",
-            d.error_estimate
-        );
+    let cases = [(r#"{"model":"phong","exponent":5091.6,"ks":0.28455,"kd":0.140315}"#, 1e-6), (haze.as_str(), 1e-8)];
+    for (json, rtol) in cases {
+        let failures = below_their_actual_error(json, "rhopoint-iq-20", rtol);
+        assert!(failures.is_empty(), "{}", failures.join("\n"));
     }
 }
 
@@ -512,28 +504,98 @@ fn pearl_paints_estimates_cover_their_actual_error_on_every_haze_receptor() {
 /// the rtol-10⁻¹⁰ reading; the failures as lines. A reading or reference without a value, or not converged, is
 /// a failure too (a check that compared nothing must not pass).
 fn below_their_actual_error(json: &str, id: &str, rtol: f64) -> Vec<String> {
+    below_at(json, &[id], &[rtol], &mut Vec::new())
+}
+
+/// [`below_their_actual_error`] on the geometries `ids` at each of `rtols` against one rtol-10⁻¹⁰ reference,
+/// with each (estimate + reference's)/actual pushed to `ratios`.
+fn below_at(json: &str, ids: &[&str], rtols: &[f64], ratios: &mut Vec<f64>) -> Vec<String> {
     let tight = PlanOptions { rtol: 1e-10, max_seconds: None, rtol_from_data: false, ..PlanOptions::default() };
     let brdf = glossmeter::recipe::parse_str(json, "open.json").unwrap().brdf;
-    let geos = vec![standards::find(id).unwrap()];
-    let options = PlanOptions { rtol, ..tight.clone() };
-    let d = Plan::compile(brdf.clone(), geos.clone(), options).unwrap().execute();
-    let r = Plan::compile(brdf, geos, tight).unwrap().execute();
+    let geos: Vec<_> = ids.iter().map(|id| standards::find(id).unwrap()).collect();
+    let r = Plan::compile(brdf.clone(), geos.clone(), tight.clone()).unwrap().execute();
     let mut failures = Vec::new();
-    if d.is_empty() || d.len() != r.len() {
-        failures.push(format!("{json} {id}: {} readings against {} references", d.len(), r.len()));
-    }
-    for (a, b) in d.iter().zip(&r) {
-        let (Some(v), Some(vr), true, true) = (a.value, b.value, a.converged, b.converged) else {
-            failures.push(format!("{json} {id} {} at rtol {rtol:e}: no converged value to compare", a.name));
-            continue;
-        };
-        let actual = (v - vr).abs();
-        if actual > a.error_estimate + b.error_estimate {
-            failures
-                .push(format!("{json} {id} {} at rtol {rtol:e}: actual {actual:e} > {:e}", a.name, a.error_estimate));
+    for &rtol in rtols {
+        let options = PlanOptions { rtol, ..tight.clone() };
+        let d = Plan::compile(brdf.clone(), geos.clone(), options).unwrap().execute();
+        if d.is_empty() || d.len() != r.len() {
+            failures.push(format!("{json} {ids:?}: {} readings against {} references", d.len(), r.len()));
+        }
+        for (a, b) in d.iter().zip(&r) {
+            let id = &a.geometry;
+            let (Some(v), Some(vr), true, true) = (a.value, b.value, a.converged, b.converged) else {
+                failures.push(format!("{json} {id} {} at rtol {rtol:e}: no converged value to compare", a.name));
+                continue;
+            };
+            let actual = (v - vr).abs();
+            if actual > 0.0 {
+                ratios.push((a.error_estimate + b.error_estimate) / actual);
+            }
+            if actual > a.error_estimate + b.error_estimate {
+                failures.push(format!(
+                    "{json} {id} {} at rtol {rtol:e}: actual {actual:e} > {:e}",
+                    a.name, a.error_estimate
+                ));
+            }
         }
     }
     failures
+}
+
+/// Narrow flakes under a smooth coat near grazing (docs/instrument.md §Quadrature, *The u width at grazing*,
+/// *Under a coat*): the u splits of a lobe formed in the coat use η² cos² θ' / (y² sin θ cos θ), far wider than
+/// the air's cot θ / y². The generated campaign's flakes (spread slopes 0.1–0.4) are wider than the stops and
+/// never reach the lobe chart; these (0.002–0.03, as the literal reading of the paper's 0.25°, slope 0.0044)
+/// do. Every reading at D523 85°, TAPPI T480 75° and D523 60°, at rtol 10⁻⁴, 10⁻⁶ and 10⁻⁸, against the
+/// rtol-10⁻¹⁰ reading (more cases by hand: `GLOSSMETER_FLAKE_CASES=N GLOSSMETER_ESTIMATE_REPORT=1`).
+#[test]
+fn narrow_flakes_under_a_coat_are_covered_near_grazing() {
+    let cases: usize = std::env::var("GLOSSMETER_FLAKE_CASES").ok().and_then(|s| s.parse().ok()).unwrap_or(2);
+    let f = |x: f64| format!("{x:.6}");
+    let mut rng = Rng(0x0000_F1A4_E5C0_A7ED);
+    let (mut failures, mut ratios) = (Vec::new(), Vec::new());
+    for i in 0..cases {
+        let spread = rng.log_uniform(0.002, 0.03);
+        let flakes = if i % 2 == 0 {
+            format!(
+                r#""metallic_flakes":{{"n":{},"k":{},"spread_slope":{},"area_ratio":{},"depth_mm":0.03}}"#,
+                f(rng.uniform(0.5, 2.5)),
+                f(rng.uniform(2.0, 7.0)),
+                f(spread),
+                f(rng.uniform(0.05, 0.4))
+            )
+        } else {
+            format!(
+                r#""pearlescent_flakes":{{"spread_slope":{},"area_ratio":{},"depth_mm":0.02,"tio2_thickness_nm":{},"tio2_index":2.5,"mica_thickness_nm":400,"mica_index":{}}}"#,
+                f(spread),
+                f(rng.uniform(0.05, 0.3)),
+                f(rng.uniform(40.0, 160.0)),
+                f(rng.uniform(1.5, 1.62))
+            )
+        };
+        let json = format!(
+            r#"{{"model":"paint","clear_coat":{{"index":{}}},"pigmented_layer":{{"thickness_mm":0.05,"primer_reflectance":[0.6,0.6,0.6],"pigments":[{{"name":"p","concentration":1.0,"k_per_mm":[0.5,0.3,0.2],"s_per_mm":[0.4,0.4,0.4]}}]}},{flakes}}}"#,
+            f(rng.uniform(1.4, 1.8))
+        );
+        failures.extend(below_at(
+            &json,
+            &["astm-d523-85", "tappi-t480-75", "astm-d523-60"],
+            &[1e-4, 1e-6, 1e-8],
+            &mut ratios,
+        ));
+    }
+    ratios.sort_by(f64::total_cmp);
+    if std::env::var_os("GLOSSMETER_ESTIMATE_REPORT").is_some() {
+        let q = |p: f64| ratios.get(((ratios.len() as f64 - 1.0) * p) as usize).copied().unwrap_or(f64::NAN);
+        eprintln!(
+            "{cases} narrow-flake paints: {} inexact readings; (estimate + reference's)/actual: min {:.3e}, median {:.3e}",
+            ratios.len(),
+            q(0.0),
+            q(0.5)
+        );
+    }
+    assert!(!ratios.is_empty(), "nothing compared");
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 
 /// The polar rule on an elongated kink square: GGX α = 0.0058 at D523 60° at 10⁻⁴, whose square's short sides

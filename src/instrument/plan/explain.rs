@@ -4,7 +4,7 @@ use std::collections::BTreeMap;
 
 use crate::brdf::{Lobe, Tail, Term, TermKind};
 use crate::colorimetry::weighting::Weighting;
-use crate::instrument::aperture::{lobe_widths_uv, Chart, DELTA_SHARE};
+use crate::instrument::aperture::{grazing_u_scale, lobe_widths_uv, Chart, DELTA_SHARE, GRAZING_REACH};
 use crate::instrument::geometry::Integral;
 use crate::instrument::method::{
     Method, Projection, Rule, Target, DELTA_FIT_RADIUS, DELTA_RADII, DELTA_RADIUS, DELTA_SAFETY, DELTA_TAIL_SAFETY,
@@ -67,8 +67,8 @@ impl Plan {
                 }
                 TermKind::Diffuse => "smooth in direction: no lobe splits needed".to_string(),
                 TermKind::Lobe(l) => format!(
-                    "glossy lobe, slope width {}{}{}: lobe variables split at 0 and ±(1, 3, 10, 30, …)× its width, \
-                     {}",
+                    "glossy lobe, slope width {}{}{}: lobe variables split at 0 and ±(1, 3, 10, 30, …)× its width as \
+                     each receptor sees it (see each geometry below), {}",
                     width(l.slope_width),
                     if l.medium_eta != 1.0 {
                         format!(" inside a medium of index {}", l.medium_eta)
@@ -144,8 +144,27 @@ impl Plan {
             }
             for l in &lobes {
                 let w = lobe_widths_uv(l, geo.theta);
+                // The u splits at grazing (`aperture::narrowed_in_u`, docs/instrument.md §Quadrature, *The u
+                // width at grazing*): min(w_u, cot θ / y²), y ≤ GRAZING_REACH widths out in v.
+                let narrowest = grazing_u_scale(geo.theta, l.medium_eta) / (GRAZING_REACH * GRAZING_REACH);
+                let grazing = if narrowest < w[0] {
+                    format!(
+                        "; its u splits use the narrower width the lobe has away from the plane of incidence, \
+                         {} / y² at y lobe widths out in v (y ≤ {GRAZING_REACH}, so down to {})",
+                        if l.medium_eta == 1.0 { "cot θ" } else { "η² cos² θ' / (sin θ cos θ)" },
+                        width(narrowest)
+                    )
+                } else {
+                    String::new()
+                };
+                let heavy = if matches!(l.tail, Tail::InverseQuartic | Tail::Table { .. }) {
+                    "; a receptor off the specular direction sees its heavy tail wider, by √(1 + (gap/width)²) on \
+                     the other axis"
+                } else {
+                    ""
+                };
                 s.push_str(&format!(
-                    "  lobe '{}' is {} × {} wide in the lobe variables (u, v)\n",
+                    "  lobe '{}' is {} × {} wide in the lobe variables (u, v){grazing}{heavy}\n",
                     l.label,
                     width(w[0]),
                     width(w[1])
