@@ -529,7 +529,11 @@ fn below_at(json: &str, ids: &[&str], rtols: &[f64], ratios: &mut Vec<f64>) -> V
             };
             let actual = (v - vr).abs();
             if actual > 0.0 {
-                ratios.push((a.error_estimate + b.error_estimate) / actual);
+                let ratio = (a.error_estimate + b.error_estimate) / actual;
+                if ratio < 2.0 && std::env::var_os("GLOSSMETER_ESTIMATE_REPORT").is_some() {
+                    eprintln!("within 2× of its actual error: {json} {id} {} at rtol {rtol:e}: {ratio:.3}", a.name);
+                }
+                ratios.push(ratio);
             }
             if actual > a.error_estimate + b.error_estimate {
                 failures.push(format!(
@@ -540,6 +544,42 @@ fn below_at(json: &str, ids: &[&str], rtols: &[f64], ratios: &mut Vec<f64>) -> V
         }
     }
     failures
+}
+
+/// GGX lobes wider than the u range at grazing (docs/instrument.md §Quadrature, *The u width at grazing*): the
+/// Ward reading that set the narrowed u width had a Gaussian tail; a GGX tail is heavy, and the campaign's
+/// generated GGX lobes are mostly narrower than D523 85°'s u range. Dielectrics and conductors, α 0.05–0.4,
+/// every reading at D523 85° and TAPPI T480 75°, at rtol 10⁻⁴, 10⁻⁶ and 10⁻⁸, against the rtol-10⁻¹⁰ reading
+/// (more cases by hand: `GLOSSMETER_GRAZING_CASES=N GLOSSMETER_ESTIMATE_REPORT=1`).
+#[test]
+fn wide_ggx_lobes_at_grazing_are_covered() {
+    let cases: usize = std::env::var("GLOSSMETER_GRAZING_CASES").ok().and_then(|s| s.parse().ok()).unwrap_or(2);
+    let f = |x: f64| format!("{x:.6}");
+    let mut rng = Rng(0x0000_0006_6A2E_85D5);
+    let (mut failures, mut ratios) = (Vec::new(), Vec::new());
+    for i in 0..cases {
+        let alpha = rng.log_uniform(0.05, 0.4);
+        let ior = if i % 2 == 0 {
+            f(rng.uniform(1.4, 1.8))
+        } else {
+            format!("[{},{}]", f(rng.uniform(0.2, 2.5)), f(rng.uniform(0.0, 4.0)))
+        };
+        let json = format!(r#"{{"model":"microfacet","distribution":"ggx","roughness":{},"ior":{ior}}}"#, f(alpha));
+        failures.extend(below_at(&json, &["astm-d523-85", "tappi-t480-75"], &[1e-4, 1e-6, 1e-8], &mut ratios));
+    }
+    ratios.sort_by(f64::total_cmp);
+    if std::env::var_os("GLOSSMETER_ESTIMATE_REPORT").is_some() {
+        let q = |p: f64| ratios.get(((ratios.len() as f64 - 1.0) * p) as usize).copied().unwrap_or(f64::NAN);
+        eprintln!(
+            "{cases} wide GGX lobes at grazing: {} inexact readings; (estimate + reference's)/actual: min {:.3e}, \
+             median {:.3e}",
+            ratios.len(),
+            q(0.0),
+            q(0.5)
+        );
+    }
+    assert!(!ratios.is_empty(), "nothing compared");
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 
 /// Narrow flakes under a smooth coat near grazing (docs/instrument.md §Quadrature, *The u width at grazing*,
