@@ -145,7 +145,8 @@ impl Plan {
             for l in &lobes {
                 let w = lobe_widths_uv(l, geo.theta);
                 // The u splits at grazing (`aperture::narrowed_in_u`, docs/instrument.md §Quadrature, *The u
-                // width at grazing*): min(w_u, cot θ / y²), y ≤ GRAZING_REACH widths out in v.
+                // width at grazing*, *Under a coat*): min(w_u, grazing_u_scale / y²), y ≤ GRAZING_REACH widths
+                // out in v.
                 let narrowest = grazing_u_scale(geo.theta, l.medium_eta) / (GRAZING_REACH * GRAZING_REACH);
                 let grazing = if narrowest < w[0] {
                     format!(
