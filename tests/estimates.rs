@@ -186,7 +186,7 @@ fn recipe(i: usize, rng: &mut Rng) -> (String, String, String) {
 
 #[test]
 fn every_default_reading_s_estimate_covers_its_actual_error() {
-    let cases: usize = std::env::var("GLOSSMETER_ESTIMATE_CASES").ok().and_then(|s| s.parse().ok()).unwrap_or(240);
+    let cases = cases_from("GLOSSMETER_ESTIMATE_CASES", 240);
     campaign(cases, None, 1e-10);
 }
 
@@ -197,7 +197,7 @@ fn every_default_reading_s_estimate_covers_its_actual_error() {
 #[test]
 fn the_estimate_covers_its_actual_error_at_rtol_1e_4_and_1e_8() {
     // `GLOSSMETER_ESTIMATE_TIGHT_CASES=N`: more of the generated recipes, by hand.
-    let cases = std::env::var("GLOSSMETER_ESTIMATE_TIGHT_CASES").ok().and_then(|s| s.parse().ok()).unwrap_or(12);
+    let cases = cases_from("GLOSSMETER_ESTIMATE_TIGHT_CASES", 12);
     campaign(cases, Some(&[1e-4, 1e-8]), 1e-10);
 }
 
@@ -209,7 +209,7 @@ fn the_estimate_covers_its_actual_error_at_rtol_1e_4_and_1e_8() {
 #[test]
 #[ignore = "a measurement of about 5 min: see the doc comment"]
 fn the_estimate_covers_its_actual_error_at_rtol_1e_10() {
-    let cases = std::env::var("GLOSSMETER_ESTIMATE_TIGHT_CASES").ok().and_then(|s| s.parse().ok()).unwrap_or(12);
+    let cases = cases_from("GLOSSMETER_ESTIMATE_TIGHT_CASES", 12);
     campaign(cases, Some(&[1e-10]), 1e-11);
 }
 
@@ -407,7 +407,7 @@ fn pearl_paints_estimates_cover_their_actual_error_on_every_haze_receptor() {
     // The rtol-10⁻¹¹ reading (docs/accuracy.md): at `MIN_RTOL` (10⁻¹²) the rough-coat paints' ISO 13803
     // compensation and D4039 integrals reach the evaluation budget unconverged.
     const REFERENCE_RTOL: f64 = 1e-11;
-    let cases: usize = std::env::var("GLOSSMETER_PEARL_CASES").ok().and_then(|s| s.parse().ok()).unwrap_or(4);
+    let cases = cases_from("GLOSSMETER_PEARL_CASES", 4);
     let report = std::env::var_os("GLOSSMETER_ESTIMATE_REPORT").is_some();
     let geos: Vec<_> = ["astm-e430-20", "astm-e430-30", "iso-13803-20", "rhopoint-iq-20", "astm-d4039"]
         .iter()
@@ -553,7 +553,7 @@ fn below_at(json: &str, ids: &[&str], rtols: &[f64], ratios: &mut Vec<f64>) -> V
 /// (more cases by hand: `GLOSSMETER_GRAZING_CASES=N GLOSSMETER_ESTIMATE_REPORT=1`).
 #[test]
 fn wide_ggx_lobes_at_grazing_are_covered() {
-    let cases: usize = std::env::var("GLOSSMETER_GRAZING_CASES").ok().and_then(|s| s.parse().ok()).unwrap_or(2);
+    let cases = cases_from("GLOSSMETER_GRAZING_CASES", 2);
     let f = |x: f64| format!("{x:.6}");
     let mut rng = Rng(0x0000_0006_6A2E_85D5);
     let (mut failures, mut ratios) = (Vec::new(), Vec::new());
@@ -567,19 +567,7 @@ fn wide_ggx_lobes_at_grazing_are_covered() {
         let json = format!(r#"{{"model":"microfacet","distribution":"ggx","roughness":{},"ior":{ior}}}"#, f(alpha));
         failures.extend(below_at(&json, &["astm-d523-85", "tappi-t480-75"], &[1e-4, 1e-6, 1e-8], &mut ratios));
     }
-    ratios.sort_by(f64::total_cmp);
-    if std::env::var_os("GLOSSMETER_ESTIMATE_REPORT").is_some() {
-        let q = |p: f64| ratios.get(((ratios.len() as f64 - 1.0) * p) as usize).copied().unwrap_or(f64::NAN);
-        eprintln!(
-            "{cases} wide GGX lobes at grazing: {} inexact readings; (estimate + reference's)/actual: min {:.3e}, \
-             median {:.3e}",
-            ratios.len(),
-            q(0.0),
-            q(0.5)
-        );
-    }
-    assert!(!ratios.is_empty(), "nothing compared");
-    assert!(failures.is_empty(), "{}", failures.join("\n"));
+    assert_covered(&format!("{cases} wide GGX lobes at grazing"), ratios, &failures);
 }
 
 /// Narrow flakes under a smooth coat near grazing (docs/instrument.md §Quadrature, *The u width at grazing*,
@@ -590,7 +578,7 @@ fn wide_ggx_lobes_at_grazing_are_covered() {
 /// rtol-10⁻¹⁰ reading (more cases by hand: `GLOSSMETER_FLAKE_CASES=N GLOSSMETER_ESTIMATE_REPORT=1`).
 #[test]
 fn narrow_flakes_under_a_coat_are_covered_near_grazing() {
-    let cases: usize = std::env::var("GLOSSMETER_FLAKE_CASES").ok().and_then(|s| s.parse().ok()).unwrap_or(2);
+    let cases = cases_from("GLOSSMETER_FLAKE_CASES", 2);
     let f = |x: f64| format!("{x:.6}");
     let mut rng = Rng(0x0000_F1A4_E5C0_A7ED);
     let (mut failures, mut ratios) = (Vec::new(), Vec::new());
@@ -624,11 +612,17 @@ fn narrow_flakes_under_a_coat_are_covered_near_grazing() {
             &mut ratios,
         ));
     }
+    assert_covered(&format!("{cases} narrow-flake paints"), ratios, &failures);
+}
+
+/// The verdict of a check made with [`below_at`]: something compared and nothing below its actual error; with
+/// `GLOSSMETER_ESTIMATE_REPORT`, the ratios' minimum and median under `label`.
+fn assert_covered(label: &str, mut ratios: Vec<f64>, failures: &[String]) {
     ratios.sort_by(f64::total_cmp);
     if std::env::var_os("GLOSSMETER_ESTIMATE_REPORT").is_some() {
         let q = |p: f64| ratios.get(((ratios.len() as f64 - 1.0) * p) as usize).copied().unwrap_or(f64::NAN);
         eprintln!(
-            "{cases} narrow-flake paints: {} inexact readings; (estimate + reference's)/actual: min {:.3e}, median {:.3e}",
+            "{label}: {} inexact readings; (estimate + reference's)/actual: min {:.3e}, median {:.3e}",
             ratios.len(),
             q(0.0),
             q(0.5)
@@ -636,6 +630,11 @@ fn narrow_flakes_under_a_coat_are_covered_near_grazing() {
     }
     assert!(!ratios.is_empty(), "nothing compared");
     assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// The number of cases from the environment variable `name`, or `default`.
+fn cases_from(name: &str, default: usize) -> usize {
+    std::env::var(name).ok().and_then(|s| s.parse().ok()).unwrap_or(default)
 }
 
 /// The polar rule on an elongated kink square: GGX α = 0.0058 at D523 60° at 10⁻⁴, whose square's short sides
