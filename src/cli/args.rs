@@ -64,6 +64,7 @@ pub enum Command {
              {DATA_MAX_RTOL:e}: given here, it is used as given, for tables too)"
         ))]
         rtol: Option<f64>,
+        /// Output: an aligned table, JSON (`schema --output-format measure`) or CSV.
         #[arg(long, value_enum, default_value_t = Format::Table)]
         format: Format,
         /// Print the measurement plan before measuring.
@@ -102,6 +103,7 @@ pub enum Command {
     /// Print the JSON Schema of the recipe format, or of an output (`--output-format
     /// measure|compare|sweep|fit|profile|convergence|topography`).
     Schema {
+        /// The output whose schema to print (default: the recipe format's).
         #[arg(long, value_enum)]
         output_format: Option<OutputSchema>,
     },
@@ -130,6 +132,7 @@ pub enum Command {
     /// Print the shell completions of glossmeter (e.g. `glossmeter completions bash >
     /// ~/.local/share/bash-completion/completions/glossmeter`).
     Completions {
+        /// The shell to complete for.
         #[arg(value_enum)]
         shell: clap_complete::Shell,
     },
@@ -179,4 +182,32 @@ pub struct ServeArgs {
     /// Connections kept open at most [default: 1024, and 64 below the open-file limit].
     #[arg(long, value_name = "N")]
     pub max_connections: Option<usize>,
+}
+
+#[cfg(test)]
+mod tests {
+    use clap::CommandFactory;
+
+    /// Every argument of every subcommand has its own help line (`--help` and the man page are written from
+    /// these; a doc comment written above the wrong field once left `--ignore-column` blank).
+    #[test]
+    fn every_argument_has_help() {
+        fn walk(cmd: &clap::Command, path: &str, blank: &mut Vec<String>) {
+            for a in cmd.get_arguments() {
+                let id = a.get_id().as_str();
+                if matches!(id, "help" | "version") || a.is_hide_set() {
+                    continue;
+                }
+                if a.get_help().is_none_or(|h| h.to_string().trim().is_empty()) {
+                    blank.push(format!("{path} {id}"));
+                }
+            }
+            for sub in cmd.get_subcommands() {
+                walk(sub, &format!("{path} {}", sub.get_name()), blank);
+            }
+        }
+        let mut blank = Vec::new();
+        walk(&super::Cli::command(), "glossmeter", &mut blank);
+        assert!(blank.is_empty(), "arguments without help: {blank:?}");
+    }
 }

@@ -43,11 +43,11 @@ pub struct CompareArgs {
     /// The sheet of a workbook (.xlsx, .xls, .ods) to read; default: its first sheet.
     #[arg(long, value_name = "NAME")]
     pub sheet_name: Option<String>,
-    /// Skip a column the reader does not know (repeatable; case and spaces do not matter).
     /// The line (or workbook row, 1-based) of the sheet's header; the rows above it are title and metadata
     /// rows (default: the first row naming known columns, else the first row).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
     pub header_row: Option<u64>,
+    /// Skip a column the reader does not know (repeatable; case and spaces do not matter).
     #[arg(long = "ignore-column", value_name = "HEADER")]
     pub ignore_columns: Vec<String>,
     /// Standard errors of the mean allowed for repeated readings (k·s/√n).
@@ -68,6 +68,7 @@ pub struct CompareArgs {
          as given, tables too)"
     ))]
     pub rtol: Option<f64>,
+    /// Output: an aligned table, JSON (`schema --output-format compare`), CSV or JUnit XML.
     #[arg(long, value_enum, default_value_t = CompareFormat::Table)]
     pub format: CompareFormat,
     /// Write to this new file instead of stdout (`-`: stdout; an existing file is refused before any work).

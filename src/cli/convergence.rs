@@ -29,6 +29,7 @@ pub struct ConvergenceArgs {
     /// Relative tolerances to sweep, comma-separated, each in (0, 1) [default: 1e-2,1e-3,…,1e-10].
     #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
     pub tolerances: Vec<f64>,
+    /// Output: an aligned table, JSON (`schema --output-format convergence`) or CSV.
     #[arg(long, value_enum, default_value_t = Format::Table)]
     pub format: Format,
     /// Also draw actual and estimated error against time, log–log, to this new .svg file.

@@ -34,11 +34,11 @@ pub struct FitArgs {
     /// The sheet of a workbook to read (default: its first sheet), as in `compare`.
     #[arg(long, value_name = "NAME", requires = "sheet")]
     pub sheet_name: Option<String>,
-    /// A sheet column to skip (repeatable), as in `compare`.
     /// The line (or workbook row, 1-based) of the sheet's header; the rows above it are title and metadata
     /// rows (default: the first row naming known columns, else the first row).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..), requires = "sheet")]
     pub header_row: Option<u64>,
+    /// A sheet column to skip (repeatable), as in `compare`.
     #[arg(long = "ignore-column", value_name = "HEADER", requires = "sheet")]
     pub ignore_columns: Vec<String>,
     /// A user geometry file (JSON, the format of `measure --geometry-file`) whose readings may be targets,
@@ -56,6 +56,7 @@ pub struct FitArgs {
     /// Relative tolerance of every forward reading.
     #[arg(long, default_value_t = crate::DEFAULT_RTOL)]
     pub rtol: f64,
+    /// Output: an aligned table, JSON (`schema --output-format fit`) or CSV.
     #[arg(long, value_enum, default_value_t = Format::Table)]
     pub format: Format,
     /// Write the fitted recipe to this new file (never overwrites one).

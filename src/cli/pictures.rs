@@ -25,6 +25,7 @@ pub enum PlotKind {
 pub struct PlotArgs {
     /// The recipe (JSON).
     pub recipe: PathBuf,
+    /// The picture to draw.
     #[arg(long, value_enum)]
     pub kind: PlotKind,
     /// A shipped geometry id (repeatable). Default: ASTM D523 20°, 60°, 85°.

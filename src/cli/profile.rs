@@ -35,6 +35,7 @@ pub struct ProfileArgs {
     /// A user geometry file with a `profile` block (instead of --geometry).
     #[arg(long = "geometry-file", conflicts_with = "geometry")]
     pub geometry_file: Option<PathBuf>,
+    /// Output: CSV (one row per pixel) or JSON (`schema --output-format profile`).
     #[arg(long, value_enum, default_value_t = ProfileFormat::Csv)]
     pub format: ProfileFormat,
     /// Also draw the profile (reading against angle) to this new .svg or .png file.

@@ -38,6 +38,7 @@ pub struct SweepArgs {
     /// Compute only the K-th of M contiguous slices (concatenated in order they equal the whole run).
     #[arg(long, value_name = "K/M")]
     pub shard: Option<String>,
+    /// Output: CSV or JSON lines (`schema --output-format sweep`), one record per point.
     #[arg(long, value_enum, default_value_t = SweepFormat::Csv)]
     pub format: SweepFormat,
     // The help is written from the one default tolerance, not a copy of its value.

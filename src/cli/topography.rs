@@ -26,6 +26,7 @@ pub struct TopographyArgs {
     /// The topography: ISO 25178-72 .x3p, ISO 25178-71 .sdf (text or binary), Gwyddion .gsf, Digital Surf
     /// .sur, or a text/CSV matrix of heights (one row per line; give --pixel-size and --height-unit).
     pub file: PathBuf,
+    /// Output: an aligned table or JSON (`schema --output-format topography`).
     #[arg(long, value_enum, default_value_t = TopographyFormat::Table)]
     pub format: TopographyFormat,
     /// The reference surface removed before the statistics: mean, plane (least squares), poly2 … poly5.
