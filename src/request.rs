@@ -575,8 +575,9 @@ pub struct FitRequest {
     pub uncertainty: f64,
     /// Solver restarts of an exactly determined fit.
     pub restarts: usize,
-    /// Relative tolerance of every forward reading.
-    pub rtol: f64,
+    /// The forward readings' tolerance (default [`DEFAULT_RTOL`], never from a table's data: the fit compares
+    /// readings at one tolerance), evaluation budget and colour conditions.
+    pub plan: PlanRequest,
     pub sheet: SheetRequest,
     /// The sample of the sheet to fit.
     pub sample: Option<String>,
@@ -589,7 +590,7 @@ impl Default for FitRequest {
             targets: vec![],
             uncertainty: fit::DEFAULT_UNCERTAINTY,
             restarts: fit::DEFAULT_RESTARTS,
-            rtol: DEFAULT_RTOL,
+            plan: PlanRequest::default(),
             sheet: SheetRequest::default(),
             sample: None,
         }
@@ -599,14 +600,21 @@ impl Default for FitRequest {
 impl FitRequest {
     /// The fit's options (without geometries), checked before any work.
     pub fn options(&self) -> Result<FitOptions> {
-        let rtol = check_rtol(self.rtol)?;
+        let plan = self.plan.options_or(DEFAULT_RTOL)?;
         if !(self.uncertainty.is_finite() && self.uncertainty > 0.0) {
             return Err(Error::argument(
                 "uncertainty",
                 format!(" must be a finite number > 0, got {}", given(self.uncertainty)),
             ));
         }
-        Ok(FitOptions { rtol, default_uncertainty: self.uncertainty, restarts: self.restarts, ..FitOptions::default() })
+        Ok(FitOptions {
+            rtol: plan.rtol,
+            max_evals: plan.max_evals,
+            colour: plan.colour,
+            default_uncertainty: self.uncertainty,
+            restarts: self.restarts,
+            ..FitOptions::default()
+        })
     }
 
     /// The free parameters.

@@ -914,3 +914,34 @@ fn the_six_parameter_two_lobe_fit_converges_on_any_number_of_threads() {
     assert!(r.verdict.iter().any(|l| l.contains("2 found another solution")), "{:?}", r.verdict);
     assert_eq!(format!("{:?}", on(1)), format!("{r:?}"), "one thread and three differ");
 }
+
+/// Colour targets are read under the fit's conditions (`FitOptions::colour`, `fit --illuminant --observer`): a
+/// pearl's b* at ASTM E2194 15° measured under illuminant A and the 2° observer at a TiO₂ layer of 69 nm is
+/// fitted back to 69 nm from 60 nm under those conditions, and to another thickness, many standard errors
+/// away, under the default D65 / 10° (the hue of an interference pearl moves with the illuminant).
+#[test]
+fn colour_targets_are_fitted_under_the_fits_illuminant_and_observer() {
+    use glossmeter::colorimetry::{Conditions, Illuminant, Observer};
+    let start: Value = serde_json::from_str(
+        &std::fs::read_to_string(root().join("fixtures/recipes/white-pearl-spectral.json")).unwrap(),
+    )
+    .unwrap();
+    let mut truth = start.clone();
+    truth["pearlescent_flakes"]["tio2_thickness_nm"] = json!(69.0);
+    let a2 = Conditions { illuminant: Illuminant::A, observer: Observer::Cie1931 };
+    let m = recipe::parse_str(&truth.to_string(), "truth.json").unwrap();
+    let geos = resolve_geometries(&["astm-e2194-15"], &[] as &[&str]).unwrap();
+    let r = measure(&m, &geos, &PlanOptions { rtol: 1e-10, colour: a2, ..PlanOptions::default() }).unwrap();
+    let b = r.iter().find(|x| x.name == "b*").unwrap().value.unwrap();
+    let t = targets(&[("astm-e2194-15", "b*")], &[b], 0.05);
+    let free_ = [free("/pearlescent_flakes/tio2_thickness_nm=30..90")];
+    let under = |colour: Conditions| {
+        let options = FitOptions { colour, restarts: 0, ..FitOptions::default() };
+        let r = fit(&start, "start.json", &free_, &t, &options).unwrap();
+        (r.parameters[0].value, r.parameters[0].std_error.unwrap())
+    };
+    let (x, se) = under(a2);
+    assert!((x - 69.0).abs() <= 3.0 * se && (x - 69.0).abs() < 1e-3, "A / 2°: fitted {x} ± {se}, true 69");
+    let (y, se) = under(Conditions::default());
+    assert!((y - 69.0).abs() > 10.0 * se, "D65 / 10°: fitted {y} ± {se}, no different from 69");
+}

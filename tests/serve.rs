@@ -273,6 +273,48 @@ fn the_endpoints_answer_on_the_command_lines_documents() {
     assert!((doc["targets"][0]["predicted"].as_f64().unwrap() - 90.0).abs() < 0.1);
 }
 
+/// A fit's colour conditions and evaluation budget are `measure`'s fields, and the served fit is the command
+/// line's with the same flags (`fit --illuminant A --observer 2 --max-evals N`), parameter for parameter.
+#[test]
+fn a_served_fit_reads_colour_under_the_given_conditions_as_the_command_line_does() {
+    let addr = default_server();
+    let pearl = "fixtures/recipes/white-pearl-spectral.json";
+    let (free, target) = ("/pearlescent_flakes/tio2_thickness_nm=30..90", "astm-e2194-15/b*=22.75±0.05");
+    let body = with_recipe(
+        &std::fs::read_to_string(pearl).unwrap(),
+        json!({"free": [free], "target": [target], "restarts": 0, "illuminant": "A", "observer": "2",
+               "max_evals": 100000}),
+    );
+    let a = request(addr, "POST", "/api/fit", &body, &[]);
+    assert_eq!(a.status, 200, "{}", a.body);
+    let served = a.json();
+    let cli = |colour: &[&str]| -> Value {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_glossmeter"))
+            .args(["fit", pearl, "--free", free, "--target", target, "--restarts", "0", "--max-evals", "100000"])
+            .args(colour)
+            .args(["--format", "json", "--no-timing"])
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        serde_json::from_slice(&out.stdout).unwrap()
+    };
+    let same = cli(&["--illuminant", "A", "--observer", "2"]);
+    for key in ["parameters", "targets", "converged"] {
+        assert_eq!(served[key], same[key], "{key}");
+    }
+    // Under the default D65 / 10° the same target gives another thickness.
+    let d65 = cli(&[]);
+    assert_ne!(served["parameters"][0]["value"], d65["parameters"][0]["value"]);
+    // A bad condition is refused under its own field.
+    let bad = with_recipe(
+        &std::fs::read_to_string(pearl).unwrap(),
+        json!({"free": [free], "target": [target], "illuminant": "D99"}),
+    );
+    let a = request(addr, "POST", "/api/fit", &bad, &[]);
+    assert_eq!(a.status, 400, "{}", a.body);
+    assert!(a.body.contains("/illuminant"), "{}", a.body);
+}
+
 /// The bytes of a file in base64 (the page's upload), written here so that the test needs no crate for it.
 fn base64(bytes: &[u8]) -> String {
     const ABC: &[u8] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";

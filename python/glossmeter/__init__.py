@@ -439,6 +439,7 @@ def fit(recipe: Recipe, targets: Optional[Targets] = ..., *, free: FreeParameter
         restarts: Optional[int] = ..., rtol: Optional[float] = ..., geometries: Geometries = ...,
         timing: bool = ..., delimiter: Optional[str] = ..., sheet_name: Optional[str] = ...,
         header_row: Optional[int] = ..., ignore_columns: Union[None, str, Sequence[str]] = ...,
+        max_evals: Optional[int] = ..., illuminant: Optional[str] = ..., observer: Optional[str] = ...,
         as_frame: Literal[False] = ...) -> FitReport: ...
 @overload
 def fit(recipe: Recipe, targets: Optional[Targets] = ..., *, free: FreeParameters,
@@ -446,12 +447,14 @@ def fit(recipe: Recipe, targets: Optional[Targets] = ..., *, free: FreeParameter
         restarts: Optional[int] = ..., rtol: Optional[float] = ..., geometries: Geometries = ...,
         timing: bool = ..., delimiter: Optional[str] = ..., sheet_name: Optional[str] = ...,
         header_row: Optional[int] = ..., ignore_columns: Union[None, str, Sequence[str]] = ...,
+        max_evals: Optional[int] = ..., illuminant: Optional[str] = ..., observer: Optional[str] = ...,
         as_frame: Literal[True]) -> "pandas.DataFrame": ...
 def fit(recipe: Recipe, targets: Optional[Targets] = None, *, free: FreeParameters,
         sheet: Optional[SheetSource] = None, sample: Optional[str] = None, uncertainty: Optional[float] = None,
         restarts: Optional[int] = None, rtol: Optional[float] = None, geometries: Geometries = None,
         timing: bool = True, delimiter: Optional[str] = None, sheet_name: Optional[str] = None,
         header_row: Optional[int] = None, ignore_columns: Union[None, str, Sequence[str]] = None,
+        max_evals: Optional[int] = None, illuminant: Optional[str] = None, observer: Optional[str] = None,
         as_frame: bool = False) -> Union[FitReport, "pandas.DataFrame"]:
     """Recipe parameters from readings: the ``free`` parameters fitted to ``targets`` or to a ``sheet``'s
     ``sample``; the document of ``glossmeter fit --format json``. With ``as_frame=True``, a pandas DataFrame
@@ -460,7 +463,8 @@ def fit(recipe: Recipe, targets: Optional[Targets] = None, *, free: FreeParamete
     frame = _check_frame_flag(as_frame)
     doc = _glossmeter.fit(recipe, targets, free=free, sheet=sheet, sample=sample, uncertainty=uncertainty,
                           restarts=restarts, rtol=rtol, geometries=geometries, timing=timing, delimiter=delimiter,
-                          sheet_name=sheet_name, header_row=header_row, ignore_columns=ignore_columns)
+                          sheet_name=sheet_name, header_row=header_row, ignore_columns=ignore_columns,
+                          max_evals=max_evals, illuminant=illuminant, observer=observer)
     if not frame:
         return doc
     columns = ("path", "value", "std_error", "lower", "upper", "at_bound")

@@ -109,6 +109,9 @@ def fit(
     sheet_name: Optional[str] = None,
     header_row: Optional[int] = None,
     ignore_columns: Union[None, str, Sequence[str]] = None,
+    max_evals: Optional[int] = None,
+    illuminant: Optional[str] = None,
+    observer: Optional[str] = None,
 ) -> FitReport: ...
 def profile(
     recipe: Recipe,

@@ -188,20 +188,6 @@ fn tolerances(v: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<String>> {
     items.enumerate().map(|(i, x)| one(&format!("tolerance[{i}]"), &x?)).collect()
 }
 
-/// The colour conditions and tolerance of a plan.
-fn plan_request(
-    rtol: Option<&Bound<'_, PyAny>>,
-    illuminant: Option<&Bound<'_, PyAny>>,
-    observer: Option<&Bound<'_, PyAny>>,
-) -> PyResult<PlanRequest> {
-    Ok(PlanRequest {
-        rtol: opt_real("rtol", rtol, "the relative tolerance of the integrals, in (0, 1), e.g. 1e-6")?,
-        max_evals: None,
-        illuminant: opt_string("illuminant", illuminant, "\"D65\", \"D50\", \"A\" or \"C\"")?,
-        observer: opt_string("observer", observer, "\"10\" or \"2\"")?,
-    })
-}
-
 /// compare(recipe, sheet, tolerance=None, k=2.0, max_de00=None, rtol=None, illuminant=None, observer=None,
 /// delimiter=None, sheet_name=None, header_row=None, ignore_columns=None) -> dict
 ///
@@ -233,7 +219,7 @@ pub fn compare<'py>(
             tolerance: None,
             tolerances: tolerances(tolerance)?,
             max_de00: opt_real("max_de00", max_de00, "the largest CIEDE2000 ΔE00, ≥ 0")?,
-            plan: plan_request(rtol, illuminant, observer)?,
+            plan: args::plan_request(rtol, None, illuminant, observer)?,
             sheet: sheet_request(delimiter, sheet_name, header_row, ignore_columns)?,
         })
     })?;
@@ -436,16 +422,18 @@ fn target_readings(v: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<String>> {
 }
 
 /// fit(recipe, targets=None, free=..., sheet=None, sample=None, uncertainty=0.2, restarts=2, rtol=None,
-/// geometries=None, timing=True, delimiter=None, sheet_name=None, header_row=None, ignore_columns=None) -> dict
+/// geometries=None, timing=True, delimiter=None, sheet_name=None, header_row=None, ignore_columns=None,
+/// max_evals=None, illuminant=None, observer=None) -> dict
 ///
 /// Recipe parameters from readings: the `free` parameters fitted to `targets` or to a `sheet`'s `sample`;
 /// the document of `glossmeter fit --format json`. `rtol` None is the library's default relative tolerance
-/// (`DEFAULT_RTOL`, the one `glossmeter fit --rtol` defaults to). A fit not to be trusted is said in the document
+/// (`DEFAULT_RTOL`, the one `glossmeter fit --rtol` defaults to); `max_evals`, `illuminant` and `observer` are
+/// `measure`'s (the budget of each aperture integral of every forward run, the conditions of colour targets). A fit not to be trusted is said in the document
 /// (`reproduces`, `identifiable`, `verdict`), not raised; a fit that cannot run raises RuntimeError.
 #[pyfunction]
 #[pyo3(signature = (recipe, targets=None, *, free, sheet=None, sample=None, uncertainty=None, restarts=None,
     rtol=None, geometries=None, timing=None, delimiter=None, sheet_name=None, header_row=None,
-    ignore_columns=None))]
+    ignore_columns=None, max_evals=None, illuminant=None, observer=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn fit<'py>(
     py: Python<'py>,
@@ -463,6 +451,9 @@ pub fn fit<'py>(
     sheet_name: Option<&Bound<'py, PyAny>>,
     header_row: Option<&Bound<'py, PyAny>>,
     ignore_columns: Option<&Bound<'py, PyAny>>,
+    max_evals: Option<&Bound<'py, PyAny>>,
+    illuminant: Option<&Bound<'py, PyAny>>,
+    observer: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let d = FitRequest::default();
     let request = guarded(|| {
@@ -473,8 +464,7 @@ pub fn fit<'py>(
                 .unwrap_or(d.uncertainty),
             restarts: opt_count("restarts", restarts, "solver restarts of an exactly determined fit")?
                 .map_or(d.restarts, |n| n as usize),
-            rtol: opt_real("rtol", rtol, "the relative tolerance of the integrals, in (0, 1), e.g. 1e-6")?
-                .unwrap_or(d.rtol),
+            plan: args::plan_request(rtol, max_evals, illuminant, observer)?,
             sheet: sheet_request(delimiter, sheet_name, header_row, ignore_columns)?,
             sample: opt_string("sample", sample, "the sample of the sheet to fit")?,
         })

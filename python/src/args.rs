@@ -32,16 +32,27 @@ pub fn measure_request(
     illuminant: Option<&Bound<'_, PyAny>>,
     observer: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<MeasureRequest> {
-    let max_evals = opt_count("max_evals", max_evals, "the evaluation budget of each aperture integral, ≥ 1")?;
     Ok(MeasureRequest {
-        plan: PlanRequest {
-            rtol: opt_real("rtol", rtol, "the relative tolerance of the integrals, in (0, 1), e.g. 1e-6")?,
-            max_evals: max_evals.map(|n| usize::try_from(n).unwrap_or(usize::MAX)),
-            illuminant: opt_string("illuminant", illuminant, "\"D65\", \"D50\", \"A\" or \"C\"")?,
-            observer: opt_string("observer", observer, "\"10\" or \"2\"")?,
-        },
+        plan: plan_request(rtol, max_evals, illuminant, observer)?,
         max_seconds: opt_real("max_seconds", max_seconds, "a wall-clock limit in seconds, ≥ 0 (0: none)")?
             .unwrap_or(0.0),
+    })
+}
+
+/// The keywords of a plan (`rtol`, `max_evals`, `illuminant`, `observer`) as the library's [`PlanRequest`],
+/// shared by every function that runs plans; only their types are checked here.
+pub fn plan_request(
+    rtol: Option<&Bound<'_, PyAny>>,
+    max_evals: Option<&Bound<'_, PyAny>>,
+    illuminant: Option<&Bound<'_, PyAny>>,
+    observer: Option<&Bound<'_, PyAny>>,
+) -> PyResult<PlanRequest> {
+    let max_evals = opt_count("max_evals", max_evals, "the evaluation budget of each aperture integral, ≥ 1")?;
+    Ok(PlanRequest {
+        rtol: opt_real("rtol", rtol, "the relative tolerance of the integrals, in (0, 1), e.g. 1e-6")?,
+        max_evals: max_evals.map(|n| usize::try_from(n).unwrap_or(usize::MAX)),
+        illuminant: opt_string("illuminant", illuminant, "\"D65\", \"D50\", \"A\" or \"C\"")?,
+        observer: opt_string("observer", observer, "\"10\" or \"2\"")?,
     })
 }
 

@@ -151,6 +151,22 @@ def test_fit_to_a_sheet_returns_the_command_line_s_document():
     assert abs(doc["parameters"][0]["value"] - 1.5) < 0.01
 
 
+def test_fit_reads_colour_targets_under_the_given_conditions_as_the_command_line_does():
+    pearl = RECIPES / "white-pearl-spectral.json"
+    free, target = "/pearlescent_flakes/tio2_thickness_nm=30..90", "astm-e2194-15/b*=22.75±0.05"
+    doc = glossmeter.fit(pearl, [target], free=[free], restarts=0, illuminant="A", observer="2",
+                         max_evals=100_000, timing=False)
+    cli = cli_json("fit", pearl, "--free", free, "--target", target, "--restarts", "0", "--illuminant", "A",
+                   "--observer", "2", "--max-evals", "100000", "--format", "json", "--no-timing")
+    assert doc == cli
+    d65 = glossmeter.fit(pearl, [target], free=[free], restarts=0, timing=False)
+    assert d65["parameters"][0]["value"] != doc["parameters"][0]["value"]
+    with pytest.raises(ValueError, match="illuminant"):
+        glossmeter.fit(pearl, [target], free=[free], illuminant="D99")
+    with pytest.raises(ValueError, match="max_evals"):
+        glossmeter.fit(pearl, [target], free=[free], max_evals=0)
+
+
 # ---- profile and convergence --------------------------------------------------------------------------------
 
 def test_profile_returns_the_command_line_s_document():

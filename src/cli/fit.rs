@@ -3,11 +3,11 @@
 //! `report::fit`.
 use std::path::PathBuf;
 
-use crate::cli::common::Format;
+use crate::cli::common::{ColourArgs, Format};
 use crate::cli::output::{print, Existing, OutputTarget};
 use crate::comparison::sheet;
 use crate::fit::{self, FitOptions, FitReport};
-use crate::request::{FitRequest, SheetRequest};
+use crate::request::{FitRequest, PlanRequest, SheetRequest};
 use crate::{recipe, Error, Result};
 
 #[derive(clap::Args, Debug)]
@@ -56,6 +56,11 @@ pub struct FitArgs {
     /// Relative tolerance of every forward reading.
     #[arg(long, default_value_t = crate::DEFAULT_RTOL)]
     pub rtol: f64,
+    /// Evaluation budget of each aperture integral of every forward run, as in `measure` (deterministic).
+    #[arg(long, default_value_t = crate::instrument::plan::PlanOptions::default().max_evals)]
+    pub max_evals: usize,
+    #[command(flatten)]
+    pub colour: ColourArgs,
     /// Output: an aligned table, JSON (`schema --output-format fit`) or CSV.
     #[arg(long, value_enum, default_value_t = Format::Table)]
     pub format: Format,
@@ -74,7 +79,7 @@ pub fn request(a: &FitArgs) -> FitRequest {
         targets: a.targets.clone(),
         uncertainty: a.uncertainty,
         restarts: a.restarts,
-        rtol: a.rtol,
+        plan: PlanRequest { max_evals: Some(a.max_evals), ..a.colour.plan(Some(a.rtol)) },
         sheet: SheetRequest {
             delimiter: a.delimiter.clone(),
             ignore_columns: a.ignore_columns.clone(),

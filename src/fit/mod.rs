@@ -240,7 +240,13 @@ fn forward<'a>(
     let start = check_free(recipe_json, free)?;
     let planner = Planner::new()?;
     let geometries = targets::geometries(&planner, targets, &options.geometries)?;
-    let plan_options = PlanOptions { rtol: options.rtol, cancel: options.cancel.clone(), ..PlanOptions::default() };
+    let plan_options = PlanOptions {
+        rtol: options.rtol,
+        max_evals: options.max_evals,
+        colour: options.colour,
+        cancel: options.cancel.clone(),
+        ..PlanOptions::default()
+    };
     // Match every target to a reading of the plan.
     let probe = planner.compile(
         recipe::parse_str(&recipe_json.to_string(), file)?.brdf,

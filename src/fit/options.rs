@@ -1,6 +1,7 @@
 //! The fit's options ([`FitOptions`]) and their defaults: the forward readings' tolerance, the uncertainty of a
-//! target given without one, the solver's budget, the restarts, the user geometries and the stop signal.
-use crate::instrument::plan::Cancel;
+//! target given without one, the forward runs' evaluation budget and colour conditions, the solver's budget, the restarts, the user geometries and the stop signal.
+use crate::colorimetry::Conditions;
+use crate::instrument::plan::{Cancel, PlanOptions};
 use crate::instrument::standards::StandardGeometry;
 
 /// Uncertainty of a target given without one, in the reading's unit: the 0.2 GU repeatability that
@@ -14,6 +15,11 @@ pub struct FitOptions {
     /// [`DEFAULT_RTOL`](crate::DEFAULT_RTOL) (1e-6): the Jacobians run on frozen methods, so their differences
     /// do not need a tighter one, and a reading's 1e-6 is far below a glossmeter's repeatability (60 GU × 1e-6 = 6·10⁻⁵ GU against 0.2 GU).
     pub rtol: f64,
+    /// Evaluation budget of each aperture integral of every forward run (`measure --max-evals`).
+    pub max_evals: usize,
+    /// The illuminant and observer of colour targets (`measure --illuminant --observer`; default D65, CIE
+    /// 1964 10°).
+    pub colour: Conditions,
     /// Uncertainty of a target without one.
     pub default_uncertainty: f64,
     /// Most forward-model runs (each a full set of readings) the solver may spend, Jacobians excluded.
@@ -37,6 +43,8 @@ impl Default for FitOptions {
     fn default() -> Self {
         FitOptions {
             rtol: crate::instrument::plan::DEFAULT_RTOL,
+            max_evals: PlanOptions::default().max_evals,
+            colour: Conditions::default(),
             default_uncertainty: DEFAULT_UNCERTAINTY,
             max_iterations: 200,
             restarts: DEFAULT_RESTARTS,

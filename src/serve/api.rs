@@ -560,10 +560,22 @@ pub(crate) fn compare(req: &Request, ctx: Context) -> Result<Reply> {
 /// PATH=log:LO..HI) fitted to `target` readings (GEOMETRY/READING=VALUE[±U]) or to a `sheet`'s `sample`.
 pub(crate) fn fit(req: &Request, ctx: Context) -> Result<Reply> {
     let o = req.obj();
-    let fields = ["recipe", "free", "target", "sample", "uncertainty", "restarts", "rtol"];
+    let fields = [
+        "recipe",
+        "free",
+        "target",
+        "sample",
+        "uncertainty",
+        "restarts",
+        "rtol",
+        "max_evals",
+        "illuminant",
+        "observer",
+    ];
     o.deny_unknown(&[&fields[..], SHEET_FIELDS].concat())?;
     let l = ctx.limits;
-    let rtol = plan_options(&o, ctx, DEFAULT_RTOL)?.rtol;
+    // Checked here for each field's own message; the request carries them as given.
+    plan_options(&o, ctx, DEFAULT_RTOL)?;
     let request = FitRequest {
         free: strings(&o, "free")?,
         targets: strings(&o, "target")?,
@@ -572,7 +584,7 @@ pub(crate) fn fit(req: &Request, ctx: Context) -> Result<Reply> {
             .unwrap_or(fit::DEFAULT_UNCERTAINTY),
         restarts: whole(&o, "restarts", 0, l.fit_restarts, "restarts")?
             .unwrap_or(fit::DEFAULT_RESTARTS.min(l.fit_restarts)),
-        rtol,
+        plan: plan_request(&o, ctx)?,
         sheet: sheet_request(&o)?,
         sample: o.opt_str("sample")?.map(str::to_owned),
     };
