@@ -274,9 +274,10 @@ fn the_endpoints_answer_on_the_command_lines_documents() {
 }
 
 /// A fit's colour conditions and evaluation budget are `measure`'s fields, and the served fit is the command
-/// line's with the same flags (`fit --illuminant A --observer 2 --max-evals N`), parameter for parameter.
+/// line's with the same flags (`fit --illuminant A --observer 2 --max-evals N`), parameter for parameter; so
+/// is a served sweep (`sweep --illuminant A --observer 2`), reading for reading.
 #[test]
-fn a_served_fit_reads_colour_under_the_given_conditions_as_the_command_line_does() {
+fn a_served_fit_and_sweep_read_colour_under_the_given_conditions_as_the_command_line_does() {
     let addr = default_server();
     let pearl = "fixtures/recipes/white-pearl-spectral.json";
     let (free, target) = ("/pearlescent_flakes/tio2_thickness_nm=30..90", "astm-e2194-15/b*=22.75±0.05");
@@ -305,6 +306,25 @@ fn a_served_fit_reads_colour_under_the_given_conditions_as_the_command_line_does
     // Under the default D65 / 10° the same target gives another thickness.
     let d65 = cli(&[]);
     assert_ne!(served["parameters"][0]["value"], d65["parameters"][0]["value"]);
+    // A served sweep under the same conditions is the command line's `sweep --illuminant A --observer 2`.
+    let vary = "/pearlescent_flakes/tio2_thickness_nm=60..69:2";
+    let body = with_recipe(
+        &std::fs::read_to_string(pearl).unwrap(),
+        json!({"vary": [vary], "geometries": ["astm-e2194-15"], "illuminant": "A", "observer": "2"}),
+    );
+    let a = request(addr, "POST", "/api/sweep", &body, &[]);
+    assert_eq!(a.status, 200, "{}", a.body);
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_glossmeter"))
+        .args(["sweep", pearl, "--vary", vary, "-g", "astm-e2194-15", "--illuminant", "A", "--observer", "2"])
+        .args(["--format", "jsonl", "--no-timing"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(a.body.lines().count(), 2);
+    for (s, c) in a.body.lines().zip(String::from_utf8(out.stdout).unwrap().lines()) {
+        let (s, c): (Value, Value) = (serde_json::from_str(s).unwrap(), serde_json::from_str(c).unwrap());
+        assert_eq!(s["readings"], c["readings"]);
+    }
     // A bad condition is refused under its own field.
     let bad = with_recipe(
         &std::fs::read_to_string(pearl).unwrap(),

@@ -311,3 +311,54 @@ fn a_table_recipe_has_nothing_to_vary_and_says_so() {
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("has no numeric parameter to vary") && !err.contains("include ;"), "{err}");
 }
+
+/// A sweep reads colour under `--illuminant` and `--observer` as `measure` does: every point's colour readings are
+/// the bits of `measure --illuminant A --observer 2` on the recipe at that point, and differ from D65 / 10°'s.
+#[test]
+fn a_sweep_reads_colour_under_the_given_conditions_as_measure_does() {
+    let pearl = "fixtures/recipes/white-pearl-spectral.json";
+    let sweep = |colour: &[&str]| -> Vec<serde_json::Value> {
+        let mut a = vec!["sweep", pearl, "--vary", "/pearlescent_flakes/tio2_thickness_nm=60..69:2"];
+        a.extend(["-g", "astm-e2194-15", "--format", "jsonl", "--no-timing"]);
+        a.extend(colour);
+        let (code, out, err) = gm(&a);
+        assert_eq!(code, 0, "{err}");
+        out.lines().map(|l| serde_json::from_str(l).unwrap()).collect()
+    };
+    let (a2, d65) = (sweep(&["--illuminant", "A", "--observer", "2"]), sweep(&[]));
+    assert_eq!(a2.len(), 2);
+    let dir = fresh_dir("sweep-colour");
+    let mut recipe: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(pearl).unwrap()).unwrap();
+    for (point, other) in a2.iter().zip(&d65) {
+        let t = &point["parameters"]["/pearlescent_flakes/tio2_thickness_nm"];
+        recipe["pearlescent_flakes"]["tio2_thickness_nm"] = t.clone();
+        let file = dir.join(format!("at-{t}.json"));
+        std::fs::write(&file, recipe.to_string()).unwrap();
+        let f = file.to_str().unwrap();
+        let (code, out, err) = gm(&[
+            "measure",
+            f,
+            "-g",
+            "astm-e2194-15",
+            "--illuminant",
+            "A",
+            "--observer",
+            "2",
+            "--format",
+            "json",
+            "--no-timing",
+        ]);
+        assert_eq!(code, 0, "{err}");
+        let measured: serde_json::Value = serde_json::from_str(&out).unwrap();
+        let readings = point["readings"].as_array().unwrap();
+        for m in measured["readings"].as_array().unwrap() {
+            let r = readings.iter().find(|r| r["name"] == m["name"]).unwrap();
+            assert_eq!(r["value"], m["value"], "{t} {}", m["name"]);
+            assert_eq!(r["error_estimate"], m["error_estimate"], "{t} {}", m["name"]);
+        }
+        let b = |p: &serde_json::Value| {
+            p["readings"].as_array().unwrap().iter().find(|r| r["name"] == "b*").unwrap()["value"].clone()
+        };
+        assert_ne!(b(point), b(other), "{t}: b* the same under A / 2° as under D65 / 10°");
+    }
+}

@@ -346,22 +346,26 @@ def sweep_rows(points: Sequence[SweepPoint]) -> List[Dict[str, Any]]:
 def sweep(template: Recipe, vary: Union[str, Sequence[str]], log: Union[None, str, Sequence[str]] = ...,
           lhs: Optional[int] = ..., seed: Optional[int] = ..., geometries: Geometries = ...,
           shard: Optional[Shard] = ..., rtol: Optional[float] = ..., max_evals: Optional[int] = ...,
-          timing: bool = ..., *, as_frame: Literal[False] = ...) -> List[SweepPoint]: ...
+          timing: bool = ..., *, illuminant: Optional[str] = ..., observer: Optional[str] = ...,
+          as_frame: Literal[False] = ...) -> List[SweepPoint]: ...
 @overload
 def sweep(template: Recipe, vary: Union[str, Sequence[str]], log: Union[None, str, Sequence[str]] = ...,
           lhs: Optional[int] = ..., seed: Optional[int] = ..., geometries: Geometries = ...,
           shard: Optional[Shard] = ..., rtol: Optional[float] = ..., max_evals: Optional[int] = ...,
-          timing: bool = ..., *, as_frame: Literal[True]) -> "pandas.DataFrame": ...
+          timing: bool = ..., *, illuminant: Optional[str] = ..., observer: Optional[str] = ...,
+          as_frame: Literal[True]) -> "pandas.DataFrame": ...
 def sweep(template: Recipe, vary: Union[str, Sequence[str]], log: Union[None, str, Sequence[str]] = None,
           lhs: Optional[int] = None, seed: Optional[int] = None, geometries: Geometries = None,
           shard: Optional[Shard] = None, rtol: Optional[float] = None, max_evals: Optional[int] = None,
-          timing: bool = True, *, as_frame: bool = False) -> Union[List[SweepPoint], "pandas.DataFrame"]:
+          timing: bool = True, *, illuminant: Optional[str] = None, observer: Optional[str] = None,
+          as_frame: bool = False) -> Union[List[SweepPoint], "pandas.DataFrame"]:
     """Measure a template recipe over a grid (``vary`` "PATH=LO..HI:N", one or a list) or a Latin hypercube
     (``lhs`` N points, ``vary`` "PATH=LO..HI"): one dict per point, the lines of ``glossmeter sweep --format
     jsonl``. With ``as_frame=True``, a pandas DataFrame of :func:`sweep_rows`. Ctrl-C stops it
     (KeyboardInterrupt). See docs/python.md."""
     frame = _check_frame_flag(as_frame)
-    points = _glossmeter.sweep(template, vary, log, lhs, seed, geometries, shard, rtol, max_evals, timing)
+    points = _glossmeter.sweep(template, vary, log, lhs, seed, geometries, shard, rtol, max_evals, timing,
+                               illuminant, observer)
     if not frame:
         return points
     import pandas as pd

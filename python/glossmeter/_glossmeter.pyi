@@ -92,6 +92,8 @@ def sweep(
     rtol: Optional[float] = None,
     max_evals: Optional[int] = None,
     timing: bool = True,
+    illuminant: Optional[str] = None,
+    observer: Optional[str] = None,
 ) -> List[SweepPoint]: ...
 def fit(
     recipe: Recipe,

@@ -293,13 +293,13 @@ fn shard(v: Option<&Bound<'_, PyAny>>) -> PyResult<(u64, u64)> {
 }
 
 /// sweep(template, vary, log=None, lhs=None, seed=0, geometries=None, shard=None, rtol=None, max_evals=None,
-/// timing=True) -> list[dict]
+/// timing=True, illuminant=None, observer=None) -> list[dict]
 ///
 /// A template recipe measured over a grid (`vary` "PATH=LO..HI:N", repeatable) or a Latin hypercube (`lhs`
 /// N points, `vary` "PATH=LO..HI"): one dict per point, the lines of `glossmeter sweep --format jsonl`.
 #[pyfunction]
 #[pyo3(signature = (template, vary, log=None, lhs=None, seed=None, geometries=None, shard=None, rtol=None,
-    max_evals=None, timing=None))]
+    max_evals=None, timing=None, illuminant=None, observer=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn sweep<'py>(
     py: Python<'py>,
@@ -313,6 +313,8 @@ pub fn sweep<'py>(
     rtol: Option<&Bound<'py, PyAny>>,
     max_evals: Option<&Bound<'py, PyAny>>,
     timing: Option<&Bound<'py, PyAny>>,
+    illuminant: Option<&Bound<'py, PyAny>>,
+    observer: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyList>> {
     let grammar = "\"PATH=LO..HI:N\" (a grid) or \"PATH=LO..HI\" (with lhs), PATH a JSON Pointer";
     let request = guarded(|| {
@@ -321,12 +323,7 @@ pub fn sweep<'py>(
             log: strings("log", log, "the vary paths whose values are spaced logarithmically")?,
             lhs: opt_count("lhs", lhs, "the points of a Latin hypercube")?,
             seed: opt_count("seed", seed, "the hypercube's seed")?.unwrap_or(0),
-            plan: PlanRequest {
-                rtol: opt_real("rtol", rtol, "the relative tolerance of the integrals, in (0, 1), e.g. 1e-6")?,
-                max_evals: opt_count("max_evals", max_evals, "the evaluation budget of each integral")?
-                    .map(|n| n as usize),
-                ..PlanRequest::default()
-            },
+            plan: args::plan_request(rtol, max_evals, illuminant, observer)?,
         })
     })?;
     let timing = args::flag("timing", timing, true)?;

@@ -117,6 +117,18 @@ def test_sweep_returns_the_command_line_s_lines(kwargs, flags):
     assert points == cli_json("sweep", ROUGH, "--format", "jsonl", "--no-timing", *flags, lines=True)
 
 
+def test_a_sweep_reads_colour_under_the_given_conditions_as_the_command_line_does():
+    pearl = RECIPES / "white-pearl-spectral.json"
+    vary = "/pearlescent_flakes/tio2_thickness_nm=60..69:2"
+    points = glossmeter.sweep(pearl, vary, geometries="astm-e2194-15", timing=False, illuminant="A", observer="2")
+    cli = cli_json("sweep", pearl, "--vary", vary, "-g", "astm-e2194-15", "--illuminant", "A", "--observer", "2",
+                   "--format", "jsonl", "--no-timing", lines=True)
+    assert points == cli
+    assert points != glossmeter.sweep(pearl, vary, geometries="astm-e2194-15", timing=False)
+    with pytest.raises(ValueError, match="observer"):
+        glossmeter.sweep(pearl, vary, geometries="astm-e2194-15", observer="7")
+
+
 def test_the_shards_of_a_sweep_make_the_whole_sweep():
     whole = glossmeter.sweep(ROUGH, "/roughness=0.05..0.3:7", geometries="astm-d523-60", timing=False)
     parts = [p for k in (1, 2, 3) for p in

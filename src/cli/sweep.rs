@@ -4,6 +4,7 @@
 use std::io::IsTerminal;
 use std::path::PathBuf;
 
+use crate::cli::common::ColourArgs;
 use crate::cli::output::{Existing, OutputTarget};
 use crate::instrument::plan::{PlanOptions, DEFAULT_RTOL};
 use crate::request::{PlanRequest, SweepRequest};
@@ -53,6 +54,8 @@ pub struct SweepArgs {
     /// Evaluation budget of each aperture integral (a reading that runs out is marked not converged).
     #[arg(long, default_value_t = PlanOptions::default().max_evals)]
     pub max_evals: usize,
+    #[command(flatten)]
+    pub colour: ColourArgs,
     /// Write to this new file instead of stdout (refused before any work if it exists; the file appears
     /// whole when the sweep ends, or not at all).
     #[arg(long, short = 'o')]
@@ -66,7 +69,7 @@ pub fn request(a: &SweepArgs) -> SweepRequest {
         log: a.log.clone(),
         lhs: a.lhs,
         seed: a.seed,
-        plan: PlanRequest { rtol: a.rtol, max_evals: Some(a.max_evals), ..PlanRequest::default() },
+        plan: PlanRequest { max_evals: Some(a.max_evals), ..a.colour.plan(a.rtol) },
     }
 }
 
