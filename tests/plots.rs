@@ -224,3 +224,26 @@ fn every_unit_and_colour_get_an_axis_of_their_own() {
     }
     assert!(!svg.contains("predicted − measured (GU, "), "no shared axis");
 }
+
+/// Readings against a parameter read colour under `--illuminant` and `--observer`, as `measure` does (the server's
+/// plot took them already): the curves under A / 2° are not D65 / 10°'s, and an unknown illuminant is refused
+/// before any work (exit 2).
+#[test]
+fn gloss_vs_parameter_reads_colour_under_the_given_conditions() {
+    let svg = |name: &str, colour: &[&str]| -> (i32, String) {
+        let p = fresh(name);
+        let mut args = vec!["glossmeter", "plot", "fixtures/recipes/white-pearl-spectral.json", "--kind"];
+        args.extend(["gloss-vs-parameter", "--vary", "/pearlescent_flakes/tio2_thickness_nm=60..69", "--points"]);
+        args.extend(["2", "-g", "astm-e2194-15", "-o", p.to_str().unwrap()]);
+        args.extend(colour);
+        let code = run(args);
+        (code, std::fs::read_to_string(&p).unwrap_or_default())
+    };
+    let (code, a2) = svg("colour-a2.svg", &["--illuminant", "A", "--observer", "2"]);
+    assert_eq!(code, 0);
+    let (code, d65) = svg("colour-d65.svg", &[]);
+    assert_eq!(code, 0);
+    assert!(a2.contains("b*") && a2 != d65, "the same curves under A / 2° as under D65 / 10°");
+    let (code, none) = svg("colour-d99.svg", &["--illuminant", "D99"]);
+    assert_eq!((code, none.is_empty()), (2, true), "an unknown illuminant is refused and nothing is drawn");
+}

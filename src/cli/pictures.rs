@@ -4,13 +4,14 @@
 //! `compare`'s comparison).
 use std::path::{Path, PathBuf};
 
+use crate::cli::common::ColourArgs;
 use crate::cli::output::Existing;
 use crate::comparison::Comparison;
 use crate::input::Stdin;
 use crate::report::pictures::charts::{
     comparison_height, draw_comparison, draw_sections, draw_vs_parameter, section, vs_parameter_size, Residual, Section,
 };
-use crate::request::{self, PlanRequest, VsParameterRequest};
+use crate::request::{self, VsParameterRequest};
 use crate::{recipe, Error, Result};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -46,6 +47,8 @@ pub struct PlotArgs {
     /// each integral's data uncertainty: given here, it is used as given).
     #[arg(long)]
     pub rtol: Option<f64>,
+    #[command(flatten)]
+    pub colour: ColourArgs,
     /// The picture: FILE.png or FILE.svg (never overwritten).
     #[arg(long, short = 'o')]
     pub output: PathBuf,
@@ -72,15 +75,14 @@ pub fn request(a: &PlotArgs) -> VsParameterRequest {
             Spacing::Linear => request::Spacing::Linear,
             Spacing::Log => request::Spacing::Log,
         },
-        plan: PlanRequest { rtol: a.rtol, ..PlanRequest::default() },
+        plan: a.colour.plan(a.rtol),
     }
 }
 
 pub fn run(a: PlotArgs, existing: Existing) -> Result<()> {
     super::plot::check_plot_path(&a.output, "--output", existing)?;
-    if let Some(rtol) = a.rtol {
-        request::check_rtol(rtol)?;
-    }
+    // The tolerance and the colour conditions, checked before any work.
+    request(&a).plan.options()?;
     let geos = crate::resolve_geometries_or(&a.geometries, &[] as &[&str], DEFAULT)?;
     match a.kind {
         PlotKind::Section => {
