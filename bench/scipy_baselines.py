@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """SciPy / hcubature baselines for the glossmeter benchmarks B1–B4 (issue 4), run by hand.
 
-The same integrands as benches/integrators.rs, re-implemented here: the specimen flux through the gloss
+The same integrands as benches/integrators/, re-implemented here: the specimen flux through the gloss
 receptor,
 
     Φ = ∫ dp_s dq_s ∫ dp_r dq_r  f(ωi, ωo) cos θi cos θo (1+p_s²+q_s²)^(-3/2) (1+p_r²+q_r²)^(-3/2),
@@ -42,7 +42,7 @@ except ImportError:  # pragma: no cover
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
-# Our engine (rtol 1e-12) / closed form, from benches/integrators.rs output (see docstring).
+# Our engine (rtol 1e-12) / closed form, from benches/integrators/ output (see docstring).
 REFERENCE = {
     "B1": 3.549063401989875e-7,  # closed form (Lambert's polygon formula)
     "B2": 3.555078509693765e-7,  # our engine at rtol 1e-12 (est. rel. err 5e-13)

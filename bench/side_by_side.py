@@ -4,7 +4,7 @@ docs/performance.md §"At the limit" (Beckmann and GGX microfacet dielectric n =
 astm-d523-20/60/85 and astm-e430-30 with its 8 receptors: 66 specimen integrals, default rtol 1e-6). Run by hand.
 
 1. The engine: `BENCH_CASES=WIDE BENCH_JSON=FILE cargo bench --bench integrators` (the WIDE section of
-   benches/integrators.rs writes every specimen integral's planner evaluations, value and error estimate to
+   benches/integrators/ writes every specimen integral's planner evaluations, value and error estimate to
    FILE), or `--engine-json FILE` to reuse a previous run (the bench's JSON, or this script's own JSON output).
 2. The limit: tools/limit_wide_lobes.py, imported (`case_run`: oracle tensor Gauss–Legendre orders, evaluations of
    the final rule alone), with its reference value and target per integral; `--limit-json FILE` reuses the limit

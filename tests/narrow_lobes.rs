@@ -3,7 +3,7 @@
 //! readings agree with the engine's own rtol-1e-10 values from before the polar rule
 //! (`fixtures/reference/narrow-lobes-d523-20.json`, with its provenance) within their estimates, and the plan names the
 //! rule it chose. Evaluation counts are exact and reproducible, so the cost targets are tests here; times are measured
-//! in `benches/integrators.rs`.
+//! in `benches/integrators/`.
 use std::sync::Arc;
 
 use glossmeter::brdf::Brdf;

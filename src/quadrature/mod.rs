@@ -5,7 +5,7 @@
 //! (a) an initial partition supplied by the caller (the splits at lobe centres, widths and kinks that keep
 //! a near-specular lobe from being silently missed: an automatic rule sampling a box at a few points cannot
 //! see a peak between them, Lyness & Kaganove, "Comments on the nature of automatic quadrature routines",
-//! ACM TOMS 2 (1976) 65–81; `benches/integrators.rs` B3 shows it on the raw box), (b) one
+//! ACM TOMS 2 (1976) 65–81; `benches/integrators/` B3 shows it on the raw box), (b) one
 //! global absolute/relative tolerance across all pieces, (c) vector values with a stated error norm, and
 //! (d) a fixed, single-threaded order of work. The Rust crates looked at (bilby 0.3: scalar only, no initial
 //! split; scirs2-integrate: very heavy) offer none of (a)–(c) together, so the rule is implemented here
