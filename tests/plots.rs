@@ -246,4 +246,6 @@ fn gloss_vs_parameter_reads_colour_under_the_given_conditions() {
     assert!(a2.contains("b*") && a2 != d65, "the same curves under A / 2° as under D65 / 10°");
     let (code, none) = svg("colour-d99.svg", &["--illuminant", "D99"]);
     assert_eq!((code, none.is_empty()), (2, true), "an unknown illuminant is refused and nothing is drawn");
+    let (code, none) = svg("budget-0.svg", &["--max-evals", "0"]);
+    assert_eq!((code, none.is_empty()), (2, true), "a budget of 0 is refused and nothing is drawn");
 }

@@ -303,3 +303,34 @@ fn instrument_exports_compare_without_edits() {
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("unrecognised column"), "{err}");
 }
+
+/// `compare --max-evals N` predicts with `measure --max-evals N`'s plan: the same values and error estimates, bit
+/// for bit (a budget that binds moves both alike), and a budget of 0 is refused (exit 2).
+#[test]
+fn compare_predicts_under_the_evaluation_budget_of_measure() {
+    let recipe = "fixtures/recipes/rough-dielectric-ggx-vcavity.json";
+    let sheet = "fixtures/sheets/glass-n1.5-trigloss.csv";
+    for budget in ["60", "2000000"] {
+        let (code, out, err) =
+            gm(&["compare", recipe, sheet, "--max-evals", budget, "--tolerance", "1", "--format", "json"]);
+        assert!(code == 0 || code == 1, "{err}");
+        let cmp: Value = serde_json::from_str(&out).unwrap();
+        let (code, out, err) =
+            gm(&["measure", recipe, "-g", "astm-d523-20", "-g", "astm-d523-60", "-g", "astm-d523-85"]
+                .into_iter()
+                .chain(["--max-evals", budget, "--format", "json", "--no-timing", "--allow-unconverged"])
+                .collect::<Vec<_>>());
+        assert_eq!(code, 0, "{err}");
+        let measured: Value = serde_json::from_str(&out).unwrap();
+        let rows = cmp["comparisons"].as_array().unwrap();
+        assert_eq!(rows.len(), 3);
+        for c in rows {
+            let m = measured["readings"].as_array().unwrap().iter().find(|r| r["geometry"] == c["geometry"]).unwrap();
+            assert_eq!(c["predicted"], m["value"], "{budget}: {}", c["geometry"]);
+            assert_eq!(c["error_estimate"], m["error_estimate"], "{budget}: {}", c["geometry"]);
+        }
+    }
+    let (code, _, err) = gm(&["compare", recipe, sheet, "--max-evals", "0"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("max-evals") || err.contains("max_evals"), "{err}");
+}

@@ -414,24 +414,24 @@ def compare(recipe: Recipe, sheet: SheetSource, tolerance: Optional[Tolerance] =
             max_de00: Optional[float] = ..., rtol: Optional[float] = ..., illuminant: Optional[str] = ...,
             observer: Optional[str] = ..., delimiter: Optional[str] = ..., sheet_name: Optional[str] = ...,
             header_row: Optional[int] = ..., ignore_columns: Union[None, str, Sequence[str]] = ..., *,
-            as_frame: Literal[False] = ...) -> CompareReport: ...
+            max_evals: Optional[int] = ..., as_frame: Literal[False] = ...) -> CompareReport: ...
 @overload
 def compare(recipe: Recipe, sheet: SheetSource, tolerance: Optional[Tolerance] = ..., k: Optional[float] = ...,
             max_de00: Optional[float] = ..., rtol: Optional[float] = ..., illuminant: Optional[str] = ...,
             observer: Optional[str] = ..., delimiter: Optional[str] = ..., sheet_name: Optional[str] = ...,
             header_row: Optional[int] = ..., ignore_columns: Union[None, str, Sequence[str]] = ..., *,
-            as_frame: Literal[True]) -> "pandas.DataFrame": ...
+            max_evals: Optional[int] = ..., as_frame: Literal[True]) -> "pandas.DataFrame": ...
 def compare(recipe: Recipe, sheet: SheetSource, tolerance: Optional[Tolerance] = None, k: Optional[float] = None,
             max_de00: Optional[float] = None, rtol: Optional[float] = None, illuminant: Optional[str] = None,
             observer: Optional[str] = None, delimiter: Optional[str] = None, sheet_name: Optional[str] = None,
             header_row: Optional[int] = None, ignore_columns: Union[None, str, Sequence[str]] = None, *,
-            as_frame: bool = False) -> Union[CompareReport, "pandas.DataFrame"]:
+            max_evals: Optional[int] = None, as_frame: bool = False) -> Union[CompareReport, "pandas.DataFrame"]:
     """The recipe's predictions beside an instrument sheet, with the verdicts: the document of ``glossmeter
     compare RECIPE SHEET --format json``. With ``as_frame=True``, a pandas DataFrame of :func:`compare_rows`,
     one row per compared (sample, reading). See docs/python.md."""
     frame = _check_frame_flag(as_frame)
     doc = _glossmeter.compare(recipe, sheet, tolerance, k, max_de00, rtol, illuminant, observer, delimiter,
-                              sheet_name, header_row, ignore_columns)
+                              sheet_name, header_row, ignore_columns, max_evals)
     if not frame:
         return doc
     return _frame(compare_rows(doc), COMPARE_COLUMNS, _COMPARE_FLOATS)

@@ -80,6 +80,7 @@ def compare(
     sheet_name: Optional[str] = None,
     header_row: Optional[int] = None,
     ignore_columns: Union[None, str, Sequence[str]] = None,
+    max_evals: Optional[int] = None,
 ) -> CompareReport: ...
 def sweep(
     template: Recipe,

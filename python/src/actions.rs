@@ -189,14 +189,14 @@ fn tolerances(v: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<String>> {
 }
 
 /// compare(recipe, sheet, tolerance=None, k=2.0, max_de00=None, rtol=None, illuminant=None, observer=None,
-/// delimiter=None, sheet_name=None, header_row=None, ignore_columns=None) -> dict
+/// delimiter=None, sheet_name=None, header_row=None, ignore_columns=None, max_evals=None) -> dict
 ///
 /// The recipe's predictions beside an instrument sheet (every sample of it), with the verdicts: the document
 /// of `glossmeter compare RECIPE SHEET --format json`. Verdicts outside the allowance are in the document
 /// (`summary`), not raised.
 #[pyfunction]
 #[pyo3(signature = (recipe, sheet, tolerance=None, k=None, max_de00=None, rtol=None, illuminant=None,
-    observer=None, delimiter=None, sheet_name=None, header_row=None, ignore_columns=None))]
+    observer=None, delimiter=None, sheet_name=None, header_row=None, ignore_columns=None, max_evals=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn compare<'py>(
     py: Python<'py>,
@@ -212,6 +212,7 @@ pub fn compare<'py>(
     sheet_name: Option<&Bound<'py, PyAny>>,
     header_row: Option<&Bound<'py, PyAny>>,
     ignore_columns: Option<&Bound<'py, PyAny>>,
+    max_evals: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let request = guarded(|| {
         Ok(CompareRequest {
@@ -219,7 +220,7 @@ pub fn compare<'py>(
             tolerance: None,
             tolerances: tolerances(tolerance)?,
             max_de00: opt_real("max_de00", max_de00, "the largest CIEDE2000 ΔE00, ≥ 0")?,
-            plan: args::plan_request(rtol, None, illuminant, observer)?,
+            plan: args::plan_request(rtol, max_evals, illuminant, observer)?,
             sheet: sheet_request(delimiter, sheet_name, header_row, ignore_columns)?,
         })
     })?;

@@ -84,6 +84,7 @@ def test_a_workbook_is_read_with_its_sheet_named():
     (GLASS, "byk-smart-chart-export.xlsx", {"rtol": 1e-5}, ["--rtol", "1e-5"]),
     (RECIPES / "blue-metallic-spectral.json", "colour-blue-metallic.csv", {"max_de00": 2.0},
      ["--max-de00", "2"]),
+    (ROUGH, "glass-n1.5-trigloss.csv", {"tolerance": 1, "max_evals": 60}, ["--tolerance", "1", "--max-evals", "60"]),
 ])
 def test_compare_returns_the_command_line_s_document(recipe, sheet, kwargs, flags):
     doc = glossmeter.compare(recipe, SHEETS / sheet, **kwargs)

@@ -210,4 +210,39 @@ mod tests {
         walk(&super::Cli::command(), "glossmeter", &mut blank);
         assert!(blank.is_empty(), "arguments without help: {blank:?}");
     }
+
+    /// Every command that runs plans hands `--max-evals`, `--illuminant` and `--observer` to its request, as
+    /// `measure` does (the server's and Python's requests take the same fields): the one place each command's
+    /// arguments become the library's.
+    #[test]
+    fn every_plan_command_hands_the_budget_and_the_colour_conditions_to_its_request() {
+        use super::{Cli, Command};
+        use crate::request::PlanRequest;
+        use clap::Parser;
+        let flags = ["--max-evals", "60", "--illuminant", "A", "--observer", "2"];
+        let plan = |args: &[&str]| -> PlanRequest {
+            let cli = Cli::try_parse_from(["glossmeter"].iter().chain(args).chain(&flags)).expect("parses");
+            match cli.command {
+                Command::Sweep(a) => crate::cli::sweep::request(&a).plan,
+                Command::Compare(a) => crate::cli::compare::request(&a).plan,
+                Command::Fit(a) => crate::cli::fit::request(&a).plan,
+                Command::Plot(a) => crate::cli::pictures::request(&a).plan,
+                other => panic!("not a plan command: {other:?}"),
+            }
+        };
+        for args in [
+            &["sweep", "r.json", "--vary", "/roughness=0.1..0.2:2"][..],
+            &["compare", "r.json", "s.csv"],
+            &["fit", "r.json", "--free", "/roughness=0.1..0.2", "--target", "astm-d523-60/gloss=50"],
+            &["plot", "r.json", "--kind", "gloss-vs-parameter", "-o", "p.svg"],
+        ] {
+            let p = plan(args);
+            assert_eq!(
+                (p.max_evals, p.illuminant.as_deref(), p.observer.as_deref()),
+                (Some(60), Some("A"), Some("2")),
+                "{}",
+                args[0]
+            );
+        }
+    }
 }
