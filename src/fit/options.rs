@@ -1,5 +1,6 @@
-//! The fit's options ([`FitOptions`]) and their defaults: the forward readings' tolerance, the uncertainty of a
-//! target given without one, the forward runs' evaluation budget and colour conditions, the solver's budget, the restarts, the user geometries and the stop signal.
+//! The fit's options ([`FitOptions`]) and their defaults: the forward readings' tolerance, evaluation budget and
+//! colour conditions, the uncertainty of a target given without one, the solver's budget, the restarts, the
+//! user geometries and the stop signal.
 use crate::colorimetry::Conditions;
 use crate::instrument::plan::{Cancel, PlanOptions};
 use crate::instrument::standards::StandardGeometry;
