@@ -136,34 +136,23 @@ fn recipe(i: usize, rng: &mut Rng) -> (String, String, String) {
             };
             let (k, s) = (rng.log_uniform(0.05, 3.0), rng.log_uniform(0.05, 3.0));
             let flakes = if i % 4 < 2 {
-                format!(
-                    r#","metallic_flakes":{{"n":{},"k":{},"spread_slope":{},"area_ratio":{},"depth_mm":0.03}}"#,
-                    f(rng.uniform(0.5, 2.5)),
-                    f(rng.uniform(2.0, 7.0)),
-                    f(rng.uniform(0.1, 0.4)),
-                    f(rng.uniform(0.05, 0.4))
+                metallic_flakes(
+                    rng.uniform(0.5, 2.5),
+                    rng.uniform(2.0, 7.0),
+                    rng.uniform(0.1, 0.4),
+                    rng.uniform(0.05, 0.4),
                 )
             } else {
-                format!(
-                    r#","pearlescent_flakes":{{"spread_slope":{},"area_ratio":{},"depth_mm":0.02,"tio2_thickness_nm":{},"tio2_index":2.5,"mica_thickness_nm":400,"mica_index":{}}}"#,
-                    f(rng.uniform(0.1, 0.4)),
-                    f(rng.uniform(0.05, 0.3)),
-                    f(rng.uniform(40.0, 160.0)),
-                    f(rng.uniform(1.5, 1.62))
+                pearlescent_flakes(
+                    rng.uniform(0.1, 0.4),
+                    rng.uniform(0.05, 0.3),
+                    rng.uniform(40.0, 160.0),
+                    rng.uniform(1.5, 1.62),
                 )
             };
             (
                 format!("paint coat n={coat_n:.3}{}", if family == 10 { " rough" } else { "" }),
-                format!(
-                    r#"{{"model":"paint","clear_coat":{{"index":{}{rough}}},"pigmented_layer":{{"thickness_mm":0.05,"primer_reflectance":[0.6,0.6,0.6],"pigments":[{{"name":"p","concentration":1.0,"k_per_mm":[{},{},{}],"s_per_mm":[{},{},{}]}}]}}{flakes}}}"#,
-                    f(coat_n),
-                    f(k),
-                    f(0.5 * k),
-                    f(0.2 * k),
-                    f(s),
-                    f(s),
-                    f(s)
-                ),
+                paint(coat_n, &rough, [k, 0.5 * k, 0.2 * k], [s; 3], &flakes),
             )
         }
         _ => {
@@ -432,20 +421,8 @@ fn pearl_paints_estimates_cover_their_actual_error_on_every_haze_receptor() {
             String::new()
         };
         let (k, s) = (rng.log_uniform(0.05, 3.0), rng.log_uniform(0.05, 3.0));
-        let json = format!(
-            r#"{{"model":"paint","clear_coat":{{"index":{}{rough}}},"pigmented_layer":{{"thickness_mm":0.05,"primer_reflectance":[0.6,0.6,0.6],"pigments":[{{"name":"p","concentration":1.0,"k_per_mm":[{},{},{}],"s_per_mm":[{},{},{}]}}]}},"pearlescent_flakes":{{"spread_slope":{},"area_ratio":{},"depth_mm":0.02,"tio2_thickness_nm":{},"tio2_index":2.5,"mica_thickness_nm":400,"mica_index":{}}}}}"#,
-            f(coat),
-            f(k),
-            f(0.5 * k),
-            f(0.2 * k),
-            f(s),
-            f(s),
-            f(s),
-            f(rng.uniform(0.1, 0.4)),
-            f(rng.uniform(0.05, 0.3)),
-            f(rng.uniform(40.0, 160.0)),
-            f(mica)
-        );
+        let flakes = pearlescent_flakes(rng.uniform(0.1, 0.4), rng.uniform(0.05, 0.3), rng.uniform(40.0, 160.0), mica);
+        let json = paint(coat, &rough, [k, 0.5 * k, 0.2 * k], [s; 3], &flakes);
         let m = glossmeter::recipe::parse_str(&json, "fixtures/recipes/generated.json").unwrap();
         let r = Plan::compile(m.brdf.clone(), geos.clone(), at(REFERENCE_RTOL)).unwrap().execute();
         for (j, rtol) in [1e-4, 1e-6, 1e-8, 1e-10].into_iter().enumerate() {
@@ -503,6 +480,48 @@ fn pearl_paints_estimates_cover_their_actual_error_on_every_haze_receptor() {
 /// Whether every reading of `json` on geometry `id` at `rtol` is within its estimate (plus the reference's) of
 /// the rtol-10⁻¹⁰ reading; the failures as lines. A reading or reference without a value, or not converged, is
 /// a failure too (a check that compared nothing must not pass).
+/// The JSON of a generated paint: a clear coat of index `coat` (`rough`: the coat's roughness members, or
+/// nothing), one pigment of K = `k` and S = `s` per mm, 0.05 mm thick over a 0.6 primer, and the flake member
+/// `flakes` ([`metallic_flakes`], [`pearlescent_flakes`]). Numbers are written to six decimals.
+fn paint(coat: f64, rough: &str, k: [f64; 3], s: [f64; 3], flakes: &str) -> String {
+    let f = |x: f64| format!("{x:.6}");
+    format!(
+        r#"{{"model":"paint","clear_coat":{{"index":{}{rough}}},"pigmented_layer":{{"thickness_mm":0.05,"primer_reflectance":[0.6,0.6,0.6],"pigments":[{{"name":"p","concentration":1.0,"k_per_mm":[{},{},{}],"s_per_mm":[{},{},{}]}}]}},{flakes}}}"#,
+        f(coat),
+        f(k[0]),
+        f(k[1]),
+        f(k[2]),
+        f(s[0]),
+        f(s[1]),
+        f(s[2])
+    )
+}
+
+/// The `metallic_flakes` member of [`paint`]: index n + ik, slope spread, area ratio, 0.03 mm deep.
+fn metallic_flakes(n: f64, k: f64, spread: f64, area: f64) -> String {
+    let f = |x: f64| format!("{x:.6}");
+    format!(
+        r#""metallic_flakes":{{"n":{},"k":{},"spread_slope":{},"area_ratio":{},"depth_mm":0.03}}"#,
+        f(n),
+        f(k),
+        f(spread),
+        f(area)
+    )
+}
+
+/// The `pearlescent_flakes` member of [`paint`]: slope spread, area ratio, TiO₂ thickness on 400 nm of mica of
+/// index `mica`, 0.02 mm deep.
+fn pearlescent_flakes(spread: f64, area: f64, tio2_nm: f64, mica: f64) -> String {
+    let f = |x: f64| format!("{x:.6}");
+    format!(
+        r#""pearlescent_flakes":{{"spread_slope":{},"area_ratio":{},"depth_mm":0.02,"tio2_thickness_nm":{},"tio2_index":2.5,"mica_thickness_nm":400,"mica_index":{}}}"#,
+        f(spread),
+        f(area),
+        f(tio2_nm),
+        f(mica)
+    )
+}
+
 fn below_their_actual_error(json: &str, id: &str, rtol: f64) -> Vec<String> {
     below_at(json, &[id], &[rtol], &mut Vec::new())
 }
@@ -579,32 +598,16 @@ fn wide_ggx_lobes_at_grazing_are_covered() {
 #[test]
 fn narrow_flakes_under_a_coat_are_covered_near_grazing() {
     let cases = cases_from("GLOSSMETER_FLAKE_CASES", 2);
-    let f = |x: f64| format!("{x:.6}");
     let mut rng = Rng(0x0000_F1A4_E5C0_A7ED);
     let (mut failures, mut ratios) = (Vec::new(), Vec::new());
     for i in 0..cases {
         let spread = rng.log_uniform(0.002, 0.03);
         let flakes = if i % 2 == 0 {
-            format!(
-                r#""metallic_flakes":{{"n":{},"k":{},"spread_slope":{},"area_ratio":{},"depth_mm":0.03}}"#,
-                f(rng.uniform(0.5, 2.5)),
-                f(rng.uniform(2.0, 7.0)),
-                f(spread),
-                f(rng.uniform(0.05, 0.4))
-            )
+            metallic_flakes(rng.uniform(0.5, 2.5), rng.uniform(2.0, 7.0), spread, rng.uniform(0.05, 0.4))
         } else {
-            format!(
-                r#""pearlescent_flakes":{{"spread_slope":{},"area_ratio":{},"depth_mm":0.02,"tio2_thickness_nm":{},"tio2_index":2.5,"mica_thickness_nm":400,"mica_index":{}}}"#,
-                f(spread),
-                f(rng.uniform(0.05, 0.3)),
-                f(rng.uniform(40.0, 160.0)),
-                f(rng.uniform(1.5, 1.62))
-            )
+            pearlescent_flakes(spread, rng.uniform(0.05, 0.3), rng.uniform(40.0, 160.0), rng.uniform(1.5, 1.62))
         };
-        let json = format!(
-            r#"{{"model":"paint","clear_coat":{{"index":{}}},"pigmented_layer":{{"thickness_mm":0.05,"primer_reflectance":[0.6,0.6,0.6],"pigments":[{{"name":"p","concentration":1.0,"k_per_mm":[0.5,0.3,0.2],"s_per_mm":[0.4,0.4,0.4]}}]}},{flakes}}}"#,
-            f(rng.uniform(1.4, 1.8))
-        );
+        let json = paint(rng.uniform(1.4, 1.8), "", [0.5, 0.3, 0.2], [0.4; 3], &flakes);
         failures.extend(below_at(
             &json,
             &["astm-d523-85", "tappi-t480-75", "astm-d523-60"],
