@@ -4,6 +4,7 @@
 use clap::ValueEnum;
 
 use crate::colorimetry::Conditions;
+use crate::instrument::plan::PlanOptions;
 use crate::request::{PlanRequest, DEFAULT_ILLUMINANT, DEFAULT_OBSERVER};
 use crate::{Error, Result};
 
@@ -27,14 +28,15 @@ pub struct ColourArgs {
 
 impl ColourArgs {
     pub fn conditions(&self) -> Result<Conditions> {
-        self.plan(None).colour()
+        self.plan(None, PlanOptions::default().max_evals).colour()
     }
 
-    /// The plan's request: these conditions and the tolerance `rtol` (`None`: the request's default).
-    pub fn plan(&self, rtol: Option<f64>) -> PlanRequest {
+    /// The plan's request of a command: these conditions, the tolerance `rtol` (`None`: the request's default)
+    /// and the evaluation budget of each aperture integral (every plan command's `--max-evals`).
+    pub fn plan(&self, rtol: Option<f64>, max_evals: usize) -> PlanRequest {
         PlanRequest {
             rtol,
-            max_evals: None,
+            max_evals: Some(max_evals),
             illuminant: Some(self.illuminant.clone()),
             observer: Some(self.observer.clone()),
         }

@@ -12,7 +12,7 @@ use crate::comparison::{self, ColourDifference, Comparison, Drift, Recipes, Verd
 use crate::instrument::plan::DEFAULT_RTOL;
 use crate::report;
 use crate::report::junit;
-use crate::request::{CompareRequest, PlanRequest, SheetRequest};
+use crate::request::{CompareRequest, SheetRequest};
 use crate::{Error, Result};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -84,9 +84,9 @@ pub struct CompareArgs {
     #[command(flatten)]
     pub colour: ColourArgs,
     /// Evaluation budget of each aperture integral, as in `measure` (deterministic: the same bits on every
-    /// machine; default: `measure`'s); a reading whose integral runs out is marked not converged.
-    #[arg(long, value_name = "N")]
-    pub max_evals: Option<usize>,
+    /// machine); a reading whose integral runs out is marked not converged.
+    #[arg(long, value_name = "N", default_value_t = crate::instrument::plan::PlanOptions::default().max_evals)]
+    pub max_evals: usize,
     /// Also draw the residuals (predicted − measured) with the allowance and the verdict per reading (FILE.png
     /// or FILE.svg, never overwritten).
     #[arg(long)]
@@ -100,7 +100,7 @@ pub fn request(a: &CompareArgs) -> CompareRequest {
         tolerance: None,
         tolerances: a.tolerance.clone(),
         max_de00: a.max_de00,
-        plan: PlanRequest { max_evals: a.max_evals, ..a.colour.plan(a.rtol) },
+        plan: a.colour.plan(a.rtol, a.max_evals),
         sheet: SheetRequest {
             delimiter: a.delimiter.clone(),
             ignore_columns: a.ignore_columns.clone(),

@@ -7,7 +7,7 @@ use crate::cli::common::{ColourArgs, Format};
 use crate::cli::output::{print, Existing, OutputTarget};
 use crate::comparison::sheet;
 use crate::fit::{self, FitOptions, FitReport};
-use crate::request::{FitRequest, PlanRequest, SheetRequest};
+use crate::request::{FitRequest, SheetRequest};
 use crate::{recipe, Error, Result};
 
 #[derive(clap::Args, Debug)]
@@ -79,7 +79,7 @@ pub fn request(a: &FitArgs) -> FitRequest {
         targets: a.targets.clone(),
         uncertainty: a.uncertainty,
         restarts: a.restarts,
-        plan: PlanRequest { max_evals: Some(a.max_evals), ..a.colour.plan(Some(a.rtol)) },
+        plan: a.colour.plan(Some(a.rtol), a.max_evals),
         sheet: SheetRequest {
             delimiter: a.delimiter.clone(),
             ignore_columns: a.ignore_columns.clone(),

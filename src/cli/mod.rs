@@ -39,7 +39,6 @@ pub mod progress;
 pub mod sweep;
 pub mod topography;
 
-use crate::request::PlanRequest;
 use args::{Cli, Command, OutputSchema};
 use common::{readings_status, Format};
 use output::{print, OutputTarget, STDOUT};
@@ -121,10 +120,7 @@ fn dispatch(cli: Cli, #[allow(unused_variables)] serve: Serve) -> Result<()> {
             max_seconds,
             envelope,
         } => {
-            let request = crate::request::MeasureRequest {
-                plan: PlanRequest { max_evals: Some(max_evals), ..colour.plan(rtol) },
-                max_seconds,
-            };
+            let request = crate::request::MeasureRequest { plan: colour.plan(rtol, max_evals), max_seconds };
             let options = request.options()?;
             let max_seconds = options.max_seconds;
             // The limit is the whole command's, counted from here: the nominal readings and every envelope

@@ -11,7 +11,7 @@ use crate::input::Stdin;
 use crate::report::pictures::charts::{
     comparison_height, draw_comparison, draw_sections, draw_vs_parameter, section, vs_parameter_size, Residual, Section,
 };
-use crate::request::{self, PlanRequest, VsParameterRequest};
+use crate::request::{self, VsParameterRequest};
 use crate::{recipe, Error, Result};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -50,9 +50,9 @@ pub struct PlotArgs {
     #[command(flatten)]
     pub colour: ColourArgs,
     /// Evaluation budget of each aperture integral, as in `measure` (deterministic: the same bits on every
-    /// machine; default: `measure`'s); a reading whose integral runs out is marked not converged.
-    #[arg(long, value_name = "N")]
-    pub max_evals: Option<usize>,
+    /// machine); a reading whose integral runs out is marked not converged.
+    #[arg(long, value_name = "N", default_value_t = crate::instrument::plan::PlanOptions::default().max_evals)]
+    pub max_evals: usize,
     /// The picture: FILE.png or FILE.svg (never overwritten).
     #[arg(long, short = 'o')]
     pub output: PathBuf,
@@ -79,7 +79,7 @@ pub fn request(a: &PlotArgs) -> VsParameterRequest {
             Spacing::Linear => request::Spacing::Linear,
             Spacing::Log => request::Spacing::Log,
         },
-        plan: PlanRequest { max_evals: a.max_evals, ..a.colour.plan(a.rtol) },
+        plan: a.colour.plan(a.rtol, a.max_evals),
     }
 }
 

@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use crate::cli::common::ColourArgs;
 use crate::cli::output::{Existing, OutputTarget};
 use crate::instrument::plan::{PlanOptions, DEFAULT_RTOL};
-use crate::request::{PlanRequest, SweepRequest};
+use crate::request::SweepRequest;
 use crate::sweep;
 use crate::{resolve_geometries, Error, Result};
 
@@ -69,7 +69,7 @@ pub fn request(a: &SweepArgs) -> SweepRequest {
         log: a.log.clone(),
         lhs: a.lhs,
         seed: a.seed,
-        plan: PlanRequest { max_evals: Some(a.max_evals), ..a.colour.plan(a.rtol) },
+        plan: a.colour.plan(a.rtol, a.max_evals),
     }
 }
 
