@@ -132,6 +132,51 @@ fn measure_gives_the_bits_of_the_command_line() {
     }
 }
 
+/// The colour conditions the registry offers (the page's choice) are the ones the requests take: every pair reads
+/// a spectral recipe as `measure --illuminant I --observer O` does, and the default pair is a request's without
+/// them.
+#[test]
+fn every_offered_colour_condition_reads_as_the_command_line_does() {
+    let addr = default_server();
+    let offered = request(addr, "GET", "/api/registry", b"", &[]).json()["colour_conditions"].clone();
+    let ids = |key: &str| -> Vec<String> {
+        offered[key].as_array().unwrap().iter().map(|x| x["id"].as_str().unwrap().to_owned()).collect()
+    };
+    let (illuminants, observers) = (ids("illuminants"), ids("observers"));
+    assert_eq!(illuminants, ["D65", "D50", "A", "C"]);
+    assert_eq!(observers, ["2", "10"]);
+    assert_eq!(offered["default"], json!({"illuminant": "D65", "observer": "10"}));
+    let file = "fixtures/recipes/white-pearl-spectral.json";
+    let text = fixture("white-pearl-spectral");
+    let geometry = "astm-e2194-15";
+    let plain = request(addr, "POST", "/api/measure", &with_recipe(&text, json!({"geometries": [geometry]})), &[]);
+    let mut b_stars = Vec::new();
+    for i in &illuminants {
+        for o in &observers {
+            let body = with_recipe(&text, json!({"geometries": [geometry], "illuminant": i, "observer": o}));
+            let a = request(addr, "POST", "/api/measure", &body, &[]);
+            assert_eq!(a.status, 200, "{i} {o}: {}", a.body);
+            let out = std::process::Command::new(env!("CARGO_BIN_EXE_glossmeter"))
+                .args(["measure", "--format", "json", "--no-timing", file, "-g", geometry])
+                .args(["--illuminant", i, "--observer", o])
+                .output()
+                .unwrap();
+            assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+            let cli: Value = serde_json::from_slice(&out.stdout).unwrap();
+            assert_eq!(a.json()["readings"], cli["readings"], "{i} {o}");
+            if (i.as_str(), o.as_str()) == ("D65", "10") {
+                assert_eq!(a.json()["readings"], plain.json()["readings"], "the default pair");
+            }
+            let b = cli["readings"].as_array().unwrap().iter().find(|r| r["name"] == "b*").unwrap()["value"].clone();
+            b_stars.push(b.as_f64().unwrap());
+        }
+    }
+    // Eight pairs, eight different colours: the conditions reach the reading.
+    b_stars.sort_by(f64::total_cmp);
+    b_stars.dedup();
+    assert_eq!(b_stars.len(), 8, "{b_stars:?}");
+}
+
 /// Objects of a geometry file with `"status": "assumed"` and a number for `value`.
 fn assumed_in(v: &Value) -> usize {
     match v {

@@ -10,7 +10,7 @@ use std::path::Path;
 use serde_json::{json, Value};
 
 use super::security::{table_path, Limits};
-use crate::colorimetry::{Illuminant, Observer};
+use crate::colorimetry::{Conditions, Illuminant, Observer};
 use crate::comparison;
 use crate::comparison::sheet::{self, Sheet};
 use crate::fit::{self, FitOptions};
@@ -640,7 +640,18 @@ pub(crate) fn registry_doc() -> Reply {
             })
         })
         .collect();
-    Reply::json(&json!({"models": registry::MODELS, "parameters": params}))
+    Reply::json(&json!({"models": registry::MODELS, "parameters": params, "colour_conditions": colour_conditions()}))
+}
+
+/// The illuminants and observers a colour reading can be computed under, by the names the requests take
+/// (`illuminant`, `observer`), and the default pair: the page's choice is built from these.
+fn colour_conditions() -> Value {
+    let default = Conditions::default();
+    json!({
+        "illuminants": Illuminant::ALL.map(|i| json!({"id": i.id(), "title": i.describe()})),
+        "observers": Observer::ALL.map(|x| json!({"id": x.id(), "title": x.describe()})),
+        "default": {"illuminant": default.illuminant.id(), "observer": default.observer.id()},
+    })
 }
 
 fn finite(x: f64) -> Value {

@@ -179,3 +179,68 @@ def test_a_table_model_without_a_data_directory_says_what_it_needs(browser):
     placeholder = d.find_element(By.CSS_SELECTOR, "#params [data-pointer='/file']").get_attribute("placeholder")
     assert ".binary" in placeholder and "--data-dir" in placeholder, placeholder
     assert console_errors(d) == []
+
+
+def test_colour_is_read_under_the_chosen_illuminant_and_observer(browser, tmp_path):
+    """The page's illuminant and observer reach every colour request: the readings are `measure --illuminant A
+    --observer 2`'s, the pinned reference is read again under them (a difference is never across two
+    conditions), a sweep is `sweep --illuminant A --observer 2`'s, and the choice is kept on reload."""
+    d = browser
+    wait_current(d)
+    choose_fixture(d, "white-pearl-spectral")
+    geometry = "astm-e2194-15"
+    tick_only(d, [geometry])
+    wait_current(d)
+    recipe = raw(d)
+    f = tmp_path / "pearl.json"
+    f.write_text(json.dumps(recipe))
+
+    def cli(args):
+        out = subprocess.run([binary(), *args], capture_output=True, text=True)
+        assert out.returncode == 0, out.stderr
+        return out.stdout
+
+    def measured(colour):
+        doc = json.loads(cli(["measure", "--format", "json", "--no-timing", str(f), "-g", geometry, *colour]))
+        return {(r["geometry"], r["name"]): r["value"] for r in doc["readings"]}
+
+    # The default is D65 / 10°, and reads as measure without flags.
+    assert Select(d.find_element(By.ID, "illuminant")).first_selected_option.get_attribute("value") == "D65"
+    assert Select(d.find_element(By.ID, "observer")).first_selected_option.get_attribute("value") == "10"
+    assert {k: float(v) for k, v in page_readings(d).items()} == measured([])
+    d.find_element(By.ID, "pin").click()
+    WebDriverWait(d, WAIT).until(lambda d: d.find_element(By.ID, "pin-state").text)
+    # A / 2°: the readings are measure's under them, and differ from D65 / 10°.
+    Select(d.find_element(By.ID, "illuminant")).select_by_value("A")
+    Select(d.find_element(By.ID, "observer")).select_by_value("2")
+    want = measured(["--illuminant", "A", "--observer", "2"])
+    assert want != measured([])
+    WebDriverWait(d, WAIT).until(lambda d: {k: float(v) for k, v in page_readings(d).items()} == want)
+    wait_current(d)
+    # The pinned reference (the same recipe) is read again under A / 2°: no difference remains.
+    WebDriverWait(d, WAIT).until(lambda d: "(A / 2°)" in d.find_element(By.ID, "colours").text
+                                 and "ΔE*ab = 0.00" in d.find_element(By.ID, "colours").text)
+    captions = [c.text for c in d.find_elements(By.CSS_SELECTOR, "#colours figcaption")]
+    assert len(captions) == 2 and all("A / 2°" in c for c in captions), captions
+    # A sweep under the same conditions is the command line's, reading for reading.
+    d.find_element(By.ID, "tab-sweep").click()
+    ptr, lo, hi = "/pearlescent_flakes/tio2_thickness_nm", "60", "80"
+    Select(d.find_element(By.ID, "sweep-path")).select_by_value(ptr)
+    for i, v in [("sweep-lo", lo), ("sweep-hi", hi)]:
+        d.find_element(By.ID, i).clear()
+        d.find_element(By.ID, i).send_keys(v)
+    d.find_element(By.ID, "sweep-n").clear()
+    d.find_element(By.ID, "sweep-n").send_keys("2")
+    d.find_element(By.ID, "sweep-go").click()
+    WebDriverWait(d, WAIT).until(lambda d: d.find_element(By.ID, "sweep-count").text == "2 / 2 points" or d.find_element(By.ID, "sweep-error").text)
+    assert d.find_element(By.ID, "sweep-error").text == ""
+    served = [json.loads(line)["readings"] for line in d.execute_script("return state.sweepText").splitlines() if line.strip()]
+    lines = cli(["sweep", str(f), "--vary", f"{ptr}={lo}..{hi}:2", "--format", "jsonl", "--no-timing", "-g", geometry,
+                 "--illuminant", "A", "--observer", "2"]).splitlines()
+    assert served == [json.loads(line)["readings"] for line in lines]
+    # The choice is this browser's: kept on reload.
+    d.execute_script("window.onbeforeunload = null; location.reload()")
+    WebDriverWait(d, WAIT).until(lambda d: d.find_elements(By.CSS_SELECTOR, "#illuminant option"))
+    assert Select(d.find_element(By.ID, "illuminant")).first_selected_option.get_attribute("value") == "A"
+    assert Select(d.find_element(By.ID, "observer")).first_selected_option.get_attribute("value") == "2"
+    assert console_errors(d) == []

@@ -5,7 +5,7 @@
 
 const $ = (id) => document.getElementById(id);
 const state = {
-  registry: null, // {models, parameters}
+  registry: null, // {models, parameters, colour_conditions}
   geometries: [],
   recipe: null, // the recipe object being edited
   measureSeq: 0, // the latest measure request; older answers are dropped
@@ -19,7 +19,7 @@ const state = {
   sweepRows: [],
   sweepPtr: "",
   doc: null, // the current recipe's measure document
-  pinned: null, // {name, recipe, geometries, doc}: the reference
+  pinned: null, // {name, recipe, geometries, conditions, doc}: the reference
   savedText: "", // the recipe as last saved or loaded (JSON)
   tables: { data_dir: false, models: [] }, // /api/tables: the table files a recipe may name, per model
 };
@@ -572,6 +572,42 @@ function chosenGeometries() {
   return [...document.querySelectorAll("#geometries input:checked")].map((i) => i.value);
 }
 
+/// The illuminant and observer every colour reading is computed under (the request fields `illuminant` and
+/// `observer`, as `measure --illuminant --observer`): every request that reads colour carries them.
+function conditions() {
+  return { illuminant: $("illuminant").value, observer: $("observer").value };
+}
+
+/// "A / 2°": the conditions as a caption says them.
+function conditionsText(c) {
+  return `${c.illuminant} / ${c.observer}°`;
+}
+
+const CONDITIONS = "glossmeter.colour-conditions";
+
+/// The illuminant and observer choices, from /api/registry; the last choice of this browser is kept.
+function buildConditions(offered) {
+  let kept = null;
+  try {
+    kept = JSON.parse(localStorage.getItem(CONDITIONS) || "null");
+  } catch (_) {
+    kept = null;
+  }
+  for (const [key, list] of [["illuminant", offered.illuminants], ["observer", offered.observers]]) {
+    const select = $(key);
+    for (const x of list) select.append(el("option", { value: x.id, text: x.title }));
+    const want = kept && list.some((x) => x.id === kept[key]) ? kept[key] : offered.default[key];
+    select.value = want;
+    select.addEventListener("change", conditionsChanged);
+  }
+}
+
+function conditionsChanged() {
+  localStorage.setItem(CONDITIONS, JSON.stringify(conditions()));
+  recipeChanged();
+  remeasurePinned();
+}
+
 function markStale(text) {
   $("readings").classList.add("stale");
   $("readings").setAttribute("aria-busy", "true");
@@ -594,7 +630,7 @@ function recipeChanged() {
 /// RGB recipe has no spectrum, so no X, Y, Z: docs/colour.md) is left out by the server, the others are read,
 /// and the document says which and why (`refused`: {geometries, message}, the library's message).
 async function measureDoc(recipe, geos, signal) {
-  return (await post("/api/measure", { recipe, geometries: geos, omit_refused_colour: true }, signal)).json();
+  return (await post("/api/measure", { recipe, geometries: geos, ...conditions(), omit_refused_colour: true }, signal)).json();
 }
 
 /// In place of the readings: what the recipe still needs (no request is sent).
@@ -800,18 +836,19 @@ function showColours(doc) {
     box.append(el("p", { class: "hint", text: "Tick a colour geometry under Geometries (ASTM E2194 or E2539 multi-angle, the d/8 sphere) to see the colour; it needs a spectral recipe (one with wavelengths_nm)." }));
     return;
   }
-  if (lab) box.append(swatch(lab, "this recipe (" + geometryOf(lab.geometry).title + ")"));
-  if (ref) box.append(swatch(ref, "reference “" + state.pinned.name + "”"));
+  const under = conditionsText(conditions());
+  if (lab) box.append(swatch(lab, `this recipe (${geometryOf(lab.geometry).title}, ${under})`));
+  if (ref) box.append(swatch(ref, `reference “${state.pinned.name}” (${conditionsText(state.pinned.conditions)})`));
   if (lab && ref) {
     const de = Math.hypot(lab.L - ref.L, lab.a - ref.a, lab.b - ref.b);
     box.append(el("p", { id: "delta-e", text: `ΔE*ab = ${de.toFixed(2)} (ΔL* ${(lab.L - ref.L).toFixed(2)}, Δa* ${(lab.a - ref.a).toFixed(2)}, Δb* ${(lab.b - ref.b).toFixed(2)})` }));
   }
-  box.append(el("p", { class: "hint", text: "Swatches are CIELAB shown as sRGB (D65) on this screen: a guide; the numbers are the readings." }));
+  box.append(el("p", { class: "hint", text: "Swatches are CIELAB shown as sRGB (D65) on this screen: a guide; the numbers are the readings. L*, a*, b* are relative to the white of the chosen illuminant, so under another illuminant the swatch is the colour as an eye adapted to it would see it, not the light itself." }));
 }
 
 function pin() {
   if (!state.doc) return status("nothing to pin: the recipe has no readings");
-  state.pinned = { name: state.recipe.name || state.recipe.model, recipe: JSON.parse(JSON.stringify(state.recipe)), geometries: chosenGeometries(), doc: state.doc };
+  state.pinned = { name: state.recipe.name || state.recipe.model, recipe: JSON.parse(JSON.stringify(state.recipe)), geometries: chosenGeometries(), conditions: conditions(), doc: state.doc };
   $("pin-state").textContent = `reference: “${state.pinned.name}”`;
   $("unpin").disabled = false;
   setHeaders();
@@ -826,13 +863,14 @@ function unpin() {
   if (state.doc) showReadings(state.doc);
 }
 
-/// The reference's readings through the geometries now ticked (measured again when they changed).
+/// The reference's readings through the geometries now ticked and under the colour conditions now chosen
+/// (measured again when either changed), so that a difference is never across two conditions.
 async function remeasurePinned() {
-  if (!state.pinned || JSON.stringify(state.pinned.geometries) === JSON.stringify(chosenGeometries())) return;
-  const geos = chosenGeometries();
+  const geos = chosenGeometries(), now = conditions();
+  if (!state.pinned || JSON.stringify([state.pinned.geometries, state.pinned.conditions]) === JSON.stringify([geos, now])) return;
   try {
     const doc = await measureDoc(state.pinned.recipe, geos);
-    if (state.pinned) Object.assign(state.pinned, { doc, geometries: geos });
+    if (state.pinned) Object.assign(state.pinned, { doc, geometries: geos, conditions: now });
     if (state.doc) showReadings(state.doc);
   } catch (e) {
     $("measure-error").textContent = "the reference: " + e.message;
@@ -969,7 +1007,7 @@ async function sweep() {
   // The colour geometries the library refused for this recipe (the readings say why) are not swept.
   const refused = state.doc && state.doc.refused ? state.doc.refused.geometries : [];
   const geos = chosenGeometries().filter((id) => !refused.includes(id));
-  const body = { recipe: recipeWith(ptr, p).recipe, vary: [`${ptr}=${lo}..${hi}:${n}`], geometries: geos };
+  const body = { recipe: recipeWith(ptr, p).recipe, vary: [`${ptr}=${lo}..${hi}:${n}`], geometries: geos, ...conditions() };
   const thead = $("sweep-rows").querySelector("thead"), tbody = $("sweep-rows").querySelector("tbody");
   tbody.replaceChildren();
   thead.replaceChildren();
@@ -1144,7 +1182,7 @@ async function readSheet() {
 }
 
 function compareBody(format) {
-  const b = { recipe: state.recipe, sheet: state.sheet, k: $("cmp-k").value.trim() ? parseNumber($("cmp-k").value) : 2, format };
+  const b = { recipe: state.recipe, sheet: state.sheet, k: $("cmp-k").value.trim() ? parseNumber($("cmp-k").value) : 2, ...conditions(), format };
   const t = $("cmp-tol").value.trim();
   if (t !== "") b.tolerance = parseNumber(t);
   return b;
@@ -1237,7 +1275,7 @@ async function fit() {
       if (w.note) notes.push(w.note);
       free.push(`${ptr}=${lo}..${hi}`);
     }
-    const body = { recipe, free };
+    const body = { recipe, free, ...conditions() };
     if ($("fit-use-sheet").checked) {
       if (!(await readSheet())) throw new Error("choose a sheet in the Compare tab first");
       body.sheet = state.sheet;
@@ -1288,7 +1326,7 @@ async function fit() {
 async function plan() {
   $("plan-error").textContent = "";
   try {
-    const doc = await (await post("/api/explain", { recipe: state.recipe, geometries: chosenGeometries() })).json();
+    const doc = await (await post("/api/explain", { recipe: state.recipe, geometries: chosenGeometries(), ...conditions() })).json();
     $("plan").textContent = doc.plan;
   } catch (e) {
     $("plan-error").textContent = e.message;
@@ -1332,6 +1370,7 @@ async function start() {
   state.tables = tables;
   state.geometries = geos.geometries;
   for (const m of reg.models) $("model").append(el("option", { value: m, text: m }));
+  buildConditions(reg.colour_conditions);
   const box = $("geometries");
   geos.geometries.forEach((g, i) => {
     const c = el("input", { type: "checkbox", id: "geo-" + i, value: g.id });
