@@ -23,6 +23,7 @@ use serde_json::{json, Value};
 use crate::error::Words;
 use crate::instrument::method::Target;
 use crate::instrument::plan::{Execution, Plan, PlanOptions, Planner, Reading};
+use crate::instrument::reading::ReadingSpec;
 use crate::instrument::standards::StandardGeometry;
 use crate::{recipe, registry, report, Error, Result};
 
@@ -312,6 +313,16 @@ impl Sweep {
         out
     }
 
+    /// Whether the reading `name` of geometry `id` is a colour reading.
+    fn is_colour(&self, id: &str, name: &str) -> bool {
+        self.geometries.iter().filter(|g| g.geometry.id == id).any(|g| {
+            g.reading_names
+                .iter()
+                .zip(&g.geometry.readings)
+                .any(|(n, spec)| n == name && matches!(spec, ReadingSpec::Colour { .. }))
+        })
+    }
+
     /// Measure point i: the template with the point's values, validated and read through the geometries.
     pub fn run_point(&self, i: u64) -> PointResult {
         let start = Instant::now();
@@ -439,7 +450,14 @@ impl Sweep {
         let mut h: Vec<String> = vec!["index".into()];
         h.extend(self.axes.iter().map(|a| a.path.clone()));
         for (g, n, u) in self.columns() {
-            h.push(format!("{g} {n} ({u})"));
+            // A colour reading's header says its conditions beside its unit (`b* (A / 2°)`, `h (°, A / 2°)`).
+            let colour = self.is_colour(&g, &n).then(|| {
+                let c = self.options.colour;
+                format!("{} / {}°", c.illuminant.id(), c.observer.id())
+            });
+            let said: Vec<&str> =
+                [Some(u.as_str()), colour.as_deref()].into_iter().flatten().filter(|s| !s.is_empty()).collect();
+            h.push(format!("{g} {n} ({})", said.join(", ")));
             h.push(format!("{g} {n} error"));
         }
         h.push("problem".into());

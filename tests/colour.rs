@@ -323,3 +323,112 @@ fn a_neutral_colour_has_no_hue_on_any_geometry_and_fails_nothing() {
         glossmeter::cli::common::readings_status(&rs, false).unwrap_or_else(|e| panic!("{recipe}: {e}"));
     }
 }
+
+/// Every document says what its colour readings are computed under, and only on colour readings (docs/
+/// instrument.md §Output): `measure`'s JSON, CSV and table, a `sweep` line, a `compare` row and a `fit` target.
+#[test]
+fn every_document_names_the_illuminant_and_observer_of_its_colour_readings() {
+    let bin = env!("CARGO_BIN_EXE_glossmeter");
+    let pearl = "fixtures/recipes/white-pearl-spectral.json";
+    let run = |args: &[&str]| -> String {
+        let out = std::process::Command::new(bin).args(args).output().unwrap();
+        assert!(out.status.success(), "{args:?}: {}", String::from_utf8_lossy(&out.stderr));
+        String::from_utf8(out.stdout).unwrap()
+    };
+    let colour = ["--illuminant", "A", "--observer", "2"];
+    let geos = ["-g", "astm-d523-60", "-g", "astm-e2194-15"];
+    // JSON: every reading of the colour geometry has the pair, the gloss reading has neither.
+    let doc: Value =
+        serde_json::from_str(&run(
+            &[&["measure", pearl, "--format", "json", "--no-timing"][..], &geos, &colour].concat()
+        ))
+        .unwrap();
+    let readings = doc["readings"].as_array().unwrap();
+    assert_eq!(readings.len(), 9);
+    for r in readings {
+        let is_colour = r["geometry"] == "astm-e2194-15";
+        assert_eq!(r.get("illuminant").cloned(), is_colour.then(|| Value::from("A")), "{r}");
+        assert_eq!(r.get("observer").cloned(), is_colour.then(|| Value::from("2")), "{r}");
+    }
+    // The default pair is D65 / 10°, said as such.
+    let plain: Value =
+        serde_json::from_str(&run(&[&["measure", pearl, "--format", "json", "--no-timing"][..], &geos].concat()))
+            .unwrap();
+    let b = plain["readings"].as_array().unwrap().iter().find(|r| r["name"] == "b*").unwrap();
+    assert_eq!((b["illuminant"].as_str(), b["observer"].as_str()), (Some("D65"), Some("10")));
+    // CSV: the two columns, filled on colour rows only.
+    let text = run(&[&["measure", pearl, "--format", "csv", "--no-timing"][..], &geos, &colour].concat());
+    let mut csv = csv::Reader::from_reader(text.as_bytes());
+    let head: Vec<String> = csv.headers().unwrap().iter().map(String::from).collect();
+    let (i, o) =
+        (head.iter().position(|h| h == "illuminant").unwrap(), head.iter().position(|h| h == "observer").unwrap());
+    for rec in csv.records() {
+        let rec = rec.unwrap();
+        let want = if &rec[0] == "astm-e2194-15" { ("A", "2") } else { ("", "") };
+        assert_eq!((&rec[i], &rec[o]), want, "{rec:?}");
+    }
+    // The table: one line under it.
+    let table = run(&[&["measure", pearl, "--no-timing"][..], &geos, &colour].concat());
+    assert!(table.contains("\ncolour: illuminant A, CIE 1931 2° observer\n"), "{table}");
+    let gloss_only = run(&["measure", pearl, "--no-timing", "-g", "astm-d523-60"]);
+    assert!(!gloss_only.contains("colour:"), "{gloss_only}");
+    // A sweep line.
+    let line = run(&[
+        &["sweep", pearl, "--vary", "/clear_coat/index=1.5..1.6:2", "--format", "jsonl", "--no-timing"][..],
+        &geos,
+        &colour,
+    ]
+    .concat());
+    let point: Value = serde_json::from_str(line.lines().next().unwrap()).unwrap();
+    for r in point["readings"].as_array().unwrap() {
+        let is_colour = r["geometry"] == "astm-e2194-15";
+        assert_eq!(r.get("illuminant").is_some() && r.get("observer").is_some(), is_colour, "{r}");
+    }
+    // The sweep's CSV says them beside each colour column's unit.
+    let rows = run(&[
+        &["sweep", pearl, "--vary", "/clear_coat/index=1.5..1.6:2", "--format", "csv", "--no-timing"][..],
+        &geos,
+        &colour,
+    ]
+    .concat());
+    let head = rows.lines().next().unwrap();
+    for column in ["astm-d523-60 gloss (GU)", "astm-e2194-15 b* (A / 2°)", "astm-e2194-15 h (°, A / 2°)"] {
+        assert!(head.contains(column), "{column} not in {head}");
+    }
+    // A compare row and a fit target: the colour ones have the pair.
+    let dir = common::tmp_dir("colour-conditions");
+    std::fs::create_dir_all(&dir).unwrap();
+    let sheet = dir.join("sheet.csv");
+    std::fs::write(
+        &sheet,
+        "sample,geometry,reading,value,uncertainty\npearl,astm-d523-60,gloss,95,5\npearl,astm-e2194-15,b*,8,5\n",
+    )
+    .unwrap();
+    let cmp: Value =
+        serde_json::from_str(&run(
+            &[&["compare", pearl, sheet.to_str().unwrap(), "--format", "json"][..], &colour].concat()
+        ))
+        .unwrap();
+    let rows = cmp["comparisons"].as_array().unwrap();
+    assert_eq!(rows.len(), 2);
+    for r in rows {
+        let want = (r["geometry"] == "astm-e2194-15").then(|| Value::from("A"));
+        assert_eq!(r.get("illuminant").cloned(), want, "{r}");
+    }
+    let compare_table = run(&[&["compare", pearl, sheet.to_str().unwrap()][..], &colour].concat());
+    assert!(compare_table.contains("colour: illuminant A, CIE 1931 2° observer"), "{compare_table}");
+    let fit: Value = serde_json::from_str(&run(&[
+        &["fit", pearl, "--free", "/pearlescent_flakes/tio2_thickness_nm=30..90", "--restarts", "0"][..],
+        &["--target", "astm-e2194-15/b*=8±0.05", "--target", "astm-d523-60/gloss=95±1"],
+        &["--format", "json", "--no-timing"],
+        &colour,
+    ]
+    .concat()))
+    .unwrap();
+    assert_eq!(fit["targets"].as_array().unwrap().len(), 2, "{fit}");
+    for t in fit["targets"].as_array().unwrap() {
+        let want = (t["geometry"] == "astm-e2194-15").then(|| Value::from("2"));
+        assert_eq!(t.get("observer").cloned(), want, "{t}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -175,8 +175,9 @@ def _flag(name: str, value: object) -> bool:
 def to_arrays(readings: Sequence[Reading]) -> Arrays:
     """Readings as NumPy arrays, one per field: ``value``, ``error_estimate`` and ``seconds`` float64 (NaN
     where a reading has no finite value: its ``problem`` says why), ``evaluations`` int64, ``converged``
-    bool, ``geometry``, ``name``, ``quantity`` and ``unit`` str, ``problem`` and ``note`` object (None where
-    absent). ``seconds`` is there only if every reading has it."""
+    bool, ``geometry``, ``name``, ``quantity`` and ``unit`` str, ``problem``, ``note``, ``illuminant`` and
+    ``observer`` object (None where absent: the last two are a colour reading's). ``seconds`` is there only if
+    every reading has it."""
     rows = list(readings)
     out: Arrays = {}
     for key in ("geometry", "name", "quantity"):
@@ -191,6 +192,8 @@ def to_arrays(readings: Sequence[Reading]) -> Arrays:
         out["seconds"] = np.array([r.get("seconds", np.nan) for r in rows], dtype=np.float64)
     out["problem"] = np.array([r.get("problem") for r in rows], dtype=object)
     out["note"] = np.array([r.get("note") for r in rows], dtype=object)
+    out["illuminant"] = np.array([r.get("illuminant") for r in rows], dtype=object)
+    out["observer"] = np.array([r.get("observer") for r in rows], dtype=object)
     return out
 
 
@@ -326,7 +329,8 @@ def read_sheet(sheet: SheetSource, delimiter: Optional[str] = None, sheet_name: 
 def sweep_rows(points: Sequence[SweepPoint]) -> List[Dict[str, Any]]:
     """A sweep's points as flat rows, one per (point, reading): ``index``, one column per varied path,
     ``geometry``, ``name``, ``unit``, ``value``, ``error_estimate``, ``converged``, ``problem`` (the reading's,
-    or the point's when its recipe is invalid: then one row with no reading) and ``seconds`` when timed."""
+    or the point's when its recipe is invalid: then one row with no reading), ``illuminant`` and ``observer``
+    (a colour reading's, else None) and ``seconds`` when timed."""
     rows: List[Dict[str, Any]] = []
     for p in points:
         base: Dict[str, Any] = {"index": p["index"], **p["parameters"]}
@@ -334,11 +338,13 @@ def sweep_rows(points: Sequence[SweepPoint]) -> List[Dict[str, Any]]:
         readings = p.get("readings") or []
         if not readings:
             rows.append({**base, "geometry": None, "name": None, "unit": None, "value": None,
-                         "error_estimate": None, "converged": False, "problem": p.get("problem"), **timed})
+                         "error_estimate": None, "converged": False, "problem": p.get("problem"),
+                         "illuminant": None, "observer": None, **timed})
         for r in readings:
             rows.append({**base, "geometry": r["geometry"], "name": r["name"], "unit": r["unit"],
                          "value": r["value"], "error_estimate": r["error_estimate"], "converged": r["converged"],
-                         "problem": r.get("problem"), **timed})
+                         "problem": r.get("problem"), "illuminant": r.get("illuminant"),
+                         "observer": r.get("observer"), **timed})
     return rows
 
 
@@ -388,10 +394,11 @@ def _frame(rows: Sequence[Mapping[str, object]], columns: Sequence[str], floats:
 
 
 #: The columns of ``compare(..., as_frame=True)``: one row per compared (sample, reading), the scalar fields of
-#: a comparison, ``allowance`` its total and ``prediction_uncertainty`` NaN without a recipe uncertainty block.
+#: a comparison, ``allowance`` its total, ``prediction_uncertainty`` NaN without a recipe uncertainty block, and
+#: ``illuminant`` and ``observer`` a colour prediction's (None on the other rows).
 COMPARE_COLUMNS = ("sample", "material", "recipe", "geometry", "reading", "predicted_reading", "n", "mean", "std",
                    "min", "max", "uncertainty", "predicted", "error_estimate", "difference", "allowance",
-                   "prediction_uncertainty", "verdict", "inside", "reason", "unchecked")
+                   "prediction_uncertainty", "verdict", "inside", "reason", "unchecked", "illuminant", "observer")
 _COMPARE_FLOATS = ("mean", "std", "min", "max", "uncertainty", "predicted", "error_estimate", "difference",
                    "allowance", "prediction_uncertainty")
 

@@ -91,6 +91,9 @@ class Reading(_ReadingRequired, total=False):
     note: str
     #: The reading's uncertainty from its data (measured tables; absent elsewhere), in its unit.
     data_uncertainty: float
+    #: A colour reading's CIE illuminant and observer (absent on gloss, haze and DOI readings).
+    illuminant: Literal["D65", "D50", "A", "C"]
+    observer: Literal["2", "10"]
     envelope_min: Optional[float]
     envelope_max: Optional[float]
     envelope: Optional[Envelope]
@@ -183,6 +186,9 @@ class _ComparisonOptional(TypedDict, total=False):
     prediction_uncertainty: float
     #: With ``prediction_uncertainty``: each stated number's share of it.
     uncertainty_budget: List[BudgetLine]
+    #: A colour prediction's CIE illuminant and observer (absent on the other rows).
+    illuminant: Literal["D65", "D50", "A", "C"]
+    observer: Literal["2", "10"]
 
 
 class Comparison(_ComparisonOptional):
@@ -280,6 +286,9 @@ class _SweepReadingRequired(TypedDict):
 
 class SweepReading(_SweepReadingRequired, total=False):
     problem: Optional[str]
+    #: A colour reading's CIE illuminant and observer (absent on gloss, haze and DOI readings).
+    illuminant: Literal["D65", "D50", "A", "C"]
+    observer: Literal["2", "10"]
 
 
 class _SweepPointRequired(TypedDict):
@@ -305,13 +314,19 @@ class FitParameter(TypedDict):
     at_bound: bool
 
 
-class FitTarget(TypedDict):
+class _FitTargetRequired(TypedDict):
     geometry: str
     name: str
     measured: float
     uncertainty: float
     predicted: Optional[float]
     residual: Optional[float]
+
+
+class FitTarget(_FitTargetRequired, total=False):
+    #: A colour target's CIE illuminant and observer (absent on the other targets).
+    illuminant: Literal["D65", "D50", "A", "C"]
+    observer: Literal["2", "10"]
 
 
 class FitReport(TypedDict):

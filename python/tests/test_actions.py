@@ -275,7 +275,8 @@ def test_a_point_without_readings_is_one_row_with_its_problem():
                                    "readings": [{"geometry": "g", "name": "gloss", "unit": "GU", "value": 1.0,
                                                  "error_estimate": 0.0, "converged": True}]}])
     assert rows[0] == {"index": 4, "/ior": 9.0, "geometry": None, "name": None, "unit": None, "value": None,
-                       "error_estimate": None, "converged": False, "problem": "ior out of range"}
+                       "error_estimate": None, "converged": False, "problem": "ior out of range",
+                       "illuminant": None, "observer": None}
     assert rows[1]["seconds"] == 0.25 and rows[1]["value"] == 1.0 and rows[1]["problem"] is None
 
 

@@ -116,7 +116,8 @@ def test_as_frame_and_as_arrays_hold_the_same_readings():
     frame = glossmeter.measure(black, geos, timing=False, as_frame=True)
     assert isinstance(frame, pd.DataFrame) and len(frame) == len(readings)
     assert list(frame.columns) == list(arrays) == ["geometry", "name", "quantity", "value", "unit",
-                                                   "error_estimate", "evaluations", "converged", "problem", "note"]
+                                                   "error_estimate", "evaluations", "converged", "problem", "note",
+                                                   "illuminant", "observer"]
     assert arrays["value"].dtype == np.float64 and arrays["evaluations"].dtype == np.int64
     assert arrays["converged"].dtype == bool
     for i, r in enumerate(readings):
@@ -128,6 +129,17 @@ def test_as_frame_and_as_arrays_hold_the_same_readings():
             else:
                 assert arrays[key][i] == r[key] == frame[key].iloc[i]  # the same bits
         assert arrays["problem"][i] == r.get("problem") and arrays["note"][i] == r.get("note")
+        assert arrays["illuminant"][i] is None and arrays["observer"][i] is None  # no colour reading here
+    # A colour reading says what it is computed under; the gloss reading beside it does not.
+    grey = {"model": "lambert", "albedo": 0.5}
+    colour = glossmeter.measure(grey, ["astm-d523-60", "d8-sci"], timing=False, illuminant="A", observer="2")
+    colour_arrays = glossmeter.measure(grey, ["astm-d523-60", "d8-sci"], timing=False, illuminant="A", observer="2",
+                                       as_arrays=True)
+    for i, r in enumerate(colour):
+        want = ("A", "2") if r["geometry"] == "d8-sci" else (None, None)
+        assert (r.get("illuminant"), r.get("observer")) == want, r
+        assert (colour_arrays["illuminant"][i], colour_arrays["observer"][i]) == want
+    assert sum(r["geometry"] == "d8-sci" for r in colour) >= 3
     assert any(r["value"] is None for r in readings) and any(r["value"] is not None for r in readings)
     assert any("problem" in r for r in readings)
     timed = glossmeter.measure(LAMBERT, geometries="astm-d523-60", as_frame=True)

@@ -56,6 +56,7 @@ pub fn table(materials: &[Material], readings: &[Vec<Reading>], timing: bool) ->
     if all().any(|r| r.value.is_some()) {
         s.push_str("numerical error: the integration's error estimate, not the uncertainty of the prediction\n");
     }
+    s.push_str(&format::colour_line(all().map(|r| r.colour)));
     for n in notes {
         s.push_str(&format!("note: {n}\n"));
     }

@@ -318,6 +318,7 @@ fn table(sheet: &Sheet, cmp: &[Comparison], rule: &VerdictRule, drift: &[Drift],
          {spread} + stated uncertainty + num. error\n{}\n",
         summary(cmp)
     ));
+    s.push_str(&super::format::colour_line(cmp.iter().filter_map(|c| c.predicted.as_ref()).map(|p| p.colour)));
     for c in cmp {
         if let (Some(u), Some(a)) = (&c.prediction_uncertainty, &c.allowance) {
             notes.push(format!(

@@ -221,6 +221,7 @@ fn table(name: &str, r: &FitReport, timing: bool) -> String {
             t.weighted_residual
         ));
     }
+    s.push_str(&super::format::colour_line(r.targets.iter().map(|t| t.colour)));
     s.push_str(&format!("\nχ² = {:.4} for {} degree(s) of freedom", r.chi2, r.dof));
     match r.p_value {
         Some(p) => s.push_str(&format!(", p = {p:.3e}")),

@@ -2,6 +2,7 @@
 //! readings, the tolerance envelope, durations. A reading without a finite value is printed as "—", with the
 //! reason: never as NaN or inf.
 use crate::cli::common::pad_table;
+use crate::colorimetry::Conditions;
 use crate::comparison::propagation::PredictionUncertainty;
 use crate::instrument::envelope::Envelopes;
 use crate::instrument::plan::Reading;
@@ -106,6 +107,7 @@ pub fn table(material: &Material, readings: &[Reading], timing: bool) -> String 
     if readings.iter().any(|r| r.value.is_some()) {
         s.push_str("numerical error: the integration's error estimate, not the uncertainty of the prediction\n");
     }
+    s.push_str(&colour_line(readings.iter().map(|r| r.colour)));
     if data {
         s.push_str(
             "data uncertainty: how far the table's resolution may put the reading from that of the surface it \
@@ -116,6 +118,17 @@ pub fn table(material: &Material, readings: &[Reading], timing: bool) -> String 
         s.push_str(&format!("note: {n}\n"));
     }
     s
+}
+
+/// The line that says what the colour readings are computed under (`colour: illuminant A, CIE 1931 2°
+/// observer`), empty when there are none: a colour coordinate means nothing without them (docs/colour.md).
+pub fn colour_line(conditions: impl IntoIterator<Item = Option<Conditions>>) -> String {
+    let all: std::collections::BTreeSet<Conditions> = conditions.into_iter().flatten().collect();
+    let said: Vec<String> = all.iter().map(|c| c.describe()).collect();
+    match said.is_empty() {
+        true => String::new(),
+        false => format!("colour: {}\n", said.join("; ")),
+    }
 }
 
 /// The envelope as a table after the readings.

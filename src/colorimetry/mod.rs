@@ -65,10 +65,10 @@ pub enum Observer {
 
 impl Observer {
     /// Every observer, in the order a choice lists them.
-    pub const ALL: [Observer; 2] = [Observer::Cie1931, Observer::Cie1964];
+    pub(crate) const ALL: [Observer; 2] = [Observer::Cie1931, Observer::Cie1964];
 
     /// The name [`Observer::parse`] takes: `2` or `10`.
-    pub fn id(self) -> &'static str {
+    pub(crate) fn id(self) -> &'static str {
         match self {
             Observer::Cie1931 => "2",
             Observer::Cie1964 => "10",
@@ -110,11 +110,11 @@ pub enum Illuminant {
 
 impl Illuminant {
     /// Every illuminant, in the order a choice lists them.
-    pub const ALL: [Illuminant; 4] = [Illuminant::D65, Illuminant::D50, Illuminant::A, Illuminant::C];
+    pub(crate) const ALL: [Illuminant; 4] = [Illuminant::D65, Illuminant::D50, Illuminant::A, Illuminant::C];
 
     /// What the illuminant stands for (CIE 15:2004 §3: A the incandescent lamp, C an older daylight made of A
     /// through a filter, D65 and D50 daylight phases; the tables are under `standards/cie/`).
-    pub fn describe(self) -> &'static str {
+    pub(crate) fn describe(self) -> &'static str {
         match self {
             Illuminant::D65 => "CIE D65 (daylight)",
             Illuminant::D50 => "CIE D50 (daylight, graphic arts)",
@@ -124,7 +124,7 @@ impl Illuminant {
     }
 
     /// The name [`Illuminant::parse`] takes: `D65`, `D50`, `A`, `C`.
-    pub fn id(self) -> &'static str {
+    pub(crate) fn id(self) -> &'static str {
         match self {
             Illuminant::D65 => "D65",
             Illuminant::D50 => "D50",

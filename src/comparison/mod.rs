@@ -745,6 +745,7 @@ mod tests {
             problem: value.is_none().then(|| "zero flux".into()),
             note: None,
             data_uncertainty: None,
+            colour: None,
         }
     }
 

@@ -259,6 +259,7 @@ mod tests {
             problem: None,
             note: None,
             data_uncertainty: None,
+            colour: None,
         };
         // No geometry at all: a run would fail; none is made.
         assert_eq!(propagate(&m, &[], &PlanOptions::default(), &[r]).unwrap(), vec![None]);

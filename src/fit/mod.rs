@@ -67,6 +67,7 @@ use std::time::Instant;
 use nalgebra::DVector;
 use serde_json::Value;
 
+use crate::colorimetry::weighting::WeightingKind;
 use crate::instrument::plan::{PlanOptions, Planner};
 use crate::{recipe, Error, Result};
 use params::check_free;
@@ -177,7 +178,7 @@ pub fn fit(
 
     // The report: goodness of fit and reach first (a model that cannot reproduce the readings makes
     // everything else moot), then what the other stages found.
-    let fitted_targets = report::fitted_targets(targets, &u_sigma, &centre, &r);
+    let fitted_targets = report::fitted_targets(targets, &fwd.colour, &u_sigma, &centre, &r);
     let cannot_reproduce = if reproduces {
         Vec::new()
     } else {
@@ -253,13 +254,17 @@ fn forward<'a>(
         geometries.clone(),
         plan_options.clone(),
     )?;
-    let names: Vec<targets::ReadingName> = probe
-        .readings
-        .iter()
-        .filter(|r| r.reported)
-        .map(|r| (r.geometry.clone(), r.name.clone(), r.spec.quantity().to_string()))
-        .collect();
+    let reported: Vec<_> = probe.readings.iter().filter(|r| r.reported).collect();
+    let names: Vec<targets::ReadingName> =
+        reported.iter().map(|r| (r.geometry.clone(), r.name.clone(), r.spec.quantity().to_string())).collect();
     let index = targets::match_targets(&names, targets)?;
+    let colour = index
+        .iter()
+        .map(|&i| match reported[i].kind {
+            WeightingKind::Xyz(c) => Some(c),
+            _ => None,
+        })
+        .collect();
     let scan_options = PlanOptions { rtol: options.rtol.max(search::SCAN_RTOL), ..plan_options.clone() };
     let fwd = Forward {
         recipe: recipe_json,
@@ -270,6 +275,7 @@ fn forward<'a>(
         options: plan_options,
         scan_options,
         index,
+        colour,
         runs: Default::default(),
     };
     Ok((fwd, start))

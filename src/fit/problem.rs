@@ -11,6 +11,7 @@ use serde_json::Value;
 
 use super::params::{FreeParameter, TargetReading};
 use crate::brdf::Brdf;
+use crate::colorimetry::Conditions;
 use crate::instrument::plan::{Plan, PlanOptions, Planner, Reading};
 use crate::instrument::standards::StandardGeometry;
 use crate::{recipe, Error, Result};
@@ -27,6 +28,8 @@ pub(super) struct Forward<'a> {
     pub(super) scan_options: PlanOptions,
     /// Index of each target in the plan's readings.
     pub(super) index: Vec<usize>,
+    /// Each target's colour conditions (its reading's, docs/colour.md); None for a target that is no colour.
+    pub(super) colour: Vec<Option<Conditions>>,
     /// Forward runs so far (counted from every thread; runs that do not depend on each other run in parallel,
     /// docs/inverse.md §Method, "Parallel runs").
     pub(super) runs: AtomicUsize,

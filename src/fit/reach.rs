@@ -267,6 +267,7 @@ mod tests {
             predicted: p,
             prediction_error: 0.0,
             residual: p - v,
+            colour: None,
             weighted_residual: (p - v) / 0.5,
         };
         let seen = [Seen { t: vec![0.1], values: vec![40.0] }, Seen { t: vec![0.9], values: vec![50.0] }];

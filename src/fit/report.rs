@@ -4,6 +4,7 @@ use nalgebra::{DMatrix, DVector};
 use serde_json::Value;
 
 use super::params::{FreeParameter, TargetReading};
+use crate::colorimetry::Conditions;
 
 /// One fitted parameter.
 #[derive(Clone, Debug)]
@@ -34,6 +35,8 @@ pub struct FittedTarget {
     pub prediction_error: f64,
     /// predicted − measured, in the reading's unit.
     pub residual: f64,
+    /// A colour target's illuminant and observer (its prediction's); None for any other target.
+    pub colour: Option<Conditions>,
     /// residual / √(u² + e²).
     pub weighted_residual: f64,
 }
@@ -102,6 +105,7 @@ impl FitReport {
 /// The targets after the fit: each with its uncertainty, prediction (value, error estimate) and residuals.
 pub(super) fn fitted_targets(
     targets: &[TargetReading],
+    colour: &[Option<Conditions>],
     u_sigma: &[f64],
     centre: &[(f64, f64)],
     r: &DVector<f64>,
@@ -117,6 +121,7 @@ pub(super) fn fitted_targets(
                 predicted: v,
                 prediction_error: e,
                 residual: v - tg.value,
+                colour: colour[i],
                 weighted_residual: r[i],
             }
         })
@@ -302,7 +307,7 @@ mod tests {
     #[test]
     fn targets_and_parameters_are_reported_in_their_units() {
         let t = [TargetReading { geometry: "g".into(), name: "gloss".into(), value: 50.0, uncertainty: None }];
-        let ft = fitted_targets(&t, &[0.2], &[(50.5, 0.01)], &DVector::from_element(1, 2.4));
+        let ft = fitted_targets(&t, &[None], &[0.2], &[(50.5, 0.01)], &DVector::from_element(1, 2.4));
         assert_eq!((ft[0].residual, ft[0].weighted_residual, ft[0].uncertainty), (0.5, 2.4, 0.2));
         let free = [FreeParameter { pointer: "/m".into(), lower: 0.01, upper: 1.0, log: true }];
         let jt = DMatrix::from_row_slice(1, 1, &[0.0]);

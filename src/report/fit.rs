@@ -42,6 +42,14 @@ pub struct TargetDoc {
     pub predicted: Option<f64>,
     /// predicted − measured.
     pub residual: Option<f64>,
+    /// A colour target's CIE illuminant and observer (the fit's `illuminant`, `observer`); absent on every
+    /// other target.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    #[schemars(extend("enum" = ["D65", "D50", "A", "C"]))]
+    pub illuminant: Option<String>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    #[schemars(extend("enum" = ["2", "10"]))]
+    pub observer: Option<String>,
 }
 
 /// `fit --format json` of a fit that ran to a report: the JSON contract of docs/inverse.md §Output, and
@@ -157,6 +165,8 @@ pub fn json(r: &FitReport, timing: bool) -> Value {
                 uncertainty: t.uncertainty,
                 predicted: finite(t.predicted),
                 residual: finite(t.residual),
+                illuminant: t.colour.map(|c| c.illuminant.id().to_owned()),
+                observer: t.colour.map(|c| c.observer.id().to_owned()),
             })
             .collect(),
         converged: r.converged,

@@ -111,6 +111,8 @@ pub(crate) fn csv(readings: &[Reading], timing: bool) -> Result<String> {
     if timing {
         head.push("seconds");
     }
+    head.push("illuminant");
+    head.push("observer");
     head.push("problem");
     head.push("note");
     let rows = readings.iter().map(|r| {
@@ -130,6 +132,8 @@ pub(crate) fn csv(readings: &[Reading], timing: bool) -> Result<String> {
         if timing {
             rec.push(plain(r.seconds));
         }
+        rec.push(r.colour.map(|c| c.illuminant.id().to_owned()).unwrap_or_default());
+        rec.push(r.colour.map(|c| c.observer.id().to_owned()).unwrap_or_default());
         rec.push(r.problem.clone().unwrap_or_default());
         rec.push(r.note.clone().unwrap_or_default());
         rec

@@ -277,6 +277,16 @@ pub struct ReadingDoc {
     /// What the reader should know (e.g. a standard's scope).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub note: Option<String>,
+    /// A colour reading's (X, Y, Z, L*, a*, b*, C*, h) CIE illuminant, as `--illuminant` takes it; absent on
+    /// every other reading (docs/colour.md).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    #[schemars(extend("enum" = ["D65", "D50", "A", "C"]))]
+    pub illuminant: Option<String>,
+    /// A colour reading's CIE observer, as `--observer` takes it: `2` (CIE 1931 2°) or `10` (CIE 1964 10°);
+    /// absent on every other reading.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    #[schemars(extend("enum" = ["2", "10"]))]
+    pub observer: Option<String>,
     /// With --envelope: the least reading within the tolerances (null where the data give none).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub envelope_min: Option<Option<f64>>,
@@ -354,6 +364,8 @@ impl ReadingDoc {
             seconds: timing.then_some(r.seconds),
             problem: r.problem.clone(),
             note: r.note.clone(),
+            illuminant: r.colour.map(|c| c.illuminant.id().to_owned()),
+            observer: r.colour.map(|c| c.observer.id().to_owned()),
             envelope_min: None,
             envelope_max: None,
             envelope: None,
@@ -512,6 +524,13 @@ pub struct SweepReadingDoc {
     pub converged: bool,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub problem: Option<String>,
+    /// A colour reading's illuminant and observer, as [`ReadingDoc`]'s.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    #[schemars(extend("enum" = ["D65", "D50", "A", "C"]))]
+    pub illuminant: Option<String>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    #[schemars(extend("enum" = ["2", "10"]))]
+    pub observer: Option<String>,
 }
 
 impl SweepReadingDoc {
@@ -525,6 +544,8 @@ impl SweepReadingDoc {
             error_estimate: d.error_estimate,
             converged: d.converged,
             problem: d.problem,
+            illuminant: d.illuminant,
+            observer: d.observer,
         }
     }
 }

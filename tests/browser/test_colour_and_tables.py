@@ -238,6 +238,8 @@ def test_colour_is_read_under_the_chosen_illuminant_and_observer(browser, tmp_pa
     lines = cli(["sweep", str(f), "--vary", f"{ptr}={lo}..{hi}:2", "--format", "jsonl", "--no-timing", "-g", geometry,
                  "--illuminant", "A", "--observer", "2"]).splitlines()
     assert served == [json.loads(line)["readings"] for line in lines]
+    head = d.execute_script("return sweepCsv()").splitlines()[0]
+    assert "astm-e2194-15/b* (A / 2°)" in head and "astm-e2194-15/h (°, A / 2°)" in head, head
     # The choice is this browser's: kept on reload.
     d.execute_script("window.onbeforeunload = null; location.reload()")
     WebDriverWait(d, WAIT).until(lambda d: d.find_elements(By.CSS_SELECTOR, "#illuminant option"))

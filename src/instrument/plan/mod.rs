@@ -224,6 +224,9 @@ pub struct Reading {
     /// §Data uncertainty of measured tables). None for a model (no data) and when there is no value.
     /// Separate from `error_estimate`, the numerical error of the integration.
     pub data_uncertainty: Option<f64>,
+    /// The illuminant and observer a colour reading (X, Y, Z, L*, a*, b*, C*, h) is computed under: the plan's
+    /// (docs/colour.md). None for every other reading.
+    pub colour: Option<Conditions>,
 }
 
 impl Reading {

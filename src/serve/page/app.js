@@ -1070,7 +1070,9 @@ function sweepCsv() {
   if (!first) return "";
   const q = (s) => (/[",\n]/.test(s) ? `"${s.replace(/"/g, '""')}"` : s);
   const head = [ptr];
-  for (const rd of first.readings) head.push(`${rd.geometry}/${rd.name} (${rd.unit})`, `${rd.geometry}/${rd.name} error estimate`);
+  // A colour reading's header says its conditions beside its unit, as the command line's sweep CSV does.
+  const said = (rd) => [rd.unit, rd.illuminant && conditionsText(rd)].filter((x) => x).join(", ");
+  for (const rd of first.readings) head.push(`${rd.geometry}/${rd.name} (${said(rd)})`, `${rd.geometry}/${rd.name} error estimate`);
   head.push("problem");
   const lines = [head.map(q).join(",")];
   for (const r of rows) {
