@@ -464,6 +464,40 @@ fn bad_requests_get_the_librarys_message_as_json_400() {
     }
 }
 
+/// The plan's fields (`rtol`, `max_evals`, `illuminant`, `observer`) are checked in one place for every
+/// endpoint that plans, and each refusal names its own field.
+#[test]
+fn every_planning_endpoint_refuses_a_bad_plan_field_by_its_name() {
+    let addr = default_server();
+    let sheet = r#""sheet": {"name": "s.csv", "text": "sample,geometry,value\ns,astm-d523-60,90\n"}"#;
+    let endpoints = [
+        ("/api/measure", String::new()),
+        ("/api/explain", String::new()),
+        ("/api/sweep", r#""vary": ["/albedo=0.1..0.9:2"]"#.to_owned()),
+        ("/api/plot", r#""kind": "profile""#.to_owned()),
+        ("/api/plot", r#""kind": "gloss-vs-parameter", "vary": "/albedo=0.1..0.9""#.to_owned()),
+        ("/api/compare", sheet.to_owned()),
+        ("/api/fit", r#""free": ["/albedo=0.1..0.9"], "target": ["astm-d523-60/gloss=1±0.1"]"#.to_owned()),
+    ];
+    let bad = [
+        (r#""rtol": -1"#, "/rtol"),
+        (r#""rtol": "tight""#, "/rtol"),
+        (r#""max_evals": 0"#, "/max_evals"),
+        (r#""illuminant": "D99""#, "/illuminant"),
+        (r#""observer": "5""#, "/observer"),
+    ];
+    for (path, rest) in &endpoints {
+        for (field, pointer) in bad {
+            let sep = if rest.is_empty() { "" } else { ", " };
+            let body = format!(r#"{{"recipe": {{"model": "lambert", "albedo": 0.5}}{sep}{rest}, {field}}}"#);
+            let a = request(addr, "POST", path, body.as_bytes(), &[]);
+            assert_eq!(a.status, 400, "{path} {body}: {}", a.body);
+            let e = a.json()["error"].as_str().unwrap().to_string();
+            assert!(e.contains(pointer), "{path} {body}: {e:?} should name {pointer}");
+        }
+    }
+}
+
 #[test]
 fn foreign_host_and_origin_are_refused() {
     let addr = default_server();

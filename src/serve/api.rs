@@ -21,7 +21,7 @@ use crate::recipe::{self, Material};
 use crate::registry::{self, Type};
 use crate::request::{
     CompareRequest, FitRequest, PlanRequest, ProfileRequest, SheetRequest, Spacing, SweepRequest, VsParameterRequest,
-    DEFAULT_K, PLOT_GEOMETRIES, PLOT_RTOL,
+    DEFAULT_K, PLOT_GEOMETRIES,
 };
 use crate::sweep::Sweep;
 use crate::{report, Error, Result};
@@ -171,7 +171,8 @@ fn at_field(o: &Obj, e: Error) -> Error {
 }
 
 /// The body's `rtol`, `max_evals` (at most the server's, which is also the default), `illuminant` and
-/// `observer`: the plan's request (the one place where the server's JSON becomes the library's).
+/// `observer`: the plan's request (the one place where the server's JSON becomes the library's), each field
+/// checked here and refused under its own name, so that a request built from it is already valid.
 fn plan_request(o: &Obj, ctx: Context) -> Result<PlanRequest> {
     let rtol = match o.get("rtol") {
         None => None,
@@ -192,25 +193,26 @@ fn plan_request(o: &Obj, ctx: Context) -> Result<PlanRequest> {
     };
     let max_evals = whole(o, "max_evals", 1, ctx.limits.max_evals, "evaluations per aperture integral")?
         .unwrap_or(ctx.limits.max_evals);
-    Ok(PlanRequest {
+    let request = PlanRequest {
         rtol,
         max_evals: Some(max_evals),
         illuminant: o.opt_str("illuminant")?.map(str::to_owned),
         observer: o.opt_str("observer")?.map(str::to_owned),
-    })
-}
-
-/// The plan's options of the body ([`plan_request`]), `default_rtol` without a tolerance.
-fn plan_options(o: &Obj, ctx: Context, default_rtol: f64) -> Result<PlanOptions> {
-    let request = plan_request(o, ctx)?;
-    // Each colour condition's message under its own field.
+    };
     if let Some(i) = &request.illuminant {
         Illuminant::parse(i).map_err(|e| o.err("illuminant", e.to_string()))?;
     }
     if let Some(x) = &request.observer {
         Observer::parse(x).map_err(|e| o.err("observer", e.to_string()))?;
     }
-    let options = request.options_or(default_rtol).map_err(|e| at_field(o, e))?;
+    // The tolerance's own range (the library's), whatever default a command gives it.
+    request.options_or(DEFAULT_RTOL).map_err(|e| at_field(o, e))?;
+    Ok(request)
+}
+
+/// The plan's options of the body ([`plan_request`]), `default_rtol` without a tolerance.
+fn plan_options(o: &Obj, ctx: Context, default_rtol: f64) -> Result<PlanOptions> {
+    let options = plan_request(o, ctx)?.options_or(default_rtol).map_err(|e| at_field(o, e))?;
     Ok(PlanOptions { cancel: ctx.cancel.clone(), ..options })
 }
 
@@ -331,8 +333,6 @@ pub(crate) fn plot(req: &Request, ctx: Context) -> Result<Reply> {
             crate::report::pictures::charts::section_svg(&material(req, ctx)?, &geos)?
         }
         "profile" => {
-            // Each field's refusal under its own name first, then the one request's options.
-            plan_options(&o, ctx, DEFAULT_RTOL)?;
             let (options, budget) = profile_request(&o, ctx)?.options().map_err(|e| at_field(&o, e))?;
             let options = PlanOptions { cancel: ctx.cancel.clone(), ..options };
             let id = o.opt_str("geometry")?.unwrap_or(crate::request::PROFILE_GEOMETRY);
@@ -343,7 +343,6 @@ pub(crate) fn plot(req: &Request, ctx: Context) -> Result<Reply> {
             crate::report::pictures::profile::svg(&prof, &format!("{}: {} profile", m.name, prof.geometry))?
         }
         "gloss-vs-parameter" => {
-            plan_options(&o, ctx, PLOT_RTOL)?;
             let request = VsParameterRequest {
                 vary: Some(o.str("vary")?.to_owned()),
                 points: whole(&o, "points", 2, ctx.limits.plot_points, "values of the varied number")?,
@@ -391,7 +390,6 @@ pub(crate) fn sweep(req: &Request, ctx: Context) -> Result<Sweep> {
         "illuminant",
         "observer",
     ])?;
-    plan_options(&o, ctx, DEFAULT_RTOL)?;
     let geos = geometries(&o, ctx, crate::api::DEFAULT_PANEL)?;
     let request = SweepRequest {
         vary: strings(&o, "vary")?,
@@ -534,7 +532,8 @@ pub(crate) fn compare(req: &Request, ctx: Context) -> Result<Reply> {
     };
     let rule = request.rule().map_err(|e| at_field(&o, e))?;
     let max_de00 = request.max_de00().map_err(|e| at_field(&o, e))?;
-    let options = plan_options(&o, ctx, DEFAULT_RTOL)?;
+    let options = request.plan.options_or(DEFAULT_RTOL).map_err(|e| at_field(&o, e))?;
+    let options = PlanOptions { cancel: ctx.cancel.clone(), ..options };
     let format = o.opt_str("format")?.unwrap_or("json");
     if !["json", "csv", "junit"].contains(&format) {
         return Err(o.err("format", format!("unknown format {format:?}; allowed: \"json\", \"csv\", \"junit\"")));
@@ -574,8 +573,6 @@ pub(crate) fn fit(req: &Request, ctx: Context) -> Result<Reply> {
     ];
     o.deny_unknown(&[&fields[..], SHEET_FIELDS].concat())?;
     let l = ctx.limits;
-    // Checked here for each field's own message; the request carries them as given.
-    plan_options(&o, ctx, DEFAULT_RTOL)?;
     let request = FitRequest {
         free: strings(&o, "free")?,
         targets: strings(&o, "target")?,
