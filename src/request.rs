@@ -12,6 +12,7 @@
 use serde_json::Value;
 
 use crate::colorimetry::{Conditions, Illuminant, Observer};
+use crate::comparison::conditions;
 use crate::comparison::sheet::{Sheet, SheetOptions};
 use crate::comparison::VerdictRule;
 use crate::error::{given, Words};
@@ -622,11 +623,17 @@ impl FitRequest {
         self.free.iter().map(|f| FreeParameter::parse(f)).collect()
     }
 
-    /// The targets: the sheet's sample's if a sheet is given (with notes on what was left out), else the
-    /// target readings.
+    /// The targets: the sheet's sample's if a sheet is given (with notes on what was left out; colour targets
+    /// only under the colour conditions the sheet states, `comparison::conditions`), else the target readings.
     pub fn targets(&self, sheet: Option<&Sheet>) -> Result<(Vec<TargetReading>, Vec<String>)> {
         match sheet {
-            Some(s) => fit::targets_from_sheet(s, self.sample.as_deref()),
+            Some(s) => {
+                let (targets, notes) = fit::targets_from_sheet(s, self.sample.as_deref())?;
+                if targets.iter().any(|t| conditions::is_colour_reading(&t.name)) {
+                    conditions::check(s, self.plan.options_or(DEFAULT_RTOL)?.colour)?;
+                }
+                Ok((targets, notes))
+            }
             None => Ok((self.targets.iter().map(|t| TargetReading::parse(t)).collect::<Result<_>>()?, vec![])),
         }
     }

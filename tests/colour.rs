@@ -269,6 +269,90 @@ fn compare_reports_de00_for_colour_sheets() {
     assert!(String::from_utf8_lossy(&strict.stderr).contains("ΔE00"));
 }
 
+/// A colour sheet that states its illuminant and observer is compared (and fitted) only under them: at every
+/// door, any other request is refused, naming the sheet's line and what to ask for; under them, the
+/// predictions are `measure`'s under the same flags.
+#[test]
+fn a_colour_sheet_is_compared_only_under_the_conditions_it_states() {
+    let bin = env!("CARGO_BIN_EXE_glossmeter");
+    let dir = common::tmp_dir("stated-conditions");
+    std::fs::create_dir_all(&dir).unwrap();
+    let shipped = std::fs::read_to_string("fixtures/sheets/colour-blue-metallic.csv").unwrap();
+    let sheet = dir.join("a2.csv");
+    std::fs::write(&sheet, shipped.replace("# illuminant/observer: D65/10°", "Illuminant: A,Observer: 2°")).unwrap();
+    let sheet = sheet.to_str().unwrap();
+    let recipe = "fixtures/recipes/blue-metallic-spectral.json";
+    let run = |args: &[&str]| std::process::Command::new(bin).args(args).output().unwrap();
+    // The shipped sheet states D65 / 10°, the default: read as before.
+    let shipped_run = run(&["compare", recipe, "fixtures/sheets/colour-blue-metallic.csv", "--max-de00", "100"]);
+    assert!(shipped_run.status.success(), "{}", String::from_utf8_lossy(&shipped_run.stderr));
+    // Under the default, the A / 2° sheet is refused, with its line and the flags that ask for its conditions.
+    for colour in [&[][..], &["--illuminant", "A"][..], &["--observer", "2"][..]] {
+        let out = run(&[&["compare", recipe, sheet][..], colour].concat());
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{colour:?}: {err}");
+        assert!(err.contains("a2.csv") && err.contains("not comparable"), "{err}");
+        assert!(err.contains("give --illuminant A --observer 2 (the sheet's)"), "{err}");
+    }
+    let fit_refused = run(&["fit", recipe, "--sheet", sheet, "--free", "/clear_coat/roughness=0.01..0.2"]);
+    assert_eq!(fit_refused.status.code(), Some(2), "{}", String::from_utf8_lossy(&fit_refused.stderr));
+    assert!(String::from_utf8_lossy(&fit_refused.stderr).contains("--illuminant A --observer 2 (the sheet's)"));
+    // Under them, every colour prediction is measure's under the same flags.
+    let out = run(&[
+        "compare",
+        recipe,
+        sheet,
+        "--illuminant",
+        "A",
+        "--observer",
+        "2",
+        "--format",
+        "json",
+        "--max-de00",
+        "100",
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let doc: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let m = run(&[
+        "measure",
+        recipe,
+        "-g",
+        "astm-e2194-15",
+        "-g",
+        "astm-e2194-45",
+        "-g",
+        "astm-e2194-110",
+        "--illuminant",
+        "A",
+        "--observer",
+        "2",
+        "--format",
+        "json",
+        "--no-timing",
+    ]);
+    let measured: Value = serde_json::from_slice(&m.stdout).unwrap();
+    let rows = doc["comparisons"].as_array().unwrap();
+    assert_eq!(rows.len(), 9);
+    for c in rows {
+        let r = measured["readings"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|r| r["geometry"] == c["geometry"] && r["name"] == c["reading"])
+            .unwrap();
+        assert_eq!(c["predicted"], r["value"], "{c}");
+        assert_eq!((c["illuminant"].as_str(), c["observer"].as_str()), (Some("A"), Some("2")));
+    }
+    // A condition glossmeter does not compute under is refused as such.
+    let f11 = dir.join("f11.csv");
+    std::fs::write(&f11, shipped.replace("D65/10°", "F11/10°")).unwrap();
+    let out = run(&["compare", recipe, f11.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("F11") && err.contains("D65, D50, A, C"), "{err}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 #[test]
 fn a_long_lived_planner_knows_the_colour_geometries() {
     // `fit` and the bindings look geometries up through a Planner.

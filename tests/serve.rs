@@ -498,6 +498,31 @@ fn every_planning_endpoint_refuses_a_bad_plan_field_by_its_name() {
     }
 }
 
+/// A colour sheet that states A / 2° is refused under the default conditions, naming the fields to give, and
+/// read under them (docs/instrument.md §Sheets, "Colour conditions").
+#[test]
+fn a_served_colour_sheet_is_compared_only_under_its_stated_conditions() {
+    let addr = default_server();
+    let text = std::fs::read_to_string("fixtures/sheets/colour-blue-metallic.csv")
+        .unwrap()
+        .replace("# illuminant/observer: D65/10°", "# illuminant/observer: A/2°");
+    let recipe = fixture("blue-metallic-spectral");
+    let body = |colour: &[(&str, &str)]| {
+        let mut rest = json!({"sheet": {"name": "a2.csv", "text": text}, "max_de00": 100});
+        for (k, v) in colour {
+            rest[*k] = json!(v);
+        }
+        with_recipe(&recipe, rest)
+    };
+    let a = request(addr, "POST", "/api/compare", &body(&[]), &[]);
+    assert_eq!(a.status, 400, "{}", a.body);
+    let e = a.json()["error"].as_str().unwrap().to_string();
+    assert!(e.contains("not comparable") && e.contains("`illuminant` A `observer` 2 (the sheet's)"), "{e}");
+    let a = request(addr, "POST", "/api/compare", &body(&[("illuminant", "A"), ("observer", "2")]), &[]);
+    assert_eq!(a.status, 200, "{}", a.body);
+    assert!(a.json()["comparisons"].as_array().unwrap().iter().all(|c| c["illuminant"] == "A"));
+}
+
 #[test]
 fn foreign_host_and_origin_are_refused() {
     let addr = default_server();

@@ -410,3 +410,15 @@ def test_a_long_fit_stops_on_ctrl_c():
         pytest.skip(f"one forward run takes {t1:.3f} s here: the whole fit is too short to tell a stop")
     took = interrupted_after(0.3, call)
     assert took < bound, (took, t1)
+
+
+def test_a_colour_sheet_is_compared_only_under_the_conditions_it_states(tmp_path):
+    sheet = tmp_path / "a2.csv"
+    sheet.write_text((SHEETS / "colour-blue-metallic.csv").read_text(encoding="utf-8")
+                     .replace("# illuminant/observer: D65/10°", "Illuminant: A,Observer: 2°"), encoding="utf-8")
+    recipe = RECIPES / "blue-metallic-spectral.json"
+    with pytest.raises(ValueError) as e:
+        glossmeter.compare(recipe, sheet)
+    assert "not comparable" in str(e.value) and "`illuminant` A `observer` 2 (the sheet's)" in str(e.value)
+    doc = glossmeter.compare(recipe, sheet, illuminant="A", observer="2", max_de00=100)
+    assert {(c["illuminant"], c["observer"]) for c in doc["comparisons"]} == {("A", "2")}

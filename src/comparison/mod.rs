@@ -39,6 +39,7 @@
 //! * [`propagation`]: the prediction's uncertainty, the recipe's stated parameter uncertainties propagated to
 //!   every reading to first order ([`propagation::propagate`]).
 mod baseline;
+pub(crate) mod conditions;
 pub mod propagation;
 pub(crate) mod series;
 pub mod sheet;
@@ -628,6 +629,7 @@ fn judge_all(
     rule: &VerdictRule,
     options: &PlanOptions,
 ) -> Result<Vec<Comparison>> {
+    conditions::check(sheet, options.colour)?;
     let material_of = |sample: &str| of_sample.iter().find(|(s, _)| s == sample).map(|(_, i)| *i);
     // Each recipe through the geometries of all the rows of its samples.
     let geometry_ids_of = |i: usize| -> Vec<String> {

@@ -84,7 +84,7 @@ pub(super) fn metadata_line(line: &str) -> Option<(String, String)> {
     let ok = !k.is_empty()
         && k.len() <= 40
         && k.split_whitespace().count() <= 4
-        && k.chars().all(|c| c.is_alphanumeric() || " _-.".contains(c));
+        && k.chars().all(|c| c.is_alphanumeric() || " _-./".contains(c));
     ok.then(|| (k.to_lowercase(), v.trim().to_string()))
 }
 
@@ -180,7 +180,7 @@ pub(super) fn title_row(rec: &csv::StringRecord) -> Vec<(String, String)> {
         !k.is_empty()
             && k.len() <= 40
             && k.split_whitespace().count() <= 4
-            && k.chars().all(|c| c.is_alphanumeric() || " _-.".contains(c))
+            && k.chars().all(|c| c.is_alphanumeric() || " _-./".contains(c))
     };
     let mut pairs: Vec<(String, String)> = vec![];
     for cell in &cells {
