@@ -501,6 +501,9 @@ fn every_document_names_the_illuminant_and_observer_of_its_colour_readings() {
     }
     let compare_table = run(&[&["compare", pearl, sheet.to_str().unwrap()][..], &colour].concat());
     assert!(compare_table.contains("colour: illuminant A, CIE 1931 2° observer"), "{compare_table}");
+    let junit = run(&[&["compare", pearl, sheet.to_str().unwrap(), "--format", "junit"][..], &colour].concat());
+    assert_eq!(junit.matches("(error estimate; illuminant A, CIE 1931 2° observer)").count(), 1, "{junit}");
+    assert_eq!(junit.matches("(error estimate);").count(), 1, "the gloss row: {junit}");
     let fit: Value = serde_json::from_str(&run(&[
         &["fit", pearl, "--free", "/pearlescent_flakes/tio2_thickness_nm=30..90", "--restarts", "0"][..],
         &["--target", "astm-e2194-15/b*=8±0.05", "--target", "astm-d523-60/gloss=95±1"],

@@ -62,8 +62,13 @@ pub(crate) fn message(c: &Comparison) -> String {
         }
         None => "none".into(),
     };
+    // A colour prediction says what it is computed under (docs/instrument.md §Output).
+    let predicted = match p.and_then(|p| p.colour) {
+        Some(c) => format!("{predicted} (error estimate; {})", c.describe()),
+        None => format!("{predicted} (error estimate)"),
+    };
     format!(
-        "measured mean {} (n = {}, std {}, min {}, max {}); predicted {predicted} (error estimate); \
+        "measured mean {} (n = {}, std {}, min {}, max {}); predicted {predicted}; \
          predicted − measured {}; allowance {}",
         report::measured(s.mean),
         s.n,

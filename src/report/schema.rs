@@ -55,3 +55,43 @@ pub fn sheet() -> Value {
 pub(crate) fn topography() -> Value {
     to_json(&schema_for!(TopographyDoc))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::colorimetry::{Illuminant, Observer};
+
+    /// Every `enum` listed under a key named `key`, anywhere in the schema.
+    fn enums_of(v: &Value, key: &str, out: &mut Vec<Vec<String>>) {
+        match v {
+            Value::Object(m) => {
+                for (k, x) in m {
+                    if k == key {
+                        if let Some(e) = x.get("enum").and_then(Value::as_array) {
+                            out.push(e.iter().filter_map(Value::as_str).map(String::from).collect());
+                        }
+                    }
+                    enums_of(x, key, out);
+                }
+            }
+            Value::Array(a) => a.iter().for_each(|x| enums_of(x, key, out)),
+            _ => {}
+        }
+    }
+
+    /// The colour conditions' names written into the schemas (`#[schemars(extend("enum" = …))]`, a literal)
+    /// are every one the library computes under, in its order.
+    #[test]
+    fn the_schemas_list_every_illuminant_and_observer() {
+        let illuminants: Vec<String> = Illuminant::ALL.iter().map(|i| i.id().to_owned()).collect();
+        let observers: Vec<String> = Observer::ALL.iter().map(|o| o.id().to_owned()).collect();
+        for (name, schema) in [("measure", measure()), ("compare", compare()), ("sweep", sweep()), ("fit", fit())] {
+            let (mut i, mut o) = (vec![], vec![]);
+            enums_of(&schema, "illuminant", &mut i);
+            enums_of(&schema, "observer", &mut o);
+            assert!(!i.is_empty() && !o.is_empty(), "{name}: no illuminant or observer in the schema");
+            assert!(i.iter().all(|e| *e == illuminants), "{name}: {i:?}");
+            assert!(o.iter().all(|e| *e == observers), "{name}: {o:?}");
+        }
+    }
+}
