@@ -401,7 +401,7 @@ class ConvergenceTiming(TypedDict):
     max_repetitions: int
 
 
-class ConvergenceRow(TypedDict):
+class _ConvergenceRowRequired(TypedDict):
     rtol: float
     geometry: str
     reading: str
@@ -419,6 +419,12 @@ class ConvergenceRow(TypedDict):
     repetitions: int
     converged: bool
     problem: Optional[str]
+
+
+class ConvergenceRow(_ConvergenceRowRequired, total=False):
+    #: A colour reading's CIE illuminant and observer (D65 / 10°: ``convergence`` takes no other).
+    illuminant: Literal["D65", "D50", "A", "C"]
+    observer: Literal["2", "10"]
 
 
 class ConvergenceReport(TypedDict):

@@ -165,6 +165,7 @@ pub fn table(material: &Material, sweep: &Sweep) -> String {
     if sweep.rows.iter().any(|r| !r.converged) {
         s.push_str("* evaluation budget exhausted before the tolerance was met\n");
     }
+    s.push_str(&super::format::colour_line(sweep.rows.iter().map(|r| r.colour)));
     for n in notes {
         s.push_str(&format!("note: {n}\n"));
     }
@@ -190,6 +191,8 @@ pub fn csv(sweep: &Sweep) -> Result<String> {
         "plan_seconds",
         "repetitions",
         "converged",
+        "illuminant",
+        "observer",
         "problem",
     ];
     let opt = |x: Option<f64>| x.map(plain).unwrap_or_default();
@@ -211,6 +214,8 @@ pub fn csv(sweep: &Sweep) -> Result<String> {
             plain(r.plan_seconds),
             r.repetitions.to_string(),
             r.converged.to_string(),
+            r.colour.map(|c| c.illuminant.id().to_owned()).unwrap_or_default(),
+            r.colour.map(|c| c.observer.id().to_owned()).unwrap_or_default(),
             r.problem.clone().unwrap_or_default(),
         ]
     });

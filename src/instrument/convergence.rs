@@ -37,6 +37,7 @@ use std::time::Instant;
 
 use crate::brdf::{Brdf, TermKind};
 use crate::colorimetry::weighting::Weighting;
+use crate::colorimetry::Conditions;
 use crate::instrument::plan::{
     haze_index_value, reading_value, Job, Plan, PlanOptions, PlannedReading, Reading, Target, MIN_RTOL,
 };
@@ -133,6 +134,8 @@ pub struct Row {
     pub repetitions: usize,
     pub converged: bool,
     pub problem: Option<String>,
+    /// A colour reading's illuminant and observer (the plan's, D65 / 10°: `convergence` takes no other).
+    pub colour: Option<Conditions>,
 }
 
 /// The result of a sweep.
@@ -400,6 +403,7 @@ pub fn sweep(
                 repetitions: reps,
                 converged: r.converged,
                 problem: r.problem.clone(),
+                colour: r.colour,
             });
         }
     }

@@ -39,6 +39,13 @@ pub struct ConvergenceRowDoc {
     pub repetitions: usize,
     pub converged: bool,
     pub problem: Option<String>,
+    /// A colour reading's CIE illuminant and observer (`measure`'s fields); absent on every other row.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    #[schemars(extend("enum" = ["D65", "D50", "A", "C"]))]
+    pub illuminant: Option<String>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    #[schemars(extend("enum" = ["2", "10"]))]
+    pub observer: Option<String>,
 }
 
 fn convergence_row_nullable(schema: &mut schemars::Schema) {
@@ -122,6 +129,8 @@ impl ConvergenceDoc {
                     repetitions: r.repetitions,
                     converged: r.converged,
                     problem: r.problem.clone(),
+                    illuminant: r.colour.map(|c| c.illuminant.id().to_owned()),
+                    observer: r.colour.map(|c| c.observer.id().to_owned()),
                 })
                 .collect(),
         }

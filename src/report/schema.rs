@@ -85,7 +85,13 @@ mod tests {
     fn the_schemas_list_every_illuminant_and_observer() {
         let illuminants: Vec<String> = Illuminant::ALL.iter().map(|i| i.id().to_owned()).collect();
         let observers: Vec<String> = Observer::ALL.iter().map(|o| o.id().to_owned()).collect();
-        for (name, schema) in [("measure", measure()), ("compare", compare()), ("sweep", sweep()), ("fit", fit())] {
+        for (name, schema) in [
+            ("measure", measure()),
+            ("compare", compare()),
+            ("sweep", sweep()),
+            ("fit", fit()),
+            ("convergence", convergence()),
+        ] {
             let (mut i, mut o) = (vec![], vec![]);
             enums_of(&schema, "illuminant", &mut i);
             enums_of(&schema, "observer", &mut o);
