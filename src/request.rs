@@ -630,7 +630,7 @@ impl FitRequest {
             Some(s) => {
                 let (targets, notes) = fit::targets_from_sheet(s, self.sample.as_deref())?;
                 if targets.iter().any(|t| conditions::is_colour_reading(&t.name)) {
-                    conditions::check(s, self.plan.options_or(DEFAULT_RTOL)?.colour)?;
+                    conditions::check(s, self.plan.colour()?)?;
                 }
                 Ok((targets, notes))
             }
