@@ -629,8 +629,13 @@ function recipeChanged() {
 /// The measure document of `recipe` through `geos`. A colour geometry the library refuses for this recipe (an
 /// RGB recipe has no spectrum, so no X, Y, Z: docs/colour.md) is left out by the server, the others are read,
 /// and the document says which and why (`refused`: {geometries, message}, the library's message).
+/// The document keeps the colour conditions it was read under (`doc.conditions`, the page's own field), so that
+/// a document still shown after the choice changed is never taken to be under the new one.
 async function measureDoc(recipe, geos, signal) {
-  return (await post("/api/measure", { recipe, geometries: geos, ...conditions(), omit_refused_colour: true }, signal)).json();
+  const c = conditions();
+  const doc = await (await post("/api/measure", { recipe, geometries: geos, ...c, omit_refused_colour: true }, signal)).json();
+  doc.conditions = c;
+  return doc;
 }
 
 /// In place of the readings: what the recipe still needs (no request is sent).
@@ -836,9 +841,8 @@ function showColours(doc) {
     box.append(el("p", { class: "hint", text: "Tick a colour geometry under Geometries (ASTM E2194 or E2539 multi-angle, the d/8 sphere) to see the colour; it needs a spectral recipe (one with wavelengths_nm)." }));
     return;
   }
-  const under = conditionsText(conditions());
-  if (lab) box.append(swatch(lab, `this recipe (${geometryOf(lab.geometry).title}, ${under})`));
-  if (ref) box.append(swatch(ref, `reference “${state.pinned.name}” (${conditionsText(state.pinned.conditions)})`));
+  if (lab) box.append(swatch(lab, `this recipe (${geometryOf(lab.geometry).title}, ${conditionsText(doc.conditions)})`));
+  if (ref) box.append(swatch(ref, `reference “${state.pinned.name}” (${conditionsText(state.pinned.doc.conditions)})`));
   if (lab && ref) {
     const de = Math.hypot(lab.L - ref.L, lab.a - ref.a, lab.b - ref.b);
     box.append(el("p", { id: "delta-e", text: `ΔE*ab = ${de.toFixed(2)} (ΔL* ${(lab.L - ref.L).toFixed(2)}, Δa* ${(lab.a - ref.a).toFixed(2)}, Δb* ${(lab.b - ref.b).toFixed(2)})` }));
@@ -848,11 +852,13 @@ function showColours(doc) {
 
 function pin() {
   if (!state.doc) return status("nothing to pin: the recipe has no readings");
-  state.pinned = { name: state.recipe.name || state.recipe.model, recipe: JSON.parse(JSON.stringify(state.recipe)), geometries: chosenGeometries(), conditions: conditions(), doc: state.doc };
+  state.pinned = { name: state.recipe.name || state.recipe.model, recipe: JSON.parse(JSON.stringify(state.recipe)), geometries: chosenGeometries(), conditions: state.doc.conditions, doc: state.doc };
   $("pin-state").textContent = `reference: “${state.pinned.name}”`;
   $("unpin").disabled = false;
   setHeaders();
   showReadings(state.doc);
+  // A reading still under way for other geometries or conditions: the reference is read under the current ones.
+  remeasurePinned();
 }
 
 function unpin() {
