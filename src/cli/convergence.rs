@@ -197,6 +197,7 @@ pub fn csv(sweep: &Sweep) -> Result<String> {
     ];
     let opt = |x: Option<f64>| x.map(plain).unwrap_or_default();
     let rows = sweep.rows.iter().map(|r| {
+        let [illuminant, observer] = crate::report::ConditionsDoc::cells(r.colour);
         [
             plain(r.rtol),
             r.geometry.clone(),
@@ -214,8 +215,8 @@ pub fn csv(sweep: &Sweep) -> Result<String> {
             plain(r.plan_seconds),
             r.repetitions.to_string(),
             r.converged.to_string(),
-            r.colour.map(|c| c.illuminant.id().to_owned()).unwrap_or_default(),
-            r.colour.map(|c| c.observer.id().to_owned()).unwrap_or_default(),
+            illuminant,
+            observer,
             r.problem.clone().unwrap_or_default(),
         ]
     });

@@ -25,6 +25,17 @@ pub enum WeightingKind {
     Xyz(crate::colorimetry::Conditions),
 }
 
+impl WeightingKind {
+    /// The illuminant and observer of a colour weighting, None for the others: what a reading through it is
+    /// computed under (docs/instrument.md §Output).
+    pub(crate) fn conditions(self) -> Option<crate::colorimetry::Conditions> {
+        match self {
+            WeightingKind::Xyz(c) => Some(c),
+            _ => None,
+        }
+    }
+}
+
 /// A k × n weighting matrix: component c of a weighted flux is Σ_j W[c][j] Φ_j over the n samples.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Weighting {

@@ -67,7 +67,6 @@ use std::time::Instant;
 use nalgebra::DVector;
 use serde_json::Value;
 
-use crate::colorimetry::weighting::WeightingKind;
 use crate::instrument::plan::{PlanOptions, Planner};
 use crate::{recipe, Error, Result};
 use params::check_free;
@@ -258,13 +257,7 @@ fn forward<'a>(
     let names: Vec<targets::ReadingName> =
         reported.iter().map(|r| (r.geometry.clone(), r.name.clone(), r.spec.quantity().to_string())).collect();
     let index = targets::match_targets(&names, targets)?;
-    let colour = index
-        .iter()
-        .map(|&i| match reported[i].kind {
-            WeightingKind::Xyz(c) => Some(c),
-            _ => None,
-        })
-        .collect();
+    let colour = index.iter().map(|&i| reported[i].kind.conditions()).collect();
     let scan_options = PlanOptions { rtol: options.rtol.max(search::SCAN_RTOL), ..plan_options.clone() };
     let fwd = Forward {
         recipe: recipe_json,

@@ -77,14 +77,9 @@ pub struct ComparisonDoc {
     pub uncertainty: Option<f64>,
     pub predicted: Option<f64>,
     pub error_estimate: Option<f64>,
-    /// A colour prediction's CIE illuminant and observer (`measure`'s `illuminant`, `observer`); absent on
-    /// every other row.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    #[schemars(extend("enum" = ["D65", "D50", "A", "C"]))]
-    pub illuminant: Option<String>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    #[schemars(extend("enum" = ["2", "10"]))]
-    pub observer: Option<String>,
+    /// A colour prediction's CIE illuminant and observer ([`ConditionsDoc`]); absent on every other row.
+    #[serde(flatten, skip_serializing_if = "Option::is_none")]
+    pub colour: Option<super::ConditionsDoc>,
     /// When the recipe states uncertainties of its numbers: the prediction's standard uncertainty u_pred
     /// (docs/instrument.md §The prediction's uncertainty).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -128,8 +123,7 @@ impl ComparisonDoc {
             uncertainty: c.group.uncertainty,
             predicted: p.and_then(|p| p.value),
             error_estimate: p.filter(|p| p.value.is_some()).map(|p| p.error_estimate),
-            illuminant: p.and_then(|p| p.colour).map(|c| c.illuminant.id().to_owned()),
-            observer: p.and_then(|p| p.colour).map(|c| c.observer.id().to_owned()),
+            colour: p.and_then(|p| p.colour).map(super::ConditionsDoc::new),
             prediction_uncertainty: c.prediction_uncertainty.as_ref().map(|u| u.u),
             uncertainty_budget: c.prediction_uncertainty.as_ref().map(BudgetLineDoc::budget),
             difference: c.difference(),

@@ -39,13 +39,9 @@ pub struct ConvergenceRowDoc {
     pub repetitions: usize,
     pub converged: bool,
     pub problem: Option<String>,
-    /// A colour reading's CIE illuminant and observer (`measure`'s fields); absent on every other row.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    #[schemars(extend("enum" = ["D65", "D50", "A", "C"]))]
-    pub illuminant: Option<String>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    #[schemars(extend("enum" = ["2", "10"]))]
-    pub observer: Option<String>,
+    /// A colour reading's CIE illuminant and observer ([`ConditionsDoc`]); absent on every other row.
+    #[serde(flatten, skip_serializing_if = "Option::is_none")]
+    pub colour: Option<super::ConditionsDoc>,
 }
 
 fn convergence_row_nullable(schema: &mut schemars::Schema) {
@@ -129,8 +125,7 @@ impl ConvergenceDoc {
                     repetitions: r.repetitions,
                     converged: r.converged,
                     problem: r.problem.clone(),
-                    illuminant: r.colour.map(|c| c.illuminant.id().to_owned()),
-                    observer: r.colour.map(|c| c.observer.id().to_owned()),
+                    colour: r.colour.map(super::ConditionsDoc::new),
                 })
                 .collect(),
         }

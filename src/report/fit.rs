@@ -42,14 +42,9 @@ pub struct TargetDoc {
     pub predicted: Option<f64>,
     /// predicted − measured.
     pub residual: Option<f64>,
-    /// A colour target's CIE illuminant and observer (the fit's `illuminant`, `observer`); absent on every
-    /// other target.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    #[schemars(extend("enum" = ["D65", "D50", "A", "C"]))]
-    pub illuminant: Option<String>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    #[schemars(extend("enum" = ["2", "10"]))]
-    pub observer: Option<String>,
+    /// A colour target's CIE illuminant and observer ([`ConditionsDoc`]); absent on every other target.
+    #[serde(flatten, skip_serializing_if = "Option::is_none")]
+    pub colour: Option<super::ConditionsDoc>,
 }
 
 /// `fit --format json` of a fit that ran to a report: the JSON contract of docs/inverse.md §Output, and
@@ -165,8 +160,7 @@ pub fn json(r: &FitReport, timing: bool) -> Value {
                 uncertainty: t.uncertainty,
                 predicted: finite(t.predicted),
                 residual: finite(t.residual),
-                illuminant: t.colour.map(|c| c.illuminant.id().to_owned()),
-                observer: t.colour.map(|c| c.observer.id().to_owned()),
+                colour: t.colour.map(super::ConditionsDoc::new),
             })
             .collect(),
         converged: r.converged,

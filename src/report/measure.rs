@@ -132,8 +132,7 @@ pub(crate) fn csv(readings: &[Reading], timing: bool) -> Result<String> {
         if timing {
             rec.push(plain(r.seconds));
         }
-        rec.push(r.colour.map(|c| c.illuminant.id().to_owned()).unwrap_or_default());
-        rec.push(r.colour.map(|c| c.observer.id().to_owned()).unwrap_or_default());
+        rec.extend(super::ConditionsDoc::cells(r.colour));
         rec.push(r.problem.clone().unwrap_or_default());
         rec.push(r.note.clone().unwrap_or_default());
         rec

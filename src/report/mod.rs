@@ -30,6 +30,7 @@ pub mod profile;
 pub mod schema;
 pub mod topography;
 
+use crate::colorimetry::Conditions;
 use crate::comparison::propagation::PredictionUncertainty;
 use crate::comparison::Drift;
 use crate::instrument::envelope::Envelope;
@@ -239,6 +240,31 @@ fn quantity_enum(schema: &mut schemars::Schema) {
     schema.insert("enum".into(), QUANTITIES.into());
 }
 
+/// The CIE illuminant and observer a colour reading is computed under, by the names `--illuminant` and
+/// `--observer` take (docs/instrument.md §Output): flattened into every document's colour readings (`measure`,
+/// `sweep`, `compare`, `fit`, `convergence`), absent on the others.
+#[derive(Clone, Debug, Serialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct ConditionsDoc {
+    /// `D65`, `D50`, `A` or `C`.
+    #[schemars(extend("enum" = ["D65", "D50", "A", "C"]))]
+    pub illuminant: String,
+    /// `2` (CIE 1931 2°) or `10` (CIE 1964 10°).
+    #[schemars(extend("enum" = ["2", "10"]))]
+    pub observer: String,
+}
+
+impl ConditionsDoc {
+    pub(crate) fn new(c: Conditions) -> ConditionsDoc {
+        ConditionsDoc { illuminant: c.illuminant.id().to_owned(), observer: c.observer.id().to_owned() }
+    }
+
+    /// The two CSV cells of a reading (`illuminant`, `observer`), empty on a reading that is no colour.
+    pub(crate) fn cells(c: Option<Conditions>) -> [String; 2] {
+        c.map(|c| [c.illuminant.id().to_owned(), c.observer.id().to_owned()]).unwrap_or_default()
+    }
+}
+
 /// One reading of `measure --format json` (docs/instrument.md §Output; the Python bindings' dicts).
 #[derive(Clone, Debug, Serialize, JsonSchema)]
 #[schemars(transform = reading_doc_nullable)]
@@ -277,16 +303,9 @@ pub struct ReadingDoc {
     /// What the reader should know (e.g. a standard's scope).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub note: Option<String>,
-    /// A colour reading's (X, Y, Z, L*, a*, b*, C*, h) CIE illuminant, as `--illuminant` takes it; absent on
-    /// every other reading (docs/colour.md).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    #[schemars(extend("enum" = ["D65", "D50", "A", "C"]))]
-    pub illuminant: Option<String>,
-    /// A colour reading's CIE observer, as `--observer` takes it: `2` (CIE 1931 2°) or `10` (CIE 1964 10°);
-    /// absent on every other reading.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    #[schemars(extend("enum" = ["2", "10"]))]
-    pub observer: Option<String>,
+    /// A colour reading (X, Y, Z, L*, a*, b*, C*, h)'s CIE illuminant and observer ([`ConditionsDoc`]); absent on every other reading.
+    #[serde(flatten, skip_serializing_if = "Option::is_none")]
+    pub colour: Option<ConditionsDoc>,
     /// With --envelope: the least reading within the tolerances (null where the data give none).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub envelope_min: Option<Option<f64>>,
@@ -364,8 +383,7 @@ impl ReadingDoc {
             seconds: timing.then_some(r.seconds),
             problem: r.problem.clone(),
             note: r.note.clone(),
-            illuminant: r.colour.map(|c| c.illuminant.id().to_owned()),
-            observer: r.colour.map(|c| c.observer.id().to_owned()),
+            colour: r.colour.map(ConditionsDoc::new),
             envelope_min: None,
             envelope_max: None,
             envelope: None,
@@ -525,12 +543,8 @@ pub struct SweepReadingDoc {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub problem: Option<String>,
     /// A colour reading's illuminant and observer, as [`ReadingDoc`]'s.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    #[schemars(extend("enum" = ["D65", "D50", "A", "C"]))]
-    pub illuminant: Option<String>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    #[schemars(extend("enum" = ["2", "10"]))]
-    pub observer: Option<String>,
+    #[serde(flatten, skip_serializing_if = "Option::is_none")]
+    pub colour: Option<ConditionsDoc>,
 }
 
 impl SweepReadingDoc {
@@ -544,8 +558,7 @@ impl SweepReadingDoc {
             error_estimate: d.error_estimate,
             converged: d.converged,
             problem: d.problem,
-            illuminant: d.illuminant,
-            observer: d.observer,
+            colour: d.colour,
         }
     }
 }

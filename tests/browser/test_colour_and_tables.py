@@ -27,6 +27,18 @@ def tick_only(d, ids):
     )
 
 
+def sweep_two_points(d, ptr, lo, hi):
+    """Sweep `ptr` from `lo` to `hi` in two points on the Sweep tab, and wait until both are in (no error)."""
+    d.find_element(By.ID, "tab-sweep").click()
+    Select(d.find_element(By.ID, "sweep-path")).select_by_value(ptr)
+    for i, v in [("sweep-lo", lo), ("sweep-hi", hi), ("sweep-n", "2")]:
+        d.find_element(By.ID, i).clear()
+        d.find_element(By.ID, i).send_keys(v)
+    d.find_element(By.ID, "sweep-go").click()
+    WebDriverWait(d, WAIT).until(lambda d: d.find_element(By.ID, "sweep-count").text == "2 / 2 points" or d.find_element(By.ID, "sweep-error").text)
+    assert d.find_element(By.ID, "sweep-error").text == ""
+
+
 def test_an_rgb_recipe_says_in_place_why_it_has_no_colour(browser, tmp_path):
     d = browser
     wait_current(d)
@@ -52,16 +64,7 @@ def test_an_rgb_recipe_says_in_place_why_it_has_no_colour(browser, tmp_path):
     assert "wavelengths_nm" in advice and "white-pearl-spectral" in advice, advice
     assert not d.find_elements(By.CSS_SELECTOR, "#colours .swatch")
     # A sweep leaves the refused geometry out and reads the rest.
-    d.find_element(By.ID, "tab-sweep").click()
-    Select(d.find_element(By.ID, "sweep-path")).select_by_value("/albedo/0")
-    for i, v in [("sweep-lo", "0,2"), ("sweep-hi", "0,8")]:
-        d.find_element(By.ID, i).clear()
-        d.find_element(By.ID, i).send_keys(v)
-    d.find_element(By.ID, "sweep-n").clear()
-    d.find_element(By.ID, "sweep-n").send_keys("2")
-    d.find_element(By.ID, "sweep-go").click()
-    WebDriverWait(d, WAIT).until(lambda d: d.find_element(By.ID, "sweep-count").text == "2 / 2 points" or d.find_element(By.ID, "sweep-error").text)
-    assert d.find_element(By.ID, "sweep-error").text == ""
+    sweep_two_points(d, "/albedo/0", "0,2", "0,8")
     WebDriverWait(d, WAIT).until(lambda d: d.find_elements(By.CSS_SELECTOR, "#sweep-charts svg.chart"))
     assert [c.get_attribute("data-unit") for c in d.find_elements(By.CSS_SELECTOR, "#sweep-charts svg.chart")] == ["GU"]
     # A spectral recipe through the same geometries gets its colour and no refusal.
@@ -78,17 +81,8 @@ def test_colour_gets_its_own_axes_in_the_sweep(browser, tmp_path):
     tick_only(d, ["astm-d523-60", "astm-e2194-45"])
     wait_current(d)
     recipe = raw(d)
-    d.find_element(By.ID, "tab-sweep").click()
     ptr, lo, hi = "/clear_coat/roughness", "0.02", "0.1"
-    Select(d.find_element(By.ID, "sweep-path")).select_by_value(ptr)
-    for i, v in [("sweep-lo", lo), ("sweep-hi", hi)]:
-        d.find_element(By.ID, i).clear()
-        d.find_element(By.ID, i).send_keys(v)
-    d.find_element(By.ID, "sweep-n").clear()
-    d.find_element(By.ID, "sweep-n").send_keys("2")
-    d.find_element(By.ID, "sweep-go").click()
-    WebDriverWait(d, WAIT).until(lambda d: d.find_element(By.ID, "sweep-count").text == "2 / 2 points" or d.find_element(By.ID, "sweep-error").text)
-    assert d.find_element(By.ID, "sweep-error").text == ""
+    sweep_two_points(d, ptr, lo, hi)
     WebDriverWait(d, WAIT).until(lambda d: d.find_elements(By.CSS_SELECTOR, "#sweep-charts svg.chart"))
     f = tmp_path / "template.json"
     f.write_text(json.dumps(recipe))
@@ -225,17 +219,8 @@ def test_colour_is_read_under_the_chosen_illuminant_and_observer(browser, tmp_pa
     settled.until(lambda d: "ΔE*ab = 0.00" in d.find_element(By.ID, "colours").text
                   and [c.text.count("A / 2°") for c in d.find_elements(By.CSS_SELECTOR, "#colours figcaption")] == [1, 1])
     # A sweep under the same conditions is the command line's, reading for reading.
-    d.find_element(By.ID, "tab-sweep").click()
     ptr, lo, hi = "/pearlescent_flakes/tio2_thickness_nm", "60", "80"
-    Select(d.find_element(By.ID, "sweep-path")).select_by_value(ptr)
-    for i, v in [("sweep-lo", lo), ("sweep-hi", hi)]:
-        d.find_element(By.ID, i).clear()
-        d.find_element(By.ID, i).send_keys(v)
-    d.find_element(By.ID, "sweep-n").clear()
-    d.find_element(By.ID, "sweep-n").send_keys("2")
-    d.find_element(By.ID, "sweep-go").click()
-    WebDriverWait(d, WAIT).until(lambda d: d.find_element(By.ID, "sweep-count").text == "2 / 2 points" or d.find_element(By.ID, "sweep-error").text)
-    assert d.find_element(By.ID, "sweep-error").text == ""
+    sweep_two_points(d, ptr, lo, hi)
     served = [json.loads(line)["readings"] for line in d.execute_script("return state.sweepText").splitlines() if line.strip()]
     lines = cli(["sweep", str(f), "--vary", f"{ptr}={lo}..{hi}:2", "--format", "jsonl", "--no-timing", "-g", geometry,
                  "--illuminant", "A", "--observer", "2"]).splitlines()

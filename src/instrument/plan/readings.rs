@@ -7,14 +7,6 @@ use crate::instrument::reading::{ColourQuantity, ReadingSpec};
 
 use super::{Job, Plan, PlannedReading, Reading};
 
-/// The conditions of a colour reading (its weighting's), None for any other.
-fn colour_of(r: &PlannedReading) -> Option<Conditions> {
-    match r.kind {
-        WeightingKind::Xyz(c) => Some(c),
-        _ => None,
-    }
-}
-
 /// A reading with a value `(v, e)`, no problem and no note (callers override those with struct update).
 fn valued_reading(
     r: &PlannedReading,
@@ -36,7 +28,7 @@ fn valued_reading(
         problem: None,
         note: None,
         data_uncertainty: None,
-        colour: colour_of(r),
+        colour: r.kind.conditions(),
     }
 }
 
@@ -54,7 +46,7 @@ fn problem_reading(r: &PlannedReading, why: String) -> Reading {
         problem: Some(why),
         note: None,
         data_uncertainty: None,
-        colour: colour_of(r),
+        colour: r.kind.conditions(),
     }
 }
 
