@@ -343,6 +343,39 @@ fn a_colour_sheet_is_compared_only_under_the_conditions_it_states() {
         assert_eq!(c["predicted"], r["value"], "{c}");
         assert_eq!((c["illuminant"].as_str(), c["observer"].as_str()), (Some("A"), Some("2")));
     }
+    // The colour columns' headers may state them instead (`L* (A/2°)`): the same refusal, naming the column.
+    let headed = dir.join("headed.csv");
+    let text =
+        shipped.replace("# illuminant/observer: D65/10°\n", "").replace("L*,a*,b*", "L* (A/2°),a* (A/2°),b* (A/2°)");
+    std::fs::write(&headed, text).unwrap();
+    let headed = headed.to_str().unwrap();
+    let out = run(&["compare", recipe, headed]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("column 3 (L* (A/2°))") && err.contains("--illuminant A --observer 2 (the sheet's)"), "{err}");
+    let under = run(&["compare", recipe, headed, "--illuminant", "A", "--observer", "2", "--format", "json"]);
+    let under_doc: Value = serde_json::from_slice(&under.stdout).unwrap();
+    let predicted =
+        |d: &Value| d["comparisons"].as_array().unwrap().iter().map(|c| c["predicted"].clone()).collect::<Vec<_>>();
+    assert_eq!(predicted(&under_doc), predicted(&doc), "the same predictions as the metadata's A / 2° sheet");
+    // An export under two illuminants: refused as duplicate columns; read under one once the others are skipped.
+    let two = dir.join("two.csv");
+    let both = shipped
+        .replace("# illuminant/observer: D65/10°\n", "")
+        .replace("L*,a*,b*", "L* (D65/10°),a* (D65/10°),b* (D65/10°),L* (A/2°),a* (A/2°),b* (A/2°)")
+        .lines()
+        .map(|l| if l.starts_with("panel") { format!("{l},1,2,3") } else { l.to_string() })
+        .collect::<Vec<_>>()
+        .join("\n");
+    std::fs::write(&two, both).unwrap();
+    let two = two.to_str().unwrap();
+    let out = run(&["compare", recipe, two]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("one illuminant and observer at a time") && err.contains("--ignore-column"), "{err}");
+    let skip = ["--ignore-column", "L* (A/2°)", "--ignore-column", "a* (A/2°)", "--ignore-column", "b* (A/2°)"];
+    let out = run(&[&["compare", recipe, two, "--max-de00", "100"][..], &skip[..]].concat());
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     // A condition glossmeter does not compute under is refused as such.
     let f11 = dir.join("f11.csv");
     std::fs::write(&f11, shipped.replace("D65/10°", "F11/10°")).unwrap();

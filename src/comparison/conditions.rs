@@ -6,8 +6,10 @@
 //!
 //! Read from the sheet's metadata (`# key: value` lines and title rows above the header): a key `illuminant`
 //! (`D65`, or with the observer, `D65/10°`, `D65 10°`), a key `observer` (`10°`, `2`, `CIE 1964`), or one key
-//! naming both (`illuminant/observer`, `ill./obs.`: `D65/10°`).
-use super::sheet::Sheet;
+//! naming both (`illuminant/observer`, `ill./obs.`: `D65/10°`); and from the headers of the colour columns,
+//! bracketed after the quantity as exports write them (`L* (D65/10°)`, `a*[A/2]`, `b*(D50)`). Every place that
+//! states a condition must state the same one.
+use super::sheet::{normalise, Layout, Sheet, LAB_COLUMNS};
 use crate::colorimetry::{Conditions, Illuminant, Observer};
 use crate::error::Words;
 use crate::instrument::reading::ColourQuantity;
@@ -24,6 +26,13 @@ pub(crate) struct Stated {
 /// under (`F11`, `CIE 2006`) is an error naming the file and the line: no prediction could be compared with it.
 pub(crate) fn stated(sheet: &Sheet) -> Result<Stated> {
     let mut out = Stated::default();
+    from_metadata(sheet, &mut out)?;
+    from_headers(sheet, &mut out)?;
+    Ok(out)
+}
+
+/// The conditions of the metadata lines, into `out`.
+fn from_metadata(sheet: &Sheet, out: &mut Stated) -> Result<()> {
     for (key, value) in &sheet.metadata {
         let key = key.replace(' ', "");
         let said = format!("{key}: {value}");
@@ -33,11 +42,7 @@ pub(crate) fn stated(sheet: &Sheet) -> Result<Stated> {
             "illuminant/observer" | "ill./obs." | "ill/obs" | "illuminant/obs." | "ill./observer" => (true, true),
             _ => continue,
         };
-        let tokens: Vec<&str> = value
-            .split(|c: char| c == '/' || c == ',' || c == ';' || c.is_whitespace())
-            .map(|t| t.trim_matches(|c: char| c == '(' || c == ')'))
-            .filter(|t| !t.is_empty() && !t.eq_ignore_ascii_case("cie"))
-            .collect();
+        let tokens = tokens(value);
         let refused = |what: &str, allowed: &str| {
             Error::input(
                 &sheet.file,
@@ -51,19 +56,125 @@ pub(crate) fn stated(sheet: &Sheet) -> Result<Stated> {
         if wants_illuminant {
             let found = tokens.iter().find_map(|t| Illuminant::parse(t).ok());
             match found {
-                Some(i) => out.illuminant = Some((i, said.clone())),
-                None => return Err(refused("the illuminant", "D65, D50, A, C")),
+                Some(i) => put_illuminant(sheet, out, i, &said)?,
+                None => return Err(refused("the illuminant", ILLUMINANTS)),
             }
         }
         // The observer: `10°`, `10`, `1964`, ... (in a combined value, any token after the illuminant).
         let observer = tokens.iter().find_map(|t| Observer::parse(t).ok());
         match (wants_observer, observer) {
-            (_, Some(o)) if wants_observer || wants_illuminant => out.observer = Some((o, said.clone())),
-            (true, None) => return Err(refused("the observer", "2 (CIE 1931 2°), 10 (CIE 1964 10°)")),
+            (_, Some(o)) if wants_observer || wants_illuminant => put_observer(sheet, out, o, &said)?,
+            (true, None) => return Err(refused("the observer", OBSERVERS)),
             _ => {}
         }
     }
-    Ok(out)
+    Ok(())
+}
+
+/// What glossmeter computes colour under, for messages.
+const ILLUMINANTS: &str = "D65, D50, A, C";
+const OBSERVERS: &str = "2 (CIE 1931 2°), 10 (CIE 1964 10°)";
+
+/// The words of a stated condition: split at `/`, `,`, `;` and spaces, brackets and a `CIE` dropped.
+fn tokens(value: &str) -> Vec<&str> {
+    value
+        .split(|c: char| c == '/' || c == ',' || c == ';' || c.is_whitespace())
+        .map(|t| t.trim_matches(|c: char| matches!(c, '(' | ')' | '[' | ']')))
+        .filter(|t| !t.is_empty() && !t.eq_ignore_ascii_case("cie"))
+        .collect()
+}
+
+/// Whether a word names an illuminant, one glossmeter computes under or another an export may write: the CIE
+/// daylights (D50, D55, D65, D75), A, B, C, E, the fluorescent F1–F12 (CIE 15:2018 §11 and its tables), and the
+/// store lamps of colour-matching cabinets (TL83, TL84, CWF, U30, U35). Only to tell a condition from other
+/// bracketed words in a colour column's header (`L* (mean)`).
+fn names_an_illuminant(word: &str) -> bool {
+    let w = word.to_ascii_uppercase();
+    let digits =
+        |s: &str, n: std::ops::RangeInclusive<usize>| n.contains(&s.len()) && s.bytes().all(|b| b.is_ascii_digit());
+    matches!(w.as_str(), "A" | "B" | "C" | "E" | "TL83" | "TL84" | "CWF" | "U30" | "U35")
+        || w.strip_prefix('D').is_some_and(|d| digits(d, 2..=2))
+        || w.strip_prefix('F').is_some_and(|d| digits(d, 1..=2))
+}
+
+/// The conditions of the colour columns' headers, into `out`: the bracketed part after the quantity
+/// (`L* (D65/10°)`) when it names an illuminant; an observer there only beside an illuminant (a bare `(2)` is a
+/// repeat number elsewhere in a sheet, `60° (2)`). A column skipped on request states nothing.
+fn from_headers(sheet: &Sheet, out: &mut Stated) -> Result<()> {
+    if sheet.layout != Layout::Colour {
+        return Ok(());
+    }
+    let lab = |n: &str| LAB_COLUMNS.iter().any(|(names, _)| names.contains(&n));
+    for (j, header) in sheet.headers.iter().enumerate() {
+        let skipped = sheet.ignored_columns.contains(header);
+        let Some(inner) = bracketed(header).filter(|_| lab(&normalise(header)) && !skipped) else { continue };
+        let words = tokens(inner);
+        if !words.iter().any(|w| names_an_illuminant(w)) {
+            continue;
+        }
+        let place = sheet.cell(sheet.header_line, Some(j), "colour");
+        let Some(i) = words.iter().find_map(|t| Illuminant::parse(t).ok()) else {
+            return Err(Error::input(
+                &sheet.file,
+                place,
+                format!(
+                    "the column states its colour under {inner:?}, an illuminant glossmeter does not compute colour \
+                     under (allowed: {ILLUMINANTS}); no prediction could be compared with this column"
+                ),
+            ));
+        };
+        put_illuminant(sheet, out, i, &place)?;
+        if let Some(o) = words.iter().find_map(|t| Observer::parse(t).ok()) {
+            put_observer(sheet, out, o, &place)?;
+        }
+    }
+    Ok(())
+}
+
+/// The text between the first `(` or `[` of a header and its closing bracket.
+fn bracketed(header: &str) -> Option<&str> {
+    let open = header.find(['(', '['])?;
+    let close = if header[open..].starts_with('(') { ')' } else { ']' };
+    let rest = &header[open + 1..];
+    Some(&rest[..rest.find(close)?])
+}
+
+/// Record the illuminant stated at `place`; a sheet stating two different ones is refused, naming both places.
+fn put_illuminant(sheet: &Sheet, out: &mut Stated, i: Illuminant, place: &str) -> Result<()> {
+    put(sheet, &mut out.illuminant, i, place, |i| format!("illuminant {}", i.id()))
+}
+
+/// Record the observer stated at `place`, as [`put_illuminant`].
+fn put_observer(sheet: &Sheet, out: &mut Stated, o: Observer, place: &str) -> Result<()> {
+    put(sheet, &mut out.observer, o, place, |o| format!("the {} observer", o.describe()))
+}
+
+fn put<T: Copy + PartialEq>(
+    sheet: &Sheet,
+    slot: &mut Option<(T, String)>,
+    value: T,
+    place: &str,
+    describe: impl Fn(T) -> String,
+) -> Result<()> {
+    match slot {
+        Some((old, at)) if *old != value => Err(Error::input(
+            &sheet.file,
+            place,
+            Words::from(format!(
+                "the sheet states its colour under {} here but under {} at `{at}`: a sheet's colour readings are \
+                 compared under one illuminant and observer (a sheet with columns under several: pass ",
+                describe(value),
+                describe(*old)
+            ))
+            .and_argument("ignore_columns")
+            .and(" with the others' headers)"),
+        )),
+        Some(_) => Ok(()),
+        None => {
+            *slot = Some((value, place.to_string()));
+            Ok(())
+        }
+    }
 }
 
 /// Whether a reading name is a colour reading's (X, Y, Z, L*, a*, b*, C*, h).
@@ -145,6 +256,61 @@ mod tests {
             let s = stated(&sheet(head)).unwrap();
             assert_eq!((s.illuminant.map(|x| x.0), s.observer.map(|x| x.0)), (i, o), "{head}");
         }
+    }
+
+    fn with_header(head: &str, ignore: &[&str]) -> Result<Sheet> {
+        // One row: a value in every column after the sample and the geometry.
+        let columns = head.lines().last().map_or(0, |h| h.split(',').count());
+        let values = ["50", "1", "2"].iter().cycle().take(columns.saturating_sub(2)).copied().collect::<Vec<_>>();
+        let text = format!("{head}\np,astm-e2194-45,{}\n", values.join(","));
+        let o = SheetOptions { ignore_columns: ignore.iter().map(|s| s.to_string()).collect(), ..Default::default() };
+        parse(&text, "h.csv", &o)
+    }
+
+    #[test]
+    fn the_colour_columns_headers_state_them_too() {
+        use Illuminant::*;
+        use Observer::*;
+        for (head, i, o) in [
+            ("sample,geometry,L* (D65/10°),a* (D65/10°),b* (D65/10°)", Some(D65), Some(Cie1964)),
+            ("sample,geometry,L*[A/2],a*,b*", Some(A), Some(Cie1931)),
+            ("sample,geometry,L*(D50),a*(D50),b*(D50)", Some(D50), None),
+            ("sample,geometry,L* (C 2°),a*,b*", Some(C), Some(Cie1931)),
+            // Bracketed words that are no condition, and a bare number (a repeat elsewhere), state nothing.
+            ("sample,geometry,L* (mean),a* [CIELAB],b* (2)", None, None),
+        ] {
+            let s = stated(&with_header(head, &[]).unwrap()).unwrap();
+            assert_eq!((s.illuminant.map(|x| x.0), s.observer.map(|x| x.0)), (i, o), "{head}");
+        }
+        // The place is the header's cell; a refusal names it.
+        let sh = with_header("sample,geometry,L* (A/2°),a* (A/2°),b* (A/2°)", &[]).unwrap();
+        let text = check(&sh, Conditions::default()).unwrap_err().naming(&|a| format!("--{a}"));
+        assert!(text.contains("line 1, column 3 (L* (A/2°))"), "{text}");
+        assert!(text.contains("give --illuminant A --observer 2 (the sheet's)"), "{text}");
+        assert!(check(&sh, conditions(Illuminant::A, Observer::Cie1931)).is_ok());
+    }
+
+    #[test]
+    fn places_that_disagree_and_illuminants_not_computed_are_refused() {
+        // The metadata against a header, and two headers.
+        let both = with_header("# illuminant: D65/10°\nsample,geometry,L* (A/10°),a*,b*", &[]).unwrap();
+        let e = stated(&both).unwrap_err().naming(&|a| format!("--{a}"));
+        assert!(e.contains("illuminant A here but under illuminant D65 at `illuminant: D65/10°`"), "{e}");
+        assert!(e.contains("--ignore_columns"), "{e}");
+        let e = stated(&with_header("sample,geometry,L* (D65/10°),a* (D65/2°),b*", &[]).unwrap()).unwrap_err();
+        assert!(e.to_string().contains("CIE 1931 2° observer here"), "{e}");
+        let e = stated(&with_header("sample,geometry,L* (F11/10°),a*,b*", &[]).unwrap()).unwrap_err().to_string();
+        assert!(e.contains("h.csv") && e.contains("L* (F11/10°)") && e.contains("allowed: D65, D50, A, C"), "{e}");
+        // An export under two illuminants: refused as duplicate columns, read once the others are skipped.
+        let two = "sample,geometry,L* (D65/10°),a* (D65/10°),b* (D65/10°),L* (A/10°),a* (A/10°),b* (A/10°)";
+        let e = with_header(two, &[]).unwrap_err().naming(&|a| format!("--{a}"));
+        assert!(e.contains("one illuminant and observer at a time") && e.contains("--ignore_columns"), "{e}");
+        let one = with_header(two, &["L* (A/10°)", "a* (A/10°)", "b* (A/10°)"]).unwrap();
+        let s = stated(&one).unwrap();
+        assert_eq!(
+            (s.illuminant.map(|x| x.0), s.observer.map(|x| x.0)),
+            (Some(Illuminant::D65), Some(Observer::Cie1964))
+        );
     }
 
     #[test]

@@ -182,6 +182,21 @@ pub(crate) fn normalise(header: &str) -> String {
     s
 }
 
+/// Whether a header is one of the columns to skip: the same normalised header; or, for an entry with a
+/// bracketed part, the same with its brackets' words kept (`L* (A/10°)` skips that column and not `L* (D65/10°)`).
+fn is_ignored(header: &str, ignore: &[String]) -> bool {
+    let keep = |h: &str| h.chars().filter(|c| c.is_alphanumeric()).flat_map(char::to_lowercase).collect::<String>();
+    ignore.iter().any(
+        |i| {
+            if i.contains(['(', '[']) {
+                keep(i) == keep(header)
+            } else {
+                normalise(i) == normalise(header)
+            }
+        },
+    )
+}
+
 /// The gloss geometry of a header such as `20`, `20°`, `G60`, `Gloss 85°`, `60 gloss`, `GU 20`.
 pub(crate) fn gloss_angle(normalised: &str) -> Option<&'static str> {
     let mut h = normalised;
@@ -249,7 +264,7 @@ pub(super) enum Role {
 
 pub(super) fn role(header: &str, ignore: &[String]) -> Option<Role> {
     let n = normalise(header);
-    if ignore.iter().any(|i| normalise(i) == n) {
+    if is_ignored(header, ignore) {
         return Some(Role::Ignored);
     }
     let is = |list: &[&str]| list.contains(&n.as_str());
@@ -348,6 +363,22 @@ pub(super) fn header_roles(
     // Duplicate headers: two columns of the same role (other than info/ignored) are ambiguous.
     for j in 0..roles.len() {
         for i in 0..j {
+            if roles[i] == roles[j] && matches!(roles[j], Role::Lab(_)) {
+                // An export with colour under several illuminants (`L* (D65/10°)`, `L* (A/10°)`).
+                return Err(Error::input(
+                    file,
+                    at(place, hline, j, &headers[j]),
+                    Words::from(format!(
+                        "duplicate column: `{}` is the same quantity as column {} (`{}`); a sheet's colour is \
+                         compared under one illuminant and observer at a time (docs/instrument.md §Sheets): pass ",
+                        headers[j],
+                        i + 1,
+                        headers[i]
+                    ))
+                    .and_argument("ignore_columns")
+                    .and(" with the headers of the columns under the others"),
+                ));
+            }
             if roles[i] == roles[j] && !matches!(roles[j], Role::Info | Role::Ignored) {
                 return Err(Error::input(
                     file,
