@@ -452,6 +452,10 @@ pub struct ConvergenceRequest {
     pub max_repetitions: usize,
     /// Compare with a run at 1/100 of the tightest tolerance even when a closed form exists.
     pub reference_run: bool,
+    /// Illuminant of colour readings (D65, D50, A or C; `None`: D65).
+    pub illuminant: Option<String>,
+    /// Observer of colour readings (10 or 2; `None`: 10).
+    pub observer: Option<String>,
 }
 
 impl Default for ConvergenceRequest {
@@ -462,6 +466,8 @@ impl Default for ConvergenceRequest {
             min_time_ms: d.min_seconds * 1e3,
             max_repetitions: d.max_repetitions,
             reference_run: false,
+            illuminant: None,
+            observer: None,
         }
     }
 }
@@ -478,10 +484,17 @@ impl ConvergenceRequest {
             ));
         }
         let max_repetitions = at_least_one("max_repetitions", self.max_repetitions)?;
+        let colour = PlanRequest {
+            illuminant: self.illuminant.clone(),
+            observer: self.observer.clone(),
+            ..PlanRequest::default()
+        }
+        .colour()?;
         let options = SweepOptions {
             min_seconds: self.min_time_ms * 1e-3,
             max_repetitions,
             force_run_reference: self.reference_run,
+            colour,
             ..SweepOptions::default()
         };
         Ok((tolerances, options))

@@ -512,7 +512,7 @@ fn every_document_names_the_illuminant_and_observer_of_its_colour_readings() {
     for column in ["astm-d523-60 gloss (GU)", "astm-e2194-15 b* (A / 2°)", "astm-e2194-15 h (°, A / 2°)"] {
         assert!(head.contains(column), "{column} not in {head}");
     }
-    // A convergence study (which reads colour under the default pair only): JSON rows, CSV columns, the table.
+    // A convergence study: JSON rows, CSV columns, the table; by default under D65 / 10°.
     let study = ["convergence", pearl, "-g", "astm-d523-60", "-g", "astm-e2194-15", "--tolerances", "1e-3"];
     let quick = ["--min-time-ms", "0", "--max-repetitions", "1"];
     let conv: Value = serde_json::from_str(&run(&[&study[..], &quick, &["--format", "json"]].concat())).unwrap();
@@ -526,6 +526,29 @@ fn every_document_names_the_illuminant_and_observer_of_its_colour_readings() {
     assert!(conv_csv.lines().next().unwrap().contains(",illuminant,observer,"), "{conv_csv}");
     let conv_table = run(&[&study[..], &quick].concat());
     assert!(conv_table.contains("colour: illuminant D65, CIE 1964 10° observer"), "{conv_table}");
+    // Under a pair asked for, every row is measure's reading under the same flags and tolerance, bit for bit.
+    let conv: Value =
+        serde_json::from_str(&run(&[&study[..], &quick, &["--format", "json"], &colour].concat())).unwrap();
+    let measured: Value = serde_json::from_str(&run(&[
+        &["measure", pearl, "--format", "json", "--no-timing", "--rtol", "1e-3"][..],
+        &geos,
+        &colour,
+    ]
+    .concat()))
+    .unwrap();
+    let rows = conv["rows"].as_array().unwrap();
+    assert_eq!(rows.len(), 9);
+    for r in rows {
+        let want = (r["geometry"] == "astm-e2194-15").then(|| (Value::from("A"), Value::from("2")));
+        assert_eq!(r.get("illuminant").cloned().zip(r.get("observer").cloned()), want, "{r}");
+        let m = measured["readings"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|m| m["geometry"] == r["geometry"] && m["name"] == r["reading"])
+            .unwrap_or_else(|| panic!("{r}"));
+        assert_eq!(m["value"], r["value"], "{r}");
+    }
     // A compare row and a fit target: the colour ones have the pair.
     let dir = common::tmp_dir("colour-conditions");
     std::fs::create_dir_all(&dir).unwrap();

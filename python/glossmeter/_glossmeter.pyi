@@ -130,6 +130,8 @@ def convergence(
     min_time_ms: Optional[float] = None,
     max_repetitions: Optional[int] = None,
     reference_run: bool = False,
+    illuminant: Optional[str] = None,
+    observer: Optional[str] = None,
 ) -> ConvergenceReport: ...
 class HeightMap:
     """A height map held in memory for recipes: a recipe's ``file`` (a topography's, a paint's applied

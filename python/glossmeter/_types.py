@@ -422,7 +422,7 @@ class _ConvergenceRowRequired(TypedDict):
 
 
 class ConvergenceRow(_ConvergenceRowRequired, total=False):
-    #: A colour reading's CIE illuminant and observer (D65 / 10°: ``convergence`` takes no other).
+    #: A colour reading's CIE illuminant and observer (``convergence``'s ``illuminant`` and ``observer``).
     illuminant: Literal["D65", "D50", "A", "C"]
     observer: Literal["2", "10"]
 

@@ -538,14 +538,15 @@ pub fn profile<'py>(
 }
 
 /// convergence(recipe, geometries=None, tolerances=None, min_time_ms=20.0, max_repetitions=50,
-/// reference_run=False) -> dict
+/// reference_run=False, illuminant=None, observer=None) -> dict
 ///
 /// Value, estimated error, actual error, evaluations and time of every reading over a sweep of tolerances
 /// (None: 1e-2 … 1e-10), on `geometries` (None: astm-d523-20, -60, -85): the document of `glossmeter
 /// convergence --format json`. Ctrl-C is seen, but the sweep runs to its end first (it has no stop signal).
 #[pyfunction]
 #[pyo3(signature = (recipe, geometries=None, tolerances=None, min_time_ms=None, max_repetitions=None,
-    reference_run=None))]
+    reference_run=None, illuminant=None, observer=None))]
+#[allow(clippy::too_many_arguments)]
 pub fn convergence<'py>(
     py: Python<'py>,
     recipe: &Bound<'py, PyAny>,
@@ -554,6 +555,8 @@ pub fn convergence<'py>(
     min_time_ms: Option<&Bound<'py, PyAny>>,
     max_repetitions: Option<&Bound<'py, PyAny>>,
     reference_run: Option<&Bound<'py, PyAny>>,
+    illuminant: Option<&Bound<'py, PyAny>>,
+    observer: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let d = ConvergenceRequest::default();
     let request = guarded(|| {
@@ -566,6 +569,8 @@ pub fn convergence<'py>(
             max_repetitions: opt_count("max_repetitions", max_repetitions, "timed executions per tolerance, ≥ 1")?
                 .map_or(d.max_repetitions, |n| n as usize),
             reference_run: args::flag("reference_run", reference_run, false)?,
+            illuminant: args::plan_request(None, None, illuminant, None)?.illuminant,
+            observer: args::plan_request(None, None, None, observer)?.observer,
         })
     })?;
     let (tolerances, options) = guarded(|| request.options().map_err(to_py_err))?;

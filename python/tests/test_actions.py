@@ -202,6 +202,16 @@ def test_convergence_returns_the_command_line_s_document_but_its_times():
 
     assert untimed(doc) == untimed(cli)
     assert [r["rtol"] for r in doc["rows"]] == [1e-3, 1e-5]
+    # Colour under a chosen illuminant and observer, as the command line's flags.
+    pearl = RECIPES / "white-pearl-spectral.json"
+    doc = glossmeter.convergence(pearl, "astm-e2194-15", tolerances=[1e-3], min_time_ms=0, max_repetitions=1,
+                                 illuminant="A", observer="2")
+    cli = cli_json("convergence", pearl, "-g", "astm-e2194-15", "--tolerances", "1e-3", "--min-time-ms", "0",
+                   "--max-repetitions", "1", "--illuminant", "A", "--observer", "2", "--format", "json")
+    assert untimed(doc) == untimed(cli)
+    assert {(r["illuminant"], r["observer"]) for r in doc["rows"]} == {("A", "2")}
+    with pytest.raises(ValueError, match="illuminant"):
+        glossmeter.convergence(pearl, "astm-e2194-15", tolerances=[1e-3], illuminant="F11")
 
 
 # ---- as_frame ---------------------------------------------------------------------------------------------

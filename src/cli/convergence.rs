@@ -3,7 +3,7 @@
 //! time (SVG). The computation is `instrument::convergence::sweep`; this module parses, formats and writes.
 use std::path::PathBuf;
 
-use super::common::{pad_table, Format};
+use super::common::{pad_table, ColourArgs, Format};
 use super::output::{Existing, OutputTarget};
 use super::plot;
 use crate::instrument::convergence::{self, ReferenceKind, Sweep};
@@ -48,6 +48,8 @@ pub struct ConvergenceArgs {
     /// Compare with a run at 1/100 of the tightest tolerance even when a closed form exists.
     #[arg(long)]
     pub reference_run: bool,
+    #[command(flatten)]
+    pub colour: ColourArgs,
 }
 
 /// The request of a command line (the one place where `convergence`'s arguments become the library's).
@@ -57,6 +59,8 @@ pub fn request(a: &ConvergenceArgs) -> ConvergenceRequest {
         min_time_ms: a.min_time_ms,
         max_repetitions: a.max_repetitions,
         reference_run: a.reference_run,
+        illuminant: Some(a.colour.illuminant.clone()),
+        observer: Some(a.colour.observer.clone()),
     }
 }
 

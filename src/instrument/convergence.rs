@@ -63,6 +63,8 @@ pub struct SweepOptions {
     pub max_evals: usize,
     /// Use a reference run even when a closed form exists (for testing the tight-run path).
     pub force_run_reference: bool,
+    /// The illuminant and observer of colour readings (as `PlanOptions::colour`).
+    pub colour: Conditions,
 }
 
 impl Default for SweepOptions {
@@ -72,6 +74,7 @@ impl Default for SweepOptions {
             max_repetitions: 50,
             max_evals: PlanOptions::default().max_evals,
             force_run_reference: false,
+            colour: Conditions::default(),
         }
     }
 }
@@ -134,7 +137,7 @@ pub struct Row {
     pub repetitions: usize,
     pub converged: bool,
     pub problem: Option<String>,
-    /// A colour reading's illuminant and observer (the plan's, D65 / 10°: `convergence` takes no other).
+    /// A colour reading's illuminant and observer (the sweep's, `SweepOptions::colour`).
     pub colour: Option<Conditions>,
 }
 
@@ -328,6 +331,7 @@ pub fn sweep(
         max_seconds: None,
         // The study is of the numerical error against the tolerance: each rtol is used as given, tables too.
         rtol_from_data: false,
+        colour: options.colour,
         ..PlanOptions::default()
     };
 
