@@ -358,6 +358,42 @@ fn a_colour_sheet_is_compared_only_under_the_conditions_it_states() {
     let predicted =
         |d: &Value| d["comparisons"].as_array().unwrap().iter().map(|c| c["predicted"].clone()).collect::<Vec<_>>();
     assert_eq!(predicted(&under_doc), predicted(&doc), "the same predictions as the metadata's A / 2° sheet");
+    // Or columns, row by row (`Illuminant`, `Observer`): the same refusal, naming the first row's cell.
+    let rows_sheet = dir.join("rows.csv");
+    let text: String = shipped
+        .replace("# illuminant/observer: D65/10°\n", "")
+        .replace("sample,geometry,", "sample,geometry,Illuminant,Observer,")
+        .lines()
+        .map(|l| match l.strip_prefix("panel-1,").and_then(|rest| rest.split_once(',')) {
+            Some((geometry, lab)) => format!("panel-1,{geometry},A,2°,{lab}\n"),
+            None => format!("{l}\n"),
+        })
+        .collect();
+    std::fs::write(&rows_sheet, text).unwrap();
+    let rows_sheet = rows_sheet.to_str().unwrap();
+    let out = run(&["compare", recipe, rows_sheet]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("column 3 (Illuminant)") && err.contains("--illuminant A --observer 2 (the sheet's)"),
+        "{err}"
+    );
+    let under = run(&[
+        "compare",
+        recipe,
+        rows_sheet,
+        "--illuminant",
+        "A",
+        "--observer",
+        "2",
+        "--format",
+        "json",
+        "--max-de00",
+        "100",
+    ]);
+    assert!(under.status.success(), "{}", String::from_utf8_lossy(&under.stderr));
+    let under_doc: Value = serde_json::from_slice(&under.stdout).unwrap();
+    assert_eq!(predicted(&under_doc), predicted(&doc));
     // An export under two illuminants: refused as duplicate columns; read under one once the others are skipped.
     let two = dir.join("two.csv");
     let both = shipped

@@ -154,3 +154,14 @@ fn many_plans_in_one_flat_loop_give_each_plans_own_bits() {
     }
     assert_eq!(Plan::run_all(&[]).len(), 0);
 }
+
+/// Every build reads a JSON number as the same bits: the nearest f64, as `str::parse` does. serde_json's
+/// default parser may land one ulp away; its `float_roundtrip` feature is exact, and a dev-dependency
+/// (jsonschema) turns it on in test builds, so a shipped binary without it in `Cargo.toml` would read recipes
+/// other than the tests read them (it did: `fit` of the two-roots document, docs/performance.md §Determinism).
+#[test]
+fn the_shipped_build_parses_json_numbers_as_the_tests_do() {
+    let manifest = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("Cargo.toml")).unwrap();
+    let line = manifest.lines().find(|l| l.starts_with("serde_json =")).expect("serde_json is a dependency");
+    assert!(line.contains("\"float_roundtrip\""), "serde_json without float_roundtrip: {line}");
+}

@@ -6,9 +6,10 @@
 //!
 //! Read from the sheet's metadata (`# key: value` lines and title rows above the header): a key `illuminant`
 //! (`D65`, or with the observer, `D65/10°`, `D65 10°`), a key `observer` (`10°`, `2`, `CIE 1964`), or one key
-//! naming both (`illuminant/observer`, `ill./obs.`: `D65/10°`); and from the headers of the colour columns,
-//! bracketed after the quantity as exports write them (`L* (D65/10°)`, `a*[A/2]`, `b*(D50)`). Every place that
-//! states a condition must state the same one.
+//! naming both (`illuminant/observer`, `ill./obs.`: `D65/10°`); from the headers of the colour columns,
+//! bracketed after the quantity as exports write them (`L* (D65/10°)`, `a*[A/2]`, `b*(D50)`); and from columns
+//! that state them row by row (`Illuminant`, `Observer`). Every place that states a condition must state the
+//! same one.
 use super::sheet::{normalise, Layout, Sheet, LAB_COLUMNS};
 use crate::colorimetry::{Conditions, Illuminant, Observer};
 use crate::error::Words;
@@ -28,6 +29,7 @@ pub(crate) fn stated(sheet: &Sheet) -> Result<Stated> {
     let mut out = Stated::default();
     from_metadata(sheet, &mut out)?;
     from_headers(sheet, &mut out)?;
+    from_columns(sheet, &mut out)?;
     Ok(out)
 }
 
@@ -42,33 +44,53 @@ fn from_metadata(sheet: &Sheet, out: &mut Stated) -> Result<()> {
             "illuminant/observer" | "ill./obs." | "ill/obs" | "illuminant/obs." | "ill./observer" => (true, true),
             _ => continue,
         };
-        let tokens = tokens(value);
-        let refused = |what: &str, allowed: &str| {
-            Error::input(
-                &sheet.file,
-                said.clone(),
-                format!(
-                    "the sheet states its colour under {what} {value:?}, which glossmeter does not compute colour \
-                     under (allowed: {allowed}); no prediction could be compared with these colour readings"
-                ),
-            )
-        };
-        if wants_illuminant {
-            let found = tokens.iter().find_map(|t| Illuminant::parse(t).ok());
-            match found {
-                Some(i) => put_illuminant(sheet, out, i, &said)?,
-                None => return Err(refused("the illuminant", ILLUMINANTS)),
-            }
-        }
-        // The observer: `10°`, `10`, `1964`, ... (in a combined value, any token after the illuminant).
-        let observer = tokens.iter().find_map(|t| Observer::parse(t).ok());
-        match (wants_observer, observer) {
-            (_, Some(o)) if wants_observer || wants_illuminant => put_observer(sheet, out, o, &said)?,
-            (true, None) => return Err(refused("the observer", OBSERVERS)),
-            _ => {}
-        }
+        state(sheet, out, (wants_illuminant, wants_observer), value, &said)?;
     }
     Ok(())
+}
+
+/// The conditions of the columns that state them row by row (`Illuminant`, `Observer`, `Ill./Obs.`), into `out`:
+/// every row must state the same (the sheet keeps each column's first two distinct cells).
+fn from_columns(sheet: &Sheet, out: &mut Stated) -> Result<()> {
+    for (line, j, text) in &sheet.condition_cells {
+        let wants = match normalise(&sheet.headers[*j]).as_str() {
+            "illuminant" | "ill" | "lightsource" => (true, false),
+            "observer" | "obs" => (false, true),
+            _ => (true, true),
+        };
+        state(sheet, out, wants, text, &sheet.cell(*line, Some(*j), "colour"))?;
+    }
+    Ok(())
+}
+
+/// Record what `value`, stated at `place`, says: an illuminant (`wants.0`), an observer (`wants.1`), or both.
+fn state(sheet: &Sheet, out: &mut Stated, wants: (bool, bool), value: &str, place: &str) -> Result<()> {
+    let (wants_illuminant, wants_observer) = wants;
+    let tokens = tokens(value);
+    let refused = |what: &str, allowed: &str| {
+        Error::input(
+            &sheet.file,
+            place,
+            format!(
+                "the sheet states its colour under {what} {value:?}, which glossmeter does not compute colour \
+                 under (allowed: {allowed}); no prediction could be compared with these colour readings"
+            ),
+        )
+    };
+    if wants_illuminant {
+        let found = tokens.iter().find_map(|t| Illuminant::parse(t).ok());
+        match found {
+            Some(i) => put_illuminant(sheet, out, i, place)?,
+            None => return Err(refused("the illuminant", ILLUMINANTS)),
+        }
+    }
+    // The observer: `10°`, `10`, `1964`, ... (in a combined value, any token after the illuminant).
+    let observer = tokens.iter().find_map(|t| Observer::parse(t).ok());
+    match (wants_observer, observer) {
+        (_, Some(o)) if wants_observer || wants_illuminant => put_observer(sheet, out, o, place),
+        (true, None) => Err(refused("the observer", OBSERVERS)),
+        _ => Ok(()),
+    }
 }
 
 /// What glossmeter computes colour under, for messages.
@@ -85,7 +107,7 @@ fn tokens(value: &str) -> Vec<&str> {
 }
 
 /// Whether a word names an illuminant, one glossmeter computes under or another an export may write: the CIE
-/// daylights (D50, D55, D65, D75), A, B, C, E, the fluorescent F1–F12 (CIE 15:2018 §11 and its tables), and the
+/// daylights (D50, D55, D65, D75), A, B, C, E and the fluorescent F1–F12 of CIE 15:2018's tables, and the
 /// store lamps of colour-matching cabinets (TL83, TL84, CWF, U30, U35). Only to tell a condition from other
 /// bracketed words in a colour column's header (`L* (mean)`).
 fn names_an_illuminant(word: &str) -> bool {
@@ -160,14 +182,13 @@ fn put<T: Copy + PartialEq>(
         Some((old, at)) if *old != value => Err(Error::input(
             &sheet.file,
             place,
-            Words::from(format!(
+            format!(
                 "the sheet states its colour under {} here but under {} at `{at}`: a sheet's colour readings are \
-                 compared under one illuminant and observer (a sheet with columns under several: pass ",
+                 compared under one illuminant and observer, so one sheet must state one pair (split a sheet \
+                 measured under several into one per pair)",
                 describe(value),
                 describe(*old)
-            ))
-            .and_argument("ignore_columns")
-            .and(" with the others' headers)"),
+            ),
         )),
         Some(_) => Ok(()),
         None => {
@@ -296,7 +317,7 @@ mod tests {
         let both = with_header("# illuminant: D65/10°\nsample,geometry,L* (A/10°),a*,b*", &[]).unwrap();
         let e = stated(&both).unwrap_err().naming(&|a| format!("--{a}"));
         assert!(e.contains("illuminant A here but under illuminant D65 at `illuminant: D65/10°`"), "{e}");
-        assert!(e.contains("--ignore_columns"), "{e}");
+        assert!(e.contains("split a sheet"), "{e}");
         let e = stated(&with_header("sample,geometry,L* (D65/10°),a* (D65/2°),b*", &[]).unwrap()).unwrap_err();
         assert!(e.to_string().contains("CIE 1931 2° observer here"), "{e}");
         let e = stated(&with_header("sample,geometry,L* (F11/10°),a*,b*", &[]).unwrap()).unwrap_err().to_string();
@@ -311,6 +332,33 @@ mod tests {
             (s.illuminant.map(|x| x.0), s.observer.map(|x| x.0)),
             (Some(Illuminant::D65), Some(Observer::Cie1964))
         );
+    }
+
+    #[test]
+    fn columns_state_them_row_by_row() {
+        use Illuminant::*;
+        use Observer::*;
+        let o = SheetOptions::default();
+        let read = |text: &str| parse(text, "r.csv", &o).map(|s| stated(&s));
+        let head = "sample,geometry,Illuminant,Observer,L*,a*,b*\n";
+        let s = read(&format!("{head}p,astm-e2194-15,D65,10°,50,1,2\np,astm-e2194-45,D65,10°,40,1,2\n")).unwrap();
+        let s = s.unwrap();
+        assert_eq!((s.illuminant.map(|x| x.0), s.observer.map(|x| x.0)), (Some(D65), Some(Cie1964)));
+        let s = read("sample,geometry,Ill./Obs.,L*,a*,b*\np,astm-e2194-15,A/2°,50,1,2\n").unwrap().unwrap();
+        assert_eq!((s.illuminant.map(|x| x.0), s.observer.map(|x| x.0)), (Some(A), Some(Cie1931)));
+        // The long layout too.
+        let s = read("sample,geometry,quantity,value,light source\np,d8-sce,L*,50,C\n").unwrap().unwrap();
+        assert_eq!((s.illuminant.map(|x| x.0), s.observer.map(|x| x.0)), (Some(C), None));
+        // Rows under two illuminants: refused at the second, naming the first.
+        let two = format!("{head}p,astm-e2194-15,D65,10°,50,1,2\np,astm-e2194-15,A,10°,40,1,2\n");
+        let e = read(&two).unwrap().unwrap_err().to_string();
+        assert!(e.contains("line 3, column 3 (Illuminant)") && e.contains("line 2, column 3 (Illuminant)"), "{e}");
+        assert!(e.contains("split a sheet"), "{e}");
+        let e = read(&format!("{head}p,astm-e2194-15,F11,10°,50,1,2\n")).unwrap().unwrap_err().to_string();
+        assert!(e.contains("F11") && e.contains("allowed: D65, D50, A, C"), "{e}");
+        // A gloss sheet may carry the column; nothing is checked without colour rows.
+        let gloss = parse("sample,60°,Illuminant\np,90,F11\n", "g.csv", &o).unwrap();
+        assert!(check(&gloss, Conditions::default()).is_ok());
     }
 
     #[test]

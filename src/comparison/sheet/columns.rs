@@ -116,6 +116,10 @@ pub(crate) const IQ: &str = "rhopoint-iq-20";
 /// Columns that say which sample a row is.
 pub(crate) const SAMPLE_COLUMNS: &[&str] =
     &["sample", "samplename", "sampleid", "specimen", "name", "id", "panel", "probe", "probenname", "muster"];
+/// Columns that state each row's colour conditions (normalised; colour software exports them per measurement:
+/// `Illuminant` `D65`, `Observer` `10°`): read by `comparison::conditions`, never compared.
+pub(crate) const CONDITION_COLUMNS: &[&str] =
+    &["illuminant", "observer", "illuminantobserver", "illobs", "lightsource", "ill", "obs"];
 /// Columns kept by the reader but not compared (bookkeeping that instruments add to each row).
 pub(crate) const INFO_COLUMNS: &[&str] = &[
     "date",
@@ -186,15 +190,11 @@ pub(crate) fn normalise(header: &str) -> String {
 /// bracketed part, the same with its brackets' words kept (`L* (A/10°)` skips that column and not `L* (D65/10°)`).
 fn is_ignored(header: &str, ignore: &[String]) -> bool {
     let keep = |h: &str| h.chars().filter(|c| c.is_alphanumeric()).flat_map(char::to_lowercase).collect::<String>();
-    ignore.iter().any(
-        |i| {
-            if i.contains(['(', '[']) {
-                keep(i) == keep(header)
-            } else {
-                normalise(i) == normalise(header)
-            }
-        },
-    )
+    let same = |i: &String| match i.contains(['(', '[']) {
+        true => keep(i) == keep(header),
+        false => normalise(i) == normalise(header),
+    };
+    ignore.iter().any(same)
 }
 
 /// The gloss geometry of a header such as `20`, `20°`, `G60`, `Gloss 85°`, `60 gloss`, `GU 20`.
@@ -241,6 +241,8 @@ pub(super) fn split_repeat(header: &str) -> (&str, Option<u32>) {
 pub(super) enum Role {
     Sample,
     Info,
+    /// An illuminant and/or observer column ([`CONDITION_COLUMNS`]).
+    Condition,
     Geometry,
     Quantity,
     Value,
@@ -273,6 +275,9 @@ pub(super) fn role(header: &str, ignore: &[String]) -> Option<Role> {
     }
     if is(INFO_COLUMNS) {
         return Some(Role::Info);
+    }
+    if is(CONDITION_COLUMNS) {
+        return Some(Role::Condition);
     }
     if is(GEOMETRY_COLUMNS) {
         return Some(Role::Geometry);
@@ -360,7 +365,8 @@ pub(super) fn header_roles(
             }
         }
     }
-    // Duplicate headers: two columns of the same role (other than info/ignored) are ambiguous.
+    // Duplicate headers: two columns of the same role (other than info, ignored and colour conditions, which
+    // must agree where they are read) are ambiguous.
     for j in 0..roles.len() {
         for i in 0..j {
             if roles[i] == roles[j] && matches!(roles[j], Role::Lab(_)) {
@@ -379,7 +385,7 @@ pub(super) fn header_roles(
                     .and(" with the headers of the columns under the others"),
                 ));
             }
-            if roles[i] == roles[j] && !matches!(roles[j], Role::Info | Role::Ignored) {
+            if roles[i] == roles[j] && !matches!(roles[j], Role::Info | Role::Ignored | Role::Condition) {
                 return Err(Error::input(
                     file,
                     at(place, hline, j, &headers[j]),

@@ -108,6 +108,9 @@ pub struct Sheet {
     pub first_column: u32,
     /// The statistics cells (`Mean 20°`, …) checked against their series.
     pub statistics_checked: usize,
+    /// The distinct cells of the columns that state each row's colour conditions (`Illuminant`, `Observer`):
+    /// (line, column, text), the first row of each distinct text, at most two per column.
+    pub condition_cells: Vec<(usize, usize, String)>,
 }
 
 impl Sheet {
@@ -280,6 +283,8 @@ fn parse_at(text: &str, file: &str, options: &SheetOptions, place: &Place) -> Re
     let stat_cols: Vec<usize> = (0..roles.len()).filter(|&j| matches!(roles[j], Role::Statistic { .. })).collect();
     let mut stat_cells: Vec<StatCell> = vec![];
     let sample_c = find(&Role::Sample);
+    let condition_cols: Vec<usize> = (0..roles.len()).filter(|&j| roles[j] == Role::Condition).collect();
+    let mut condition_cells: Vec<(usize, usize, String)> = vec![];
     let ignored_columns = (0..roles.len()).filter(|&j| roles[j] == Role::Ignored).map(|j| headers[j].clone()).collect();
     let mut rows = Vec::new();
     // Statistics rows summarise the rows from `block_start` (after the previous statistics rows).
@@ -319,6 +324,14 @@ fn parse_at(text: &str, file: &str, options: &SheetOptions, place: &Place) -> Re
             }
         }
         let sample = r.get(sample_c);
+        // Two distinct texts of a column are enough to refuse it (`comparison::conditions`): no more are kept.
+        for &j in &condition_cols {
+            let text = r.get(Some(j));
+            let kept = condition_cells.iter().filter(|(_, c, _)| *c == j).count();
+            if !text.is_empty() && kept < 2 && !condition_cells.iter().any(|(_, c, t)| *c == j && *t == text) {
+                condition_cells.push((line, j, text));
+            }
+        }
         rows.extend(match layout {
             Layout::Long => {
                 let (g, v) = (geo_c.expect("long"), val_c.expect("long"));
@@ -354,6 +367,7 @@ fn parse_at(text: &str, file: &str, options: &SheetOptions, place: &Place) -> Re
         workbook_sheet: None,
         first_column: 0,
         statistics_checked: stat_cells.len(),
+        condition_cells,
     })
 }
 
