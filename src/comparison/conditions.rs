@@ -10,7 +10,7 @@
 //! bracketed after the quantity as exports write them (`L* (D65/10°)`, `a*[A/2]`, `b*(D50)`); and from columns
 //! that state them row by row (`Illuminant`, `Observer`). Every place that states a condition must state the
 //! same one.
-use super::sheet::{normalise, Layout, Sheet, LAB_COLUMNS};
+use super::sheet::{normalise, Layout, Sheet, CONDITION_TEXTS, LAB_COLUMNS};
 use crate::colorimetry::{Conditions, Illuminant, Observer};
 use crate::error::Words;
 use crate::instrument::reading::ColourQuantity;
@@ -53,6 +53,16 @@ fn from_metadata(sheet: &Sheet, out: &mut Stated) -> Result<()> {
 /// every row must state the same (the sheet keeps each column's first two distinct cells).
 fn from_columns(sheet: &Sheet, out: &mut Stated) -> Result<()> {
     for (line, j, text) in &sheet.condition_cells {
+        if sheet.condition_cells.iter().filter(|(_, c, _)| c == j).count() > CONDITION_TEXTS {
+            return Err(Error::input(
+                &sheet.file,
+                sheet.cell(sheet.header_line, Some(*j), "colour"),
+                format!(
+                    "the column states the colour conditions in more than {CONDITION_TEXTS} different ways; one \
+                     sheet's colour readings are compared under one illuminant and observer"
+                ),
+            ));
+        }
         let wants = match normalise(&sheet.headers[*j]).as_str() {
             "illuminant" | "ill" | "lightsource" => (true, false),
             "observer" | "obs" => (false, true),
@@ -349,6 +359,12 @@ mod tests {
         // The long layout too.
         let s = read("sample,geometry,quantity,value,light source\np,d8-sce,L*,50,C\n").unwrap().unwrap();
         assert_eq!((s.illuminant.map(|x| x.0), s.observer.map(|x| x.0)), (Some(C), None));
+        // Texts of one illuminant in several spellings, then another: the third text is still read.
+        let spelt = format!(
+            "{head}p,astm-e2194-15,D65,10,50,1,2\np,astm-e2194-25,d65,10,50,1,2\np,astm-e2194-45,A,10,50,1,2\n"
+        );
+        let e = read(&spelt).unwrap().unwrap_err().to_string();
+        assert!(e.contains("line 4, column 3 (Illuminant)") && e.contains("illuminant A here"), "{e}");
         // Rows under two illuminants: refused at the second, naming the first.
         let two = format!("{head}p,astm-e2194-15,D65,10°,50,1,2\np,astm-e2194-15,A,10°,40,1,2\n");
         let e = read(&two).unwrap().unwrap_err().to_string();
@@ -356,6 +372,10 @@ mod tests {
         assert!(e.contains("split a sheet"), "{e}");
         let e = read(&format!("{head}p,astm-e2194-15,F11,10°,50,1,2\n")).unwrap().unwrap_err().to_string();
         assert!(e.contains("F11") && e.contains("allowed: D65, D50, A, C"), "{e}");
+        // A column that states them in more than CONDITION_TEXTS ways is refused, not read in part.
+        let many: String = (0..=CONDITION_TEXTS).map(|k| format!("p,astm-e2194-15,D65 r{k},10,50,1,2\n")).collect();
+        let e = read(&format!("{head}{many}")).unwrap().unwrap_err().to_string();
+        assert!(e.contains("line 1, column 3 (Illuminant)") && e.contains("more than 32 different ways"), "{e}");
         // A gloss sheet may carry the column; nothing is checked without colour rows.
         let gloss = parse("sample,60°,Illuminant\np,90,F11\n", "g.csv", &o).unwrap();
         assert!(check(&gloss, Conditions::default()).is_ok());

@@ -120,6 +120,9 @@ pub(crate) const SAMPLE_COLUMNS: &[&str] =
 /// `Illuminant` `D65`, `Observer` `10°`): read by `comparison::conditions`, never compared.
 pub(crate) const CONDITION_COLUMNS: &[&str] =
     &["illuminant", "observer", "illuminantobserver", "illobs", "lightsource", "ill", "obs"];
+/// The most distinct texts a condition column may hold (`D65`, `D65 `, `d65`, … all one illuminant); a column
+/// with more is refused rather than read in part.
+pub(crate) const CONDITION_TEXTS: usize = 32;
 /// Columns kept by the reader but not compared (bookkeeping that instruments add to each row).
 pub(crate) const INFO_COLUMNS: &[&str] = &[
     "date",

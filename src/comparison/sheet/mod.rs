@@ -109,7 +109,7 @@ pub struct Sheet {
     /// The statistics cells (`Mean 20°`, …) checked against their series.
     pub statistics_checked: usize,
     /// The distinct cells of the columns that state each row's colour conditions (`Illuminant`, `Observer`):
-    /// (line, column, text), the first row of each distinct text, at most two per column.
+    /// (line, column, text), the first row of each distinct text, at most [`CONDITION_TEXTS`] + 1 per column.
     pub condition_cells: Vec<(usize, usize, String)>,
 }
 
@@ -324,11 +324,13 @@ fn parse_at(text: &str, file: &str, options: &SheetOptions, place: &Place) -> Re
             }
         }
         let sample = r.get(sample_c);
-        // Two distinct texts of a column are enough to refuse it (`comparison::conditions`): no more are kept.
+        // Each distinct text once (`D65` and `d65 ` are two texts of one illuminant, so more than two are kept),
+        // up to one more than `CONDITION_TEXTS`, which `comparison::conditions` refuses.
         for &j in &condition_cols {
             let text = r.get(Some(j));
             let kept = condition_cells.iter().filter(|(_, c, _)| *c == j).count();
-            if !text.is_empty() && kept < 2 && !condition_cells.iter().any(|(_, c, t)| *c == j && *t == text) {
+            let seen = condition_cells.iter().any(|(_, c, t)| *c == j && *t == text);
+            if !text.is_empty() && !seen && kept <= CONDITION_TEXTS {
                 condition_cells.push((line, j, text));
             }
         }
