@@ -23,8 +23,9 @@ pub(crate) struct Stated {
     pub(crate) observer: Option<(Observer, String)>,
 }
 
-/// The conditions the sheet's metadata states. A stated illuminant or observer that glossmeter does not compute
-/// under (`F11`, `CIE 2006`) is an error naming the file and the line: no prediction could be compared with it.
+/// The conditions the sheet states, in its metadata, its colour columns' headers and its condition columns. A
+/// stated illuminant or observer that glossmeter does not compute under (`F11`, `CIE 2006`) is an error naming
+/// the file and the place: no prediction could be compared with it; so is a place that contradicts another.
 pub(crate) fn stated(sheet: &Sheet) -> Result<Stated> {
     let mut out = Stated::default();
     from_metadata(sheet, &mut out)?;
