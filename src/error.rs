@@ -61,6 +61,9 @@ pub struct Words {
     text: String,
     /// The arguments named, and where their names (in backquotes) stand in `text`.
     arguments: Vec<(Range<usize>, &'static str)>,
+    /// The arguments given with a value ([`Words::and_setting`]): the argument's index, where its value's text
+    /// (` A`) ends in `text`, and the value.
+    settings: Vec<(usize, usize, String)>,
 }
 
 impl Words {
@@ -83,6 +86,15 @@ impl Words {
         self
     }
 
+    /// These words, then an argument with the value to give it: as text `` `illuminant` A ``, and written by
+    /// each front end its own way ([`Words::naming_settings`]: `--illuminant A`, `illuminant="A"`).
+    pub(crate) fn and_setting(mut self, name: &'static str, value: impl Into<String>) -> Words {
+        let value = value.into();
+        self = self.and_argument(name).and(format!(" {value}"));
+        self.settings.push((self.arguments.len() - 1, self.text.len(), value));
+        self
+    }
+
     /// The argument these words begin with, and the words after it (`` `rtol` must be … `` → `rtol` and
     /// ` must be …`), so that a front end can name the argument apart (the server: as the field of its body).
     pub(crate) fn leading_argument(&self) -> Option<(&'static str, Words)> {
@@ -94,18 +106,41 @@ impl Words {
         let rest = Words {
             text: self.text[at..].to_string(),
             arguments: self.arguments[1..].iter().map(|(r, a)| (r.start - at..r.end - at, *a)).collect(),
+            settings: self
+                .settings
+                .iter()
+                .filter(|s| s.0 > 0)
+                .map(|(i, end, v)| (i - 1, end - at, v.clone()))
+                .collect(),
         };
         Some((name, rest))
     }
 
-    /// The words with each argument written by `name`.
+    /// The words with each argument written by `name` (an argument given a value: then the value, after a space).
     pub(crate) fn naming(&self, name: &dyn Fn(&'static str) -> String) -> String {
+        self.naming_settings(name, &|a, v| format!("{} {v}", name(a)))
+    }
+
+    /// The words with each argument written by `name`, and each argument given a value by `setting`.
+    pub(crate) fn naming_settings(
+        &self,
+        name: &dyn Fn(&'static str) -> String,
+        setting: &dyn Fn(&'static str, &str) -> String,
+    ) -> String {
         let mut out = String::with_capacity(self.text.len());
         let mut at = 0;
-        for (span, argument) in &self.arguments {
+        for (i, (span, argument)) in self.arguments.iter().enumerate() {
             out.push_str(&self.text[at..span.start]);
-            out.push_str(&name(argument));
-            at = span.end;
+            match self.settings.iter().find(|s| s.0 == i) {
+                Some((_, end, value)) => {
+                    out.push_str(&setting(argument, value));
+                    at = *end;
+                }
+                None => {
+                    out.push_str(&name(argument));
+                    at = span.end;
+                }
+            }
         }
         out.push_str(&self.text[at..]);
         out
@@ -127,7 +162,7 @@ impl fmt::Display for Words {
 
 impl From<String> for Words {
     fn from(text: String) -> Words {
-        Words { text, arguments: Vec::new() }
+        Words { text, arguments: Vec::new(), settings: Vec::new() }
     }
 }
 
@@ -157,12 +192,23 @@ impl Error {
     /// The message with each argument it names written by `name` (see [`Words`]; the command line passes its
     /// flags). The [`Display`](fmt::Display) of an error is the message in the library's words.
     pub fn naming(&self, name: &dyn Fn(&'static str) -> String) -> String {
+        self.naming_settings(name, &|a, v| format!("{} {v}", name(a)))
+    }
+
+    /// As [`Error::naming`], with each argument the message gives a value to (`give --illuminant A`) written by
+    /// `setting` (Python: `illuminant="A"`).
+    pub fn naming_settings(
+        &self,
+        name: &dyn Fn(&'static str) -> String,
+        setting: &dyn Fn(&'static str, &str) -> String,
+    ) -> String {
+        let words = |w: &Words| w.naming_settings(name, setting);
         match self {
-            Error::Input { file, field, message } if field.is_empty() => format!("{file}: {}", message.naming(name)),
-            Error::Input { file, field, message } => format!("{file}: field `{field}`: {}", message.naming(name)),
+            Error::Input { file, field, message } if field.is_empty() => format!("{file}: {}", words(message)),
+            Error::Input { file, field, message } => format!("{file}: field `{field}`: {}", words(message)),
             Error::Io { file, source } => format!("{file}: {source}"),
             Error::Usage(m) => m.clone(),
-            Error::Argument(words) => words.naming(name),
+            Error::Argument(w) => words(w),
             Error::Numeric(m) => format!("numerical failure: {m}"),
             Error::Check(m) => format!("check failed: {m}"),
         }
@@ -199,5 +245,33 @@ mod tests {
         // A user's text in backquotes is not an argument.
         let e = Error::argument("vary", " `lhs`: no `=`");
         assert_eq!(e.naming(&|n| format!("--{n}")), "--vary `lhs`: no `=`");
+    }
+
+    #[test]
+    fn an_argument_given_a_value_is_written_as_each_front_end_passes_it() {
+        let w = Words::argument("rtol")
+            .and(" too loose; give")
+            .and(" ")
+            .and_setting("illuminant", "A")
+            .and(" ")
+            .and_setting("observer", "2")
+            .and(" (the sheet's)");
+        assert_eq!(&*w, "`rtol` too loose; give `illuminant` A `observer` 2 (the sheet's)");
+        let flag = |n: &'static str| format!("--{n}");
+        assert_eq!(w.naming(&flag), "--rtol too loose; give --illuminant A --observer 2 (the sheet's)");
+        let python = w.naming_settings(&|n| format!("`{n}`"), &|n, v| format!("{n}={v:?}"));
+        assert_eq!(python, "`rtol` too loose; give illuminant=\"A\" observer=\"2\" (the sheet's)");
+        // Past a leading argument the settings keep their places.
+        let (name, rest) = w.leading_argument().unwrap();
+        assert_eq!(name, "rtol");
+        assert_eq!(
+            rest.naming_settings(&flag, &|n, v| format!("{n}:{v}")),
+            " too loose; give illuminant:A observer:2 (the sheet's)"
+        );
+        let e = Error::input("s.csv", "illuminant: A", w);
+        assert_eq!(
+            e.naming(&flag),
+            "s.csv: field `illuminant: A`: --rtol too loose; give --illuminant A --observer 2 (the sheet's)"
+        );
     }
 }

@@ -31,7 +31,8 @@ mod topography;
 /// input and bad requests are `ValueError`; files that cannot be read are `OSError` (`FileNotFoundError` when
 /// missing); a computation without a finite result is `RuntimeError`.
 pub(crate) fn to_py_err(e: Error) -> PyErr {
-    let msg = e.naming(&args::keyword);
+    // An argument the message gives a value to, as the keyword to pass: `give illuminant="A"`.
+    let msg = e.naming_settings(&args::keyword, &|a, v| format!("{a}={v:?}"));
     match &e {
         Error::Input { .. } | Error::Usage(_) | Error::Argument(_) => PyValueError::new_err(msg),
         Error::Io { source, .. } if source.kind() == std::io::ErrorKind::NotFound => PyFileNotFoundError::new_err(msg),

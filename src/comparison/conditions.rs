@@ -250,10 +250,10 @@ pub(crate) fn check(sheet: &Sheet, colour: Conditions) -> Result<()> {
         theirs.join(" and ")
     ));
     if let Some((i, _)) = &s.illuminant {
-        words = words.and(" ").and_argument("illuminant").and(format!(" {}", i.id()));
+        words = words.and(" ").and_setting("illuminant", i.id());
     }
     if let Some((o, _)) = &s.observer {
-        words = words.and(" ").and_argument("observer").and(format!(" {}", o.id()));
+        words = words.and(" ").and_setting("observer", o.id());
     }
     Err(Error::input(&sheet.file, said, words.and(" (the sheet's)")))
 }

@@ -98,7 +98,7 @@ impl Shared {
 
     /// A library error as a 400 answer, scrubbed.
     fn refusal(&self, e: &Error) -> Response {
-        message(StatusCode::BAD_REQUEST, &self.scrub(e.naming(&|a| format!("`{a}`"))))
+        message(StatusCode::BAD_REQUEST, &self.scrub(named(e)))
     }
 }
 
@@ -299,7 +299,13 @@ fn message(status: StatusCode, text: &str) -> Response {
 
 /// A library error: its message, the arguments named as the request's fields.
 fn error(status: StatusCode, e: &Error) -> Response {
-    message(status, &e.naming(&|a| format!("`{a}`")))
+    message(status, &named(e))
+}
+
+/// A library error's message in the request's words: each argument as its field in backquotes (`` `rtol` ``),
+/// and an argument given a value as the JSON member to send (`give "illuminant": "A"`).
+fn named(e: &Error) -> String {
+    e.naming_settings(&|a| format!("`{a}`"), &|a, v| format!("\"{a}\": \"{v}\""))
 }
 
 fn fixtures() -> Response {
@@ -380,7 +386,7 @@ fn late_error(s: &Shared, cancel: &Cancel, e: Error) -> Error {
         Error::Usage(format!(
             "the request reached the server's time limit of {limit} s per computation (docs/serve.md §Limits) \
              before it could answer: {}",
-            e.naming(&|a| format!("`{a}`"))
+            named(&e)
         ))
     } else {
         e
@@ -448,7 +454,7 @@ async fn sweep(State(s): State<Arc<Shared>>, req: Request) -> Response {
             })
         });
         if let Err(e) = out {
-            let line = serde_json::json!({"error": shared.scrub(e.naming(&|a| format!("`{a}`")))}).to_string() + "\n";
+            let line = serde_json::json!({"error": shared.scrub(named(&e))}).to_string() + "\n";
             let _ = tx.blocking_send(Ok(line));
         }
     });
