@@ -560,6 +560,8 @@ pub fn convergence<'py>(
 ) -> PyResult<Bound<'py, PyAny>> {
     let d = ConvergenceRequest::default();
     let request = guarded(|| {
+        // The colour conditions through the one conversion of a plan's keywords.
+        let colour = args::plan_request(None, None, illuminant, observer)?;
         Ok(ConvergenceRequest {
             tolerances: match tolerances.filter(|t| !t.is_none()) {
                 None => vec![],
@@ -569,8 +571,8 @@ pub fn convergence<'py>(
             max_repetitions: opt_count("max_repetitions", max_repetitions, "timed executions per tolerance, ≥ 1")?
                 .map_or(d.max_repetitions, |n| n as usize),
             reference_run: args::flag("reference_run", reference_run, false)?,
-            illuminant: args::plan_request(None, None, illuminant, None)?.illuminant,
-            observer: args::plan_request(None, None, None, observer)?.observer,
+            illuminant: colour.illuminant,
+            observer: colour.observer,
         })
     })?;
     let (tolerances, options) = guarded(|| request.options().map_err(to_py_err))?;

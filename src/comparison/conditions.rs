@@ -182,6 +182,8 @@ fn put_observer(sheet: &Sheet, out: &mut Stated, o: Observer, place: &str) -> Re
     put(sheet, &mut out.observer, o, place, |o| format!("the {} observer", o.describe()))
 }
 
+/// Record `value`, stated at `place`, in `slot`: the first place that states it is kept, and a place that
+/// states another value is refused, naming both.
 fn put<T: Copy + PartialEq>(
     sheet: &Sheet,
     slot: &mut Option<(T, String)>,
