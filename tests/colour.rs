@@ -298,21 +298,13 @@ fn a_colour_sheet_is_compared_only_under_the_conditions_it_states() {
     assert_eq!(fit_refused.status.code(), Some(2), "{}", String::from_utf8_lossy(&fit_refused.stderr));
     assert!(String::from_utf8_lossy(&fit_refused.stderr).contains("--illuminant A --observer 2 (the sheet's)"));
     // Under them, every colour prediction is measure's under the same flags.
-    let out = run(&[
-        "compare",
-        recipe,
-        sheet,
-        "--illuminant",
-        "A",
-        "--observer",
-        "2",
-        "--format",
-        "json",
-        "--max-de00",
-        "100",
-    ]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let doc: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let under_a2 = |sheet: &str| -> Value {
+        let colour = ["--illuminant", "A", "--observer", "2", "--format", "json", "--max-de00", "100"];
+        let out = run(&[&["compare", recipe, sheet][..], &colour].concat());
+        assert!(out.status.success(), "{sheet}: {}", String::from_utf8_lossy(&out.stderr));
+        serde_json::from_slice(&out.stdout).unwrap()
+    };
+    let doc = under_a2(sheet);
     let m = run(&[
         "measure",
         recipe,
@@ -343,25 +335,16 @@ fn a_colour_sheet_is_compared_only_under_the_conditions_it_states() {
         assert_eq!(c["predicted"], r["value"], "{c}");
         assert_eq!((c["illuminant"].as_str(), c["observer"].as_str()), (Some("A"), Some("2")));
     }
-    // The colour columns' headers may state them instead (`L* (A/2°)`): the same refusal, naming the column.
-    let headed = dir.join("headed.csv");
-    let text =
-        shipped.replace("# illuminant/observer: D65/10°\n", "").replace("L*,a*,b*", "L* (A/2°),a* (A/2°),b* (A/2°)");
-    std::fs::write(&headed, text).unwrap();
-    let headed = headed.to_str().unwrap();
-    let out = run(&["compare", recipe, headed]);
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(2), "{err}");
-    assert!(err.contains("column 3 (L* (A/2°))") && err.contains("--illuminant A --observer 2 (the sheet's)"), "{err}");
-    let under = run(&["compare", recipe, headed, "--illuminant", "A", "--observer", "2", "--format", "json"]);
-    let under_doc: Value = serde_json::from_slice(&under.stdout).unwrap();
-    let predicted =
-        |d: &Value| d["comparisons"].as_array().unwrap().iter().map(|c| c["predicted"].clone()).collect::<Vec<_>>();
-    assert_eq!(predicted(&under_doc), predicted(&doc), "the same predictions as the metadata's A / 2° sheet");
-    // Or columns, row by row (`Illuminant`, `Observer`): the same refusal, naming the first row's cell.
-    let rows_sheet = dir.join("rows.csv");
-    let text: String = shipped
-        .replace("# illuminant/observer: D65/10°\n", "")
+    // The colour columns' headers may state them instead (`L* (A/2°)`), or columns row by row (`Illuminant`,
+    // `Observer`): the same refusal under the default, naming the column; under A / 2° the same predictions.
+    let write = |name: &str, text: String| {
+        let path = dir.join(name);
+        std::fs::write(&path, text).unwrap();
+        path.to_str().unwrap().to_string()
+    };
+    let unstated = shipped.replace("# illuminant/observer: D65/10°\n", "");
+    let headed = write("headed.csv", unstated.replace("L*,a*,b*", "L* (A/2°),a* (A/2°),b* (A/2°)"));
+    let by_rows = unstated
         .replace("sample,geometry,", "sample,geometry,Illuminant,Observer,")
         .lines()
         .map(|l| match l.strip_prefix("panel-1,").and_then(|rest| rest.split_once(',')) {
@@ -369,31 +352,16 @@ fn a_colour_sheet_is_compared_only_under_the_conditions_it_states() {
             None => format!("{l}\n"),
         })
         .collect();
-    std::fs::write(&rows_sheet, text).unwrap();
-    let rows_sheet = rows_sheet.to_str().unwrap();
-    let out = run(&["compare", recipe, rows_sheet]);
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(2), "{err}");
-    assert!(
-        err.contains("column 3 (Illuminant)") && err.contains("--illuminant A --observer 2 (the sheet's)"),
-        "{err}"
-    );
-    let under = run(&[
-        "compare",
-        recipe,
-        rows_sheet,
-        "--illuminant",
-        "A",
-        "--observer",
-        "2",
-        "--format",
-        "json",
-        "--max-de00",
-        "100",
-    ]);
-    assert!(under.status.success(), "{}", String::from_utf8_lossy(&under.stderr));
-    let under_doc: Value = serde_json::from_slice(&under.stdout).unwrap();
-    assert_eq!(predicted(&under_doc), predicted(&doc));
+    let by_rows = write("rows.csv", by_rows);
+    let predicted =
+        |d: &Value| d["comparisons"].as_array().unwrap().iter().map(|c| c["predicted"].clone()).collect::<Vec<_>>();
+    for (stated, place) in [(&headed, "column 3 (L* (A/2°))"), (&by_rows, "column 3 (Illuminant)")] {
+        let out = run(&["compare", recipe, stated]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{err}");
+        assert!(err.contains(place) && err.contains("--illuminant A --observer 2 (the sheet's)"), "{err}");
+        assert_eq!(predicted(&under_a2(stated)), predicted(&doc), "{stated}: the metadata sheet's predictions");
+    }
     // An export under two illuminants: refused as duplicate columns; read under one once the others are skipped.
     let two = dir.join("two.csv");
     let both = shipped

@@ -145,21 +145,8 @@ fn from_headers(sheet: &Sheet, out: &mut Stated) -> Result<()> {
         if !words.iter().any(|w| names_an_illuminant(w)) {
             continue;
         }
-        let place = sheet.cell(sheet.header_line, Some(j), "colour");
-        let Some(i) = words.iter().find_map(|t| Illuminant::parse(t).ok()) else {
-            return Err(Error::input(
-                &sheet.file,
-                place,
-                format!(
-                    "the column states its colour under {inner:?}, an illuminant glossmeter does not compute colour \
-                     under (allowed: {ILLUMINANTS}); no prediction could be compared with this column"
-                ),
-            ));
-        };
-        put_illuminant(sheet, out, i, &place)?;
-        if let Some(o) = words.iter().find_map(|t| Observer::parse(t).ok()) {
-            put_observer(sheet, out, o, &place)?;
-        }
+        // An illuminant named (else refused as one glossmeter does not compute), an observer beside it if any.
+        state(sheet, out, (true, false), inner, &sheet.cell(sheet.header_line, Some(j), "colour"))?;
     }
     Ok(())
 }

@@ -218,11 +218,10 @@ pub fn parse(text: &str, file: &str, options: &SheetOptions) -> Result<Sheet> {
     parse_at(text, file, options, &Place::Lines)
 }
 
-fn parse_at(text: &str, file: &str, options: &SheetOptions, place: &Place) -> Result<Sheet> {
-    let mut metadata: Vec<(usize, (String, String))> =
-        text.lines().enumerate().filter_map(|(i, l)| metadata_line(l).map(|m| (i + 1, m))).collect();
+/// Stage 0, the separator: the one asked for, else that of the first content line that has one (a title line
+/// above the header has none); a text with no content line, or a JSON file, is refused.
+fn delimiter_of(text: &str, file: &str, options: &SheetOptions, place: &Place) -> Result<u8> {
     let is_content = |l: &&str| !l.trim().is_empty() && !l.trim_start().starts_with('#');
-    let content = || text.lines().filter(is_content);
     let Some((first_at, first_line)) = text.lines().enumerate().find(|(_, l)| is_content(l)) else {
         return Err(Error::input(file, "", "the sheet is empty (no header line)"));
     };
@@ -235,11 +234,17 @@ fn parse_at(text: &str, file: &str, options: &SheetOptions, place: &Place) -> Re
              being a CSV or a workbook (.xlsx, .xlsm, .xlsb, .xls, .ods) of readings (docs/instrument.md §Sheets)",
         ));
     }
-    // The separator of the first content line that has one (a title line above the header has none).
-    let delimiter = options.delimiter.unwrap_or_else(|| {
-        let with_one = content().take(TITLE_ROWS + 1).find(|l| l.bytes().any(|c| matches!(c, b',' | b';' | b'\t')));
+    Ok(options.delimiter.unwrap_or_else(|| {
+        let mut content = text.lines().filter(is_content).take(TITLE_ROWS + 1);
+        let with_one = content.find(|l| l.bytes().any(|c| matches!(c, b',' | b';' | b'\t')));
         detect_delimiter(with_one.unwrap_or(first_line))
-    });
+    }))
+}
+
+fn parse_at(text: &str, file: &str, options: &SheetOptions, place: &Place) -> Result<Sheet> {
+    let mut metadata: Vec<(usize, (String, String))> =
+        text.lines().enumerate().filter_map(|(i, l)| metadata_line(l).map(|m| (i + 1, m))).collect();
+    let delimiter = delimiter_of(text, file, options, place)?;
     let reader = || {
         csv::ReaderBuilder::new()
             .delimiter(delimiter)
@@ -324,16 +329,7 @@ fn parse_at(text: &str, file: &str, options: &SheetOptions, place: &Place) -> Re
             }
         }
         let sample = r.get(sample_c);
-        // Each distinct text once (`D65` and `d65 ` are two texts of one illuminant, so more than two are kept),
-        // up to one more than `CONDITION_TEXTS`, which `comparison::conditions` refuses.
-        for &j in &condition_cols {
-            let text = r.get(Some(j));
-            let kept = condition_cells.iter().filter(|(_, c, _)| *c == j).count();
-            let seen = condition_cells.iter().any(|(_, c, t)| *c == j && *t == text);
-            if !text.is_empty() && !seen && kept <= CONDITION_TEXTS {
-                condition_cells.push((line, j, text));
-            }
-        }
+        keep_condition_cells(&r, &condition_cols, &mut condition_cells);
         rows.extend(match layout {
             Layout::Long => {
                 let (g, v) = (geo_c.expect("long"), val_c.expect("long"));

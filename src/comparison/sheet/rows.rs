@@ -127,6 +127,20 @@ pub(super) fn long_row(
     }])
 }
 
+/// A row's cells of the condition columns, into `kept`: each distinct text once (`D65` and `d65` are two texts of
+/// one illuminant, so more than two are kept), up to one more than [`CONDITION_TEXTS`], which
+/// `comparison::conditions` refuses.
+pub(super) fn keep_condition_cells(r: &Record, columns: &[usize], kept: &mut Vec<(usize, usize, String)>) {
+    for &j in columns {
+        let text = r.get(Some(j));
+        let count = kept.iter().filter(|(_, c, _)| *c == j).count();
+        let seen = kept.iter().any(|(_, c, t)| *c == j && *t == text);
+        if !text.is_empty() && !seen && count <= CONDITION_TEXTS {
+            kept.push((r.line, j, text));
+        }
+    }
+}
+
 /// Stage 3, the colour layout's row: L*, a* and b* of one geometry.
 pub(super) fn colour_rows(r: &Record, sample: &str, g: usize, lab: &[Option<usize>]) -> Result<Vec<SheetRow>> {
     let mut rows = vec![];
